@@ -1,0 +1,117 @@
+//! The `subd` command-line tool as a library: [`run`] parses arguments and executes a
+//! command, writing to the given output streams and returning the process exit code.
+//!
+//! Exit codes: 0 success; 2 bad input (unreadable file, unknown extension, parse error,
+//! invalid topology, bad arguments) with one line on stderr naming the file and, for parse
+//! errors, the line; 1 for other failures (e.g. an output file that cannot be written).
+//!
+//! ```
+//! let mut out = Vec::new();
+//! let mut err = Vec::new();
+//! let code = subd_cli::run(["subd", "info", "no-such-file.obj"], &mut out, &mut err);
+//! assert_eq!(code, 2);
+//! assert!(String::from_utf8(err).unwrap().starts_with("subd: no-such-file.obj: cannot read"));
+//! ```
+
+mod info;
+
+use std::ffi::OsString;
+use std::io::Write;
+
+use clap::{Parser, Subcommand};
+
+/// Exit code for success.
+pub const EXIT_OK: i32 = 0;
+/// Exit code for other failures (writing output, internal).
+pub const EXIT_FAILURE: i32 = 1;
+/// Exit code for bad input.
+pub const EXIT_BAD_INPUT: i32 = 2;
+
+/// Warnings printed per input before the rest are summarised.
+const MAX_WARNINGS: usize = 10;
+
+#[derive(Debug, Parser)]
+#[command(name = "subd", version, about = "Subdivision curves and surfaces", long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Topology summary: counts, face-size and valence histograms, boundary, non-manifold
+    /// elements, tags, components, Euler characteristic and genus.
+    Info(info::InfoArgs),
+}
+
+/// A command's failure: exit code and one-line message.
+#[derive(Debug)]
+pub struct Failure {
+    /// Process exit code.
+    pub code: i32,
+    /// One-line message (without the `subd: ` prefix).
+    pub message: String,
+}
+
+impl From<subd_io::IoError> for Failure {
+    fn from(e: subd_io::IoError) -> Self {
+        let code = match e {
+            subd_io::IoError::Write { .. } => EXIT_FAILURE,
+            _ => EXIT_BAD_INPUT,
+        };
+        Failure {
+            code,
+            message: e.to_string(),
+        }
+    }
+}
+
+/// Prints reader warnings for `path` on `err`, at most [`MAX_WARNINGS`] of them.
+pub(crate) fn print_warnings(err: &mut dyn Write, path: &std::path::Path, warnings: &[String]) {
+    for w in warnings.iter().take(MAX_WARNINGS) {
+        let _ = writeln!(err, "subd: warning: {}: {w}", path.display());
+    }
+    if warnings.len() > MAX_WARNINGS {
+        let _ = writeln!(
+            err,
+            "subd: warning: {}: {} more warnings not shown",
+            path.display(),
+            warnings.len() - MAX_WARNINGS
+        );
+    }
+}
+
+/// Runs `subd` with `args` (the first item is the program name). Returns the exit code.
+pub fn run<I, T>(args: I, out: &mut dyn Write, err: &mut dyn Write) -> i32
+where
+    I: IntoIterator<Item = T>,
+    T: Into<OsString> + Clone,
+{
+    let cli = match Cli::try_parse_from(args) {
+        Ok(c) => c,
+        Err(e) => {
+            let code = if e.use_stderr() {
+                EXIT_BAD_INPUT
+            } else {
+                EXIT_OK
+            };
+            let text = e.render().to_string();
+            if e.use_stderr() {
+                let _ = write!(err, "{text}");
+            } else {
+                let _ = write!(out, "{text}");
+            }
+            return code;
+        }
+    };
+    let result = match cli.command {
+        Command::Info(a) => info::run(&a, out, err),
+    };
+    match result {
+        Ok(()) => EXIT_OK,
+        Err(f) => {
+            let _ = writeln!(err, "subd: {}", f.message);
+            f.code
+        }
+    }
+}

@@ -1,0 +1,270 @@
+//! The `subd` binary as a user runs it: exit codes, one-line errors, JSON output.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn subd(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_subd"))
+        .args(args)
+        .env("RUST_BACKTRACE", "1")
+        .output()
+        .expect("run subd");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn meshes() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/meshes/osd")
+}
+
+struct Scratch(PathBuf);
+
+impl Scratch {
+    fn new(tag: &str) -> Self {
+        let d = std::env::temp_dir().join(format!("subd-cli-{tag}-{}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        Scratch(d)
+    }
+    fn file(&self, name: &str, bytes: &[u8]) -> PathBuf {
+        let p = self.0.join(name);
+        std::fs::write(&p, bytes).unwrap();
+        p
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// Runs `subd info` on a bad input and checks the user-facing contract: exit 2, exactly one
+/// line on stderr starting with `subd: <file>`, containing `expect`, no panic or backtrace.
+fn assert_bad_input(path: &Path, expect: &str) {
+    let p = path.to_str().unwrap();
+    let (code, out, err) = subd(&["info", p]);
+    assert_eq!(code, 2, "{p}: stderr {err:?}");
+    assert!(out.is_empty(), "{p}: stdout {out:?}");
+    let lines: Vec<&str> = err
+        .lines()
+        .filter(|l| !l.starts_with("subd: warning:"))
+        .collect();
+    assert_eq!(lines.len(), 1, "{p}: stderr {err:?}");
+    assert!(lines[0].starts_with(&format!("subd: {p}")), "{p}: {err:?}");
+    assert!(
+        lines[0].contains(expect),
+        "{p}: expected {expect:?} in {err:?}"
+    );
+    assert!(
+        !err.contains("panicked") && !err.contains("backtrace"),
+        "{err}"
+    );
+}
+
+#[test]
+fn malformed_obj_inputs_exit_2_with_the_line() {
+    let s = Scratch::new("bad");
+    let quad = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n";
+    let cases: &[(&str, String, &str)] = &[
+        (
+            "truncated_vertex.obj",
+            "v 0 0 0\nv 1 0\n".into(),
+            ":2: vertex has 2 coordinates",
+        ),
+        (
+            "index_zero.obj",
+            format!("{quad}f 0 1 2\n"),
+            ":5: face index 0 is invalid",
+        ),
+        (
+            "index_beyond.obj",
+            format!("{quad}f 1 2 9\n"),
+            ":5: face refers to vertex 9, but the file has 4 vertices",
+        ),
+        (
+            "relative_before_start.obj",
+            format!("{quad}f -1 -2 -5\n"),
+            ":5: relative face index -5",
+        ),
+        (
+            "nan.obj",
+            "v 0 nan 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n".into(),
+            ":1: vertex 1 has a non-finite coordinate",
+        ),
+        (
+            "inf.obj",
+            "v 0 0 0\nv inf 0 0\nv 0 1 0\nf 1 2 3\n".into(),
+            ":2: vertex 2 has a non-finite coordinate",
+        ),
+        ("empty.obj", String::new(), "no vertices and no faces"),
+        (
+            "two_vertex_face.obj",
+            format!("{quad}f 1 2\n"),
+            ":5: face has 2 vertices; a face needs at least 3",
+        ),
+        (
+            "bad_number.obj",
+            "v 0 0 x\n".into(),
+            ":1: vertex coordinate \"x\" is not a number",
+        ),
+        (
+            "bad_index.obj",
+            format!("{quad}f 1 2 three\n"),
+            ":5: face vertex \"three\" is not an index",
+        ),
+        (
+            "truncated_face.obj",
+            format!("{quad}f 1 2 3 4\nf 1"),
+            ":6: face has 1 vertices",
+        ),
+        (
+            "crease_missing_vertex.obj",
+            format!("{quad}f 1 2 3 4\nt crease 2/1/0 0 7 1.0\n"),
+            ":6: crease tag names vertex 7",
+        ),
+        (
+            "crease_negative_sharpness.obj",
+            format!("{quad}f 1 2 3 4\nt crease 2/1/0 0 1 -2\n"),
+            ":6: crease tag has invalid sharpness -2",
+        ),
+        (
+            "corner_negative_index.obj",
+            format!("{quad}f 1 2 3 4\nt corner 1/1/0 -1 2\n"),
+            ":6: corner tag names vertex -1",
+        ),
+        (
+            "hole_missing_face.obj",
+            format!("{quad}f 1 2 3 4\nt hole 1/0/0 3\n"),
+            ":6: hole tag names face 3",
+        ),
+        (
+            "tag_counts.obj",
+            format!("{quad}f 1 2 3 4\nt crease 2/1/0 0 1\n"),
+            ":6: tag \"crease\" declares 2/1/0 arguments but has 2",
+        ),
+        ("no_faces.obj", quad.into(), "no faces"),
+    ];
+    for (name, text, expect) in cases {
+        let p = s.file(name, text.as_bytes());
+        assert_bad_input(&p, expect);
+    }
+    // Binary garbage: bytes that are not text.
+    let garbage: Vec<u8> = (0..4096u32)
+        .map(|i| (i.wrapping_mul(2654435761) >> 13) as u8)
+        .collect();
+    assert_bad_input(&s.file("garbage.obj", &garbage), ":1: ");
+    // Text that is not OBJ.
+    assert_bad_input(
+        &s.file("prose.obj", b"{\"not\": \"obj\"}\n"),
+        ":1: not an OBJ statement",
+    );
+}
+
+#[test]
+fn malformed_files_of_other_kinds_exit_2() {
+    let s = Scratch::new("other");
+    assert_bad_input(&s.0.join("missing.obj"), "cannot read");
+    assert_bad_input(
+        &s.file("mesh.stl", b"solid x\n"),
+        "unsupported file extension",
+    );
+    assert_bad_input(
+        &s.file(
+            "bad.ply",
+            b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nend_header\n",
+        ),
+        "lacks an x, y or z",
+    );
+    assert_bad_input(
+        &s.file("short.ply", b"ply\nformat binary_little_endian 1.0\nelement vertex 1000000000\nproperty float x\nproperty float y\nproperty float z\nend_header\n\x00\x00"),
+        "binary data ends inside vertex 0",
+    );
+    assert_bad_input(
+        &s.file("ascii_face.ply", b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n2 0 1\n"),
+        ":13: face 0 has 2 vertices",
+    );
+    // A directory is not a mesh file.
+    let dir = s.0.join("dir.obj");
+    std::fs::create_dir_all(&dir).unwrap();
+    assert_bad_input(&dir, "cannot read");
+}
+
+#[test]
+fn negative_indices_resolve_as_obj_defines() {
+    let s = Scratch::new("neg");
+    let p = s.file(
+        "neg.obj",
+        b"v 0 0 0\nv 1 0 0\nv 1 1 0\nf -3 -2 -1\nv 0 1 0\nf 1 -2 -1\n",
+    );
+    let (code, out, err) = subd(&["info", p.to_str().unwrap(), "--json"]);
+    assert_eq!(code, 0, "{err}");
+    let j: serde_json::Value = serde_json::from_str(&out).unwrap();
+    // Faces (0,1,2) and (0,2,3): two triangles sharing edge (0,2).
+    assert_eq!(
+        (
+            j["vertices"].as_u64(),
+            j["edges"].as_u64(),
+            j["faces"].as_u64()
+        ),
+        (Some(4), Some(5), Some(2))
+    );
+}
+
+#[test]
+fn info_json_on_a_shape() {
+    let p = meshes().join("catmark_torus.obj");
+    let (code, out, err) = subd(&["info", p.to_str().unwrap(), "--json"]);
+    assert_eq!(code, 0, "{err}");
+    let j: serde_json::Value = serde_json::from_str(&out).expect("one JSON object");
+    for key in [
+        "vertices",
+        "edges",
+        "faces",
+        "boundary_edges",
+        "nonmanifold_edges",
+        "components",
+        "euler",
+        "genus",
+    ] {
+        assert!(j.get(key).is_some(), "missing {key}");
+    }
+    assert_eq!(j["genus"], 1);
+    assert_eq!(j["euler"], 0);
+    // Open mesh: genus is null.
+    let p = meshes().join("catmark_tent.obj");
+    let (_, out, _) = subd(&["info", p.to_str().unwrap(), "--json"]);
+    let j: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert!(j["genus"].is_null());
+    assert_eq!(j["boundary_edges"], 12);
+}
+
+#[test]
+fn info_text_and_warnings() {
+    let p = meshes().join("catmark_square_hedit0.obj");
+    let (code, out, err) = subd(&["info", p.to_str().unwrap()]);
+    assert_eq!(code, 0);
+    assert!(out.contains("faces             9"), "{out}");
+    assert!(
+        err.contains("hierarchical edit tag \"vertexedit\" is not supported"),
+        "{err}"
+    );
+    let p = meshes().join("catmark_nonman_quadpole8.obj");
+    let (code, _, err) = subd(&["info", p.to_str().unwrap()]);
+    assert_eq!(code, 0);
+    assert!(err.contains("repeats vertex"), "{err}");
+}
+
+#[test]
+fn usage_errors_exit_2() {
+    let (code, _, err) = subd(&["info"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("Usage"), "{err}");
+    let (code, _, _) = subd(&["frobnicate"]);
+    assert_eq!(code, 2);
+    let (code, out, _) = subd(&["--help"]);
+    assert_eq!(code, 0);
+    assert!(out.contains("info"));
+}

@@ -1,0 +1,176 @@
+//! Mesh file formats for subd.
+//!
+//! * **OBJ** in and out, with the tag lines of OpenSubdiv's shape files (`t crease`,
+//!   `t corner`, `t hole`, `t interpolateboundary`, `t creasemethod`, `t smoothtriangles`);
+//!   vertex indices are kept exactly as in the file ([`obj`]).
+//! * **PLY** in (ASCII, binary little- and big-endian) and out (ASCII, binary little-endian)
+//!   ([`ply`]).
+//! * **glTF 2.0 binary** (`.glb`) out: positions, normals, triangle indices ([`glb`]).
+//!
+//! The format is chosen by the file extension. Every output goes through
+//! [`atomic_write`]: the data is written to a temporary file beside the target and renamed
+//! over it only when complete, so a failed run leaves no partial file.
+//!
+//! ```
+//! use subd_io::{parse_mesh, Format, ReadOptions};
+//! let obj = b"v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\nt corner 1/1/0 0 10\n";
+//! let file = parse_mesh(obj, Format::Obj, &ReadOptions::default()).unwrap();
+//! assert_eq!(file.mesh.topology.num_faces(), 1);
+//! assert_eq!(file.mesh.topology.vertex_sharpness(0), 10.0);
+//! ```
+
+pub mod error;
+pub mod glb;
+pub mod obj;
+pub mod ply;
+
+use std::io::Write;
+use std::path::Path;
+
+pub use error::{IoError, ReadError};
+pub use ply::PlyEncoding;
+use subd_mesh::Mesh;
+
+/// A mesh file format.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Format {
+    /// Wavefront OBJ with OpenSubdiv tags.
+    Obj,
+    /// Stanford PLY.
+    Ply,
+    /// glTF 2.0 binary (write only).
+    Glb,
+}
+
+impl Format {
+    /// The format named by a path's extension (case-insensitive).
+    pub fn from_path(path: &Path) -> Option<Format> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        match ext.as_str() {
+            "obj" => Some(Format::Obj),
+            "ply" => Some(Format::Ply),
+            "glb" => Some(Format::Glb),
+            _ => None,
+        }
+    }
+}
+
+/// Options for reading.
+#[derive(Debug, Clone, Default)]
+pub struct ReadOptions {
+    /// Accept faces whose windings disagree across a shared edge (the edge becomes
+    /// non-manifold) instead of failing.
+    pub accept_inconsistent_orientation: bool,
+}
+
+/// Options for writing.
+#[derive(Debug, Clone, Default)]
+pub struct WriteOptions {
+    /// PLY encoding.
+    pub ply_encoding: PlyEncoding,
+    /// Tag lines written verbatim at the end of an OBJ file (e.g. [`MeshFile::extra_tags`]).
+    pub extra_obj_tags: Vec<String>,
+}
+
+/// A mesh read from a file, with what the reader noticed.
+#[derive(Debug, Clone)]
+pub struct MeshFile {
+    /// Topology, positions and scheme hints.
+    pub mesh: Mesh,
+    /// Accepted oddities worth telling the user (repeated vertices in a face, tags that are
+    /// kept but not applied, ...), one line each.
+    pub warnings: Vec<String>,
+    /// OBJ tag lines kept verbatim but not interpreted (hierarchical edits, face-varying
+    /// options).
+    pub extra_tags: Vec<String>,
+    /// Number of edges that two faces traverse in the same direction (only non-zero when
+    /// [`ReadOptions::accept_inconsistent_orientation`] is set).
+    pub orientation_conflicts: usize,
+}
+
+/// Parses a mesh from bytes in the given format (not [`Format::Glb`], which is write-only).
+pub fn parse_mesh(
+    bytes: &[u8],
+    format: Format,
+    options: &ReadOptions,
+) -> Result<MeshFile, ReadError> {
+    match format {
+        Format::Obj => obj::parse_obj(bytes, options),
+        Format::Ply => ply::parse_ply(bytes, options),
+        Format::Glb => Err(ReadError::Syntax {
+            line: None,
+            message: "reading .glb is not supported; use .obj or .ply".into(),
+        }),
+    }
+}
+
+/// Reads a mesh file, choosing the format by extension (`.obj`, `.ply`).
+pub fn read_mesh(path: &Path, options: &ReadOptions) -> Result<MeshFile, IoError> {
+    let format = match Format::from_path(path) {
+        Some(f @ (Format::Obj | Format::Ply)) => f,
+        _ => {
+            return Err(IoError::UnknownFormat {
+                path: path.to_path_buf(),
+                expected: ".obj or .ply",
+            });
+        }
+    };
+    let bytes = std::fs::read(path).map_err(|source| IoError::Read {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    parse_mesh(&bytes, format, options).map_err(|e| e.at(path))
+}
+
+/// Encodes `mesh` in `format` into `w`.
+pub fn encode_mesh(
+    w: &mut dyn Write,
+    mesh: &Mesh,
+    format: Format,
+    options: &WriteOptions,
+) -> std::io::Result<()> {
+    match format {
+        Format::Obj => obj::write_obj(w, mesh, &options.extra_obj_tags),
+        Format::Ply => ply::write_ply(w, mesh, options.ply_encoding),
+        Format::Glb => glb::write_glb(w, mesh),
+    }
+}
+
+/// Writes a mesh file atomically, choosing the format by extension (`.obj`, `.ply`, `.glb`).
+pub fn write_mesh(path: &Path, mesh: &Mesh, options: &WriteOptions) -> Result<(), IoError> {
+    let format = Format::from_path(path).ok_or_else(|| IoError::UnknownFormat {
+        path: path.to_path_buf(),
+        expected: ".obj, .ply or .glb",
+    })?;
+    atomic_write(path, |w| encode_mesh(w, mesh, format, options))
+}
+
+/// Writes a file atomically: `write` fills a temporary file in the target's directory, which
+/// is flushed, synced and renamed over `path` only if `write` succeeds. On any failure the
+/// temporary file is removed and `path` is left as it was.
+pub fn atomic_write(
+    path: &Path,
+    write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> Result<(), IoError> {
+    let err = |source| IoError::Write {
+        path: path.to_path_buf(),
+        source,
+    };
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let mut tmp = tempfile::Builder::new()
+        .prefix(".subd-")
+        .suffix(".tmp")
+        .tempfile_in(dir)
+        .map_err(err)?;
+    {
+        let mut buf = std::io::BufWriter::with_capacity(1 << 20, tmp.as_file_mut());
+        write(&mut buf).map_err(err)?;
+        buf.flush().map_err(err)?;
+    }
+    tmp.as_file().sync_all().map_err(err)?;
+    tmp.persist(path).map_err(|e| err(e.error))?;
+    Ok(())
+}

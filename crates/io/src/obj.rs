@@ -1,0 +1,506 @@
+//! Wavefront OBJ with OpenSubdiv's tag lines.
+//!
+//! Read: `v` (first three coordinates, `f64`), `f` (polygons kept as they are, vertex index
+//! before the first `/`, negative indices relative to the vertices read so far as OBJ
+//! defines them), and OpenSubdiv's `t` tag lines with **0-based** indices:
+//! `t crease 2/1/0 a b s` (a chain `n/1/0` or `n/(n-1)/0` also works), `t corner 1/1/0 v s`,
+//! `t hole 1/0/0 f`, `t interpolateboundary 1/0/0 k` (0 none, 1 edge-and-corner, 2 edge-only),
+//! `t creasemethod 0/0/1 normal|chaikin`, `t smoothtriangles 0/0/1 catmark|smooth`. Other
+//! tags (face-varying options, the hierarchical edits `vertexedit`/`edgeedit`/`faceedit`)
+//! are kept verbatim and reported in a warning. Texture coordinates, normals, groups and
+//! materials are skipped.
+//!
+//! Why not `tobj` for the geometry: `tobj` renumbers vertices by first use and drops vertices
+//! no face uses, which would break the vertex-index contract with OpenSubdiv (vertex `v` of the
+//! file is vertex `v` of the mesh, unused ones included); it reports no line numbers and turns
+//! two-vertex faces into lines silently. The reader here is tested against `tobj` on every
+//! shape instead.
+
+use std::io::Write;
+
+use subd_mesh::{
+    BoundaryInterpolation, CreaseMethod, DVec3, Mesh, SchemeHints, TopologyBuilder,
+    TriangleSubdivision,
+};
+
+use crate::error::ReadError;
+use crate::{MeshFile, ReadOptions};
+
+/// One `t` line.
+struct TagLine {
+    line: usize,
+    name: String,
+    ints: Vec<i64>,
+    floats: Vec<f64>,
+    strings: Vec<String>,
+    raw: String,
+}
+
+fn is_statement_name(s: &str) -> bool {
+    !s.is_empty()
+        && s.bytes()
+            .all(|b| b.is_ascii_alphanumeric() || b == b'_' || b == b'#')
+}
+
+/// Parses OBJ text. Errors carry the 1-based line number.
+pub fn parse_obj(bytes: &[u8], options: &ReadOptions) -> Result<MeshFile, ReadError> {
+    let mut positions: Vec<DVec3> = Vec::new();
+    let mut face_sizes: Vec<u32> = Vec::new();
+    let mut face_vertices: Vec<u32> = Vec::new();
+    let mut face_lines: Vec<u32> = Vec::new();
+    let mut tags: Vec<TagLine> = Vec::new();
+    let mut warnings: Vec<String> = Vec::new();
+    let mut unknown_reported = false;
+    let mut raw_indices: Vec<i64> = Vec::new();
+
+    let mut line_no = 0usize;
+    let mut rest = bytes;
+    let mut joined = String::new();
+    while !rest.is_empty() {
+        let end = rest.iter().position(|&b| b == b'\n').unwrap_or(rest.len());
+        let raw = &rest[..end];
+        rest = if end < rest.len() {
+            &rest[end + 1..]
+        } else {
+            &[]
+        };
+        line_no += 1;
+        let this_line = line_no;
+        let text = std::str::from_utf8(raw).map_err(|_| {
+            ReadError::line(this_line, "not valid UTF-8 text (is this an OBJ file?)")
+        })?;
+        let text = text.strip_suffix('\r').unwrap_or(text);
+        // A trailing backslash continues the statement on the next line.
+        if let Some(head) = text.strip_suffix('\\') {
+            joined.push_str(head);
+            joined.push(' ');
+            continue;
+        }
+        let owned;
+        let text = if joined.is_empty() {
+            text
+        } else {
+            joined.push_str(text);
+            owned = std::mem::take(&mut joined);
+            owned.as_str()
+        };
+        let mut tokens = text.split_ascii_whitespace();
+        let Some(keyword) = tokens.next() else {
+            continue;
+        };
+        if keyword.starts_with('#') {
+            continue;
+        }
+        match keyword {
+            "v" => {
+                let mut p = [0.0f64; 3];
+                for (k, slot) in p.iter_mut().enumerate() {
+                    let tok = tokens.next().ok_or_else(|| {
+                        ReadError::line(
+                            this_line,
+                            format!("vertex has {k} coordinates; 3 are needed"),
+                        )
+                    })?;
+                    *slot = tok.parse::<f64>().map_err(|_| {
+                        ReadError::line(
+                            this_line,
+                            format!("vertex coordinate {tok:?} is not a number"),
+                        )
+                    })?;
+                    if !slot.is_finite() {
+                        return Err(ReadError::line(
+                            this_line,
+                            format!(
+                                "vertex {} has a non-finite coordinate {tok:?}",
+                                positions.len() + 1
+                            ),
+                        ));
+                    }
+                }
+                positions.push(DVec3::from_array(p));
+            }
+            "f" | "fo" => {
+                raw_indices.clear();
+                for tok in tokens {
+                    let head = tok.split('/').next().unwrap_or("");
+                    let idx = head.parse::<i64>().map_err(|_| {
+                        ReadError::line(this_line, format!("face vertex {tok:?} is not an index"))
+                    })?;
+                    let resolved = if idx > 0 {
+                        idx - 1
+                    } else if idx < 0 {
+                        let r = positions.len() as i64 + idx;
+                        if r < 0 {
+                            return Err(ReadError::line(
+                                this_line,
+                                format!(
+                                    "relative face index {idx} points before the first vertex ({} vertices read so far)",
+                                    positions.len()
+                                ),
+                            ));
+                        }
+                        r
+                    } else {
+                        return Err(ReadError::line(
+                            this_line,
+                            "face index 0 is invalid (OBJ indices start at 1)",
+                        ));
+                    };
+                    raw_indices.push(resolved);
+                }
+                if raw_indices.len() < 3 {
+                    return Err(ReadError::line(
+                        this_line,
+                        format!(
+                            "face has {} vertices; a face needs at least 3",
+                            raw_indices.len()
+                        ),
+                    ));
+                }
+                if raw_indices.len() >= u32::MAX as usize {
+                    return Err(ReadError::line(this_line, "face has too many vertices"));
+                }
+                for &i in &raw_indices {
+                    // Range against the final vertex count is checked once all lines are read.
+                    face_vertices.push(u32::try_from(i).unwrap_or(u32::MAX));
+                }
+                face_sizes.push(raw_indices.len() as u32);
+                face_lines.push(this_line as u32);
+            }
+            "t" => {
+                let tag = parse_tag(this_line, text, tokens)?;
+                tags.push(tag);
+            }
+            "vt" | "vn" | "vp" | "o" | "g" | "s" | "mg" | "usemtl" | "mtllib" | "l" | "p"
+            | "lod" | "bevel" | "c_interp" | "d_interp" | "shadow_obj" | "trace_obj" | "maplib"
+            | "usemap" | "cstype" | "deg" | "bmat" | "step" | "curv" | "curv2" | "surf"
+            | "parm" | "trim" | "hole" | "scrv" | "sp" | "end" | "con" | "ctech" | "stech"
+            | "call" | "csh" => {}
+            other if is_statement_name(other) => {
+                if !unknown_reported {
+                    warnings.push(format!(
+                        "line {this_line}: unknown OBJ statement {other:?} ignored"
+                    ));
+                    unknown_reported = true;
+                }
+            }
+            _ => {
+                return Err(ReadError::line(
+                    this_line,
+                    "not an OBJ statement (is this an OBJ file?)",
+                ));
+            }
+        }
+    }
+    if !joined.is_empty() {
+        return Err(ReadError::line(line_no, "line continuation at end of file"));
+    }
+    if face_sizes.is_empty() {
+        return Err(ReadError::general(if positions.is_empty() {
+            "no vertices and no faces (empty or not an OBJ file)"
+        } else {
+            "no faces"
+        }));
+    }
+    // Index range check with the line of the offending face.
+    let nv = positions.len();
+    let mut offset = 0usize;
+    for (f, &n) in face_sizes.iter().enumerate() {
+        for &v in &face_vertices[offset..offset + n as usize] {
+            if v as usize >= nv {
+                let shown = if v == u32::MAX {
+                    "beyond 2^32".to_string()
+                } else {
+                    (v as u64 + 1).to_string()
+                };
+                return Err(ReadError::line(
+                    face_lines[f] as usize,
+                    format!("face refers to vertex {shown}, but the file has {nv} vertices"),
+                ));
+            }
+        }
+        offset += n as usize;
+    }
+
+    let (mut topology, build_warnings) = TopologyBuilder::new(nv)
+        .accept_inconsistent_orientation(options.accept_inconsistent_orientation)
+        .build_with_warnings(&face_sizes, &face_vertices)
+        .map_err(|e| match e {
+            subd_mesh::TopologyError::InconsistentOrientation { second_face, .. } => {
+                ReadError::line(
+                    face_lines[second_face] as usize,
+                    format!("{e} (accept with --accept-inconsistent-orientation)"),
+                )
+            }
+            other => ReadError::Topology(other),
+        })?;
+    let orientation_conflicts = build_warnings
+        .iter()
+        .filter(|w| matches!(w, subd_mesh::BuildWarning::InconsistentOrientation { .. }))
+        .count();
+    for w in build_warnings {
+        let face = match &w {
+            subd_mesh::BuildWarning::RepeatedVertex { face, .. } => *face,
+            subd_mesh::BuildWarning::InconsistentOrientation { second_face, .. } => *second_face,
+            _ => 0,
+        };
+        warnings.push(format!("line {}: {w}", face_lines[face]));
+    }
+
+    let mut hints = SchemeHints::default();
+    let mut extra_tags = Vec::new();
+    for tag in &tags {
+        apply_tag(
+            tag,
+            &mut topology,
+            &mut hints,
+            &mut warnings,
+            &mut extra_tags,
+        )?;
+    }
+    let mut mesh = Mesh::new(topology, positions).map_err(ReadError::Topology)?;
+    mesh.hints = hints;
+    Ok(MeshFile {
+        mesh,
+        warnings,
+        extra_tags,
+        orientation_conflicts,
+    })
+}
+
+fn parse_tag<'a>(
+    line: usize,
+    text: &str,
+    mut tokens: impl Iterator<Item = &'a str>,
+) -> Result<TagLine, ReadError> {
+    let name = tokens
+        .next()
+        .ok_or_else(|| ReadError::line(line, "tag line has no tag name"))?
+        .to_string();
+    let counts = tokens.next().ok_or_else(|| {
+        ReadError::line(line, format!("tag {name:?} has no argument counts (n/m/k)"))
+    })?;
+    let parts: Vec<&str> = counts.split('/').collect();
+    let parsed: Option<Vec<usize>> = parts.iter().map(|p| p.parse::<usize>().ok()).collect();
+    let [ni, nf, ns] = match parsed.as_deref() {
+        Some(&[a, b, c]) => [a, b, c],
+        _ => {
+            return Err(ReadError::line(
+                line,
+                format!("tag {name:?} has malformed argument counts {counts:?} (expected n/m/k)"),
+            ));
+        }
+    };
+    let args: Vec<&str> = tokens.collect();
+    if args.len() != ni.saturating_add(nf).saturating_add(ns) {
+        return Err(ReadError::line(
+            line,
+            format!(
+                "tag {name:?} declares {ni}/{nf}/{ns} arguments but has {}",
+                args.len()
+            ),
+        ));
+    }
+    let ints = args[..ni]
+        .iter()
+        .map(|s| {
+            s.parse::<i64>().map_err(|_| {
+                ReadError::line(line, format!("tag {name:?}: {s:?} is not an integer"))
+            })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let floats = args[ni..ni + nf]
+        .iter()
+        .map(|s| {
+            s.parse::<f64>()
+                .map_err(|_| ReadError::line(line, format!("tag {name:?}: {s:?} is not a number")))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let strings = args[ni + nf..].iter().map(|s| s.to_string()).collect();
+    Ok(TagLine {
+        line,
+        name,
+        ints,
+        floats,
+        strings,
+        raw: text.trim().to_string(),
+    })
+}
+
+fn tag_index(tag: &TagLine, what: &str, i: i64) -> Result<u64, ReadError> {
+    u64::try_from(i).map_err(|_| {
+        ReadError::line(
+            tag.line,
+            format!("{} tag names {what} {i}, which does not exist", tag.name),
+        )
+    })
+}
+
+fn apply_tag(
+    tag: &TagLine,
+    topo: &mut subd_mesh::Topology,
+    hints: &mut SchemeHints,
+    warnings: &mut Vec<String>,
+    extra: &mut Vec<String>,
+) -> Result<(), ReadError> {
+    let at = |e: subd_mesh::TopologyError| ReadError::line(tag.line, e.to_string());
+    let bad = |msg: &str| ReadError::line(tag.line, format!("{} tag: {msg}", tag.name));
+    match tag.name.as_str() {
+        "crease" => {
+            let n = tag.ints.len();
+            if n < 2 || !(tag.floats.len() == 1 || tag.floats.len() == n - 1) {
+                return Err(bad(
+                    "expected n >= 2 vertices and 1 or n-1 sharpness values",
+                ));
+            }
+            for i in 0..n - 1 {
+                let a = tag_index(tag, "vertex", tag.ints[i])?;
+                let b = tag_index(tag, "vertex", tag.ints[i + 1])?;
+                let s = tag.floats[i.min(tag.floats.len() - 1)];
+                if topo.set_crease(a, b, s).map_err(at)?.is_none() {
+                    warnings.push(format!(
+                        "line {}: crease tag names edge ({a}, {b}), which is not an edge of the mesh; ignored",
+                        tag.line
+                    ));
+                }
+            }
+        }
+        "corner" => {
+            let n = tag.ints.len();
+            if n < 1 || !(tag.floats.len() == 1 || tag.floats.len() == n) {
+                return Err(bad("expected n >= 1 vertices and 1 or n sharpness values"));
+            }
+            for i in 0..n {
+                let v = tag_index(tag, "vertex", tag.ints[i])?;
+                topo.set_corner(v, tag.floats[i.min(tag.floats.len() - 1)])
+                    .map_err(at)?;
+            }
+        }
+        "hole" => {
+            if tag.ints.is_empty() {
+                return Err(bad("expected at least one face index"));
+            }
+            for &f in &tag.ints {
+                topo.set_hole_checked(tag_index(tag, "face", f)?)
+                    .map_err(at)?;
+            }
+        }
+        "interpolateboundary" => {
+            let k = match tag.ints.as_slice() {
+                [k] => *k,
+                _ => {
+                    return Err(bad(
+                        "expected one integer (0 none, 1 edge-and-corner, 2 edge-only)",
+                    ));
+                }
+            };
+            hints.boundary_interpolation =
+                Some(BoundaryInterpolation::from_shape_tag(k).ok_or_else(|| {
+                    bad(&format!(
+                        "unknown value {k} (0 none, 1 edge-and-corner, 2 edge-only)"
+                    ))
+                })?);
+        }
+        "creasemethod" => {
+            hints.crease_method = Some(match tag.strings.first().map(String::as_str) {
+                Some("normal") | Some("uniform") => CreaseMethod::Uniform,
+                Some("chaikin") => CreaseMethod::Chaikin,
+                _ => return Err(bad("expected one string: normal or chaikin")),
+            });
+        }
+        "smoothtriangles" => {
+            hints.triangle_subdivision = Some(match tag.strings.first().map(String::as_str) {
+                Some("catmark") => TriangleSubdivision::Catmark,
+                Some("smooth") => TriangleSubdivision::Smooth,
+                _ => return Err(bad("expected one string: catmark or smooth")),
+            });
+        }
+        "vertexedit" | "edgeedit" | "faceedit" => {
+            warnings.push(format!(
+                "line {}: hierarchical edit tag {:?} is not supported (OpenSubdiv's Far ignores it too); kept but not applied",
+                tag.line, tag.name
+            ));
+            extra.push(tag.raw.clone());
+        }
+        other => {
+            warnings.push(format!(
+                "line {}: tag {other:?} does not affect vertex positions; kept but not applied",
+                tag.line
+            ));
+            extra.push(tag.raw.clone());
+        }
+    }
+    Ok(())
+}
+
+/// Writes `mesh` as OBJ with OpenSubdiv's tag lines (0-based indices in tags), plus the
+/// verbatim `extra_tags`. Coordinates are written with Rust's shortest round-trip formatting,
+/// so reading the file back gives the same `f64` values.
+pub fn write_obj(w: &mut dyn Write, mesh: &Mesh, extra_tags: &[String]) -> std::io::Result<()> {
+    let topo = &mesh.topology;
+    writeln!(w, "# written by subd {}", env!("CARGO_PKG_VERSION"))?;
+    writeln!(
+        w,
+        "# {} vertices, {} faces; tag indices are 0-based (OpenSubdiv shape convention)",
+        topo.num_vertices(),
+        topo.num_faces()
+    )?;
+    for p in &mesh.positions {
+        writeln!(w, "v {} {} {}", p.x, p.y, p.z)?;
+    }
+    let mut line = String::new();
+    for f in 0..topo.num_faces() {
+        use std::fmt::Write as _;
+        line.clear();
+        line.push('f');
+        for &v in topo.face_vertices(f) {
+            let _ = write!(line, " {}", v as u64 + 1);
+        }
+        writeln!(w, "{line}")?;
+    }
+    write_tags(w, mesh)?;
+    for t in extra_tags {
+        writeln!(w, "{t}")?;
+    }
+    Ok(())
+}
+
+fn write_tags(w: &mut dyn Write, mesh: &Mesh) -> std::io::Result<()> {
+    let topo = &mesh.topology;
+    if let Some(b) = mesh.hints.boundary_interpolation {
+        writeln!(w, "t interpolateboundary 1/0/0 {}", b.to_shape_tag())?;
+    }
+    if let Some(c) = mesh.hints.crease_method {
+        let s = match c {
+            CreaseMethod::Uniform => "normal",
+            CreaseMethod::Chaikin => "chaikin",
+        };
+        writeln!(w, "t creasemethod 0/0/1 {s}")?;
+    }
+    if let Some(t) = mesh.hints.triangle_subdivision {
+        let s = match t {
+            TriangleSubdivision::Catmark => "catmark",
+            TriangleSubdivision::Smooth => "smooth",
+        };
+        writeln!(w, "t smoothtriangles 0/0/1 {s}")?;
+    }
+    for e in 0..topo.num_edges() {
+        let s = topo.edge_sharpness(e);
+        if s > 0.0 {
+            let [a, b] = topo.edge_vertices(e);
+            writeln!(w, "t crease 2/1/0 {a} {b} {s}")?;
+        }
+    }
+    for v in 0..topo.num_vertices() {
+        let s = topo.vertex_sharpness(v);
+        if s > 0.0 {
+            writeln!(w, "t corner 1/1/0 {v} {s}")?;
+        }
+    }
+    for f in 0..topo.num_faces() {
+        if topo.is_hole(f) {
+            writeln!(w, "t hole 1/0/0 {f}")?;
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,699 @@
+//! PLY (Stanford polygon format): ASCII, binary little-endian and binary big-endian in,
+//! ASCII and binary little-endian out.
+//!
+//! The `vertex` element must have `x`, `y`, `z`; faces come from the list property
+//! `vertex_indices` (or `vertex_index`) of the `face` element; other elements and properties
+//! are skipped. subd also writes (and reads back) its tags as extra elements that other
+//! readers ignore: `crease` (`v0`, `v1`, `sharpness`), `corner` (`vertex`, `sharpness`),
+//! `hole` (`face`), and scheme options as `comment subd <tag> <value>` header lines.
+//!
+//! Written by hand rather than with a PLY crate: the available crates are unmaintained or
+//! allocate per element, and a reader here must name the header line or the element of
+//! every error, reject absurd counts without allocating them, and be fuzzed as part of subd.
+
+use std::io::Write;
+
+use subd_mesh::{
+    BoundaryInterpolation, CreaseMethod, DVec3, Mesh, SchemeHints, TopologyBuilder,
+    TriangleSubdivision,
+};
+
+use crate::error::ReadError;
+use crate::{MeshFile, ReadOptions};
+
+/// PLY encoding to write.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum PlyEncoding {
+    /// Human-readable text.
+    Ascii,
+    /// Binary little-endian (compact, exact).
+    #[default]
+    BinaryLittleEndian,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Scalar {
+    I8,
+    U8,
+    I16,
+    U16,
+    I32,
+    U32,
+    F32,
+    F64,
+}
+
+impl Scalar {
+    fn parse(s: &str) -> Option<Scalar> {
+        Some(match s {
+            "char" | "int8" => Scalar::I8,
+            "uchar" | "uint8" => Scalar::U8,
+            "short" | "int16" => Scalar::I16,
+            "ushort" | "uint16" => Scalar::U16,
+            "int" | "int32" => Scalar::I32,
+            "uint" | "uint32" => Scalar::U32,
+            "float" | "float32" => Scalar::F32,
+            "double" | "float64" => Scalar::F64,
+            _ => return None,
+        })
+    }
+
+    fn size(self) -> usize {
+        match self {
+            Scalar::I8 | Scalar::U8 => 1,
+            Scalar::I16 | Scalar::U16 => 2,
+            Scalar::I32 | Scalar::U32 | Scalar::F32 => 4,
+            Scalar::F64 => 8,
+        }
+    }
+}
+
+#[derive(Debug, Clone)]
+enum Property {
+    Scalar(String, Scalar),
+    List(String, Scalar, Scalar),
+}
+
+impl Property {
+    fn name(&self) -> &str {
+        match self {
+            Property::Scalar(n, _) | Property::List(n, _, _) => n,
+        }
+    }
+}
+
+#[derive(Debug, Clone)]
+struct Element {
+    name: String,
+    count: usize,
+    props: Vec<Property>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Encoding {
+    Ascii,
+    Le,
+    Be,
+}
+
+/// Reads values of an element body, either from ASCII tokens or from binary bytes.
+enum Body<'a> {
+    Ascii {
+        text: &'a str,
+        pos: usize,
+        line: usize,
+    },
+    Binary {
+        data: &'a [u8],
+        pos: usize,
+        big_endian: bool,
+    },
+}
+
+impl Body<'_> {
+    fn line(&self) -> Option<usize> {
+        match self {
+            Body::Ascii { line, .. } => Some(*line),
+            Body::Binary { .. } => None,
+        }
+    }
+
+    fn remaining_bytes(&self) -> usize {
+        match self {
+            Body::Ascii { text, pos, .. } => text.len() - pos,
+            Body::Binary { data, pos, .. } => data.len() - pos,
+        }
+    }
+
+    fn read(&mut self, ty: Scalar, what: &dyn Fn() -> String) -> Result<f64, ReadError> {
+        match self {
+            Body::Ascii { text, pos, line } => {
+                let bytes = text.as_bytes();
+                while *pos < bytes.len() && bytes[*pos].is_ascii_whitespace() {
+                    if bytes[*pos] == b'\n' {
+                        *line += 1;
+                    }
+                    *pos += 1;
+                }
+                let start = *pos;
+                while *pos < bytes.len() && !bytes[*pos].is_ascii_whitespace() {
+                    *pos += 1;
+                }
+                if start == *pos {
+                    return Err(ReadError::line(
+                        *line,
+                        format!("file ends inside {}", what()),
+                    ));
+                }
+                let tok = &text[start..*pos];
+                let v: f64 = tok.parse().map_err(|_| {
+                    ReadError::line(*line, format!("{}: {tok:?} is not a number", what()))
+                })?;
+                if !matches!(ty, Scalar::F32 | Scalar::F64) && v.fract() != 0.0 {
+                    return Err(ReadError::line(
+                        *line,
+                        format!("{}: {tok:?} is not an integer", what()),
+                    ));
+                }
+                Ok(v)
+            }
+            Body::Binary {
+                data,
+                pos,
+                big_endian,
+            } => {
+                let n = ty.size();
+                if data.len() - *pos < n {
+                    return Err(ReadError::general(format!(
+                        "binary data ends inside {}",
+                        what()
+                    )));
+                }
+                let mut b = [0u8; 8];
+                b[..n].copy_from_slice(&data[*pos..*pos + n]);
+                if *big_endian {
+                    b[..n].reverse();
+                }
+                *pos += n;
+                Ok(match ty {
+                    Scalar::I8 => b[0] as i8 as f64,
+                    Scalar::U8 => b[0] as f64,
+                    Scalar::I16 => i16::from_le_bytes([b[0], b[1]]) as f64,
+                    Scalar::U16 => u16::from_le_bytes([b[0], b[1]]) as f64,
+                    Scalar::I32 => i32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+                    Scalar::U32 => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+                    Scalar::F32 => f32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+                    Scalar::F64 => f64::from_le_bytes(b),
+                })
+            }
+        }
+    }
+}
+
+fn err_at(body: &Body, msg: String) -> ReadError {
+    match body.line() {
+        Some(l) => ReadError::line(l, msg),
+        None => ReadError::general(msg),
+    }
+}
+
+struct Header {
+    encoding: Encoding,
+    elements: Vec<Element>,
+    hints: SchemeHints,
+    body_offset: usize,
+    body_line: usize,
+}
+
+fn parse_header(bytes: &[u8]) -> Result<Header, ReadError> {
+    if !bytes.starts_with(b"ply") {
+        return Err(ReadError::line(
+            1,
+            "not a PLY file (it must start with \"ply\")",
+        ));
+    }
+    let mut encoding = None;
+    let mut elements: Vec<Element> = Vec::new();
+    let mut hints = SchemeHints::default();
+    let mut pos = 0usize;
+    let mut line = 0usize;
+    loop {
+        if pos >= bytes.len() {
+            return Err(ReadError::line(
+                line.max(1),
+                "header has no end_header line",
+            ));
+        }
+        let end = bytes[pos..]
+            .iter()
+            .position(|&b| b == b'\n')
+            .map_or(bytes.len(), |i| pos + i);
+        line += 1;
+        let text = std::str::from_utf8(&bytes[pos..end])
+            .map_err(|_| ReadError::line(line, "header line is not text"))?;
+        let text = text.strip_suffix('\r').unwrap_or(text);
+        pos = (end + 1).min(bytes.len());
+        let words: Vec<&str> = text.split_ascii_whitespace().collect();
+        match words.as_slice() {
+            ["ply"] if line == 1 => {}
+            ["format", f, _version] => {
+                encoding = Some(match *f {
+                    "ascii" => Encoding::Ascii,
+                    "binary_little_endian" => Encoding::Le,
+                    "binary_big_endian" => Encoding::Be,
+                    _ => return Err(ReadError::line(line, format!("unknown PLY format {f:?}"))),
+                });
+            }
+            ["comment", "subd", rest @ ..] => parse_hint(line, rest, &mut hints)?,
+            ["comment", ..] | ["obj_info", ..] | [] => {}
+            ["element", name, count] => {
+                let count: usize = count.parse().map_err(|_| {
+                    ReadError::line(line, format!("element count {count:?} is not a number"))
+                })?;
+                elements.push(Element {
+                    name: name.to_string(),
+                    count,
+                    props: Vec::new(),
+                });
+            }
+            ["property", "list", c, i, name] => {
+                let el = elements
+                    .last_mut()
+                    .ok_or_else(|| ReadError::line(line, "property before any element"))?;
+                let (Some(c), Some(i)) = (Scalar::parse(c), Scalar::parse(i)) else {
+                    return Err(ReadError::line(line, "unknown property type in list"));
+                };
+                if matches!(c, Scalar::F32 | Scalar::F64) {
+                    return Err(ReadError::line(
+                        line,
+                        "list count type must be an integer type",
+                    ));
+                }
+                el.props.push(Property::List(name.to_string(), c, i));
+            }
+            ["property", ty, name] => {
+                let el = elements
+                    .last_mut()
+                    .ok_or_else(|| ReadError::line(line, "property before any element"))?;
+                let ty = Scalar::parse(ty).ok_or_else(|| {
+                    ReadError::line(line, format!("unknown property type {ty:?}"))
+                })?;
+                el.props.push(Property::Scalar(name.to_string(), ty));
+            }
+            ["end_header"] => break,
+            _ => {
+                return Err(ReadError::line(
+                    line,
+                    format!("unrecognised header line {text:?}"),
+                ));
+            }
+        }
+    }
+    let encoding = encoding.ok_or_else(|| ReadError::line(line, "header has no format line"))?;
+    Ok(Header {
+        encoding,
+        elements,
+        hints,
+        body_offset: pos,
+        body_line: line + 1,
+    })
+}
+
+fn parse_hint(line: usize, words: &[&str], hints: &mut SchemeHints) -> Result<(), ReadError> {
+    let bad = || {
+        ReadError::line(
+            line,
+            format!("unrecognised subd comment {:?}", words.join(" ")),
+        )
+    };
+    match words {
+        ["interpolateboundary", k] => {
+            let k: i64 = k.parse().map_err(|_| bad())?;
+            hints.boundary_interpolation =
+                Some(BoundaryInterpolation::from_shape_tag(k).ok_or_else(bad)?);
+        }
+        ["creasemethod", "normal"] => hints.crease_method = Some(CreaseMethod::Uniform),
+        ["creasemethod", "chaikin"] => hints.crease_method = Some(CreaseMethod::Chaikin),
+        ["smoothtriangles", "catmark"] => {
+            hints.triangle_subdivision = Some(TriangleSubdivision::Catmark)
+        }
+        ["smoothtriangles", "smooth"] => {
+            hints.triangle_subdivision = Some(TriangleSubdivision::Smooth)
+        }
+        _ => return Err(bad()),
+    }
+    Ok(())
+}
+
+/// Parses a PLY file. ASCII errors carry the line; binary errors name the element.
+pub fn parse_ply(bytes: &[u8], options: &ReadOptions) -> Result<MeshFile, ReadError> {
+    let header = parse_header(bytes)?;
+    let data = &bytes[header.body_offset..];
+    let mut body = match header.encoding {
+        Encoding::Ascii => Body::Ascii {
+            text: std::str::from_utf8(data)
+                .map_err(|_| ReadError::line(header.body_line, "ASCII PLY body is not text"))?,
+            pos: 0,
+            line: header.body_line,
+        },
+        Encoding::Le | Encoding::Be => Body::Binary {
+            data,
+            pos: 0,
+            big_endian: header.encoding == Encoding::Be,
+        },
+    };
+    let mut positions: Vec<DVec3> = Vec::new();
+    let mut face_sizes: Vec<u32> = Vec::new();
+    let mut face_vertices: Vec<u32> = Vec::new();
+    let mut creases: Vec<(f64, f64, f64, Option<usize>)> = Vec::new();
+    let mut corners: Vec<(f64, f64, Option<usize>)> = Vec::new();
+    let mut holes: Vec<(f64, Option<usize>)> = Vec::new();
+    let mut have_vertex = false;
+    let mut have_face = false;
+    let mut values: Vec<f64> = Vec::new();
+    let mut list: Vec<f64> = Vec::new();
+    for el in &header.elements {
+        let find = |n: &str| el.props.iter().position(|p| p.name() == n);
+        let role = match el.name.as_str() {
+            "vertex" => {
+                have_vertex = true;
+                let (Some(x), Some(y), Some(z)) = (find("x"), find("y"), find("z")) else {
+                    return Err(ReadError::general(
+                        "vertex element lacks an x, y or z property",
+                    ));
+                };
+                Some(("vertex", [x, y, z]))
+            }
+            "face" => {
+                have_face = true;
+                let Some(i) = find("vertex_indices").or_else(|| find("vertex_index")) else {
+                    return Err(ReadError::general(
+                        "face element has no vertex_indices list",
+                    ));
+                };
+                if !matches!(el.props[i], Property::List(..)) {
+                    return Err(ReadError::general(
+                        "face vertex_indices is not a list property",
+                    ));
+                }
+                Some(("face", [i, 0, 0]))
+            }
+            "crease" => match (find("v0"), find("v1"), find("sharpness")) {
+                (Some(a), Some(b), Some(s)) => Some(("crease", [a, b, s])),
+                _ => None,
+            },
+            "corner" => match (find("vertex"), find("sharpness")) {
+                (Some(a), Some(s)) => Some(("corner", [a, s, 0])),
+                _ => None,
+            },
+            "hole" => find("face").map(|a| ("hole", [a, 0, 0])),
+            _ => None,
+        };
+        // Each instance needs at least one byte, so a count beyond the remaining bytes is
+        // malformed; capping the reservation keeps absurd headers from allocating.
+        let reserve = el.count.min(body.remaining_bytes());
+        match role {
+            Some(("vertex", _)) => positions.reserve(reserve),
+            Some(("face", _)) => face_sizes.reserve(reserve),
+            _ => {}
+        }
+        for k in 0..el.count {
+            values.clear();
+            list.clear();
+            for (pi, prop) in el.props.iter().enumerate() {
+                let what = || format!("{} {k} property {}", el.name, prop.name());
+                match prop {
+                    Property::Scalar(_, ty) => values.push(body.read(*ty, &what)?),
+                    Property::List(_, cty, ity) => {
+                        let n = body.read(*cty, &what)?;
+                        if n < 0.0 {
+                            return Err(err_at(&body, format!("{}: negative list length", what())));
+                        }
+                        let n = n as usize;
+                        if n > body.remaining_bytes() {
+                            return Err(err_at(
+                                &body,
+                                format!("{}: list length {n} exceeds the file", what()),
+                            ));
+                        }
+                        let keep = matches!(role, Some(("face", [i, _, _])) if i == pi);
+                        for _ in 0..n {
+                            let v = body.read(*ity, &what)?;
+                            if keep {
+                                list.push(v);
+                            }
+                        }
+                        values.push(f64::NAN);
+                    }
+                }
+            }
+            // The line of the instance's last value: where a text instance lives.
+            let line = body.line();
+            match role {
+                Some(("vertex", [x, y, z])) => {
+                    let p = DVec3::new(values[x], values[y], values[z]);
+                    if !p.is_finite() {
+                        return Err(err_at(
+                            &body,
+                            format!("vertex {k} has a non-finite coordinate"),
+                        ));
+                    }
+                    positions.push(p);
+                }
+                Some(("face", _)) => {
+                    if list.len() < 3 {
+                        return Err(err_at(
+                            &body,
+                            format!(
+                                "face {k} has {} vertices; a face needs at least 3",
+                                list.len()
+                            ),
+                        ));
+                    }
+                    for &v in &list {
+                        if v < 0.0 || v.fract() != 0.0 || v >= u32::MAX as f64 {
+                            return Err(err_at(
+                                &body,
+                                format!("face {k} has invalid vertex index {v}"),
+                            ));
+                        }
+                        face_vertices.push(v as u32);
+                    }
+                    face_sizes.push(list.len() as u32);
+                }
+                Some(("crease", [a, b, s])) => {
+                    creases.push((values[a], values[b], values[s], line))
+                }
+                Some(("corner", [a, s, _])) => corners.push((values[a], values[s], line)),
+                Some(("hole", [a, _, _])) => holes.push((values[a], line)),
+                _ => {}
+            }
+        }
+    }
+    if !have_vertex || !have_face || face_sizes.is_empty() {
+        return Err(ReadError::general(
+            "PLY file has no faces (needs vertex and face elements)",
+        ));
+    }
+    let nv = positions.len();
+    let mut offset = 0;
+    for (f, &n) in face_sizes.iter().enumerate() {
+        for &v in &face_vertices[offset..offset + n as usize] {
+            if v as usize >= nv {
+                return Err(ReadError::general(format!(
+                    "face {f} refers to vertex {v}, but there are only {nv} vertices"
+                )));
+            }
+        }
+        offset += n as usize;
+    }
+    let (mut topology, build_warnings) = TopologyBuilder::new(nv)
+        .accept_inconsistent_orientation(options.accept_inconsistent_orientation)
+        .build_with_warnings(&face_sizes, &face_vertices)?;
+    let orientation_conflicts = build_warnings
+        .iter()
+        .filter(|w| matches!(w, subd_mesh::BuildWarning::InconsistentOrientation { .. }))
+        .count();
+    let mut warnings: Vec<String> = build_warnings.iter().map(|w| w.to_string()).collect();
+    let at = |line: Option<usize>, e: subd_mesh::TopologyError| match line {
+        Some(l) => ReadError::line(l, e.to_string()),
+        None => ReadError::Topology(e),
+    };
+    let index =
+        |x: f64, tag: &'static str, what: &'static str, count: usize, line: Option<usize>| {
+            if x >= 0.0 && x.fract() == 0.0 {
+                Ok(x as u64)
+            } else {
+                Err(at(
+                    line,
+                    subd_mesh::TopologyError::TagIndexOutOfRange {
+                        tag,
+                        what,
+                        index: x.max(0.0) as u64,
+                        count,
+                    },
+                ))
+            }
+        };
+    for &(a, b, s, line) in &creases {
+        let (a, b) = (
+            index(a, "crease", "vertex", nv, line)?,
+            index(b, "crease", "vertex", nv, line)?,
+        );
+        if topology
+            .set_crease(a, b, s)
+            .map_err(|e| at(line, e))?
+            .is_none()
+        {
+            warnings.push(format!(
+                "crease names edge ({a}, {b}), which is not an edge of the mesh; ignored"
+            ));
+        }
+    }
+    for &(v, s, line) in &corners {
+        let v = index(v, "corner", "vertex", nv, line)?;
+        topology.set_corner(v, s).map_err(|e| at(line, e))?;
+    }
+    let nf = face_sizes.len();
+    for &(f, line) in &holes {
+        let f = index(f, "hole", "face", nf, line)?;
+        topology.set_hole_checked(f).map_err(|e| at(line, e))?;
+    }
+    let mut mesh = Mesh::new(topology, positions)?;
+    mesh.hints = header.hints;
+    Ok(MeshFile {
+        mesh,
+        warnings,
+        extra_tags: Vec::new(),
+        orientation_conflicts,
+    })
+}
+
+/// Writes `mesh` as PLY: positions as `double`, faces as a `uchar`/`uint` count list of
+/// `int` indices, and subd's tag elements when the mesh has tags.
+pub fn write_ply(w: &mut dyn Write, mesh: &Mesh, encoding: PlyEncoding) -> std::io::Result<()> {
+    let topo = &mesh.topology;
+    let creases: Vec<usize> = (0..topo.num_edges())
+        .filter(|&e| topo.edge_sharpness(e) > 0.0)
+        .collect();
+    let corners: Vec<usize> = (0..topo.num_vertices())
+        .filter(|&v| topo.vertex_sharpness(v) > 0.0)
+        .collect();
+    let holes: Vec<usize> = (0..topo.num_faces()).filter(|&f| topo.is_hole(f)).collect();
+    let wide_lists = topo.face_sizes().any(|n| n > 255);
+    let index_ty = if topo.num_vertices() > i32::MAX as usize {
+        "uint"
+    } else {
+        "int"
+    };
+    writeln!(w, "ply")?;
+    writeln!(
+        w,
+        "format {} 1.0",
+        match encoding {
+            PlyEncoding::Ascii => "ascii",
+            PlyEncoding::BinaryLittleEndian => "binary_little_endian",
+        }
+    )?;
+    writeln!(w, "comment written by subd {}", env!("CARGO_PKG_VERSION"))?;
+    if let Some(b) = mesh.hints.boundary_interpolation {
+        writeln!(w, "comment subd interpolateboundary {}", b.to_shape_tag())?;
+    }
+    if let Some(c) = mesh.hints.crease_method {
+        let s = if c == CreaseMethod::Chaikin {
+            "chaikin"
+        } else {
+            "normal"
+        };
+        writeln!(w, "comment subd creasemethod {s}")?;
+    }
+    if let Some(t) = mesh.hints.triangle_subdivision {
+        let s = if t == TriangleSubdivision::Smooth {
+            "smooth"
+        } else {
+            "catmark"
+        };
+        writeln!(w, "comment subd smoothtriangles {s}")?;
+    }
+    writeln!(w, "element vertex {}", topo.num_vertices())?;
+    for c in ["x", "y", "z"] {
+        writeln!(w, "property double {c}")?;
+    }
+    writeln!(w, "element face {}", topo.num_faces())?;
+    writeln!(
+        w,
+        "property list {} {index_ty} vertex_indices",
+        if wide_lists { "uint" } else { "uchar" }
+    )?;
+    if !creases.is_empty() {
+        writeln!(w, "element crease {}", creases.len())?;
+        writeln!(
+            w,
+            "property {index_ty} v0\nproperty {index_ty} v1\nproperty float sharpness"
+        )?;
+    }
+    if !corners.is_empty() {
+        writeln!(w, "element corner {}", corners.len())?;
+        writeln!(w, "property {index_ty} vertex\nproperty float sharpness")?;
+    }
+    if !holes.is_empty() {
+        writeln!(w, "element hole {}", holes.len())?;
+        writeln!(w, "property int face")?;
+    }
+    writeln!(w, "end_header")?;
+    match encoding {
+        PlyEncoding::Ascii => {
+            for p in &mesh.positions {
+                writeln!(w, "{} {} {}", p.x, p.y, p.z)?;
+            }
+            let mut line = String::new();
+            for f in 0..topo.num_faces() {
+                use std::fmt::Write as _;
+                line.clear();
+                let fv = topo.face_vertices(f);
+                let _ = write!(line, "{}", fv.len());
+                for &v in fv {
+                    let _ = write!(line, " {v}");
+                }
+                writeln!(w, "{line}")?;
+            }
+            for &e in &creases {
+                let [a, b] = topo.edge_vertices(e);
+                writeln!(w, "{a} {b} {}", topo.edge_sharpness(e))?;
+            }
+            for &v in &corners {
+                writeln!(w, "{v} {}", topo.vertex_sharpness(v))?;
+            }
+            for &f in &holes {
+                writeln!(w, "{f}")?;
+            }
+        }
+        PlyEncoding::BinaryLittleEndian => {
+            let mut buf: Vec<u8> = Vec::with_capacity(1 << 16);
+            let flush =
+                |buf: &mut Vec<u8>, w: &mut dyn Write, force: bool| -> std::io::Result<()> {
+                    if force || buf.len() >= 1 << 16 {
+                        w.write_all(buf)?;
+                        buf.clear();
+                    }
+                    Ok(())
+                };
+            for p in &mesh.positions {
+                for c in p.to_array() {
+                    buf.extend_from_slice(&c.to_le_bytes());
+                }
+                flush(&mut buf, w, false)?;
+            }
+            for f in 0..topo.num_faces() {
+                let fv = topo.face_vertices(f);
+                if wide_lists {
+                    buf.extend_from_slice(&(fv.len() as u32).to_le_bytes());
+                } else {
+                    buf.push(fv.len() as u8);
+                }
+                for &v in fv {
+                    buf.extend_from_slice(&v.to_le_bytes());
+                }
+                flush(&mut buf, w, false)?;
+            }
+            for &e in &creases {
+                let [a, b] = topo.edge_vertices(e);
+                buf.extend_from_slice(&a.to_le_bytes());
+                buf.extend_from_slice(&b.to_le_bytes());
+                buf.extend_from_slice(&topo.edge_sharpness(e).to_le_bytes());
+                flush(&mut buf, w, false)?;
+            }
+            for &v in &corners {
+                buf.extend_from_slice(&(v as u32).to_le_bytes());
+                buf.extend_from_slice(&topo.vertex_sharpness(v).to_le_bytes());
+                flush(&mut buf, w, false)?;
+            }
+            for &f in &holes {
+                buf.extend_from_slice(&(f as u32).to_le_bytes());
+                flush(&mut buf, w, false)?;
+            }
+            flush(&mut buf, w, true)?;
+        }
+    }
+    Ok(())
+}

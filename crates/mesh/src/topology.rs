@@ -1,0 +1,383 @@
+//! The [`Topology`] type: flat, index-based adjacency of a polygon mesh.
+
+use crate::error::TopologyError;
+use crate::tags::{self, Tags};
+
+/// Edge flag: the edge has exactly one incident face.
+pub(crate) const EDGE_BOUNDARY: u8 = 1;
+/// Edge flag: the edge is non-manifold (more than two faces, same-direction use by two faces,
+/// repeated within a face, or degenerate).
+pub(crate) const EDGE_NON_MANIFOLD: u8 = 2;
+/// Edge flag: both ends of the edge are the same vertex.
+pub(crate) const EDGE_DEGENERATE: u8 = 4;
+
+/// Vertex flag: the vertex lies on a boundary edge.
+pub(crate) const VERTEX_BOUNDARY: u8 = 1;
+/// Vertex flag: the faces and edges around the vertex do not form a single fan.
+pub(crate) const VERTEX_NON_MANIFOLD: u8 = 2;
+/// Vertex flag: no face uses the vertex.
+pub(crate) const VERTEX_ISOLATED: u8 = 4;
+
+/// Adjacency of a polygon mesh in compressed-sparse-row (CSR) arrays.
+///
+/// Built by [`crate::TopologyBuilder`] from face-vertex lists. All relations are flat `u32`
+/// arrays with offsets, so a scheme can walk them without chasing pointers:
+///
+/// * face → vertices and face → edges (edge `i` of a face joins its vertices `i` and `i+1`);
+/// * edge → its two vertices and edge → incident faces (in face order);
+/// * vertex → incident faces and vertex → incident edges, **ordered counter-clockwise** (with
+///   respect to the face winding) around every manifold vertex. For a boundary vertex the
+///   walk starts at the boundary edge that leaves the vertex in its face.
+///
+/// Edges are numbered as OpenSubdiv numbers them: by first appearance when walking the faces
+/// in order and each face's edges `(v_i, v_{i+1})`; an edge keeps the direction of the first
+/// face that uses it. A face that repeats an edge, or has a degenerate edge (`v_i == v_{i+1}`),
+/// gets an extra non-manifold edge instance, again as OpenSubdiv does.
+///
+/// Geometry is not stored here: positions live in a separate slice indexed by vertex (see
+/// [`crate::Mesh`]). Tags (crease and corner sharpness, holes) are stored with the topology
+/// because refinement propagates them together.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Topology {
+    pub(crate) num_vertices: u32,
+    pub(crate) face_offsets: Vec<u32>,
+    pub(crate) face_vertices: Vec<u32>,
+    pub(crate) face_edges: Vec<u32>,
+    pub(crate) edge_vertices: Vec<[u32; 2]>,
+    pub(crate) edge_face_offsets: Vec<u32>,
+    pub(crate) edge_faces: Vec<u32>,
+    pub(crate) edge_face_local: Vec<u32>,
+    pub(crate) vertex_face_offsets: Vec<u32>,
+    pub(crate) vertex_faces: Vec<u32>,
+    pub(crate) vertex_face_local: Vec<u32>,
+    pub(crate) vertex_edge_offsets: Vec<u32>,
+    pub(crate) vertex_edges: Vec<u32>,
+    pub(crate) edge_flags: Vec<u8>,
+    pub(crate) vertex_flags: Vec<u8>,
+    pub(crate) tags: Tags,
+}
+
+#[inline]
+fn range(offsets: &[u32], i: usize) -> std::ops::Range<usize> {
+    offsets[i] as usize..offsets[i + 1] as usize
+}
+
+impl Topology {
+    /// Number of vertices (including isolated ones that no face uses).
+    #[inline]
+    pub fn num_vertices(&self) -> usize {
+        self.num_vertices as usize
+    }
+
+    /// Number of unique edges (non-manifold instances counted separately, as OpenSubdiv does).
+    #[inline]
+    pub fn num_edges(&self) -> usize {
+        self.edge_vertices.len()
+    }
+
+    /// Number of faces.
+    #[inline]
+    pub fn num_faces(&self) -> usize {
+        self.face_offsets.len() - 1
+    }
+
+    /// Total number of face-vertices (sum of the face sizes).
+    #[inline]
+    pub fn num_face_vertices(&self) -> usize {
+        self.face_vertices.len()
+    }
+
+    /// Offsets of each face's run in [`Self::all_face_vertices`] (length `num_faces + 1`).
+    #[inline]
+    pub fn face_offsets(&self) -> &[u32] {
+        &self.face_offsets
+    }
+
+    /// All face-vertex indices, face after face.
+    #[inline]
+    pub fn all_face_vertices(&self) -> &[u32] {
+        &self.face_vertices
+    }
+
+    /// Number of vertices of face `f`.
+    #[inline]
+    pub fn face_size(&self, f: usize) -> usize {
+        (self.face_offsets[f + 1] - self.face_offsets[f]) as usize
+    }
+
+    /// Vertices of face `f` in winding order.
+    #[inline]
+    pub fn face_vertices(&self, f: usize) -> &[u32] {
+        &self.face_vertices[range(&self.face_offsets, f)]
+    }
+
+    /// Edges of face `f`: edge `i` joins face vertices `i` and `i + 1`.
+    #[inline]
+    pub fn face_edges(&self, f: usize) -> &[u32] {
+        &self.face_edges[range(&self.face_offsets, f)]
+    }
+
+    /// The two vertices of edge `e`, in the direction of the first face that used it.
+    #[inline]
+    pub fn edge_vertices(&self, e: usize) -> [u32; 2] {
+        self.edge_vertices[e]
+    }
+
+    /// Faces incident to edge `e`, in face order.
+    #[inline]
+    pub fn edge_faces(&self, e: usize) -> &[u32] {
+        &self.edge_faces[range(&self.edge_face_offsets, e)]
+    }
+
+    /// For each face of [`Self::edge_faces`], the position of edge `e` within that face.
+    #[inline]
+    pub fn edge_face_local_indices(&self, e: usize) -> &[u32] {
+        &self.edge_face_local[range(&self.edge_face_offsets, e)]
+    }
+
+    /// Faces incident to vertex `v`, counter-clockwise for manifold vertices.
+    #[inline]
+    pub fn vertex_faces(&self, v: usize) -> &[u32] {
+        &self.vertex_faces[range(&self.vertex_face_offsets, v)]
+    }
+
+    /// For each face of [`Self::vertex_faces`], the corner of that face at which `v` sits.
+    #[inline]
+    pub fn vertex_face_local_indices(&self, v: usize) -> &[u32] {
+        &self.vertex_face_local[range(&self.vertex_face_offsets, v)]
+    }
+
+    /// Edges incident to vertex `v`, counter-clockwise for manifold vertices.
+    #[inline]
+    pub fn vertex_edges(&self, v: usize) -> &[u32] {
+        &self.vertex_edges[range(&self.vertex_edge_offsets, v)]
+    }
+
+    /// The end of edge `e` that is not `v` (for a degenerate edge, `v` itself).
+    #[inline]
+    pub fn edge_other_vertex(&self, e: usize, v: u32) -> u32 {
+        let [a, b] = self.edge_vertices[e];
+        if a == v { b } else { a }
+    }
+
+    /// Valence of `v`: the number of incident edges.
+    #[inline]
+    pub fn valence(&self, v: usize) -> usize {
+        range(&self.vertex_edge_offsets, v).len()
+    }
+
+    /// The 1-ring of `v`: the far end of each incident edge, in the ordered edge order
+    /// (counter-clockwise for a manifold vertex).
+    pub fn vertex_ring(&self, v: usize) -> impl ExactSizeIterator<Item = u32> + '_ {
+        let vv = v as u32;
+        self.vertex_edges(v)
+            .iter()
+            .map(move |&e| self.edge_other_vertex(e as usize, vv))
+    }
+
+    /// The vertex diagonally opposite corner `corner` of face `f` when `f` is a quad; `None`
+    /// for other face sizes. This is where Catmull-Clark limit masks put their face weights.
+    #[inline]
+    pub fn quad_opposite_vertex(&self, f: usize, corner: usize) -> Option<u32> {
+        let fv = self.face_vertices(f);
+        (fv.len() == 4).then(|| fv[(corner + 2) % 4])
+    }
+
+    /// For each face around `v` (in [`Self::vertex_faces`] order), the vertex diagonally
+    /// opposite `v` if that face is a quad.
+    pub fn vertex_quad_diagonals(
+        &self,
+        v: usize,
+    ) -> impl ExactSizeIterator<Item = Option<u32>> + '_ {
+        self.vertex_faces(v)
+            .iter()
+            .zip(self.vertex_face_local_indices(v))
+            .map(|(&f, &c)| self.quad_opposite_vertex(f as usize, c as usize))
+    }
+
+    /// Looks up the edge joining `a` and `b` (either direction). For a pair with several
+    /// non-manifold instances, the first one created is returned, as OpenSubdiv does.
+    pub fn find_edge(&self, a: u32, b: u32) -> Option<u32> {
+        if a as usize >= self.num_vertices() || b as usize >= self.num_vertices() {
+            return None;
+        }
+        self.vertex_edges(a as usize)
+            .iter()
+            .copied()
+            .filter(|&e| {
+                let [x, y] = self.edge_vertices[e as usize];
+                (x == a && y == b) || (x == b && y == a)
+            })
+            .min()
+    }
+
+    /// `true` when edge `e` has exactly one incident face.
+    #[inline]
+    pub fn is_boundary_edge(&self, e: usize) -> bool {
+        self.edge_flags[e] & EDGE_BOUNDARY != 0
+    }
+
+    /// `true` when edge `e` is non-manifold (see [`Topology`]).
+    #[inline]
+    pub fn is_non_manifold_edge(&self, e: usize) -> bool {
+        self.edge_flags[e] & EDGE_NON_MANIFOLD != 0
+    }
+
+    /// `true` when both ends of edge `e` are the same vertex.
+    #[inline]
+    pub fn is_degenerate_edge(&self, e: usize) -> bool {
+        self.edge_flags[e] & EDGE_DEGENERATE != 0
+    }
+
+    /// `true` when `v` lies on a boundary edge.
+    #[inline]
+    pub fn is_boundary_vertex(&self, v: usize) -> bool {
+        self.vertex_flags[v] & VERTEX_BOUNDARY != 0
+    }
+
+    /// `true` when the faces around `v` do not form one fan, or `v` touches a non-manifold
+    /// edge. Isolated vertices are reported by [`Self::is_isolated_vertex`] instead.
+    #[inline]
+    pub fn is_non_manifold_vertex(&self, v: usize) -> bool {
+        self.vertex_flags[v] & VERTEX_NON_MANIFOLD != 0
+    }
+
+    /// `true` when no face uses `v`.
+    #[inline]
+    pub fn is_isolated_vertex(&self, v: usize) -> bool {
+        self.vertex_flags[v] & VERTEX_ISOLATED != 0
+    }
+
+    /// `true` when `v` is a manifold vertex whose number of faces differs from the scheme's
+    /// regular count: `regular_valence` in the interior (4 for Catmull-Clark and Bilinear, 6
+    /// for Loop) and half of it on a boundary. Non-manifold and isolated vertices are not
+    /// called extraordinary, as in OpenSubdiv; OpenSubdiv additionally calls an infinitely
+    /// sharp corner with one face regular, which depends on tags and boundary options and is
+    /// left to the scheme.
+    pub fn is_extraordinary(&self, v: usize, regular_valence: usize) -> bool {
+        if self.vertex_flags[v] & (VERTEX_NON_MANIFOLD | VERTEX_ISOLATED) != 0 {
+            return false;
+        }
+        let nf = self.vertex_faces(v).len();
+        if self.is_boundary_vertex(v) {
+            nf != regular_valence / 2
+        } else {
+            nf != regular_valence
+        }
+    }
+
+    /// Tags: crease and corner sharpness, holes.
+    #[inline]
+    pub fn tags(&self) -> &Tags {
+        &self.tags
+    }
+
+    /// Crease sharpness of edge `e`.
+    #[inline]
+    pub fn edge_sharpness(&self, e: usize) -> f32 {
+        self.tags.edge_sharpness[e]
+    }
+
+    /// Corner sharpness of vertex `v`.
+    #[inline]
+    pub fn vertex_sharpness(&self, v: usize) -> f32 {
+        self.tags.vertex_sharpness[v]
+    }
+
+    /// `true` when face `f` is a hole.
+    #[inline]
+    pub fn is_hole(&self, f: usize) -> bool {
+        self.tags.face_hole[f]
+    }
+
+    /// Sets the crease sharpness of edge `e` (stored as `f32`; negative values clamp to 0).
+    pub fn set_edge_sharpness(&mut self, e: usize, sharpness: f32) {
+        self.tags.edge_sharpness[e] = sharpness.max(tags::SHARPNESS_SMOOTH);
+    }
+
+    /// Sets the corner sharpness of vertex `v` (negative values clamp to 0).
+    pub fn set_vertex_sharpness(&mut self, v: usize, sharpness: f32) {
+        self.tags.vertex_sharpness[v] = sharpness.max(tags::SHARPNESS_SMOOTH);
+    }
+
+    /// Marks face `f` as a hole or not.
+    pub fn set_hole(&mut self, f: usize, hole: bool) {
+        self.tags.face_hole[f] = hole;
+    }
+
+    /// Face-vertex lists as (sizes, indices), the form the builder takes: handy to rebuild
+    /// or to hand to another library.
+    pub fn face_sizes(&self) -> impl ExactSizeIterator<Item = u32> + '_ {
+        self.face_offsets.windows(2).map(|w| w[1] - w[0])
+    }
+}
+
+/// Checked tag assignment, as a file reader needs it: indices are validated and sharpness
+/// must be finite and non-negative.
+impl Topology {
+    /// Sets the crease sharpness of the edge joining `a` and `b`. Returns the edge, or
+    /// `Ok(None)` when both vertices exist but no edge joins them (OpenSubdiv warns and skips
+    /// such a tag).
+    pub fn set_crease(
+        &mut self,
+        a: u64,
+        b: u64,
+        sharpness: f64,
+    ) -> Result<Option<u32>, TopologyError> {
+        let nv = self.num_vertices();
+        for x in [a, b] {
+            if x >= nv as u64 {
+                return Err(TopologyError::TagIndexOutOfRange {
+                    tag: "crease",
+                    what: "vertex",
+                    index: x,
+                    count: nv,
+                });
+            }
+        }
+        check_sharpness("crease", sharpness)?;
+        let e = self.find_edge(a as u32, b as u32);
+        if let Some(e) = e {
+            self.tags.edge_sharpness[e as usize] = tags::sharpness_from_f64(sharpness);
+        }
+        Ok(e)
+    }
+
+    /// Sets the corner sharpness of vertex `v`.
+    pub fn set_corner(&mut self, v: u64, sharpness: f64) -> Result<(), TopologyError> {
+        let nv = self.num_vertices();
+        if v >= nv as u64 {
+            return Err(TopologyError::TagIndexOutOfRange {
+                tag: "corner",
+                what: "vertex",
+                index: v,
+                count: nv,
+            });
+        }
+        check_sharpness("corner", sharpness)?;
+        self.tags.vertex_sharpness[v as usize] = tags::sharpness_from_f64(sharpness);
+        Ok(())
+    }
+
+    /// Marks face `f` as a hole.
+    pub fn set_hole_checked(&mut self, f: u64) -> Result<(), TopologyError> {
+        let nf = self.num_faces();
+        if f >= nf as u64 {
+            return Err(TopologyError::TagIndexOutOfRange {
+                tag: "hole",
+                what: "face",
+                index: f,
+                count: nf,
+            });
+        }
+        self.tags.face_hole[f as usize] = true;
+        Ok(())
+    }
+}
+
+fn check_sharpness(tag: &'static str, s: f64) -> Result<(), TopologyError> {
+    if s.is_nan() || s < 0.0 || s.is_infinite() {
+        return Err(TopologyError::InvalidSharpness { tag, value: s });
+    }
+    Ok(())
+}

@@ -1,0 +1,119 @@
+//! Project automation: `cargo xtask test` runs the whole test suite (installing the system
+//! packages it needs when run as root), `cargo xtask fuzz` runs the fuzz targets.
+
+use std::process::{Command, ExitCode};
+
+use clap::{Parser, Subcommand};
+
+#[derive(Parser)]
+#[command(name = "xtask", about = "subd project automation")]
+struct Cli {
+    #[command(subcommand)]
+    command: Task,
+}
+
+#[derive(Subcommand)]
+enum Task {
+    /// Build once in release mode and run every test of the workspace (unit, integration,
+    /// doc tests), after installing missing system packages when run as root.
+    Test {
+        /// Extra arguments passed to `cargo test` (after `--`).
+        #[arg(last = true)]
+        extra: Vec<String>,
+    },
+    /// Run each cargo-fuzz target for a while (needs `cargo install cargo-fuzz` and a nightly
+    /// toolchain).
+    Fuzz {
+        /// Seconds per target.
+        #[arg(long, default_value_t = 600)]
+        seconds: u64,
+        /// Only this target.
+        #[arg(long)]
+        target: Option<String>,
+    },
+}
+
+/// System packages the tests need: (command or file that proves it is there, Debian package).
+/// Empty today; the OpenSubdiv conformance harness adds `libosd-dev`.
+const SYSTEM_PACKAGES: &[(&str, &str)] = &[];
+
+fn is_root() -> bool {
+    Command::new("id")
+        .arg("-u")
+        .output()
+        .map(|o| String::from_utf8_lossy(&o.stdout).trim() == "0")
+        .unwrap_or(false)
+}
+
+fn ensure_system_packages() -> Result<(), String> {
+    let missing: Vec<&str> = SYSTEM_PACKAGES
+        .iter()
+        .filter(|(probe, _)| !std::path::Path::new(probe).exists())
+        .map(|(_, pkg)| *pkg)
+        .collect();
+    if missing.is_empty() {
+        return Ok(());
+    }
+    if !is_root() {
+        return Err(format!(
+            "missing system packages: {}; install them with: sudo apt-get install -y {}",
+            missing.join(" "),
+            missing.join(" ")
+        ));
+    }
+    run(Command::new("apt-get").arg("update"))?;
+    run(Command::new("apt-get")
+        .args(["install", "-y"])
+        .args(&missing))
+}
+
+fn run(cmd: &mut Command) -> Result<(), String> {
+    eprintln!("xtask: running {cmd:?}");
+    let status = cmd
+        .status()
+        .map_err(|e| format!("cannot run {cmd:?}: {e}"))?;
+    if status.success() {
+        Ok(())
+    } else {
+        Err(format!("{cmd:?} failed with {status}"))
+    }
+}
+
+fn cargo() -> Command {
+    Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Task::Test { extra } => ensure_system_packages().and_then(|_| {
+            run(cargo()
+                .args(["test", "--workspace", "--release"])
+                .arg("--")
+                .args(&extra))
+        }),
+        Task::Fuzz { seconds, target } => {
+            let targets = match target {
+                Some(t) => vec![t],
+                None => vec!["obj_topology".to_string(), "ply".to_string()],
+            };
+            targets.iter().try_for_each(|t| {
+                run(cargo().args([
+                    "+nightly",
+                    "fuzz",
+                    "run",
+                    t,
+                    "--",
+                    &format!("-max_total_time={seconds}"),
+                ]))
+            })
+        }
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("xtask: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
