@@ -60,14 +60,37 @@ fn topology_matches_opensubdiv_counts() {
                 (a.min(b), a.max(b), w[2].parse().unwrap())
             })
             .collect();
-        let distinct: std::collections::BTreeSet<_> =
-            crease_lines.iter().filter(|c| c.2 > 0.0).map(|c| (c.0, c.1)).collect();
-        assert_eq!(crease_lines.len(), row.semi_sharp + row.inf_sharp, "{}", row.shape);
-        assert_eq!(s.semi_sharp_creases + s.infinite_creases, distinct.len(), "creases of {}", row.shape);
+        let distinct: std::collections::BTreeSet<_> = crease_lines
+            .iter()
+            .filter(|c| c.2 > 0.0)
+            .map(|c| (c.0, c.1))
+            .collect();
+        assert_eq!(
+            crease_lines.len(),
+            row.semi_sharp + row.inf_sharp,
+            "{}",
+            row.shape
+        );
+        assert_eq!(
+            s.semi_sharp_creases + s.infinite_creases,
+            distinct.len(),
+            "creases of {}",
+            row.shape
+        );
         if distinct.len() == crease_lines.len() {
-            assert_eq!((s.semi_sharp_creases, s.infinite_creases), (row.semi_sharp, row.inf_sharp), "{}", row.shape);
+            assert_eq!(
+                (s.semi_sharp_creases, s.infinite_creases),
+                (row.semi_sharp, row.inf_sharp),
+                "{}",
+                row.shape
+            );
         }
-        assert_eq!((s.corners, s.holes), (row.corners, row.holes), "tags of {}", row.shape);
+        assert_eq!(
+            (s.corners, s.holes),
+            (row.corners, row.holes),
+            "tags of {}",
+            row.shape
+        );
         let rule = match file.mesh.hints.boundary_interpolation {
             None | Some(subd_mesh::BoundaryInterpolation::EdgeOnly) => "edge-only",
             Some(subd_mesh::BoundaryInterpolation::EdgeAndCorner) => "edge-and-corner",
@@ -107,7 +130,6 @@ fn obj_reader_agrees_with_tobj() {
             single_index: false,
             ignore_points: true,
             ignore_lines: true,
-            ..Default::default()
         };
         let (models, _) =
             tobj::load_obj(&path, &opts).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
@@ -145,7 +167,10 @@ fn obj_reader_agrees_with_tobj() {
     }
 }
 
-fn tag_map(m: &Mesh) -> (BTreeMap<[u32; 2], u32>, Vec<(usize, u32)>, Vec<usize>) {
+/// Creases (edge → sharpness bits), corners (vertex, sharpness bits), holes.
+type TagSnapshot = (BTreeMap<[u32; 2], u32>, Vec<(usize, u32)>, Vec<usize>);
+
+fn tag_map(m: &Mesh) -> TagSnapshot {
     let t = &m.topology;
     let creases = (0..t.num_edges())
         .filter(|&e| t.edge_sharpness(e) > 0.0)

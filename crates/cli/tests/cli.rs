@@ -180,7 +180,19 @@ fn malformed_files_of_other_kinds_exit_2() {
     );
     assert_bad_input(
         &s.file("short.ply", b"ply\nformat binary_little_endian 1.0\nelement vertex 1000000000\nproperty float x\nproperty float y\nproperty float z\nend_header\n\x00\x00"),
-        "binary data ends inside vertex 0",
+        "element vertex declares 1000000000 instances but only 2 bytes of data remain",
+    );
+    assert_bad_input(
+        &s.file("short2.ply", b"ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n\x00\x00"),
+        "binary data ends inside vertex 0 property x",
+    );
+    // Found by fuzzing: a huge element with no properties must fail fast, not loop.
+    assert_bad_input(
+        &s.file(
+            "empty_element.ply",
+            b"ply\nformat binary_big_endian 1.0\nelement crease 01569664312\nend_header\n",
+        ),
+        "element crease declares 1569664312 instances but has no properties",
     );
     assert_bad_input(
         &s.file("ascii_face.ply", b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n2 0 1\n"),

@@ -389,9 +389,25 @@ pub fn parse_ply(bytes: &[u8], options: &ReadOptions) -> Result<MeshFile, ReadEr
             "hole" => find("face").map(|a| ("hole", [a, 0, 0])),
             _ => None,
         };
-        // Each instance needs at least one byte, so a count beyond the remaining bytes is
-        // malformed; capping the reservation keeps absurd headers from allocating.
-        let reserve = el.count.min(body.remaining_bytes());
+        // An instance with at least one property takes at least one byte, so a count beyond
+        // the remaining bytes is malformed. Checking it up front keeps a forged header from
+        // driving allocation or a long loop (found by fuzzing: `element crease 01569664312`
+        // with no properties spun for billions of empty iterations).
+        if el.count > 0 && el.props.is_empty() {
+            return Err(ReadError::general(format!(
+                "element {} declares {} instances but has no properties",
+                el.name, el.count
+            )));
+        }
+        if el.count > body.remaining_bytes() {
+            return Err(ReadError::general(format!(
+                "element {} declares {} instances but only {} bytes of data remain",
+                el.name,
+                el.count,
+                body.remaining_bytes()
+            )));
+        }
+        let reserve = el.count;
         match role {
             Some(("vertex", _)) => positions.reserve(reserve),
             Some(("face", _)) => face_sizes.reserve(reserve),

@@ -40,3 +40,7 @@ pub use geometry::{Mesh, bounding_box, validate_positions};
 pub use glam::DVec3;
 pub use tags::{BoundaryInterpolation, CreaseMethod, SchemeHints, Tags, TriangleSubdivision};
 pub use topology::Topology;
+
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;
