@@ -323,3 +323,38 @@ fn tempfile_dir() -> std::path::PathBuf {
     std::fs::create_dir_all(&d).unwrap();
     d
 }
+
+/// Re-assembling a topology from its own numbered edges gives the same topology: the two
+/// construction paths (search-free for refinement, first-appearance for files) agree.
+#[test]
+fn numbered_edge_assembly_matches_builder() {
+    for path in osd_meshes() {
+        let t = read_mesh(&path, &accept()).unwrap().mesh.topology;
+        let nm: Vec<u32> = (0..t.num_edges() as u32)
+            .filter(|&e| t.is_non_manifold_edge(e as usize))
+            .collect();
+        let faces = (0..t.num_faces())
+            .flat_map(|f| t.face_edges(f).to_vec())
+            .collect();
+        let edges = (0..t.num_edges()).map(|e| t.edge_vertices(e)).collect();
+        let mut again = subd_mesh::Topology::from_numbered_edges(
+            t.num_vertices(),
+            t.face_offsets().to_vec(),
+            t.all_face_vertices().to_vec(),
+            faces,
+            edges,
+            &nm,
+        )
+        .unwrap();
+        for e in 0..t.num_edges() {
+            again.set_edge_sharpness(e, t.edge_sharpness(e));
+        }
+        for v in 0..t.num_vertices() {
+            again.set_vertex_sharpness(v, t.vertex_sharpness(v));
+        }
+        for f in 0..t.num_faces() {
+            again.set_hole(f, t.is_hole(f));
+        }
+        assert!(again == t, "{}", path.display());
+    }
+}

@@ -238,120 +238,263 @@ impl TopologyBuilder {
         }
         drop(first_half);
         drop(edge_last_face);
-        let ne = edge_vertices.len();
-
-        // Edge -> faces, in face order, with the edge's position in each face.
-        let mut edge_face_offsets = Vec::with_capacity(ne + 1);
-        edge_face_offsets.push(0u32);
-        let mut acc = 0u32;
-        for &c in &edge_face_count {
-            acc += c;
-            edge_face_offsets.push(acc);
-        }
-        let mut edge_faces = vec![0u32; nh];
-        let mut edge_face_local = vec![0u32; nh];
-        {
-            let mut fill = edge_face_offsets.clone();
-            for h in 0..nh {
-                let f = half_face[h];
-                let e = face_edges[h] as usize;
-                let slot = fill[e] as usize;
-                edge_faces[slot] = f;
-                edge_face_local[slot] = (h - face_offsets[f as usize] as usize) as u32;
-                fill[e] += 1;
-            }
-        }
-        for (e, &c) in edge_face_count.iter().enumerate() {
-            if c == 1 {
-                edge_flags[e] |= EDGE_BOUNDARY;
-            }
-        }
         drop(edge_face_count);
-
-        // Vertex -> faces (face order for now, with the corner index).
-        let mut vertex_face_offsets = vec![0u32; nv + 1];
-        for &v in face_vertices {
-            vertex_face_offsets[v as usize + 1] += 1;
-        }
-        for i in 0..nv {
-            vertex_face_offsets[i + 1] += vertex_face_offsets[i];
-        }
-        let mut vertex_faces = vec![0u32; nh];
-        let mut vertex_face_local = vec![0u32; nh];
-        {
-            let mut fill = vertex_face_offsets.clone();
-            for h in 0..nh {
-                let v = face_vertices[h] as usize;
-                let f = half_face[h];
-                let slot = fill[v] as usize;
-                vertex_faces[slot] = f;
-                vertex_face_local[slot] = (h - face_offsets[f as usize] as usize) as u32;
-                fill[v] += 1;
-            }
-        }
         drop(half_face);
-
-        // Vertex -> edges in creation order (a degenerate edge appears twice at its vertex).
-        let mut vertex_edge_offsets = vec![0u32; nv + 1];
-        for &[a, b] in &edge_vertices {
-            vertex_edge_offsets[a as usize + 1] += 1;
-            vertex_edge_offsets[b as usize + 1] += 1;
-        }
-        for i in 0..nv {
-            vertex_edge_offsets[i + 1] += vertex_edge_offsets[i];
-        }
-        let mut vertex_edges = vec![0u32; vertex_edge_offsets[nv] as usize];
-        {
-            let mut fill = vertex_edge_offsets.clone();
-            for (e, &[a, b]) in edge_vertices.iter().enumerate() {
-                for v in [a, b] {
-                    vertex_edges[fill[v as usize] as usize] = e as u32;
-                    fill[v as usize] += 1;
-                }
-            }
-        }
-
-        // Vertex flags.
-        let mut vertex_flags = vec![0u8; nv];
-        for (e, &[a, b]) in edge_vertices.iter().enumerate() {
-            let fl = edge_flags[e];
-            let mut vf = 0;
-            if fl & EDGE_BOUNDARY != 0 {
-                vf |= VERTEX_BOUNDARY;
-            }
-            if fl & EDGE_NON_MANIFOLD != 0 {
-                vf |= VERTEX_NON_MANIFOLD;
-            }
-            vertex_flags[a as usize] |= vf;
-            vertex_flags[b as usize] |= vf;
-        }
-        for v in 0..nv {
-            if vertex_face_offsets[v] == vertex_face_offsets[v + 1] {
-                vertex_flags[v] |= VERTEX_ISOLATED;
-            }
-        }
-
-        let mut topo = Topology {
-            num_vertices: nv as u32,
+        let topo = assemble(
+            nv,
             face_offsets,
-            face_vertices: face_vertices.to_vec(),
+            face_vertices.to_vec(),
             face_edges,
             edge_vertices,
-            edge_face_offsets,
-            edge_faces,
-            edge_face_local,
-            vertex_face_offsets,
-            vertex_faces,
-            vertex_face_local,
-            vertex_edge_offsets,
-            vertex_edges,
             edge_flags,
-            vertex_flags,
-            tags: Tags::new(nv, ne, nf),
-        };
-        topo.order_vertex_fans();
+        );
         Ok((topo, warnings))
     }
+}
+
+impl Topology {
+    /// Assembles a topology whose edges are already numbered: `face_edges[i]` is the edge
+    /// from face-vertex `i` to the next vertex of the same face, and `edge_vertices` gives each
+    /// edge's two vertices. This is how a refinement builds a child level with OpenSubdiv's
+    /// edge order without a search. The remaining relations, vertex rings and flags are
+    /// computed as by [`TopologyBuilder`]; an edge is flagged non-manifold when it has more
+    /// than two faces, when two faces use it in the same direction, when it is degenerate,
+    /// or when it is listed in `non_manifold_edges` (flags a refinement inherits).
+    ///
+    /// ```
+    /// use subd_mesh::Topology;
+    /// // One quad, edges numbered by hand.
+    /// let t = Topology::from_numbered_edges(
+    ///     4, vec![0, 4], vec![0, 1, 2, 3], vec![0, 1, 2, 3],
+    ///     vec![[0, 1], [1, 2], [2, 3], [3, 0]], &[],
+    /// ).unwrap();
+    /// assert_eq!(t.edge_faces(2), &[0]);
+    /// assert!(t.is_boundary_vertex(3));
+    /// ```
+    pub fn from_numbered_edges(
+        num_vertices: usize,
+        face_offsets: Vec<u32>,
+        face_vertices: Vec<u32>,
+        face_edges: Vec<u32>,
+        edge_vertices: Vec<[u32; 2]>,
+        non_manifold_edges: &[u32],
+    ) -> Result<Topology, TopologyError> {
+        if num_vertices >= NONE as usize || face_vertices.len() >= NONE as usize {
+            return Err(TopologyError::TooLarge {
+                what: "vertex",
+                count: num_vertices.max(face_vertices.len()),
+            });
+        }
+        let bad = |face, detail| Err(TopologyError::InconsistentEdges { face, detail });
+        if face_offsets.first() != Some(&0)
+            || *face_offsets.last().unwrap_or(&0) as usize != face_vertices.len()
+            || face_edges.len() != face_vertices.len()
+        {
+            return bad(
+                0,
+                "face offsets, face-vertices and face-edges do not agree in length",
+            );
+        }
+        let ne = edge_vertices.len();
+        let mut uses = vec![[0u8; 2]; ne];
+        for f in 0..face_offsets.len() - 1 {
+            let (a, b) = (face_offsets[f] as usize, face_offsets[f + 1] as usize);
+            if b < a + 3 {
+                return Err(TopologyError::FaceTooSmall {
+                    face: f,
+                    size: b.saturating_sub(a),
+                });
+            }
+            for h in a..b {
+                let (v0, v1) = (
+                    face_vertices[h],
+                    face_vertices[if h + 1 == b { a } else { h + 1 }],
+                );
+                if v0 as usize >= num_vertices {
+                    return Err(TopologyError::VertexIndexOutOfRange {
+                        face: f,
+                        corner: h - a,
+                        index: v0 as u64,
+                        num_vertices,
+                    });
+                }
+                let e = face_edges[h] as usize;
+                if e >= ne {
+                    return bad(f, "face edge index out of range");
+                }
+                let ev = edge_vertices[e];
+                let dir = if ev == [v0, v1] {
+                    0
+                } else if ev == [v1, v0] {
+                    1
+                } else {
+                    return bad(f, "face edge does not join the face's consecutive vertices");
+                };
+                uses[e][dir] = uses[e][dir].saturating_add(1);
+            }
+        }
+        let mut edge_flags = vec![0u8; ne];
+        for (e, &[a, b]) in edge_vertices.iter().enumerate() {
+            if a == b {
+                edge_flags[e] |= EDGE_NON_MANIFOLD | EDGE_DEGENERATE;
+            } else if uses[e][0] > 1 || uses[e][1] > 1 {
+                edge_flags[e] |= EDGE_NON_MANIFOLD;
+            }
+        }
+        for &e in non_manifold_edges {
+            if let Some(fl) = edge_flags.get_mut(e as usize) {
+                *fl |= EDGE_NON_MANIFOLD;
+            }
+        }
+        Ok(assemble(
+            num_vertices,
+            face_offsets,
+            face_vertices,
+            face_edges,
+            edge_vertices,
+            edge_flags,
+        ))
+    }
+}
+
+/// Completes a topology from face-vertices, face-edges and numbered edges: edge-faces,
+/// vertex-faces, vertex-edges (ordered), boundary/non-manifold/isolated flags. `edge_flags`
+/// carries non-manifold and degenerate flags already known; boundary flags and edges with
+/// more than two faces are added here.
+pub(crate) fn assemble(
+    nv: usize,
+    face_offsets: Vec<u32>,
+    face_vertices: Vec<u32>,
+    face_edges: Vec<u32>,
+    edge_vertices: Vec<[u32; 2]>,
+    mut edge_flags: Vec<u8>,
+) -> Topology {
+    let nf = face_offsets.len() - 1;
+    let nh = face_vertices.len();
+    let ne = edge_vertices.len();
+    let mut half_face = vec![0u32; nh];
+    for f in 0..nf {
+        half_face[face_offsets[f] as usize..face_offsets[f + 1] as usize].fill(f as u32);
+    }
+    let mut edge_face_count = vec![0u32; ne];
+    for &e in &face_edges {
+        edge_face_count[e as usize] += 1;
+    }
+    for (e, &c) in edge_face_count.iter().enumerate() {
+        if c > 2 {
+            edge_flags[e] |= EDGE_NON_MANIFOLD;
+        }
+    }
+
+    // Edge -> faces, in face order, with the edge's position in each face.
+    let mut edge_face_offsets = Vec::with_capacity(ne + 1);
+    edge_face_offsets.push(0u32);
+    let mut acc = 0u32;
+    for &c in &edge_face_count {
+        acc += c;
+        edge_face_offsets.push(acc);
+    }
+    let mut edge_faces = vec![0u32; nh];
+    let mut edge_face_local = vec![0u32; nh];
+    {
+        let mut fill = edge_face_offsets.clone();
+        for h in 0..nh {
+            let f = half_face[h];
+            let e = face_edges[h] as usize;
+            let slot = fill[e] as usize;
+            edge_faces[slot] = f;
+            edge_face_local[slot] = (h - face_offsets[f as usize] as usize) as u32;
+            fill[e] += 1;
+        }
+    }
+    for (e, &c) in edge_face_count.iter().enumerate() {
+        if c == 1 {
+            edge_flags[e] |= EDGE_BOUNDARY;
+        }
+    }
+
+    // Vertex -> faces (face order for now, with the corner index).
+    let mut vertex_face_offsets = vec![0u32; nv + 1];
+    for &v in &face_vertices {
+        vertex_face_offsets[v as usize + 1] += 1;
+    }
+    for i in 0..nv {
+        vertex_face_offsets[i + 1] += vertex_face_offsets[i];
+    }
+    let mut vertex_faces = vec![0u32; nh];
+    let mut vertex_face_local = vec![0u32; nh];
+    {
+        let mut fill = vertex_face_offsets.clone();
+        for h in 0..nh {
+            let v = face_vertices[h] as usize;
+            let f = half_face[h];
+            let slot = fill[v] as usize;
+            vertex_faces[slot] = f;
+            vertex_face_local[slot] = (h - face_offsets[f as usize] as usize) as u32;
+            fill[v] += 1;
+        }
+    }
+
+    // Vertex -> edges in creation order (a degenerate edge appears twice at its vertex).
+    let mut vertex_edge_offsets = vec![0u32; nv + 1];
+    for &[a, b] in &edge_vertices {
+        vertex_edge_offsets[a as usize + 1] += 1;
+        vertex_edge_offsets[b as usize + 1] += 1;
+    }
+    for i in 0..nv {
+        vertex_edge_offsets[i + 1] += vertex_edge_offsets[i];
+    }
+    let mut vertex_edges = vec![0u32; vertex_edge_offsets[nv] as usize];
+    {
+        let mut fill = vertex_edge_offsets.clone();
+        for (e, &[a, b]) in edge_vertices.iter().enumerate() {
+            for v in [a, b] {
+                vertex_edges[fill[v as usize] as usize] = e as u32;
+                fill[v as usize] += 1;
+            }
+        }
+    }
+
+    // Vertex flags.
+    let mut vertex_flags = vec![0u8; nv];
+    for (e, &[a, b]) in edge_vertices.iter().enumerate() {
+        let fl = edge_flags[e];
+        let mut vf = 0;
+        if fl & EDGE_BOUNDARY != 0 {
+            vf |= VERTEX_BOUNDARY;
+        }
+        if fl & EDGE_NON_MANIFOLD != 0 {
+            vf |= VERTEX_NON_MANIFOLD;
+        }
+        vertex_flags[a as usize] |= vf;
+        vertex_flags[b as usize] |= vf;
+    }
+    for v in 0..nv {
+        if vertex_face_offsets[v] == vertex_face_offsets[v + 1] {
+            vertex_flags[v] |= VERTEX_ISOLATED;
+        }
+    }
+
+    let mut topo = Topology {
+        num_vertices: nv as u32,
+        face_offsets,
+        face_vertices,
+        face_edges,
+        edge_vertices,
+        edge_face_offsets,
+        edge_faces,
+        edge_face_local,
+        vertex_face_offsets,
+        vertex_faces,
+        vertex_face_local,
+        vertex_edge_offsets,
+        vertex_edges,
+        edge_flags,
+        vertex_flags,
+        tags: Tags::new(nv, ne, nf),
+    };
+    topo.order_vertex_fans();
+    topo
 }
 
 impl Topology {

@@ -93,6 +93,15 @@ pub enum TopologyError {
         /// Number of elements of that kind.
         count: usize,
     },
+    /// Pre-numbered edges given to [`crate::Topology::from_numbered_edges`] do not match the
+    /// faces.
+    #[error("face {face}: {detail}")]
+    InconsistentEdges {
+        /// Face index.
+        face: usize,
+        /// What does not match.
+        detail: &'static str,
+    },
     /// A sharpness value is negative or not a number.
     #[error("{tag} tag has invalid sharpness {value}; sharpness must be a finite number >= 0")]
     InvalidSharpness {

@@ -14,10 +14,12 @@ pub const SHARPNESS_INFINITE: f32 = 10.0;
 /// Sharpness of a smooth edge or vertex.
 pub const SHARPNESS_SMOOTH: f32 = 0.0;
 
-/// Rounds a user-given sharpness to the `f32` OpenSubdiv stores.
+/// Rounds a user-given sharpness to the `f32` OpenSubdiv stores. Values beyond the `f32`
+/// range saturate at `f32::MAX` (still infinitely sharp) rather than becoming `inf`, so that
+/// every stored sharpness can be written out and read back as a finite number.
 #[inline]
 pub fn sharpness_from_f64(s: f64) -> f32 {
-    s as f32
+    s.clamp(-(f32::MAX as f64), f32::MAX as f64) as f32
 }
 
 /// `true` when `s` is infinitely sharp.

@@ -290,14 +290,16 @@ impl Topology {
         self.tags.face_hole[f]
     }
 
-    /// Sets the crease sharpness of edge `e` (stored as `f32`; negative values clamp to 0).
+    /// Sets the crease sharpness of edge `e` (negative and NaN values become 0, infinity
+    /// saturates at `f32::MAX`).
     pub fn set_edge_sharpness(&mut self, e: usize, sharpness: f32) {
-        self.tags.edge_sharpness[e] = sharpness.max(tags::SHARPNESS_SMOOTH);
+        self.tags.edge_sharpness[e] = sharpness.max(tags::SHARPNESS_SMOOTH).min(f32::MAX);
     }
 
-    /// Sets the corner sharpness of vertex `v` (negative values clamp to 0).
+    /// Sets the corner sharpness of vertex `v` (negative and NaN values become 0, infinity
+    /// saturates at `f32::MAX`).
     pub fn set_vertex_sharpness(&mut self, v: usize, sharpness: f32) {
-        self.tags.vertex_sharpness[v] = sharpness.max(tags::SHARPNESS_SMOOTH);
+        self.tags.vertex_sharpness[v] = sharpness.max(tags::SHARPNESS_SMOOTH).min(f32::MAX);
     }
 
     /// Marks face `f` as a hole or not.

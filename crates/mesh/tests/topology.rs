@@ -198,6 +198,10 @@ fn tags_are_checked() {
     t.set_corner(3, 7.9).unwrap();
     // Sharpness is kept in f32, as OpenSubdiv keeps it.
     assert_eq!(t.vertex_sharpness(3), 7.9f32);
+    // Huge but finite sharpness (found by fuzzing) saturates instead of becoming inf.
+    t.set_corner(4, 3.4e79).unwrap();
+    assert_eq!(t.vertex_sharpness(4), f32::MAX);
+    t.set_corner(4, 0.0).unwrap();
     t.set_hole_checked(3).unwrap();
     assert_eq!(
         (

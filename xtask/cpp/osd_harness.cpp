@@ -1,0 +1,201 @@
+// OpenSubdiv side of subd's conformance and benchmark harness.
+//
+// Reads one mesh in a small binary format from stdin (written by `cargo xtask`), refines it
+// uniformly with OpenSubdiv's Far API in double precision, and writes every refined level to
+// stdout. With --bench it instead times topology refinement + primvar interpolation and
+// prints one line of JSON. Linked against the system OpenSubdiv (Debian libosd-dev).
+//
+// Input (little-endian): "SUBDOSD1", u32 scheme (0 bilinear, 1 catmark, 2 loop),
+// u32 boundary (0 none, 1 edge-only, 2 edge-and-corner), u32 crease method (0 uniform,
+// 1 chaikin), u32 triangle rule (0 catmark, 1 smooth), u32 levels, u32 nv, u32 nf,
+// u32 sizes[nf], u32 nidx, u32 idx[nidx], f64 pos[3 nv], u32 ncrease, {u32 a, u32 b, f32 s},
+// u32 ncorner, {u32 v, f32 s}, u32 nhole, u32 f[nhole].
+// Output per level 1..L: u32 nv, u32 nf, u32 sizes[nf], u32 idx[sum sizes], f64 pos[3 nv].
+
+#include <opensubdiv/far/primvarRefiner.h>
+#include <opensubdiv/far/topologyDescriptor.h>
+#include <opensubdiv/far/topologyRefinerFactory.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+using namespace OpenSubdiv;
+
+namespace {
+
+struct Reader {
+    std::vector<unsigned char> data;
+    size_t pos = 0;
+    template <typename T> T get() {
+        if (pos + sizeof(T) > data.size()) throw std::runtime_error("input truncated");
+        T v;
+        std::memcpy(&v, &data[pos], sizeof(T));
+        pos += sizeof(T);
+        return v;
+    }
+};
+
+struct Point {
+    double p[3];
+    void Clear() { p[0] = p[1] = p[2] = 0.0; }
+    void AddWithWeight(Point const &src, double w) {
+        p[0] += w * src.p[0];
+        p[1] += w * src.p[1];
+        p[2] += w * src.p[2];
+    }
+};
+
+template <typename T> void put(std::vector<unsigned char> &out, T v) {
+    size_t n = out.size();
+    out.resize(n + sizeof(T));
+    std::memcpy(&out[n], &v, sizeof(T));
+}
+
+struct Mesh {
+    Sdc::SchemeType scheme;
+    Sdc::Options options;
+    int levels;
+    int nv;
+    std::vector<int> sizes;
+    std::vector<Far::Index> idx;
+    std::vector<Point> pos;
+    std::vector<Far::Index> creasePairs;
+    std::vector<float> creaseWeights;
+    std::vector<Far::Index> corners;
+    std::vector<float> cornerWeights;
+    std::vector<Far::Index> holes;
+};
+
+Mesh readMesh(Reader &r) {
+    if (r.data.size() < 8 || std::memcmp(r.data.data(), "SUBDOSD1", 8) != 0)
+        throw std::runtime_error("bad magic");
+    r.pos = 8;
+    Mesh m;
+    uint32_t scheme = r.get<uint32_t>();
+    m.scheme = scheme == 0 ? Sdc::SCHEME_BILINEAR : scheme == 1 ? Sdc::SCHEME_CATMARK : Sdc::SCHEME_LOOP;
+    uint32_t boundary = r.get<uint32_t>();
+    m.options.SetVtxBoundaryInterpolation(boundary == 0   ? Sdc::Options::VTX_BOUNDARY_NONE
+                                          : boundary == 1 ? Sdc::Options::VTX_BOUNDARY_EDGE_ONLY
+                                                          : Sdc::Options::VTX_BOUNDARY_EDGE_AND_CORNER);
+    m.options.SetCreasingMethod(r.get<uint32_t>() == 0 ? Sdc::Options::CREASE_UNIFORM
+                                                       : Sdc::Options::CREASE_CHAIKIN);
+    m.options.SetTriangleSubdivision(r.get<uint32_t>() == 0 ? Sdc::Options::TRI_SUB_CATMARK
+                                                            : Sdc::Options::TRI_SUB_SMOOTH);
+    m.levels = (int)r.get<uint32_t>();
+    m.nv = (int)r.get<uint32_t>();
+    uint32_t nf = r.get<uint32_t>();
+    m.sizes.resize(nf);
+    for (auto &s : m.sizes) s = (int)r.get<uint32_t>();
+    uint32_t nidx = r.get<uint32_t>();
+    m.idx.resize(nidx);
+    for (auto &i : m.idx) i = (Far::Index)r.get<uint32_t>();
+    m.pos.resize(m.nv);
+    for (auto &p : m.pos)
+        for (double &c : p.p) c = r.get<double>();
+    uint32_t nc = r.get<uint32_t>();
+    for (uint32_t i = 0; i < nc; ++i) {
+        m.creasePairs.push_back((Far::Index)r.get<uint32_t>());
+        m.creasePairs.push_back((Far::Index)r.get<uint32_t>());
+        m.creaseWeights.push_back(r.get<float>());
+    }
+    uint32_t nk = r.get<uint32_t>();
+    for (uint32_t i = 0; i < nk; ++i) {
+        m.corners.push_back((Far::Index)r.get<uint32_t>());
+        m.cornerWeights.push_back(r.get<float>());
+    }
+    uint32_t nh = r.get<uint32_t>();
+    for (uint32_t i = 0; i < nh; ++i) m.holes.push_back((Far::Index)r.get<uint32_t>());
+    return m;
+}
+
+Far::TopologyRefiner *createRefiner(Mesh const &m) {
+    Far::TopologyDescriptor desc;
+    desc.numVertices = m.nv;
+    desc.numFaces = (int)m.sizes.size();
+    desc.numVertsPerFace = m.sizes.data();
+    desc.vertIndicesPerFace = m.idx.data();
+    desc.numCreases = (int)m.creaseWeights.size();
+    desc.creaseVertexIndexPairs = m.creasePairs.data();
+    desc.creaseWeights = m.creaseWeights.data();
+    desc.numCorners = (int)m.cornerWeights.size();
+    desc.cornerVertexIndices = m.corners.data();
+    desc.cornerWeights = m.cornerWeights.data();
+    desc.numHoles = (int)m.holes.size();
+    desc.holeIndices = m.holes.data();
+    typedef Far::TopologyRefinerFactory<Far::TopologyDescriptor> Factory;
+    Far::TopologyRefiner *refiner =
+        Factory::Create(desc, Factory::Options(m.scheme, m.options));
+    if (!refiner) throw std::runtime_error("OpenSubdiv rejected the topology");
+    return refiner;
+}
+
+// Refines and interpolates; returns the positions of every level (level 0 included).
+std::vector<std::vector<Point>> refineAll(Far::TopologyRefiner &refiner, Mesh const &m) {
+    Far::TopologyRefiner::UniformOptions uo(m.levels);
+    uo.fullTopologyInLastLevel = true;
+    refiner.RefineUniform(uo);
+    std::vector<std::vector<Point>> levels(m.levels + 1);
+    levels[0] = m.pos;
+    Far::PrimvarRefinerReal<double> primvar(refiner);
+    for (int l = 1; l <= m.levels; ++l) {
+        levels[l].resize(refiner.GetLevel(l).GetNumVertices());
+        primvar.Interpolate(l, levels[l - 1], levels[l]);
+    }
+    return levels;
+}
+
+} // namespace
+
+int main(int argc, char **argv) {
+    try {
+        bool bench = argc > 1 && std::string(argv[1]) == "--bench";
+        int repeats = argc > 2 ? std::atoi(argv[2]) : 5;
+        Reader r;
+        unsigned char buf[1 << 16];
+        size_t n;
+        while ((n = std::fread(buf, 1, sizeof buf, stdin)) > 0) r.data.insert(r.data.end(), buf, buf + n);
+        Mesh m = readMesh(r);
+        if (bench) {
+            // Median of `repeats` runs of (topology refinement + primvar interpolation).
+            std::vector<double> times;
+            for (int i = 0; i < repeats; ++i) {
+                auto t0 = std::chrono::steady_clock::now();
+                Far::TopologyRefiner *refiner = createRefiner(m);
+                auto levels = refineAll(*refiner, m);
+                auto t1 = std::chrono::steady_clock::now();
+                times.push_back(std::chrono::duration<double>(t1 - t0).count());
+                delete refiner;
+            }
+            std::sort(times.begin(), times.end());
+            std::printf("{\"median_seconds\": %.9f, \"min_seconds\": %.9f}\n", times[times.size() / 2], times[0]);
+            return 0;
+        }
+        Far::TopologyRefiner *refiner = createRefiner(m);
+        auto levels = refineAll(*refiner, m);
+        std::vector<unsigned char> out;
+        for (int l = 1; l <= m.levels; ++l) {
+            Far::TopologyLevel const &lev = refiner->GetLevel(l);
+            put<uint32_t>(out, (uint32_t)lev.GetNumVertices());
+            put<uint32_t>(out, (uint32_t)lev.GetNumFaces());
+            for (int f = 0; f < lev.GetNumFaces(); ++f) put<uint32_t>(out, (uint32_t)lev.GetFaceVertices(f).size());
+            for (int f = 0; f < lev.GetNumFaces(); ++f) {
+                Far::ConstIndexArray fv = lev.GetFaceVertices(f);
+                for (int k = 0; k < fv.size(); ++k) put<uint32_t>(out, (uint32_t)fv[k]);
+            }
+            for (auto const &p : levels[l])
+                for (double c : p.p) put<double>(out, c);
+        }
+        std::fwrite(out.data(), 1, out.size(), stdout);
+        delete refiner;
+        return 0;
+    } catch (std::exception const &e) {
+        std::fprintf(stderr, "osd_harness: %s\n", e.what());
+        return 2;
+    }
+}
