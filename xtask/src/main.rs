@@ -5,6 +5,9 @@ use std::process::{Command, ExitCode};
 
 use clap::{Parser, Subcommand};
 
+mod conformance;
+mod osd;
+
 #[derive(Parser)]
 #[command(name = "xtask", about = "subd project automation")]
 struct Cli {
@@ -21,6 +24,12 @@ enum Task {
         #[arg(last = true)]
         extra: Vec<String>,
     },
+    /// Compare subd's refinement with OpenSubdiv's on every shape and on random meshes.
+    Conformance {
+        /// Directory of OpenSubdiv shapes.
+        #[arg(long, default_value = "../shared/meshes/osd")]
+        shapes: std::path::PathBuf,
+    },
     /// Run each cargo-fuzz target for a while (needs `cargo install cargo-fuzz` and a nightly
     /// toolchain).
     Fuzz {
@@ -33,9 +42,14 @@ enum Task {
     },
 }
 
-/// System packages the tests need: (command or file that proves it is there, Debian package).
-/// Empty today; the OpenSubdiv conformance harness adds `libosd-dev`.
-const SYSTEM_PACKAGES: &[(&str, &str)] = &[];
+/// System packages the tests need: (file that proves it is there, Debian package).
+const SYSTEM_PACKAGES: &[(&str, &str)] = &[
+    (
+        "/usr/include/opensubdiv/far/topologyRefinerFactory.h",
+        "libosd-dev",
+    ),
+    ("/usr/bin/g++", "g++"),
+];
 
 fn is_root() -> bool {
     Command::new("id")
@@ -91,6 +105,15 @@ fn main() -> ExitCode {
                 .args(["test", "--workspace", "--release"])
                 .arg("--")
                 .args(&extra))
+        }),
+        Task::Conformance { shapes } => ensure_system_packages().and_then(|_| {
+            let exe = osd::build_harness()?;
+            let rows = conformance::shapes(&exe, &shapes)?;
+            if conformance::report(&rows) {
+                Ok(())
+            } else {
+                Err("conformance failed".into())
+            }
         }),
         Task::Fuzz { seconds, target } => {
             let targets = match target {

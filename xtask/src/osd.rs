@@ -1,0 +1,193 @@
+//! Driving the OpenSubdiv harness (`xtask/cpp/osd_harness.cpp`): building it against the
+//! system OpenSubdiv and exchanging meshes with it.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+
+use subd_mesh::{BoundaryInterpolation, CreaseMethod, DVec3, Topology, TriangleSubdivision};
+use subd_schemes::{Options, Scheme};
+
+/// One refined level as OpenSubdiv produced it.
+pub struct OsdLevel {
+    pub face_sizes: Vec<u32>,
+    pub face_vertices: Vec<u32>,
+    pub positions: Vec<DVec3>,
+}
+
+fn workspace_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("workspace root")
+        .to_path_buf()
+}
+
+/// Compiles the harness (when missing or older than its source) and returns its path.
+pub fn build_harness() -> Result<PathBuf, String> {
+    let root = workspace_root();
+    let src = root.join("xtask/cpp/osd_harness.cpp");
+    let out_dir = root.join("target/xtask");
+    std::fs::create_dir_all(&out_dir).map_err(|e| e.to_string())?;
+    let exe = out_dir.join("osd_harness");
+    let stale = match (std::fs::metadata(&exe), std::fs::metadata(&src)) {
+        (Ok(a), Ok(b)) => a.modified().ok() < b.modified().ok(),
+        _ => true,
+    };
+    if stale {
+        let status = Command::new("g++")
+            .args(["-O2", "-std=c++14", "-o"])
+            .arg(&exe)
+            .arg(&src)
+            .arg("-losdCPU")
+            .status()
+            .map_err(|e| format!("cannot run g++: {e}"))?;
+        if !status.success() {
+            return Err(
+                "compiling the OpenSubdiv harness failed (is libosd-dev installed?)".into(),
+            );
+        }
+    }
+    Ok(exe)
+}
+
+fn scheme_code(s: Scheme) -> u32 {
+    match s {
+        Scheme::Bilinear => 0,
+        Scheme::CatmullClark => 1,
+        Scheme::Loop => 2,
+    }
+}
+
+/// Serialises a mesh for the harness.
+pub fn encode(
+    topo: &Topology,
+    positions: &[DVec3],
+    scheme: Scheme,
+    options: &Options,
+    levels: u32,
+) -> Vec<u8> {
+    let mut b = Vec::new();
+    let u = |b: &mut Vec<u8>, x: u32| b.extend_from_slice(&x.to_le_bytes());
+    b.extend_from_slice(b"SUBDOSD1");
+    u(&mut b, scheme_code(scheme));
+    u(
+        &mut b,
+        match options.boundary_interpolation {
+            BoundaryInterpolation::None => 0,
+            BoundaryInterpolation::EdgeOnly => 1,
+            BoundaryInterpolation::EdgeAndCorner => 2,
+        },
+    );
+    u(
+        &mut b,
+        (options.crease_method == CreaseMethod::Chaikin) as u32,
+    );
+    u(
+        &mut b,
+        (options.triangle_subdivision == TriangleSubdivision::Smooth) as u32,
+    );
+    u(&mut b, levels);
+    u(&mut b, topo.num_vertices() as u32);
+    u(&mut b, topo.num_faces() as u32);
+    for s in topo.face_sizes() {
+        u(&mut b, s);
+    }
+    u(&mut b, topo.num_face_vertices() as u32);
+    for &v in topo.all_face_vertices() {
+        u(&mut b, v);
+    }
+    for p in positions {
+        for c in p.to_array() {
+            b.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    let creases: Vec<usize> = (0..topo.num_edges())
+        .filter(|&e| topo.edge_sharpness(e) > 0.0)
+        .collect();
+    u(&mut b, creases.len() as u32);
+    for e in creases {
+        let [x, y] = topo.edge_vertices(e);
+        u(&mut b, x);
+        u(&mut b, y);
+        b.extend_from_slice(&topo.edge_sharpness(e).to_le_bytes());
+    }
+    let corners: Vec<usize> = (0..topo.num_vertices())
+        .filter(|&v| topo.vertex_sharpness(v) > 0.0)
+        .collect();
+    u(&mut b, corners.len() as u32);
+    for v in corners {
+        u(&mut b, v as u32);
+        b.extend_from_slice(&topo.vertex_sharpness(v).to_le_bytes());
+    }
+    let holes: Vec<usize> = (0..topo.num_faces()).filter(|&f| topo.is_hole(f)).collect();
+    u(&mut b, holes.len() as u32);
+    for f in holes {
+        u(&mut b, f as u32);
+    }
+    b
+}
+
+/// Runs the harness on an encoded mesh; with `bench`, returns its JSON line in `Err`-free
+/// form as the second value.
+pub fn run(exe: &Path, input: &[u8], args: &[&str]) -> Result<Vec<u8>, String> {
+    let mut child = Command::new(exe)
+        .args(args)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .map_err(|e| format!("cannot run {}: {e}", exe.display()))?;
+    child
+        .stdin
+        .take()
+        .expect("stdin")
+        .write_all(input)
+        .map_err(|e| e.to_string())?;
+    let out = child.wait_with_output().map_err(|e| e.to_string())?;
+    if !out.status.success() {
+        return Err(String::from_utf8_lossy(&out.stderr).trim().to_string());
+    }
+    Ok(out.stdout)
+}
+
+/// Decodes the harness output: `levels` refined levels.
+pub fn decode(bytes: &[u8], levels: usize) -> Result<Vec<OsdLevel>, String> {
+    let mut pos = 0usize;
+    let u = |pos: &mut usize| -> Result<u32, String> {
+        let s = bytes
+            .get(*pos..*pos + 4)
+            .ok_or("harness output truncated")?;
+        *pos += 4;
+        Ok(u32::from_le_bytes(s.try_into().unwrap()))
+    };
+    let mut out = Vec::with_capacity(levels);
+    for _ in 0..levels {
+        let nv = u(&mut pos)? as usize;
+        let nf = u(&mut pos)? as usize;
+        let face_sizes = (0..nf)
+            .map(|_| u(&mut pos))
+            .collect::<Result<Vec<_>, _>>()?;
+        let total: usize = face_sizes.iter().map(|&s| s as usize).sum();
+        let face_vertices = (0..total)
+            .map(|_| u(&mut pos))
+            .collect::<Result<Vec<_>, _>>()?;
+        let need = nv * 24;
+        let raw = bytes
+            .get(pos..pos + need)
+            .ok_or("harness output truncated")?;
+        pos += need;
+        let positions = raw
+            .chunks_exact(24)
+            .map(|c| {
+                let f = |i: usize| f64::from_le_bytes(c[8 * i..8 * i + 8].try_into().unwrap());
+                DVec3::new(f(0), f(1), f(2))
+            })
+            .collect();
+        out.push(OsdLevel {
+            face_sizes,
+            face_vertices,
+            positions,
+        });
+    }
+    Ok(out)
+}
