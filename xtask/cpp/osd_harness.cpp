@@ -150,6 +150,18 @@ std::vector<std::vector<Point>> refineAll(Far::TopologyRefiner &refiner, Mesh co
     return levels;
 }
 
+// Peak resident set size of this process in bytes (VmHWM), 0 if unknown.
+long peakRssBytes() {
+    FILE *f = std::fopen("/proc/self/status", "r");
+    if (!f) return 0;
+    char line[256];
+    long kb = 0;
+    while (std::fgets(line, sizeof line, f))
+        if (std::strncmp(line, "VmHWM:", 6) == 0) kb = std::atol(line + 6);
+    std::fclose(f);
+    return kb * 1024;
+}
+
 } // namespace
 
 int main(int argc, char **argv) {
@@ -162,18 +174,35 @@ int main(int argc, char **argv) {
         while ((n = std::fread(buf, 1, sizeof buf, stdin)) > 0) r.data.insert(r.data.end(), buf, buf + n);
         Mesh m = readMesh(r);
         if (bench) {
-            // Median of `repeats` runs of (topology refinement + primvar interpolation).
-            std::vector<double> times;
+            // Median of `repeats` runs of topology refinement (OpenSubdiv's default uniform
+            // options: full topology only below the last level) + primvar interpolation.
+            std::vector<double> topo, prim, total;
             for (int i = 0; i < repeats; ++i) {
                 auto t0 = std::chrono::steady_clock::now();
                 Far::TopologyRefiner *refiner = createRefiner(m);
-                auto levels = refineAll(*refiner, m);
+                Far::TopologyRefiner::UniformOptions uo(m.levels);
+                refiner->RefineUniform(uo);
                 auto t1 = std::chrono::steady_clock::now();
-                times.push_back(std::chrono::duration<double>(t1 - t0).count());
+                std::vector<std::vector<Point>> levels(m.levels + 1);
+                levels[0] = m.pos;
+                Far::PrimvarRefinerReal<double> primvar(*refiner);
+                for (int l = 1; l <= m.levels; ++l) {
+                    levels[l].resize(refiner->GetLevel(l).GetNumVertices());
+                    primvar.Interpolate(l, levels[l - 1], levels[l]);
+                }
+                auto t2 = std::chrono::steady_clock::now();
+                topo.push_back(std::chrono::duration<double>(t1 - t0).count());
+                prim.push_back(std::chrono::duration<double>(t2 - t1).count());
+                total.push_back(std::chrono::duration<double>(t2 - t0).count());
                 delete refiner;
             }
-            std::sort(times.begin(), times.end());
-            std::printf("{\"median_seconds\": %.9f, \"min_seconds\": %.9f}\n", times[times.size() / 2], times[0]);
+            auto median = [](std::vector<double> v) {
+                std::sort(v.begin(), v.end());
+                return v[v.size() / 2];
+            };
+            std::printf("{\"seconds\": %.9f, \"topology_seconds\": %.9f, \"primvar_seconds\": %.9f, "
+                        "\"peak_rss_bytes\": %ld}\n",
+                        median(total), median(topo), median(prim), peakRssBytes());
             return 0;
         }
         Far::TopologyRefiner *refiner = createRefiner(m);

@@ -5,6 +5,7 @@ use std::process::{Command, ExitCode};
 
 use clap::{Parser, Subcommand};
 
+mod bench;
 mod conformance;
 mod osd;
 
@@ -29,6 +30,29 @@ enum Task {
         /// Directory of OpenSubdiv shapes.
         #[arg(long, default_value = "../shared/meshes/osd")]
         shapes: std::path::PathBuf,
+    },
+    /// Time subd against OpenSubdiv on ~100k-face meshes (levels 1..L, 1 and all threads).
+    Bench {
+        /// Deepest level.
+        #[arg(long, default_value_t = 3)]
+        levels: usize,
+        /// Runs per measurement (the median is reported).
+        #[arg(long, default_value_t = 5)]
+        repeats: usize,
+    },
+    /// (internal) One subd measurement for `bench`, in its own process.
+    #[command(hide = true)]
+    BenchRun {
+        #[arg(long)]
+        mesh: std::path::PathBuf,
+        #[arg(long)]
+        scheme: String,
+        #[arg(long)]
+        levels: usize,
+        #[arg(long)]
+        threads: usize,
+        #[arg(long)]
+        repeats: usize,
     },
     /// Run each cargo-fuzz target for a while (needs `cargo install cargo-fuzz` and a nightly
     /// toolchain).
@@ -115,6 +139,23 @@ fn main() -> ExitCode {
                 Err("conformance failed".into())
             }
         }),
+        Task::Bench { levels, repeats } => {
+            ensure_system_packages().and_then(|_| bench::run(levels, repeats))
+        }
+        Task::BenchRun {
+            mesh,
+            scheme,
+            levels,
+            threads,
+            repeats,
+        } => {
+            let scheme = if scheme == "loop" {
+                subd_schemes::Scheme::Loop
+            } else {
+                subd_schemes::Scheme::CatmullClark
+            };
+            bench::run_subd(&mesh, scheme, levels, threads, repeats)
+        }
         Task::Fuzz { seconds, target } => {
             let targets = match target {
                 Some(t) => vec![t],

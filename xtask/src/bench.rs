@@ -1,0 +1,260 @@
+//! `cargo xtask bench`: subd and OpenSubdiv side by side on the same meshes in one run.
+//!
+//! Each measurement runs in its own process (the OpenSubdiv harness, or `xtask bench-run`
+//! for subd) so that peak memory is that of the work alone. Times are medians of repeated
+//! runs: topology refinement + stencils + positions for subd, topology refinement + primvar
+//! interpolation for OpenSubdiv (double precision, default uniform options).
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Instant;
+
+use subd_mesh::{DVec3, Mesh, TopologyBuilder};
+use subd_schemes::{Options, Refinement, Scheme};
+
+use crate::osd;
+
+/// A closed quad mesh of about 100k faces with extraordinary vertices: a 160 x 160 torus
+/// grid in which every 8th quad pair is merged into a hexagon (two valence-3 vertices each),
+/// refined once with Catmull-Clark (the hexagon centres become valence-6 vertices).
+pub fn quad_bench_mesh() -> Mesh {
+    let (m, n) = (160u32, 160u32);
+    let id = |i: u32, j: u32| (i % m) * n + (j % n);
+    let tau = std::f64::consts::TAU;
+    let positions: Vec<DVec3> = (0..m * n)
+        .map(|k| {
+            let (u, v) = (
+                (k / n) as f64 * tau / m as f64,
+                (k % n) as f64 * tau / n as f64,
+            );
+            DVec3::new(
+                (3.0 + v.cos()) * u.cos(),
+                (3.0 + v.cos()) * u.sin(),
+                v.sin(),
+            )
+        })
+        .collect();
+    let mut sizes = Vec::new();
+    let mut idx = Vec::new();
+    for i in 0..m {
+        let mut j = 0;
+        while j < n {
+            if i % 8 == 0 && j % 8 == 0 {
+                // Quads (i,j) and (i,j+1) merged: drop their shared edge.
+                idx.extend_from_slice(&[
+                    id(i, j),
+                    id(i + 1, j),
+                    id(i + 1, j + 1),
+                    id(i + 1, j + 2),
+                    id(i, j + 2),
+                    id(i, j + 1),
+                ]);
+                sizes.push(6);
+                j += 2;
+            } else {
+                idx.extend_from_slice(&[id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
+                sizes.push(4);
+                j += 1;
+            }
+        }
+    }
+    let base = TopologyBuilder::new(positions.len())
+        .build(&sizes, &idx)
+        .expect("valid torus");
+    let r = Refinement::new(&base, Scheme::CatmullClark, &Options::default(), 1).expect("refine");
+    let pts = r.refine_points(&positions).pop().expect("level 1");
+    let t = r.topology(1);
+    let topo = TopologyBuilder::new(t.num_vertices())
+        .build(&t.face_sizes().collect::<Vec<_>>(), t.all_face_vertices())
+        .expect("valid");
+    Mesh::new(topo, pts).expect("finite")
+}
+
+/// The quad bench mesh with every quad split along its 0-2 diagonal, for Loop.
+pub fn tri_bench_mesh() -> Mesh {
+    let q = quad_bench_mesh();
+    let t = &q.topology;
+    let mut idx = Vec::with_capacity(t.num_faces() * 6);
+    for f in 0..t.num_faces() {
+        let v = t.face_vertices(f);
+        idx.extend_from_slice(&[v[0], v[1], v[2], v[0], v[2], v[3]]);
+    }
+    let topo = TopologyBuilder::new(t.num_vertices())
+        .build(&vec![3; 2 * t.num_faces()], &idx)
+        .expect("valid");
+    Mesh::new(topo, q.positions).expect("finite")
+}
+
+fn peak_rss_bytes() -> u64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("VmHWM:"))
+                .and_then(|l| l.split_whitespace().nth(1)?.parse::<u64>().ok())
+        })
+        .map_or(0, |kb| kb * 1024)
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// The subd side, run in a child process: refine `mesh` to `levels` with `threads` threads,
+/// `repeats` times, and print one JSON line.
+pub fn run_subd(
+    mesh: &Path,
+    scheme: Scheme,
+    levels: usize,
+    threads: usize,
+    repeats: usize,
+) -> Result<(), String> {
+    let file =
+        subd_io::read_mesh(mesh, &subd_io::ReadOptions::default()).map_err(|e| e.to_string())?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| e.to_string())?;
+    let (topo, pos) = (&file.mesh.topology, &file.mesh.positions);
+    let (mut total, mut refine, mut points) = (Vec::new(), Vec::new(), Vec::new());
+    let mut check = 0.0;
+    for _ in 0..repeats {
+        pool.install(|| {
+            let t0 = Instant::now();
+            let r = Refinement::new(topo, scheme, &Options::default(), levels).expect("refine");
+            let t1 = Instant::now();
+            let p = r.refine_points(pos);
+            let t2 = Instant::now();
+            check += p[levels].len() as f64;
+            refine.push((t1 - t0).as_secs_f64());
+            points.push((t2 - t1).as_secs_f64());
+            total.push((t2 - t0).as_secs_f64());
+        });
+    }
+    println!(
+        "{{\"seconds\": {:.9}, \"topology_seconds\": {:.9}, \"primvar_seconds\": {:.9}, \"peak_rss_bytes\": {}, \"vertices\": {}}}",
+        median(total),
+        median(refine),
+        median(points),
+        peak_rss_bytes(),
+        check / repeats as f64
+    );
+    Ok(())
+}
+
+fn json_number(line: &str, key: &str) -> Option<f64> {
+    let k = format!("\"{key}\":");
+    let rest = &line[line.find(&k)? + k.len()..];
+    let end = rest.find([',', '}']).unwrap_or(rest.len());
+    rest[..end].trim().parse().ok()
+}
+
+struct Measure {
+    seconds: f64,
+    peak: f64,
+}
+
+fn measure(cmd: &mut Command) -> Result<Measure, String> {
+    let out = cmd.output().map_err(|e| e.to_string())?;
+    if !out.status.success() {
+        return Err(String::from_utf8_lossy(&out.stderr).to_string());
+    }
+    let line = String::from_utf8_lossy(&out.stdout).to_string();
+    Ok(Measure {
+        seconds: json_number(&line, "seconds").ok_or("no seconds")?,
+        peak: json_number(&line, "peak_rss_bytes").ok_or("no peak")? / (1024.0 * 1024.0),
+    })
+}
+
+/// Runs the whole comparison and prints the table.
+pub fn run(levels: usize, repeats: usize) -> Result<(), String> {
+    let exe = osd::build_harness()?;
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/xtask/bench");
+    std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
+    let me = std::env::current_exe().map_err(|e| e.to_string())?;
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    println!(
+        "subd vs OpenSubdiv {}, uniform refinement, median of {repeats} runs; ratio = subd time / OpenSubdiv time",
+        "3.5 (Far, double)"
+    );
+    println!(
+        "{:<8} {:>8} {:>5} {:>10} {:>10} {:>10} {:>7} {:>10} {:>7} {:>9} {:>9}",
+        "scheme",
+        "faces",
+        "level",
+        "out faces",
+        "osd s",
+        "subd 1T s",
+        "ratio",
+        format!("subd {threads}T s"),
+        "ratio",
+        "osd MB",
+        "subd MB"
+    );
+    for (scheme, mesh) in [
+        (Scheme::CatmullClark, quad_bench_mesh()),
+        (Scheme::Loop, tri_bench_mesh()),
+    ] {
+        let name = if scheme == Scheme::Loop {
+            "loop"
+        } else {
+            "catmark"
+        };
+        let path = dir.join(format!("{name}.obj"));
+        subd_io::write_mesh(&path, &mesh, &subd_io::WriteOptions::default())
+            .map_err(|e| e.to_string())?;
+        for level in 1..=levels {
+            let input = osd::encode(
+                &mesh.topology,
+                &mesh.positions,
+                scheme,
+                &Options::default(),
+                level as u32,
+            );
+            let input_path = dir.join(format!("{name}_{level}.bin"));
+            std::fs::write(&input_path, &input).map_err(|e| e.to_string())?;
+            let osd = measure(
+                Command::new(&exe)
+                    .args(["--bench", &repeats.to_string()])
+                    .stdin(std::fs::File::open(&input_path).map_err(|e| e.to_string())?),
+            )?;
+            let subd = |t: usize| {
+                measure(Command::new(&me).args([
+                    "bench-run",
+                    "--mesh",
+                    path.to_str().unwrap(),
+                    "--scheme",
+                    name,
+                    "--levels",
+                    &level.to_string(),
+                    "--threads",
+                    &t.to_string(),
+                    "--repeats",
+                    &repeats.to_string(),
+                ]))
+            };
+            let one = subd(1)?;
+            let all = subd(threads)?;
+            let out_faces = mesh.topology.num_face_vertices()
+                * 4usize.pow(level as u32 - 1)
+                * if scheme == Scheme::Loop { 4 } else { 1 }
+                / if scheme == Scheme::Loop { 3 } else { 1 };
+            println!(
+                "{:<8} {:>8} {:>5} {:>10} {:>10.4} {:>10.4} {:>7.2} {:>10.4} {:>7.2} {:>9.0} {:>9.0}",
+                name,
+                mesh.topology.num_faces(),
+                level,
+                out_faces,
+                osd.seconds,
+                one.seconds,
+                one.seconds / osd.seconds,
+                all.seconds,
+                all.seconds / osd.seconds,
+                osd.peak,
+                one.peak.max(all.peak)
+            );
+        }
+    }
+    Ok(())
+}
