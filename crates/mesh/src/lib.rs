@@ -39,7 +39,7 @@ pub use error::{BuildWarning, TopologyError};
 pub use geometry::{Mesh, bounding_box, validate_positions};
 pub use glam::DVec3;
 pub use tags::{BoundaryInterpolation, CreaseMethod, SchemeHints, Tags, TriangleSubdivision};
-pub use topology::Topology;
+pub use topology::{Topology, TopologyParts};
 
 #[cfg(doctest)]
 #[doc = include_str!("../README.md")]

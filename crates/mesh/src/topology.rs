@@ -383,3 +383,158 @@ fn check_sharpness(tag: &'static str, s: f64) -> Result<(), TopologyError> {
     }
     Ok(())
 }
+
+/// Every array of a [`Topology`], for code that derives a topology directly (a refinement
+/// computes a child level's relations from its parent's in the order OpenSubdiv uses, with no
+/// search). The invariants are those [`Topology`] documents: CSR offsets start at 0 and end
+/// at the length of their array; `face_edges[i]` joins `face_vertices[i]` and the next
+/// vertex of the face; edge-faces and vertex-faces come with the local index of the edge or
+/// vertex in each face; vertex-faces and vertex-edges of a manifold vertex are ordered
+/// counter-clockwise with `vertex_edges[i]` the edge leaving the vertex in `vertex_faces[i]`.
+#[derive(Debug, Clone, Default)]
+pub struct TopologyParts {
+    /// Number of vertices.
+    pub num_vertices: usize,
+    /// Face offsets (faces + 1).
+    pub face_offsets: Vec<u32>,
+    /// Face vertices.
+    pub face_vertices: Vec<u32>,
+    /// Face edges (parallel to `face_vertices`).
+    pub face_edges: Vec<u32>,
+    /// Edge vertices.
+    pub edge_vertices: Vec<[u32; 2]>,
+    /// Edge-face offsets (edges + 1).
+    pub edge_face_offsets: Vec<u32>,
+    /// Edge faces.
+    pub edge_faces: Vec<u32>,
+    /// Position of the edge in each of its faces.
+    pub edge_face_local: Vec<u32>,
+    /// Vertex-face offsets (vertices + 1).
+    pub vertex_face_offsets: Vec<u32>,
+    /// Vertex faces.
+    pub vertex_faces: Vec<u32>,
+    /// Corner of the vertex in each of its faces.
+    pub vertex_face_local: Vec<u32>,
+    /// Vertex-edge offsets (vertices + 1).
+    pub vertex_edge_offsets: Vec<u32>,
+    /// Vertex edges.
+    pub vertex_edges: Vec<u32>,
+    /// Per edge: boundary (1 face).
+    pub edge_boundary: Vec<bool>,
+    /// Per edge: non-manifold.
+    pub edge_non_manifold: Vec<bool>,
+    /// Per vertex: non-manifold (faces not a single fan).
+    pub vertex_non_manifold: Vec<bool>,
+}
+
+impl Topology {
+    /// Assembles a topology from precomputed relations (see [`TopologyParts`]). The lengths
+    /// of the arrays are checked; their contents are trusted, with full checks in debug
+    /// builds. Degenerate, boundary-vertex and isolated flags are derived here. Tags start
+    /// smooth.
+    ///
+    /// # Errors
+    /// [`TopologyError::InconsistentEdges`] when the array lengths do not fit together.
+    pub fn from_parts(parts: TopologyParts) -> Result<Topology, TopologyError> {
+        let nv = parts.num_vertices;
+        let nf = parts.face_offsets.len().saturating_sub(1);
+        let ne = parts.edge_vertices.len();
+        let nh = parts.face_vertices.len();
+        let ok = !parts.face_offsets.is_empty()
+            && parts.face_offsets.last() == Some(&(nh as u32))
+            && parts.face_edges.len() == nh
+            && parts.edge_face_offsets.len() == ne + 1
+            && parts.edge_faces.len() == *parts.edge_face_offsets.last().unwrap_or(&0) as usize
+            && parts.edge_face_local.len() == parts.edge_faces.len()
+            && parts.vertex_face_offsets.len() == nv + 1
+            && parts.vertex_faces.len() == *parts.vertex_face_offsets.last().unwrap_or(&0) as usize
+            && parts.vertex_face_local.len() == parts.vertex_faces.len()
+            && parts.vertex_edge_offsets.len() == nv + 1
+            && parts.vertex_edges.len() == *parts.vertex_edge_offsets.last().unwrap_or(&0) as usize
+            && parts.edge_boundary.len() == ne
+            && parts.edge_non_manifold.len() == ne
+            && parts.vertex_non_manifold.len() == nv
+            && nv < u32::MAX as usize;
+        if !ok {
+            return Err(TopologyError::InconsistentEdges {
+                face: 0,
+                detail: "topology parts do not agree in length",
+            });
+        }
+        let mut edge_flags = vec![0u8; ne];
+        for (e, fl) in edge_flags.iter_mut().enumerate() {
+            let [a, b] = parts.edge_vertices[e];
+            *fl = (parts.edge_boundary[e] as u8 * EDGE_BOUNDARY)
+                | (parts.edge_non_manifold[e] as u8 * EDGE_NON_MANIFOLD)
+                | ((a == b) as u8 * (EDGE_DEGENERATE | EDGE_NON_MANIFOLD));
+        }
+        let mut vertex_flags = vec![0u8; nv];
+        for (v, fl) in vertex_flags.iter_mut().enumerate() {
+            *fl = parts.vertex_non_manifold[v] as u8 * VERTEX_NON_MANIFOLD;
+            if parts.vertex_face_offsets[v] == parts.vertex_face_offsets[v + 1] {
+                *fl |= VERTEX_ISOLATED;
+            }
+        }
+        for (e, &[a, b]) in parts.edge_vertices.iter().enumerate() {
+            if edge_flags[e] & EDGE_BOUNDARY != 0 {
+                vertex_flags[a as usize] |= VERTEX_BOUNDARY;
+                vertex_flags[b as usize] |= VERTEX_BOUNDARY;
+            }
+        }
+        let topo = Topology {
+            num_vertices: nv as u32,
+            face_offsets: parts.face_offsets,
+            face_vertices: parts.face_vertices,
+            face_edges: parts.face_edges,
+            edge_vertices: parts.edge_vertices,
+            edge_face_offsets: parts.edge_face_offsets,
+            edge_faces: parts.edge_faces,
+            edge_face_local: parts.edge_face_local,
+            vertex_face_offsets: parts.vertex_face_offsets,
+            vertex_faces: parts.vertex_faces,
+            vertex_face_local: parts.vertex_face_local,
+            vertex_edge_offsets: parts.vertex_edge_offsets,
+            vertex_edges: parts.vertex_edges,
+            edge_flags,
+            vertex_flags,
+            tags: Tags::new(nv, ne, nf),
+        };
+        debug_assert!(topo.check_relations().is_ok(), "{:?}", topo.check_relations());
+        Ok(topo)
+    }
+
+    /// Checks that the relations agree with each other (every face edge joins consecutive
+    /// face vertices and lists the face; every vertex face contains the vertex at its local
+    /// corner; every vertex edge touches the vertex). Used by tests and debug builds.
+    pub fn check_relations(&self) -> Result<(), String> {
+        for f in 0..self.num_faces() {
+            let fv = self.face_vertices(f);
+            for (i, &e) in self.face_edges(f).iter().enumerate() {
+                let [a, b] = self.edge_vertices(e as usize);
+                let (x, y) = (fv[i], fv[(i + 1) % fv.len()]);
+                if !((a == x && b == y) || (a == y && b == x)) {
+                    return Err(format!("face {f} edge {i} ({e}) does not join {x} {y}"));
+                }
+                let ef = self.edge_faces(e as usize);
+                let el = self.edge_face_local_indices(e as usize);
+                if !ef.iter().zip(el).any(|(&g, &l)| g as usize == f && l as usize == i) {
+                    return Err(format!("edge {e} does not list face {f} at {i}"));
+                }
+            }
+        }
+        for v in 0..self.num_vertices() {
+            for (&f, &c) in self.vertex_faces(v).iter().zip(self.vertex_face_local_indices(v)) {
+                if self.face_vertices(f as usize).get(c as usize) != Some(&(v as u32)) {
+                    return Err(format!("vertex {v} face {f} corner {c} mismatch"));
+                }
+            }
+            for &e in self.vertex_edges(v) {
+                let [a, b] = self.edge_vertices(e as usize);
+                if a as usize != v && b as usize != v {
+                    return Err(format!("vertex {v} lists edge {e} ({a}, {b})"));
+                }
+            }
+        }
+        Ok(())
+    }
+}

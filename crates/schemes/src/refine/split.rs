@@ -1,156 +1,393 @@
-//! Topology splits: the child topology of one uniform refinement step, numbered exactly as
-//! OpenSubdiv numbers it (`Vtr::QuadRefinement`, `Vtr::TriRefinement`).
+//! Topology splits: the child topology of one uniform refinement step, with every relation
+//! derived directly from the parent's in the order OpenSubdiv's `Vtr::QuadRefinement` and
+//! `Vtr::TriRefinement` give it — no search, no sort, one pass per relation.
 //!
 //! Child vertices: children of parent vertices first (so vertex `v` stays `v`), then of
 //! faces (quad split only), then of edges. Child faces are consecutive per parent face.
 //! Child edges: the edges interior to each parent face (face order), then the two halves of
 //! each parent edge (edge order), each half listed as (edge point, end vertex).
 
-use subd_mesh::Topology;
+use subd_mesh::{Topology, TopologyParts};
 
-/// Which half of parent edge `e` touches the child of the parent vertex at face corner
-/// `corner` of a face whose vertices are `fv`: `start` says whether the half is the one that
-/// leaves the corner (edge `corner` of the face) or the one that arrives at it (edge
-/// `corner - 1`). For a degenerate edge both ends are the same vertex; the leaving side then
-/// takes half 0 and the arriving side half 1.
+/// Index of the half of parent edge `e` at its end `k` (0 or 1), relative to the first half.
 #[inline]
-fn half_at(parent: &Topology, e: u32, v: u32, leaving: bool) -> u32 {
-    let [a, b] = parent.edge_vertices(e as usize);
-    let half = if a == b {
-        u32::from(!leaving)
-    } else {
-        u32::from(a != v)
-    };
-    2 * e + half
+fn half(e: u32, k: u32) -> u32 {
+    2 * e + k
 }
 
-/// Child edges that inherit a parent edge's non-manifold flag: both halves of it.
-fn inherited_non_manifold(parent: &Topology, half_base: u32) -> Vec<u32> {
-    (0..parent.num_edges() as u32)
-        .filter(|&e| parent.is_non_manifold_edge(e as usize))
-        .flat_map(|e| [half_base + 2 * e, half_base + 2 * e + 1])
-        .collect()
+/// Which end (0 or 1) of parent edge `e` is at face corner vertex `v`: for a degenerate edge
+/// the leaving side of the corner takes end 0 and the arriving side end 1.
+#[inline]
+fn end_at(p: &Topology, e: u32, v: u32, leaving: bool) -> u32 {
+    let [a, b] = p.edge_vertices(e as usize);
+    if a == b { u32::from(!leaving) } else { u32::from(a != v) }
+}
+
+/// Ends of each parent vertex's edges, in vertex-edge order: `k_i` with `e_i.v[k_i] == v`
+/// (for a degenerate edge listed twice, 0 then 1).
+#[inline]
+fn vertex_edge_end(p: &Topology, v: usize, i: usize) -> u32 {
+    let ve = p.vertex_edges(v);
+    let e = ve[i];
+    let [a, b] = p.edge_vertices(e as usize);
+    if a == b {
+        u32::from(i > 0 && ve[i - 1] == e)
+    } else {
+        u32::from(b as usize == v)
+    }
+}
+
+/// Offsets from a count per element.
+fn offsets_from(counts: impl Iterator<Item = usize>, len: usize) -> Vec<u32> {
+    let mut off = Vec::with_capacity(len + 1);
+    off.push(0u32);
+    let mut acc = 0u32;
+    for c in counts {
+        acc += c as u32;
+        off.push(acc);
+    }
+    off
 }
 
 /// The quad split of Catmull-Clark and Bilinear: every face of size n becomes n quads.
-pub(crate) fn quad_split(parent: &Topology) -> Topology {
-    let nv = parent.num_vertices() as u32;
-    let nf = parent.num_faces();
-    let nh = parent.num_face_vertices();
-    let face_point = |f: usize| nv + f as u32;
-    let edge_point = |e: u32| nv + nf as u32 + e;
-    let half_base = nh as u32;
+pub(crate) fn quad_split(p: &Topology) -> Topology {
+    let (nv, nf, ne, nh) = (p.num_vertices(), p.num_faces(), p.num_edges(), p.num_face_vertices());
+    let off = p.face_offsets();
+    let face_point = |f: usize| (nv + f) as u32;
+    let edge_point = |e: u32| (nv + nf) as u32 + e;
+    let hb = nh as u32; // first half-edge child
+    let size = |f: usize| (off[f + 1] - off[f]) as usize;
 
-    let n_child_faces = nh;
-    let mut face_offsets = Vec::with_capacity(n_child_faces + 1);
-    let mut face_vertices = Vec::with_capacity(4 * n_child_faces);
-    let mut face_edges = Vec::with_capacity(4 * n_child_faces);
+    // Faces: (V_k, E_k, F, E_{k-1}) with edges (hNext, I_k, I_{k-1}, hPrev); a quad's child k
+    // is rotated so the parent corner sits at position k.
+    let mut face_vertices = vec![0u32; 4 * nh];
+    let mut face_edges = vec![0u32; 4 * nh];
     for f in 0..nf {
-        let fv = parent.face_vertices(f);
-        let fe = parent.face_edges(f);
+        let fv = p.face_vertices(f);
+        let fe = p.face_edges(f);
         let n = fv.len();
-        let interior = parent.face_offsets()[f];
+        let base = off[f];
         for k in 0..n {
             let km1 = if k == 0 { n - 1 } else { k - 1 };
-            // The n-gon child: (V_k, E_k, F, E_{k-1}) with its four edges.
             let verts = [fv[k], edge_point(fe[k]), face_point(f), edge_point(fe[km1])];
             let edges = [
-                half_base + half_at(parent, fe[k], fv[k], true),
-                interior + k as u32,
-                interior + km1 as u32,
-                half_base + half_at(parent, fe[km1], fv[k], false),
+                hb + half(fe[k], end_at(p, fe[k], fv[k], true)),
+                base + k as u32,
+                base + km1 as u32,
+                hb + half(fe[km1], end_at(p, fe[km1], fv[k], false)),
             ];
-            // A quad's child k keeps the parent corner at position k.
             let rot = if n == 4 { k } else { 0 };
-            face_offsets.push(face_vertices.len() as u32);
+            let o = 4 * (base as usize + k);
             for j in 0..4 {
-                let src = (j + 4 - rot) % 4;
-                face_vertices.push(verts[src]);
-                face_edges.push(edges[src]);
+                face_vertices[o + (j + rot) % 4] = verts[j];
+                face_edges[o + (j + rot) % 4] = edges[j];
             }
         }
     }
-    face_offsets.push(face_vertices.len() as u32);
+    let face_offsets = (0..=nh as u32).map(|i| 4 * i).collect();
 
-    let ne = parent.num_edges();
+    // Edges: I_f[j] = (F, E_j); H(e, k) = (E, V_{e.v[k]}).
     let mut edge_vertices = Vec::with_capacity(nh + 2 * ne);
     for f in 0..nf {
-        for &e in parent.face_edges(f) {
+        for &e in p.face_edges(f) {
             edge_vertices.push([face_point(f), edge_point(e)]);
         }
     }
     for e in 0..ne as u32 {
-        let [a, b] = parent.edge_vertices(e as usize);
+        let [a, b] = p.edge_vertices(e as usize);
         edge_vertices.push([edge_point(e), a]);
         edge_vertices.push([edge_point(e), b]);
     }
-    let nm = inherited_non_manifold(parent, half_base);
-    let num_vertices = nv as usize + nf + ne;
-    Topology::from_numbered_edges(
-        num_vertices,
+
+    // Edge -> faces.
+    let edge_face_offsets = offsets_from(
+        (0..nh)
+            .map(|_| 2)
+            .chain((0..ne).flat_map(|e| [p.edge_faces(e).len(); 2])),
+        nh + 2 * ne,
+    );
+    let total = *edge_face_offsets.last().unwrap() as usize;
+    let mut edge_faces = Vec::with_capacity(total);
+    let mut edge_face_local = Vec::with_capacity(total);
+    for f in 0..nf {
+        let n = size(f);
+        let base = off[f];
+        for j in 0..n {
+            edge_faces.extend_from_slice(&[base + j as u32, base + ((j + 1) % n) as u32]);
+            if n == 4 {
+                edge_face_local.extend_from_slice(&[((j + 1) % 4) as u32, ((j + 3) % 4) as u32]);
+            } else {
+                edge_face_local.extend_from_slice(&[1, 2]);
+            }
+        }
+    }
+    for e in 0..ne {
+        let ev = p.edge_vertices(e);
+        let degenerate = ev[0] == ev[1];
+        for k in 0..2usize {
+            for (&pf, &l) in p.edge_faces(e).iter().zip(p.edge_face_local_indices(e)) {
+                let (pf, l) = (pf as usize, l as usize);
+                let n = size(pf);
+                let c = if degenerate { k } else { usize::from(p.face_vertices(pf)[l] != ev[k]) };
+                edge_faces.push(off[pf] + ((l + c) % n) as u32);
+                edge_face_local.push(if n == 4 {
+                    l as u32
+                } else if c == 1 {
+                    3
+                } else {
+                    0
+                });
+            }
+        }
+    }
+
+    // Vertex -> faces.
+    let vertex_face_offsets = offsets_from(
+        (0..nv)
+            .map(|v| p.vertex_faces(v).len())
+            .chain((0..nf).map(size))
+            .chain((0..ne).map(|e| 2 * p.edge_faces(e).len())),
+        nv + nf + ne,
+    );
+    let total = *vertex_face_offsets.last().unwrap() as usize;
+    let mut vertex_faces = Vec::with_capacity(total);
+    let mut vertex_face_local = Vec::with_capacity(total);
+    for v in 0..nv {
+        for (&pf, &c) in p.vertex_faces(v).iter().zip(p.vertex_face_local_indices(v)) {
+            vertex_faces.push(off[pf as usize] + c);
+            vertex_face_local.push(if size(pf as usize) == 4 { c } else { 0 });
+        }
+    }
+    for f in 0..nf {
+        let n = size(f);
+        for j in 0..n {
+            vertex_faces.push(off[f] + j as u32);
+            vertex_face_local.push(if n == 4 { ((j + 2) % 4) as u32 } else { 2 });
+        }
+    }
+    for e in 0..ne {
+        for (&pf, &l) in p.edge_faces(e).iter().zip(p.edge_face_local_indices(e)) {
+            let (pf, l) = (pf as usize, l as usize);
+            let n = size(pf);
+            vertex_faces.push(off[pf] + ((l + 1) % n) as u32);
+            vertex_face_local.push(if n == 4 { l as u32 } else { 3 });
+            vertex_faces.push(off[pf] + l as u32);
+            vertex_face_local.push(if n == 4 { ((l + 1) % 4) as u32 } else { 1 });
+        }
+    }
+
+    // Vertex -> edges.
+    let vertex_edge_offsets = offsets_from(
+        (0..nv)
+            .map(|v| p.valence(v))
+            .chain((0..nf).map(size))
+            .chain((0..ne).map(|e| p.edge_faces(e).len() + 2)),
+        nv + nf + ne,
+    );
+    let total = *vertex_edge_offsets.last().unwrap() as usize;
+    let mut vertex_edges = Vec::with_capacity(total);
+    for v in 0..nv {
+        for (i, &e) in p.vertex_edges(v).iter().enumerate() {
+            vertex_edges.push(hb + half(e, vertex_edge_end(p, v, i)));
+        }
+    }
+    for f in 0..nf {
+        let n = size(f) as u32;
+        let base = off[f];
+        vertex_edges.push(base + n - 1);
+        vertex_edges.extend((0..n - 1).map(|j| base + j));
+    }
+    for e in 0..ne {
+        let ev = p.edge_vertices(e);
+        let ef = p.edge_faces(e);
+        let el = p.edge_face_local_indices(e);
+        let (h0, h1) = (hb + half(e as u32, 0), hb + half(e as u32, 1));
+        let first = off[ef[0] as usize] + el[0];
+        let same_dir = ev[0] != ev[1] && p.face_vertices(ef[0] as usize)[el[0] as usize] == ev[0];
+        if same_dir {
+            vertex_edges.extend_from_slice(&[h1, first, h0]);
+        } else {
+            vertex_edges.extend_from_slice(&[h0, first, h1]);
+        }
+        for (&pf, &l) in ef.iter().zip(el).skip(1) {
+            vertex_edges.push(off[pf as usize] + l);
+        }
+    }
+
+    let mut edge_boundary = vec![false; nh];
+    let mut edge_non_manifold = vec![false; nh];
+    for e in 0..ne {
+        let (b, m) = (p.is_boundary_edge(e), p.is_non_manifold_edge(e));
+        edge_boundary.extend_from_slice(&[b, b]);
+        edge_non_manifold.extend_from_slice(&[m, m]);
+    }
+    let mut vertex_non_manifold: Vec<bool> = (0..nv).map(|v| p.is_non_manifold_vertex(v)).collect();
+    vertex_non_manifold.resize(nv + nf, false);
+    vertex_non_manifold.extend((0..ne).map(|e| p.is_non_manifold_edge(e)));
+
+    Topology::from_parts(TopologyParts {
+        num_vertices: nv + nf + ne,
         face_offsets,
         face_vertices,
         face_edges,
         edge_vertices,
-        &nm,
-    )
+        edge_face_offsets,
+        edge_faces,
+        edge_face_local,
+        vertex_face_offsets,
+        vertex_faces,
+        vertex_face_local,
+        vertex_edge_offsets,
+        vertex_edges,
+        edge_boundary,
+        edge_non_manifold,
+        vertex_non_manifold,
+    })
     .expect("a quad split of a valid topology is valid")
 }
 
 /// The triangle split of Loop: every triangle becomes four. The caller checks that every face
 /// is a triangle.
-pub(crate) fn tri_split(parent: &Topology) -> Topology {
-    let nv = parent.num_vertices() as u32;
-    let nf = parent.num_faces();
-    let ne = parent.num_edges();
-    let edge_point = |e: u32| nv + e;
-    let half_base = 3 * nf as u32;
+pub(crate) fn tri_split(p: &Topology) -> Topology {
+    let (nv, nf, ne) = (p.num_vertices(), p.num_faces(), p.num_edges());
+    let edge_point = |e: u32| nv as u32 + e;
+    let hb = 3 * nf as u32;
     let mut face_vertices = Vec::with_capacity(12 * nf);
     let mut face_edges = Vec::with_capacity(12 * nf);
     for f in 0..nf {
-        let v = parent.face_vertices(f);
-        let e = parent.face_edges(f);
+        let v = p.face_vertices(f);
+        let e = p.face_edges(f);
         let (e0, e1, e2) = (edge_point(e[0]), edge_point(e[1]), edge_point(e[2]));
         let i = 3 * f as u32;
-        let h = |k: usize, corner: usize, leaving: bool| {
-            half_base + half_at(parent, e[k], v[corner], leaving)
-        };
+        // S_k: the half of edge k at its start corner; T_k: at its end corner.
+        let s = |k: usize| hb + half(e[k], end_at(p, e[k], v[k], true));
+        let t = |k: usize| hb + half(e[k], end_at(p, e[k], v[(k + 1) % 3], false));
         face_vertices.extend_from_slice(&[v[0], e0, e2, e0, v[1], e1, e2, e1, v[2], e1, e2, e0]);
-        face_edges.extend_from_slice(&[
-            h(0, 0, true),
-            i,
-            h(2, 0, false),
-            h(0, 1, false),
-            h(1, 1, true),
-            i + 1,
-            i + 2,
-            h(1, 2, false),
-            h(2, 2, true),
-            i + 2,
-            i,
-            i + 1,
-        ]);
+        face_edges.extend_from_slice(&[s(0), i, t(2), t(0), s(1), i + 1, i + 2, t(1), s(2), i + 2, i, i + 1]);
     }
     let face_offsets = (0..=4 * nf as u32).map(|k| 3 * k).collect();
     let mut edge_vertices = Vec::with_capacity(3 * nf + 2 * ne);
     for f in 0..nf {
-        let e = parent.face_edges(f);
+        let e = p.face_edges(f);
         let (e0, e1, e2) = (edge_point(e[0]), edge_point(e[1]), edge_point(e[2]));
         edge_vertices.extend_from_slice(&[[e0, e2], [e1, e0], [e2, e1]]);
     }
     for e in 0..ne as u32 {
-        let [a, b] = parent.edge_vertices(e as usize);
+        let [a, b] = p.edge_vertices(e as usize);
         edge_vertices.push([edge_point(e), a]);
         edge_vertices.push([edge_point(e), b]);
     }
-    let nm = inherited_non_manifold(parent, half_base);
-    Topology::from_numbered_edges(
-        nv as usize + ne,
+
+    let edge_face_offsets = offsets_from(
+        (0..3 * nf)
+            .map(|_| 2)
+            .chain((0..ne).flat_map(|e| [p.edge_faces(e).len(); 2])),
+        3 * nf + 2 * ne,
+    );
+    let total = *edge_face_offsets.last().unwrap() as usize;
+    let mut edge_faces = Vec::with_capacity(total);
+    let mut edge_face_local = Vec::with_capacity(total);
+    for f in 0..nf as u32 {
+        for j in 0..3u32 {
+            edge_faces.extend_from_slice(&[4 * f + j, 4 * f + 3]);
+            edge_face_local.extend_from_slice(&[(j + 1) % 3, (j + 1) % 3]);
+        }
+    }
+    for e in 0..ne {
+        let ev = p.edge_vertices(e);
+        let degenerate = ev[0] == ev[1];
+        for k in 0..2usize {
+            for (&pf, &l) in p.edge_faces(e).iter().zip(p.edge_face_local_indices(e)) {
+                let c = if degenerate {
+                    k as u32
+                } else {
+                    u32::from(p.face_vertices(pf as usize)[l as usize] != ev[k])
+                };
+                edge_faces.push(4 * pf + (l + c) % 3);
+                edge_face_local.push(l);
+            }
+        }
+    }
+
+    let vertex_face_offsets = offsets_from(
+        (0..nv)
+            .map(|v| p.vertex_faces(v).len())
+            .chain((0..ne).map(|e| 3 * p.edge_faces(e).len())),
+        nv + ne,
+    );
+    let total = *vertex_face_offsets.last().unwrap() as usize;
+    let mut vertex_faces = Vec::with_capacity(total);
+    let mut vertex_face_local = Vec::with_capacity(total);
+    for v in 0..nv {
+        for (&pf, &c) in p.vertex_faces(v).iter().zip(p.vertex_face_local_indices(v)) {
+            vertex_faces.push(4 * pf + c);
+            vertex_face_local.push(c);
+        }
+    }
+    for e in 0..ne {
+        for (&pf, &l) in p.edge_faces(e).iter().zip(p.edge_face_local_indices(e)) {
+            vertex_faces.extend_from_slice(&[4 * pf + (l + 1) % 3, 4 * pf + 3, 4 * pf + l]);
+            vertex_face_local.extend_from_slice(&[l, (l + 2) % 3, (l + 1) % 3]);
+        }
+    }
+
+    let vertex_edge_offsets = offsets_from(
+        (0..nv)
+            .map(|v| p.valence(v))
+            .chain((0..ne).map(|e| 2 * p.edge_faces(e).len() + 2)),
+        nv + ne,
+    );
+    let total = *vertex_edge_offsets.last().unwrap() as usize;
+    let mut vertex_edges = Vec::with_capacity(total);
+    for v in 0..nv {
+        for (i, &e) in p.vertex_edges(v).iter().enumerate() {
+            vertex_edges.push(hb + half(e, vertex_edge_end(p, v, i)));
+        }
+    }
+    for e in 0..ne {
+        let ev = p.edge_vertices(e);
+        let ef = p.edge_faces(e);
+        let el = p.edge_face_local_indices(e);
+        let (pf, l) = (ef[0], el[0]);
+        let rev = u32::from(ev[0] != ev[1] && p.face_vertices(pf as usize)[l as usize] != ev[0]);
+        vertex_edges.extend_from_slice(&[
+            hb + half(e as u32, 1 - rev),
+            3 * pf + (l + 1) % 3,
+            3 * pf + l,
+            hb + half(e as u32, rev),
+        ]);
+        for (&pf, &l) in ef.iter().zip(el).skip(1) {
+            vertex_edges.extend_from_slice(&[3 * pf + (l + 1) % 3, 3 * pf + l]);
+        }
+    }
+
+    let mut edge_boundary = vec![false; 3 * nf];
+    let mut edge_non_manifold = vec![false; 3 * nf];
+    for e in 0..ne {
+        let (b, m) = (p.is_boundary_edge(e), p.is_non_manifold_edge(e));
+        edge_boundary.extend_from_slice(&[b, b]);
+        edge_non_manifold.extend_from_slice(&[m, m]);
+    }
+    let mut vertex_non_manifold: Vec<bool> = (0..nv).map(|v| p.is_non_manifold_vertex(v)).collect();
+    vertex_non_manifold.extend((0..ne).map(|e| p.is_non_manifold_edge(e)));
+
+    Topology::from_parts(TopologyParts {
+        num_vertices: nv + ne,
         face_offsets,
         face_vertices,
         face_edges,
         edge_vertices,
-        &nm,
-    )
+        edge_face_offsets,
+        edge_faces,
+        edge_face_local,
+        vertex_face_offsets,
+        vertex_faces,
+        vertex_face_local,
+        vertex_edge_offsets,
+        vertex_edges,
+        edge_boundary,
+        edge_non_manifold,
+        vertex_non_manifold,
+    })
     .expect("a triangle split of a valid topology is valid")
 }
