@@ -13,23 +13,42 @@ fn derived_child_topology_matches_the_builder() {
     };
     for path in osd_meshes() {
         let name = path.file_stem().unwrap().to_string_lossy().to_string();
-        let scheme = if name.starts_with("loop_") { Scheme::Loop } else { Scheme::CatmullClark };
+        let scheme = if name.starts_with("loop_") {
+            Scheme::Loop
+        } else {
+            Scheme::CatmullClark
+        };
         let file = read_mesh(&path, &opts).unwrap();
-        let r = Refinement::new(&file.mesh.topology, scheme, &Options::from_hints(&file.mesh.hints), 2).unwrap();
+        let r = Refinement::new(
+            &file.mesh.topology,
+            scheme,
+            &Options::from_hints(&file.mesh.hints),
+            2,
+        )
+        .unwrap();
         for level in 1..=2 {
             let t = r.topology(level);
-            t.check_relations().unwrap_or_else(|e| panic!("{name} level {level}: {e}"));
+            t.check_relations()
+                .unwrap_or_else(|e| panic!("{name} level {level}: {e}"));
             // Manifold rings: edge i leaves the vertex in face i, edge i+1 arrives in it.
             for v in 0..t.num_vertices() {
                 if t.is_non_manifold_vertex(v) || t.is_isolated_vertex(v) {
                     continue;
                 }
-                let (vf, vl, ve) = (t.vertex_faces(v), t.vertex_face_local_indices(v), t.vertex_edges(v));
+                let (vf, vl, ve) = (
+                    t.vertex_faces(v),
+                    t.vertex_face_local_indices(v),
+                    t.vertex_edges(v),
+                );
                 for i in 0..vf.len() {
                     let fe = t.face_edges(vf[i] as usize);
                     let c = vl[i] as usize;
                     assert_eq!(fe[c], ve[i], "{name} L{level} v{v} leading edge {i}");
-                    assert_eq!(fe[(c + fe.len() - 1) % fe.len()], ve[(i + 1) % ve.len()], "{name} L{level} v{v} trailing {i}");
+                    assert_eq!(
+                        fe[(c + fe.len() - 1) % fe.len()],
+                        ve[(i + 1) % ve.len()],
+                        "{name} L{level} v{v} trailing {i}"
+                    );
                 }
             }
             // On a manifold base the generic builder, given the same faces, finds the same
@@ -50,13 +69,30 @@ fn derived_child_topology_matches_the_builder() {
                 .unwrap();
             let (a, b) = (TopologySummary::new(t), TopologySummary::new(&rebuilt));
             assert_eq!(
-                (a.edges, a.boundary_edges, a.nonmanifold_edges, a.nonmanifold_vertices, a.euler, &a.valences),
-                (b.edges, b.boundary_edges, b.nonmanifold_edges, b.nonmanifold_vertices, b.euler, &b.valences),
+                (
+                    a.edges,
+                    a.boundary_edges,
+                    a.nonmanifold_edges,
+                    a.nonmanifold_vertices,
+                    a.euler,
+                    &a.valences
+                ),
+                (
+                    b.edges,
+                    b.boundary_edges,
+                    b.nonmanifold_edges,
+                    b.nonmanifold_vertices,
+                    b.euler,
+                    &b.valences
+                ),
                 "{name} level {level}"
             );
             for e in 0..t.num_edges() {
                 let [x, y] = t.edge_vertices(e);
-                assert!(rebuilt.find_edge(x, y).is_some(), "{name} L{level} edge {e}");
+                assert!(
+                    rebuilt.find_edge(x, y).is_some(),
+                    "{name} L{level} edge {e}"
+                );
             }
         }
     }

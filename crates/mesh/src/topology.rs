@@ -499,7 +499,11 @@ impl Topology {
             vertex_flags,
             tags: Tags::new(nv, ne, nf),
         };
-        debug_assert!(topo.check_relations().is_ok(), "{:?}", topo.check_relations());
+        debug_assert!(
+            topo.check_relations().is_ok(),
+            "{:?}",
+            topo.check_relations()
+        );
         Ok(topo)
     }
 
@@ -517,13 +521,21 @@ impl Topology {
                 }
                 let ef = self.edge_faces(e as usize);
                 let el = self.edge_face_local_indices(e as usize);
-                if !ef.iter().zip(el).any(|(&g, &l)| g as usize == f && l as usize == i) {
+                if !ef
+                    .iter()
+                    .zip(el)
+                    .any(|(&g, &l)| g as usize == f && l as usize == i)
+                {
                     return Err(format!("edge {e} does not list face {f} at {i}"));
                 }
             }
         }
         for v in 0..self.num_vertices() {
-            for (&f, &c) in self.vertex_faces(v).iter().zip(self.vertex_face_local_indices(v)) {
+            for (&f, &c) in self
+                .vertex_faces(v)
+                .iter()
+                .zip(self.vertex_face_local_indices(v))
+            {
                 if self.face_vertices(f as usize).get(c as usize) != Some(&(v as u32)) {
                     return Err(format!("vertex {v} face {f} corner {c} mismatch"));
                 }

@@ -44,6 +44,8 @@ mod refine;
 pub mod rules;
 pub mod stencil;
 
+use std::sync::OnceLock;
+
 use subd_mesh::{
     BoundaryInterpolation, CreaseMethod, DVec3, SchemeHints, Topology, TriangleSubdivision,
 };
@@ -127,13 +129,33 @@ pub enum RefineError {
     },
 }
 
+/// One level of a refinement.
+#[derive(Debug)]
+struct Level {
+    /// Full topology with tags; built eagerly below the last level (the next level needs it)
+    /// and on first request for the last.
+    topology: OnceLock<Topology>,
+    /// Face lists of the last level, available without building its full topology.
+    faces: Option<refine::ChildFaces>,
+    /// Rule of every vertex.
+    rules: Vec<Rule>,
+    /// Number of vertices.
+    num_vertices: usize,
+}
+
 /// A uniform refinement: the topology of every level and the stencils between levels.
-#[derive(Debug, Clone)]
+///
+/// The work OpenSubdiv's `TopologyRefiner` and `PrimvarRefiner` do is split the same way: the
+/// constructor derives every level's topology and vertex rules; [`Self::refine_points`] (or
+/// [`Self::refine_values`]) evaluates the masks level by level. Stencil tables and the last
+/// level's full topology (edges, rings, tags) are built on first request, so a refinement that
+/// only needs the final faces and positions does not pay for them.
+#[derive(Debug)]
 pub struct Refinement {
     scheme: Scheme,
     options: Options,
-    levels: Vec<refine::Level>,
-    stencils: Vec<StencilTable>,
+    levels: Vec<Level>,
+    stencils: Vec<OnceLock<StencilTable>>,
 }
 
 impl Refinement {
@@ -158,24 +180,45 @@ impl Refinement {
                 size: base.face_size(f),
             });
         }
+        let (t0, rules0) = refine::prepare_base(base, scheme, options);
         let mut r = Refinement {
             scheme,
             options: *options,
-            levels: vec![refine::prepare_base(base, scheme, options)],
-            stencils: Vec::with_capacity(levels),
+            levels: vec![Level {
+                num_vertices: t0.num_vertices(),
+                topology: OnceLock::from(t0),
+                faces: None,
+                rules: rules0,
+            }],
+            stencils: (0..levels).map(|_| OnceLock::new()).collect(),
         };
         for l in 1..=levels {
-            let p = &r.levels[l - 1].topology;
-            let growth = match scheme {
-                Scheme::Loop => 4 * p.num_face_vertices() as u64,
-                _ => 4 * p.num_face_vertices() as u64,
-            };
-            if growth >= u32::MAX as u64 / 2 {
+            let p = r.levels[l - 1]
+                .topology
+                .get()
+                .expect("parent level is built");
+            // Each level multiplies face-vertices by 4 (quad split) or 4 (triangles, 3 → 12).
+            if 4 * p.num_face_vertices() as u64 + 4 * p.num_edges() as u64 >= u32::MAX as u64 {
                 return Err(RefineError::TooLarge { level: l });
             }
-            let (child, st) = refine::refine_level(&r.levels[l - 1], scheme, options);
-            r.levels.push(child);
-            r.stencils.push(st);
+            let layout = refine::Layout::new(p, scheme);
+            let rules = refine::child_rules(p, &r.levels[l - 1].rules, options, layout);
+            let level = if l < levels {
+                Level {
+                    num_vertices: layout.num_child_vertices,
+                    topology: OnceLock::from(refine::child_topology(p, scheme, options, layout)),
+                    faces: None,
+                    rules,
+                }
+            } else {
+                Level {
+                    num_vertices: layout.num_child_vertices,
+                    topology: OnceLock::new(),
+                    faces: Some(refine::child_faces(p, scheme)),
+                    rules,
+                }
+            };
+            r.levels.push(level);
         }
         Ok(r)
     }
@@ -195,9 +238,38 @@ impl Refinement {
         self.levels.len() - 1
     }
 
-    /// Topology of `level` (0 = base, with the boundary rules applied to its tags).
+    /// Number of vertices of `level`.
+    pub fn num_vertices(&self, level: usize) -> usize {
+        self.levels[level].num_vertices
+    }
+
+    /// Face offsets and face-vertex indices of `level`, without building its full topology.
+    pub fn faces(&self, level: usize) -> (&[u32], &[u32]) {
+        match &self.levels[level].faces {
+            Some(f) => (&f.offsets, &f.vertices),
+            None => {
+                let t = self.topology(level);
+                (t.face_offsets(), t.all_face_vertices())
+            }
+        }
+    }
+
+    /// Hole flags of the faces of `level`.
+    pub fn holes(&self, level: usize) -> &[bool] {
+        match &self.levels[level].faces {
+            Some(f) => &f.holes,
+            None => self.topology(level).tags().holes(),
+        }
+    }
+
+    /// Topology of `level` (0 = base, with the boundary rules applied to its tags), built on
+    /// first request for the last level.
     pub fn topology(&self, level: usize) -> &Topology {
-        &self.levels[level].topology
+        self.levels[level].topology.get_or_init(|| {
+            let p = self.topology(level - 1);
+            let layout = refine::Layout::new(p, self.scheme);
+            refine::child_topology(p, self.scheme, &self.options, layout)
+        })
     }
 
     /// The rule of every vertex of `level`.
@@ -205,25 +277,47 @@ impl Refinement {
         &self.levels[level].rules
     }
 
-    /// Stencils giving the vertices of `level` from those of `level - 1` (`level ≥ 1`).
+    fn step(&self, level: usize) -> refine::Step<'_> {
+        let p = self.topology(level - 1);
+        refine::Step {
+            parent: p,
+            parent_rules: &self.levels[level - 1].rules,
+            child_rules: &self.levels[level].rules,
+            scheme: self.scheme,
+            options: &self.options,
+            layout: refine::Layout::new(p, self.scheme),
+        }
+    }
+
+    /// Stencils giving the vertices of `level` from those of `level - 1` (`level ≥ 1`), built
+    /// on first request.
     pub fn stencils(&self, level: usize) -> &StencilTable {
-        &self.stencils[level - 1]
+        self.stencils[level - 1].get_or_init(|| self.step(level).stencils())
     }
 
     /// One table from the base vertices to the vertices of `level`.
     pub fn composed(&self, level: usize) -> StencilTable {
-        let mut t = StencilTable::identity(self.levels[0].topology.num_vertices());
+        let mut t = StencilTable::identity(self.levels[0].num_vertices);
         for l in 1..=level {
-            t = t.then(&self.stencils[l - 1]);
+            t = t.then(self.stencils(l));
         }
         t
     }
 
-    /// Positions of every level from base positions, level by level (`result[0]` is `base`).
+    /// Positions of every level from base positions (`result[0]` is `base`), evaluating the
+    /// masks directly, level by level, in parallel.
+    ///
+    /// # Panics
+    /// If `base.len()` differs from the number of base vertices.
     pub fn refine_points(&self, base: &[DVec3]) -> Vec<Vec<DVec3>> {
+        assert_eq!(
+            base.len(),
+            self.levels[0].num_vertices,
+            "one position per base vertex"
+        );
         let mut out = vec![base.to_vec()];
-        for st in &self.stencils {
-            let next = st.apply_points(out.last().expect("level 0"));
+        for l in 1..self.levels.len() {
+            let next = self.step(l).points(out.last().expect("level 0"));
             out.push(next);
         }
         out

@@ -113,12 +113,12 @@ pub fn child_vertex_sharpness(s: f32) -> f32 {
 /// (`Sdc::Crease::ComputeFractionalWeightAtVertex`): the mean sharpness of what decayed — the
 /// vertex itself if its sharpness reached 0, and each semi-sharp edge that "transitions"
 /// (uniform: every edge with `0 < s ≤ 1`; Chaikin: every sharp edge whose child is smooth) —
-/// clamped to 1. `f32` throughout, in vertex-edge order.
+/// clamped to 1. `edges` yields (parent, child) sharpness per incident edge in vertex-edge
+/// order; `f32` throughout.
 pub fn fractional_weight(
     parent_vertex: f32,
     child_vertex: f32,
-    parent_edges: &[f32],
-    child_edges: &[f32],
+    edges: impl IntoIterator<Item = (f32, f32)>,
     method: CreaseMethod,
 ) -> f32 {
     let mut sum = 0.0f32;
@@ -127,7 +127,7 @@ pub fn fractional_weight(
         sum = parent_vertex;
         n = 1;
     }
-    for (&p, &c) in parent_edges.iter().zip(child_edges) {
+    for (p, c) in edges {
         let include = match method {
             CreaseMethod::Uniform => p > 0.0 && p <= 1.0,
             CreaseMethod::Chaikin => p > 0.0 && c <= 0.0,
@@ -141,20 +141,24 @@ pub fn fractional_weight(
     w.min(1.0)
 }
 
-/// Positions, in vertex-edge order, of the two edges a crease mask uses: the first sharp
-/// edge from the front and the first from the back (`Sdc::Crease::GetSharpEdgePairOfCrease`).
-pub fn crease_pair(edge_sharpness: &[f32]) -> (usize, usize) {
-    let first = edge_sharpness.iter().position(|&s| s > 0.0).unwrap_or(0);
-    let last = edge_sharpness
-        .iter()
-        .rposition(|&s| s > 0.0)
-        .unwrap_or(first);
+/// Positions, among `count` incident edges in vertex-edge order, of the two edges a crease
+/// mask uses: the first sharp edge from the front and the first from the back
+/// (`Sdc::Crease::GetSharpEdgePairOfCrease`).
+pub fn crease_pair(count: usize, is_sharp: impl Fn(usize) -> bool) -> (usize, usize) {
+    let first = (0..count).find(|&i| is_sharp(i)).unwrap_or(0);
+    let last = (0..count).rev().find(|&i| is_sharp(i)).unwrap_or(first);
     (first, last)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn crease_pair_takes_outermost_sharp_edges() {
+        let s = [0.0f32, 2.0, 0.0, 1.0, 0.0];
+        assert_eq!(crease_pair(s.len(), |i| s[i] > 0.0), (1, 3));
+    }
 
     #[test]
     fn rules_by_sharp_edge_count() {
@@ -200,7 +204,12 @@ mod tests {
         );
         assert_eq!(w, 0.75);
         // A decayed vertex sharpness counts too, and the mean is clamped at 1.
-        let w = fractional_weight(3.0, 0.0, &[], &[], CreaseMethod::Uniform);
+        let w = fractional_weight(3.0, 0.0, [], CreaseMethod::Uniform);
         assert_eq!(w, 1.0);
+        // Chaikin counts the edges whose child became smooth.
+        let w = fractional_weight(0.0, 0.0, [(1.5, 0.0), (2.5, 0.5)], CreaseMethod::Chaikin);
+        assert_eq!(w, 1.0);
+        let w = fractional_weight(0.0, 0.0, [(0.25, 0.0), (0.75, 0.0)], CreaseMethod::Chaikin);
+        assert_eq!(w, 0.5);
     }
 }

@@ -1,8 +1,12 @@
-//! One uniform refinement step: child topology, child tags and rules, and the stencils that
-//! give child vertices from parent vertices, following OpenSubdiv's Far/Vtr/Sdc behaviour.
+//! One uniform refinement step, following OpenSubdiv's Far/Vtr/Sdc behaviour: the child
+//! topology and its tags, the rule of every child vertex, and the masks that give child
+//! vertices from parent vertices — evaluated directly into positions, or recorded as a
+//! [`StencilTable`].
 
 mod split;
 
+use glam::DVec3;
+use rayon::prelude::*;
 use subd_mesh::tags::{SHARPNESS_INFINITE, is_infinite, is_semi_sharp};
 use subd_mesh::{BoundaryInterpolation, CreaseMethod, Topology, TriangleSubdivision};
 
@@ -10,13 +14,8 @@ use crate::rules::{self, Rule};
 use crate::stencil::{RowSink, StencilTable};
 use crate::{Options, Scheme};
 
-/// A refinement level: topology with its tags (sharpness after the boundary rules) and the
-/// rule of every vertex.
-#[derive(Debug, Clone)]
-pub(crate) struct Level {
-    pub topology: Topology,
-    pub rules: Vec<Rule>,
-}
+/// Rows per parallel task when evaluating points.
+const CHUNK: usize = 4096;
 
 /// OpenSubdiv's notion of a non-manifold vertex includes isolated ones.
 fn nm_vertex(t: &Topology, v: usize) -> bool {
@@ -28,7 +27,11 @@ fn nm_vertex(t: &Topology, v: usize) -> bool {
 /// non-manifold edges become infinitely sharp, non-manifold vertices (except interior "fin"
 /// vertices) and, with edge-and-corner, one-face corners become infinitely sharp, and with
 /// boundary `None` the faces around unsharpened boundaries become holes.
-pub(crate) fn prepare_base(base: &Topology, scheme: Scheme, options: &Options) -> Level {
+pub(crate) fn prepare_base(
+    base: &Topology,
+    scheme: Scheme,
+    options: &Options,
+) -> (Topology, Vec<Rule>) {
     let mut t = base.clone();
     if options.boundary_interpolation == BoundaryInterpolation::None && scheme != Scheme::Bilinear {
         let mut holes = Vec::new();
@@ -74,7 +77,7 @@ pub(crate) fn prepare_base(base: &Topology, scheme: Scheme, options: &Options) -
         }
         rules.push(Rule::determine(t.vertex_sharpness(v), sharp));
     }
-    Level { topology: t, rules }
+    (t, rules)
 }
 
 /// Sharpness of the half of parent edge `e` at its end vertex `u`.
@@ -92,177 +95,524 @@ fn half_sharpness(p: &Topology, e: usize, u: usize, method: CreaseMethod) -> f32
 }
 
 /// Where the children of a parent level live in the child level.
-#[derive(Clone, Copy)]
-struct Layout {
-    /// First face-child vertex (quad split) — equal to `edge_vertex_base` for Loop.
-    face_vertex_base: u32,
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Layout {
+    /// Number of parent vertices (= first face-child vertex).
+    pub face_vertex_base: u32,
     /// First edge-child vertex.
-    edge_vertex_base: u32,
+    pub edge_vertex_base: u32,
     /// First child edge that is a half of a parent edge.
-    half_edge_base: u32,
+    pub half_edge_base: u32,
+    /// Number of child vertices.
+    pub num_child_vertices: usize,
 }
 
-/// Refines `parent` one level: the child level and the stencils of its vertices.
-pub(crate) fn refine_level(
-    parent: &Level,
-    scheme: Scheme,
-    options: &Options,
-) -> (Level, StencilTable) {
-    let p = &parent.topology;
-    let method = options.crease_method;
-    let (nv, nf, ne) = (
-        p.num_vertices() as u32,
-        p.num_faces() as u32,
-        p.num_edges() as u32,
-    );
-    let (mut child, layout) = match scheme {
-        Scheme::Loop => (
-            split::tri_split(p),
-            Layout {
+impl Layout {
+    pub(crate) fn new(p: &Topology, scheme: Scheme) -> Layout {
+        let (nv, nf, ne) = (
+            p.num_vertices() as u32,
+            p.num_faces() as u32,
+            p.num_edges() as u32,
+        );
+        match scheme {
+            Scheme::Loop => Layout {
                 face_vertex_base: nv,
                 edge_vertex_base: nv,
                 half_edge_base: 3 * nf,
+                num_child_vertices: (nv + ne) as usize,
             },
-        ),
-        Scheme::CatmullClark | Scheme::Bilinear => (
-            split::quad_split(p),
-            Layout {
+            _ => Layout {
                 face_vertex_base: nv,
                 edge_vertex_base: nv + nf,
                 half_edge_base: p.num_face_vertices() as u32,
+                num_child_vertices: (nv + nf + ne) as usize,
             },
-        ),
-    };
+        }
+    }
+}
 
-    // Holes: children of holes are holes.
-    for f in 0..nf as usize {
+/// Faces of a child level without the other relations: what a last level needs for output.
+#[derive(Debug, Clone)]
+pub(crate) struct ChildFaces {
+    pub offsets: Vec<u32>,
+    pub vertices: Vec<u32>,
+    pub holes: Vec<bool>,
+}
+
+/// Hole flags of the child faces: children of holes are holes.
+fn child_holes(p: &Topology, scheme: Scheme, num_child_faces: usize) -> Vec<bool> {
+    let mut holes = vec![false; num_child_faces];
+    for f in 0..p.num_faces() {
         if p.is_hole(f) {
             let children = match scheme {
                 Scheme::Loop => 4 * f..4 * f + 4,
                 _ => p.face_offsets()[f] as usize..p.face_offsets()[f + 1] as usize,
             };
-            for c in children {
-                child.set_hole(c, true);
-            }
+            holes[children].fill(true);
         }
     }
-    // Edge sharpness: interior child edges are smooth, halves decay.
-    for e in 0..ne as usize {
+    holes
+}
+
+/// The child faces only (face-vertex lists and holes).
+pub(crate) fn child_faces(p: &Topology, scheme: Scheme) -> ChildFaces {
+    let (offsets, vertices) = match scheme {
+        Scheme::Loop => split::tri_faces(p),
+        _ => split::quad_faces(p),
+    };
+    let holes = child_holes(p, scheme, offsets.len() - 1);
+    ChildFaces {
+        offsets,
+        vertices,
+        holes,
+    }
+}
+
+/// The full child topology with its tags: holes, decayed edge and vertex sharpness.
+pub(crate) fn child_topology(
+    p: &Topology,
+    scheme: Scheme,
+    options: &Options,
+    layout: Layout,
+) -> Topology {
+    let mut child = match scheme {
+        Scheme::Loop => split::tri_split(p),
+        _ => split::quad_split(p),
+    };
+    for (f, h) in child_holes(p, scheme, child.num_faces())
+        .into_iter()
+        .enumerate()
+    {
+        if h {
+            child.set_hole(f, true);
+        }
+    }
+    let method = options.crease_method;
+    for e in 0..p.num_edges() {
         let [a, b] = p.edge_vertices(e);
         let h = layout.half_edge_base as usize + 2 * e;
         child.set_edge_sharpness(h, half_sharpness(p, e, a as usize, method));
         child.set_edge_sharpness(h + 1, half_sharpness(p, e, b as usize, method));
     }
-    // Vertex sharpness: only vertex-children inherit (decayed).
-    for v in 0..nv as usize {
+    for v in 0..p.num_vertices() {
         child.set_vertex_sharpness(v, rules::child_vertex_sharpness(p.vertex_sharpness(v)));
     }
+    child
+}
 
-    // Rules (`Vtr::Refinement::propagateComponentTags` and `reclassifySemisharpVertices`).
-    let mut child_rules = vec![Rule::Smooth; child.num_vertices()];
-    for v in 0..nv as usize {
-        let mut rule = parent.rules[v];
-        let (ps, cs) = (p.vertex_sharpness(v), child.vertex_sharpness(v));
-        let semi_edges = p
-            .vertex_edges(v)
+/// The rule of every child vertex (`Vtr::Refinement::propagateComponentTags` and
+/// `reclassifySemisharpVertices`), from the parent alone.
+pub(crate) fn child_rules(
+    p: &Topology,
+    parent_rules: &[Rule],
+    options: &Options,
+    layout: Layout,
+) -> Vec<Rule> {
+    let method = options.crease_method;
+    let mut out = vec![Rule::Smooth; layout.num_child_vertices];
+    for (v, slot) in out.iter_mut().enumerate().take(p.num_vertices()) {
+        let mut rule = parent_rules[v];
+        let ps = p.vertex_sharpness(v);
+        let cs = rules::child_vertex_sharpness(ps);
+        let ve = p.vertex_edges(v);
+        let semi_edges = ve
             .iter()
             .any(|&e| is_semi_sharp(p.edge_sharpness(e as usize)));
         if (is_semi_sharp(ps) || semi_edges) && (semi_edges || (ps > 0.0 && cs <= 0.0)) && cs <= 0.0
         {
-            let sharp = p
-                .vertex_edges(v)
+            let sharp = ve
                 .iter()
                 .filter(|&&e| half_sharpness(p, e as usize, v, method) > 0.0)
                 .count();
             rule = Rule::determine(0.0, sharp);
         }
-        child_rules[v] = rule;
+        *slot = rule;
     }
-    for e in 0..ne as usize {
+    for e in 0..p.num_edges() {
         let s = p.edge_sharpness(e);
-        let h = layout.half_edge_base as usize + 2 * e;
         let rule = if is_infinite(s) {
             Rule::Crease
         } else if s > 0.0 {
-            let semi = [h, h + 1]
-                .iter()
-                .filter(|&&c| child.edge_sharpness(c) > 0.0)
-                .count();
+            let [a, b] = p.edge_vertices(e);
+            let semi = (half_sharpness(p, e, a as usize, method) > 0.0) as usize
+                + (half_sharpness(p, e, b as usize, method) > 0.0) as usize;
             [Rule::Smooth, Rule::Dart, Rule::Crease][semi]
         } else {
             Rule::Smooth
         };
-        child_rules[(layout.edge_vertex_base + e as u32) as usize] = rule;
+        out[layout.edge_vertex_base as usize + e] = rule;
     }
-
-    let stencils = match scheme {
-        Scheme::Bilinear => bilinear_stencils(p, layout, child.num_vertices()),
-        _ => smooth_stencils(parent, &child, &child_rules, scheme, options, layout),
-    };
-    (
-        Level {
-            topology: child,
-            rules: child_rules,
-        },
-        stencils,
-    )
+    out
 }
 
-/// Adds the face point of parent face `f`, times `w`, to a row: `w/n` on each face vertex.
-#[inline]
-fn add_face_point(p: &Topology, f: usize, w: f64, sink: &mut RowSink) {
-    let fv = p.face_vertices(f);
-    let inv = 1.0 / fv.len() as f64;
-    for &v in fv {
-        sink.add(v, w * inv);
+/// Where a mask's weights go: a stencil row (face points expanded onto the parent face's
+/// vertices) or a point being accumulated (face points read from the child level).
+pub(crate) trait MaskSink {
+    /// Adds `w` times parent vertex `i`.
+    fn vertex(&mut self, i: u32, w: f64);
+    /// Adds `w` times the face point of parent face `f`.
+    fn face(&mut self, p: &Topology, f: usize, w: f64);
+}
+
+impl MaskSink for RowSink<'_> {
+    #[inline]
+    fn vertex(&mut self, i: u32, w: f64) {
+        self.add(i, w);
+    }
+    #[inline]
+    fn face(&mut self, p: &Topology, f: usize, w: f64) {
+        let fv = p.face_vertices(f);
+        let inv = 1.0 / fv.len() as f64;
+        for &v in fv {
+            self.add(v, w * inv);
+        }
     }
 }
 
-fn bilinear_stencils(p: &Topology, layout: Layout, num_rows: usize) -> StencilTable {
-    let nv = p.num_vertices();
-    StencilTable::build(num_rows, nv, |r, sink| {
+/// Accumulates a child point from parent points and the already computed child face points.
+struct PointSink<'a> {
+    src: &'a [DVec3],
+    face_points: &'a [DVec3],
+    acc: DVec3,
+}
+
+impl MaskSink for PointSink<'_> {
+    #[inline]
+    fn vertex(&mut self, i: u32, w: f64) {
+        self.acc += w * self.src[i as usize];
+    }
+    #[inline]
+    fn face(&mut self, _p: &Topology, f: usize, w: f64) {
+        self.acc += w * self.face_points[f];
+    }
+}
+
+/// Everything a child row needs.
+pub(crate) struct Step<'a> {
+    pub parent: &'a Topology,
+    pub parent_rules: &'a [Rule],
+    pub child_rules: &'a [Rule],
+    pub scheme: Scheme,
+    pub options: &'a Options,
+    pub layout: Layout,
+}
+
+impl Step<'_> {
+    /// The mask of child vertex `r` into `sink`.
+    fn row<S: MaskSink>(&self, r: usize, sink: &mut S) {
+        let p = self.parent;
         let r32 = r as u32;
-        if r < nv {
-            sink.add(r32, 1.0);
-        } else if r32 < layout.edge_vertex_base {
-            add_face_point(p, (r32 - layout.face_vertex_base) as usize, 1.0, sink);
+        let l = self.layout;
+        if r32 < l.face_vertex_base {
+            match self.scheme {
+                Scheme::Bilinear => sink.vertex(r32, 1.0),
+                _ => self.vertex_row(r, sink),
+            }
+        } else if r32 < l.edge_vertex_base {
+            let f = (r32 - l.face_vertex_base) as usize;
+            let fv = p.face_vertices(f);
+            let inv = 1.0 / fv.len() as f64;
+            for &v in fv {
+                sink.vertex(v, inv);
+            }
         } else {
-            let [a, b] = p.edge_vertices((r32 - layout.edge_vertex_base) as usize);
-            sink.add(a, 0.5);
-            sink.add(b, 0.5);
-        }
-    })
-}
-
-/// Weights of a vertex mask: on the vertex, on each incident edge's far end (vertex-edge
-/// order) and on each incident face (vertex-face order; face points for Catmull-Clark).
-#[derive(Default, Clone)]
-struct VertexMask {
-    vertex: f64,
-    edges: Option<Vec<f64>>,
-    faces: Option<Vec<f64>>,
-}
-
-fn smooth_vertex_mask(p: &Topology, v: usize, scheme: Scheme) -> VertexMask {
-    let nf = p.vertex_faces(v).len();
-    let ne = p.valence(v);
-    match scheme {
-        Scheme::Loop => {
-            let (e, vw) = loop_smooth_weights(nf);
-            VertexMask {
-                vertex: vw,
-                edges: Some(vec![e; ne]),
-                faces: None,
+            let e = (r32 - l.edge_vertex_base) as usize;
+            match self.scheme {
+                Scheme::Bilinear => {
+                    let [a, b] = p.edge_vertices(e);
+                    sink.vertex(a, 0.5);
+                    sink.vertex(b, 0.5);
+                }
+                _ => self.edge_row(e, self.child_rules[r], sink),
             }
         }
-        _ => {
-            let n = nf as f64;
-            let w = 1.0 / (nf * nf) as f64;
-            VertexMask {
-                vertex: (n - 2.0) / n,
-                edges: Some(vec![w; ne]),
-                faces: Some(vec![w; nf]),
+    }
+
+    /// Stencil of the child of parent edge `e` (`Sdc::Scheme::ComputeEdgeVertexMask`).
+    fn edge_row<S: MaskSink>(&self, e: usize, child_rule: Rule, sink: &mut S) {
+        let p = self.parent;
+        let [a, b] = p.edge_vertices(e);
+        let s = p.edge_sharpness(e);
+        if s > 0.0 && child_rule == Rule::Crease {
+            sink.vertex(a, 0.5);
+            sink.vertex(b, 0.5);
+            return;
+        }
+        let faces = p.edge_faces(e);
+        let nf = faces.len();
+        let (mut vw, mut fw) = match self.scheme {
+            Scheme::Loop => (
+                0.375,
+                if nf == 2 {
+                    0.125
+                } else {
+                    0.125 * 2.0 / nf as f64
+                },
+            ),
+            _ if nf == 2 => {
+                let tri = |f: u32| p.face_size(f as usize) == 3;
+                if self.options.triangle_subdivision == TriangleSubdivision::Smooth
+                    && (tri(faces[0]) || tri(faces[1]))
+                {
+                    let wt = |f: u32| if tri(f) { 0.470 } else { 0.25 };
+                    let f = 0.5 * (wt(faces[0]) + wt(faces[1]));
+                    (0.5 * (1.0 - 2.0 * f), f)
+                } else {
+                    (0.25, 0.25)
+                }
             }
+            _ => (0.25, 0.5 / nf as f64),
+        };
+        if s > 0.0 {
+            // A semi-sharp edge whose child is no longer a crease: blend by the parent
+            // sharpness (not clamped: Chaikin can extrapolate).
+            let pw = s as f64;
+            let cw = 1.0 - pw;
+            vw = pw * 0.5 + cw * vw;
+            fw *= cw;
+        }
+        sink.vertex(a, vw);
+        sink.vertex(b, vw);
+        for (&f, &l) in faces.iter().zip(p.edge_face_local_indices(e)) {
+            match self.scheme {
+                Scheme::Loop => {
+                    // The vertex opposite the edge, from the edge's first position in the face.
+                    let fe = p.face_edges(f as usize);
+                    let k = if fe[0] as usize == e {
+                        0
+                    } else if fe[1] as usize == e {
+                        1
+                    } else {
+                        l as usize
+                    };
+                    sink.vertex(p.face_vertices(f as usize)[(k + 2) % 3], fw);
+                }
+                _ => sink.face(p, f as usize, fw),
+            }
+        }
+    }
+
+    /// Stencil of the child of parent vertex `v` (`Sdc::Scheme::ComputeVertexVertexMask`).
+    fn vertex_row<S: MaskSink>(&self, v: usize, sink: &mut S) {
+        let p = self.parent;
+        let prule = self.parent_rules[v];
+        let crule = self.child_rules[v];
+        let mask = match prule {
+            Rule::Smooth | Rule::Dart => Mask::smooth(p, v, self.scheme),
+            _ => {
+                let pmask = Mask::for_rule(p, v, prule, self.scheme, |e| p.edge_sharpness(e));
+                if crule == prule {
+                    pmask
+                } else {
+                    let method = self.options.crease_method;
+                    let half = |e: usize| half_sharpness(p, e, v, method);
+                    let cmask = Mask::for_rule(p, v, crule, self.scheme, half);
+                    let ps = p.vertex_sharpness(v);
+                    let pw =
+                        fractional_weight_at(p, v, ps, rules::child_vertex_sharpness(ps), method);
+                    return self.emit_blend(v, &pmask, &cmask, pw as f64, sink);
+                }
+            }
+        };
+        self.emit(v, &mask, sink);
+    }
+
+    fn emit<S: MaskSink>(&self, v: usize, m: &Mask, sink: &mut S) {
+        let p = self.parent;
+        if m.has_faces() {
+            for (i, &f) in p.vertex_faces(v).iter().enumerate() {
+                sink.face(p, f as usize, m.face(i));
+            }
+        }
+        if m.has_edges() {
+            for (i, &e) in p.vertex_edges(v).iter().enumerate() {
+                sink.vertex(p.edge_other_vertex(e as usize, v as u32), m.edge(i));
+            }
+        }
+        sink.vertex(v as u32, m.vertex());
+    }
+
+    /// Emits `pw · parent + (1 − pw) · child` (`Sdc::Scheme::LocalMask::
+    /// CombineVertexVertexMasks`).
+    fn emit_blend<S: MaskSink>(&self, v: usize, pm: &Mask, cm: &Mask, pw: f64, sink: &mut S) {
+        let p = self.parent;
+        let cw = 1.0 - pw;
+        let mix = |has_p: bool, a: f64, has_c: bool, b: f64| match (has_p, has_c) {
+            (true, true) => pw * a + cw * b,
+            (true, false) => pw * a,
+            (false, true) => cw * b,
+            (false, false) => 0.0,
+        };
+        if pm.has_faces() || cm.has_faces() {
+            for (i, &f) in p.vertex_faces(v).iter().enumerate() {
+                let w = mix(pm.has_faces(), pm.face(i), cm.has_faces(), cm.face(i));
+                sink.face(p, f as usize, w);
+            }
+        }
+        if pm.has_edges() || cm.has_edges() {
+            for (i, &e) in p.vertex_edges(v).iter().enumerate() {
+                let w = mix(pm.has_edges(), pm.edge(i), cm.has_edges(), cm.edge(i));
+                sink.vertex(p.edge_other_vertex(e as usize, v as u32), w);
+            }
+        }
+        sink.vertex(v as u32, pw * pm.vertex() + cw * cm.vertex());
+    }
+
+    /// The stencil table of this step.
+    pub(crate) fn stencils(&self) -> StencilTable {
+        StencilTable::build(
+            self.layout.num_child_vertices,
+            self.parent.num_vertices(),
+            |r, sink| self.row(r, sink),
+        )
+    }
+
+    /// Child points from parent points: face points first, then vertex and edge points,
+    /// which use them (the order of OpenSubdiv's `PrimvarRefiner`). Parallel over rows; each
+    /// row is computed alone, so the result does not depend on the number of threads.
+    pub(crate) fn points(&self, src: &[DVec3]) -> Vec<DVec3> {
+        let l = self.layout;
+        let nv = l.face_vertex_base as usize;
+        let nfp = (l.edge_vertex_base - l.face_vertex_base) as usize;
+        let mut out = vec![DVec3::ZERO; l.num_child_vertices];
+        let (vertex_part, rest) = out.split_at_mut(nv);
+        let (face_part, edge_part) = rest.split_at_mut(nfp);
+        face_part
+            .par_chunks_mut(CHUNK)
+            .enumerate()
+            .for_each(|(c, chunk)| {
+                for (k, o) in chunk.iter_mut().enumerate() {
+                    let mut s = PointSink {
+                        src,
+                        face_points: &[],
+                        acc: DVec3::ZERO,
+                    };
+                    self.row(nv + c * CHUNK + k, &mut s);
+                    *o = s.acc;
+                }
+            });
+        let face_points: &[DVec3] = face_part;
+        let fill = |first: usize, chunk: &mut [DVec3]| {
+            for (k, o) in chunk.iter_mut().enumerate() {
+                let mut s = PointSink {
+                    src,
+                    face_points,
+                    acc: DVec3::ZERO,
+                };
+                self.row(first + k, &mut s);
+                *o = s.acc;
+            }
+        };
+        rayon::join(
+            || {
+                vertex_part
+                    .par_chunks_mut(CHUNK)
+                    .enumerate()
+                    .for_each(|(c, chunk)| fill(c * CHUNK, chunk))
+            },
+            || {
+                edge_part
+                    .par_chunks_mut(CHUNK)
+                    .enumerate()
+                    .for_each(|(c, chunk)| fill(l.edge_vertex_base as usize + c * CHUNK, chunk))
+            },
+        );
+        out
+    }
+}
+
+/// A vertex mask without storage: weights are computed per incident edge or face.
+enum Mask {
+    /// Uniform edge and face weights (Catmull-Clark) or edge weights only (Loop).
+    Smooth {
+        vertex: f64,
+        edge: f64,
+        face: Option<f64>,
+    },
+    /// 3/4 on the vertex, 1/8 on the two crease neighbours (positions in vertex-edge order).
+    Crease { pair: (usize, usize) },
+    /// The vertex itself.
+    Corner,
+}
+
+impl Mask {
+    fn smooth(p: &Topology, v: usize, scheme: Scheme) -> Mask {
+        let nf = p.vertex_faces(v).len();
+        match scheme {
+            Scheme::Loop => {
+                let (e, vw) = loop_smooth_weights(nf);
+                Mask::Smooth {
+                    vertex: vw,
+                    edge: e,
+                    face: None,
+                }
+            }
+            _ => {
+                let n = nf as f64;
+                let w = 1.0 / (nf * nf) as f64;
+                Mask::Smooth {
+                    vertex: (n - 2.0) / n,
+                    edge: w,
+                    face: Some(w),
+                }
+            }
+        }
+    }
+
+    /// The mask of `rule`, with `sharpness(e)` the sharpness used to find crease edges.
+    fn for_rule(
+        p: &Topology,
+        v: usize,
+        rule: Rule,
+        scheme: Scheme,
+        sharpness: impl Fn(usize) -> f32,
+    ) -> Mask {
+        match rule {
+            Rule::Smooth | Rule::Dart => Mask::smooth(p, v, scheme),
+            Rule::Crease => {
+                let ve = p.vertex_edges(v);
+                Mask::Crease {
+                    pair: rules::crease_pair(ve.len(), |i| sharpness(ve[i] as usize) > 0.0),
+                }
+            }
+            Rule::Corner => Mask::Corner,
+        }
+    }
+
+    fn has_faces(&self) -> bool {
+        matches!(self, Mask::Smooth { face: Some(_), .. })
+    }
+
+    fn has_edges(&self) -> bool {
+        !matches!(self, Mask::Corner)
+    }
+
+    fn vertex(&self) -> f64 {
+        match self {
+            Mask::Smooth { vertex, .. } => *vertex,
+            Mask::Crease { .. } => 0.75,
+            Mask::Corner => 1.0,
+        }
+    }
+
+    fn edge(&self, i: usize) -> f64 {
+        match self {
+            Mask::Smooth { edge, .. } => *edge,
+            Mask::Crease { pair } => {
+                if i == pair.0 || i == pair.1 {
+                    0.125
+                } else {
+                    0.0
+                }
+            }
+            Mask::Corner => 0.0,
+        }
+    }
+
+    fn face(&self, _i: usize) -> f64 {
+        match self {
+            Mask::Smooth { face: Some(f), .. } => *f,
+            _ => 0.0,
         }
     }
 }
@@ -280,215 +630,18 @@ fn loop_smooth_weights(n: usize) -> (f64, f64) {
     (e, 1.0 - e * n as f64)
 }
 
-fn crease_vertex_mask(ne: usize, pair: (usize, usize)) -> VertexMask {
-    let mut edges = vec![0.0; ne];
-    edges[pair.0] = 0.125;
-    edges[pair.1] = 0.125;
-    VertexMask {
-        vertex: 0.75,
-        edges: Some(edges),
-        faces: None,
-    }
-}
-
-fn corner_vertex_mask() -> VertexMask {
-    VertexMask {
-        vertex: 1.0,
-        edges: None,
-        faces: None,
-    }
-}
-
-fn mask_for_rule(
-    p: &Topology,
-    v: usize,
-    rule: Rule,
-    scheme: Scheme,
-    edge_sharpness: &[f32],
-) -> VertexMask {
-    match rule {
-        Rule::Smooth | Rule::Dart => smooth_vertex_mask(p, v, scheme),
-        Rule::Crease => crease_vertex_mask(p.valence(v), rules::crease_pair(edge_sharpness)),
-        Rule::Corner => corner_vertex_mask(),
-    }
-}
-
-/// Blends two masks: `pw · parent + (1 − pw) · child` (`Sdc::Scheme::LocalMask::
-/// CombineVertexVertexMasks`).
-fn combine(parent: VertexMask, child: VertexMask, pw: f64) -> VertexMask {
-    let cw = 1.0 - pw;
-    let mix = |a: Option<Vec<f64>>, b: Option<Vec<f64>>| match (a, b) {
-        (None, None) => None,
-        (Some(a), None) => Some(a.iter().map(|x| pw * x).collect()),
-        (None, Some(b)) => Some(b.iter().map(|x| cw * x).collect()),
-        (Some(a), Some(b)) => Some(a.iter().zip(&b).map(|(x, y)| pw * x + cw * y).collect()),
-    };
-    VertexMask {
-        vertex: pw * parent.vertex + cw * child.vertex,
-        edges: mix(parent.edges, child.edges),
-        faces: mix(parent.faces, child.faces),
-    }
-}
-
-fn smooth_stencils(
-    parent: &Level,
-    child: &Topology,
-    child_rules: &[Rule],
-    scheme: Scheme,
-    options: &Options,
-    layout: Layout,
-) -> StencilTable {
-    let p = &parent.topology;
-    let nv = p.num_vertices();
-    let method = options.crease_method;
-    StencilTable::build(child.num_vertices(), nv, |r, sink| {
-        let r32 = r as u32;
-        if r < nv {
-            vertex_row(parent, child, child_rules, scheme, method, r, sink);
-        } else if r32 < layout.edge_vertex_base {
-            add_face_point(p, (r32 - layout.face_vertex_base) as usize, 1.0, sink);
+/// [`rules::fractional_weight`] over the edges of parent vertex `v`, without allocating.
+fn fractional_weight_at(p: &Topology, v: usize, ps: f32, cs: f32, method: CreaseMethod) -> f32 {
+    let edges = p.vertex_edges(v).iter().map(|&e| {
+        let e = e as usize;
+        let pe = p.edge_sharpness(e);
+        // The child's sharpness matters only to Chaikin (uniform looks at the parent alone).
+        let ce = if method == CreaseMethod::Chaikin {
+            half_sharpness(p, e, v, method)
         } else {
-            let e = (r32 - layout.edge_vertex_base) as usize;
-            edge_row(
-                p,
-                e,
-                child_rules[r],
-                scheme,
-                options.triangle_subdivision,
-                sink,
-            );
-        }
-    })
-}
-
-/// Stencil of the child of parent edge `e` (`Sdc::Scheme::ComputeEdgeVertexMask`).
-fn edge_row(
-    p: &Topology,
-    e: usize,
-    child_rule: Rule,
-    scheme: Scheme,
-    tri: TriangleSubdivision,
-    sink: &mut RowSink,
-) {
-    let [a, b] = p.edge_vertices(e);
-    let s = p.edge_sharpness(e);
-    if s > 0.0 && child_rule == Rule::Crease {
-        sink.add(a, 0.5);
-        sink.add(b, 0.5);
-        return;
-    }
-    let faces = p.edge_faces(e);
-    let nf = faces.len();
-    let (mut vw, mut fw) = match scheme {
-        Scheme::Loop => (
-            0.375,
-            if nf == 2 {
-                0.125
-            } else {
-                0.125 * 2.0 / nf as f64
-            },
-        ),
-        _ => {
-            if nf == 2 {
-                if tri == TriangleSubdivision::Smooth
-                    && (p.face_size(faces[0] as usize) == 3 || p.face_size(faces[1] as usize) == 3)
-                {
-                    let wt = |f: u32| {
-                        if p.face_size(f as usize) == 3 {
-                            0.470
-                        } else {
-                            0.25
-                        }
-                    };
-                    let f = 0.5 * (wt(faces[0]) + wt(faces[1]));
-                    (0.5 * (1.0 - 2.0 * f), f)
-                } else {
-                    (0.25, 0.25)
-                }
-            } else {
-                (0.25, 0.5 / nf as f64)
-            }
-        }
-    };
-    if s > 0.0 {
-        // A semi-sharp edge whose child is no longer a crease: blend by the parent sharpness
-        // (not clamped: Chaikin can extrapolate).
-        let pw = s as f64;
-        let cw = 1.0 - pw;
-        vw = pw * 0.5 + cw * vw;
-        fw *= cw;
-    }
-    sink.add(a, vw);
-    sink.add(b, vw);
-    let locals = p.edge_face_local_indices(e);
-    for (&f, &l) in faces.iter().zip(locals) {
-        match scheme {
-            Scheme::Loop => {
-                let fv = p.face_vertices(f as usize);
-                // The vertex opposite the edge; the edge's first position in the face.
-                let k = p
-                    .face_edges(f as usize)
-                    .iter()
-                    .position(|&x| x as usize == e)
-                    .unwrap_or(l as usize);
-                sink.add(fv[(k + 2) % 3], fw);
-            }
-            _ => add_face_point(p, f as usize, fw, sink),
-        }
-    }
-}
-
-/// Stencil of the child of parent vertex `v` (`Sdc::Scheme::ComputeVertexVertexMask`).
-fn vertex_row(
-    parent: &Level,
-    child: &Topology,
-    child_rules: &[Rule],
-    scheme: Scheme,
-    method: CreaseMethod,
-    v: usize,
-    sink: &mut RowSink,
-) {
-    let p = &parent.topology;
-    let prule = parent.rules[v];
-    let crule = child_rules[v];
-    let pe: Vec<f32> = p
-        .vertex_edges(v)
-        .iter()
-        .map(|&e| p.edge_sharpness(e as usize))
-        .collect();
-    let mask = match prule {
-        Rule::Smooth | Rule::Dart => smooth_vertex_mask(p, v, scheme),
-        _ => {
-            let pmask = mask_for_rule(p, v, prule, scheme, &pe);
-            if crule == prule {
-                pmask
-            } else {
-                let ce: Vec<f32> = p
-                    .vertex_edges(v)
-                    .iter()
-                    .map(|&e| half_sharpness(p, e as usize, v, method))
-                    .collect();
-                let cmask = mask_for_rule(p, v, crule, scheme, &ce);
-                let pw = rules::fractional_weight(
-                    p.vertex_sharpness(v),
-                    child.vertex_sharpness(v),
-                    &pe,
-                    &ce,
-                    method,
-                );
-                combine(pmask, cmask, pw as f64)
-            }
-        }
-    };
-    if let Some(fw) = &mask.faces {
-        for (&f, &w) in p.vertex_faces(v).iter().zip(fw) {
-            add_face_point(p, f as usize, w, sink);
-        }
-    }
-    if let Some(ew) = &mask.edges {
-        for (&e, &w) in p.vertex_edges(v).iter().zip(ew) {
-            sink.add(p.edge_other_vertex(e as usize, v as u32), w);
-        }
-    }
-    sink.add(v as u32, mask.vertex);
+            0.0
+        };
+        (pe, ce)
+    });
+    rules::fractional_weight(ps, cs, edges, method)
 }

@@ -20,7 +20,11 @@ fn half(e: u32, k: u32) -> u32 {
 #[inline]
 fn end_at(p: &Topology, e: u32, v: u32, leaving: bool) -> u32 {
     let [a, b] = p.edge_vertices(e as usize);
-    if a == b { u32::from(!leaving) } else { u32::from(a != v) }
+    if a == b {
+        u32::from(!leaving)
+    } else {
+        u32::from(a != v)
+    }
 }
 
 /// Ends of each parent vertex's edges, in vertex-edge order: `k_i` with `e_i.v[k_i] == v`
@@ -49,19 +53,14 @@ fn offsets_from(counts: impl Iterator<Item = usize>, len: usize) -> Vec<u32> {
     off
 }
 
-/// The quad split of Catmull-Clark and Bilinear: every face of size n becomes n quads.
-pub(crate) fn quad_split(p: &Topology) -> Topology {
-    let (nv, nf, ne, nh) = (p.num_vertices(), p.num_faces(), p.num_edges(), p.num_face_vertices());
+/// Child faces of the quad split: (V_k, E_k, F, E_{k-1}) with edges (hNext, I_k, I_{k-1},
+/// hPrev); a quad's child k is rotated so that the parent corner sits at position k.
+fn quad_face_loop(p: &Topology, face_vertices: &mut [u32], mut face_edges: Option<&mut [u32]>) {
+    let (nv, nf, nh) = (p.num_vertices(), p.num_faces(), p.num_face_vertices());
     let off = p.face_offsets();
     let face_point = |f: usize| (nv + f) as u32;
     let edge_point = |e: u32| (nv + nf) as u32 + e;
-    let hb = nh as u32; // first half-edge child
-    let size = |f: usize| (off[f + 1] - off[f]) as usize;
-
-    // Faces: (V_k, E_k, F, E_{k-1}) with edges (hNext, I_k, I_{k-1}, hPrev); a quad's child k
-    // is rotated so the parent corner sits at position k.
-    let mut face_vertices = vec![0u32; 4 * nh];
-    let mut face_edges = vec![0u32; 4 * nh];
+    let hb = nh as u32;
     for f in 0..nf {
         let fv = p.face_vertices(f);
         let fe = p.face_edges(f);
@@ -70,20 +69,64 @@ pub(crate) fn quad_split(p: &Topology) -> Topology {
         for k in 0..n {
             let km1 = if k == 0 { n - 1 } else { k - 1 };
             let verts = [fv[k], edge_point(fe[k]), face_point(f), edge_point(fe[km1])];
-            let edges = [
-                hb + half(fe[k], end_at(p, fe[k], fv[k], true)),
-                base + k as u32,
-                base + km1 as u32,
-                hb + half(fe[km1], end_at(p, fe[km1], fv[k], false)),
-            ];
             let rot = if n == 4 { k } else { 0 };
             let o = 4 * (base as usize + k);
             for j in 0..4 {
                 face_vertices[o + (j + rot) % 4] = verts[j];
-                face_edges[o + (j + rot) % 4] = edges[j];
+            }
+            if let Some(face_edges) = face_edges.as_deref_mut() {
+                let edges = [
+                    hb + half(fe[k], end_at(p, fe[k], fv[k], true)),
+                    base + k as u32,
+                    base + km1 as u32,
+                    hb + half(fe[km1], end_at(p, fe[km1], fv[k], false)),
+                ];
+                for j in 0..4 {
+                    face_edges[o + (j + rot) % 4] = edges[j];
+                }
             }
         }
     }
+}
+
+/// Face offsets and face-vertices of the quad split alone.
+pub(crate) fn quad_faces(p: &Topology) -> (Vec<u32>, Vec<u32>) {
+    let nh = p.num_face_vertices();
+    let mut face_vertices = vec![0u32; 4 * nh];
+    quad_face_loop(p, &mut face_vertices, None);
+    ((0..=nh as u32).map(|i| 4 * i).collect(), face_vertices)
+}
+
+/// Face offsets and face-vertices of the triangle split alone.
+pub(crate) fn tri_faces(p: &Topology) -> (Vec<u32>, Vec<u32>) {
+    let (nv, nf) = (p.num_vertices() as u32, p.num_faces());
+    let mut face_vertices = Vec::with_capacity(12 * nf);
+    for f in 0..nf {
+        let v = p.face_vertices(f);
+        let e = p.face_edges(f);
+        let (e0, e1, e2) = (nv + e[0], nv + e[1], nv + e[2]);
+        face_vertices.extend_from_slice(&[v[0], e0, e2, e0, v[1], e1, e2, e1, v[2], e1, e2, e0]);
+    }
+    ((0..=4 * nf as u32).map(|k| 3 * k).collect(), face_vertices)
+}
+
+/// The quad split of Catmull-Clark and Bilinear: every face of size n becomes n quads.
+pub(crate) fn quad_split(p: &Topology) -> Topology {
+    let (nv, nf, ne, nh) = (
+        p.num_vertices(),
+        p.num_faces(),
+        p.num_edges(),
+        p.num_face_vertices(),
+    );
+    let off = p.face_offsets();
+    let face_point = |f: usize| (nv + f) as u32;
+    let edge_point = |e: u32| (nv + nf) as u32 + e;
+    let hb = nh as u32; // first half-edge child
+    let size = |f: usize| (off[f + 1] - off[f]) as usize;
+
+    let mut face_vertices = vec![0u32; 4 * nh];
+    let mut face_edges = vec![0u32; 4 * nh];
+    quad_face_loop(p, &mut face_vertices, Some(&mut face_edges));
     let face_offsets = (0..=nh as u32).map(|i| 4 * i).collect();
 
     // Edges: I_f[j] = (F, E_j); H(e, k) = (E, V_{e.v[k]}).
@@ -128,7 +171,11 @@ pub(crate) fn quad_split(p: &Topology) -> Topology {
             for (&pf, &l) in p.edge_faces(e).iter().zip(p.edge_face_local_indices(e)) {
                 let (pf, l) = (pf as usize, l as usize);
                 let n = size(pf);
-                let c = if degenerate { k } else { usize::from(p.face_vertices(pf)[l] != ev[k]) };
+                let c = if degenerate {
+                    k
+                } else {
+                    usize::from(p.face_vertices(pf)[l] != ev[k])
+                };
                 edge_faces.push(off[pf] + ((l + c) % n) as u32);
                 edge_face_local.push(if n == 4 {
                     l as u32
@@ -252,20 +299,30 @@ pub(crate) fn tri_split(p: &Topology) -> Topology {
     let (nv, nf, ne) = (p.num_vertices(), p.num_faces(), p.num_edges());
     let edge_point = |e: u32| nv as u32 + e;
     let hb = 3 * nf as u32;
-    let mut face_vertices = Vec::with_capacity(12 * nf);
+    let (face_offsets, face_vertices) = tri_faces(p);
     let mut face_edges = Vec::with_capacity(12 * nf);
     for f in 0..nf {
         let v = p.face_vertices(f);
         let e = p.face_edges(f);
-        let (e0, e1, e2) = (edge_point(e[0]), edge_point(e[1]), edge_point(e[2]));
         let i = 3 * f as u32;
         // S_k: the half of edge k at its start corner; T_k: at its end corner.
         let s = |k: usize| hb + half(e[k], end_at(p, e[k], v[k], true));
         let t = |k: usize| hb + half(e[k], end_at(p, e[k], v[(k + 1) % 3], false));
-        face_vertices.extend_from_slice(&[v[0], e0, e2, e0, v[1], e1, e2, e1, v[2], e1, e2, e0]);
-        face_edges.extend_from_slice(&[s(0), i, t(2), t(0), s(1), i + 1, i + 2, t(1), s(2), i + 2, i, i + 1]);
+        face_edges.extend_from_slice(&[
+            s(0),
+            i,
+            t(2),
+            t(0),
+            s(1),
+            i + 1,
+            i + 2,
+            t(1),
+            s(2),
+            i + 2,
+            i,
+            i + 1,
+        ]);
     }
-    let face_offsets = (0..=4 * nf as u32).map(|k| 3 * k).collect();
     let mut edge_vertices = Vec::with_capacity(3 * nf + 2 * ne);
     for f in 0..nf {
         let e = p.face_edges(f);
