@@ -195,13 +195,8 @@ mod tests {
     #[test]
     fn fractional_weight_means_what_decays() {
         // Uniform: edges with s ≤ 1 transition; 0.5 and 1.0 average to 0.75.
-        let w = fractional_weight(
-            0.0,
-            0.0,
-            &[0.5, 1.0, 3.0],
-            &[0.0, 0.0, 2.0],
-            CreaseMethod::Uniform,
-        );
+        let edges = [(0.5, 0.0), (1.0, 0.0), (3.0, 2.0)];
+        let w = fractional_weight(0.0, 0.0, edges, CreaseMethod::Uniform);
         assert_eq!(w, 0.75);
         // A decayed vertex sharpness counts too, and the mean is clamped at 1.
         let w = fractional_weight(3.0, 0.0, [], CreaseMethod::Uniform);
