@@ -14,6 +14,7 @@
 //! ```
 
 mod info;
+mod refine;
 
 use std::ffi::OsString;
 use std::io::Write;
@@ -42,6 +43,8 @@ enum Command {
     /// Topology summary: counts, face-size and valence histograms, boundary, non-manifold
     /// elements, tags, components, Euler characteristic and genus.
     Info(info::InfoArgs),
+    /// Uniform refinement with Catmull-Clark, Loop or Bilinear, agreeing with OpenSubdiv.
+    Refine(refine::RefineArgs),
 }
 
 /// A command's failure: exit code and one-line message.
@@ -106,6 +109,7 @@ where
     };
     let result = match cli.command {
         Command::Info(a) => info::run(&a, out, err),
+        Command::Refine(a) => refine::run(&a, out, err),
     };
     match result {
         Ok(()) => EXIT_OK,

@@ -280,3 +280,121 @@ fn usage_errors_exit_2() {
     assert_eq!(code, 0);
     assert!(out.contains("info"));
 }
+
+#[test]
+fn refine_writes_each_format_and_reports_json() {
+    let s = Scratch::new("refine");
+    let input =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/meshes/torus_creased.obj");
+    for ext in ["obj", "ply", "glb"] {
+        let out = s.0.join(format!("torus.{ext}"));
+        let (code, stdout, err) = subd(&[
+            "refine",
+            "--scheme",
+            "catmull-clark",
+            "--levels",
+            "2",
+            input.to_str().unwrap(),
+            out.to_str().unwrap(),
+            "--json",
+        ]);
+        assert_eq!(code, 0, "{err}");
+        let j: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+        // 72 quads -> 72 * 16 after two levels; a closed quad mesh has V = F and E = 2F.
+        assert_eq!(j["output_counts"]["faces"], 1152);
+        assert_eq!(j["output_counts"]["vertices"], 1152);
+        assert_eq!(j["input_counts"]["faces"], 72);
+        for phase in ["read", "topology", "positions", "write", "total"] {
+            assert!(j["seconds"][phase].as_f64().unwrap() >= 0.0);
+        }
+        assert!(out.exists());
+    }
+    // The OBJ keeps the decayed tags: the 2.5 crease ring is 0.5 after two levels, the
+    // infinitely sharp ring stays infinite, the corner (3) is 1.
+    let (code, stdout, _) = subd(&["info", s.0.join("torus.obj").to_str().unwrap(), "--json"]);
+    assert_eq!(code, 0);
+    let j: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    assert_eq!(j["infinite_creases"], 6 * 4);
+    assert_eq!(j["semi_sharp_creases"], 6 * 4);
+    assert_eq!(j["corners"], 1);
+    let text = std::fs::read_to_string(s.0.join("torus.obj")).unwrap();
+    assert!(
+        text.lines()
+            .any(|l| l.starts_with("t crease 2/1/0") && l.ends_with(" 0.5"))
+    );
+    assert!(
+        text.lines()
+            .any(|l| l.starts_with("t corner 1/1/0") && l.ends_with(" 1"))
+    );
+}
+
+#[test]
+fn refine_bad_input_exits_2_without_output() {
+    let s = Scratch::new("refine-bad");
+    let quad = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n";
+    let cases: &[(&str, String, &[&str], &str)] = &[
+        (
+            "quads.obj",
+            quad.into(),
+            &["--scheme", "loop"],
+            "face 0 has 4 vertices; the Loop scheme needs triangles",
+        ),
+        (
+            "neg.obj",
+            format!("{quad}t crease 2/1/0 0 1 -1\n"),
+            &["--scheme", "catmull-clark"],
+            "invalid sharpness -1",
+        ),
+        (
+            "nan.obj",
+            "v 0 0 nan\nv 1 0 0\nv 0 1 0\nf 1 2 3\n".into(),
+            &["--scheme", "loop"],
+            "non-finite coordinate",
+        ),
+        (
+            "ok.obj",
+            quad.into(),
+            &["--scheme", "doo-sabin"],
+            "invalid value 'doo-sabin'",
+        ),
+        (
+            "ok2.obj",
+            quad.into(),
+            &["--scheme", "bilinear", "--levels", "99"],
+            "99 levels requested",
+        ),
+    ];
+    for (name, text, extra, expect) in cases {
+        let input = s.file(name, text.as_bytes());
+        let out = s.0.join(format!("{name}.out.obj"));
+        let mut args = vec!["refine"];
+        args.extend_from_slice(extra);
+        if !extra.contains(&"--levels") {
+            args.extend_from_slice(&["--levels", "1"]);
+        }
+        args.push(input.to_str().unwrap());
+        args.push(out.to_str().unwrap());
+        let (code, _, err) = subd(&args);
+        assert_eq!(code, 2, "{name}: {err}");
+        assert!(
+            err.contains(expect),
+            "{name}: expected {expect:?} in {err:?}"
+        );
+        assert!(!err.contains("panicked"), "{err}");
+        assert!(!out.exists(), "{name}: output written");
+    }
+    // The input is never overwritten.
+    let input = s.file("same.obj", quad.as_bytes());
+    let (code, _, err) = subd(&[
+        "refine",
+        "--scheme",
+        "bilinear",
+        "--levels",
+        "1",
+        input.to_str().unwrap(),
+        input.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2);
+    assert!(err.contains("would overwrite the input"), "{err}");
+    assert_eq!(std::fs::read_to_string(&input).unwrap(), quad);
+}

@@ -1,0 +1,287 @@
+//! `subd refine`: uniform Catmull-Clark, Loop or Bilinear refinement of a mesh file.
+
+use std::io::{IsTerminal, Write};
+use std::path::PathBuf;
+use std::time::Instant;
+
+use clap::{Args, ValueEnum};
+use serde::Serialize;
+use subd_mesh::{
+    BoundaryInterpolation, CreaseMethod, Mesh, SchemeHints, Topology, TriangleSubdivision,
+};
+use subd_schemes::{Options, Refinement, Scheme};
+
+use crate::{EXIT_BAD_INPUT, Failure, print_warnings};
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub(crate) enum SchemeArg {
+    CatmullClark,
+    Loop,
+    Bilinear,
+}
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub(crate) enum BoundaryArg {
+    None,
+    EdgeOnly,
+    EdgeAndCorner,
+}
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub(crate) enum CreaseArg {
+    Uniform,
+    Chaikin,
+}
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub(crate) enum TriangleArg {
+    Catmark,
+    Smooth,
+}
+
+#[derive(Debug, Args)]
+pub(crate) struct RefineArgs {
+    /// Subdivision scheme.
+    #[arg(long, value_enum)]
+    scheme: SchemeArg,
+    /// Number of uniform refinement levels (0 to 15).
+    #[arg(long)]
+    levels: usize,
+    /// Boundary interpolation (default: the file's `t interpolateboundary` tag, else
+    /// edge-only).
+    #[arg(long, value_enum)]
+    boundary: Option<BoundaryArg>,
+    /// Crease method for semi-sharp creases (default: the file's `t creasemethod` tag, else
+    /// uniform).
+    #[arg(long, value_enum)]
+    crease_method: Option<CreaseArg>,
+    /// Catmull-Clark triangle rule (default: the file's `t smoothtriangles` tag, else
+    /// catmark).
+    #[arg(long, value_enum)]
+    triangles: Option<TriangleArg>,
+    /// Accept faces whose windings disagree across a shared edge (treated as non-manifold).
+    #[arg(long)]
+    accept_inconsistent_orientation: bool,
+    /// Input mesh (.obj or .ply).
+    input: PathBuf,
+    /// Output mesh (.obj with tags, .ply or .glb).
+    output: PathBuf,
+    /// Print a JSON report (counts, timings) on stdout.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Serialize)]
+struct Counts {
+    vertices: usize,
+    edges: Option<usize>,
+    faces: usize,
+}
+
+#[derive(Serialize)]
+struct Timings {
+    read: f64,
+    topology: f64,
+    positions: f64,
+    write: f64,
+    total: f64,
+}
+
+#[derive(Serialize)]
+struct RefineReport {
+    input: String,
+    output: String,
+    scheme: Scheme,
+    levels: usize,
+    boundary_interpolation: BoundaryInterpolation,
+    crease_method: CreaseMethod,
+    triangle_subdivision: TriangleSubdivision,
+    input_counts: Counts,
+    output_counts: Counts,
+    seconds: Timings,
+    warnings: Vec<String>,
+}
+
+fn bad(message: String) -> Failure {
+    Failure {
+        code: EXIT_BAD_INPUT,
+        message,
+    }
+}
+
+/// The tags worth writing at the refined level: the ones the user gave and their decayed
+/// children. Sharpness the boundary rules imply (boundary and non-manifold edges,
+/// non-manifold vertices, corners under edge-and-corner) is left out, since any reader
+/// applies those rules again.
+fn visible_tags(t: &mut Topology, options: &Options) {
+    for e in 0..t.num_edges() {
+        if t.is_boundary_edge(e) || t.is_non_manifold_edge(e) {
+            t.set_edge_sharpness(e, 0.0);
+        }
+    }
+    for v in 0..t.num_vertices() {
+        let corner = t.vertex_faces(v).len() == 1 && t.valence(v) == 2;
+        if t.is_non_manifold_vertex(v)
+            || t.is_isolated_vertex(v)
+            || (corner && options.boundary_interpolation == BoundaryInterpolation::EdgeAndCorner)
+        {
+            t.set_vertex_sharpness(v, 0.0);
+        }
+    }
+}
+
+pub(crate) fn run(
+    args: &RefineArgs,
+    out: &mut dyn Write,
+    err: &mut dyn Write,
+) -> Result<(), Failure> {
+    let t_start = Instant::now();
+    if let (Ok(a), Ok(b)) = (args.input.canonicalize(), args.output.canonicalize())
+        && a == b
+    {
+        return Err(bad(format!(
+            "{}: the output would overwrite the input",
+            args.output.display()
+        )));
+    }
+    if subd_io::Format::from_path(&args.output).is_none() {
+        return Err(bad(format!(
+            "{}: unsupported output extension (expected .obj, .ply or .glb)",
+            args.output.display()
+        )));
+    }
+    let read_opts = subd_io::ReadOptions {
+        accept_inconsistent_orientation: args.accept_inconsistent_orientation,
+    };
+    let file = subd_io::read_mesh(&args.input, &read_opts)?;
+    print_warnings(err, &args.input, &file.warnings);
+    let t_read = t_start.elapsed().as_secs_f64();
+
+    let scheme = match args.scheme {
+        SchemeArg::CatmullClark => Scheme::CatmullClark,
+        SchemeArg::Loop => Scheme::Loop,
+        SchemeArg::Bilinear => Scheme::Bilinear,
+    };
+    let mut options = Options::from_hints(&file.mesh.hints);
+    if let Some(b) = args.boundary {
+        options.boundary_interpolation = match b {
+            BoundaryArg::None => BoundaryInterpolation::None,
+            BoundaryArg::EdgeOnly => BoundaryInterpolation::EdgeOnly,
+            BoundaryArg::EdgeAndCorner => BoundaryInterpolation::EdgeAndCorner,
+        };
+    }
+    if let Some(c) = args.crease_method {
+        options.crease_method = match c {
+            CreaseArg::Uniform => CreaseMethod::Uniform,
+            CreaseArg::Chaikin => CreaseMethod::Chaikin,
+        };
+    }
+    if let Some(t) = args.triangles {
+        options.triangle_subdivision = match t {
+            TriangleArg::Catmark => TriangleSubdivision::Catmark,
+            TriangleArg::Smooth => TriangleSubdivision::Smooth,
+        };
+    }
+
+    let progress = Progress::new(args.levels, args.json);
+    let t0 = Instant::now();
+    let refinement = Refinement::new(&file.mesh.topology, scheme, &options, args.levels)
+        .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
+    progress.step("topology");
+    let t_topology = t0.elapsed().as_secs_f64();
+    let t1 = Instant::now();
+    let mut levels = refinement.refine_points(&file.mesh.positions);
+    let positions = levels.pop().expect("last level");
+    drop(levels);
+    progress.step("positions");
+    let t_positions = t1.elapsed().as_secs_f64();
+
+    let t2 = Instant::now();
+    let mut topology = refinement.topology(args.levels).clone();
+    visible_tags(&mut topology, &options);
+    let out_counts = Counts {
+        vertices: topology.num_vertices(),
+        edges: Some(topology.num_edges()),
+        faces: topology.num_faces(),
+    };
+    let mut mesh = Mesh::new(topology, positions)
+        .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
+    mesh.hints = SchemeHints {
+        boundary_interpolation: Some(options.boundary_interpolation),
+        crease_method: Some(options.crease_method),
+        triangle_subdivision: file
+            .mesh
+            .hints
+            .triangle_subdivision
+            .or(args.triangles.map(|_| options.triangle_subdivision)),
+    };
+    subd_io::write_mesh(&args.output, &mesh, &subd_io::WriteOptions::default())?;
+    progress.finish();
+    let t_write = t2.elapsed().as_secs_f64();
+
+    if args.json {
+        let base = &file.mesh.topology;
+        let report = RefineReport {
+            input: args.input.display().to_string(),
+            output: args.output.display().to_string(),
+            scheme,
+            levels: args.levels,
+            boundary_interpolation: options.boundary_interpolation,
+            crease_method: options.crease_method,
+            triangle_subdivision: options.triangle_subdivision,
+            input_counts: Counts {
+                vertices: base.num_vertices(),
+                edges: Some(base.num_edges()),
+                faces: base.num_faces(),
+            },
+            output_counts: out_counts,
+            seconds: Timings {
+                read: t_read,
+                topology: t_topology,
+                positions: t_positions,
+                write: t_write,
+                total: t_start.elapsed().as_secs_f64(),
+            },
+            warnings: file.warnings.clone(),
+        };
+        let _ = serde_json::to_writer(&mut *out, &report);
+        let _ = writeln!(out);
+    }
+    Ok(())
+}
+
+/// A progress bar on a terminal for refinements deep enough to take a while; nothing when
+/// stderr is not a terminal or a JSON report was asked for.
+struct Progress(Option<indicatif::ProgressBar>);
+
+impl Progress {
+    fn new(levels: usize, json: bool) -> Progress {
+        if json || levels < 4 || !std::io::stderr().is_terminal() {
+            return Progress(None);
+        }
+        let bar = indicatif::ProgressBar::new(3);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template("{spinner} refining [{bar:20}] {msg}")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        bar.set_message("topology");
+        bar.enable_steady_tick(std::time::Duration::from_millis(100));
+        Progress(Some(bar))
+    }
+
+    fn step(&self, done: &str) {
+        if let Some(b) = &self.0 {
+            b.inc(1);
+            b.set_message(match done {
+                "topology" => "positions",
+                _ => "writing",
+            });
+        }
+    }
+
+    fn finish(&self) {
+        if let Some(b) = &self.0 {
+            b.finish_and_clear();
+        }
+    }
+}
