@@ -177,6 +177,23 @@ pub fn shapes(exe: &Path, dir: &Path) -> Result<Vec<Row>, String> {
     Ok(rows)
 }
 
+/// `count` random meshes (see `random_mesh`).
+pub fn random(exe: &Path, count: u64) -> Vec<Row> {
+    let mut rows = Vec::new();
+    for seed in 0..count {
+        let c = crate::random_mesh::case(seed);
+        rows.extend(compare(
+            exe,
+            &c.name,
+            &c.topology,
+            &c.positions,
+            c.scheme,
+            &c.options,
+        ));
+    }
+    rows
+}
+
 /// Prints the table and returns whether every row passed.
 pub fn report(rows: &[Row]) -> bool {
     println!(

@@ -8,6 +8,7 @@ use clap::{Parser, Subcommand};
 mod bench;
 mod conformance;
 mod osd;
+mod random_mesh;
 
 #[derive(Parser)]
 #[command(name = "xtask", about = "subd project automation")]
@@ -30,6 +31,9 @@ enum Task {
         /// Directory of OpenSubdiv shapes.
         #[arg(long, default_value = "../shared/meshes/osd")]
         shapes: std::path::PathBuf,
+        /// Number of random meshes.
+        #[arg(long, default_value_t = 360)]
+        random: u64,
     },
     /// Time subd against OpenSubdiv on ~100k-face meshes (levels 1..L, 1 and all threads).
     Bench {
@@ -130,9 +134,10 @@ fn main() -> ExitCode {
                 .arg("--")
                 .args(&extra))
         }),
-        Task::Conformance { shapes } => ensure_system_packages().and_then(|_| {
+        Task::Conformance { shapes, random } => ensure_system_packages().and_then(|_| {
             let exe = osd::build_harness()?;
-            let rows = conformance::shapes(&exe, &shapes)?;
+            let mut rows = conformance::shapes(&exe, &shapes)?;
+            rows.extend(conformance::random(&exe, random));
             if conformance::report(&rows) {
                 Ok(())
             } else {
