@@ -3,6 +3,9 @@
 
 use std::path::{Path, PathBuf};
 
+use proptest::prelude::*;
+use subd_mesh::{Topology, TopologyBuilder};
+
 /// Directory of OpenSubdiv's regression shapes (`<repo>/../shared/meshes/osd`), overridable
 /// with the `SUBD_MESHES` environment variable (pointing at the `meshes` directory).
 pub fn osd_mesh_dir() -> PathBuf {
@@ -121,4 +124,125 @@ pub fn index_rows() -> Vec<IndexRow> {
         });
     }
     rows
+}
+
+/// A random face list: a closed surface (torus grid, or a cylinder capped by two n-gons) or
+/// an open planar grid, whose quads are randomly kept, split into two triangles, or fanned
+/// around a new centre vertex (which gives random valences).
+#[derive(Debug, Clone)]
+pub struct RandomMesh {
+    /// Number of vertices.
+    pub num_vertices: usize,
+    /// Faces.
+    pub faces: Vec<Vec<u32>>,
+    /// Planar positions for the open grid (None for closed surfaces).
+    pub planar: Option<Vec<[f64; 2]>>,
+    /// Genus of a closed surface, `None` for the open grid.
+    pub genus: Option<i64>,
+}
+
+/// Builds the random mesh of `kind` (0 torus, 1 capped cylinder, 2 planar grid).
+pub fn random_mesh(kind: u8, m: u32, n: u32, choices: &[u8], jitter: &[(f64, f64)]) -> RandomMesh {
+    let mut faces: Vec<Vec<u32>> = Vec::new();
+    let mut nv;
+    let mut planar = None;
+    let quads: Vec<[u32; 4]>;
+    let genus;
+    match kind {
+        0 => {
+            // Torus: m x n grid, wrapping both ways.
+            let id = |i: u32, j: u32| (i % m) * n + (j % n);
+            quads = (0..m)
+                .flat_map(|i| {
+                    (0..n).map(move |j| [id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)])
+                })
+                .collect();
+            nv = (m * n) as usize;
+            genus = Some(1);
+        }
+        1 => {
+            // Cylinder of m rings of n vertices, capped by two n-gons: a sphere.
+            let id = |i: u32, j: u32| i * n + (j % n);
+            quads = (0..m - 1)
+                .flat_map(|i| {
+                    (0..n).map(move |j| [id(i, j), id(i, j + 1), id(i + 1, j + 1), id(i + 1, j)])
+                })
+                .collect();
+            faces.push((0..n).rev().map(|j| id(0, j)).collect());
+            faces.push((0..n).map(|j| id(m - 1, j)).collect());
+            nv = (m * n) as usize;
+            genus = Some(0);
+        }
+        _ => {
+            // Open planar (m+1) x (n+1) grid, counter-clockwise in the xy plane, jittered.
+            let id = |i: u32, j: u32| i * (n + 1) + j;
+            quads = (0..m)
+                .flat_map(|i| {
+                    (0..n).map(move |j| [id(i, j), id(i, j + 1), id(i + 1, j + 1), id(i + 1, j)])
+                })
+                .collect();
+            let mut pos = Vec::new();
+            for i in 0..=m {
+                for j in 0..=n {
+                    let (dx, dy) = jitter[(i * (n + 1) + j) as usize % jitter.len()];
+                    pos.push([j as f64 + 0.15 * dx, i as f64 + 0.15 * dy]);
+                }
+            }
+            planar = Some(pos);
+            nv = ((m + 1) * (n + 1)) as usize;
+            genus = None;
+        }
+    }
+    for (k, q) in quads.iter().enumerate() {
+        match choices[k % choices.len()] % 4 {
+            0 | 1 => faces.push(q.to_vec()),
+            2 => {
+                faces.push(vec![q[0], q[1], q[2]]);
+                faces.push(vec![q[0], q[2], q[3]]);
+            }
+            _ => {
+                let c = nv as u32;
+                nv += 1;
+                if let Some(pos) = planar.as_mut() {
+                    let p = q.iter().fold([0.0, 0.0], |a, &v| {
+                        [
+                            a[0] + pos[v as usize][0] / 4.0,
+                            a[1] + pos[v as usize][1] / 4.0,
+                        ]
+                    });
+                    pos.push(p);
+                }
+                for i in 0..4 {
+                    faces.push(vec![q[i], q[(i + 1) % 4], c]);
+                }
+            }
+        }
+    }
+    RandomMesh {
+        num_vertices: nv,
+        faces,
+        planar,
+        genus,
+    }
+}
+
+/// Builds the topology of a face list.
+pub fn build(nv: usize, faces: &[Vec<u32>]) -> Topology {
+    let sizes: Vec<u32> = faces.iter().map(|f| f.len() as u32).collect();
+    let idx: Vec<u32> = faces.iter().flatten().copied().collect();
+    TopologyBuilder::new(nv)
+        .build(&sizes, &idx)
+        .expect("valid mesh")
+}
+
+/// Strategy for [`RandomMesh`].
+pub fn mesh_strategy() -> impl Strategy<Value = RandomMesh> {
+    (
+        0u8..3,
+        3u32..9,
+        3u32..9,
+        prop::collection::vec(any::<u8>(), 1..64),
+        prop::collection::vec((-1.0f64..1.0, -1.0f64..1.0), 1..32),
+    )
+        .prop_map(|(k, m, n, c, j)| random_mesh(k, m, n, &c, &j))
 }

@@ -175,8 +175,7 @@ pub fn run(levels: usize, repeats: usize) -> Result<(), String> {
     let me = std::env::current_exe().map_err(|e| e.to_string())?;
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
     println!(
-        "subd vs OpenSubdiv {}, uniform refinement, median of {repeats} runs; ratio = subd time / OpenSubdiv time",
-        "3.5 (Far, double)"
+        "subd vs OpenSubdiv 3.5 (Far, double), uniform refinement, median of {repeats} runs; ratio = subd time / OpenSubdiv time"
     );
     println!(
         "{:<8} {:>8} {:>5} {:>10} {:>10} {:>10} {:>7} {:>10} {:>7} {:>9} {:>9}",

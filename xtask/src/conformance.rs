@@ -109,7 +109,7 @@ pub fn compare(
         } else {
             f64::INFINITY
         };
-        if problem.is_none() && !(error <= TOLERANCE) {
+        if problem.is_none() && (error.is_nan() || error > TOLERANCE) {
             let v = ours[level]
                 .iter()
                 .zip(&o.positions)

@@ -22,6 +22,17 @@ pub fn sharpness_from_f64(s: f64) -> f32 {
     s.clamp(-(f32::MAX as f64), f32::MAX as f64) as f32
 }
 
+/// A storable sharpness: NaN and negative values become smooth (0), infinity saturates at
+/// `f32::MAX`.
+#[inline]
+pub fn sanitize(s: f32) -> f32 {
+    if s.is_nan() {
+        SHARPNESS_SMOOTH
+    } else {
+        s.clamp(SHARPNESS_SMOOTH, f32::MAX)
+    }
+}
+
 /// `true` when `s` is infinitely sharp.
 #[inline]
 pub fn is_infinite(s: f32) -> bool {

@@ -293,13 +293,13 @@ impl Topology {
     /// Sets the crease sharpness of edge `e` (negative and NaN values become 0, infinity
     /// saturates at `f32::MAX`).
     pub fn set_edge_sharpness(&mut self, e: usize, sharpness: f32) {
-        self.tags.edge_sharpness[e] = sharpness.max(tags::SHARPNESS_SMOOTH).min(f32::MAX);
+        self.tags.edge_sharpness[e] = tags::sanitize(sharpness);
     }
 
     /// Sets the corner sharpness of vertex `v` (negative and NaN values become 0, infinity
     /// saturates at `f32::MAX`).
     pub fn set_vertex_sharpness(&mut self, v: usize, sharpness: f32) {
-        self.tags.vertex_sharpness[v] = sharpness.max(tags::SHARPNESS_SMOOTH).min(f32::MAX);
+        self.tags.vertex_sharpness[v] = tags::sanitize(sharpness);
     }
 
     /// Marks face `f` as a hole or not.

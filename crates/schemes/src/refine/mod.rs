@@ -218,8 +218,9 @@ pub(crate) fn child_rules(
         let semi_edges = ve
             .iter()
             .any(|&e| is_semi_sharp(p.edge_sharpness(e as usize)));
-        if (is_semi_sharp(ps) || semi_edges) && (semi_edges || (ps > 0.0 && cs <= 0.0)) && cs <= 0.0
-        {
+        // Reclassify only a vertex that had semi-sharp features and ends up not sharp
+        // itself: its semi-sharp edges decayed, or its own semi-sharpness did.
+        if cs <= 0.0 && (semi_edges || is_semi_sharp(ps)) {
             let sharp = ve
                 .iter()
                 .filter(|&&e| half_sharpness(p, e as usize, v, method) > 0.0)

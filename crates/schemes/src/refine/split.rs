@@ -7,6 +7,9 @@
 //! Child edges: the edges interior to each parent face (face order), then the two halves of
 //! each parent edge (edge order), each half listed as (edge point, end vertex).
 
+// The relations are indexed by parent face, edge and end together, so index loops read best.
+#![allow(clippy::needless_range_loop)]
+
 use subd_mesh::{Topology, TopologyParts};
 
 /// Index of the half of parent edge `e` at its end `k` (0 or 1), relative to the first half.

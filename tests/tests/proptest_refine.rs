@@ -1,0 +1,239 @@
+//! Property tests of refinement on random meshes with random tags: stencil rows sum to one,
+//! refinement commutes with affine maps, relabelling input vertices only permutes the
+//! result, the stencil tables and the direct evaluation agree, and thread count does not
+//! change a bit.
+
+use proptest::prelude::*;
+use subd_mesh::{CreaseMethod, DVec3, Topology, TopologyBuilder};
+use subd_schemes::{Options, Refinement, Scheme};
+use subd_tests::{RandomMesh, build, mesh_strategy, random_mesh};
+
+/// A refinement case: mesh, positions, tags and options.
+#[derive(Debug, Clone)]
+struct Case {
+    mesh: RandomMesh,
+    positions: Vec<DVec3>,
+    creases: Vec<(usize, f32)>,
+    corners: Vec<(usize, f32)>,
+    scheme: Scheme,
+    chaikin: bool,
+}
+
+const SHARPNESS: [f32; 6] = [0.3, 1.0, 1.7, 2.5, 4.2, 10.0];
+
+fn case_strategy() -> impl Strategy<Value = Case> {
+    (
+        mesh_strategy(),
+        0u8..3,
+        any::<bool>(),
+        prop::collection::vec((any::<u16>(), 0usize..6), 0..12),
+        prop::collection::vec((any::<u16>(), 0usize..6), 0..4),
+        any::<u64>(),
+    )
+        .prop_map(|(mut mesh, s, chaikin, creases, corners, seed)| {
+            let scheme = [Scheme::CatmullClark, Scheme::Loop, Scheme::Bilinear][s as usize];
+            if scheme == Scheme::Loop {
+                // Fan-triangulate every face for Loop.
+                mesh.faces = mesh
+                    .faces
+                    .iter()
+                    .flat_map(|f| (1..f.len() - 1).map(move |i| vec![f[0], f[i], f[i + 1]]))
+                    .collect();
+            }
+            let mut state = seed | 1;
+            let mut rnd = || {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                (state >> 11) as f64 / (1u64 << 53) as f64
+            };
+            let positions = (0..mesh.num_vertices)
+                .map(|_| DVec3::new(rnd(), rnd(), rnd()) * 2.0 - DVec3::ONE)
+                .collect();
+            Case {
+                creases: creases
+                    .into_iter()
+                    .map(|(e, s)| (e as usize, SHARPNESS[s]))
+                    .collect(),
+                corners: corners
+                    .into_iter()
+                    .map(|(v, s)| (v as usize, SHARPNESS[s]))
+                    .collect(),
+                mesh,
+                positions,
+                scheme,
+                chaikin,
+            }
+        })
+}
+
+fn topology(c: &Case, faces: &[Vec<u32>]) -> Topology {
+    let mut t = build(c.mesh.num_vertices, faces);
+    let (ne, nv) = (t.num_edges(), t.num_vertices());
+    for &(e, s) in &c.creases {
+        t.set_edge_sharpness(e % ne, s);
+    }
+    for &(v, s) in &c.corners {
+        t.set_vertex_sharpness(v % nv, s);
+    }
+    t
+}
+
+fn options(c: &Case) -> Options {
+    Options {
+        crease_method: if c.chaikin {
+            CreaseMethod::Chaikin
+        } else {
+            CreaseMethod::Uniform
+        },
+        ..Options::default()
+    }
+}
+
+fn max_diff(a: &[DVec3], b: &[DVec3]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (*x - *y).abs().max_element())
+        .fold(0.0, f64::max)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    #[test]
+    fn stencil_rows_sum_to_one(c in case_strategy()) {
+        let t = topology(&c, &c.mesh.faces);
+        let r = Refinement::new(&t, c.scheme, &options(&c), 2).unwrap();
+        for table in [r.stencils(1).clone(), r.stencils(2).clone(), r.composed(2)] {
+            for row in 0..table.num_rows() {
+                let (_, w) = table.row(row);
+                let sum: f64 = w.iter().sum();
+                prop_assert!((sum - 1.0).abs() < 1e-12, "row {} sums to {}", row, sum);
+            }
+        }
+    }
+
+    #[test]
+    fn refinement_commutes_with_affine_maps(c in case_strategy(), a in prop::array::uniform9(-2.0f64..2.0), b in prop::array::uniform3(-5.0f64..5.0)) {
+        let t = topology(&c, &c.mesh.faces);
+        let r = Refinement::new(&t, c.scheme, &options(&c), 2).unwrap();
+        let m = glam::DMat3::from_cols_array(&a);
+        let shift = DVec3::from_array(b);
+        let map = |p: DVec3| m * p + shift;
+        let moved: Vec<DVec3> = c.positions.iter().map(|&p| map(p)).collect();
+        let direct = r.refine_points(&moved).pop().unwrap();
+        let mapped: Vec<DVec3> = r.refine_points(&c.positions).pop().unwrap().into_iter().map(map).collect();
+        prop_assert!(max_diff(&direct, &mapped) < 1e-12 * 10.0, "{}", max_diff(&direct, &mapped));
+    }
+
+    #[test]
+    fn relabelling_vertices_permutes_the_result(c in case_strategy(), seed in any::<u64>()) {
+        let nv = c.mesh.num_vertices;
+        let mut perm: Vec<u32> = (0..nv as u32).collect();
+        let mut state = seed | 1;
+        for i in (1..nv).rev() {
+            state ^= state << 13; state ^= state >> 7; state ^= state << 17;
+            perm.swap(i, (state % (i as u64 + 1)) as usize);
+        }
+        let t = topology(&c, &c.mesh.faces);
+        let faces: Vec<Vec<u32>> = c.mesh.faces.iter().map(|f| f.iter().map(|&v| perm[v as usize]).collect()).collect();
+        let mut u = build(nv, &faces);
+        // Carry the tags over through the permutation.
+        for e in 0..t.num_edges() {
+            let [x, y] = t.edge_vertices(e);
+            let f = u.find_edge(perm[x as usize], perm[y as usize]).unwrap() as usize;
+            u.set_edge_sharpness(f, t.edge_sharpness(e));
+        }
+        for v in 0..nv {
+            u.set_vertex_sharpness(perm[v] as usize, t.vertex_sharpness(v));
+        }
+        let mut pos = vec![DVec3::ZERO; nv];
+        for v in 0..nv {
+            pos[perm[v] as usize] = c.positions[v];
+        }
+        let a = Refinement::new(&t, c.scheme, &options(&c), 2).unwrap().refine_points(&c.positions);
+        let b = Refinement::new(&u, c.scheme, &options(&c), 2).unwrap().refine_points(&pos);
+        // Edges are numbered by first appearance in face order, which relabelling keeps, so
+        // only the base-vertex block of each level is permuted.
+        for level in 1..=2 {
+            let (x, y) = (&a[level], &b[level]);
+            prop_assert_eq!(x.len(), y.len());
+            for i in 0..x.len() {
+                let j = if i < nv { perm[i] as usize } else { i };
+                prop_assert!((x[i] - y[j]).abs().max_element() < 1e-12, "level {} vertex {}", level, i);
+            }
+        }
+    }
+
+    #[test]
+    fn stencil_tables_agree_with_direct_evaluation(c in case_strategy()) {
+        let t = topology(&c, &c.mesh.faces);
+        let r = Refinement::new(&t, c.scheme, &options(&c), 3).unwrap();
+        let direct = r.refine_points(&c.positions);
+        let composed = r.composed(3).apply_points(&c.positions);
+        prop_assert!(max_diff(&direct[3], &composed) < 1e-12);
+        let mut flat = vec![0.0; 3 * r.num_vertices(3)];
+        let src: Vec<f64> = direct[2].iter().flat_map(|p| p.to_array()).collect();
+        r.stencils(3).apply(&src, 3, &mut flat);
+        let per_level: Vec<DVec3> = flat.chunks_exact(3).map(|c| DVec3::new(c[0], c[1], c[2])).collect();
+        prop_assert!(max_diff(&direct[3], &per_level) < 1e-12);
+    }
+}
+
+/// One thread and many threads give bit-identical points and stencil tables on a mesh large
+/// enough to be split across threads.
+#[test]
+fn one_thread_equals_many_threads() {
+    let mesh = random_mesh(0, 60, 70, &[0, 1, 2, 3, 0, 2, 1], &[(0.0, 0.0)]);
+    let mut t = build(mesh.num_vertices, &mesh.faces);
+    for e in (0..t.num_edges()).step_by(7) {
+        t.set_edge_sharpness(e, 1.7);
+    }
+    let positions: Vec<DVec3> = (0..mesh.num_vertices)
+        .map(|i| {
+            DVec3::new(
+                (i as f64 * 0.37).sin(),
+                (i as f64 * 0.11).cos(),
+                (i as f64 * 0.05).sin(),
+            )
+        })
+        .collect();
+    let run = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| {
+                let r = Refinement::new(&t, Scheme::CatmullClark, &Options::default(), 3).unwrap();
+                (r.refine_points(&positions), r.composed(3))
+            })
+    };
+    let (p1, s1) = run(1);
+    let (p4, s4) = run(4);
+    assert!(s1.num_rows() > 50_000);
+    let bits = |v: &[DVec3]| {
+        v.iter()
+            .map(|p| p.to_array().map(f64::to_bits))
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(bits(&p1[3]), bits(&p4[3]));
+    assert_eq!(s1, s4);
+}
+
+/// Two triangles become eight after one Loop level; a closed torus keeps V − E + F = 0.
+#[test]
+fn counts_grow_as_expected() {
+    let t = TopologyBuilder::new(4)
+        .build(&[3, 3], &[0, 1, 2, 0, 2, 3])
+        .unwrap();
+    let r = Refinement::new(&t, Scheme::Loop, &Options::default(), 1).unwrap();
+    assert_eq!((r.topology(1).num_faces(), r.num_vertices(1)), (8, 9));
+    let mesh = random_mesh(0, 5, 6, &[0], &[(0.0, 0.0)]);
+    let t = build(mesh.num_vertices, &mesh.faces);
+    let r = Refinement::new(&t, Scheme::CatmullClark, &Options::default(), 2).unwrap();
+    let l2 = r.topology(2);
+    assert_eq!(
+        l2.num_vertices() as i64 - l2.num_edges() as i64 + l2.num_faces() as i64,
+        0
+    );
+}
