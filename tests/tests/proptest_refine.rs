@@ -144,12 +144,10 @@ proptest! {
             let f = u.find_edge(perm[x as usize], perm[y as usize]).unwrap() as usize;
             u.set_edge_sharpness(f, t.edge_sharpness(e));
         }
-        for v in 0..nv {
-            u.set_vertex_sharpness(perm[v] as usize, t.vertex_sharpness(v));
-        }
         let mut pos = vec![DVec3::ZERO; nv];
-        for v in 0..nv {
-            pos[perm[v] as usize] = c.positions[v];
+        for (v, &w) in perm.iter().enumerate() {
+            u.set_vertex_sharpness(w as usize, t.vertex_sharpness(v));
+            pos[w as usize] = c.positions[v];
         }
         let a = Refinement::new(&t, c.scheme, &options(&c), 2).unwrap().refine_points(&c.positions);
         let b = Refinement::new(&u, c.scheme, &options(&c), 2).unwrap().refine_points(&pos);
