@@ -93,6 +93,24 @@ impl Topology {
         &self.face_offsets
     }
 
+    /// Offsets of each edge's run in the edge-face relation (length `num_edges + 1`).
+    #[inline]
+    pub fn edge_face_offsets(&self) -> &[u32] {
+        &self.edge_face_offsets
+    }
+
+    /// Offsets of each vertex's run in the vertex-face relation (length `num_vertices + 1`).
+    #[inline]
+    pub fn vertex_face_offsets(&self) -> &[u32] {
+        &self.vertex_face_offsets
+    }
+
+    /// Offsets of each vertex's run in the vertex-edge relation (length `num_vertices + 1`).
+    #[inline]
+    pub fn vertex_edge_offsets(&self) -> &[u32] {
+        &self.vertex_edge_offsets
+    }
+
     /// All face-vertex indices, face after face.
     #[inline]
     pub fn all_face_vertices(&self) -> &[u32] {

@@ -3,6 +3,7 @@
 //! vertices from parent vertices — evaluated directly into positions, or recorded as a
 //! [`StencilTable`].
 
+mod par;
 mod split;
 
 use glam::DVec3;

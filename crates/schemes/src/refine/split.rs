@@ -10,7 +10,12 @@
 // The relations are indexed by parent face, edge and end together, so index loops read best.
 #![allow(clippy::needless_range_loop)]
 
+use std::ops::Range;
+
+use rayon::prelude::*;
 use subd_mesh::{Topology, TopologyParts};
+
+use super::par;
 
 /// Index of the half of parent edge `e` at its end `k` (0 or 1), relative to the first half.
 #[inline]
@@ -44,7 +49,7 @@ fn vertex_edge_end(p: &Topology, v: usize, i: usize) -> u32 {
     }
 }
 
-/// Offsets from a count per element.
+/// Offsets from a count per element (sequential prefix sum, for the triangle split).
 fn offsets_from(counts: impl Iterator<Item = usize>, len: usize) -> Vec<u32> {
     let mut off = Vec::with_capacity(len + 1);
     off.push(0u32);
@@ -56,37 +61,38 @@ fn offsets_from(counts: impl Iterator<Item = usize>, len: usize) -> Vec<u32> {
     off
 }
 
-/// Child faces of the quad split: (V_k, E_k, F, E_{k-1}) with edges (hNext, I_k, I_{k-1},
-/// hPrev); a quad's child k is rotated so that the parent corner sits at position k.
-fn quad_face_loop(p: &Topology, face_vertices: &mut [u32], mut face_edges: Option<&mut [u32]>) {
+/// Child faces of the quad split for parent faces `faces`: (V_k, E_k, F, E_{k-1}) with
+/// edges (hNext, I_k, I_{k-1}, hPrev); a quad's child k is rotated so that the parent corner
+/// sits at position k. Writes vertices (`edges == false`) or edges into `out`, which starts at
+/// the first child face-vertex of `faces`.
+fn quad_face_block(p: &Topology, faces: Range<usize>, edges: bool, out: &mut [u32]) {
     let (nv, nf, nh) = (p.num_vertices(), p.num_faces(), p.num_face_vertices());
     let off = p.face_offsets();
     let face_point = |f: usize| (nv + f) as u32;
     let edge_point = |e: u32| (nv + nf) as u32 + e;
     let hb = nh as u32;
-    for f in 0..nf {
+    let origin = 4 * off[faces.start] as usize;
+    for f in faces {
         let fv = p.face_vertices(f);
         let fe = p.face_edges(f);
         let n = fv.len();
         let base = off[f];
         for k in 0..n {
             let km1 = if k == 0 { n - 1 } else { k - 1 };
-            let verts = [fv[k], edge_point(fe[k]), face_point(f), edge_point(fe[km1])];
-            let rot = if n == 4 { k } else { 0 };
-            let o = 4 * (base as usize + k);
-            for j in 0..4 {
-                face_vertices[o + (j + rot) % 4] = verts[j];
-            }
-            if let Some(face_edges) = face_edges.as_deref_mut() {
-                let edges = [
+            let vals = if edges {
+                [
                     hb + half(fe[k], end_at(p, fe[k], fv[k], true)),
                     base + k as u32,
                     base + km1 as u32,
                     hb + half(fe[km1], end_at(p, fe[km1], fv[k], false)),
-                ];
-                for j in 0..4 {
-                    face_edges[o + (j + rot) % 4] = edges[j];
-                }
+                ]
+            } else {
+                [fv[k], edge_point(fe[k]), face_point(f), edge_point(fe[km1])]
+            };
+            let rot = if n == 4 { k } else { 0 };
+            let o = 4 * (base as usize + k) - origin;
+            for j in 0..4 {
+                out[o + (j + rot) % 4] = vals[j];
             }
         }
     }
@@ -94,9 +100,9 @@ fn quad_face_loop(p: &Topology, face_vertices: &mut [u32], mut face_edges: Optio
 
 /// Face offsets and face-vertices of the quad split alone.
 pub(crate) fn quad_faces(p: &Topology) -> (Vec<u32>, Vec<u32>) {
-    let nh = p.num_face_vertices();
-    let mut face_vertices = vec![0u32; 4 * nh];
-    quad_face_loop(p, &mut face_vertices, None);
+    let (nf, nh) = (p.num_faces(), p.num_face_vertices());
+    let off = p.face_offsets();
+    let face_vertices = par::build(4 * nh, nf, |f| 4 * off[f] as usize, |r, out| quad_face_block(p, r, false, out));
     ((0..=nh as u32).map(|i| 4 * i).collect(), face_vertices)
 }
 
@@ -114,166 +120,250 @@ pub(crate) fn tri_faces(p: &Topology) -> (Vec<u32>, Vec<u32>) {
 }
 
 /// The quad split of Catmull-Clark and Bilinear: every face of size n becomes n quads.
+/// Every relation is filled in parallel blocks; offsets come in closed form from the
+/// parent's offsets.
 pub(crate) fn quad_split(p: &Topology) -> Topology {
-    let (nv, nf, ne, nh) = (
-        p.num_vertices(),
-        p.num_faces(),
-        p.num_edges(),
-        p.num_face_vertices(),
-    );
+    let (nv, nf, ne, nh) = (p.num_vertices(), p.num_faces(), p.num_edges(), p.num_face_vertices());
     let off = p.face_offsets();
+    let pefo = p.edge_face_offsets();
+    let pvfo = p.vertex_face_offsets();
+    let pveo = p.vertex_edge_offsets();
     let face_point = |f: usize| (nv + f) as u32;
-    let edge_point = |e: u32| (nv + nf) as u32 + e;
-    let hb = nh as u32; // first half-edge child
+    let edge_point = |e: usize| (nv + nf + e) as u32;
+    let hb = nh as u32;
     let size = |f: usize| (off[f + 1] - off[f]) as usize;
+    let nfaces = |e: usize| (pefo[e + 1] - pefo[e]) as usize;
 
-    let mut face_vertices = vec![0u32; 4 * nh];
-    let mut face_edges = vec![0u32; 4 * nh];
-    quad_face_loop(p, &mut face_vertices, Some(&mut face_edges));
-    let face_offsets = (0..=nh as u32).map(|i| 4 * i).collect();
+    let face_vertices = par::build(4 * nh, nf, |f| 4 * off[f] as usize, |r, out| quad_face_block(p, r, false, out));
+    let face_edges = par::build(4 * nh, nf, |f| 4 * off[f] as usize, |r, out| quad_face_block(p, r, true, out));
+    let face_offsets: Vec<u32> = (0..=nh as u32).map(|i| 4 * i).collect();
 
-    // Edges: I_f[j] = (F, E_j); H(e, k) = (E, V_{e.v[k]}).
-    let mut edge_vertices = Vec::with_capacity(nh + 2 * ne);
-    for f in 0..nf {
-        for &e in p.face_edges(f) {
-            edge_vertices.push([face_point(f), edge_point(e)]);
-        }
-    }
-    for e in 0..ne as u32 {
-        let [a, b] = p.edge_vertices(e as usize);
-        edge_vertices.push([edge_point(e), a]);
-        edge_vertices.push([edge_point(e), b]);
-    }
-
-    // Edge -> faces.
-    let edge_face_offsets = offsets_from(
-        (0..nh)
-            .map(|_| 2)
-            .chain((0..ne).flat_map(|e| [p.edge_faces(e).len(); 2])),
-        nh + 2 * ne,
-    );
-    let total = *edge_face_offsets.last().unwrap() as usize;
-    let mut edge_faces = Vec::with_capacity(total);
-    let mut edge_face_local = Vec::with_capacity(total);
-    for f in 0..nf {
-        let n = size(f);
-        let base = off[f];
-        for j in 0..n {
-            edge_faces.extend_from_slice(&[base + j as u32, base + ((j + 1) % n) as u32]);
-            if n == 4 {
-                edge_face_local.extend_from_slice(&[((j + 1) % 4) as u32, ((j + 3) % 4) as u32]);
-            } else {
-                edge_face_local.extend_from_slice(&[1, 2]);
+    // Edges: I_f[j] = (F, E_j) for the face edges, then H(e, k) = (E, V_{e.v[k]}).
+    let mut edge_vertices = vec![[0u32; 2]; nh + 2 * ne];
+    let (interior, halves) = edge_vertices.split_at_mut(nh);
+    par::fill(interior, nf, |f| off[f] as usize, |r, out| {
+        let mut i = 0;
+        for f in r {
+            for &e in p.face_edges(f) {
+                out[i] = [face_point(f), edge_point(e as usize)];
+                i += 1;
             }
         }
-    }
-    for e in 0..ne {
-        let ev = p.edge_vertices(e);
-        let degenerate = ev[0] == ev[1];
-        for k in 0..2usize {
-            for (&pf, &l) in p.edge_faces(e).iter().zip(p.edge_face_local_indices(e)) {
-                let (pf, l) = (pf as usize, l as usize);
-                let n = size(pf);
-                let c = if degenerate {
-                    k
-                } else {
-                    usize::from(p.face_vertices(pf)[l] != ev[k])
-                };
-                edge_faces.push(off[pf] + ((l + c) % n) as u32);
-                edge_face_local.push(if n == 4 {
-                    l as u32
-                } else if c == 1 {
-                    3
-                } else {
-                    0
-                });
+    });
+    par::fill(halves, ne, |e| 2 * e, |r, out| {
+        for (i, e) in r.enumerate() {
+            let [a, b] = p.edge_vertices(e);
+            out[2 * i] = [edge_point(e), a];
+            out[2 * i + 1] = [edge_point(e), b];
+        }
+    });
+
+    // Edge -> faces: two per interior edge; as many per half as the parent edge has faces.
+    let total_ef = 2 * nh + 2 * pefo[ne] as usize;
+    let mut edge_face_offsets = vec![0u32; nh + 2 * ne + 1];
+    {
+        let (a, b) = edge_face_offsets.split_at_mut(nh);
+        a.par_iter_mut().enumerate().for_each(|(i, o)| *o = 2 * i as u32);
+        par::fill(b, ne, |e| 2 * e + usize::from(e == ne), |r, out| {
+            for (i, e) in r.clone().enumerate() {
+                let base = 2 * nh as u32 + 2 * pefo[e];
+                out[2 * i] = base;
+                if e < ne {
+                    out[2 * i + 1] = base + nfaces(e) as u32;
+                }
             }
-        }
+        });
+        // The closing offset (written by the block that holds `ne`, if any).
+        b[2 * ne] = total_ef as u32;
+    }
+    let ef_start = |e: usize| 2 * pefo[e] as usize;
+    let mut edge_faces = vec![0u32; total_ef];
+    let mut edge_face_local = vec![0u32; total_ef];
+    for (dst, local) in [(&mut edge_faces, false), (&mut edge_face_local, true)] {
+        let (a, b) = dst.split_at_mut(2 * nh);
+        par::fill(a, nf, |f| 2 * off[f] as usize, |r, out| {
+            let mut i = 0;
+            for f in r {
+                let n = size(f);
+                let base = off[f];
+                for j in 0..n {
+                    let vals = match (local, n == 4) {
+                        (false, _) => [base + j as u32, base + ((j + 1) % n) as u32],
+                        (true, true) => [((j + 1) % 4) as u32, ((j + 3) % 4) as u32],
+                        (true, false) => [1, 2],
+                    };
+                    out[i..i + 2].copy_from_slice(&vals);
+                    i += 2;
+                }
+            }
+        });
+        par::fill(b, ne, ef_start, |r, out| {
+            let mut i = 0;
+            for e in r {
+                let ev = p.edge_vertices(e);
+                let degenerate = ev[0] == ev[1];
+                for k in 0..2usize {
+                    for (&pf, &l) in p.edge_faces(e).iter().zip(p.edge_face_local_indices(e)) {
+                        let (pf, l) = (pf as usize, l as usize);
+                        let n = size(pf);
+                        let c = if degenerate { k } else { usize::from(p.face_vertices(pf)[l] != ev[k]) };
+                        out[i] = if !local {
+                            off[pf] + ((l + c) % n) as u32
+                        } else if n == 4 {
+                            l as u32
+                        } else if c == 1 {
+                            3
+                        } else {
+                            0
+                        };
+                        i += 1;
+                    }
+                }
+            }
+        });
     }
 
-    // Vertex -> faces.
-    let vertex_face_offsets = offsets_from(
-        (0..nv)
-            .map(|v| p.vertex_faces(v).len())
-            .chain((0..nf).map(size))
-            .chain((0..ne).map(|e| 2 * p.edge_faces(e).len())),
-        nv + nf + ne,
-    );
-    let total = *vertex_face_offsets.last().unwrap() as usize;
-    let mut vertex_faces = Vec::with_capacity(total);
-    let mut vertex_face_local = Vec::with_capacity(total);
-    for v in 0..nv {
-        for (&pf, &c) in p.vertex_faces(v).iter().zip(p.vertex_face_local_indices(v)) {
-            vertex_faces.push(off[pf as usize] + c);
-            vertex_face_local.push(if size(pf as usize) == 4 { c } else { 0 });
-        }
+    // Vertex -> faces: V_v (as the parent), F_f (n), E_e (two per parent face).
+    let nvf = pvfo[nv] as usize;
+    let mut vertex_face_offsets = vec![0u32; nv + nf + ne + 1];
+    {
+        let (a, rest) = vertex_face_offsets.split_at_mut(nv);
+        let (b, c) = rest.split_at_mut(nf);
+        a.copy_from_slice(&pvfo[..nv]);
+        b.par_iter_mut().enumerate().for_each(|(f, o)| *o = (nvf + off[f] as usize) as u32);
+        c.par_iter_mut()
+            .enumerate()
+            .for_each(|(e, o)| *o = (nvf + nh + 2 * pefo[e] as usize) as u32);
     }
-    for f in 0..nf {
-        let n = size(f);
-        for j in 0..n {
-            vertex_faces.push(off[f] + j as u32);
-            vertex_face_local.push(if n == 4 { ((j + 2) % 4) as u32 } else { 2 });
-        }
-    }
-    for e in 0..ne {
-        for (&pf, &l) in p.edge_faces(e).iter().zip(p.edge_face_local_indices(e)) {
-            let (pf, l) = (pf as usize, l as usize);
-            let n = size(pf);
-            vertex_faces.push(off[pf] + ((l + 1) % n) as u32);
-            vertex_face_local.push(if n == 4 { l as u32 } else { 3 });
-            vertex_faces.push(off[pf] + l as u32);
-            vertex_face_local.push(if n == 4 { ((l + 1) % 4) as u32 } else { 1 });
-        }
-    }
-
-    // Vertex -> edges.
-    let vertex_edge_offsets = offsets_from(
-        (0..nv)
-            .map(|v| p.valence(v))
-            .chain((0..nf).map(size))
-            .chain((0..ne).map(|e| p.edge_faces(e).len() + 2)),
-        nv + nf + ne,
-    );
-    let total = *vertex_edge_offsets.last().unwrap() as usize;
-    let mut vertex_edges = Vec::with_capacity(total);
-    for v in 0..nv {
-        for (i, &e) in p.vertex_edges(v).iter().enumerate() {
-            vertex_edges.push(hb + half(e, vertex_edge_end(p, v, i)));
-        }
-    }
-    for f in 0..nf {
-        let n = size(f) as u32;
-        let base = off[f];
-        vertex_edges.push(base + n - 1);
-        vertex_edges.extend((0..n - 1).map(|j| base + j));
-    }
-    for e in 0..ne {
-        let ev = p.edge_vertices(e);
-        let ef = p.edge_faces(e);
-        let el = p.edge_face_local_indices(e);
-        let (h0, h1) = (hb + half(e as u32, 0), hb + half(e as u32, 1));
-        let first = off[ef[0] as usize] + el[0];
-        let same_dir = ev[0] != ev[1] && p.face_vertices(ef[0] as usize)[el[0] as usize] == ev[0];
-        if same_dir {
-            vertex_edges.extend_from_slice(&[h1, first, h0]);
-        } else {
-            vertex_edges.extend_from_slice(&[h0, first, h1]);
-        }
-        for (&pf, &l) in ef.iter().zip(el).skip(1) {
-            vertex_edges.push(off[pf as usize] + l);
-        }
+    let total_vf = nvf + nh + 2 * pefo[ne] as usize;
+    let mut vertex_faces = vec![0u32; total_vf];
+    let mut vertex_face_local = vec![0u32; total_vf];
+    for (dst, local) in [(&mut vertex_faces, false), (&mut vertex_face_local, true)] {
+        let (a, rest) = dst.split_at_mut(nvf);
+        let (b, c) = rest.split_at_mut(nh);
+        par::fill(a, nv, |v| pvfo[v] as usize, |r, out| {
+            let mut i = 0;
+            for v in r {
+                for (&pf, &c) in p.vertex_faces(v).iter().zip(p.vertex_face_local_indices(v)) {
+                    out[i] = match (local, size(pf as usize) == 4) {
+                        (false, _) => off[pf as usize] + c,
+                        (true, true) => c,
+                        (true, false) => 0,
+                    };
+                    i += 1;
+                }
+            }
+        });
+        par::fill(b, nf, |f| off[f] as usize, |r, out| {
+            let mut i = 0;
+            for f in r {
+                let n = size(f);
+                for j in 0..n {
+                    out[i] = match (local, n == 4) {
+                        (false, _) => off[f] + j as u32,
+                        (true, true) => ((j + 2) % 4) as u32,
+                        (true, false) => 2,
+                    };
+                    i += 1;
+                }
+            }
+        });
+        par::fill(c, ne, ef_start, |r, out| {
+            let mut i = 0;
+            for e in r {
+                for (&pf, &l) in p.edge_faces(e).iter().zip(p.edge_face_local_indices(e)) {
+                    let (pf, l) = (pf as usize, l as usize);
+                    let n = size(pf);
+                    let vals = match (local, n == 4) {
+                        (false, _) => [off[pf] + ((l + 1) % n) as u32, off[pf] + l as u32],
+                        (true, true) => [l as u32, ((l + 1) % 4) as u32],
+                        (true, false) => [3, 1],
+                    };
+                    out[i..i + 2].copy_from_slice(&vals);
+                    i += 2;
+                }
+            }
+        });
     }
 
-    let mut edge_boundary = vec![false; nh];
-    let mut edge_non_manifold = vec![false; nh];
-    for e in 0..ne {
-        let (b, m) = (p.is_boundary_edge(e), p.is_non_manifold_edge(e));
-        edge_boundary.extend_from_slice(&[b, b]);
-        edge_non_manifold.extend_from_slice(&[m, m]);
+    // Vertex -> edges: V_v (halves, as the parent), F_f (interior, leading edges first),
+    // E_e (halves and interior edges interleaved, in OpenSubdiv's order).
+    let nve = pveo[nv] as usize;
+    let mut vertex_edge_offsets = vec![0u32; nv + nf + ne + 1];
+    {
+        let (a, rest) = vertex_edge_offsets.split_at_mut(nv);
+        let (b, c) = rest.split_at_mut(nf);
+        a.copy_from_slice(&pveo[..nv]);
+        b.par_iter_mut().enumerate().for_each(|(f, o)| *o = (nve + off[f] as usize) as u32);
+        c.par_iter_mut()
+            .enumerate()
+            .for_each(|(e, o)| *o = (nve + nh + pefo[e] as usize + 2 * e) as u32);
     }
-    let mut vertex_non_manifold: Vec<bool> = (0..nv).map(|v| p.is_non_manifold_vertex(v)).collect();
-    vertex_non_manifold.resize(nv + nf, false);
-    vertex_non_manifold.extend((0..ne).map(|e| p.is_non_manifold_edge(e)));
+    let total_ve = nve + nh + pefo[ne] as usize + 2 * ne;
+    let mut vertex_edges = vec![0u32; total_ve];
+    {
+        let (a, rest) = vertex_edges.split_at_mut(nve);
+        let (b, c) = rest.split_at_mut(nh);
+        par::fill(a, nv, |v| pveo[v] as usize, |r, out| {
+            let mut i = 0;
+            for v in r {
+                for (k, &e) in p.vertex_edges(v).iter().enumerate() {
+                    out[i] = hb + half(e, vertex_edge_end(p, v, k));
+                    i += 1;
+                }
+            }
+        });
+        par::fill(b, nf, |f| off[f] as usize, |r, out| {
+            let mut i = 0;
+            for f in r {
+                let n = size(f) as u32;
+                let base = off[f];
+                out[i] = base + n - 1;
+                for j in 0..n - 1 {
+                    out[i + 1 + j as usize] = base + j;
+                }
+                i += n as usize;
+            }
+        });
+        par::fill(c, ne, |e| pefo[e] as usize + 2 * e, |r, out| {
+            let mut i = 0;
+            for e in r {
+                let ev = p.edge_vertices(e);
+                let ef = p.edge_faces(e);
+                let el = p.edge_face_local_indices(e);
+                let (h0, h1) = (hb + half(e as u32, 0), hb + half(e as u32, 1));
+                let first = off[ef[0] as usize] + el[0];
+                let same_dir = ev[0] != ev[1] && p.face_vertices(ef[0] as usize)[el[0] as usize] == ev[0];
+                let head = if same_dir { [h1, first, h0] } else { [h0, first, h1] };
+                out[i..i + 3].copy_from_slice(&head);
+                i += 3;
+                for (&pf, &l) in ef.iter().zip(el).skip(1) {
+                    out[i] = off[pf as usize] + l;
+                    i += 1;
+                }
+            }
+        });
+    }
+    vertex_face_offsets[nv + nf + ne] = total_vf as u32;
+    vertex_edge_offsets[nv + nf + ne] = total_ve as u32;
+
+    let mut edge_boundary = vec![false; nh + 2 * ne];
+    let mut edge_non_manifold = vec![false; nh + 2 * ne];
+    for (dst, nm) in [(&mut edge_boundary, false), (&mut edge_non_manifold, true)] {
+        dst[nh..].par_chunks_mut(2).enumerate().for_each(|(e, o)| {
+            let v = if nm { p.is_non_manifold_edge(e) } else { p.is_boundary_edge(e) };
+            o.fill(v);
+        });
+    }
+    let mut vertex_non_manifold = vec![false; nv + nf + ne];
+    vertex_non_manifold[..nv]
+        .par_iter_mut()
+        .enumerate()
+        .for_each(|(v, o)| *o = p.is_non_manifold_vertex(v));
+    vertex_non_manifold[nv + nf..]
+        .par_iter_mut()
+        .enumerate()
+        .for_each(|(e, o)| *o = p.is_non_manifold_edge(e));
 
     Topology::from_parts(TopologyParts {
         num_vertices: nv + nf + ne,
