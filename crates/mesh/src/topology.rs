@@ -320,6 +320,43 @@ impl Topology {
         self.tags.vertex_sharpness[v] = tags::sanitize(sharpness);
     }
 
+    /// Replaces every tag at once (edge crease sharpness, vertex corner sharpness, holes),
+    /// as a refinement does for a whole level. Sharpness is sanitised as by
+    /// [`Self::set_edge_sharpness`].
+    ///
+    /// # Errors
+    /// [`TopologyError::InconsistentEdges`] when a length does not match the topology.
+    pub fn set_all_tags(
+        &mut self,
+        edge_sharpness: Vec<f32>,
+        vertex_sharpness: Vec<f32>,
+        holes: Vec<bool>,
+    ) -> Result<(), TopologyError> {
+        if edge_sharpness.len() != self.num_edges()
+            || vertex_sharpness.len() != self.num_vertices()
+            || holes.len() != self.num_faces()
+        {
+            return Err(TopologyError::InconsistentEdges {
+                face: 0,
+                detail: "tag arrays do not match the topology",
+            });
+        }
+        let mut edge_sharpness = edge_sharpness;
+        let mut vertex_sharpness = vertex_sharpness;
+        edge_sharpness
+            .iter_mut()
+            .for_each(|s| *s = tags::sanitize(*s));
+        vertex_sharpness
+            .iter_mut()
+            .for_each(|s| *s = tags::sanitize(*s));
+        self.tags = Tags {
+            edge_sharpness,
+            vertex_sharpness,
+            face_hole: holes,
+        };
+        Ok(())
+    }
+
     /// Marks face `f` as a hole or not.
     pub fn set_hole(&mut self, f: usize, hole: bool) {
         self.tags.face_hole[f] = hole;

@@ -323,3 +323,6 @@ impl Refinement {
         out
     }
 }
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

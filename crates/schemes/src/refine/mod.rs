@@ -180,24 +180,28 @@ pub(crate) fn child_topology(
         Scheme::Loop => split::tri_split(p),
         _ => split::quad_split(p),
     };
-    for (f, h) in child_holes(p, scheme, child.num_faces())
-        .into_iter()
-        .enumerate()
-    {
-        if h {
-            child.set_hole(f, true);
-        }
-    }
     let method = options.crease_method;
-    for e in 0..p.num_edges() {
-        let [a, b] = p.edge_vertices(e);
-        let h = layout.half_edge_base as usize + 2 * e;
-        child.set_edge_sharpness(h, half_sharpness(p, e, a as usize, method));
-        child.set_edge_sharpness(h + 1, half_sharpness(p, e, b as usize, method));
-    }
-    for v in 0..p.num_vertices() {
-        child.set_vertex_sharpness(v, rules::child_vertex_sharpness(p.vertex_sharpness(v)));
-    }
+    let hb = layout.half_edge_base as usize;
+    // Interior child edges are smooth; the halves of each parent edge decay.
+    let mut edge_sharpness = vec![0.0f32; child.num_edges()];
+    edge_sharpness[hb..]
+        .par_chunks_mut(2)
+        .enumerate()
+        .for_each(|(e, o)| {
+            let [a, b] = p.edge_vertices(e);
+            o[0] = half_sharpness(p, e, a as usize, method);
+            o[1] = half_sharpness(p, e, b as usize, method);
+        });
+    // Only vertex-children keep a (decayed) vertex sharpness.
+    let mut vertex_sharpness = vec![0.0f32; child.num_vertices()];
+    vertex_sharpness[..p.num_vertices()]
+        .par_iter_mut()
+        .enumerate()
+        .for_each(|(v, o)| *o = rules::child_vertex_sharpness(p.vertex_sharpness(v)));
+    let holes = child_holes(p, scheme, child.num_faces());
+    child
+        .set_all_tags(edge_sharpness, vertex_sharpness, holes)
+        .expect("child tag arrays match the child topology");
     child
 }
 
@@ -211,28 +215,34 @@ pub(crate) fn child_rules(
 ) -> Vec<Rule> {
     let method = options.crease_method;
     let mut out = vec![Rule::Smooth; layout.num_child_vertices];
-    for (v, slot) in out.iter_mut().enumerate().take(p.num_vertices()) {
-        let mut rule = parent_rules[v];
-        let ps = p.vertex_sharpness(v);
-        let cs = rules::child_vertex_sharpness(ps);
-        let ve = p.vertex_edges(v);
-        let semi_edges = ve
-            .iter()
-            .any(|&e| is_semi_sharp(p.edge_sharpness(e as usize)));
-        // Reclassify only a vertex that had semi-sharp features and ends up not sharp
-        // itself: its semi-sharp edges decayed, or its own semi-sharpness did.
-        if cs <= 0.0 && (semi_edges || is_semi_sharp(ps)) {
-            let sharp = ve
+    let nv = p.num_vertices();
+    let (vertex_part, rest) = out.split_at_mut(nv);
+    vertex_part
+        .par_iter_mut()
+        .enumerate()
+        .for_each(|(v, slot)| {
+            let mut rule = parent_rules[v];
+            let ps = p.vertex_sharpness(v);
+            let cs = rules::child_vertex_sharpness(ps);
+            let ve = p.vertex_edges(v);
+            let semi_edges = ve
                 .iter()
-                .filter(|&&e| half_sharpness(p, e as usize, v, method) > 0.0)
-                .count();
-            rule = Rule::determine(0.0, sharp);
-        }
-        *slot = rule;
-    }
-    for e in 0..p.num_edges() {
+                .any(|&e| is_semi_sharp(p.edge_sharpness(e as usize)));
+            // Reclassify only a vertex that had semi-sharp features and ends up not sharp
+            // itself: its semi-sharp edges decayed, or its own semi-sharpness did.
+            if cs <= 0.0 && (semi_edges || is_semi_sharp(ps)) {
+                let sharp = ve
+                    .iter()
+                    .filter(|&&e| half_sharpness(p, e as usize, v, method) > 0.0)
+                    .count();
+                rule = Rule::determine(0.0, sharp);
+            }
+            *slot = rule;
+        });
+    let edge_part = &mut rest[(layout.edge_vertex_base as usize - nv)..];
+    edge_part.par_iter_mut().enumerate().for_each(|(e, slot)| {
         let s = p.edge_sharpness(e);
-        let rule = if is_infinite(s) {
+        *slot = if is_infinite(s) {
             Rule::Crease
         } else if s > 0.0 {
             let [a, b] = p.edge_vertices(e);
@@ -242,8 +252,7 @@ pub(crate) fn child_rules(
         } else {
             Rule::Smooth
         };
-        out[layout.edge_vertex_base as usize + e] = rule;
-    }
+    });
     out
 }
 

@@ -49,18 +49,6 @@ fn vertex_edge_end(p: &Topology, v: usize, i: usize) -> u32 {
     }
 }
 
-/// Offsets from a count per element (sequential prefix sum, for the triangle split).
-fn offsets_from(counts: impl Iterator<Item = usize>, len: usize) -> Vec<u32> {
-    let mut off = Vec::with_capacity(len + 1);
-    off.push(0u32);
-    let mut acc = 0u32;
-    for c in counts {
-        acc += c as u32;
-        off.push(acc);
-    }
-    off
-}
-
 /// Child faces of the quad split for parent faces `faces`: (V_k, E_k, F, E_{k-1}) with
 /// edges (hNext, I_k, I_{k-1}, hPrev); a quad's child k is rotated so that the parent corner
 /// sits at position k. Writes vertices (`edges == false`) or edges into `out`, which starts at
@@ -102,20 +90,32 @@ fn quad_face_block(p: &Topology, faces: Range<usize>, edges: bool, out: &mut [u3
 pub(crate) fn quad_faces(p: &Topology) -> (Vec<u32>, Vec<u32>) {
     let (nf, nh) = (p.num_faces(), p.num_face_vertices());
     let off = p.face_offsets();
-    let face_vertices = par::build(4 * nh, nf, |f| 4 * off[f] as usize, |r, out| quad_face_block(p, r, false, out));
+    let face_vertices = par::build(
+        4 * nh,
+        nf,
+        |f| 4 * off[f] as usize,
+        |r, out| quad_face_block(p, r, false, out),
+    );
     ((0..=nh as u32).map(|i| 4 * i).collect(), face_vertices)
 }
 
 /// Face offsets and face-vertices of the triangle split alone.
 pub(crate) fn tri_faces(p: &Topology) -> (Vec<u32>, Vec<u32>) {
     let (nv, nf) = (p.num_vertices() as u32, p.num_faces());
-    let mut face_vertices = Vec::with_capacity(12 * nf);
-    for f in 0..nf {
-        let v = p.face_vertices(f);
-        let e = p.face_edges(f);
-        let (e0, e1, e2) = (nv + e[0], nv + e[1], nv + e[2]);
-        face_vertices.extend_from_slice(&[v[0], e0, e2, e0, v[1], e1, e2, e1, v[2], e1, e2, e0]);
-    }
+    let face_vertices = par::build(
+        12 * nf,
+        nf,
+        |f| 12 * f,
+        |r, out| {
+            for (i, f) in r.enumerate() {
+                let v = p.face_vertices(f);
+                let e = p.face_edges(f);
+                let (e0, e1, e2) = (nv + e[0], nv + e[1], nv + e[2]);
+                out[12 * i..12 * i + 12]
+                    .copy_from_slice(&[v[0], e0, e2, e0, v[1], e1, e2, e1, v[2], e1, e2, e0]);
+            }
+        },
+    );
     ((0..=4 * nf as u32).map(|k| 3 * k).collect(), face_vertices)
 }
 
@@ -123,7 +123,12 @@ pub(crate) fn tri_faces(p: &Topology) -> (Vec<u32>, Vec<u32>) {
 /// Every relation is filled in parallel blocks; offsets come in closed form from the
 /// parent's offsets.
 pub(crate) fn quad_split(p: &Topology) -> Topology {
-    let (nv, nf, ne, nh) = (p.num_vertices(), p.num_faces(), p.num_edges(), p.num_face_vertices());
+    let (nv, nf, ne, nh) = (
+        p.num_vertices(),
+        p.num_faces(),
+        p.num_edges(),
+        p.num_face_vertices(),
+    );
     let off = p.face_offsets();
     let pefo = p.edge_face_offsets();
     let pvfo = p.vertex_face_offsets();
@@ -134,45 +139,72 @@ pub(crate) fn quad_split(p: &Topology) -> Topology {
     let size = |f: usize| (off[f + 1] - off[f]) as usize;
     let nfaces = |e: usize| (pefo[e + 1] - pefo[e]) as usize;
 
-    let face_vertices = par::build(4 * nh, nf, |f| 4 * off[f] as usize, |r, out| quad_face_block(p, r, false, out));
-    let face_edges = par::build(4 * nh, nf, |f| 4 * off[f] as usize, |r, out| quad_face_block(p, r, true, out));
+    let face_vertices = par::build(
+        4 * nh,
+        nf,
+        |f| 4 * off[f] as usize,
+        |r, out| quad_face_block(p, r, false, out),
+    );
+    let face_edges = par::build(
+        4 * nh,
+        nf,
+        |f| 4 * off[f] as usize,
+        |r, out| quad_face_block(p, r, true, out),
+    );
     let face_offsets: Vec<u32> = (0..=nh as u32).map(|i| 4 * i).collect();
 
     // Edges: I_f[j] = (F, E_j) for the face edges, then H(e, k) = (E, V_{e.v[k]}).
     let mut edge_vertices = vec![[0u32; 2]; nh + 2 * ne];
     let (interior, halves) = edge_vertices.split_at_mut(nh);
-    par::fill(interior, nf, |f| off[f] as usize, |r, out| {
-        let mut i = 0;
-        for f in r {
-            for &e in p.face_edges(f) {
-                out[i] = [face_point(f), edge_point(e as usize)];
-                i += 1;
+    par::fill(
+        interior,
+        nf,
+        |f| off[f] as usize,
+        |r, out| {
+            let mut i = 0;
+            for f in r {
+                for &e in p.face_edges(f) {
+                    out[i] = [face_point(f), edge_point(e as usize)];
+                    i += 1;
+                }
             }
-        }
-    });
-    par::fill(halves, ne, |e| 2 * e, |r, out| {
-        for (i, e) in r.enumerate() {
-            let [a, b] = p.edge_vertices(e);
-            out[2 * i] = [edge_point(e), a];
-            out[2 * i + 1] = [edge_point(e), b];
-        }
-    });
+        },
+    );
+    par::fill(
+        halves,
+        ne,
+        |e| 2 * e,
+        |r, out| {
+            for (i, e) in r.enumerate() {
+                let [a, b] = p.edge_vertices(e);
+                out[2 * i] = [edge_point(e), a];
+                out[2 * i + 1] = [edge_point(e), b];
+            }
+        },
+    );
 
     // Edge -> faces: two per interior edge; as many per half as the parent edge has faces.
     let total_ef = 2 * nh + 2 * pefo[ne] as usize;
     let mut edge_face_offsets = vec![0u32; nh + 2 * ne + 1];
     {
         let (a, b) = edge_face_offsets.split_at_mut(nh);
-        a.par_iter_mut().enumerate().for_each(|(i, o)| *o = 2 * i as u32);
-        par::fill(b, ne, |e| 2 * e + usize::from(e == ne), |r, out| {
-            for (i, e) in r.clone().enumerate() {
-                let base = 2 * nh as u32 + 2 * pefo[e];
-                out[2 * i] = base;
-                if e < ne {
-                    out[2 * i + 1] = base + nfaces(e) as u32;
+        a.par_iter_mut()
+            .enumerate()
+            .for_each(|(i, o)| *o = 2 * i as u32);
+        par::fill(
+            b,
+            ne,
+            |e| 2 * e + usize::from(e == ne),
+            |r, out| {
+                for (i, e) in r.clone().enumerate() {
+                    let base = 2 * nh as u32 + 2 * pefo[e];
+                    out[2 * i] = base;
+                    if e < ne {
+                        out[2 * i + 1] = base + nfaces(e) as u32;
+                    }
                 }
-            }
-        });
+            },
+        );
         // The closing offset (written by the block that holds `ne`, if any).
         b[2 * ne] = total_ef as u32;
     }
@@ -181,22 +213,27 @@ pub(crate) fn quad_split(p: &Topology) -> Topology {
     let mut edge_face_local = vec![0u32; total_ef];
     for (dst, local) in [(&mut edge_faces, false), (&mut edge_face_local, true)] {
         let (a, b) = dst.split_at_mut(2 * nh);
-        par::fill(a, nf, |f| 2 * off[f] as usize, |r, out| {
-            let mut i = 0;
-            for f in r {
-                let n = size(f);
-                let base = off[f];
-                for j in 0..n {
-                    let vals = match (local, n == 4) {
-                        (false, _) => [base + j as u32, base + ((j + 1) % n) as u32],
-                        (true, true) => [((j + 1) % 4) as u32, ((j + 3) % 4) as u32],
-                        (true, false) => [1, 2],
-                    };
-                    out[i..i + 2].copy_from_slice(&vals);
-                    i += 2;
+        par::fill(
+            a,
+            nf,
+            |f| 2 * off[f] as usize,
+            |r, out| {
+                let mut i = 0;
+                for f in r {
+                    let n = size(f);
+                    let base = off[f];
+                    for j in 0..n {
+                        let vals = match (local, n == 4) {
+                            (false, _) => [base + j as u32, base + ((j + 1) % n) as u32],
+                            (true, true) => [((j + 1) % 4) as u32, ((j + 3) % 4) as u32],
+                            (true, false) => [1, 2],
+                        };
+                        out[i..i + 2].copy_from_slice(&vals);
+                        i += 2;
+                    }
                 }
-            }
-        });
+            },
+        );
         par::fill(b, ne, ef_start, |r, out| {
             let mut i = 0;
             for e in r {
@@ -206,7 +243,11 @@ pub(crate) fn quad_split(p: &Topology) -> Topology {
                     for (&pf, &l) in p.edge_faces(e).iter().zip(p.edge_face_local_indices(e)) {
                         let (pf, l) = (pf as usize, l as usize);
                         let n = size(pf);
-                        let c = if degenerate { k } else { usize::from(p.face_vertices(pf)[l] != ev[k]) };
+                        let c = if degenerate {
+                            k
+                        } else {
+                            usize::from(p.face_vertices(pf)[l] != ev[k])
+                        };
                         out[i] = if !local {
                             off[pf] + ((l + c) % n) as u32
                         } else if n == 4 {
@@ -230,7 +271,9 @@ pub(crate) fn quad_split(p: &Topology) -> Topology {
         let (a, rest) = vertex_face_offsets.split_at_mut(nv);
         let (b, c) = rest.split_at_mut(nf);
         a.copy_from_slice(&pvfo[..nv]);
-        b.par_iter_mut().enumerate().for_each(|(f, o)| *o = (nvf + off[f] as usize) as u32);
+        b.par_iter_mut()
+            .enumerate()
+            .for_each(|(f, o)| *o = (nvf + off[f] as usize) as u32);
         c.par_iter_mut()
             .enumerate()
             .for_each(|(e, o)| *o = (nvf + nh + 2 * pefo[e] as usize) as u32);
@@ -241,33 +284,43 @@ pub(crate) fn quad_split(p: &Topology) -> Topology {
     for (dst, local) in [(&mut vertex_faces, false), (&mut vertex_face_local, true)] {
         let (a, rest) = dst.split_at_mut(nvf);
         let (b, c) = rest.split_at_mut(nh);
-        par::fill(a, nv, |v| pvfo[v] as usize, |r, out| {
-            let mut i = 0;
-            for v in r {
-                for (&pf, &c) in p.vertex_faces(v).iter().zip(p.vertex_face_local_indices(v)) {
-                    out[i] = match (local, size(pf as usize) == 4) {
-                        (false, _) => off[pf as usize] + c,
-                        (true, true) => c,
-                        (true, false) => 0,
-                    };
-                    i += 1;
+        par::fill(
+            a,
+            nv,
+            |v| pvfo[v] as usize,
+            |r, out| {
+                let mut i = 0;
+                for v in r {
+                    for (&pf, &c) in p.vertex_faces(v).iter().zip(p.vertex_face_local_indices(v)) {
+                        out[i] = match (local, size(pf as usize) == 4) {
+                            (false, _) => off[pf as usize] + c,
+                            (true, true) => c,
+                            (true, false) => 0,
+                        };
+                        i += 1;
+                    }
                 }
-            }
-        });
-        par::fill(b, nf, |f| off[f] as usize, |r, out| {
-            let mut i = 0;
-            for f in r {
-                let n = size(f);
-                for j in 0..n {
-                    out[i] = match (local, n == 4) {
-                        (false, _) => off[f] + j as u32,
-                        (true, true) => ((j + 2) % 4) as u32,
-                        (true, false) => 2,
-                    };
-                    i += 1;
+            },
+        );
+        par::fill(
+            b,
+            nf,
+            |f| off[f] as usize,
+            |r, out| {
+                let mut i = 0;
+                for f in r {
+                    let n = size(f);
+                    for j in 0..n {
+                        out[i] = match (local, n == 4) {
+                            (false, _) => off[f] + j as u32,
+                            (true, true) => ((j + 2) % 4) as u32,
+                            (true, false) => 2,
+                        };
+                        i += 1;
+                    }
                 }
-            }
-        });
+            },
+        );
         par::fill(c, ne, ef_start, |r, out| {
             let mut i = 0;
             for e in r {
@@ -294,7 +347,9 @@ pub(crate) fn quad_split(p: &Topology) -> Topology {
         let (a, rest) = vertex_edge_offsets.split_at_mut(nv);
         let (b, c) = rest.split_at_mut(nf);
         a.copy_from_slice(&pveo[..nv]);
-        b.par_iter_mut().enumerate().for_each(|(f, o)| *o = (nve + off[f] as usize) as u32);
+        b.par_iter_mut()
+            .enumerate()
+            .for_each(|(f, o)| *o = (nve + off[f] as usize) as u32);
         c.par_iter_mut()
             .enumerate()
             .for_each(|(e, o)| *o = (nve + nh + pefo[e] as usize + 2 * e) as u32);
@@ -304,45 +359,65 @@ pub(crate) fn quad_split(p: &Topology) -> Topology {
     {
         let (a, rest) = vertex_edges.split_at_mut(nve);
         let (b, c) = rest.split_at_mut(nh);
-        par::fill(a, nv, |v| pveo[v] as usize, |r, out| {
-            let mut i = 0;
-            for v in r {
-                for (k, &e) in p.vertex_edges(v).iter().enumerate() {
-                    out[i] = hb + half(e, vertex_edge_end(p, v, k));
-                    i += 1;
+        par::fill(
+            a,
+            nv,
+            |v| pveo[v] as usize,
+            |r, out| {
+                let mut i = 0;
+                for v in r {
+                    for (k, &e) in p.vertex_edges(v).iter().enumerate() {
+                        out[i] = hb + half(e, vertex_edge_end(p, v, k));
+                        i += 1;
+                    }
                 }
-            }
-        });
-        par::fill(b, nf, |f| off[f] as usize, |r, out| {
-            let mut i = 0;
-            for f in r {
-                let n = size(f) as u32;
-                let base = off[f];
-                out[i] = base + n - 1;
-                for j in 0..n - 1 {
-                    out[i + 1 + j as usize] = base + j;
+            },
+        );
+        par::fill(
+            b,
+            nf,
+            |f| off[f] as usize,
+            |r, out| {
+                let mut i = 0;
+                for f in r {
+                    let n = size(f) as u32;
+                    let base = off[f];
+                    out[i] = base + n - 1;
+                    for j in 0..n - 1 {
+                        out[i + 1 + j as usize] = base + j;
+                    }
+                    i += n as usize;
                 }
-                i += n as usize;
-            }
-        });
-        par::fill(c, ne, |e| pefo[e] as usize + 2 * e, |r, out| {
-            let mut i = 0;
-            for e in r {
-                let ev = p.edge_vertices(e);
-                let ef = p.edge_faces(e);
-                let el = p.edge_face_local_indices(e);
-                let (h0, h1) = (hb + half(e as u32, 0), hb + half(e as u32, 1));
-                let first = off[ef[0] as usize] + el[0];
-                let same_dir = ev[0] != ev[1] && p.face_vertices(ef[0] as usize)[el[0] as usize] == ev[0];
-                let head = if same_dir { [h1, first, h0] } else { [h0, first, h1] };
-                out[i..i + 3].copy_from_slice(&head);
-                i += 3;
-                for (&pf, &l) in ef.iter().zip(el).skip(1) {
-                    out[i] = off[pf as usize] + l;
-                    i += 1;
+            },
+        );
+        par::fill(
+            c,
+            ne,
+            |e| pefo[e] as usize + 2 * e,
+            |r, out| {
+                let mut i = 0;
+                for e in r {
+                    let ev = p.edge_vertices(e);
+                    let ef = p.edge_faces(e);
+                    let el = p.edge_face_local_indices(e);
+                    let (h0, h1) = (hb + half(e as u32, 0), hb + half(e as u32, 1));
+                    let first = off[ef[0] as usize] + el[0];
+                    let same_dir =
+                        ev[0] != ev[1] && p.face_vertices(ef[0] as usize)[el[0] as usize] == ev[0];
+                    let head = if same_dir {
+                        [h1, first, h0]
+                    } else {
+                        [h0, first, h1]
+                    };
+                    out[i..i + 3].copy_from_slice(&head);
+                    i += 3;
+                    for (&pf, &l) in ef.iter().zip(el).skip(1) {
+                        out[i] = off[pf as usize] + l;
+                        i += 1;
+                    }
                 }
-            }
-        });
+            },
+        );
     }
     vertex_face_offsets[nv + nf + ne] = total_vf as u32;
     vertex_edge_offsets[nv + nf + ne] = total_ve as u32;
@@ -351,7 +426,11 @@ pub(crate) fn quad_split(p: &Topology) -> Topology {
     let mut edge_non_manifold = vec![false; nh + 2 * ne];
     for (dst, nm) in [(&mut edge_boundary, false), (&mut edge_non_manifold, true)] {
         dst[nh..].par_chunks_mut(2).enumerate().for_each(|(e, o)| {
-            let v = if nm { p.is_non_manifold_edge(e) } else { p.is_boundary_edge(e) };
+            let v = if nm {
+                p.is_non_manifold_edge(e)
+            } else {
+                p.is_boundary_edge(e)
+            };
             o.fill(v);
         });
     }
@@ -387,139 +466,277 @@ pub(crate) fn quad_split(p: &Topology) -> Topology {
 }
 
 /// The triangle split of Loop: every triangle becomes four. The caller checks that every face
-/// is a triangle.
+/// is a triangle. Filled in parallel blocks like the quad split.
 pub(crate) fn tri_split(p: &Topology) -> Topology {
     let (nv, nf, ne) = (p.num_vertices(), p.num_faces(), p.num_edges());
-    let edge_point = |e: u32| nv as u32 + e;
+    let pefo = p.edge_face_offsets();
+    let pvfo = p.vertex_face_offsets();
+    let pveo = p.vertex_edge_offsets();
+    let edge_point = |e: usize| (nv + e) as u32;
     let hb = 3 * nf as u32;
+    let nfaces = |e: usize| (pefo[e + 1] - pefo[e]) as usize;
     let (face_offsets, face_vertices) = tri_faces(p);
-    let mut face_edges = Vec::with_capacity(12 * nf);
-    for f in 0..nf {
-        let v = p.face_vertices(f);
-        let e = p.face_edges(f);
-        let i = 3 * f as u32;
-        // S_k: the half of edge k at its start corner; T_k: at its end corner.
-        let s = |k: usize| hb + half(e[k], end_at(p, e[k], v[k], true));
-        let t = |k: usize| hb + half(e[k], end_at(p, e[k], v[(k + 1) % 3], false));
-        face_edges.extend_from_slice(&[
-            s(0),
-            i,
-            t(2),
-            t(0),
-            s(1),
-            i + 1,
-            i + 2,
-            t(1),
-            s(2),
-            i + 2,
-            i,
-            i + 1,
-        ]);
-    }
-    let mut edge_vertices = Vec::with_capacity(3 * nf + 2 * ne);
-    for f in 0..nf {
-        let e = p.face_edges(f);
-        let (e0, e1, e2) = (edge_point(e[0]), edge_point(e[1]), edge_point(e[2]));
-        edge_vertices.extend_from_slice(&[[e0, e2], [e1, e0], [e2, e1]]);
-    }
-    for e in 0..ne as u32 {
-        let [a, b] = p.edge_vertices(e as usize);
-        edge_vertices.push([edge_point(e), a]);
-        edge_vertices.push([edge_point(e), b]);
-    }
-
-    let edge_face_offsets = offsets_from(
-        (0..3 * nf)
-            .map(|_| 2)
-            .chain((0..ne).flat_map(|e| [p.edge_faces(e).len(); 2])),
-        3 * nf + 2 * ne,
-    );
-    let total = *edge_face_offsets.last().unwrap() as usize;
-    let mut edge_faces = Vec::with_capacity(total);
-    let mut edge_face_local = Vec::with_capacity(total);
-    for f in 0..nf as u32 {
-        for j in 0..3u32 {
-            edge_faces.extend_from_slice(&[4 * f + j, 4 * f + 3]);
-            edge_face_local.extend_from_slice(&[(j + 1) % 3, (j + 1) % 3]);
-        }
-    }
-    for e in 0..ne {
-        let ev = p.edge_vertices(e);
-        let degenerate = ev[0] == ev[1];
-        for k in 0..2usize {
-            for (&pf, &l) in p.edge_faces(e).iter().zip(p.edge_face_local_indices(e)) {
-                let c = if degenerate {
-                    k as u32
-                } else {
-                    u32::from(p.face_vertices(pf as usize)[l as usize] != ev[k])
-                };
-                edge_faces.push(4 * pf + (l + c) % 3);
-                edge_face_local.push(l);
+    let face_edges = par::build(
+        12 * nf,
+        nf,
+        |f| 12 * f,
+        |r, out| {
+            for (o, f) in r.enumerate() {
+                let v = p.face_vertices(f);
+                let e = p.face_edges(f);
+                let i = 3 * f as u32;
+                // S_k: the half of edge k at its start corner; T_k: at its end corner.
+                let s = |k: usize| hb + half(e[k], end_at(p, e[k], v[k], true));
+                let t = |k: usize| hb + half(e[k], end_at(p, e[k], v[(k + 1) % 3], false));
+                out[12 * o..12 * o + 12].copy_from_slice(&[
+                    s(0),
+                    i,
+                    t(2),
+                    t(0),
+                    s(1),
+                    i + 1,
+                    i + 2,
+                    t(1),
+                    s(2),
+                    i + 2,
+                    i,
+                    i + 1,
+                ]);
             }
-        }
-    }
-
-    let vertex_face_offsets = offsets_from(
-        (0..nv)
-            .map(|v| p.vertex_faces(v).len())
-            .chain((0..ne).map(|e| 3 * p.edge_faces(e).len())),
-        nv + ne,
+        },
     );
-    let total = *vertex_face_offsets.last().unwrap() as usize;
-    let mut vertex_faces = Vec::with_capacity(total);
-    let mut vertex_face_local = Vec::with_capacity(total);
-    for v in 0..nv {
-        for (&pf, &c) in p.vertex_faces(v).iter().zip(p.vertex_face_local_indices(v)) {
-            vertex_faces.push(4 * pf + c);
-            vertex_face_local.push(c);
-        }
-    }
-    for e in 0..ne {
-        for (&pf, &l) in p.edge_faces(e).iter().zip(p.edge_face_local_indices(e)) {
-            vertex_faces.extend_from_slice(&[4 * pf + (l + 1) % 3, 4 * pf + 3, 4 * pf + l]);
-            vertex_face_local.extend_from_slice(&[l, (l + 2) % 3, (l + 1) % 3]);
-        }
+
+    let mut edge_vertices = vec![[0u32; 2]; 3 * nf + 2 * ne];
+    {
+        let (interior, halves) = edge_vertices.split_at_mut(3 * nf);
+        par::fill(
+            interior,
+            nf,
+            |f| 3 * f,
+            |r, out| {
+                for (o, f) in r.enumerate() {
+                    let e = p.face_edges(f);
+                    let (e0, e1, e2) = (
+                        edge_point(e[0] as usize),
+                        edge_point(e[1] as usize),
+                        edge_point(e[2] as usize),
+                    );
+                    out[3 * o..3 * o + 3].copy_from_slice(&[[e0, e2], [e1, e0], [e2, e1]]);
+                }
+            },
+        );
+        par::fill(
+            halves,
+            ne,
+            |e| 2 * e,
+            |r, out| {
+                for (i, e) in r.enumerate() {
+                    let [a, b] = p.edge_vertices(e);
+                    out[2 * i] = [edge_point(e), a];
+                    out[2 * i + 1] = [edge_point(e), b];
+                }
+            },
+        );
     }
 
-    let vertex_edge_offsets = offsets_from(
-        (0..nv)
-            .map(|v| p.valence(v))
-            .chain((0..ne).map(|e| 2 * p.edge_faces(e).len() + 2)),
-        nv + ne,
-    );
-    let total = *vertex_edge_offsets.last().unwrap() as usize;
-    let mut vertex_edges = Vec::with_capacity(total);
-    for v in 0..nv {
-        for (i, &e) in p.vertex_edges(v).iter().enumerate() {
-            vertex_edges.push(hb + half(e, vertex_edge_end(p, v, i)));
-        }
+    let total_ef = 6 * nf + 2 * pefo[ne] as usize;
+    let mut edge_face_offsets = vec![0u32; 3 * nf + 2 * ne + 1];
+    {
+        let (a, b) = edge_face_offsets.split_at_mut(3 * nf);
+        a.par_iter_mut()
+            .enumerate()
+            .for_each(|(i, o)| *o = 2 * i as u32);
+        b.par_chunks_mut(2).enumerate().for_each(|(e, o)| {
+            if e < ne {
+                let base = (6 * nf) as u32 + 2 * pefo[e];
+                o[0] = base;
+                o[1] = base + nfaces(e) as u32;
+            } else {
+                o[0] = total_ef as u32;
+            }
+        });
     }
-    for e in 0..ne {
-        let ev = p.edge_vertices(e);
-        let ef = p.edge_faces(e);
-        let el = p.edge_face_local_indices(e);
-        let (pf, l) = (ef[0], el[0]);
-        let rev = u32::from(ev[0] != ev[1] && p.face_vertices(pf as usize)[l as usize] != ev[0]);
-        vertex_edges.extend_from_slice(&[
-            hb + half(e as u32, 1 - rev),
-            3 * pf + (l + 1) % 3,
-            3 * pf + l,
-            hb + half(e as u32, rev),
-        ]);
-        for (&pf, &l) in ef.iter().zip(el).skip(1) {
-            vertex_edges.extend_from_slice(&[3 * pf + (l + 1) % 3, 3 * pf + l]);
-        }
+    let mut edge_faces = vec![0u32; total_ef];
+    let mut edge_face_local = vec![0u32; total_ef];
+    for (dst, local) in [(&mut edge_faces, false), (&mut edge_face_local, true)] {
+        let (a, b) = dst.split_at_mut(6 * nf);
+        par::fill(
+            a,
+            nf,
+            |f| 6 * f,
+            |r, out| {
+                for (o, f) in r.enumerate() {
+                    let f = f as u32;
+                    for j in 0..3u32 {
+                        let vals = if local {
+                            [(j + 1) % 3; 2]
+                        } else {
+                            [4 * f + j, 4 * f + 3]
+                        };
+                        out[6 * o + 2 * j as usize..6 * o + 2 * j as usize + 2]
+                            .copy_from_slice(&vals);
+                    }
+                }
+            },
+        );
+        par::fill(
+            b,
+            ne,
+            |e| 2 * pefo[e] as usize,
+            |r, out| {
+                let mut i = 0;
+                for e in r {
+                    let ev = p.edge_vertices(e);
+                    let degenerate = ev[0] == ev[1];
+                    for k in 0..2usize {
+                        for (&pf, &l) in p.edge_faces(e).iter().zip(p.edge_face_local_indices(e)) {
+                            out[i] = if local {
+                                l
+                            } else {
+                                let c = if degenerate {
+                                    k as u32
+                                } else {
+                                    u32::from(p.face_vertices(pf as usize)[l as usize] != ev[k])
+                                };
+                                4 * pf + (l + c) % 3
+                            };
+                            i += 1;
+                        }
+                    }
+                }
+            },
+        );
     }
 
-    let mut edge_boundary = vec![false; 3 * nf];
-    let mut edge_non_manifold = vec![false; 3 * nf];
-    for e in 0..ne {
-        let (b, m) = (p.is_boundary_edge(e), p.is_non_manifold_edge(e));
-        edge_boundary.extend_from_slice(&[b, b]);
-        edge_non_manifold.extend_from_slice(&[m, m]);
+    let nvf = pvfo[nv] as usize;
+    let total_vf = nvf + 3 * pefo[ne] as usize;
+    let mut vertex_face_offsets = vec![0u32; nv + ne + 1];
+    {
+        let (a, b) = vertex_face_offsets.split_at_mut(nv);
+        a.copy_from_slice(&pvfo[..nv]);
+        b.par_iter_mut()
+            .enumerate()
+            .for_each(|(e, o)| *o = (nvf + 3 * pefo[e] as usize) as u32);
     }
-    let mut vertex_non_manifold: Vec<bool> = (0..nv).map(|v| p.is_non_manifold_vertex(v)).collect();
-    vertex_non_manifold.extend((0..ne).map(|e| p.is_non_manifold_edge(e)));
+    let mut vertex_faces = vec![0u32; total_vf];
+    let mut vertex_face_local = vec![0u32; total_vf];
+    for (dst, local) in [(&mut vertex_faces, false), (&mut vertex_face_local, true)] {
+        let (a, b) = dst.split_at_mut(nvf);
+        par::fill(
+            a,
+            nv,
+            |v| pvfo[v] as usize,
+            |r, out| {
+                let mut i = 0;
+                for v in r {
+                    for (&pf, &c) in p.vertex_faces(v).iter().zip(p.vertex_face_local_indices(v)) {
+                        out[i] = if local { c } else { 4 * pf + c };
+                        i += 1;
+                    }
+                }
+            },
+        );
+        par::fill(
+            b,
+            ne,
+            |e| 3 * pefo[e] as usize,
+            |r, out| {
+                let mut i = 0;
+                for e in r {
+                    for (&pf, &l) in p.edge_faces(e).iter().zip(p.edge_face_local_indices(e)) {
+                        let vals = if local {
+                            [l, (l + 2) % 3, (l + 1) % 3]
+                        } else {
+                            [4 * pf + (l + 1) % 3, 4 * pf + 3, 4 * pf + l]
+                        };
+                        out[i..i + 3].copy_from_slice(&vals);
+                        i += 3;
+                    }
+                }
+            },
+        );
+    }
+
+    let nve = pveo[nv] as usize;
+    let total_ve = nve + 2 * pefo[ne] as usize + 2 * ne;
+    let mut vertex_edge_offsets = vec![0u32; nv + ne + 1];
+    {
+        let (a, b) = vertex_edge_offsets.split_at_mut(nv);
+        a.copy_from_slice(&pveo[..nv]);
+        b.par_iter_mut()
+            .enumerate()
+            .for_each(|(e, o)| *o = (nve + 2 * pefo[e] as usize + 2 * e) as u32);
+    }
+    let mut vertex_edges = vec![0u32; total_ve];
+    {
+        let (a, b) = vertex_edges.split_at_mut(nve);
+        par::fill(
+            a,
+            nv,
+            |v| pveo[v] as usize,
+            |r, out| {
+                let mut i = 0;
+                for v in r {
+                    for (k, &e) in p.vertex_edges(v).iter().enumerate() {
+                        out[i] = hb + half(e, vertex_edge_end(p, v, k));
+                        i += 1;
+                    }
+                }
+            },
+        );
+        par::fill(
+            b,
+            ne,
+            |e| 2 * pefo[e] as usize + 2 * e,
+            |r, out| {
+                let mut i = 0;
+                for e in r {
+                    let ev = p.edge_vertices(e);
+                    let ef = p.edge_faces(e);
+                    let el = p.edge_face_local_indices(e);
+                    let (pf, l) = (ef[0], el[0]);
+                    let rev = u32::from(
+                        ev[0] != ev[1] && p.face_vertices(pf as usize)[l as usize] != ev[0],
+                    );
+                    out[i..i + 4].copy_from_slice(&[
+                        hb + half(e as u32, 1 - rev),
+                        3 * pf + (l + 1) % 3,
+                        3 * pf + l,
+                        hb + half(e as u32, rev),
+                    ]);
+                    i += 4;
+                    for (&pf, &l) in ef.iter().zip(el).skip(1) {
+                        out[i..i + 2].copy_from_slice(&[3 * pf + (l + 1) % 3, 3 * pf + l]);
+                        i += 2;
+                    }
+                }
+            },
+        );
+    }
+
+    let mut edge_boundary = vec![false; 3 * nf + 2 * ne];
+    let mut edge_non_manifold = vec![false; 3 * nf + 2 * ne];
+    for (dst, nm) in [(&mut edge_boundary, false), (&mut edge_non_manifold, true)] {
+        dst[3 * nf..]
+            .par_chunks_mut(2)
+            .enumerate()
+            .for_each(|(e, o)| {
+                o.fill(if nm {
+                    p.is_non_manifold_edge(e)
+                } else {
+                    p.is_boundary_edge(e)
+                });
+            });
+    }
+    let mut vertex_non_manifold = vec![false; nv + ne];
+    vertex_non_manifold[..nv]
+        .par_iter_mut()
+        .enumerate()
+        .for_each(|(v, o)| *o = p.is_non_manifold_vertex(v));
+    vertex_non_manifold[nv..]
+        .par_iter_mut()
+        .enumerate()
+        .for_each(|(e, o)| *o = p.is_non_manifold_edge(e));
 
     Topology::from_parts(TopologyParts {
         num_vertices: nv + ne,
