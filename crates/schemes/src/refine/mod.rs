@@ -485,7 +485,10 @@ impl Step<'_> {
         let l = self.layout;
         let nv = l.face_vertex_base as usize;
         let nfp = (l.edge_vertex_base - l.face_vertex_base) as usize;
-        let mut out = vec![DVec3::ZERO; l.num_child_vertices];
+        // Zeroed memory straight from the allocator (no single-threaded fill), so its pages
+        // are first touched by the parallel writers below.
+        let mut out: Vec<DVec3> =
+            bytemuck::allocation::cast_vec(vec![0.0f64; 3 * l.num_child_vertices]);
         let (vertex_part, rest) = out.split_at_mut(nv);
         let (face_part, edge_part) = rest.split_at_mut(nfp);
         face_part
