@@ -1,5 +1,7 @@
-//! Project automation: `cargo xtask test` runs the whole test suite (installing the system
-//! packages it needs when run as root), `cargo xtask fuzz` runs the fuzz targets.
+//! Project automation: `cargo xtask test` runs the whole test suite; `cargo xtask conformance`
+//! and `cargo xtask bench` compare subd with the system OpenSubdiv (installing `libosd-dev`
+//! when run as root, otherwise saying what to install); `cargo xtask fuzz` runs the fuzz
+//! targets.
 
 use std::process::{Command, ExitCode};
 
@@ -20,7 +22,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Task {
     /// Build once in release mode and run every test of the workspace (unit, integration,
-    /// doc tests), after installing missing system packages when run as root.
+    /// property and doc tests).
     Test {
         /// Extra arguments passed to `cargo test` (after `--`).
         #[arg(last = true)]
@@ -70,8 +72,9 @@ enum Task {
     },
 }
 
-/// System packages the tests need: (file that proves it is there, Debian package).
-const SYSTEM_PACKAGES: &[(&str, &str)] = &[
+/// System packages the OpenSubdiv harness needs: (file that proves it is there, Debian
+/// package). The unit and integration tests need none.
+const OPENSUBDIV_PACKAGES: &[(&str, &str)] = &[
     (
         "/usr/include/opensubdiv/far/topologyRefinerFactory.h",
         "libosd-dev",
@@ -87,8 +90,8 @@ fn is_root() -> bool {
         .unwrap_or(false)
 }
 
-fn ensure_system_packages() -> Result<(), String> {
-    let missing: Vec<&str> = SYSTEM_PACKAGES
+fn ensure_system_packages(packages: &[(&str, &str)]) -> Result<(), String> {
+    let missing: Vec<&str> = packages
         .iter()
         .filter(|(probe, _)| !std::path::Path::new(probe).exists())
         .map(|(_, pkg)| *pkg)
@@ -128,24 +131,23 @@ fn cargo() -> Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Task::Test { extra } => ensure_system_packages().and_then(|_| {
-            run(cargo()
-                .args(["test", "--workspace", "--release"])
-                .arg("--")
-                .args(&extra))
-        }),
-        Task::Conformance { shapes, random } => ensure_system_packages().and_then(|_| {
-            let exe = osd::build_harness()?;
-            let mut rows = conformance::shapes(&exe, &shapes)?;
-            rows.extend(conformance::random(&exe, random));
-            if conformance::report(&rows) {
-                Ok(())
-            } else {
-                Err("conformance failed".into())
-            }
-        }),
+        Task::Test { extra } => run(cargo()
+            .args(["test", "--workspace", "--release"])
+            .arg("--")
+            .args(&extra)),
+        Task::Conformance { shapes, random } => ensure_system_packages(OPENSUBDIV_PACKAGES)
+            .and_then(|_| {
+                let exe = osd::build_harness()?;
+                let mut rows = conformance::shapes(&exe, &shapes)?;
+                rows.extend(conformance::random(&exe, random));
+                if conformance::report(&rows) {
+                    Ok(())
+                } else {
+                    Err("conformance failed".into())
+                }
+            }),
         Task::Bench { levels, repeats } => {
-            ensure_system_packages().and_then(|_| bench::run(levels, repeats))
+            ensure_system_packages(OPENSUBDIV_PACKAGES).and_then(|_| bench::run(levels, repeats))
         }
         Task::BenchRun {
             mesh,
