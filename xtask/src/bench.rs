@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
 
-use subd_mesh::{DVec3, Mesh, TopologyBuilder};
+use subd_mesh::{Mesh, TopologyBuilder};
 use subd_schemes::{Options, Refinement, Scheme};
 
 use crate::osd;
@@ -20,20 +20,7 @@ use crate::osd;
 pub fn quad_bench_mesh() -> Mesh {
     let (m, n) = (160u32, 160u32);
     let id = |i: u32, j: u32| (i % m) * n + (j % n);
-    let tau = std::f64::consts::TAU;
-    let positions: Vec<DVec3> = (0..m * n)
-        .map(|k| {
-            let (u, v) = (
-                (k / n) as f64 * tau / m as f64,
-                (k % n) as f64 * tau / n as f64,
-            );
-            DVec3::new(
-                (3.0 + v.cos()) * u.cos(),
-                (3.0 + v.cos()) * u.sin(),
-                v.sin(),
-            )
-        })
-        .collect();
+    let positions = subd_mesh::primitives::torus(m, n, 3.0, 1.0).positions;
     let mut sizes = Vec::new();
     let mut idx = Vec::new();
     for i in 0..m {

@@ -30,6 +30,7 @@ pub mod analysis;
 mod build;
 pub mod error;
 pub mod geometry;
+pub mod primitives;
 pub mod tags;
 mod topology;
 

@@ -4,39 +4,11 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use subd_mesh::{DVec3, TopologyBuilder};
 use subd_schemes::{Options, Refinement, Scheme};
 
-fn torus(m: u32, n: u32) -> (subd_mesh::Topology, Vec<DVec3>) {
-    let id = |i: u32, j: u32| (i % m) * n + (j % n);
-    let mut idx = Vec::new();
-    for i in 0..m {
-        for j in 0..n {
-            idx.extend_from_slice(&[id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
-        }
-    }
-    let tau = std::f64::consts::TAU;
-    let pos = (0..m * n)
-        .map(|k| {
-            let (u, v) = (
-                (k / n) as f64 * tau / m as f64,
-                (k % n) as f64 * tau / n as f64,
-            );
-            DVec3::new(
-                (3.0 + v.cos()) * u.cos(),
-                (3.0 + v.cos()) * u.sin(),
-                v.sin(),
-            )
-        })
-        .collect();
-    let t = TopologyBuilder::new((m * n) as usize)
-        .build(&vec![4; (m * n) as usize], &idx)
-        .unwrap();
-    (t, pos)
-}
-
 fn bench(c: &mut Criterion) {
-    let (t, pos) = torus(160, 160);
+    let mesh = subd_mesh::primitives::torus(160, 160, 3.0, 1.0);
+    let (t, pos) = (mesh.topology, mesh.positions);
     let opts = Options::default();
     let mut g = c.benchmark_group("catmull_clark_25k_faces");
     g.sample_size(10);

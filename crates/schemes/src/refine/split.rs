@@ -119,6 +119,63 @@ pub(crate) fn tri_faces(p: &Topology) -> (Vec<u32>, Vec<u32>) {
     ((0..=4 * nf as u32).map(|k| 3 * k).collect(), face_vertices)
 }
 
+/// Flags the children inherit (`Vtr::Refinement::propagateComponentTags`): both halves of a
+/// parent edge take its boundary and non-manifold flags, a vertex-child its vertex's
+/// non-manifold flag, an edge-child its edge's; the `interior_edges` face-interior edges and
+/// `face_children` face-children are manifold interior. Returns (edge boundary, edge
+/// non-manifold, vertex non-manifold).
+fn inherited_flags(
+    p: &Topology,
+    interior_edges: usize,
+    face_children: usize,
+) -> (Vec<bool>, Vec<bool>, Vec<bool>) {
+    let (nv, ne) = (p.num_vertices(), p.num_edges());
+    let mut edge_boundary = vec![false; interior_edges + 2 * ne];
+    let mut edge_non_manifold = vec![false; interior_edges + 2 * ne];
+    for (dst, nm) in [(&mut edge_boundary, false), (&mut edge_non_manifold, true)] {
+        dst[interior_edges..]
+            .par_chunks_mut(2)
+            .enumerate()
+            .for_each(|(e, o)| {
+                o.fill(if nm {
+                    p.is_non_manifold_edge(e)
+                } else {
+                    p.is_boundary_edge(e)
+                });
+            });
+    }
+    let mut vertex_non_manifold = vec![false; nv + face_children + ne];
+    vertex_non_manifold[..nv]
+        .par_iter_mut()
+        .enumerate()
+        .for_each(|(v, o)| *o = p.is_non_manifold_vertex(v));
+    vertex_non_manifold[nv + face_children..]
+        .par_iter_mut()
+        .enumerate()
+        .for_each(|(e, o)| *o = p.is_non_manifold_edge(e));
+    (edge_boundary, edge_non_manifold, vertex_non_manifold)
+}
+
+/// Vertex-edges of the vertex-children: the half of each parent vertex-edge at the vertex,
+/// in the parent's order. `out` is the vertex-child part of the child vertex-edge relation.
+fn vertex_child_edges(p: &Topology, hb: u32, out: &mut [u32]) {
+    let pveo = p.vertex_edge_offsets();
+    par::fill(
+        out,
+        p.num_vertices(),
+        |v| pveo[v] as usize,
+        |r, out| {
+            let mut i = 0;
+            for v in r {
+                for (k, &e) in p.vertex_edges(v).iter().enumerate() {
+                    out[i] = hb + half(e, vertex_edge_end(p, v, k));
+                    i += 1;
+                }
+            }
+        },
+    );
+}
+
 /// The quad split of Catmull-Clark and Bilinear: every face of size n becomes n quads.
 /// Every relation is filled in parallel blocks; offsets come in closed form from the
 /// parent's offsets.
@@ -359,20 +416,7 @@ pub(crate) fn quad_split(p: &Topology) -> Topology {
     {
         let (a, rest) = vertex_edges.split_at_mut(nve);
         let (b, c) = rest.split_at_mut(nh);
-        par::fill(
-            a,
-            nv,
-            |v| pveo[v] as usize,
-            |r, out| {
-                let mut i = 0;
-                for v in r {
-                    for (k, &e) in p.vertex_edges(v).iter().enumerate() {
-                        out[i] = hb + half(e, vertex_edge_end(p, v, k));
-                        i += 1;
-                    }
-                }
-            },
-        );
+        vertex_child_edges(p, hb, a);
         par::fill(
             b,
             nf,
@@ -422,27 +466,7 @@ pub(crate) fn quad_split(p: &Topology) -> Topology {
     vertex_face_offsets[nv + nf + ne] = total_vf as u32;
     vertex_edge_offsets[nv + nf + ne] = total_ve as u32;
 
-    let mut edge_boundary = vec![false; nh + 2 * ne];
-    let mut edge_non_manifold = vec![false; nh + 2 * ne];
-    for (dst, nm) in [(&mut edge_boundary, false), (&mut edge_non_manifold, true)] {
-        dst[nh..].par_chunks_mut(2).enumerate().for_each(|(e, o)| {
-            let v = if nm {
-                p.is_non_manifold_edge(e)
-            } else {
-                p.is_boundary_edge(e)
-            };
-            o.fill(v);
-        });
-    }
-    let mut vertex_non_manifold = vec![false; nv + nf + ne];
-    vertex_non_manifold[..nv]
-        .par_iter_mut()
-        .enumerate()
-        .for_each(|(v, o)| *o = p.is_non_manifold_vertex(v));
-    vertex_non_manifold[nv + nf..]
-        .par_iter_mut()
-        .enumerate()
-        .for_each(|(e, o)| *o = p.is_non_manifold_edge(e));
+    let (edge_boundary, edge_non_manifold, vertex_non_manifold) = inherited_flags(p, nh, nf);
 
     Topology::from_parts(TopologyParts {
         num_vertices: nv + nf + ne,
@@ -670,20 +694,7 @@ pub(crate) fn tri_split(p: &Topology) -> Topology {
     let mut vertex_edges = vec![0u32; total_ve];
     {
         let (a, b) = vertex_edges.split_at_mut(nve);
-        par::fill(
-            a,
-            nv,
-            |v| pveo[v] as usize,
-            |r, out| {
-                let mut i = 0;
-                for v in r {
-                    for (k, &e) in p.vertex_edges(v).iter().enumerate() {
-                        out[i] = hb + half(e, vertex_edge_end(p, v, k));
-                        i += 1;
-                    }
-                }
-            },
-        );
+        vertex_child_edges(p, hb, a);
         par::fill(
             b,
             ne,
@@ -714,29 +725,7 @@ pub(crate) fn tri_split(p: &Topology) -> Topology {
         );
     }
 
-    let mut edge_boundary = vec![false; 3 * nf + 2 * ne];
-    let mut edge_non_manifold = vec![false; 3 * nf + 2 * ne];
-    for (dst, nm) in [(&mut edge_boundary, false), (&mut edge_non_manifold, true)] {
-        dst[3 * nf..]
-            .par_chunks_mut(2)
-            .enumerate()
-            .for_each(|(e, o)| {
-                o.fill(if nm {
-                    p.is_non_manifold_edge(e)
-                } else {
-                    p.is_boundary_edge(e)
-                });
-            });
-    }
-    let mut vertex_non_manifold = vec![false; nv + ne];
-    vertex_non_manifold[..nv]
-        .par_iter_mut()
-        .enumerate()
-        .for_each(|(v, o)| *o = p.is_non_manifold_vertex(v));
-    vertex_non_manifold[nv..]
-        .par_iter_mut()
-        .enumerate()
-        .for_each(|(e, o)| *o = p.is_non_manifold_edge(e));
+    let (edge_boundary, edge_non_manifold, vertex_non_manifold) = inherited_flags(p, 3 * nf, 0);
 
     Topology::from_parts(TopologyParts {
         num_vertices: nv + ne,
