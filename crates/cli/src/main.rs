@@ -13,11 +13,12 @@ fn main() {
             .unwrap_or_else(|| "unknown panic".into());
         eprintln!("subd: internal error: {msg} (please report this)");
     }));
+    // stderr stays unlocked between writes: the progress bar draws to it from its own thread.
     let stdout = std::io::stdout();
-    let stderr = std::io::stderr();
+    let mut err = std::io::stderr();
     let code = {
         let mut out = stdout.lock();
-        let code = subd_cli::run(std::env::args_os(), &mut out, &mut stderr.lock());
+        let code = subd_cli::run(std::env::args_os(), &mut out, &mut err);
         let _ = std::io::Write::flush(&mut out);
         code
     };

@@ -197,7 +197,7 @@ pub(crate) fn run(
     let t_positions = t1.elapsed().as_secs_f64();
 
     let t2 = Instant::now();
-    let mut topology = refinement.topology(args.levels).clone();
+    let mut topology = refinement.into_topology(args.levels);
     visible_tags(&mut topology, &options);
     let out_counts = Counts {
         vertices: topology.num_vertices(),

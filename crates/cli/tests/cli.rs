@@ -398,3 +398,39 @@ fn refine_bad_input_exits_2_without_output() {
     assert!(err.contains("would overwrite the input"), "{err}");
     assert_eq!(std::fs::read_to_string(&input).unwrap(), quad);
 }
+
+/// On a terminal a deep refinement shows a progress bar drawn from its own thread; it must
+/// not deadlock against the command's own stderr (it once did). `script` gives the run a
+/// pseudo-terminal.
+#[test]
+fn progress_bar_on_a_terminal_does_not_block() {
+    let s = Scratch::new("tty");
+    let input =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/meshes/torus_creased.obj");
+    let out = s.0.join("deep.ply");
+    let cmd = format!(
+        "{} refine --scheme catmull-clark --levels 7 {} {}",
+        env!("CARGO_BIN_EXE_subd"),
+        input.display(),
+        out.display()
+    );
+    let mut child = Command::new("script")
+        .args(["-qec", &cmd, "/dev/null"])
+        .stdin(std::process::Stdio::null())
+        .stdout(std::process::Stdio::null())
+        .spawn()
+        .expect("`script` (util-linux) runs the command on a pseudo-terminal");
+    let start = std::time::Instant::now();
+    let status = loop {
+        if let Some(st) = child.try_wait().unwrap() {
+            break st;
+        }
+        if start.elapsed() > std::time::Duration::from_secs(60) {
+            let _ = child.kill();
+            panic!("subd refine on a terminal did not finish within 60 s");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    };
+    assert!(status.success(), "{status:?}");
+    assert!(out.exists());
+}

@@ -146,8 +146,10 @@ pub fn write_mesh(path: &Path, mesh: &Mesh, options: &WriteOptions) -> Result<()
 }
 
 /// Writes a file atomically: `write` fills a temporary file in the target's directory, which
-/// is flushed, synced and renamed over `path` only if `write` succeeds. On any failure the
-/// temporary file is removed and `path` is left as it was.
+/// is flushed and renamed over `path` only if `write` succeeds, so no reader ever sees a
+/// partial file. On any failure the temporary file is removed and `path` is left as it was.
+/// (No fsync: durability across power loss is the file system's job, and syncing every
+/// output made large writes several times slower.)
 pub fn atomic_write(
     path: &Path,
     write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
@@ -170,7 +172,6 @@ pub fn atomic_write(
         write(&mut buf).map_err(err)?;
         buf.flush().map_err(err)?;
     }
-    tmp.as_file().sync_all().map_err(err)?;
     tmp.persist(path).map_err(|e| err(e.error))?;
     Ok(())
 }

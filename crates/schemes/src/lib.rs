@@ -272,6 +272,17 @@ impl Refinement {
         })
     }
 
+    /// Takes the topology of `level` out of the refinement (building it if needed), without
+    /// copying it.
+    pub fn into_topology(mut self, level: usize) -> Topology {
+        self.topology(level);
+        self.levels
+            .swap_remove(level)
+            .topology
+            .into_inner()
+            .expect("built just above")
+    }
+
     /// The rule of every vertex of `level`.
     pub fn vertex_rules(&self, level: usize) -> &[Rule] {
         &self.levels[level].rules
