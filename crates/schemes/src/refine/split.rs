@@ -96,7 +96,10 @@ pub(crate) fn quad_faces(p: &Topology) -> (Vec<u32>, Vec<u32>) {
         |f| 4 * off[f] as usize,
         |r, out| quad_face_block(p, r, false, out),
     );
-    ((0..=nh as u32).map(|i| 4 * i).collect(), face_vertices)
+    (
+        (0..=nh as u32).into_par_iter().map(|i| 4 * i).collect(),
+        face_vertices,
+    )
 }
 
 /// Face offsets and face-vertices of the triangle split alone.
@@ -116,7 +119,10 @@ pub(crate) fn tri_faces(p: &Topology) -> (Vec<u32>, Vec<u32>) {
             }
         },
     );
-    ((0..=4 * nf as u32).map(|k| 3 * k).collect(), face_vertices)
+    (
+        (0..=4 * nf as u32).into_par_iter().map(|k| 3 * k).collect(),
+        face_vertices,
+    )
 }
 
 /// Flags the children inherit (`Vtr::Refinement::propagateComponentTags`): both halves of a
@@ -208,7 +214,7 @@ pub(crate) fn quad_split(p: &Topology) -> Topology {
         |f| 4 * off[f] as usize,
         |r, out| quad_face_block(p, r, true, out),
     );
-    let face_offsets: Vec<u32> = (0..=nh as u32).map(|i| 4 * i).collect();
+    let face_offsets: Vec<u32> = (0..=nh as u32).into_par_iter().map(|i| 4 * i).collect();
 
     // Edges: I_f[j] = (F, E_j) for the face edges, then H(e, k) = (E, V_{e.v[k]}).
     let mut edge_vertices = vec![[0u32; 2]; nh + 2 * ne];
