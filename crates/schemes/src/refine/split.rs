@@ -125,6 +125,30 @@ pub(crate) fn tri_faces(p: &Topology) -> (Vec<u32>, Vec<u32>) {
     )
 }
 
+/// Offsets of a child vertex relation: vertex-children copy the parent's offsets
+/// (`parent[..nv]`), face-children start at `face_start(f)` and edge-children at
+/// `edge_start(e)`; `edge_start(ne)` closes the array. All closed forms, filled in parallel.
+fn child_vertex_offsets(
+    parent: &[u32],
+    nf: usize,
+    ne: usize,
+    face_start: impl Fn(usize) -> usize + Sync + Send,
+    edge_start: impl Fn(usize) -> usize + Sync + Send,
+) -> Vec<u32> {
+    let nv = parent.len() - 1;
+    let mut out = vec![0u32; nv + nf + ne + 1];
+    let (a, rest) = out.split_at_mut(nv);
+    let (b, c) = rest.split_at_mut(nf);
+    a.copy_from_slice(&parent[..nv]);
+    b.par_iter_mut()
+        .enumerate()
+        .for_each(|(f, o)| *o = face_start(f) as u32);
+    c.par_iter_mut()
+        .enumerate()
+        .for_each(|(e, o)| *o = edge_start(e) as u32);
+    out
+}
+
 /// Flags the children inherit (`Vtr::Refinement::propagateComponentTags`): both halves of a
 /// parent edge take its boundary and non-manifold flags, a vertex-child its vertex's
 /// non-manifold flag, an edge-child its edge's; the `interior_edges` face-interior edges and
@@ -329,18 +353,13 @@ pub(crate) fn quad_split(p: &Topology) -> Topology {
 
     // Vertex -> faces: V_v (as the parent), F_f (n), E_e (two per parent face).
     let nvf = pvfo[nv] as usize;
-    let mut vertex_face_offsets = vec![0u32; nv + nf + ne + 1];
-    {
-        let (a, rest) = vertex_face_offsets.split_at_mut(nv);
-        let (b, c) = rest.split_at_mut(nf);
-        a.copy_from_slice(&pvfo[..nv]);
-        b.par_iter_mut()
-            .enumerate()
-            .for_each(|(f, o)| *o = (nvf + off[f] as usize) as u32);
-        c.par_iter_mut()
-            .enumerate()
-            .for_each(|(e, o)| *o = (nvf + nh + 2 * pefo[e] as usize) as u32);
-    }
+    let vertex_face_offsets = child_vertex_offsets(
+        pvfo,
+        nf,
+        ne,
+        |f| nvf + off[f] as usize,
+        |e| nvf + nh + 2 * pefo[e] as usize,
+    );
     let total_vf = nvf + nh + 2 * pefo[ne] as usize;
     let mut vertex_faces = vec![0u32; total_vf];
     let mut vertex_face_local = vec![0u32; total_vf];
@@ -405,18 +424,13 @@ pub(crate) fn quad_split(p: &Topology) -> Topology {
     // Vertex -> edges: V_v (halves, as the parent), F_f (interior, leading edges first),
     // E_e (halves and interior edges interleaved, in OpenSubdiv's order).
     let nve = pveo[nv] as usize;
-    let mut vertex_edge_offsets = vec![0u32; nv + nf + ne + 1];
-    {
-        let (a, rest) = vertex_edge_offsets.split_at_mut(nv);
-        let (b, c) = rest.split_at_mut(nf);
-        a.copy_from_slice(&pveo[..nv]);
-        b.par_iter_mut()
-            .enumerate()
-            .for_each(|(f, o)| *o = (nve + off[f] as usize) as u32);
-        c.par_iter_mut()
-            .enumerate()
-            .for_each(|(e, o)| *o = (nve + nh + pefo[e] as usize + 2 * e) as u32);
-    }
+    let vertex_edge_offsets = child_vertex_offsets(
+        pveo,
+        nf,
+        ne,
+        |f| nve + off[f] as usize,
+        |e| nve + nh + pefo[e] as usize + 2 * e,
+    );
     let total_ve = nve + nh + pefo[ne] as usize + 2 * ne;
     let mut vertex_edges = vec![0u32; total_ve];
     {
@@ -469,8 +483,6 @@ pub(crate) fn quad_split(p: &Topology) -> Topology {
             },
         );
     }
-    vertex_face_offsets[nv + nf + ne] = total_vf as u32;
-    vertex_edge_offsets[nv + nf + ne] = total_ve as u32;
 
     let (edge_boundary, edge_non_manifold, vertex_non_manifold) = inherited_flags(p, nh, nf);
 
@@ -640,14 +652,8 @@ pub(crate) fn tri_split(p: &Topology) -> Topology {
 
     let nvf = pvfo[nv] as usize;
     let total_vf = nvf + 3 * pefo[ne] as usize;
-    let mut vertex_face_offsets = vec![0u32; nv + ne + 1];
-    {
-        let (a, b) = vertex_face_offsets.split_at_mut(nv);
-        a.copy_from_slice(&pvfo[..nv]);
-        b.par_iter_mut()
-            .enumerate()
-            .for_each(|(e, o)| *o = (nvf + 3 * pefo[e] as usize) as u32);
-    }
+    let vertex_face_offsets =
+        child_vertex_offsets(pvfo, 0, ne, |_| 0, |e| nvf + 3 * pefo[e] as usize);
     let mut vertex_faces = vec![0u32; total_vf];
     let mut vertex_face_local = vec![0u32; total_vf];
     for (dst, local) in [(&mut vertex_faces, false), (&mut vertex_face_local, true)] {
@@ -689,14 +695,8 @@ pub(crate) fn tri_split(p: &Topology) -> Topology {
 
     let nve = pveo[nv] as usize;
     let total_ve = nve + 2 * pefo[ne] as usize + 2 * ne;
-    let mut vertex_edge_offsets = vec![0u32; nv + ne + 1];
-    {
-        let (a, b) = vertex_edge_offsets.split_at_mut(nv);
-        a.copy_from_slice(&pveo[..nv]);
-        b.par_iter_mut()
-            .enumerate()
-            .for_each(|(e, o)| *o = (nve + 2 * pefo[e] as usize + 2 * e) as u32);
-    }
+    let vertex_edge_offsets =
+        child_vertex_offsets(pveo, 0, ne, |_| 0, |e| nve + 2 * pefo[e] as usize + 2 * e);
     let mut vertex_edges = vec![0u32; total_ve];
     {
         let (a, b) = vertex_edges.split_at_mut(nve);
