@@ -148,8 +148,8 @@ pub fn write_mesh(path: &Path, mesh: &Mesh, options: &WriteOptions) -> Result<()
 /// Writes a file atomically: `write` fills a temporary file in the target's directory, which
 /// is flushed and renamed over `path` only if `write` succeeds, so no reader ever sees a
 /// partial file. On any failure the temporary file is removed and `path` is left as it was.
-/// (No fsync: durability across power loss is the file system's job, and syncing every
-/// output made large writes several times slower.)
+/// (No fsync: the contract is that a failed run leaves no partial file, which the rename
+/// gives; durability across power loss is left to the file system.)
 pub fn atomic_write(
     path: &Path,
     write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
