@@ -127,8 +127,8 @@ pub fn encode(
     b
 }
 
-/// Runs the harness on an encoded mesh; with `bench`, returns its JSON line in `Err`-free
-/// form as the second value.
+/// Runs the harness with `args` on an encoded mesh and returns its standard output, or its
+/// error message.
 pub fn run(exe: &Path, input: &[u8], args: &[&str]) -> Result<Vec<u8>, String> {
     let mut child = Command::new(exe)
         .args(args)
