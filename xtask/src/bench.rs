@@ -50,11 +50,7 @@ pub fn quad_bench_mesh() -> Mesh {
         .expect("valid torus");
     let r = Refinement::new(&base, Scheme::CatmullClark, &Options::default(), 1).expect("refine");
     let pts = r.refine_points(&positions).pop().expect("level 1");
-    let t = r.topology(1);
-    let topo = TopologyBuilder::new(t.num_vertices())
-        .build(&t.face_sizes().collect::<Vec<_>>(), t.all_face_vertices())
-        .expect("valid");
-    Mesh::new(topo, pts).expect("finite")
+    Mesh::new(r.into_topology(1), pts).expect("finite")
 }
 
 /// The quad bench mesh with every quad split along its 0-2 diagonal, for Loop.

@@ -149,6 +149,44 @@ fn child_vertex_offsets(
     out
 }
 
+/// Vertices of the half-edge children, `H(e, k) = (E_e, V_{e.v[k]})`, into `out` (two per
+/// parent edge); `edge_point_base` is the first edge-child vertex.
+fn half_edge_vertices(p: &Topology, edge_point_base: usize, out: &mut [[u32; 2]]) {
+    par::fill(
+        out,
+        p.num_edges(),
+        |e| 2 * e,
+        |r, out| {
+            for (i, e) in r.enumerate() {
+                let [a, b] = p.edge_vertices(e);
+                let ep = (edge_point_base + e) as u32;
+                out[2 * i] = [ep, a];
+                out[2 * i + 1] = [ep, b];
+            }
+        },
+    );
+}
+
+/// Edge-face offsets of a child level: two faces per face-interior child edge (the first
+/// `interior_edges` edges), then for each parent edge two halves with as many faces as the
+/// parent edge has.
+fn child_edge_face_offsets(p: &Topology, interior_edges: usize) -> Vec<u32> {
+    let (ne, pefo) = (p.num_edges(), p.edge_face_offsets());
+    let mut out = vec![0u32; interior_edges + 2 * ne + 1];
+    let (a, b) = out.split_at_mut(interior_edges);
+    a.par_iter_mut()
+        .enumerate()
+        .for_each(|(i, o)| *o = 2 * i as u32);
+    b.par_chunks_mut(2).enumerate().for_each(|(e, o)| {
+        let base = (2 * interior_edges) as u32 + 2 * pefo[e];
+        o[0] = base;
+        if e < ne {
+            o[1] = base + (pefo[e + 1] - pefo[e]);
+        }
+    });
+    out
+}
+
 /// Flags the children inherit (`Vtr::Refinement::propagateComponentTags`): both halves of a
 /// parent edge take its boundary and non-manifold flags, a vertex-child its vertex's
 /// non-manifold flag, an edge-child its edge's; the `interior_edges` face-interior edges and
@@ -224,7 +262,6 @@ pub(crate) fn quad_split(p: &Topology) -> Topology {
     let edge_point = |e: usize| (nv + nf + e) as u32;
     let hb = nh as u32;
     let size = |f: usize| (off[f + 1] - off[f]) as usize;
-    let nfaces = |e: usize| (pefo[e + 1] - pefo[e]) as usize;
 
     let face_vertices = par::build(
         4 * nh,
@@ -257,44 +294,11 @@ pub(crate) fn quad_split(p: &Topology) -> Topology {
             }
         },
     );
-    par::fill(
-        halves,
-        ne,
-        |e| 2 * e,
-        |r, out| {
-            for (i, e) in r.enumerate() {
-                let [a, b] = p.edge_vertices(e);
-                out[2 * i] = [edge_point(e), a];
-                out[2 * i + 1] = [edge_point(e), b];
-            }
-        },
-    );
+    half_edge_vertices(p, nv + nf, halves);
 
     // Edge -> faces: two per interior edge; as many per half as the parent edge has faces.
     let total_ef = 2 * nh + 2 * pefo[ne] as usize;
-    let mut edge_face_offsets = vec![0u32; nh + 2 * ne + 1];
-    {
-        let (a, b) = edge_face_offsets.split_at_mut(nh);
-        a.par_iter_mut()
-            .enumerate()
-            .for_each(|(i, o)| *o = 2 * i as u32);
-        par::fill(
-            b,
-            ne,
-            |e| 2 * e + usize::from(e == ne),
-            |r, out| {
-                for (i, e) in r.clone().enumerate() {
-                    let base = 2 * nh as u32 + 2 * pefo[e];
-                    out[2 * i] = base;
-                    if e < ne {
-                        out[2 * i + 1] = base + nfaces(e) as u32;
-                    }
-                }
-            },
-        );
-        // The closing offset (written by the block that holds `ne`, if any).
-        b[2 * ne] = total_ef as u32;
-    }
+    let edge_face_offsets = child_edge_face_offsets(p, nh);
     let ef_start = |e: usize| 2 * pefo[e] as usize;
     let mut edge_faces = vec![0u32; total_ef];
     let mut edge_face_local = vec![0u32; total_ef];
@@ -516,7 +520,6 @@ pub(crate) fn tri_split(p: &Topology) -> Topology {
     let pveo = p.vertex_edge_offsets();
     let edge_point = |e: usize| (nv + e) as u32;
     let hb = 3 * nf as u32;
-    let nfaces = |e: usize| (pefo[e + 1] - pefo[e]) as usize;
     let (face_offsets, face_vertices) = tri_faces(p);
     let face_edges = par::build(
         12 * nf,
@@ -567,37 +570,11 @@ pub(crate) fn tri_split(p: &Topology) -> Topology {
                 }
             },
         );
-        par::fill(
-            halves,
-            ne,
-            |e| 2 * e,
-            |r, out| {
-                for (i, e) in r.enumerate() {
-                    let [a, b] = p.edge_vertices(e);
-                    out[2 * i] = [edge_point(e), a];
-                    out[2 * i + 1] = [edge_point(e), b];
-                }
-            },
-        );
+        half_edge_vertices(p, nv, halves);
     }
 
     let total_ef = 6 * nf + 2 * pefo[ne] as usize;
-    let mut edge_face_offsets = vec![0u32; 3 * nf + 2 * ne + 1];
-    {
-        let (a, b) = edge_face_offsets.split_at_mut(3 * nf);
-        a.par_iter_mut()
-            .enumerate()
-            .for_each(|(i, o)| *o = 2 * i as u32);
-        b.par_chunks_mut(2).enumerate().for_each(|(e, o)| {
-            if e < ne {
-                let base = (6 * nf) as u32 + 2 * pefo[e];
-                o[0] = base;
-                o[1] = base + nfaces(e) as u32;
-            } else {
-                o[0] = total_ef as u32;
-            }
-        });
-    }
+    let edge_face_offsets = child_edge_face_offsets(p, 3 * nf);
     let mut edge_faces = vec![0u32; total_ef];
     let mut edge_face_local = vec![0u32; total_ef];
     for (dst, local) in [(&mut edge_faces, false), (&mut edge_face_local, true)] {
