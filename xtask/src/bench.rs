@@ -138,7 +138,10 @@ struct Measure {
     peak: f64,
 }
 
-fn measure(cmd: &mut Command) -> Result<Measure, String> {
+fn measure(cmd: &mut Command, huge_pages: bool) -> Result<Measure, String> {
+    if huge_pages {
+        cmd.env("GLIBC_TUNABLES", "glibc.malloc.hugetlb=1");
+    }
     let out = cmd.output().map_err(|e| e.to_string())?;
     if !out.status.success() {
         return Err(String::from_utf8_lossy(&out.stderr).to_string());
@@ -150,15 +153,21 @@ fn measure(cmd: &mut Command) -> Result<Measure, String> {
     })
 }
 
-/// Runs the whole comparison and prints the table.
-pub fn run(levels: usize, repeats: usize) -> Result<(), String> {
+/// Runs the whole comparison and prints the table; with `huge_pages` both sides run under
+/// the same transparent-huge-page malloc setting.
+pub fn run(levels: usize, repeats: usize, huge_pages: bool) -> Result<(), String> {
     let exe = osd::build_harness()?;
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/xtask/bench");
     std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
     let me = std::env::current_exe().map_err(|e| e.to_string())?;
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
     println!(
-        "subd vs OpenSubdiv 3.5 (Far, double), uniform refinement, median of {repeats} runs; ratio = subd time / OpenSubdiv time"
+        "subd vs OpenSubdiv 3.5 (Far, double), uniform refinement, median of {repeats} runs; ratio = subd time / OpenSubdiv time{}",
+        if huge_pages {
+            "; both with GLIBC_TUNABLES=glibc.malloc.hugetlb=1"
+        } else {
+            ""
+        }
     );
     println!(
         "{:<8} {:>8} {:>5} {:>10} {:>10} {:>10} {:>7} {:>10} {:>7} {:>9} {:>9}",
@@ -200,21 +209,25 @@ pub fn run(levels: usize, repeats: usize) -> Result<(), String> {
                 Command::new(&exe)
                     .args(["--bench", &repeats.to_string()])
                     .stdin(std::fs::File::open(&input_path).map_err(|e| e.to_string())?),
+                huge_pages,
             )?;
             let subd = |t: usize| {
-                measure(Command::new(&me).args([
-                    "bench-run",
-                    "--mesh",
-                    path.to_str().unwrap(),
-                    "--scheme",
-                    name,
-                    "--levels",
-                    &level.to_string(),
-                    "--threads",
-                    &t.to_string(),
-                    "--repeats",
-                    &repeats.to_string(),
-                ]))
+                measure(
+                    Command::new(&me).args([
+                        "bench-run",
+                        "--mesh",
+                        path.to_str().unwrap(),
+                        "--scheme",
+                        name,
+                        "--levels",
+                        &level.to_string(),
+                        "--threads",
+                        &t.to_string(),
+                        "--repeats",
+                        &repeats.to_string(),
+                    ]),
+                    huge_pages,
+                )
             };
             let one = subd(1)?;
             let all = subd(threads)?;

@@ -45,6 +45,11 @@ enum Task {
         /// Runs per measurement (the median is reported).
         #[arg(long, default_value_t = 5)]
         repeats: usize,
+        /// Run both OpenSubdiv and subd with glibc's transparent-huge-page malloc
+        /// (`GLIBC_TUNABLES=glibc.malloc.hugetlb=1`), which removes most page-fault time from
+        /// both sides where the kernel allows THP on request.
+        #[arg(long)]
+        huge_pages: bool,
     },
     /// (internal) One subd measurement for `bench`, in its own process.
     #[command(hide = true)]
@@ -146,9 +151,12 @@ fn main() -> ExitCode {
                     Err("conformance failed".into())
                 }
             }),
-        Task::Bench { levels, repeats } => {
-            ensure_system_packages(OPENSUBDIV_PACKAGES).and_then(|_| bench::run(levels, repeats))
-        }
+        Task::Bench {
+            levels,
+            repeats,
+            huge_pages,
+        } => ensure_system_packages(OPENSUBDIV_PACKAGES)
+            .and_then(|_| bench::run(levels, repeats, huge_pages)),
         Task::BenchRun {
             mesh,
             scheme,

@@ -508,6 +508,10 @@ impl Step<'_> {
         let face_points: &[DVec3] = face_part;
         let fill = |first: usize, chunk: &mut [DVec3]| {
             for (k, o) in chunk.iter_mut().enumerate() {
+                if let Some(q) = self.smooth_catmark_point(first + k, src, face_points) {
+                    *o = q;
+                    continue;
+                }
                 let mut s = PointSink {
                     src,
                     face_points,
@@ -532,6 +536,58 @@ impl Step<'_> {
             },
         );
         out
+    }
+}
+
+impl Step<'_> {
+    /// The common Catmull-Clark cases without the general mask machinery: the child of a
+    /// smooth (or dart) vertex, and of an uncreased edge between two faces without the
+    /// smooth-triangle rule. Same sums in the same order as [`Step::row`] with a
+    /// [`PointSink`], so the results are identical bit for bit; `None` for every other row.
+    #[inline]
+    fn smooth_catmark_point(
+        &self,
+        r: usize,
+        src: &[DVec3],
+        face_points: &[DVec3],
+    ) -> Option<DVec3> {
+        if self.scheme != Scheme::CatmullClark {
+            return None;
+        }
+        let p = self.parent;
+        let l = self.layout;
+        let r32 = r as u32;
+        if r32 < l.face_vertex_base {
+            if !matches!(self.parent_rules[r], Rule::Smooth | Rule::Dart) {
+                return None;
+            }
+            let faces = p.vertex_faces(r);
+            let n = faces.len();
+            let w = 1.0 / (n * n) as f64;
+            let mut acc = DVec3::ZERO;
+            for &f in faces {
+                acc += w * face_points[f as usize];
+            }
+            for &e in p.vertex_edges(r) {
+                acc += w * src[p.edge_other_vertex(e as usize, r32) as usize];
+            }
+            let nf = n as f64;
+            return Some(acc + ((nf - 2.0) / nf) * src[r]);
+        }
+        let e = (r32 - l.edge_vertex_base) as usize;
+        let faces = p.edge_faces(e);
+        if p.edge_sharpness(e) > 0.0
+            || faces.len() != 2
+            || self.options.triangle_subdivision == TriangleSubdivision::Smooth
+        {
+            return None;
+        }
+        let [a, b] = p.edge_vertices(e);
+        let mut acc = 0.25 * src[a as usize];
+        acc += 0.25 * src[b as usize];
+        acc += 0.25 * face_points[faces[0] as usize];
+        acc += 0.25 * face_points[faces[1] as usize];
+        Some(acc)
     }
 }
 

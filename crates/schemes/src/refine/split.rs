@@ -51,9 +51,14 @@ fn vertex_edge_end(p: &Topology, v: usize, i: usize) -> u32 {
 
 /// Child faces of the quad split for parent faces `faces`: (V_k, E_k, F, E_{k-1}) with
 /// edges (hNext, I_k, I_{k-1}, hPrev); a quad's child k is rotated so that the parent corner
-/// sits at position k. Writes vertices (`edges == false`) or edges into `out`, which starts at
-/// the first child face-vertex of `faces`.
-fn quad_face_block(p: &Topology, faces: Range<usize>, edges: bool, out: &mut [u32]) {
+/// sits at position k. Writes the vertices into `verts` and, when given, the edges into
+/// `edges`; both start at the first child face-vertex of `faces`.
+fn quad_face_block(
+    p: &Topology,
+    faces: Range<usize>,
+    verts: &mut [u32],
+    mut edges: Option<&mut [u32]>,
+) {
     let (nv, nf, nh) = (p.num_vertices(), p.num_faces(), p.num_face_vertices());
     let off = p.face_offsets();
     let face_point = |f: usize| (nv + f) as u32;
@@ -65,22 +70,25 @@ fn quad_face_block(p: &Topology, faces: Range<usize>, edges: bool, out: &mut [u3
         let fe = p.face_edges(f);
         let n = fv.len();
         let base = off[f];
+        let rot_quad = n == 4;
         for k in 0..n {
             let km1 = if k == 0 { n - 1 } else { k - 1 };
-            let vals = if edges {
-                [
+            let rot = if rot_quad { k } else { 0 };
+            let o = 4 * (base as usize + k) - origin;
+            let vv = [fv[k], edge_point(fe[k]), face_point(f), edge_point(fe[km1])];
+            for j in 0..4 {
+                verts[o + (j + rot) % 4] = vv[j];
+            }
+            if let Some(out) = edges.as_deref_mut() {
+                let ee = [
                     hb + half(fe[k], end_at(p, fe[k], fv[k], true)),
                     base + k as u32,
                     base + km1 as u32,
                     hb + half(fe[km1], end_at(p, fe[km1], fv[k], false)),
-                ]
-            } else {
-                [fv[k], edge_point(fe[k]), face_point(f), edge_point(fe[km1])]
-            };
-            let rot = if n == 4 { k } else { 0 };
-            let o = 4 * (base as usize + k) - origin;
-            for j in 0..4 {
-                out[o + (j + rot) % 4] = vals[j];
+                ];
+                for j in 0..4 {
+                    out[o + (j + rot) % 4] = ee[j];
+                }
             }
         }
     }
@@ -94,7 +102,7 @@ pub(crate) fn quad_faces(p: &Topology) -> (Vec<u32>, Vec<u32>) {
         4 * nh,
         nf,
         |f| 4 * off[f] as usize,
-        |r, out| quad_face_block(p, r, false, out),
+        |r, out| quad_face_block(p, r, out, None),
     );
     (
         (0..=nh as u32).into_par_iter().map(|i| 4 * i).collect(),
@@ -263,17 +271,14 @@ pub(crate) fn quad_split(p: &Topology) -> Topology {
     let hb = nh as u32;
     let size = |f: usize| (off[f + 1] - off[f]) as usize;
 
-    let face_vertices = par::build(
-        4 * nh,
+    let mut face_vertices = vec![0u32; 4 * nh];
+    let mut face_edges = vec![0u32; 4 * nh];
+    par::fill_pair(
+        &mut face_vertices,
+        &mut face_edges,
         nf,
         |f| 4 * off[f] as usize,
-        |r, out| quad_face_block(p, r, false, out),
-    );
-    let face_edges = par::build(
-        4 * nh,
-        nf,
-        |f| 4 * off[f] as usize,
-        |r, out| quad_face_block(p, r, true, out),
+        |r, verts, edges| quad_face_block(p, r, verts, Some(edges)),
     );
     let face_offsets: Vec<u32> = (0..=nh as u32).into_par_iter().map(|i| 4 * i).collect();
 
@@ -302,30 +307,33 @@ pub(crate) fn quad_split(p: &Topology) -> Topology {
     let ef_start = |e: usize| 2 * pefo[e] as usize;
     let mut edge_faces = vec![0u32; total_ef];
     let mut edge_face_local = vec![0u32; total_ef];
-    for (dst, local) in [(&mut edge_faces, false), (&mut edge_face_local, true)] {
-        let (a, b) = dst.split_at_mut(2 * nh);
-        par::fill(
-            a,
+    {
+        let (fa, fb) = edge_faces.split_at_mut(2 * nh);
+        let (la, lb) = edge_face_local.split_at_mut(2 * nh);
+        par::fill_pair(
+            fa,
+            la,
             nf,
             |f| 2 * off[f] as usize,
-            |r, out| {
+            |r, faces, local| {
                 let mut i = 0;
                 for f in r {
                     let n = size(f);
                     let base = off[f];
                     for j in 0..n {
-                        let vals = match (local, n == 4) {
-                            (false, _) => [base + j as u32, base + ((j + 1) % n) as u32],
-                            (true, true) => [((j + 1) % 4) as u32, ((j + 3) % 4) as u32],
-                            (true, false) => [1, 2],
+                        faces[i] = base + j as u32;
+                        faces[i + 1] = base + ((j + 1) % n) as u32;
+                        (local[i], local[i + 1]) = if n == 4 {
+                            (((j + 1) % 4) as u32, ((j + 3) % 4) as u32)
+                        } else {
+                            (1, 2)
                         };
-                        out[i..i + 2].copy_from_slice(&vals);
                         i += 2;
                     }
                 }
             },
         );
-        par::fill(b, ne, ef_start, |r, out| {
+        par::fill_pair(fb, lb, ne, ef_start, |r, faces, local| {
             let mut i = 0;
             for e in r {
                 let ev = p.edge_vertices(e);
@@ -339,9 +347,8 @@ pub(crate) fn quad_split(p: &Topology) -> Topology {
                         } else {
                             usize::from(p.face_vertices(pf)[l] != ev[k])
                         };
-                        out[i] = if !local {
-                            off[pf] + ((l + c) % n) as u32
-                        } else if n == 4 {
+                        faces[i] = off[pf] + ((l + c) % n) as u32;
+                        local[i] = if n == 4 {
                             l as u32
                         } else if c == 1 {
                             3
@@ -367,58 +374,57 @@ pub(crate) fn quad_split(p: &Topology) -> Topology {
     let total_vf = nvf + nh + 2 * pefo[ne] as usize;
     let mut vertex_faces = vec![0u32; total_vf];
     let mut vertex_face_local = vec![0u32; total_vf];
-    for (dst, local) in [(&mut vertex_faces, false), (&mut vertex_face_local, true)] {
-        let (a, rest) = dst.split_at_mut(nvf);
-        let (b, c) = rest.split_at_mut(nh);
-        par::fill(
-            a,
+    {
+        let (fa, rest) = vertex_faces.split_at_mut(nvf);
+        let (fb, fc) = rest.split_at_mut(nh);
+        let (la, rest) = vertex_face_local.split_at_mut(nvf);
+        let (lb, lc) = rest.split_at_mut(nh);
+        par::fill_pair(
+            fa,
+            la,
             nv,
             |v| pvfo[v] as usize,
-            |r, out| {
+            |r, faces, local| {
                 let mut i = 0;
                 for v in r {
                     for (&pf, &c) in p.vertex_faces(v).iter().zip(p.vertex_face_local_indices(v)) {
-                        out[i] = match (local, size(pf as usize) == 4) {
-                            (false, _) => off[pf as usize] + c,
-                            (true, true) => c,
-                            (true, false) => 0,
-                        };
+                        faces[i] = off[pf as usize] + c;
+                        local[i] = if size(pf as usize) == 4 { c } else { 0 };
                         i += 1;
                     }
                 }
             },
         );
-        par::fill(
-            b,
+        par::fill_pair(
+            fb,
+            lb,
             nf,
             |f| off[f] as usize,
-            |r, out| {
+            |r, faces, local| {
                 let mut i = 0;
                 for f in r {
                     let n = size(f);
                     for j in 0..n {
-                        out[i] = match (local, n == 4) {
-                            (false, _) => off[f] + j as u32,
-                            (true, true) => ((j + 2) % 4) as u32,
-                            (true, false) => 2,
-                        };
+                        faces[i] = off[f] + j as u32;
+                        local[i] = if n == 4 { ((j + 2) % 4) as u32 } else { 2 };
                         i += 1;
                     }
                 }
             },
         );
-        par::fill(c, ne, ef_start, |r, out| {
+        par::fill_pair(fc, lc, ne, ef_start, |r, faces, local| {
             let mut i = 0;
             for e in r {
                 for (&pf, &l) in p.edge_faces(e).iter().zip(p.edge_face_local_indices(e)) {
                     let (pf, l) = (pf as usize, l as usize);
                     let n = size(pf);
-                    let vals = match (local, n == 4) {
-                        (false, _) => [off[pf] + ((l + 1) % n) as u32, off[pf] + l as u32],
-                        (true, true) => [l as u32, ((l + 1) % 4) as u32],
-                        (true, false) => [3, 1],
+                    faces[i] = off[pf] + ((l + 1) % n) as u32;
+                    faces[i + 1] = off[pf] + l as u32;
+                    (local[i], local[i + 1]) = if n == 4 {
+                        (l as u32, ((l + 1) % 4) as u32)
+                    } else {
+                        (3, 1)
                     };
-                    out[i..i + 2].copy_from_slice(&vals);
                     i += 2;
                 }
             }
