@@ -1,0 +1,153 @@
+//! Limit surfaces for subd.
+//!
+//! * [`masks`]: closed-form limit position and tangent masks of Catmull-Clark and Loop for
+//!   smooth, crease and corner vertices (the formulas OpenSubdiv's `Sdc` uses, with their
+//!   sources).
+//! * [`eigen`]: the local subdivision matrix around a vertex of any valence, read off the
+//!   refinement itself, and its eigen analysis with `faer` (subdominant eigenvalues, limit
+//!   masks as dominant left eigenvectors, tangent masks from the subdominant ones) — checked
+//!   against the closed forms of seed 001 §5, and used where no closed form is exact
+//!   (darts, interior valence 2).
+//! * [`LimitStencilTable`]: limit positions, tangents and normals of every vertex of a
+//!   refinement level as stencil tables; [`base_limit`] gives the exact limit of every base
+//!   vertex, refining first as far as semi-sharp creases need to decay.
+//!
+//! ```
+//! use subd_mesh::{DVec3, TopologyBuilder};
+//! use subd_schemes::{Options, Scheme};
+//!
+//! // A unit square grid of 3 × 3 quads: the limit of the centre vertices is smooth,
+//! // boundary vertices follow the B-spline boundary curve.
+//! let mut faces = Vec::new();
+//! for j in 0..3u32 {
+//!     for i in 0..3u32 {
+//!         let v = j * 4 + i;
+//!         faces.extend([v, v + 1, v + 5, v + 4]);
+//!     }
+//! }
+//! let topo = TopologyBuilder::new(16).build(&[4; 9], &faces).unwrap();
+//! let points: Vec<DVec3> =
+//!     (0..16).map(|v| DVec3::new((v % 4) as f64, (v / 4) as f64, 0.0)).collect();
+//! let table = subd_limit::base_limit(&topo, Scheme::CatmullClark, &Options::default()).unwrap();
+//! let limit = table.apply(&points);
+//! // A flat grid stays flat and the interior vertex 5 is a regular B-spline point.
+//! assert!((limit.positions[5] - DVec3::new(1.0, 1.0, 0.0)).length() < 1e-15);
+//! assert!((limit.normals[5] - DVec3::Z).length() < 1e-15);
+//! ```
+
+pub mod eigen;
+pub mod masks;
+mod table;
+
+use subd_mesh::Topology;
+use subd_mesh::tags::is_semi_sharp;
+use subd_schemes::{Options, RefineError, Refinement, Scheme, StencilTable};
+use thiserror::Error;
+
+pub use masks::{LimitMask, RingMask};
+pub use table::{LimitPoints, LimitStencilTable};
+
+/// What can go wrong computing limits.
+#[derive(Debug, Error)]
+pub enum LimitError {
+    /// Bilinear has no limit masks (its limit is the mesh itself).
+    #[error("limit masks exist for catmull-clark and loop only")]
+    Scheme,
+    /// Catmull-Clark limit masks at a level with a face that is not a quad.
+    #[error(
+        "level {level}, face {face}: {size} vertices; catmull-clark limit masks need quads (refine one level first)"
+    )]
+    NotQuad {
+        /// Level.
+        level: usize,
+        /// Face.
+        face: usize,
+        /// Its size.
+        size: usize,
+    },
+    /// Refinement failed.
+    #[error(transparent)]
+    Refine(#[from] RefineError),
+    /// The refinement semi-sharp creases need to decay would be too large.
+    #[error(
+        "semi-sharp sharpness {sharpness} needs {levels} levels of refinement, more than {max} face-vertices"
+    )]
+    TooDeep {
+        /// Largest finite sharpness.
+        sharpness: f32,
+        /// Levels needed.
+        levels: usize,
+        /// The face-vertex budget.
+        max: usize,
+    },
+    /// The eigen analysis failed (a degenerate local configuration).
+    #[error("eigen analysis: {0}")]
+    Analysis(String),
+}
+
+/// Face-vertices the decay refinement of [`base_limit`] may create.
+pub const MAX_DECAY_FACE_VERTICES: usize = 1 << 26;
+
+/// Levels of uniform refinement after which no semi-sharp feature is left (every finite
+/// sharpness `s` decays by at least 1 per level, Chaikin included), and, for Catmull-Clark,
+/// at least one level when a face is not a quad.
+pub fn levels_for_exact_limit(topology: &Topology, scheme: Scheme) -> (usize, f32) {
+    let semi = (0..topology.num_edges())
+        .map(|e| topology.edge_sharpness(e))
+        .chain((0..topology.num_vertices()).map(|v| topology.vertex_sharpness(v)))
+        .filter(|&s| is_semi_sharp(s))
+        .fold(0.0f32, f32::max);
+    let quads = scheme != Scheme::CatmullClark
+        || (0..topology.num_faces()).all(|f| topology.face_size(f) == 4);
+    let decay = semi.ceil() as usize;
+    (decay.max(usize::from(!quads)), semi)
+}
+
+/// The rows `0..k` of `t`.
+fn first_rows(t: &StencilTable, k: usize) -> StencilTable {
+    let end = t.offsets()[k] as usize;
+    StencilTable::from_csr(
+        t.num_sources(),
+        t.offsets()[..=k].to_vec(),
+        t.indices()[..end].to_vec(),
+        t.weights()[..end].to_vec(),
+    )
+}
+
+/// The exact limit (position, tangents, normal) of every base vertex, as stencils over the
+/// base vertices. Refines uniformly until semi-sharp creases and corners have decayed (and,
+/// for Catmull-Clark, until every face is a quad), takes the limit masks there
+/// ([`LimitStencilTable::at_level`]) and composes them back to the base mesh; base vertex
+/// `v` is vertex `v` at every level.
+pub fn base_limit(
+    topology: &Topology,
+    scheme: Scheme,
+    options: &Options,
+) -> Result<LimitStencilTable, LimitError> {
+    if scheme == Scheme::Bilinear {
+        return Err(LimitError::Scheme);
+    }
+    let (levels, sharpness) = levels_for_exact_limit(topology, scheme);
+    let estimate = topology
+        .num_face_vertices()
+        .saturating_mul(4usize.saturating_pow(levels as u32));
+    if estimate > MAX_DECAY_FACE_VERTICES {
+        return Err(LimitError::TooDeep {
+            sharpness,
+            levels,
+            max: MAX_DECAY_FACE_VERTICES,
+        });
+    }
+    let r = Refinement::new(topology, scheme, options, levels)?;
+    let at = LimitStencilTable::at_level(&r, levels)?;
+    let nv = topology.num_vertices();
+    let mut t = LimitStencilTable {
+        position: first_rows(&at.position, nv),
+        tangent1: first_rows(&at.tangent1, nv),
+        tangent2: first_rows(&at.tangent2, nv),
+    };
+    for l in (1..=levels).rev() {
+        t = t.after(r.stencils(l));
+    }
+    Ok(t)
+}

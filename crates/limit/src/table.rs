@@ -1,0 +1,253 @@
+//! [`LimitStencilTable`]: limit positions and tangents of every vertex of a level, as stencils.
+
+use std::collections::HashMap;
+
+use glam::DVec3;
+use subd_mesh::Topology;
+use subd_mesh::tags::is_infinite;
+use subd_schemes::{Refinement, RowSink, Rule, Scheme, StencilTable, rules};
+
+use crate::LimitError;
+use crate::eigen::{RingFeature, ring_limit_mask};
+use crate::masks::{self, LimitMask, RingMask};
+
+/// Limit position, tangents and unit normals of a set of vertices.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct LimitPoints {
+    /// Limit positions.
+    pub positions: Vec<DVec3>,
+    /// First tangents (see [`crate::masks`] for the convention).
+    pub tangent1: Vec<DVec3>,
+    /// Second tangents.
+    pub tangent2: Vec<DVec3>,
+    /// `normalize(tangent1 × tangent2)`; zero where the tangents are parallel.
+    pub normals: Vec<DVec3>,
+}
+
+/// Three stencil tables with one row per vertex: limit position, first and second tangent.
+/// Same CSR form as the refinement stencils, so they compose with them and apply to any
+/// per-vertex data.
+///
+/// ```
+/// use subd_mesh::{DVec3, TopologyBuilder};
+/// use subd_schemes::{Options, Refinement, Scheme};
+/// use subd_limit::LimitStencilTable;
+///
+/// // A cube (OpenSubdiv's catmark_cube): every vertex is smooth of valence 3.
+/// let faces = [0, 1, 3, 2, 2, 3, 5, 4, 4, 5, 7, 6, 6, 7, 1, 0, 1, 7, 5, 3, 6, 0, 2, 4];
+/// let topo = TopologyBuilder::new(8).build(&[4; 6], &faces).unwrap();
+/// let s = [(-1., -1., 1.), (1., -1., 1.), (-1., 1., 1.), (1., 1., 1.),
+///          (-1., 1., -1.), (1., 1., -1.), (-1., -1., -1.), (1., -1., -1.)];
+/// let cube: Vec<DVec3> = s.iter().map(|&(x, y, z)| 0.5 * DVec3::new(x, y, z)).collect();
+/// let r = Refinement::new(&topo, Scheme::CatmullClark, &Options::default(), 0).unwrap();
+/// let limit = LimitStencilTable::at_level(&r, 0).unwrap().apply(&cube);
+/// // The limit of corner 0 lies on the diagonal through it, inside the cube, and its normal
+/// // points outwards along that diagonal.
+/// let (p, d) = (limit.positions[0], DVec3::new(-1.0, -1.0, 1.0));
+/// assert!(p.cross(d).length() < 1e-15 && p.dot(d) > 0.0 && p.dot(d) < 1.5);
+/// assert!((limit.normals[0] - d.normalize()).length() < 1e-15);
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct LimitStencilTable {
+    /// Limit positions.
+    pub position: StencilTable,
+    /// First tangents.
+    pub tangent1: StencilTable,
+    /// Second tangents.
+    pub tangent2: StencilTable,
+}
+
+/// How one vertex's limit is taken.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+enum VertexCase {
+    Isolated,
+    Corner,
+    Crease(usize, usize),
+    /// Closed form (Catmull-Clark valence ≥ 3, Loop), or a semi-sharp dart.
+    Smooth,
+    /// By eigen analysis: an infinitely sharp dart (sharp edge at the given position), or a
+    /// Catmull-Clark interior vertex of valence 2.
+    Numeric(RingFeature, usize),
+}
+
+fn classify(t: &Topology, v: usize, rule: Rule, scheme: Scheme) -> VertexCase {
+    let ve = t.vertex_edges(v);
+    if ve.is_empty() {
+        return VertexCase::Isolated;
+    }
+    let n = t.vertex_faces(v).len();
+    match rule {
+        Rule::Corner => VertexCase::Corner,
+        Rule::Crease => {
+            let (a, b) = rules::crease_pair(ve.len(), |i| t.edge_sharpness(ve[i] as usize) > 0.0);
+            VertexCase::Crease(a, b)
+        }
+        Rule::Dart => {
+            let k = ve
+                .iter()
+                .position(|&e| t.edge_sharpness(e as usize) > 0.0)
+                .unwrap_or(0);
+            if is_infinite(t.edge_sharpness(ve[k] as usize)) && n == ve.len() {
+                VertexCase::Numeric(RingFeature::Dart, k)
+            } else {
+                VertexCase::Smooth
+            }
+        }
+        Rule::Smooth => {
+            if scheme == Scheme::CatmullClark && n == 2 && ve.len() == 2 {
+                VertexCase::Numeric(RingFeature::Smooth, 0)
+            } else {
+                VertexCase::Smooth
+            }
+        }
+    }
+}
+
+/// `m` with its ring rotated so that entry `i` moves to `i + k`.
+fn rotated(m: &RingMask, k: usize) -> RingMask {
+    let rot = |w: &[f64]| -> Vec<f64> {
+        let n = w.len();
+        let mut out = vec![0.0; n];
+        for (i, &x) in w.iter().enumerate() {
+            out[(i + k) % n] = x;
+        }
+        out
+    };
+    RingMask {
+        vertex: m.vertex,
+        edges: rot(&m.edges),
+        faces: rot(&m.faces),
+    }
+}
+
+impl LimitStencilTable {
+    /// Limit masks of every vertex of `level` of `refinement`, in terms of the vertices of
+    /// that level. Each vertex takes the mask of its rule at that level, as OpenSubdiv's
+    /// `PrimvarRefiner::Limit` does (so semi-sharp features still present at that level count
+    /// as sharp), except where OpenSubdiv is not exact: an interior Catmull-Clark vertex of
+    /// valence 2 and a dart on an infinitely sharp edge get their true limit, from the eigen
+    /// analysis of their local subdivision matrix ([`crate::eigen`]).
+    ///
+    /// Catmull-Clark needs quads at that level (any level ≥ 1 is all quads); Bilinear has no
+    /// limit masks.
+    pub fn at_level(refinement: &Refinement, level: usize) -> Result<Self, LimitError> {
+        let scheme = refinement.scheme();
+        if scheme == Scheme::Bilinear {
+            return Err(LimitError::Scheme);
+        }
+        let t = refinement.topology(level);
+        if scheme == Scheme::CatmullClark
+            && let Some(f) = (0..t.num_faces()).find(|&f| t.face_size(f) != 4)
+        {
+            return Err(LimitError::NotQuad {
+                level,
+                face: f,
+                size: t.face_size(f),
+            });
+        }
+        let rules = refinement.vertex_rules(level);
+        let cases: Vec<VertexCase> = (0..t.num_vertices())
+            .map(|v| classify(t, v, rules[v], scheme))
+            .collect();
+        // Numeric masks depend only on (feature, valence): compute each once.
+        let mut numeric: HashMap<(RingFeature, usize), LimitMask> = HashMap::new();
+        for (v, c) in cases.iter().enumerate() {
+            if let VertexCase::Numeric(feature, _) = *c {
+                let n = t.vertex_faces(v).len();
+                if let std::collections::hash_map::Entry::Vacant(e) = numeric.entry((feature, n)) {
+                    e.insert(ring_limit_mask(scheme, n, feature)?);
+                }
+            }
+        }
+        let mask_of = |v: usize, which: usize| -> RingMask {
+            let (ne, nf) = (t.vertex_edges(v).len(), t.vertex_faces(v).len());
+            let m = match cases[v] {
+                VertexCase::Isolated => masks::corner(0, 0, 0.0),
+                VertexCase::Corner => {
+                    masks::corner(ne, nf, if scheme == Scheme::Loop { 3.0 } else { 1.0 })
+                }
+                VertexCase::Crease(a, b) => match scheme {
+                    Scheme::Loop => masks::loop_crease(ne, (a, b)),
+                    _ => masks::catmark_crease(ne, nf, (a, b)),
+                },
+                VertexCase::Smooth => match scheme {
+                    Scheme::Loop => masks::loop_smooth(nf),
+                    _ => masks::catmark_smooth(nf),
+                },
+                VertexCase::Numeric(feature, k) => {
+                    let m = &numeric[&(feature, nf)];
+                    return rotated([&m.position, &m.tangent1, &m.tangent2][which], k);
+                }
+            };
+            let [p, t1, t2] = [m.position, m.tangent1, m.tangent2];
+            [p, t1, t2].into_iter().nth(which).expect("which < 3")
+        };
+        let table = |which: usize| {
+            StencilTable::build(t.num_vertices(), t.num_vertices(), |v, sink| {
+                emit(t, v, &mask_of(v, which), sink)
+            })
+        };
+        Ok(LimitStencilTable {
+            position: table(0),
+            tangent1: table(1),
+            tangent2: table(2),
+        })
+    }
+
+    /// Number of rows (vertices).
+    pub fn num_rows(&self) -> usize {
+        self.position.num_rows()
+    }
+
+    /// The three tables composed after `first`: rows of this table expressed in terms of
+    /// `first`'s sources (e.g. `refinement.composed(level)` gives limit stencils over the base
+    /// vertices).
+    pub fn after(&self, first: &StencilTable) -> LimitStencilTable {
+        LimitStencilTable {
+            position: first.then(&self.position),
+            tangent1: first.then(&self.tangent1),
+            tangent2: first.then(&self.tangent2),
+        }
+    }
+
+    /// Limit positions, tangents and unit normals from the control points the rows refer to.
+    pub fn apply(&self, points: &[DVec3]) -> LimitPoints {
+        let positions = self.position.apply_points(points);
+        let tangent1 = self.tangent1.apply_points(points);
+        let tangent2 = self.tangent2.apply_points(points);
+        let normals = tangent1
+            .iter()
+            .zip(&tangent2)
+            .map(|(a, b)| a.cross(*b).normalize_or_zero())
+            .collect();
+        LimitPoints {
+            positions,
+            tangent1,
+            tangent2,
+            normals,
+        }
+    }
+}
+
+/// Writes a ring mask of vertex `v` as a stencil row: face terms first, then edge terms, then
+/// the vertex (OpenSubdiv's summation order); zero weights are left out.
+fn emit(t: &Topology, v: usize, m: &RingMask, sink: &mut RowSink) {
+    if !m.faces.is_empty() {
+        let local = t.vertex_face_local_indices(v);
+        for (i, &f) in t.vertex_faces(v).iter().enumerate() {
+            if m.faces[i] != 0.0 {
+                let fv = t.face_vertices(f as usize);
+                let opposite = fv[(local[i] as usize + 2) % fv.len()];
+                sink.add(opposite, m.faces[i]);
+            }
+        }
+    }
+    for (i, &e) in t.vertex_edges(v).iter().enumerate() {
+        if i < m.edges.len() && m.edges[i] != 0.0 {
+            sink.add(t.edge_other_vertex(e as usize, v as u32), m.edges[i]);
+        }
+    }
+    if m.vertex != 0.0 {
+        sink.add(v as u32, m.vertex);
+    }
+}
