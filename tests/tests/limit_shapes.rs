@@ -3,6 +3,9 @@
 //! what makes a mask a limit mask — a left eigenvector of the subdivision), and refined
 //! points must converge to it.
 
+// Vertices index several parallel arrays.
+#![allow(clippy::needless_range_loop)]
+
 use glam::DVec3;
 use subd_io::{ReadOptions, read_mesh};
 use subd_limit::{LimitError, LimitStencilTable, base_limit, levels_for_exact_limit, masks};

@@ -11,6 +11,9 @@
 // u32 sizes[nf], u32 nidx, u32 idx[nidx], f64 pos[3 nv], u32 ncrease, {u32 a, u32 b, f32 s},
 // u32 ncorner, {u32 v, f32 s}, u32 nhole, u32 f[nhole].
 // Output per level 1..L: u32 nv, u32 nf, u32 sizes[nf], u32 idx[sum sizes], f64 pos[3 nv].
+// With --limit: PrimvarRefiner::Limit applied to level L instead: u32 nv, then f64 pos[3 nv],
+// f64 tan1[3 nv], f64 tan2[3 nv]; --limit-positions the same with zero tangents (for the
+// meshes where OpenSubdiv's tangent masks overflow their buffers and crash).
 
 #include <opensubdiv/far/primvarRefiner.h>
 #include <opensubdiv/far/topologyDescriptor.h>
@@ -208,6 +211,26 @@ int main(int argc, char **argv) {
         Far::TopologyRefiner *refiner = createRefiner(m);
         auto levels = refineAll(*refiner, m);
         std::vector<unsigned char> out;
+        bool limitPositions = argc > 1 && std::string(argv[1]) == "--limit-positions";
+        if (limitPositions || (argc > 1 && std::string(argv[1]) == "--limit")) {
+            std::vector<Point> const &last = levels[m.levels];
+            size_t nv = last.size();
+            std::vector<Point> pos(nv), tan1(nv), tan2(nv);
+            for (auto *v : {&tan1, &tan2})
+                for (auto &p : *v) p.Clear();
+            Far::PrimvarRefinerReal<double> primvar(*refiner);
+            if (limitPositions)
+                primvar.Limit(last, pos);
+            else
+                primvar.Limit(last, pos, tan1, tan2);
+            put<uint32_t>(out, (uint32_t)nv);
+            for (auto const *v : {&pos, &tan1, &tan2})
+                for (auto const &p : *v)
+                    for (double c : p.p) put<double>(out, c);
+            std::fwrite(out.data(), 1, out.size(), stdout);
+            delete refiner;
+            return 0;
+        }
         for (int l = 1; l <= m.levels; ++l) {
             Far::TopologyLevel const &lev = refiner->GetLevel(l);
             put<uint32_t>(out, (uint32_t)lev.GetNumVertices());

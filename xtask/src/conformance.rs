@@ -13,12 +13,24 @@ const TOLERANCE: f64 = 1e-12;
 /// Levels are capped where the mesh would pass this many vertices.
 const MAX_VERTICES: usize = 2_000_000;
 
-/// Outcome of one mesh at one level.
+/// Tolerance on the difference of unit normals.
+const NORMAL_TOLERANCE: f64 = 1e-10;
+/// Limit checks refine at most this many face-vertices deep.
+const MAX_LIMIT_FACE_VERTICES: usize = 8_000_000;
+
+/// Outcome of one check of one mesh at one level.
 pub struct Row {
     pub mesh: String,
+    /// "refine" (positions of the refined level) or "limit" (PrimvarRefiner::Limit there).
+    pub check: &'static str,
     pub level: usize,
     pub vertices: usize,
     pub error: f64,
+    /// Max difference of unit normals (limit checks only).
+    pub normal_error: Option<f64>,
+    /// Vertices left out of the limit check because OpenSubdiv is not exact there, with the
+    /// largest |Δ|/diag seen at them.
+    pub excluded: Option<(usize, f64)>,
     pub problem: Option<String>,
 }
 
@@ -53,9 +65,12 @@ pub fn compare(
     let levels = levels_for(topo, scheme);
     let fail = |level: usize, msg: String| Row {
         mesh: name.to_string(),
+        check: "refine",
         level,
         vertices: 0,
         error: f64::INFINITY,
+        normal_error: None,
+        excluded: None,
         problem: Some(msg),
     };
     let input = osd::encode(topo, positions, scheme, options, levels as u32);
@@ -125,13 +140,172 @@ pub fn compare(
         }
         rows.push(Row {
             mesh: name.to_string(),
+            check: "refine",
             level,
             vertices: t.num_vertices(),
             error,
+            normal_error: None,
+            excluded: None,
             problem,
         });
     }
+    if scheme != Scheme::Bilinear {
+        rows.push(compare_limit(
+            exe, name, topo, positions, scheme, options, diag,
+        ));
+    }
     rows
+}
+
+/// Limit positions, tangents and normals of every vertex of level N against OpenSubdiv's
+/// `PrimvarRefiner::Limit` there; N is the level where semi-sharp features have decayed
+/// (at least 1), lowered where the mesh would grow too large (both sides then take the masks
+/// of the rules at that level). Positions and tangents within 1e-12 of the bounding-box
+/// diagonal, unit normals within 1e-10, except at the vertices where OpenSubdiv is not exact
+/// (interior valence 2, darts on infinitely sharp edges), which are counted and reported.
+fn compare_limit(
+    exe: &Path,
+    name: &str,
+    topo: &Topology,
+    positions: &[DVec3],
+    scheme: Scheme,
+    options: &Options,
+    diag: f64,
+) -> Row {
+    let mut level = subd_limit::levels_for_exact_limit(topo, scheme).0.max(1);
+    while level > 1 && topo.num_face_vertices() << (2 * level) > MAX_LIMIT_FACE_VERTICES {
+        level -= 1;
+    }
+    let mut row = Row {
+        mesh: name.to_string(),
+        check: "limit",
+        level,
+        vertices: 0,
+        error: f64::INFINITY,
+        normal_error: None,
+        excluded: None,
+        problem: None,
+    };
+    let input = osd::encode(topo, positions, scheme, options, level as u32);
+    // Where OpenSubdiv crashes computing tangents (see `overflow` below), compare positions.
+    let mut with_tangents = true;
+    let theirs = match osd::run(exe, &input, &["--limit"])
+        .or_else(|_| {
+            with_tangents = false;
+            osd::run(exe, &input, &["--limit-positions"])
+        })
+        .and_then(|b| osd::decode_limit(&b))
+    {
+        Ok(l) => l,
+        Err(e) => {
+            row.problem = Some(format!("OpenSubdiv: {e}"));
+            return row;
+        }
+    };
+    let topo_at = match Refinement::new(topo, scheme, options, level) {
+        Ok(r) => r,
+        Err(e) => {
+            row.problem = Some(format!("subd: {e}"));
+            return row;
+        }
+    };
+    let ours = subd_limit::LimitStencilTable::at_level(&topo_at, level)
+        .map_err(|e| e.to_string())
+        .map(|table| {
+            let pts = topo_at.refine_points(positions);
+            (
+                table.apply(&pts[level]),
+                subd_limit::eigen_limit_vertices(&topo_at, level),
+            )
+        });
+    let (ours, skip) = match ours {
+        Ok(x) => x,
+        Err(e) => {
+            row.problem = Some(format!("subd: {e}"));
+            return row;
+        }
+    };
+    row.vertices = ours.positions.len();
+    if ours.positions.len() != theirs.positions.len() {
+        row.problem = Some(format!(
+            "{} limit points, OpenSubdiv {}",
+            ours.positions.len(),
+            theirs.positions.len()
+        ));
+        return row;
+    }
+    let mut excluded = vec![false; row.vertices];
+    // OpenSubdiv sizes its limit-mask buffers by `Level::getMaxValence()`, which refinement
+    // sets to max(parent, 4, 2 + max edge faces) — fewer than the 2·k faces of the child of a
+    // non-manifold edge with k > 2 faces. There the face weights of the first tangent run
+    // into the second tangent's buffer (Far/primvarRefiner.h, `limit()`), so OpenSubdiv's
+    // tangents are garbled; positions are unaffected. Tangents and normals of non-manifold
+    // vertices with more faces than edges are left out of the comparison.
+    let overflow: Vec<bool> = (0..row.vertices)
+        .map(|v| {
+            let t = topo_at.topology(level);
+            t.is_non_manifold_vertex(v) && t.vertex_faces(v).len() > t.vertex_edges(v).len()
+        })
+        .collect();
+    for &v in &skip {
+        excluded[v] = true;
+    }
+    let (mut err, mut nerr, mut skipped_err) = (0.0f64, 0.0f64, 0.0f64);
+    let mut worst = 0;
+    for v in 0..row.vertices {
+        let tangents = if overflow[v] || !with_tangents { 1 } else { 3 };
+        let d = [
+            ours.positions[v] - theirs.positions[v],
+            ours.tangent1[v] - theirs.tangent1[v],
+            ours.tangent2[v] - theirs.tangent2[v],
+        ][..tangents]
+            .iter()
+            .map(|x| x.abs().max_element())
+            .fold(0.0, f64::max)
+            / diag;
+        let pd = (ours.positions[v] - theirs.positions[v])
+            .abs()
+            .max_element()
+            / diag;
+        if excluded[v] {
+            skipped_err = skipped_err.max(pd);
+            continue;
+        }
+        if d > err || d.is_nan() {
+            worst = v;
+        }
+        err = err.max(d);
+        if d.is_nan() {
+            err = f64::NAN;
+        }
+        let cross = theirs.tangent1[v].cross(theirs.tangent2[v]);
+        let (l1, l2) = (theirs.tangent1[v].length(), theirs.tangent2[v].length());
+        // No normal where a tangent vanishes or both are parallel.
+        let defined = l1.min(l2) > 1e-9 * diag && cross.length() > 1e-9 * l1 * l2;
+        if with_tangents && defined && ours.normals[v] != DVec3::ZERO && !overflow[v] {
+            let dn = (ours.normals[v] - cross.normalize()).abs().max_element();
+            if dn > nerr && dn > NORMAL_TOLERANCE && d <= TOLERANCE {
+                worst = v;
+            }
+            nerr = nerr.max(dn);
+        }
+    }
+    row.error = err;
+    row.normal_error = with_tangents.then_some(nerr);
+    row.excluded = (!skip.is_empty()).then_some((skip.len(), skipped_err));
+    if err.is_nan() || err > TOLERANCE || nerr > NORMAL_TOLERANCE {
+        let w = worst;
+        row.problem = Some(format!(
+            "worst vertex {w}: subd p {} t1 {} t2 {}, OpenSubdiv p {} t1 {} t2 {}",
+            ours.positions[w],
+            ours.tangent1[w],
+            ours.tangent2[w],
+            theirs.positions[w],
+            theirs.tangent1[w],
+            theirs.tangent2[w]
+        ));
+    }
+    row
 }
 
 fn scheme_of(name: &str) -> Option<Scheme> {
@@ -197,20 +371,31 @@ pub fn random(exe: &Path, count: u64) -> Vec<Row> {
 /// Prints the table and returns whether every row passed.
 pub fn report(rows: &[Row]) -> bool {
     println!(
-        "{:<36} {:>5} {:>9} {:>12}  status",
-        "mesh", "level", "vertices", "max|Δ|/diag"
+        "{:<36} {:<6} {:>5} {:>9} {:>12} {:>10}  status",
+        "mesh", "check", "level", "vertices", "max|Δ|/diag", "normal Δ"
     );
     let mut ok = true;
     for r in rows {
         let pass = r.problem.is_none();
         ok &= pass;
+        let normal = r
+            .normal_error
+            .map_or_else(|| "-".to_string(), |e| format!("{e:.3e}"));
+        let excluded = r.excluded.map_or_else(String::new, |(n, e)| {
+            format!(
+                " ({n} vertices where OpenSubdiv is inexact left out; there |Δ|/diag ≤ {e:.1e})"
+            )
+        });
         println!(
-            "{:<36} {:>5} {:>9} {:>12.3e}  {}",
+            "{:<36} {:<6} {:>5} {:>9} {:>12.3e} {:>10}  {}{}",
             r.mesh,
+            r.check,
             r.level,
             r.vertices,
             r.error,
-            r.problem.as_deref().unwrap_or("ok")
+            normal,
+            r.problem.as_deref().unwrap_or("ok"),
+            excluded
         );
     }
     let failed = rows.iter().filter(|r| r.problem.is_some()).count();

@@ -145,7 +145,12 @@ pub fn run(exe: &Path, input: &[u8], args: &[&str]) -> Result<Vec<u8>, String> {
         .map_err(|e| e.to_string())?;
     let out = child.wait_with_output().map_err(|e| e.to_string())?;
     if !out.status.success() {
-        return Err(String::from_utf8_lossy(&out.stderr).trim().to_string());
+        let msg = String::from_utf8_lossy(&out.stderr).trim().to_string();
+        return Err(if msg.is_empty() {
+            format!("harness failed ({})", out.status)
+        } else {
+            msg
+        });
     }
     Ok(out.stdout)
 }
@@ -190,4 +195,36 @@ pub fn decode(bytes: &[u8], levels: usize) -> Result<Vec<OsdLevel>, String> {
         });
     }
     Ok(out)
+}
+
+/// OpenSubdiv's `PrimvarRefiner::Limit` at the last level: positions and both tangents.
+pub struct OsdLimit {
+    pub positions: Vec<DVec3>,
+    pub tangent1: Vec<DVec3>,
+    pub tangent2: Vec<DVec3>,
+}
+
+/// Decodes the output of `--limit`.
+pub fn decode_limit(bytes: &[u8]) -> Result<OsdLimit, String> {
+    let nv = bytes
+        .get(..4)
+        .map(|s| u32::from_le_bytes(s.try_into().unwrap()) as usize)
+        .ok_or("harness output truncated")?;
+    let raw = bytes
+        .get(4..4 + 72 * nv)
+        .ok_or("harness output truncated")?;
+    let points = |k: usize| -> Vec<DVec3> {
+        raw[24 * nv * k..24 * nv * (k + 1)]
+            .chunks_exact(24)
+            .map(|c| {
+                let f = |i: usize| f64::from_le_bytes(c[8 * i..8 * i + 8].try_into().unwrap());
+                DVec3::new(f(0), f(1), f(2))
+            })
+            .collect()
+    };
+    Ok(OsdLimit {
+        positions: points(0),
+        tangent1: points(1),
+        tangent2: points(2),
+    })
 }

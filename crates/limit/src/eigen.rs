@@ -142,10 +142,10 @@ pub fn dominant_left_eigenvector(s: &Mat<f64>) -> Result<Vec<f64>, LimitError> {
     Ok(l)
 }
 
-/// Real left eigenvectors of `s` whose eigenvalues are among the two largest in modulus after
-/// eigenvalue 1: the candidates for the tangent functionals. A complex pair gives its
-/// real and imaginary parts.
-fn subdominant_left_vectors(s: &Mat<f64>) -> Result<Vec<Vec<f64>>, LimitError> {
+/// Real left eigenvectors of `s` other than the dominant one, grouped by the modulus of their
+/// eigenvalue, largest first (a complex pair gives its real and imaginary parts): the
+/// candidates for the tangent functionals.
+fn left_vectors_by_modulus(s: &Mat<f64>) -> Result<Vec<Vec<Vec<f64>>>, LimitError> {
     let m = s.nrows();
     let st = Mat::<f64>::from_fn(m, m, |i, j| s[(j, i)]);
     let evd = st
@@ -157,9 +157,6 @@ fn subdominant_left_vectors(s: &Mat<f64>) -> Result<Vec<Vec<f64>>, LimitError> {
         .filter(|&k| (vals[k] - c64::new(1.0, 0.0)).norm() > 1e-9)
         .collect();
     rest.sort_by(|&a, &b| vals[b].norm().total_cmp(&vals[a].norm()));
-    // Everything down to the second largest modulus: a double (or complex) subdominant
-    // eigenvalue, two distinct ones (darts), or a shared modulus (valence 2).
-    let top = rest.get(1).map_or(0.0, |&k| vals[k].norm());
     let col = |k: usize, imag: bool| -> Vec<f64> {
         (0..m)
             .map(|i| {
@@ -168,16 +165,19 @@ fn subdominant_left_vectors(s: &Mat<f64>) -> Result<Vec<Vec<f64>>, LimitError> {
             })
             .collect()
     };
-    let mut out = Vec::new();
+    let mut groups: Vec<(f64, Vec<Vec<f64>>)> = Vec::new();
     for &k in &rest {
-        if vals[k].norm() >= top * (1.0 - 1e-9) {
-            out.push(col(k, false));
-            if vals[k].im.abs() > 1e-12 {
-                out.push(col(k, true));
-            }
+        let r = vals[k].norm();
+        if groups.last().is_none_or(|g| r < g.0 * (1.0 - 1e-9)) {
+            groups.push((r, Vec::new()));
+        }
+        let g = &mut groups.last_mut().expect("just pushed").1;
+        g.push(col(k, false));
+        if vals[k].im.abs() > 1e-12 {
+            g.push(col(k, true));
         }
     }
-    Ok(out)
+    Ok(groups.into_iter().map(|g| g.1).collect())
 }
 
 /// A planar embedding of the ring (the spoke ends on the unit circle, the diagonal vertices
@@ -214,26 +214,36 @@ pub fn ring_limit_mask(
 ) -> Result<LimitMask, LimitError> {
     let s = ring_matrix(scheme, n, feature)?;
     let pos = dominant_left_eigenvector(&s)?;
-    let candidates = subdominant_left_vectors(&s)?;
+    let groups = left_vectors_by_modulus(&s)?;
     let plane = planar_ring(scheme, n);
     let apply = |w: &[f64]| {
         w.iter().zip(&plane).fold([0.0, 0.0], |acc, (wi, p)| {
             [acc[0] + wi * p[0], acc[1] + wi * p[1]]
         })
     };
-    // Of the subdominant eigenvectors, the pair that spans the plane best (with a double
-    // eigenvalue any two do; at valence 2 the modulus is shared by a symmetric vector that
-    // does not move the centre in the plane, which this leaves out).
-    let responses: Vec<[f64; 2]> = candidates.iter().map(|c| apply(c)).collect();
+    // The tangent functionals: the eigenvectors of the largest moduli after 1 that span the
+    // plane. A double subdominant eigenvalue (smooth) or two distinct ones (darts) give them
+    // at once; at valence 2 the subdominant modulus is shared with a symmetric vector that
+    // does not move the centre in the plane, and at a valence-2 dart the two largest both
+    // move it along the crease, so smaller moduli are taken in until a pair spans the plane.
+    let mut candidates: Vec<Vec<f64>> = Vec::new();
     let mut best = (0.0f64, 0, 0);
-    for i in 0..candidates.len() {
-        for j in i + 1..candidates.len() {
-            let (p, q) = (responses[i], responses[j]);
-            // Eigenvectors come normalised, so the raw determinant compares fairly.
-            let det = (p[0] * q[1] - p[1] * q[0]).abs();
-            if det > best.0 {
-                best = (det, i, j);
+    let mut responses: Vec<[f64; 2]> = Vec::new();
+    for g in groups {
+        candidates.extend(g);
+        responses = candidates.iter().map(|c| apply(c)).collect();
+        for i in 0..candidates.len() {
+            for j in i + 1..candidates.len() {
+                let (p, q) = (responses[i], responses[j]);
+                // Eigenvectors come normalised, so the raw determinant compares fairly.
+                let det = (p[0] * q[1] - p[1] * q[0]).abs();
+                if det > best.0 {
+                    best = (det, i, j);
+                }
             }
+        }
+        if best.0 >= 1e-9 {
+            break;
         }
     }
     if best.0 < 1e-9 {

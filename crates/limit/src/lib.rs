@@ -45,7 +45,7 @@ use subd_schemes::{Options, RefineError, Refinement, Scheme, StencilTable};
 use thiserror::Error;
 
 pub use masks::{LimitMask, RingMask};
-pub use table::{LimitPoints, LimitStencilTable};
+pub use table::{LimitPoints, LimitStencilTable, eigen_limit_vertices};
 
 /// What can go wrong computing limits.
 #[derive(Debug, Error)]

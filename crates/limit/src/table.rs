@@ -103,6 +103,22 @@ fn classify(t: &Topology, v: usize, rule: Rule, scheme: Scheme) -> VertexCase {
     }
 }
 
+/// Vertices of `level` whose limit comes from the eigen analysis rather than a closed form:
+/// interior Catmull-Clark vertices of valence 2 and darts on infinitely sharp edges — the
+/// vertices where OpenSubdiv's `PrimvarRefiner::Limit` is not the limit (see OPENSUBDIV.md).
+pub fn eigen_limit_vertices(refinement: &Refinement, level: usize) -> Vec<usize> {
+    let t = refinement.topology(level);
+    let rules = refinement.vertex_rules(level);
+    (0..t.num_vertices())
+        .filter(|&v| {
+            matches!(
+                classify(t, v, rules[v], refinement.scheme()),
+                VertexCase::Numeric(..)
+            )
+        })
+        .collect()
+}
+
 /// `m` with its ring rotated so that entry `i` moves to `i + k`.
 fn rotated(m: &RingMask, k: usize) -> RingMask {
     let rot = |w: &[f64]| -> Vec<f64> {
