@@ -14,6 +14,7 @@
 //! ```
 
 mod info;
+mod limit;
 mod refine;
 
 use std::ffi::OsString;
@@ -45,6 +46,9 @@ enum Command {
     Info(info::InfoArgs),
     /// Uniform refinement with Catmull-Clark, Loop or Bilinear, agreeing with OpenSubdiv.
     Refine(refine::RefineArgs),
+    /// Limit position (and normal) of every vertex, exact: semi-sharp creases are refined
+    /// until they decay, darts and valence-2 vertices use the eigen analysis.
+    Limit(limit::LimitArgs),
 }
 
 /// A command's failure: exit code and one-line message.
@@ -110,6 +114,7 @@ where
     let result = match cli.command {
         Command::Info(a) => info::run(&a, out, err),
         Command::Refine(a) => refine::run(&a, out, err),
+        Command::Limit(a) => limit::run(&a, out, err),
     };
     match result {
         Ok(()) => EXIT_OK,

@@ -39,14 +39,9 @@ pub(crate) enum TriangleArg {
     Smooth,
 }
 
+/// The rule options a command shares: defaults from the file's tags, overridden here.
 #[derive(Debug, Args)]
-pub(crate) struct RefineArgs {
-    /// Subdivision scheme.
-    #[arg(long, value_enum)]
-    scheme: SchemeArg,
-    /// Number of uniform refinement levels (0 to 15).
-    #[arg(long)]
-    levels: usize,
+pub(crate) struct RuleArgs {
     /// Boundary interpolation (default: the file's `t interpolateboundary` tag, else
     /// edge-only).
     #[arg(long, value_enum)]
@@ -61,7 +56,63 @@ pub(crate) struct RefineArgs {
     triangles: Option<TriangleArg>,
     /// Accept faces whose windings disagree across a shared edge (treated as non-manifold).
     #[arg(long)]
-    accept_inconsistent_orientation: bool,
+    pub(crate) accept_inconsistent_orientation: bool,
+}
+
+impl RuleArgs {
+    /// The options for `hints` (a file's tags) with this command line's overrides.
+    pub(crate) fn options(&self, hints: &SchemeHints) -> Options {
+        let mut options = Options::from_hints(hints);
+        if let Some(b) = self.boundary {
+            options.boundary_interpolation = match b {
+                BoundaryArg::None => BoundaryInterpolation::None,
+                BoundaryArg::EdgeOnly => BoundaryInterpolation::EdgeOnly,
+                BoundaryArg::EdgeAndCorner => BoundaryInterpolation::EdgeAndCorner,
+            };
+        }
+        if let Some(c) = self.crease_method {
+            options.crease_method = match c {
+                CreaseArg::Uniform => CreaseMethod::Uniform,
+                CreaseArg::Chaikin => CreaseMethod::Chaikin,
+            };
+        }
+        if let Some(t) = self.triangles {
+            options.triangle_subdivision = match t {
+                TriangleArg::Catmark => TriangleSubdivision::Catmark,
+                TriangleArg::Smooth => TriangleSubdivision::Smooth,
+            };
+        }
+        options
+    }
+
+    /// Reader options.
+    pub(crate) fn read_options(&self) -> subd_io::ReadOptions {
+        subd_io::ReadOptions {
+            accept_inconsistent_orientation: self.accept_inconsistent_orientation,
+        }
+    }
+}
+
+impl SchemeArg {
+    pub(crate) fn scheme(self) -> Scheme {
+        match self {
+            SchemeArg::CatmullClark => Scheme::CatmullClark,
+            SchemeArg::Loop => Scheme::Loop,
+            SchemeArg::Bilinear => Scheme::Bilinear,
+        }
+    }
+}
+
+#[derive(Debug, Args)]
+pub(crate) struct RefineArgs {
+    /// Subdivision scheme.
+    #[arg(long, value_enum)]
+    scheme: SchemeArg,
+    /// Number of uniform refinement levels (0 to 15).
+    #[arg(long)]
+    levels: usize,
+    #[command(flatten)]
+    rules: RuleArgs,
     /// Input mesh (.obj or .ply).
     input: PathBuf,
     /// Output mesh (.obj with tags, .ply or .glb).
@@ -102,7 +153,23 @@ struct RefineReport {
     warnings: Vec<String>,
 }
 
-fn bad(message: String) -> Failure {
+/// Refuses an output path that names the input file.
+pub(crate) fn refuse_overwrite(
+    input: &std::path::Path,
+    output: &std::path::Path,
+) -> Result<(), Failure> {
+    if let (Ok(a), Ok(b)) = (input.canonicalize(), output.canonicalize())
+        && a == b
+    {
+        return Err(bad(format!(
+            "{}: the output would overwrite the input",
+            output.display()
+        )));
+    }
+    Ok(())
+}
+
+pub(crate) fn bad(message: String) -> Failure {
     Failure {
         code: EXIT_BAD_INPUT,
         message,
@@ -136,52 +203,18 @@ pub(crate) fn run(
     err: &mut dyn Write,
 ) -> Result<(), Failure> {
     let t_start = Instant::now();
-    if let (Ok(a), Ok(b)) = (args.input.canonicalize(), args.output.canonicalize())
-        && a == b
-    {
-        return Err(bad(format!(
-            "{}: the output would overwrite the input",
-            args.output.display()
-        )));
-    }
+    refuse_overwrite(&args.input, &args.output)?;
     if subd_io::Format::from_path(&args.output).is_none() {
         return Err(bad(format!(
             "{}: unsupported output extension (expected .obj, .ply or .glb)",
             args.output.display()
         )));
     }
-    let read_opts = subd_io::ReadOptions {
-        accept_inconsistent_orientation: args.accept_inconsistent_orientation,
-    };
-    let file = subd_io::read_mesh(&args.input, &read_opts)?;
+    let file = subd_io::read_mesh(&args.input, &args.rules.read_options())?;
     print_warnings(err, &args.input, &file.warnings);
     let t_read = t_start.elapsed().as_secs_f64();
-
-    let scheme = match args.scheme {
-        SchemeArg::CatmullClark => Scheme::CatmullClark,
-        SchemeArg::Loop => Scheme::Loop,
-        SchemeArg::Bilinear => Scheme::Bilinear,
-    };
-    let mut options = Options::from_hints(&file.mesh.hints);
-    if let Some(b) = args.boundary {
-        options.boundary_interpolation = match b {
-            BoundaryArg::None => BoundaryInterpolation::None,
-            BoundaryArg::EdgeOnly => BoundaryInterpolation::EdgeOnly,
-            BoundaryArg::EdgeAndCorner => BoundaryInterpolation::EdgeAndCorner,
-        };
-    }
-    if let Some(c) = args.crease_method {
-        options.crease_method = match c {
-            CreaseArg::Uniform => CreaseMethod::Uniform,
-            CreaseArg::Chaikin => CreaseMethod::Chaikin,
-        };
-    }
-    if let Some(t) = args.triangles {
-        options.triangle_subdivision = match t {
-            TriangleArg::Catmark => TriangleSubdivision::Catmark,
-            TriangleArg::Smooth => TriangleSubdivision::Smooth,
-        };
-    }
+    let scheme = args.scheme.scheme();
+    let options = args.rules.options(&file.mesh.hints);
 
     let progress = Progress::new(args.levels, args.json);
     let t0 = Instant::now();
@@ -213,7 +246,7 @@ pub(crate) fn run(
             .mesh
             .hints
             .triangle_subdivision
-            .or(args.triangles.map(|_| options.triangle_subdivision)),
+            .or(args.rules.triangles.map(|_| options.triangle_subdivision)),
     };
     subd_io::write_mesh(&args.output, &mesh, &subd_io::WriteOptions::default())?;
     progress.finish();

@@ -151,3 +151,7 @@ pub fn base_limit(
     }
     Ok(t)
 }
+
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;
