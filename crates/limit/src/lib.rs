@@ -37,6 +37,8 @@
 
 pub mod eigen;
 pub mod masks;
+pub mod patch;
+pub mod stam;
 mod table;
 
 use subd_mesh::Topology;

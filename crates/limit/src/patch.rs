@@ -1,0 +1,240 @@
+//! Control points of one Catmull-Clark face's limit patch, and the bicubic B-spline.
+//!
+//! **Corner patch.** For a quad face `f` seen from its corner `c` (the corner at local
+//! parameter (0, 0), `u` towards the next corner), when the other three corners are smooth
+//! interior vertices of valence 4 with quads around them and the corner vertex `x0` is a
+//! smooth interior vertex of valence `n` with quads around it, the limit surface over `f`
+//! depends on 2n + 8 control points, in this order (grid coordinates as in a 4 × 4
+//! B-spline patch whose face is the square (1,1)–(2,2)):
+//!
+//! * 0: `x0`, at (1, 1);
+//! * 1 + 2i: the far end of the i-th edge of `x0` counter-clockwise from the edge to `f`'s
+//!   next corner (e_0 at (2, 1), e_1 at (1, 2));
+//! * 2 + 2i: the vertex opposite `x0` in the face between edges i and i + 1 (f_0 at (2, 2));
+//! * 2n + 1 … 2n + 7: (3,0), (3,1), (3,2), (3,3), (2,3), (1,3), (0,3).
+//!
+//! This is Stam's 2n + 8 neighbourhood (Stam 1998, "Exact evaluation of Catmull-Clark
+//! subdivision surfaces at arbitrary parameter values", §3) in an order of our own. With
+//! n = 4 it is the regular 16-point patch, reordered by [`REGULAR_GRID`].
+
+use glam::DVec3;
+use subd_mesh::Topology;
+use subd_schemes::Rule;
+
+/// For n = 4: the corner-patch index of grid point (i, j) at `REGULAR_GRID[4 j + i]`.
+pub const REGULAR_GRID: [usize; 16] = [6, 7, 8, 9, 5, 0, 1, 10, 4, 3, 2, 11, 15, 14, 13, 12];
+
+/// Uniform cubic B-spline basis at `t` and its first two derivatives.
+#[inline]
+pub fn bspline_basis(t: f64) -> ([f64; 4], [f64; 4], [f64; 4]) {
+    let s = 1.0 - t;
+    let (t2, t3) = (t * t, t * t * t);
+    let b = [
+        s * s * s / 6.0,
+        (3.0 * t3 - 6.0 * t2 + 4.0) / 6.0,
+        (-3.0 * t3 + 3.0 * t2 + 3.0 * t + 1.0) / 6.0,
+        t3 / 6.0,
+    ];
+    let d = [
+        -0.5 * s * s,
+        1.5 * t2 - 2.0 * t,
+        -1.5 * t2 + t + 0.5,
+        0.5 * t2,
+    ];
+    let dd = [s, 3.0 * t - 2.0, -3.0 * t + 1.0, t];
+    (b, d, dd)
+}
+
+/// Position and derivatives of a surface point with respect to the face parameters.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SurfacePoint {
+    /// Position.
+    pub position: DVec3,
+    /// ∂/∂u.
+    pub du: DVec3,
+    /// ∂/∂v.
+    pub dv: DVec3,
+    /// ∂²/∂u².
+    pub duu: DVec3,
+    /// ∂²/∂u∂v.
+    pub duv: DVec3,
+    /// ∂²/∂v².
+    pub dvv: DVec3,
+}
+
+impl SurfacePoint {
+    /// Unit normal `normalize(du × dv)` (zero where the derivatives are parallel).
+    pub fn normal(&self) -> DVec3 {
+        self.du.cross(self.dv).normalize_or_zero()
+    }
+
+    /// The same point with derivatives scaled for a parameter map `u' = s u + …`,
+    /// `v' = s v + …` (first derivatives by `s`, second by `s²`).
+    pub(crate) fn scaled(mut self, s: f64) -> SurfacePoint {
+        self.du *= s;
+        self.dv *= s;
+        self.duu *= s * s;
+        self.duv *= s * s;
+        self.dvv *= s * s;
+        self
+    }
+}
+
+/// The 16 tensor-product weights (grid order `4 j + i`) of position and derivatives.
+pub(crate) fn bicubic_weights(u: f64, v: f64) -> [[f64; 16]; 6] {
+    let (bu, du, ddu) = bspline_basis(u);
+    let (bv, dv, ddv) = bspline_basis(v);
+    let mut w = [[0.0; 16]; 6];
+    for j in 0..4 {
+        for i in 0..4 {
+            let k = 4 * j + i;
+            w[0][k] = bu[i] * bv[j];
+            w[1][k] = du[i] * bv[j];
+            w[2][k] = bu[i] * dv[j];
+            w[3][k] = ddu[i] * bv[j];
+            w[4][k] = du[i] * dv[j];
+            w[5][k] = bu[i] * ddv[j];
+        }
+    }
+    w
+}
+
+/// The bicubic B-spline patch over grid control points `grid[4 j + i]` at (u, v).
+pub fn eval_bicubic(grid: &[DVec3; 16], u: f64, v: f64) -> SurfacePoint {
+    let w = bicubic_weights(u, v);
+    let sum = |k: usize| {
+        grid.iter()
+            .zip(&w[k])
+            .fold(DVec3::ZERO, |acc, (p, &x)| acc + x * *p)
+    };
+    SurfacePoint {
+        position: sum(0),
+        du: sum(1),
+        dv: sum(2),
+        duu: sum(3),
+        duv: sum(4),
+        dvv: sum(5),
+    }
+}
+
+/// The ring of `v` starting at face `f`: for each incident face in counter-clockwise order,
+/// (next vertex, opposite vertex, previous vertex) in that face. `None` unless every face
+/// around `v` is a quad, `v` is interior and manifold, and `f` is incident to it.
+fn quad_ring(t: &Topology, v: usize, f: usize) -> Option<Vec<[u32; 3]>> {
+    let faces = t.vertex_faces(v);
+    if t.is_boundary_vertex(v)
+        || t.is_non_manifold_vertex(v)
+        || faces.len() != t.vertex_edges(v).len()
+    {
+        return None;
+    }
+    let start = faces.iter().position(|&g| g as usize == f)?;
+    let local = t.vertex_face_local_indices(v);
+    let n = faces.len();
+    (0..n)
+        .map(|j| {
+            let i = (start + j) % n;
+            let fv = t.face_vertices(faces[i] as usize);
+            if fv.len() != 4 {
+                return None;
+            }
+            let c = local[i] as usize;
+            Some([fv[(c + 1) % 4], fv[(c + 2) % 4], fv[(c + 3) % 4]])
+        })
+        .collect()
+}
+
+/// The 2n + 8 control points of quad `f` seen from its corner `c` (see the module docs), or
+/// `None` when the neighbourhood is not of that form.
+pub fn corner_patch(t: &Topology, f: usize, c: usize) -> Option<Vec<u32>> {
+    let fv = t.face_vertices(f);
+    if fv.len() != 4 {
+        return None;
+    }
+    let x = |k: usize| fv[(c + k) % 4] as usize;
+    let r0 = quad_ring(t, x(0), f)?;
+    let n = r0.len();
+    let mut out = Vec::with_capacity(2 * n + 8);
+    out.push(x(0) as u32);
+    for r in &r0 {
+        out.push(r[0]);
+        out.push(r[1]);
+    }
+    let (r1, r2, r3) = (
+        quad_ring(t, x(1), f)?,
+        quad_ring(t, x(2), f)?,
+        quad_ring(t, x(3), f)?,
+    );
+    if r1.len() != 4 || r2.len() != 4 || r3.len() != 4 {
+        return None;
+    }
+    out.extend_from_slice(&[
+        r1[2][1], r1[3][0], r1[3][1], r2[2][1], r2[3][0], r2[3][1], r3[2][1],
+    ]);
+    Some(out)
+}
+
+/// `true` when nothing in the 1-ring of face `f` is sharp: every vertex of `f` has the smooth
+/// rule and no vertex sharpness, and no edge at those vertices is sharp, and no face around
+/// them is a hole.
+pub fn smooth_neighbourhood(t: &Topology, rules: &[Rule], f: usize) -> bool {
+    t.face_vertices(f).iter().all(|&v| {
+        let v = v as usize;
+        rules[v] == Rule::Smooth
+            && t.vertex_sharpness(v) == 0.0
+            && t.vertex_edges(v)
+                .iter()
+                .all(|&e| t.edge_sharpness(e as usize) == 0.0)
+            && t.vertex_faces(v).iter().all(|&g| !t.is_hole(g as usize))
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn basis_is_a_partition_of_unity_with_matching_derivatives() {
+        for k in 0..=10 {
+            let t = k as f64 / 10.0;
+            let (b, d, dd) = bspline_basis(t);
+            assert!((b.iter().sum::<f64>() - 1.0).abs() < 1e-15);
+            assert!(d.iter().sum::<f64>().abs() < 1e-15);
+            assert!(dd.iter().sum::<f64>().abs() < 1e-15);
+            // Linear precision: Σ B_i(t)·(i − 1) = t.
+            let x: f64 = b
+                .iter()
+                .enumerate()
+                .map(|(i, w)| w * (i as f64 - 1.0))
+                .sum();
+            assert!((x - t).abs() < 1e-15);
+            // Central differences of the basis match the derivatives.
+            let h = 1e-6;
+            let (bp, dp, _) = bspline_basis(t + h);
+            let (bm, dm, _) = bspline_basis(t - h);
+            for i in 0..4 {
+                assert!(((bp[i] - bm[i]) / (2.0 * h) - d[i]).abs() < 1e-8);
+                assert!(((dp[i] - dm[i]) / (2.0 * h) - dd[i]).abs() < 1e-8);
+            }
+        }
+    }
+
+    #[test]
+    fn regular_grid_is_a_permutation() {
+        let mut seen = [false; 16];
+        for &k in &REGULAR_GRID {
+            assert!(!seen[k]);
+            seen[k] = true;
+        }
+        // The face corners: (1,1) = x0, (2,1) = e0, (2,2) = f0, (1,2) = e1.
+        assert_eq!(
+            [
+                REGULAR_GRID[5],
+                REGULAR_GRID[6],
+                REGULAR_GRID[10],
+                REGULAR_GRID[9]
+            ],
+            [0, 1, 2, 3]
+        );
+    }
+}
