@@ -36,6 +36,7 @@
 //! ```
 
 pub mod eigen;
+pub mod eval;
 pub mod masks;
 pub mod patch;
 pub mod stam;
@@ -81,6 +82,17 @@ pub enum LimitError {
         levels: usize,
         /// The face-vertex budget.
         max: usize,
+    },
+    /// An evaluation point outside the mesh or the parameter square.
+    #[error("{0}")]
+    Param(String),
+    /// A face the exact evaluator does not cover yet.
+    #[error("face {face}: {reason}")]
+    Unsupported {
+        /// Base face.
+        face: usize,
+        /// Why.
+        reason: &'static str,
     },
     /// The eigen analysis failed (a degenerate local configuration).
     #[error("eigen analysis: {0}")]

@@ -72,11 +72,11 @@ fn synthetic_faces(n: usize) -> Vec<u32> {
 }
 
 impl CornerPatchMatrices {
-    /// Builds the matrices for valence `n ≥ 3` by refining the synthetic neighbourhood once.
+    /// Builds the matrices for valence `n ≥ 2` by refining the synthetic neighbourhood once.
     pub fn new(n: usize) -> Result<CornerPatchMatrices, LimitError> {
-        if n < 3 {
+        if n < 2 {
             return Err(LimitError::Analysis(format!(
-                "corner patches need valence ≥ 3, not {n}"
+                "corner patches need valence ≥ 2, not {n}"
             )));
         }
         let k = 2 * n + 8;

@@ -1,0 +1,326 @@
+//! Exact evaluation of the Catmull-Clark limit surface at any (face, u, v).
+//!
+//! **Parameterisation** (OpenSubdiv's, so values can be compared with its patch evaluation):
+//! a quad with vertices v0 v1 v2 v3 has `(0,0) = v0`, `(1,0) = v1`, `(1,1) = v2`,
+//! `(0,1) = v3`; a face with n ≠ 4 vertices is split into n sub-faces, sub-face k being the
+//! quad at corner k after one refinement step: `(0,0)` at vertex k, `(1,0)` at the midpoint
+//! of edge k → k+1, `(0,1)` at the midpoint of edge k−1 → k, `(1,1)` at the centroid.
+//! Derivatives are with respect to these (sub-)face parameters.
+//!
+//! **Method.** A face whose neighbourhood is regular is a bicubic B-spline patch; a face with
+//! one extraordinary corner (and smooth, regular other corners) is evaluated with Stam's
+//! eigenbasis ([`crate::stam`]). Any other face (several extraordinary corners, non-quads)
+//! is refined two levels, after which each of its pieces is one of these two; the value is
+//! exact either way (no end-cap approximation).
+//!
+//! **Not yet covered** (an error, [`LimitError::Unsupported`]): faces whose neighbourhood
+//! has a crease, corner, dart, boundary or hole, and the Loop scheme.
+
+use glam::DVec3;
+use subd_mesh::Topology;
+use subd_schemes::{Options, Refinement, Scheme};
+
+use crate::LimitError;
+use crate::masks;
+use crate::patch::{REGULAR_GRID, SurfacePoint, corner_patch, eval_bicubic, smooth_neighbourhood};
+use crate::stam::corner_patch_matrices;
+
+/// A place on the limit surface: base face, sub-face (for a Catmull-Clark face that is not a
+/// quad; 0 otherwise) and parameters in `[0, 1]²`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FaceParam {
+    /// Base face.
+    pub face: usize,
+    /// Sub-face of a non-quad face (its corner index); 0 for quads.
+    pub sub: usize,
+    /// First parameter.
+    pub u: f64,
+    /// Second parameter.
+    pub v: f64,
+}
+
+/// How one face (of the base level or of level 2) is evaluated.
+#[derive(Clone, Debug)]
+enum Piece {
+    /// Bicubic B-spline over 16 control points (grid order).
+    Regular([u32; 16]),
+    /// Stam evaluation with the extraordinary vertex at corner `corner` of the face.
+    Corner { corner: usize, cp: Vec<u32> },
+    /// Refined two levels (base faces only).
+    Refined,
+    /// Not covered, with the reason.
+    Unsupported(&'static str),
+}
+
+/// Why a face of a smooth neighbourhood might still not be a single piece.
+fn piece_of(t: &Topology, rules: &[subd_schemes::Rule], f: usize) -> Piece {
+    if t.is_hole(f) {
+        return Piece::Unsupported("the face is a hole");
+    }
+    if t.face_size(f) != 4 {
+        return Piece::Refined;
+    }
+    if !smooth_neighbourhood(t, rules, f) {
+        return Piece::Unsupported("a crease, corner, dart, boundary or hole touches the face");
+    }
+    let fv = t.face_vertices(f);
+    let irregular: Vec<usize> = (0..4)
+        .filter(|&c| t.vertex_faces(fv[c] as usize).len() != 4)
+        .collect();
+    match irregular.as_slice() {
+        [] => match corner_patch(t, f, 0) {
+            Some(cp) => Piece::Regular(REGULAR_GRID.map(|g| cp[g])),
+            None => Piece::Refined,
+        },
+        [c] => match corner_patch(t, f, *c) {
+            Some(cp) => Piece::Corner { corner: *c, cp },
+            None => Piece::Refined,
+        },
+        _ => Piece::Refined,
+    }
+}
+
+/// Exact limit-surface evaluator for one mesh topology (Catmull-Clark).
+///
+/// ```
+/// use subd_mesh::{DVec3, TopologyBuilder};
+/// use subd_schemes::{Options, Scheme};
+/// use subd_limit::eval::{FaceParam, LimitEvaluator};
+///
+/// // A cube: every face has four extraordinary (valence-3) corners.
+/// let faces = [0, 1, 3, 2, 2, 3, 5, 4, 4, 5, 7, 6, 6, 7, 1, 0, 1, 7, 5, 3, 6, 0, 2, 4];
+/// let topo = TopologyBuilder::new(8).build(&[4; 6], &faces).unwrap();
+/// let s = [(-1., -1., 1.), (1., -1., 1.), (-1., 1., 1.), (1., 1., 1.),
+///          (-1., 1., -1.), (1., 1., -1.), (-1., -1., -1.), (1., -1., -1.)];
+/// let p: Vec<DVec3> = s.iter().map(|&(x, y, z)| DVec3::new(x, y, z)).collect();
+/// let eval = LimitEvaluator::new(&topo, Scheme::CatmullClark, &Options::default()).unwrap();
+/// let points = eval.prepare(&p);
+/// // The centre of face 0 (z = 1): on the z axis, below the face, normal +z.
+/// let c = eval.evaluate(&points, FaceParam { face: 0, sub: 0, u: 0.5, v: 0.5 }).unwrap();
+/// assert!(c.position.x.abs() < 1e-15 && c.position.y.abs() < 1e-15);
+/// assert!(c.position.z > 0.5 && c.position.z < 1.0);
+/// assert!((c.normal() - DVec3::Z).length() < 1e-12);
+/// ```
+#[derive(Debug)]
+pub struct LimitEvaluator {
+    base: Topology,
+    base_pieces: Vec<Piece>,
+    /// Two levels of refinement, when some base face needs them.
+    refined: Option<Refinement>,
+    level2_pieces: Vec<Piece>,
+}
+
+/// Control points of every level the evaluator reads, for one set of base positions.
+#[derive(Clone, Debug)]
+pub struct PatchPoints {
+    base: Vec<DVec3>,
+    level2: Vec<DVec3>,
+}
+
+impl LimitEvaluator {
+    /// Prepares evaluation on `topology` (the rules of `options`; Catmull-Clark only).
+    pub fn new(topology: &Topology, scheme: Scheme, options: &Options) -> Result<Self, LimitError> {
+        match scheme {
+            Scheme::CatmullClark => {}
+            Scheme::Loop => {
+                return Err(LimitError::Unsupported {
+                    face: 0,
+                    reason: "exact evaluation of Loop surfaces is not implemented yet",
+                });
+            }
+            Scheme::Bilinear => return Err(LimitError::Scheme),
+        }
+        let r0 = Refinement::new(topology, scheme, options, 0)?;
+        let base = r0.topology(0).clone();
+        let rules0 = r0.vertex_rules(0);
+        let base_pieces: Vec<Piece> = (0..base.num_faces())
+            .map(|f| piece_of(&base, rules0, f))
+            .collect();
+        let (refined, level2_pieces) = if base_pieces.iter().any(|p| matches!(p, Piece::Refined)) {
+            let r = Refinement::new(topology, scheme, options, 2)?;
+            let t2 = r.topology(2);
+            let rules2 = r.vertex_rules(2);
+            let pieces = (0..t2.num_faces())
+                .map(|f| match piece_of(t2, rules2, f) {
+                    Piece::Refined => Piece::Unsupported("irregular after two levels"),
+                    p => p,
+                })
+                .collect();
+            (Some(r), pieces)
+        } else {
+            (None, Vec::new())
+        };
+        Ok(LimitEvaluator {
+            base,
+            base_pieces,
+            refined,
+            level2_pieces,
+        })
+    }
+
+    /// The control points for base positions `points` (one per base vertex).
+    ///
+    /// # Panics
+    /// If `points.len()` is not the number of base vertices.
+    pub fn prepare(&self, points: &[DVec3]) -> PatchPoints {
+        assert_eq!(
+            points.len(),
+            self.base.num_vertices(),
+            "one point per base vertex"
+        );
+        let level2 = match &self.refined {
+            Some(r) => r.refine_points(points).pop().expect("level 2"),
+            None => Vec::new(),
+        };
+        PatchPoints {
+            base: points.to_vec(),
+            level2,
+        }
+    }
+
+    /// Checks `at` against the topology: face and sub-face in range, parameters in [0, 1].
+    pub fn check(&self, at: &FaceParam) -> Result<(), LimitError> {
+        let nf = self.base.num_faces();
+        if at.face >= nf {
+            return Err(LimitError::Param(format!(
+                "face {} out of range (the mesh has {nf} faces)",
+                at.face
+            )));
+        }
+        let size = self.base.face_size(at.face);
+        let subs = if size == 4 { 1 } else { size };
+        if at.sub >= subs {
+            return Err(LimitError::Param(format!(
+                "sub-face {} out of range (face {} has {subs})",
+                at.sub, at.face
+            )));
+        }
+        if !(0.0..=1.0).contains(&at.u) || !(0.0..=1.0).contains(&at.v) {
+            return Err(LimitError::Param(format!(
+                "parameters ({}, {}) outside [0, 1]",
+                at.u, at.v
+            )));
+        }
+        Ok(())
+    }
+
+    /// The limit surface at `at`: position and first and second derivatives.
+    pub fn evaluate(
+        &self,
+        points: &PatchPoints,
+        at: FaceParam,
+    ) -> Result<SurfacePoint, LimitError> {
+        self.check(&at)?;
+        match &self.base_pieces[at.face] {
+            Piece::Refined => {
+                let r = self.refined.as_ref().expect("refined when a face needs it");
+                let off = self.base.face_offsets()[at.face] as usize;
+                // Level 1: a quad's child by quadrant, or a non-quad's sub-face.
+                let (c1, s, t, scale1) = if self.base.face_size(at.face) == 4 {
+                    let (j, s, t) = quadrant(at.u, at.v);
+                    (off + j, s, t, 2.0)
+                } else {
+                    (off + at.sub, at.u, at.v, 1.0)
+                };
+                // Level 2: every level-1 face is a quad with 4 consecutive children.
+                let (k, s2, t2) = quadrant(s, t);
+                let f2 = 4 * c1 + k;
+                debug_assert!(f2 < r.topology(2).num_faces());
+                let p = eval_piece(&self.level2_pieces[f2], &points.level2, at.face, s2, t2)?;
+                Ok(p.scaled(2.0 * scale1))
+            }
+            piece => eval_piece(piece, &points.base, at.face, at.u, at.v),
+        }
+    }
+}
+
+/// The child of a quad holding (u, v) and the parameters in it: child j has the parent's
+/// corner j at its corner j (OpenSubdiv's order), `(0,0)` at its first vertex.
+fn quadrant(u: f64, v: f64) -> (usize, f64, f64) {
+    match (u >= 0.5, v >= 0.5) {
+        (false, false) => (0, 2.0 * u, 2.0 * v),
+        (true, false) => (1, 2.0 * u - 1.0, 2.0 * v),
+        (true, true) => (2, 2.0 * u - 1.0, 2.0 * v - 1.0),
+        (false, true) => (3, 2.0 * u, 2.0 * v - 1.0),
+    }
+}
+
+/// Evaluates one piece at (s, t) in its face's parameters.
+fn eval_piece(
+    piece: &Piece,
+    pts: &[DVec3],
+    face: usize,
+    s: f64,
+    tp: f64,
+) -> Result<SurfacePoint, LimitError> {
+    match piece {
+        Piece::Regular(grid) => {
+            let g: [DVec3; 16] = std::array::from_fn(|i| pts[grid[i] as usize]);
+            Ok(eval_bicubic(&g, s, tp))
+        }
+        Piece::Corner { corner, cp } => {
+            let n = (cp.len() - 8) / 2;
+            let m = corner_patch_matrices(n)?;
+            let c: Vec<DVec3> = cp.iter().map(|&i| pts[i as usize]).collect();
+            // Corner frame (a, b): origin at the corner, a towards the next corner, b towards
+            // the previous one; J = ∂(a, b)/∂(s, t).
+            let (a, b, j) = match corner {
+                0 => (s, tp, [[1.0, 0.0], [0.0, 1.0]]),
+                1 => (tp, 1.0 - s, [[0.0, 1.0], [-1.0, 0.0]]),
+                2 => (1.0 - s, 1.0 - tp, [[-1.0, 0.0], [0.0, -1.0]]),
+                _ => (1.0 - tp, s, [[0.0, -1.0], [1.0, 0.0]]),
+            };
+            let q = if a == 0.0 && b == 0.0 {
+                at_extraordinary_vertex(&c, n)?
+            } else {
+                m.evaluate(&c, a, b)
+            };
+            Ok(pull_back(&q, j))
+        }
+        Piece::Refined => unreachable!("refined pieces are resolved by the caller"),
+        Piece::Unsupported(reason) => Err(LimitError::Unsupported { face, reason }),
+    }
+}
+
+/// At the extraordinary vertex itself the parametric derivatives are singular (they vanish
+/// or grow without bound with the valence); the position is the limit mask's and the first
+/// derivatives are the limit tangents (their directions are exact, their scale is the mask's
+/// convention), second derivatives zero.
+fn at_extraordinary_vertex(c: &[DVec3], n: usize) -> Result<SurfacePoint, LimitError> {
+    // Valence 2 has no closed form (OpenSubdiv's is not the limit): the eigen analysis.
+    let m = if n == 2 {
+        crate::eigen::ring_limit_mask(Scheme::CatmullClark, 2, crate::eigen::RingFeature::Smooth)?
+    } else {
+        masks::catmark_smooth(n)
+    };
+    let apply = |r: &masks::RingMask| {
+        let mut p = r.vertex * c[0];
+        for i in 0..n {
+            p += r.edges[i] * c[1 + 2 * i] + r.faces[i] * c[2 + 2 * i];
+        }
+        p
+    };
+    // tangent1 runs along edge 0 = the a axis; the b axis is edge 1 of the ring only when
+    // n = 4, so take the tangent towards edge 1 from the smooth tangent pair: for the normal
+    // only the plane and its orientation matter.
+    Ok(SurfacePoint {
+        position: apply(&m.position),
+        du: apply(&m.tangent1),
+        dv: apply(&m.tangent2),
+        ..SurfacePoint::default()
+    })
+}
+
+/// Derivatives with respect to (s, t) from those with respect to (a, b), `j = ∂(a,b)/∂(s,t)`
+/// (rows a, b; columns s, t).
+fn pull_back(q: &SurfacePoint, j: [[f64; 2]; 2]) -> SurfacePoint {
+    let (a_s, a_t, b_s, b_t) = (j[0][0], j[0][1], j[1][0], j[1][1]);
+    SurfacePoint {
+        position: q.position,
+        du: a_s * q.du + b_s * q.dv,
+        dv: a_t * q.du + b_t * q.dv,
+        duu: a_s * a_s * q.duu + 2.0 * a_s * b_s * q.duv + b_s * b_s * q.dvv,
+        duv: a_s * a_t * q.duu + (a_s * b_t + a_t * b_s) * q.duv + b_s * b_t * q.dvv,
+        dvv: a_t * a_t * q.duu + 2.0 * a_t * b_t * q.duv + b_t * b_t * q.dvv,
+    }
+}
