@@ -254,7 +254,7 @@ impl Eigenbasis {
                 err = err.max((rec - c64::new(a[(i, j)], 0.0)).norm());
             }
         }
-        if !(err < 1e-10) {
+        if err.is_nan() || err >= 1e-10 {
             return None;
         }
         let phi = std::array::from_fn(|q| {
