@@ -14,7 +14,14 @@
 // With --limit: PrimvarRefiner::Limit applied to level L instead: u32 nv, then f64 pos[3 nv],
 // f64 tan1[3 nv], f64 tan2[3 nv]; --limit-positions the same with zero tangents (for the
 // meshes where OpenSubdiv's tangent masks overflow their buffers and crash).
+// With --eval, the input continues with u32 count, {u32 ptex face, f64 u, f64 v}: the mesh is
+// refined adaptively to isolation level L (infinitely sharp patches on, legacy sharp corners
+// off, Gregory end caps) and the patch table evaluated in double precision at each point:
+// output per point f64 P[3], Du[3], Dv[3], Duu[3], Duv[3], Dvv[3].
 
+#include <opensubdiv/far/patchMap.h>
+#include <opensubdiv/far/patchTable.h>
+#include <opensubdiv/far/patchTableFactory.h>
 #include <opensubdiv/far/primvarRefiner.h>
 #include <opensubdiv/far/topologyDescriptor.h>
 #include <opensubdiv/far/topologyRefinerFactory.h>
@@ -206,6 +213,56 @@ int main(int argc, char **argv) {
             std::printf("{\"seconds\": %.9f, \"topology_seconds\": %.9f, \"primvar_seconds\": %.9f, "
                         "\"peak_rss_bytes\": %ld}\n",
                         median(total), median(topo), median(prim), peakRssBytes());
+            return 0;
+        }
+        if (argc > 1 && std::string(argv[1]) == "--eval") {
+            uint32_t count = r.get<uint32_t>();
+            std::vector<int> faces(count);
+            std::vector<double> us(count), vs(count);
+            for (uint32_t i = 0; i < count; ++i) {
+                faces[i] = (int)r.get<uint32_t>();
+                us[i] = r.get<double>();
+                vs[i] = r.get<double>();
+            }
+            Far::TopologyRefiner *refiner = createRefiner(m);
+            Far::PatchTableFactory::Options po(m.levels);
+            po.SetPatchPrecision<double>();
+            po.useInfSharpPatch = true;
+            po.generateLegacySharpCornerPatches = false;
+            po.generateVaryingTables = false;
+            po.endCapType = Far::PatchTableFactory::Options::ENDCAP_GREGORY_BASIS;
+            refiner->RefineAdaptive(po.GetRefineAdaptiveOptions());
+            Far::PatchTable const *table = Far::PatchTableFactory::Create(*refiner, po);
+            int nRefined = refiner->GetNumVerticesTotal();
+            int nLocal = table->GetNumLocalPoints();
+            std::vector<Point> verts(nRefined + nLocal);
+            std::copy(m.pos.begin(), m.pos.end(), verts.begin());
+            Far::PrimvarRefinerReal<double> primvar(*refiner);
+            Point *src = verts.data();
+            for (int l = 1; l < refiner->GetNumLevels(); ++l) {
+                Point *dst = src + refiner->GetLevel(l - 1).GetNumVertices();
+                primvar.Interpolate(l, src, dst);
+                src = dst;
+            }
+            if (nLocal) table->GetLocalPointStencilTable<double>()->UpdateValues(verts.data(), verts.data() + nRefined);
+            Far::PatchMap map(*table);
+            std::vector<unsigned char> out;
+            double w[6][20];
+            for (uint32_t i = 0; i < count; ++i) {
+                Far::PatchTable::PatchHandle const *h = map.FindPatch(faces[i], us[i], vs[i]);
+                if (!h) throw std::runtime_error("no patch at point " + std::to_string(i));
+                table->EvaluateBasis(*h, us[i], vs[i], w[0], w[1], w[2], w[3], w[4], w[5]);
+                Far::ConstIndexArray cvs = table->GetPatchVertices(*h);
+                for (int d = 0; d < 6; ++d) {
+                    Point acc;
+                    acc.Clear();
+                    for (int c = 0; c < cvs.size(); ++c) acc.AddWithWeight(verts[cvs[c]], w[d][c]);
+                    for (double x : acc.p) put<double>(out, x);
+                }
+            }
+            std::fwrite(out.data(), 1, out.size(), stdout);
+            delete table;
+            delete refiner;
             return 0;
         }
         Far::TopologyRefiner *refiner = createRefiner(m);

@@ -228,3 +228,35 @@ pub fn decode_limit(bytes: &[u8]) -> Result<OsdLimit, String> {
         tangent2: points(2),
     })
 }
+
+/// Appends evaluation points (ptex face, u, v) to an encoded mesh for `--eval`.
+pub fn encode_eval_points(mut input: Vec<u8>, points: &[(u32, f64, f64)]) -> Vec<u8> {
+    input.extend_from_slice(&(points.len() as u32).to_le_bytes());
+    for &(f, u, v) in points {
+        input.extend_from_slice(&f.to_le_bytes());
+        input.extend_from_slice(&u.to_le_bytes());
+        input.extend_from_slice(&v.to_le_bytes());
+    }
+    input
+}
+
+/// Decodes `--eval` output: per point position, Du, Dv, Duu, Duv, Dvv.
+pub fn decode_eval(bytes: &[u8], count: usize) -> Result<Vec<[DVec3; 6]>, String> {
+    if bytes.len() != count * 144 {
+        return Err(format!(
+            "harness returned {} bytes for {count} points",
+            bytes.len()
+        ));
+    }
+    Ok(bytes
+        .chunks_exact(144)
+        .map(|c| {
+            std::array::from_fn(|d| {
+                let f = |i: usize| {
+                    f64::from_le_bytes(c[24 * d + 8 * i..24 * d + 8 * i + 8].try_into().unwrap())
+                };
+                DVec3::new(f(0), f(1), f(2))
+            })
+        })
+        .collect())
+}
