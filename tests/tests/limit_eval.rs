@@ -158,3 +158,158 @@ fn dyadic_points_are_limits_of_refined_vertices() {
     }
     assert!(checked > 1000, "{checked}");
 }
+
+/// A closed quad mesh with extraordinary vertices of valence 3 and 5, two edges apart or
+/// more: a pentagonal prism refined twice (its base positions are the level-2 points).
+fn prism_level2() -> (Topology, Vec<DVec3>) {
+    let mut faces: Vec<Vec<u32>> = vec![(0..5).rev().collect(), (5..10).collect()];
+    for i in 0..5u32 {
+        let j = (i + 1) % 5;
+        faces.push(vec![i, j, 5 + j, 5 + i]);
+    }
+    let topo = subd_tests::build(10, &faces);
+    let pts: Vec<DVec3> = (0..10)
+        .map(|v| {
+            let a = std::f64::consts::TAU * (v % 5) as f64 / 5.0 + 0.1 * v as f64;
+            DVec3::new(
+                a.cos() * (1.0 + 0.1 * v as f64),
+                a.sin(),
+                if v < 5 { -0.6 } else { 0.7 },
+            )
+        })
+        .collect();
+    let r = Refinement::new(&topo, Scheme::CatmullClark, &Options::default(), 2).unwrap();
+    let p = r.refine_points(&pts).pop().unwrap();
+    (r.topology(2).clone(), p)
+}
+
+/// Near an extraordinary vertex of valence n the refined control point at parameter
+/// (2^-L, 0) and the exact surface point there differ by a distance that shrinks like λ^L,
+/// λ the subdominant eigenvalue (seed 001 §5): the measured ratio of successive errors is λ.
+#[test]
+fn refined_points_approach_the_exact_surface_at_the_subdominant_rate() {
+    let (topo, pts) = prism_level2();
+    let ev = LimitEvaluator::new(&topo, Scheme::CatmullClark, &Options::default()).unwrap();
+    let patch_points = ev.prepare(&pts);
+    let r = Refinement::new(&topo, Scheme::CatmullClark, &Options::default(), 9).unwrap();
+    let refined = r.refine_points(&pts);
+    let mut seen = std::collections::BTreeSet::new();
+    for f in 0..topo.num_faces() {
+        // The first extraordinary corner c of face f; the points run along edge c from it.
+        let Some(c) =
+            (0..4).find(|&c| topo.vertex_faces(topo.face_vertices(f)[c] as usize).len() != 4)
+        else {
+            continue;
+        };
+        let n = topo.vertex_faces(topo.face_vertices(f)[c] as usize).len();
+        if !seen.insert(n) {
+            continue;
+        }
+        let lambda = subd_limit::masks::catmark_subdominant(n);
+        let errors: Vec<f64> = (3..=9)
+            .map(|l| {
+                let a = 0.5f64.powi(l);
+                let (u, v) = [(a, 0.0), (1.0, a), (1.0 - a, 1.0), (0.0, 1.0 - a)][c];
+                let at = FaceParam {
+                    face: f,
+                    sub: 0,
+                    u,
+                    v,
+                };
+                let exact = ev.evaluate(&patch_points, at).unwrap().position;
+                (refined[l as usize][vertex_at(&r, l as usize, at)] - exact).length()
+            })
+            .collect();
+        let ratios: Vec<f64> = errors.windows(2).map(|w| w[1] / w[0]).collect();
+        eprintln!("valence {n}: λ = {lambda:.6}, errors L=3..9 {errors:.3e?}, ratios {ratios:.4?}");
+        for &q in &ratios[3..] {
+            assert!(
+                (q - lambda).abs() < 0.01,
+                "valence {n}: ratios {ratios:?}, λ = {lambda}"
+            );
+        }
+    }
+    assert_eq!(seen.into_iter().collect::<Vec<_>>(), vec![3, 5]);
+}
+
+/// Normals agree across every edge shared by two quads: the surface is tangent-plane
+/// continuous, including edges ending at extraordinary vertices.
+#[test]
+fn normals_are_continuous_across_faces() {
+    let mut worst = 0.0f64;
+    let mut checked = 0;
+    let (prism, prism_points) = prism_level2();
+    let mut cases: Vec<(String, Topology, Vec<DVec3>)> =
+        vec![("prism".into(), prism, prism_points)];
+    for (name, mesh, _, _) in smooth_shapes() {
+        // Faces glued back to back or folded over make surfaces that turn around along
+        // edges: no tangent plane there by construction.
+        let folded = name.contains("back2back") || name.contains("foldover");
+        if mesh.topology.num_faces() <= 2000 && !folded {
+            cases.push((name, mesh.topology, mesh.positions));
+        }
+    }
+    // Parameters of the point at fraction t along edge k of a quad (corner k to k+1).
+    let on_edge = |k: usize, t: f64| match k {
+        0 => (t, 0.0),
+        1 => (1.0, t),
+        2 => (1.0 - t, 1.0),
+        _ => (0.0, 1.0 - t),
+    };
+    for (name, topo, pts) in &cases {
+        let ev = LimitEvaluator::new(topo, Scheme::CatmullClark, &Options::default()).unwrap();
+        let pp = ev.prepare(pts);
+        for e in 0..topo.num_edges() {
+            let ef = topo.edge_faces(e);
+            if ef.len() != 2 || ef.iter().any(|&f| topo.face_size(f as usize) != 4) {
+                continue;
+            }
+            let local = topo.edge_face_local_indices(e);
+            let (f0, f1) = (ef[0] as usize, ef[1] as usize);
+            let (k0, k1) = (local[0] as usize, local[1] as usize);
+            for t in [1e-6, 0.125, 0.3, 0.5, 0.77, 1.0 - 1e-6] {
+                let (u0, v0) = on_edge(k0, t);
+                let (u1, v1) = on_edge(k1, 1.0 - t);
+                let a = ev
+                    .evaluate(
+                        &pp,
+                        FaceParam {
+                            face: f0,
+                            sub: 0,
+                            u: u0,
+                            v: v0,
+                        },
+                    )
+                    .unwrap();
+                let b = ev
+                    .evaluate(
+                        &pp,
+                        FaceParam {
+                            face: f1,
+                            sub: 0,
+                            u: u1,
+                            v: v1,
+                        },
+                    )
+                    .unwrap();
+                assert!(
+                    (a.position - b.position).length() < 1e-12,
+                    "{name} edge {e} t {t}"
+                );
+                // Round-off in derivatives grows like 1/δ at distance δ from a vertex: the
+                // jump is measured scaled by δ.
+                let (na, nb) = (a.normal(), b.normal());
+                // atan2 keeps full precision for tiny angles, where acos(1 − ε) does not.
+                let angle = na.cross(nb).length().atan2(na.dot(nb)) * t.min(1.0 - t);
+                assert!(
+                    angle < 1e-12,
+                    "{name} edge {e} t {t}: normals jump by {angle:e} rad · δ"
+                );
+                worst = worst.max(angle);
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked > 5000, "{checked}");
+    eprintln!("normal continuity: {checked} edge points, largest jump × distance {worst:e} rad");
+}
