@@ -221,7 +221,7 @@ fn refined_points_approach_the_exact_surface_at_the_subdominant_rate() {
             })
             .collect();
         let ratios: Vec<f64> = errors.windows(2).map(|w| w[1] / w[0]).collect();
-        eprintln!("valence {n}: λ = {lambda:.6}, errors L=3..9 {errors:.3e?}, ratios {ratios:.4?}");
+        eprintln!("valence {n}: λ = {lambda:.6}, errors L=3..9 {errors:?}, ratios {ratios:.4?}");
         for &q in &ratios[3..] {
             assert!(
                 (q - lambda).abs() < 0.01,
