@@ -13,6 +13,7 @@
 //! assert!(String::from_utf8(err).unwrap().starts_with("subd: no-such-file.obj: cannot read"));
 //! ```
 
+mod eval;
 mod info;
 mod limit;
 mod refine;
@@ -49,6 +50,9 @@ enum Command {
     /// Limit position (and normal) of every vertex, exact: semi-sharp creases are refined
     /// until they decay, darts and valence-2 vertices use the eigen analysis.
     Limit(limit::LimitArgs),
+    /// The exact limit surface (position and unit normal) at given (face, u, v) parameters,
+    /// in OpenSubdiv's parameterisation.
+    Eval(eval::EvalArgs),
 }
 
 /// A command's failure: exit code and one-line message.
@@ -115,6 +119,7 @@ where
         Command::Info(a) => info::run(&a, out, err),
         Command::Refine(a) => refine::run(&a, out, err),
         Command::Limit(a) => limit::run(&a, out, err),
+        Command::Eval(a) => eval::run(&a, out, err),
     };
     match result {
         Ok(()) => EXIT_OK,
