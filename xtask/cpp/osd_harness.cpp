@@ -215,7 +215,8 @@ int main(int argc, char **argv) {
                         median(total), median(topo), median(prim), peakRssBytes());
             return 0;
         }
-        if (argc > 1 && std::string(argv[1]) == "--eval") {
+        bool evalBench = argc > 1 && std::string(argv[1]) == "--eval-bench";
+        if (evalBench || (argc > 1 && std::string(argv[1]) == "--eval")) {
             uint32_t count = r.get<uint32_t>();
             std::vector<int> faces(count);
             std::vector<double> us(count), vs(count);
@@ -224,6 +225,7 @@ int main(int argc, char **argv) {
                 us[i] = r.get<double>();
                 vs[i] = r.get<double>();
             }
+            auto t0 = std::chrono::steady_clock::now();
             Far::TopologyRefiner *refiner = createRefiner(m);
             Far::PatchTableFactory::Options po(m.levels);
             po.SetPatchPrecision<double>();
@@ -248,6 +250,32 @@ int main(int argc, char **argv) {
             Far::PatchMap map(*table);
             std::vector<unsigned char> out;
             double w[6][20];
+            if (evalBench) {
+                // Setup (refinement, patch table, points, patch map) once; then the median of
+                // `repeats` passes over all points: find the patch, evaluate the basis with
+                // derivatives, combine the control points.
+                double setup = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+                std::vector<double> times;
+                double check = 0.0;
+                for (int rep = 0; rep < repeats; ++rep) {
+                    auto a = std::chrono::steady_clock::now();
+                    for (uint32_t i = 0; i < count; ++i) {
+                        Far::PatchTable::PatchHandle const *h = map.FindPatch(faces[i], us[i], vs[i]);
+                        table->EvaluateBasis(*h, us[i], vs[i], w[0], w[1], w[2], w[3], w[4], w[5]);
+                        Far::ConstIndexArray cvs = table->GetPatchVertices(*h);
+                        Point acc[6];
+                        for (auto &p : acc) p.Clear();
+                        for (int c = 0; c < cvs.size(); ++c)
+                            for (int d = 0; d < 6; ++d) acc[d].AddWithWeight(verts[cvs[c]], w[d][c]);
+                        check += acc[0].p[0] + acc[1].p[1];
+                    }
+                    times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - a).count());
+                }
+                std::sort(times.begin(), times.end());
+                std::printf("{\"setup_seconds\": %.9f, \"seconds\": %.9f, \"points\": %u, \"check\": %.6f}\n",
+                            setup, times[times.size() / 2], count, check);
+                return 0;
+            }
             for (uint32_t i = 0; i < count; ++i) {
                 Far::PatchTable::PatchHandle const *h = map.FindPatch(faces[i], us[i], vs[i]);
                 if (!h) throw std::runtime_error("no patch at point " + std::to_string(i));

@@ -253,3 +253,139 @@ pub fn run(levels: usize, repeats: usize, huge_pages: bool) -> Result<(), String
     }
     Ok(())
 }
+
+/// Points evaluated by the evaluation benchmark.
+pub const EVAL_POINTS: usize = 100_000;
+
+/// `count` pseudo-random (face, u, v) on a quad mesh with `faces` faces (a fixed LCG, so
+/// both processes draw the same points).
+pub fn eval_points(faces: usize, count: usize) -> Vec<(u32, f64, f64)> {
+    let mut x: u64 = 0x9E37_79B9_7F4A_7C15;
+    let mut next = || {
+        x = x
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (x >> 11) as f64 / (1u64 << 53) as f64
+    };
+    (0..count)
+        .map(|_| {
+            let f = ((next() * faces as f64) as usize).min(faces - 1) as u32;
+            (f, next(), next())
+        })
+        .collect()
+}
+
+/// The subd side of the evaluation benchmark, in its own process: setup (evaluator and
+/// control points) once, then the median over `repeats` of evaluating every point with
+/// derivatives on one thread; prints one JSON line.
+pub fn run_subd_eval(mesh: &Path, repeats: usize) -> Result<(), String> {
+    use subd_limit::eval::{FaceParam, LimitEvaluator};
+    let file =
+        subd_io::read_mesh(mesh, &subd_io::ReadOptions::default()).map_err(|e| e.to_string())?;
+    let (topo, pos) = (&file.mesh.topology, &file.mesh.positions);
+    let t0 = Instant::now();
+    let ev = LimitEvaluator::new(topo, Scheme::CatmullClark, &Options::default())
+        .map_err(|e| e.to_string())?;
+    let pts = ev.prepare(pos);
+    let setup = t0.elapsed().as_secs_f64();
+    let points = eval_points(topo.num_faces(), EVAL_POINTS);
+    let mut times = Vec::new();
+    let mut check = 0.0;
+    for _ in 0..repeats {
+        let t = Instant::now();
+        for &(face, u, v) in &points {
+            let at = FaceParam {
+                face: face as usize,
+                sub: 0,
+                u,
+                v,
+            };
+            let p = ev.evaluate(&pts, at).map_err(|e| e.to_string())?;
+            check += p.position.x + p.du.y;
+        }
+        times.push(t.elapsed().as_secs_f64());
+    }
+    println!(
+        "{{\"setup_seconds\": {setup:.9}, \"seconds\": {:.9}, \"points\": {}, \"check\": {check:.6}}}",
+        median(times),
+        points.len()
+    );
+    Ok(())
+}
+
+/// Evaluation throughput against OpenSubdiv's PatchTable + PatchMap on the quad bench mesh.
+pub fn run_eval(repeats: usize) -> Result<(), String> {
+    let exe = osd::build_harness()?;
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/xtask/bench");
+    std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
+    let me = std::env::current_exe().map_err(|e| e.to_string())?;
+    let mesh = quad_bench_mesh();
+    let path = dir.join("catmark.obj");
+    subd_io::write_mesh(&path, &mesh, &subd_io::WriteOptions::default())
+        .map_err(|e| e.to_string())?;
+    let points = eval_points(mesh.topology.num_faces(), EVAL_POINTS);
+    let input = osd::encode_eval_points(
+        osd::encode(
+            &mesh.topology,
+            &mesh.positions,
+            Scheme::CatmullClark,
+            &Options::default(),
+            10,
+        ),
+        &points,
+    );
+    let run = |cmd: &mut Command| -> Result<(f64, f64), String> {
+        let out = cmd.output().map_err(|e| e.to_string())?;
+        if !out.status.success() {
+            return Err(String::from_utf8_lossy(&out.stderr).to_string());
+        }
+        let line = String::from_utf8_lossy(&out.stdout).to_string();
+        Ok((
+            json_number(&line, "setup_seconds").ok_or("no setup time")?,
+            json_number(&line, "seconds").ok_or("no time")?,
+        ))
+    };
+    let input_path = dir.join("catmark_eval.bin");
+    std::fs::write(&input_path, &input).map_err(|e| e.to_string())?;
+    let (osd_setup, osd_eval) = run(Command::new(&exe)
+        .args(["--eval-bench", &repeats.to_string()])
+        .stdin(std::fs::File::open(&input_path).map_err(|e| e.to_string())?))?;
+    let (subd_setup, subd_eval) = run(Command::new(&me).args([
+        "bench-eval",
+        "--mesh",
+        path.to_str().unwrap(),
+        "--repeats",
+        &repeats.to_string(),
+    ]))?;
+    println!();
+    println!(
+        "Exact evaluation vs OpenSubdiv's PatchTable + PatchMap (isolation 10, Gregory end caps), {} random (face, u, v) with first and second derivatives, 1 thread, median of {repeats} passes",
+        points.len()
+    );
+    println!(
+        "{:<8} {:>8} {:>12} {:>12} {:>12} {:>12} {:>7} {:>12} {:>12}",
+        "scheme",
+        "faces",
+        "osd pts/s",
+        "subd pts/s",
+        "osd eval s",
+        "subd eval s",
+        "ratio",
+        "osd setup s",
+        "subd setup s"
+    );
+    let n = points.len() as f64;
+    println!(
+        "{:<8} {:>8} {:>12.0} {:>12.0} {:>12.4} {:>12.4} {:>7.2} {:>12.4} {:>12.4}",
+        "catmark",
+        mesh.topology.num_faces(),
+        n / osd_eval,
+        n / subd_eval,
+        osd_eval,
+        subd_eval,
+        subd_eval / osd_eval,
+        osd_setup,
+        subd_setup
+    );
+    Ok(())
+}

@@ -50,6 +50,17 @@ enum Task {
         /// both sides where the kernel allows THP on request.
         #[arg(long)]
         huge_pages: bool,
+        /// Only the evaluation benchmark.
+        #[arg(long)]
+        eval_only: bool,
+    },
+    /// (internal) The subd side of the evaluation benchmark, in its own process.
+    #[command(hide = true)]
+    BenchEval {
+        #[arg(long)]
+        mesh: std::path::PathBuf,
+        #[arg(long)]
+        repeats: usize,
     },
     /// (internal) One subd measurement for `bench`, in its own process.
     #[command(hide = true)]
@@ -155,8 +166,17 @@ fn main() -> ExitCode {
             levels,
             repeats,
             huge_pages,
+            eval_only,
         } => ensure_system_packages(OPENSUBDIV_PACKAGES)
-            .and_then(|_| bench::run(levels, repeats, huge_pages)),
+            .and_then(|_| {
+                if eval_only {
+                    Ok(())
+                } else {
+                    bench::run(levels, repeats, huge_pages)
+                }
+            })
+            .and_then(|_| bench::run_eval(repeats)),
+        Task::BenchEval { mesh, repeats } => bench::run_subd_eval(&mesh, repeats),
         Task::BenchRun {
             mesh,
             scheme,

@@ -23,7 +23,8 @@ use subd_schemes::{Options, Refinement, Scheme};
 use crate::LimitError;
 use crate::masks;
 use crate::patch::{REGULAR_GRID, SurfacePoint, corner_patch, eval_bicubic, smooth_neighbourhood};
-use crate::stam::corner_patch_matrices;
+use crate::stam::{CornerPatchMatrices, Projected, corner_patch_matrices};
+use std::sync::Arc;
 
 /// A place on the limit surface: base face, sub-face (for a Catmull-Clark face that is not a
 /// quad; 0 otherwise) and parameters in `[0, 1]²`.
@@ -45,38 +46,60 @@ enum Piece {
     /// Bicubic B-spline over 16 control points (grid order).
     Regular([u32; 16]),
     /// Stam evaluation with the extraordinary vertex at corner `corner` of the face.
-    Corner { corner: usize, cp: Vec<u32> },
+    Corner {
+        corner: usize,
+        cp: Vec<u32>,
+        matrices: Arc<CornerPatchMatrices>,
+    },
     /// Refined two levels (base faces only).
     Refined,
     /// Not covered, with the reason.
     Unsupported(&'static str),
 }
 
-/// Why a face of a smooth neighbourhood might still not be a single piece.
-fn piece_of(t: &Topology, rules: &[subd_schemes::Rule], f: usize) -> Piece {
+/// How face `f` of `t` is evaluated.
+fn piece_of(t: &Topology, rules: &[subd_schemes::Rule], f: usize) -> Result<Piece, LimitError> {
+    Ok(match piece_kind(t, rules, f) {
+        Ok(p) => p,
+        Err((corner, cp)) => Piece::Corner {
+            corner,
+            matrices: corner_patch_matrices((cp.len() - 8) / 2)?,
+            cp,
+        },
+    })
+}
+
+/// `Ok(piece)` for every kind but a corner patch, which is `Err((corner, control points))`.
+fn piece_kind(
+    t: &Topology,
+    rules: &[subd_schemes::Rule],
+    f: usize,
+) -> Result<Piece, (usize, Vec<u32>)> {
     if t.is_hole(f) {
-        return Piece::Unsupported("the face is a hole");
+        return Ok(Piece::Unsupported("the face is a hole"));
     }
     if t.face_size(f) != 4 {
-        return Piece::Refined;
+        return Ok(Piece::Refined);
     }
     if !smooth_neighbourhood(t, rules, f) {
-        return Piece::Unsupported("a crease, corner, dart, boundary or hole touches the face");
+        return Ok(Piece::Unsupported(
+            "a crease, corner, dart, boundary or hole touches the face",
+        ));
     }
     let fv = t.face_vertices(f);
     let irregular: Vec<usize> = (0..4)
         .filter(|&c| t.vertex_faces(fv[c] as usize).len() != 4)
         .collect();
     match irregular.as_slice() {
-        [] => match corner_patch(t, f, 0) {
+        [] => Ok(match corner_patch(t, f, 0) {
             Some(cp) => Piece::Regular(REGULAR_GRID.map(|g| cp[g])),
             None => Piece::Refined,
-        },
+        }),
         [c] => match corner_patch(t, f, *c) {
-            Some(cp) => Piece::Corner { corner: *c, cp },
-            None => Piece::Refined,
+            Some(cp) => Err((*c, cp)),
+            None => Ok(Piece::Refined),
         },
-        _ => Piece::Refined,
+        _ => Ok(Piece::Refined),
     }
 }
 
@@ -110,11 +133,28 @@ pub struct LimitEvaluator {
     level2_pieces: Vec<Piece>,
 }
 
-/// Control points of every level the evaluator reads, for one set of base positions.
+/// Control points of every level the evaluator reads, for one set of base positions, with
+/// the corner patches' points already projected on their eigenbases.
 #[derive(Clone, Debug)]
 pub struct PatchPoints {
     base: Vec<DVec3>,
     level2: Vec<DVec3>,
+    base_projected: Vec<Option<Projected>>,
+    level2_projected: Vec<Option<Projected>>,
+}
+
+/// Projected control points of every corner piece.
+fn project_all(pieces: &[Piece], pts: &[DVec3]) -> Vec<Option<Projected>> {
+    pieces
+        .iter()
+        .map(|p| match p {
+            Piece::Corner { cp, matrices, .. } => {
+                let c: Vec<DVec3> = cp.iter().map(|&i| pts[i as usize]).collect();
+                Some(matrices.project(&c))
+            }
+            _ => None,
+        })
+        .collect()
 }
 
 impl LimitEvaluator {
@@ -133,19 +173,21 @@ impl LimitEvaluator {
         let r0 = Refinement::new(topology, scheme, options, 0)?;
         let base = r0.topology(0).clone();
         let rules0 = r0.vertex_rules(0);
-        let base_pieces: Vec<Piece> = (0..base.num_faces())
+        let base_pieces = (0..base.num_faces())
             .map(|f| piece_of(&base, rules0, f))
-            .collect();
+            .collect::<Result<Vec<_>, _>>()?;
         let (refined, level2_pieces) = if base_pieces.iter().any(|p| matches!(p, Piece::Refined)) {
             let r = Refinement::new(topology, scheme, options, 2)?;
             let t2 = r.topology(2);
             let rules2 = r.vertex_rules(2);
             let pieces = (0..t2.num_faces())
-                .map(|f| match piece_of(t2, rules2, f) {
-                    Piece::Refined => Piece::Unsupported("irregular after two levels"),
-                    p => p,
+                .map(|f| {
+                    piece_of(t2, rules2, f).map(|p| match p {
+                        Piece::Refined => Piece::Unsupported("irregular after two levels"),
+                        p => p,
+                    })
                 })
-                .collect();
+                .collect::<Result<Vec<_>, _>>()?;
             (Some(r), pieces)
         } else {
             (None, Vec::new())
@@ -173,6 +215,8 @@ impl LimitEvaluator {
             None => Vec::new(),
         };
         PatchPoints {
+            base_projected: project_all(&self.base_pieces, points),
+            level2_projected: project_all(&self.level2_pieces, &level2),
             base: points.to_vec(),
             level2,
         }
@@ -226,10 +270,24 @@ impl LimitEvaluator {
                 let (k, s2, t2) = quadrant(s, t);
                 let f2 = 4 * c1 + k;
                 debug_assert!(f2 < r.topology(2).num_faces());
-                let p = eval_piece(&self.level2_pieces[f2], &points.level2, at.face, s2, t2)?;
+                let p = eval_piece(
+                    &self.level2_pieces[f2],
+                    &points.level2,
+                    points.level2_projected[f2].as_ref(),
+                    at.face,
+                    s2,
+                    t2,
+                )?;
                 Ok(p.scaled(2.0 * scale1))
             }
-            piece => eval_piece(piece, &points.base, at.face, at.u, at.v),
+            piece => eval_piece(
+                piece,
+                &points.base,
+                points.base_projected[at.face].as_ref(),
+                at.face,
+                at.u,
+                at.v,
+            ),
         }
     }
 }
@@ -249,6 +307,7 @@ fn quadrant(u: f64, v: f64) -> (usize, f64, f64) {
 fn eval_piece(
     piece: &Piece,
     pts: &[DVec3],
+    projected: Option<&Projected>,
     face: usize,
     s: f64,
     tp: f64,
@@ -258,10 +317,12 @@ fn eval_piece(
             let g: [DVec3; 16] = std::array::from_fn(|i| pts[grid[i] as usize]);
             Ok(eval_bicubic(&g, s, tp))
         }
-        Piece::Corner { corner, cp } => {
+        Piece::Corner {
+            corner,
+            cp,
+            matrices,
+        } => {
             let n = (cp.len() - 8) / 2;
-            let m = corner_patch_matrices(n)?;
-            let c: Vec<DVec3> = cp.iter().map(|&i| pts[i as usize]).collect();
             // Corner frame (a, b): origin at the corner, a towards the next corner, b towards
             // the previous one; J = ∂(a, b)/∂(s, t).
             let (a, b, j) = match corner {
@@ -271,9 +332,10 @@ fn eval_piece(
                 _ => (1.0 - tp, s, [[0.0, -1.0], [1.0, 0.0]]),
             };
             let q = if a == 0.0 && b == 0.0 {
+                let c: Vec<DVec3> = cp.iter().map(|&i| pts[i as usize]).collect();
                 at_extraordinary_vertex(&c, n)?
             } else {
-                m.evaluate(&c, a, b)
+                matrices.evaluate_projected(projected.expect("corner pieces are projected"), a, b)
             };
             Ok(pull_back(&q, j))
         }

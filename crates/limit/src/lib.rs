@@ -35,6 +35,7 @@
 //! assert!((limit.normals[5] - DVec3::Z).length() < 1e-15);
 //! ```
 
+pub mod acc;
 pub mod eigen;
 pub mod eval;
 pub mod masks;

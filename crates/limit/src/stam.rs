@@ -46,8 +46,8 @@ pub struct CornerPatchMatrices {
 struct Eigenbasis {
     /// Eigenvalues λ_i.
     values: Vec<c64>,
-    /// `Ā_k V`, 16 × K, per quarter.
-    phi: [Mat<c64>; 3],
+    /// `Ā_k V` per quarter: for each eigenvector i, its 16 B-spline control weights.
+    phi: [Vec<[c64; 16]>; 3],
     /// `V⁻¹`, K × K.
     v_inv: Mat<c64>,
 }
@@ -134,6 +134,40 @@ impl CornerPatchMatrices {
 
     /// [`Self::evaluate`] choosing the method: the eigenbasis or `A` applied `m − 1` times.
     pub fn evaluate_with(&self, cp: &[DVec3], s: f64, t: f64, eigen: bool) -> SurfacePoint {
+        self.evaluate_projected(&self.project_with(cp, eigen), s, t)
+    }
+
+    /// The control points prepared for evaluation: projected on the eigenbasis
+    /// (`ĉ = V⁻¹ C`) when there is one. Do this once per patch, then evaluate many points.
+    pub fn project(&self, cp: &[DVec3]) -> Projected {
+        self.project_with(cp, true)
+    }
+
+    fn project_with(&self, cp: &[DVec3], eigen: bool) -> Projected {
+        match (&self.eigen, eigen) {
+            (Some(e), true) => {
+                let k = cp.len();
+                let chat = (0..k)
+                    .map(|i| {
+                        cp.iter()
+                            .enumerate()
+                            .fold([c64::new(0.0, 0.0); 3], |mut acc, (j, p)| {
+                                let z = e.v_inv[(i, j)];
+                                acc[0] += z * p.x;
+                                acc[1] += z * p.y;
+                                acc[2] += z * p.z;
+                                acc
+                            })
+                    })
+                    .collect();
+                Projected::Eigen(chat)
+            }
+            _ => Projected::Points(cp.to_vec()),
+        }
+    }
+
+    /// [`Self::evaluate`] from [`Self::project`]ed control points.
+    pub fn evaluate_projected(&self, c: &Projected, s: f64, t: f64) -> SurfacePoint {
         debug_assert!(s > 0.0 || t > 0.0);
         // Steps m − 1 until max(s, t) · 2^(m−1) lies in [1/2, 1].
         let p = s.max(t);
@@ -156,44 +190,32 @@ impl CornerPatchMatrices {
         };
         let w = bicubic_weights(u, v);
         let mut out = [DVec3::ZERO; 6];
-        match (&self.eigen, eigen) {
-            (Some(e), true) => {
-                let k = cp.len();
-                // ĉ = V⁻¹ C (complex, per coordinate).
-                let mut chat = vec![[c64::new(0.0, 0.0); 3]; k];
-                for (i, ci) in chat.iter_mut().enumerate() {
-                    for (j, p) in cp.iter().enumerate() {
-                        let z = e.v_inv[(i, j)];
-                        ci[0] += z * p.x;
-                        ci[1] += z * p.y;
-                        ci[2] += z * p.z;
-                    }
-                }
-                let phi = &e.phi[quarter];
-                for (i, lam) in e.values.iter().enumerate() {
+        match c {
+            Projected::Eigen(chat) => {
+                let e = self
+                    .eigen
+                    .as_ref()
+                    .expect("eigen projections come from this eigenbasis");
+                let one = c64::new(1.0, 0.0);
+                for ((lam, phi), ch) in e.values.iter().zip(&e.phi[quarter]).zip(chat) {
                     let lp = lam.powi(steps);
                     // The eigenvalue-1 term is the constant (the limit point): derivatives
                     // of a constant are exactly zero, and leaving it out keeps derivatives
                     // near the vertex to full relative precision (its round-off would be
                     // scaled up by 2^m).
-                    let first = if *lam == c64::new(1.0, 0.0) {
-                        0..1
-                    } else {
-                        0..6
-                    };
-                    for (d, o) in out.iter_mut().enumerate().take(first.end).skip(first.start) {
-                        let mut b = c64::new(0.0, 0.0);
-                        for g in 0..16 {
-                            b += phi[(g, i)] * w[d][g];
-                        }
+                    let outputs = if *lam == one { 1 } else { 6 };
+                    for (o, wd) in out.iter_mut().zip(&w).take(outputs) {
+                        let b = phi
+                            .iter()
+                            .zip(wd)
+                            .fold(c64::new(0.0, 0.0), |acc, (f, &x)| acc + *f * x);
                         let f = lp * b;
-                        let c = &chat[i];
-                        *o += DVec3::new((f * c[0]).re, (f * c[1]).re, (f * c[2]).re);
+                        *o += DVec3::new((f * ch[0]).re, (f * ch[1]).re, (f * ch[2]).re);
                     }
                 }
             }
-            _ => {
-                let mut c = cp.to_vec();
+            Projected::Points(cp) => {
+                let mut c = cp.clone();
                 let mut next = vec![DVec3::ZERO; c.len()];
                 for _ in 0..steps {
                     for (i, o) in next.iter_mut().enumerate() {
@@ -220,6 +242,15 @@ impl CornerPatchMatrices {
         }
         .scaled(2.0 * scale)
     }
+}
+
+/// Control points of a corner patch prepared for evaluation ([`CornerPatchMatrices::project`]).
+#[derive(Clone, Debug)]
+pub enum Projected {
+    /// Coordinates in the eigenbasis, `ĉ = V⁻¹ C` (x, y, z).
+    Eigen(Vec<[c64; 3]>),
+    /// The control points themselves (no usable eigenbasis).
+    Points(Vec<DVec3>),
 }
 
 impl Eigenbasis {
@@ -267,11 +298,15 @@ impl Eigenbasis {
             return None;
         }
         let phi = std::array::from_fn(|q| {
-            Mat::<c64>::from_fn(16, k, |g, i| {
-                (0..k).fold(c64::new(0.0, 0.0), |acc, j| {
-                    acc + v[(j, i)] * abar[q][(g, j)]
+            (0..k)
+                .map(|i| {
+                    std::array::from_fn(|g| {
+                        (0..k).fold(c64::new(0.0, 0.0), |acc, j| {
+                            acc + v[(j, i)] * abar[q][(g, j)]
+                        })
+                    })
                 })
-            })
+                .collect()
         });
         Some(Eigenbasis { values, phi, v_inv })
     }
