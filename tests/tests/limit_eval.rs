@@ -313,3 +313,131 @@ fn normals_are_continuous_across_faces() {
     assert!(checked > 5000, "{checked}");
     eprintln!("normal continuity: {checked} edge points, largest jump × distance {worst:e} rad");
 }
+
+/// Loop shapes the evaluator covers entirely.
+fn smooth_loop_shapes() -> Vec<(String, subd_mesh::Mesh, Options, LimitEvaluator)> {
+    let opts = ReadOptions {
+        accept_inconsistent_orientation: true,
+    };
+    let mut out = Vec::new();
+    for path in osd_meshes() {
+        let name = path.file_stem().unwrap().to_string_lossy().to_string();
+        if !name.starts_with("loop_") {
+            continue;
+        }
+        let mesh = read_mesh(&path, &opts).unwrap().mesh;
+        let options = Options::from_hints(&mesh.hints);
+        let Ok(ev) = LimitEvaluator::new(&mesh.topology, Scheme::Loop, &options) else {
+            continue;
+        };
+        let pts = ev.prepare(&mesh.positions);
+        let covered = (0..mesh.topology.num_faces()).all(|f| {
+            ev.evaluate(
+                &pts,
+                FaceParam {
+                    face: f,
+                    sub: 0,
+                    u: 0.25,
+                    v: 0.25,
+                },
+            )
+            .is_ok()
+        });
+        if covered {
+            out.push((name, mesh, options, ev));
+        }
+    }
+    out
+}
+
+/// The level-`level` vertex at dyadic barycentric parameter `(u, v)` of a Loop base face.
+fn loop_vertex_at(r: &Refinement, level: usize, face: usize, u: f64, v: f64) -> usize {
+    let (mut f, mut u, mut v) = (face, u, v);
+    for _ in 0..level {
+        let (j, s, t) = if u >= 0.5 {
+            (1, 2.0 * u - 1.0, 2.0 * v)
+        } else if v >= 0.5 {
+            (2, 2.0 * u, 2.0 * v - 1.0)
+        } else if u + v < 0.5 {
+            (0, 2.0 * u, 2.0 * v)
+        } else {
+            (3, 1.0 - 2.0 * u, 1.0 - 2.0 * v)
+        };
+        f = 4 * f + j;
+        (u, v) = (s, t);
+    }
+    let corner = match (u, v) {
+        (0.0, 0.0) => 0,
+        (1.0, 0.0) => 1,
+        (0.0, 1.0) => 2,
+        _ => panic!("({u}, {v}) is not a corner at level {level}"),
+    };
+    r.topology(level).face_vertices(f)[corner] as usize
+}
+
+#[test]
+fn loop_dyadic_points_are_limits_of_refined_vertices() {
+    let shapes = smooth_loop_shapes();
+    assert!(
+        shapes.len() >= 4,
+        "only {} smooth Loop shapes",
+        shapes.len()
+    );
+    let level = 4;
+    let mut checked = 0;
+    for (name, mesh, options, ev) in &shapes {
+        if mesh.topology.num_face_vertices() > 5000 {
+            continue;
+        }
+        let pts = ev.prepare(&mesh.positions);
+        let r = Refinement::new(&mesh.topology, Scheme::Loop, options, level).unwrap();
+        let refined = r.refine_points(&mesh.positions);
+        let limit = LimitStencilTable::at_level(&r, level)
+            .unwrap()
+            .apply(&refined[level]);
+        let diag = {
+            let (lo, hi) = subd_mesh::bounding_box(mesh.positions.iter().copied()).unwrap();
+            (hi - lo).length()
+        };
+        let params = [
+            (0.0, 0.0),
+            (1.0, 0.0),
+            (0.0, 1.0),
+            (1.0 / 16.0, 0.0),
+            (0.0, 1.0 / 16.0),
+            (0.25, 0.25),
+            (0.5, 0.5),
+            (0.1875, 0.3125),
+            (0.0625, 0.0625),
+            (0.75, 0.125),
+            (0.5, 0.0),
+        ];
+        for f in 0..mesh.topology.num_faces() {
+            for &(u, v) in &params {
+                let p = ev
+                    .evaluate(
+                        &pts,
+                        FaceParam {
+                            face: f,
+                            sub: 0,
+                            u,
+                            v,
+                        },
+                    )
+                    .unwrap();
+                let vtx = loop_vertex_at(&r, level, f, u, v);
+                let d = (p.position - limit.positions[vtx]).length() / diag;
+                assert!(d < 1e-12, "{name} face {f} ({u}, {v}): {d:e}");
+                if limit.normals[vtx] != DVec3::ZERO && p.normal() != DVec3::ZERO {
+                    let dn = (p.normal() - limit.normals[vtx]).length();
+                    assert!(
+                        dn < 1e-9,
+                        "{name} face {f} ({u}, {v}): normal off by {dn:e}"
+                    );
+                }
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked > 500, "{checked}");
+}

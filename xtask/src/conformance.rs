@@ -154,8 +154,10 @@ pub fn compare(
             exe, name, topo, positions, scheme, options, diag,
         ));
     }
-    if scheme == Scheme::CatmullClark {
-        rows.push(compare_eval(exe, name, topo, positions, options, diag));
+    if scheme != Scheme::Bilinear {
+        rows.push(compare_eval(
+            exe, name, topo, positions, scheme, options, diag,
+        ));
     }
     rows
 }
@@ -193,6 +195,7 @@ fn compare_eval(
     name: &str,
     topo: &Topology,
     positions: &[DVec3],
+    scheme: Scheme,
     options: &Options,
     diag: f64,
 ) -> Row {
@@ -207,7 +210,7 @@ fn compare_eval(
         excluded: None,
         problem: None,
     };
-    let ev = match LimitEvaluator::new(topo, Scheme::CatmullClark, options) {
+    let ev = match LimitEvaluator::new(topo, scheme, options) {
         Ok(e) => e,
         Err(e) => {
             row.problem = Some(format!("subd: {e}"));
@@ -216,9 +219,10 @@ fn compare_eval(
     };
     let pts = ev.prepare(positions);
     let near = 1.0 / f64::from(1u32 << ISOLATION);
+    let regular_valence = if scheme == Scheme::Loop { 6 } else { 4 };
     let irregular = |v: u32| {
         let v = v as usize;
-        topo.vertex_faces(v).len() != 4 || topo.is_boundary_vertex(v)
+        topo.vertex_faces(v).len() != regular_valence || topo.is_boundary_vertex(v)
     };
     let mut ours = Vec::new();
     let mut queries = Vec::new();
@@ -228,10 +232,18 @@ fn compare_eval(
     for f in 0..topo.num_faces() {
         let fv = topo.face_vertices(f);
         let n = fv.len();
-        let subs = if n == 4 { 1 } else { n };
+        let loop_scheme = scheme == Scheme::Loop;
+        let subs = if n == 4 || loop_scheme { 1 } else { n };
         for sub in 0..subs {
             // The irregular corners of this ptex face, in its (u, v).
-            let corners: Vec<(f64, f64)> = if n == 4 {
+            let corners: Vec<(f64, f64)> = if loop_scheme {
+                [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)]
+                    .into_iter()
+                    .zip(fv)
+                    .filter(|&(_, &v)| irregular(v))
+                    .map(|(c, _)| c)
+                    .collect()
+            } else if n == 4 {
                 [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
                     .into_iter()
                     .zip(fv)
@@ -247,8 +259,18 @@ fn compare_eval(
                 c
             };
             // A sub-face is already one level down, so its end caps are twice as large.
-            let near = if n == 4 { near } else { 2.0 * near };
+            let near = if n == 4 || loop_scheme {
+                near
+            } else {
+                2.0 * near
+            };
             for &(u, v) in &EVAL_PARAMS {
+                // A Loop triangle's parameters are barycentric: fold the square onto it.
+                let (u, v) = if loop_scheme && u + v > 1.0 {
+                    (1.0 - v, 1.0 - u)
+                } else {
+                    (u, v)
+                };
                 match ev.evaluate(&pts, FaceParam { face: f, sub, u, v }) {
                     Ok(p) => {
                         ours.push(p);
@@ -277,7 +299,7 @@ fn compare_eval(
         return row;
     }
     let input = osd::encode_eval_points(
-        osd::encode(topo, positions, Scheme::CatmullClark, options, ISOLATION),
+        osd::encode(topo, positions, scheme, options, ISOLATION),
         &queries,
     );
     let theirs = match osd::run(exe, &input, &["--eval"])

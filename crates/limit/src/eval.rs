@@ -13,14 +13,19 @@
 //! is refined two levels, after which each of its pieces is one of these two; the value is
 //! exact either way (no end-cap approximation).
 //!
+//! Loop triangles (`(0,0) = v0`, `(1,0) = v1`, `(0,1) = v2`, barycentric
+//! `(1 − u − v, u, v)`) are quartic box-spline patches where regular and Stam's Loop
+//! eigenbasis at one extraordinary corner ([`crate::loop_patch`]).
+//!
 //! **Not yet covered** (an error, [`LimitError::Unsupported`]): faces whose neighbourhood
-//! has a crease, corner, dart, boundary or hole, and the Loop scheme.
+//! has a crease, corner, dart, boundary or hole.
 
 use glam::DVec3;
 use subd_mesh::Topology;
 use subd_schemes::{Options, Refinement, Scheme};
 
 use crate::LimitError;
+use crate::loop_patch::{LoopCornerMatrices, box_spline, loop_corner_matrices, tri_corner_patch};
 use crate::masks;
 use crate::patch::{REGULAR_GRID, SurfacePoint, corner_patch, eval_bicubic, smooth_neighbourhood};
 use crate::stam::{CornerPatchMatrices, Projected, corner_patch_matrices};
@@ -51,6 +56,14 @@ enum Piece {
         cp: Vec<u32>,
         matrices: Arc<CornerPatchMatrices>,
     },
+    /// Quartic box spline over 12 control points (Loop).
+    LoopRegular(Vec<u32>),
+    /// Loop eigenbasis evaluation, extraordinary vertex at corner `corner`.
+    LoopCorner {
+        corner: usize,
+        cp: Vec<u32>,
+        matrices: Arc<LoopCornerMatrices>,
+    },
     /// Refined two levels (base faces only).
     Refined,
     /// Not covered, with the reason.
@@ -58,7 +71,15 @@ enum Piece {
 }
 
 /// How face `f` of `t` is evaluated.
-fn piece_of(t: &Topology, rules: &[subd_schemes::Rule], f: usize) -> Result<Piece, LimitError> {
+fn piece_of(
+    t: &Topology,
+    rules: &[subd_schemes::Rule],
+    f: usize,
+    scheme: Scheme,
+) -> Result<Piece, LimitError> {
+    if scheme == Scheme::Loop {
+        return loop_piece(t, rules, f);
+    }
     Ok(match piece_kind(t, rules, f) {
         Ok(p) => p,
         Err((corner, cp)) => Piece::Corner {
@@ -66,6 +87,40 @@ fn piece_of(t: &Topology, rules: &[subd_schemes::Rule], f: usize) -> Result<Piec
             matrices: corner_patch_matrices((cp.len() - 8) / 2)?,
             cp,
         },
+    })
+}
+
+/// How Loop triangle `f` of `t` is evaluated.
+fn loop_piece(t: &Topology, rules: &[subd_schemes::Rule], f: usize) -> Result<Piece, LimitError> {
+    if t.is_hole(f) {
+        return Ok(Piece::Unsupported("the face is a hole"));
+    }
+    if !smooth_neighbourhood(t, rules, f) {
+        return Ok(Piece::Unsupported(
+            "a crease, corner, dart, boundary or hole touches the face",
+        ));
+    }
+    let fv = t.face_vertices(f);
+    let irregular: Vec<usize> = (0..3)
+        .filter(|&c| t.vertex_faces(fv[c] as usize).len() != 6)
+        .collect();
+    Ok(match irregular.as_slice() {
+        [] => match tri_corner_patch(t, f, 0) {
+            Some(cp) => Piece::LoopRegular(cp),
+            None => Piece::Refined,
+        },
+        [c] if t.vertex_faces(fv[*c] as usize).len() < 3 => {
+            Piece::Unsupported("interior Loop vertex of valence 2")
+        }
+        [c] => match tri_corner_patch(t, f, *c) {
+            Some(cp) => Piece::LoopCorner {
+                corner: *c,
+                matrices: loop_corner_matrices(cp.len() - 6)?,
+                cp,
+            },
+            None => Piece::Refined,
+        },
+        _ => Piece::Refined,
     })
 }
 
@@ -126,6 +181,7 @@ fn piece_kind(
 /// ```
 #[derive(Debug)]
 pub struct LimitEvaluator {
+    scheme: Scheme,
     base: Topology,
     base_pieces: Vec<Piece>,
     /// Two levels of refinement, when some base face needs them.
@@ -152,6 +208,10 @@ fn project_all(pieces: &[Piece], pts: &[DVec3]) -> Vec<Option<Projected>> {
                 let c: Vec<DVec3> = cp.iter().map(|&i| pts[i as usize]).collect();
                 Some(matrices.project(&c))
             }
+            Piece::LoopCorner { cp, matrices, .. } => {
+                let c: Vec<DVec3> = cp.iter().map(|&i| pts[i as usize]).collect();
+                Some(matrices.project(&c))
+            }
             _ => None,
         })
         .collect()
@@ -163,10 +223,7 @@ impl LimitEvaluator {
         match scheme {
             Scheme::CatmullClark => {}
             Scheme::Loop => {
-                return Err(LimitError::Unsupported {
-                    face: 0,
-                    reason: "exact evaluation of Loop surfaces is not implemented yet",
-                });
+                box_spline()?;
             }
             Scheme::Bilinear => return Err(LimitError::Scheme),
         }
@@ -174,7 +231,7 @@ impl LimitEvaluator {
         let base = r0.topology(0).clone();
         let rules0 = r0.vertex_rules(0);
         let base_pieces = (0..base.num_faces())
-            .map(|f| piece_of(&base, rules0, f))
+            .map(|f| piece_of(&base, rules0, f, scheme))
             .collect::<Result<Vec<_>, _>>()?;
         let (refined, level2_pieces) = if base_pieces.iter().any(|p| matches!(p, Piece::Refined)) {
             let r = Refinement::new(topology, scheme, options, 2)?;
@@ -182,7 +239,7 @@ impl LimitEvaluator {
             let rules2 = r.vertex_rules(2);
             let pieces = (0..t2.num_faces())
                 .map(|f| {
-                    piece_of(t2, rules2, f).map(|p| match p {
+                    piece_of(t2, rules2, f, scheme).map(|p| match p {
                         Piece::Refined => Piece::Unsupported("irregular after two levels"),
                         p => p,
                     })
@@ -193,6 +250,7 @@ impl LimitEvaluator {
             (None, Vec::new())
         };
         Ok(LimitEvaluator {
+            scheme,
             base,
             base_pieces,
             refined,
@@ -232,7 +290,11 @@ impl LimitEvaluator {
             )));
         }
         let size = self.base.face_size(at.face);
-        let subs = if size == 4 { 1 } else { size };
+        let subs = if size == 4 || self.scheme == Scheme::Loop {
+            1
+        } else {
+            size
+        };
         if at.sub >= subs {
             return Err(LimitError::Param(format!(
                 "sub-face {} out of range (face {} has {subs})",
@@ -242,6 +304,12 @@ impl LimitEvaluator {
         if !(0.0..=1.0).contains(&at.u) || !(0.0..=1.0).contains(&at.v) {
             return Err(LimitError::Param(format!(
                 "parameters ({}, {}) outside [0, 1]",
+                at.u, at.v
+            )));
+        }
+        if self.scheme == Scheme::Loop && at.u + at.v > 1.0 + 1e-12 {
+            return Err(LimitError::Param(format!(
+                "parameters ({}, {}) outside the triangle u + v ≤ 1",
                 at.u, at.v
             )));
         }
@@ -259,16 +327,23 @@ impl LimitEvaluator {
             Piece::Refined => {
                 let r = self.refined.as_ref().expect("refined when a face needs it");
                 let off = self.base.face_offsets()[at.face] as usize;
-                // Level 1: a quad's child by quadrant, or a non-quad's sub-face.
-                let (c1, s, t, scale1) = if self.base.face_size(at.face) == 4 {
-                    let (j, s, t) = quadrant(at.u, at.v);
-                    (off + j, s, t, 2.0)
+                let (f2, s2, t2, scale) = if self.scheme == Scheme::Loop {
+                    // Four children per triangle at each level.
+                    let (j, s, t, k1) = tri_child(at.u, at.v.min(1.0 - at.u));
+                    let (k, s2, t2, k2) = tri_child(s, t.min(1.0 - s));
+                    (4 * (4 * at.face + j) + k, s2, t2, k1 * k2)
                 } else {
-                    (off + at.sub, at.u, at.v, 1.0)
+                    // Level 1: a quad's child by quadrant, or a non-quad's sub-face; level 2:
+                    // every level-1 face is a quad with 4 consecutive children.
+                    let (c1, s, t, scale1) = if self.base.face_size(at.face) == 4 {
+                        let (j, s, t) = quadrant(at.u, at.v);
+                        (off + j, s, t, 2.0)
+                    } else {
+                        (off + at.sub, at.u, at.v, 1.0)
+                    };
+                    let (k, s2, t2) = quadrant(s, t);
+                    (4 * c1 + k, s2, t2, 2.0 * scale1)
                 };
-                // Level 2: every level-1 face is a quad with 4 consecutive children.
-                let (k, s2, t2) = quadrant(s, t);
-                let f2 = 4 * c1 + k;
                 debug_assert!(f2 < r.topology(2).num_faces());
                 let p = eval_piece(
                     &self.level2_pieces[f2],
@@ -278,7 +353,7 @@ impl LimitEvaluator {
                     s2,
                     t2,
                 )?;
-                Ok(p.scaled(2.0 * scale1))
+                Ok(p.scaled(scale))
             }
             piece => eval_piece(
                 piece,
@@ -300,6 +375,21 @@ fn quadrant(u: f64, v: f64) -> (usize, f64, f64) {
         (true, false) => (1, 2.0 * u - 1.0, 2.0 * v),
         (true, true) => (2, 2.0 * u - 1.0, 2.0 * v - 1.0),
         (false, true) => (3, 2.0 * u, 2.0 * v - 1.0),
+    }
+}
+
+/// The child of a Loop triangle holding (u, v), its parameters there, and the scale of the
+/// map (negative for the middle child, which is turned around): children
+/// `(V0,E0,E2)`, `(E0,V1,E1)`, `(E2,E1,V2)`, `(E1,E2,E0)` in OpenSubdiv's order.
+fn tri_child(u: f64, v: f64) -> (usize, f64, f64, f64) {
+    if u >= 0.5 {
+        (1, 2.0 * u - 1.0, 2.0 * v, 2.0)
+    } else if v >= 0.5 {
+        (2, 2.0 * u, 2.0 * v - 1.0, 2.0)
+    } else if u + v < 0.5 {
+        (0, 2.0 * u, 2.0 * v, 2.0)
+    } else {
+        (3, 1.0 - 2.0 * u, 1.0 - 2.0 * v, -2.0)
     }
 }
 
@@ -336,6 +426,47 @@ fn eval_piece(
                 at_extraordinary_vertex(&c, n)?
             } else {
                 matrices.evaluate_projected(projected.expect("corner pieces are projected"), a, b)
+            };
+            Ok(pull_back(&q, j))
+        }
+        Piece::LoopRegular(cp) => {
+            let c: Vec<DVec3> = cp.iter().map(|&i| pts[i as usize]).collect();
+            Ok(box_spline()?.evaluate(&c, s, tp))
+        }
+        Piece::LoopCorner {
+            corner,
+            cp,
+            matrices,
+        } => {
+            let n = cp.len() - 6;
+            // Corner frame: origin at the corner, a towards the next corner, b towards the
+            // one after; J = ∂(a, b)/∂(s, t).
+            let (a, b, j) = match corner {
+                0 => (s, tp, [[1.0, 0.0], [0.0, 1.0]]),
+                1 => (tp, 1.0 - s - tp, [[0.0, 1.0], [-1.0, -1.0]]),
+                _ => (1.0 - s - tp, s, [[-1.0, -1.0], [1.0, 0.0]]),
+            };
+            let q = if a <= 0.0 && b <= 0.0 {
+                let m = masks::loop_smooth(n);
+                let apply = |r: &masks::RingMask| {
+                    let mut p = r.vertex * pts[cp[0] as usize];
+                    for i in 0..n {
+                        p += r.edges[i] * pts[cp[1 + i] as usize];
+                    }
+                    p
+                };
+                SurfacePoint {
+                    position: apply(&m.position),
+                    du: apply(&m.tangent1),
+                    dv: apply(&m.tangent2),
+                    ..SurfacePoint::default()
+                }
+            } else {
+                matrices.evaluate(
+                    projected.expect("corner pieces are projected"),
+                    a.max(0.0),
+                    b.max(0.0),
+                )?
             };
             Ok(pull_back(&q, j))
         }

@@ -38,6 +38,7 @@
 pub mod acc;
 pub mod eigen;
 pub mod eval;
+pub mod loop_patch;
 pub mod masks;
 pub mod patch;
 pub mod stam;
