@@ -18,6 +18,9 @@
 //!
 //! Parameters: `(0,0) = x0`, `(1,0) = x1`, `(0,1) = x2`, barycentric `(1 − u − v, u, v)`.
 
+// Basis functions and derivatives index several parallel arrays.
+#![allow(clippy::needless_range_loop)]
+
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, OnceLock};
 
@@ -246,7 +249,15 @@ pub struct LoopCornerMatrices {
     a: Mat<f64>,
     /// Rows giving the regular control points of sub-triangles 1, 2, 3 (index − 1).
     abar: [Mat<f64>; 3],
-    eigen: Option<(Vec<c64>, [Vec<[c64; 12]>; 3], Mat<c64>)>,
+    eigen: Option<LoopEigenbasis>,
+}
+
+/// `A = V Λ V⁻¹`: eigenvalues, `Ā_k V` per sub-triangle (12 weights per eigenvector), `V⁻¹`.
+#[derive(Debug)]
+struct LoopEigenbasis {
+    values: Vec<c64>,
+    phi: [Vec<[c64; 12]>; 3],
+    v_inv: Mat<c64>,
 }
 
 impl LoopCornerMatrices {
@@ -311,8 +322,7 @@ impl LoopCornerMatrices {
             Ok(rows(&tri_corner_patch(child, j, 0).ok_or_else(bad)?))
         };
         let abar = [sub(1)?, sub(2)?, sub(3)?];
-        let basis = box_spline()?;
-        let eigen = loop_eigenbasis(&a, &abar, basis);
+        let eigen = loop_eigenbasis(&a, &abar);
         Ok(LoopCornerMatrices { a, abar, eigen })
     }
 
@@ -324,7 +334,7 @@ impl LoopCornerMatrices {
     /// Control points prepared for evaluation.
     pub fn project(&self, cp: &[DVec3]) -> Projected {
         match &self.eigen {
-            Some((_, _, v_inv)) => Projected::Eigen(
+            Some(LoopEigenbasis { v_inv, .. }) => Projected::Eigen(
                 (0..cp.len())
                     .map(|i| {
                         cp.iter()
@@ -375,7 +385,8 @@ impl LoopCornerMatrices {
         let mut out = [DVec3::ZERO; 6];
         match c {
             Projected::Eigen(chat) => {
-                let (values, phi, _) = self.eigen.as_ref().expect("projected on this eigenbasis");
+                let LoopEigenbasis { values, phi, .. } =
+                    self.eigen.as_ref().expect("projected on this eigenbasis");
                 let one = c64::new(1.0, 0.0);
                 for ((lam, ph), ch) in values.iter().zip(&phi[sub]).zip(chat) {
                     let lp = lam.powi(steps);
@@ -422,12 +433,7 @@ impl LoopCornerMatrices {
 }
 
 /// `A = V Λ V⁻¹` with `Ā_k V` pre-multiplied; `None` when it does not reproduce `A`.
-#[allow(clippy::type_complexity)]
-fn loop_eigenbasis(
-    a: &Mat<f64>,
-    abar: &[Mat<f64>; 3],
-    _basis: &BoxSpline,
-) -> Option<(Vec<c64>, [Vec<[c64; 12]>; 3], Mat<c64>)> {
+fn loop_eigenbasis(a: &Mat<f64>, abar: &[Mat<f64>; 3]) -> Option<LoopEigenbasis> {
     let k = a.nrows();
     let evd = a.eigen().ok()?;
     let one = c64::new(1.0, 0.0);
@@ -465,7 +471,7 @@ fn loop_eigenbasis(
             })
             .collect()
     });
-    Some((values, phi, v_inv))
+    Some(LoopEigenbasis { values, phi, v_inv })
 }
 
 /// Loop corner-patch matrices per valence, built on first use and shared.
