@@ -45,7 +45,12 @@ struct EvalReport {
 }
 
 /// Parses the parameter file into points, checking each against the mesh.
-fn read_points(path: &Path, ev: &LimitEvaluator, sizes: &[u32]) -> Result<Vec<FaceParam>, Failure> {
+fn read_points(
+    path: &Path,
+    ev: &LimitEvaluator,
+    sizes: &[u32],
+    catmark: bool,
+) -> Result<Vec<FaceParam>, Failure> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| bad(format!("{}: cannot read: {e}", path.display())))?;
     let mut out = Vec::new();
@@ -75,7 +80,7 @@ fn read_points(path: &Path, ev: &LimitEvaluator, sizes: &[u32]) -> Result<Vec<Fa
                 )));
             }
         };
-        if face < sizes.len() && sizes[face] != 4 && fields.len() == 3 {
+        if catmark && face < sizes.len() && sizes[face] != 4 && fields.len() == 3 {
             return Err(at_line(format!(
                 "face {face} has {} vertices: give its sub-face (`face sub u v`)",
                 sizes[face]
@@ -106,7 +111,7 @@ pub(crate) fn run(
     let ev = LimitEvaluator::new(topo, scheme, &options)
         .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
     let sizes: Vec<u32> = topo.face_sizes().collect();
-    let points = read_points(&args.at, &ev, &sizes)?;
+    let points = read_points(&args.at, &ev, &sizes, scheme == Scheme::CatmullClark)?;
     let patch_points = ev.prepare(&file.mesh.positions);
     let mut body = String::with_capacity(points.len() * 120);
     for (i, p) in points.iter().enumerate() {

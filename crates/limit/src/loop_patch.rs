@@ -512,4 +512,58 @@ mod tests {
             }
         }
     }
+
+    fn points(k: usize) -> Vec<DVec3> {
+        (0..k)
+            .map(|i| {
+                let x = i as f64;
+                DVec3::new((0.7 * x).sin(), (1.3 * x).cos(), 0.1 * x + (2.1 * x).sin())
+            })
+            .collect()
+    }
+
+    #[test]
+    fn eigenbasis_equals_repeated_subdivision_and_reaches_the_limit_mask() {
+        for n in [3, 4, 5, 7, 9, 12] {
+            let m = LoopCornerMatrices::new(n).unwrap();
+            // At valence 3 the matrix has a Jordan block (Stam 1998 notes it for Loop), so
+            // its eigenvectors do not reproduce it and evaluation subdivides instead.
+            assert_eq!(m.uses_eigenbasis(), n != 3, "valence {n}");
+            let cp = points(n + 6);
+            let eig = m.project(&cp);
+            let pts = Projected::Points(cp.clone());
+            for &(u, v) in &[(0.6, 0.2), (0.1, 0.3), (0.01, 0.004), (3e-5, 1e-5)] {
+                let a = m.evaluate(&eig, u, v).unwrap();
+                let b = m.evaluate(&pts, u, v).unwrap();
+                assert!(
+                    (a.position - b.position).length() < 1e-12,
+                    "n={n} ({u},{v})"
+                );
+                assert!(
+                    (a.du - b.du).length() < 1e-9 * (1.0 + b.du.length()) / (u + v),
+                    "n={n}"
+                );
+            }
+            let mask = crate::masks::loop_smooth(n).position;
+            let mut limit = mask.vertex * cp[0];
+            for i in 0..n {
+                limit += mask.edges[i] * cp[1 + i];
+            }
+            let near = m.evaluate(&eig, 1e-100, 1e-100).unwrap().position;
+            assert!((near - limit).length() < 1e-13, "n={n}: {near} vs {limit}");
+        }
+    }
+
+    #[test]
+    fn valence_six_corner_patch_is_the_box_spline() {
+        let m = LoopCornerMatrices::new(6).unwrap();
+        let cp = points(12);
+        let b = box_spline().unwrap();
+        for &(u, v) in &[(0.3, 0.2), (0.05, 0.01), (0.5, 0.5), (0.9, 0.05)] {
+            let a = m.evaluate(&m.project(&cp), u, v).unwrap();
+            let e = b.evaluate(&cp, u, v);
+            assert!((a.position - e.position).length() < 1e-12, "({u},{v})");
+            assert!((a.du - e.du).length() < 1e-9, "({u},{v})");
+        }
+    }
 }
