@@ -623,3 +623,47 @@ fn eval_writes_points_and_names_bad_lines() {
         assert!(!out2.exists());
     }
 }
+
+#[test]
+fn eval_loop_points_are_barycentric() {
+    let s = Scratch::new("evalloop");
+    let mesh = meshes().join("loop_cube.obj");
+    let at = s.file("at.txt", b"0 0.25 0.25\n1 1 0\n");
+    let out = s.0.join("out.txt");
+    let (code, _, err) = subd(&[
+        "eval",
+        "--scheme",
+        "loop",
+        mesh.to_str().unwrap(),
+        "--at",
+        at.to_str().unwrap(),
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let rows: Vec<Vec<f64>> = std::fs::read_to_string(&out)
+        .unwrap()
+        .lines()
+        .map(|l| l.split_whitespace().map(|x| x.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 2);
+    for r in &rows {
+        let n = (r[3] * r[3] + r[4] * r[4] + r[5] * r[5]).sqrt();
+        assert!((n - 1.0).abs() < 1e-12, "{r:?}");
+    }
+    // Outside the triangle is refused with the line.
+    let bad = s.file("bad.txt", b"0 0.75 0.5\n");
+    let (code, _, err) = subd(&[
+        "eval",
+        "--scheme",
+        "loop",
+        mesh.to_str().unwrap(),
+        "--at",
+        bad.to_str().unwrap(),
+        s.0.join("x.txt").to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2);
+    assert!(
+        err.contains("bad.txt:1: parameters (0.75, 0.5) outside the triangle"),
+        "{err}"
+    );
+}

@@ -11,6 +11,9 @@
 //! * [`LimitStencilTable`]: limit positions, tangents and normals of every vertex of a
 //!   refinement level as stencil tables; [`base_limit`] gives the exact limit of every base
 //!   vertex, refining first as far as semi-sharp creases need to decay.
+//! * [`eval`]: exact evaluation at any (face, u, v) with derivatives — bicubic B-splines and
+//!   [`stam`]'s eigenbasis for Catmull-Clark, box splines and [`loop_patch`] for Loop.
+//! * [`acc`]: Loop & Schaefer's bicubic approximation (geometry and tangent patches).
 //!
 //! ```
 //! use subd_mesh::{DVec3, TopologyBuilder};
