@@ -235,16 +235,25 @@ impl LimitEvaluator {
             .collect::<Result<Vec<_>, _>>()?;
         let (refined, level2_pieces) = if base_pieces.iter().any(|p| matches!(p, Piece::Refined)) {
             let r = Refinement::new(topology, scheme, options, 2)?;
+            let t1 = r.topology(1);
             let t2 = r.topology(2);
             let rules2 = r.vertex_rules(2);
-            let pieces = (0..t2.num_faces())
-                .map(|f| {
-                    piece_of(t2, rules2, f, scheme).map(|p| match p {
-                        Piece::Refined => Piece::Unsupported("irregular after two levels"),
-                        p => p,
-                    })
-                })
-                .collect::<Result<Vec<_>, _>>()?;
+            // Only the level-2 descendants of the faces that need them are classified.
+            let mut pieces = vec![Piece::Unsupported("not a refined face"); t2.num_faces()];
+            for f in (0..base.num_faces()).filter(|&f| matches!(base_pieces[f], Piece::Refined)) {
+                let children = base.face_offsets()[f] as usize..base.face_offsets()[f + 1] as usize;
+                let children = if scheme == Scheme::Loop { 4 * f..4 * f + 4 } else { children };
+                for c in children {
+                    let grand = t1.face_offsets()[c] as usize..t1.face_offsets()[c + 1] as usize;
+                    let grand = if scheme == Scheme::Loop { 4 * c..4 * c + 4 } else { grand };
+                    for g in grand {
+                        pieces[g] = match piece_of(t2, rules2, g, scheme)? {
+                            Piece::Refined => Piece::Unsupported("irregular after two levels"),
+                            p => p,
+                        };
+                    }
+                }
+            }
             (Some(r), pieces)
         } else {
             (None, Vec::new())
