@@ -50,6 +50,26 @@ fn smooth_shapes() -> Vec<(String, subd_mesh::Mesh, Options, LimitEvaluator)> {
     out
 }
 
+/// Catmull-Clark shapes the evaluator can be built for (some faces may not be covered).
+fn covered_shapes() -> Vec<(String, subd_mesh::Mesh, Options, LimitEvaluator)> {
+    let opts = ReadOptions {
+        accept_inconsistent_orientation: true,
+    };
+    let mut out = Vec::new();
+    for path in osd_meshes() {
+        let name = path.file_stem().unwrap().to_string_lossy().to_string();
+        if !name.starts_with("catmark_") {
+            continue;
+        }
+        let mesh = read_mesh(&path, &opts).unwrap().mesh;
+        let options = Options::from_hints(&mesh.hints);
+        if let Ok(ev) = LimitEvaluator::new(&mesh.topology, Scheme::CatmullClark, &options) {
+            out.push((name, mesh, options, ev));
+        }
+    }
+    out
+}
+
 /// The level-`level` vertex at dyadic parameter `at` (a multiple of 2^-level, of the
 /// sub-face for a non-quad), found by descending through the child faces.
 fn vertex_at(r: &Refinement, level: usize, at: FaceParam) -> usize {
@@ -89,8 +109,8 @@ fn vertex_at(r: &Refinement, level: usize, at: FaceParam) -> usize {
 
 #[test]
 fn dyadic_points_are_limits_of_refined_vertices() {
-    let shapes = smooth_shapes();
-    assert!(shapes.len() >= 8, "only {} smooth shapes", shapes.len());
+    let shapes = covered_shapes();
+    assert!(shapes.len() >= 60, "only {} shapes", shapes.len());
     let level = 4;
     let mut checked = 0;
     for (name, mesh, options, ev) in &shapes {
@@ -130,17 +150,28 @@ fn dyadic_points_are_limits_of_refined_vertices() {
                         continue;
                     }
                     let at = FaceParam { face: f, sub, u, v };
-                    let p = ev.evaluate(&pts, at).unwrap();
+                    // Pieces next to irregular creases or boundaries are not covered yet.
+                    let p = match ev.evaluate(&pts, at) {
+                        Ok(p) => p,
+                        Err(subd_limit::LimitError::Unsupported { .. }) => continue,
+                        Err(e) => panic!("{name}: {e}"),
+                    };
                     let vtx = vertex_at(&r, level, at);
                     let d = (p.position - limit.positions[vtx]).length() / diag;
                     assert!(d < 1e-12, "{name} face {f}.{sub} ({u}, {v}): {d:e}");
                     // No tangent plane at an interior valence-2 vertex (three eigenvalues of
                     // modulus 1/4), so no normal to compare there; and catmark_val2_back2back
-                    // is pairs of coincident faces glued back to back, a surface folded flat
-                    // along every edge.
+                    // and catmark_val2_nonman are made of coincident faces glued back to back,
+                    // surfaces folded flat along their edges.
                     let valence2 = r.topology(level).vertex_faces(vtx).len() == 2;
-                    let folded = name == "catmark_val2_back2back";
+                    let folded = name.contains("back2back") || name.contains("val2_nonman");
+                    // On a crease or at a corner the surface has a normal per side.
+                    let one_sided = matches!(
+                        r.vertex_rules(level)[vtx],
+                        subd_schemes::Rule::Crease | subd_schemes::Rule::Corner
+                    );
                     if !valence2
+                        && !one_sided
                         && !folded
                         && limit.normals[vtx] != DVec3::ZERO
                         && p.normal() != DVec3::ZERO

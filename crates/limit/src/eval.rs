@@ -27,7 +27,10 @@ use subd_schemes::{Options, Refinement, Scheme};
 use crate::LimitError;
 use crate::loop_patch::{LoopCornerMatrices, box_spline, loop_corner_matrices, tri_corner_patch};
 use crate::masks;
-use crate::patch::{REGULAR_GRID, SurfacePoint, corner_patch, eval_bicubic, smooth_neighbourhood};
+use crate::patch::{
+    GridPoint, REGULAR_GRID, SurfacePoint, corner_patch, eval_bicubic, sharp_regular_grid,
+    smooth_neighbourhood,
+};
 use crate::stam::{CornerPatchMatrices, Projected, corner_patch_matrices};
 use std::sync::Arc;
 
@@ -50,6 +53,9 @@ pub struct FaceParam {
 enum Piece {
     /// Bicubic B-spline over 16 control points (grid order).
     Regular([u32; 16]),
+    /// Bicubic B-spline over 16 control points some of which are phantom points reflected
+    /// across infinitely sharp edges or boundaries.
+    SharpRegular(Box<[GridPoint; 16]>),
     /// Stam evaluation with the extraordinary vertex at corner `corner` of the face.
     Corner {
         corner: usize,
@@ -137,9 +143,13 @@ fn piece_kind(
         return Ok(Piece::Refined);
     }
     if !smooth_neighbourhood(t, rules, f) {
-        return Ok(Piece::Unsupported(
-            "a crease, corner, dart, boundary or hole touches the face",
-        ));
+        // Straight infinitely sharp creases, regular boundaries and sharp corners are
+        // B-splines with phantom points; other features are refined (and stay unsupported
+        // next to an irregular feature).
+        return Ok(match sharp_regular_grid(t, rules, f) {
+            Some(g) => Piece::SharpRegular(Box::new(g)),
+            None => Piece::Refined,
+        });
     }
     let fv = t.face_vertices(f);
     let irregular: Vec<usize> = (0..4)
@@ -242,10 +252,18 @@ impl LimitEvaluator {
             let mut pieces = vec![Piece::Unsupported("not a refined face"); t2.num_faces()];
             for f in (0..base.num_faces()).filter(|&f| matches!(base_pieces[f], Piece::Refined)) {
                 let children = base.face_offsets()[f] as usize..base.face_offsets()[f + 1] as usize;
-                let children = if scheme == Scheme::Loop { 4 * f..4 * f + 4 } else { children };
+                let children = if scheme == Scheme::Loop {
+                    4 * f..4 * f + 4
+                } else {
+                    children
+                };
                 for c in children {
                     let grand = t1.face_offsets()[c] as usize..t1.face_offsets()[c + 1] as usize;
-                    let grand = if scheme == Scheme::Loop { 4 * c..4 * c + 4 } else { grand };
+                    let grand = if scheme == Scheme::Loop {
+                        4 * c..4 * c + 4
+                    } else {
+                        grand
+                    };
                     for g in grand {
                         pieces[g] = match piece_of(t2, rules2, g, scheme)? {
                             Piece::Refined => Piece::Unsupported("irregular after two levels"),
@@ -414,6 +432,14 @@ fn eval_piece(
     match piece {
         Piece::Regular(grid) => {
             let g: [DVec3; 16] = std::array::from_fn(|i| pts[grid[i] as usize]);
+            Ok(eval_bicubic(&g, s, tp))
+        }
+        Piece::SharpRegular(grid) => {
+            let g: [DVec3; 16] = std::array::from_fn(|i| {
+                grid[i]
+                    .iter()
+                    .fold(DVec3::ZERO, |acc, &(v, w)| acc + w * pts[v as usize])
+            });
             Ok(eval_bicubic(&g, s, tp))
         }
         Piece::Corner {

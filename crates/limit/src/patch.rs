@@ -238,3 +238,146 @@ mod tests {
         );
     }
 }
+
+/// A grid control point as a combination of mesh vertices (a real vertex, or a phantom point
+/// reflected across a sharp edge or boundary).
+pub type GridPoint = Vec<(u32, f64)>;
+
+/// The corner of face `f` at local index `k` is regular for a B-spline patch with phantom
+/// points: a smooth interior vertex of valence 4; a crease vertex whose two infinitely sharp
+/// edges run straight through it (interior valence 4, or a boundary vertex with two faces);
+/// or a sharp corner with one face. Returns `false` for anything else (darts, semi-sharp
+/// features, irregular valences).
+fn regular_sharp_corner(t: &Topology, rules: &[Rule], v: usize) -> bool {
+    use subd_mesh::tags::is_infinite;
+    let (ve, vf) = (t.vertex_edges(v), t.vertex_faces(v));
+    if t.is_non_manifold_vertex(v)
+        || vf
+            .iter()
+            .any(|&g| t.face_size(g as usize) != 4 || t.is_hole(g as usize))
+    {
+        return false;
+    }
+    let vs = t.vertex_sharpness(v);
+    if vs != 0.0 && !is_infinite(vs) {
+        return false;
+    }
+    let sharp: Vec<usize> = (0..ve.len())
+        .filter(|&i| t.edge_sharpness(ve[i] as usize) > 0.0)
+        .collect();
+    if sharp
+        .iter()
+        .any(|&i| !is_infinite(t.edge_sharpness(ve[i] as usize)))
+    {
+        return false;
+    }
+    match (rules[v], ve.len(), vf.len(), sharp.as_slice()) {
+        (Rule::Smooth, 4, 4, []) => vs == 0.0,
+        (Rule::Crease, 4, 4, [a, b]) => b - a == 2 && vs == 0.0,
+        (Rule::Crease, 3, 2, [0, 2]) => vs == 0.0,
+        (Rule::Corner, 2, 1, [0, 1]) => true,
+        _ => false,
+    }
+}
+
+/// The 16 B-spline control points (grid order `4 j + i`) of quad `f` whose corners are all
+/// regular in the sense of [`regular_sharp_corner`], with phantom points `2 p − q` across
+/// infinitely sharp edges and boundaries (the reflection that turns the B-spline rules into
+/// the crease rules: midpoint on the edge, (1, 6, 1)/8 at crease vertices, interpolation at
+/// corners). `None` when the neighbourhood is not of that form.
+pub fn sharp_regular_grid(t: &Topology, rules: &[Rule], f: usize) -> Option<[GridPoint; 16]> {
+    let fv = t.face_vertices(f);
+    if fv.len() != 4
+        || t.is_hole(f)
+        || fv
+            .iter()
+            .any(|&v| !regular_sharp_corner(t, rules, v as usize))
+    {
+        return None;
+    }
+    let fe = t.face_edges(f);
+    let sharp = |k: usize| t.edge_sharpness(fe[k] as usize) > 0.0;
+    let mut g: [GridPoint; 16] = std::array::from_fn(|_| Vec::new());
+    let at = |i: usize, j: usize| 4 * j + i;
+    // The face itself: corners k at (1,1), (2,1), (2,2), (1,2).
+    let inner = [(1, 1), (2, 1), (2, 2), (1, 2)];
+    for k in 0..4 {
+        g[at(inner[k].0, inner[k].1)] = vec![(fv[k], 1.0)];
+    }
+    // Outer rows/columns beside edge k (corner k to k + 1): the points beyond corner k and
+    // beyond corner k + 1, and the grid step pointing out of the face across that edge.
+    let beside = [
+        [(1, 0), (2, 0)],
+        [(3, 1), (3, 2)],
+        [(2, 3), (1, 3)],
+        [(0, 2), (0, 1)],
+    ];
+    let inward = [(0i32, 1i32), (-1, 0), (0, -1), (1, 0)];
+    let comb = |a: &GridPoint, wa: f64, b: &GridPoint, wb: f64| -> GridPoint {
+        a.iter()
+            .map(|&(v, w)| (v, w * wa))
+            .chain(b.iter().map(|&(v, w)| (v, w * wb)))
+            .collect()
+    };
+    for k in 0..4 {
+        let across = t
+            .edge_faces(fe[k] as usize)
+            .iter()
+            .map(|&x| x as usize)
+            .find(|&x| x != f);
+        match (sharp(k), across) {
+            (false, Some(h)) => {
+                let hv = t.face_vertices(h);
+                if hv.len() != 4 {
+                    return None;
+                }
+                // h runs (x_{k+1}, x_k, beyond x_k, beyond x_{k+1}).
+                let s = hv.iter().position(|&x| x == fv[(k + 1) % 4])?;
+                if hv[(s + 1) % 4] != fv[k] {
+                    return None;
+                }
+                g[at(beside[k][0].0, beside[k][0].1)] = vec![(hv[(s + 2) % 4], 1.0)];
+                g[at(beside[k][1].0, beside[k][1].1)] = vec![(hv[(s + 3) % 4], 1.0)];
+            }
+            (false, None) => return None,
+            (true, _) => {
+                for &(i, j) in &beside[k] {
+                    let (di, dj) = inward[k];
+                    let on = (i as i32 + di) as usize;
+                    let oj = (j as i32 + dj) as usize;
+                    let (ii, ij) = ((on as i32 + di) as usize, (oj as i32 + dj) as usize);
+                    g[at(i, j)] = comb(&g[at(on, oj)].clone(), 2.0, &g[at(ii, ij)].clone(), -1.0);
+                }
+            }
+        }
+    }
+    // Diagonal corners at corner k, between edge k − 1 (before) and edge k (after).
+    let diag = [(0, 0), (3, 0), (3, 3), (0, 3)];
+    for k in 0..4 {
+        let (before, after) = ((k + 3) % 4, k);
+        let (i, j) = diag[k];
+        g[at(i, j)] = match (sharp(before), sharp(after)) {
+            (false, false) => {
+                let ring = quad_ring(t, fv[k] as usize, f)?;
+                if ring.len() != 4 {
+                    return None;
+                }
+                vec![(ring[2][1], 1.0)]
+            }
+            // Reflect across the sharp edge after corner k: step inward[after].
+            (_, true) => {
+                let (di, dj) = inward[after];
+                let (a, b) = ((i as i32 + di) as usize, (j as i32 + dj) as usize);
+                let (c, d) = ((a as i32 + di) as usize, (b as i32 + dj) as usize);
+                comb(&g[at(a, b)].clone(), 2.0, &g[at(c, d)].clone(), -1.0)
+            }
+            (true, false) => {
+                let (di, dj) = inward[before];
+                let (a, b) = ((i as i32 + di) as usize, (j as i32 + dj) as usize);
+                let (c, d) = ((a as i32 + di) as usize, (b as i32 + dj) as usize);
+                comb(&g[at(a, b)].clone(), 2.0, &g[at(c, d)].clone(), -1.0)
+            }
+        };
+    }
+    Some(g)
+}
