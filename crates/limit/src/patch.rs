@@ -189,56 +189,6 @@ pub fn smooth_neighbourhood(t: &Topology, rules: &[Rule], f: usize) -> bool {
     })
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn basis_is_a_partition_of_unity_with_matching_derivatives() {
-        for k in 0..=10 {
-            let t = k as f64 / 10.0;
-            let (b, d, dd) = bspline_basis(t);
-            assert!((b.iter().sum::<f64>() - 1.0).abs() < 1e-15);
-            assert!(d.iter().sum::<f64>().abs() < 1e-15);
-            assert!(dd.iter().sum::<f64>().abs() < 1e-15);
-            // Linear precision: Σ B_i(t)·(i − 1) = t.
-            let x: f64 = b
-                .iter()
-                .enumerate()
-                .map(|(i, w)| w * (i as f64 - 1.0))
-                .sum();
-            assert!((x - t).abs() < 1e-15);
-            // Central differences of the basis match the derivatives.
-            let h = 1e-6;
-            let (bp, dp, _) = bspline_basis(t + h);
-            let (bm, dm, _) = bspline_basis(t - h);
-            for i in 0..4 {
-                assert!(((bp[i] - bm[i]) / (2.0 * h) - d[i]).abs() < 1e-8);
-                assert!(((dp[i] - dm[i]) / (2.0 * h) - dd[i]).abs() < 1e-8);
-            }
-        }
-    }
-
-    #[test]
-    fn regular_grid_is_a_permutation() {
-        let mut seen = [false; 16];
-        for &k in &REGULAR_GRID {
-            assert!(!seen[k]);
-            seen[k] = true;
-        }
-        // The face corners: (1,1) = x0, (2,1) = e0, (2,2) = f0, (1,2) = e1.
-        assert_eq!(
-            [
-                REGULAR_GRID[5],
-                REGULAR_GRID[6],
-                REGULAR_GRID[10],
-                REGULAR_GRID[9]
-            ],
-            [0, 1, 2, 3]
-        );
-    }
-}
-
 /// A grid control point as a combination of mesh vertices (a real vertex, or a phantom point
 /// reflected across a sharp edge or boundary).
 pub type GridPoint = Vec<(u32, f64)>;
@@ -380,4 +330,54 @@ pub fn sharp_regular_grid(t: &Topology, rules: &[Rule], f: usize) -> Option<[Gri
         };
     }
     Some(g)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn basis_is_a_partition_of_unity_with_matching_derivatives() {
+        for k in 0..=10 {
+            let t = k as f64 / 10.0;
+            let (b, d, dd) = bspline_basis(t);
+            assert!((b.iter().sum::<f64>() - 1.0).abs() < 1e-15);
+            assert!(d.iter().sum::<f64>().abs() < 1e-15);
+            assert!(dd.iter().sum::<f64>().abs() < 1e-15);
+            // Linear precision: Σ B_i(t)·(i − 1) = t.
+            let x: f64 = b
+                .iter()
+                .enumerate()
+                .map(|(i, w)| w * (i as f64 - 1.0))
+                .sum();
+            assert!((x - t).abs() < 1e-15);
+            // Central differences of the basis match the derivatives.
+            let h = 1e-6;
+            let (bp, dp, _) = bspline_basis(t + h);
+            let (bm, dm, _) = bspline_basis(t - h);
+            for i in 0..4 {
+                assert!(((bp[i] - bm[i]) / (2.0 * h) - d[i]).abs() < 1e-8);
+                assert!(((dp[i] - dm[i]) / (2.0 * h) - dd[i]).abs() < 1e-8);
+            }
+        }
+    }
+
+    #[test]
+    fn regular_grid_is_a_permutation() {
+        let mut seen = [false; 16];
+        for &k in &REGULAR_GRID {
+            assert!(!seen[k]);
+            seen[k] = true;
+        }
+        // The face corners: (1,1) = x0, (2,1) = e0, (2,2) = f0, (1,2) = e1.
+        assert_eq!(
+            [
+                REGULAR_GRID[5],
+                REGULAR_GRID[6],
+                REGULAR_GRID[10],
+                REGULAR_GRID[9]
+            ],
+            [0, 1, 2, 3]
+        );
+    }
 }
