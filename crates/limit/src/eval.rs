@@ -17,8 +17,15 @@
 //! `(1 − u − v, u, v)`) are quartic box-spline patches where regular and Stam's Loop
 //! eigenbasis at one extraordinary corner ([`crate::loop_patch`]).
 //!
-//! **Not yet covered** (an error, [`LimitError::Unsupported`]): faces whose neighbourhood
-//! has a crease, corner, dart, boundary or hole.
+//! Catmull-Clark faces along straight infinitely sharp creases, regular boundaries (boundary
+//! vertices of valence 3) and sharp corners are B-spline patches with phantom points
+//! ([`crate::patch::sharp_regular_grid`]); faces with other sharp features are refined two
+//! levels like irregular faces.
+//!
+//! **Not yet covered** (an error, [`LimitError::Unsupported`]): the pieces next to an
+//! irregular sharp feature (darts, crease or boundary vertices of irregular valence,
+//! semi-sharp creases not yet decayed, holes), and Loop faces touching creases or
+//! boundaries.
 
 use glam::DVec3;
 use subd_mesh::Topology;
