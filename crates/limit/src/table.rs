@@ -165,19 +165,18 @@ impl LimitStencilTable {
         let cases: Vec<VertexCase> = (0..t.num_vertices())
             .map(|v| classify(t, v, rules[v], scheme))
             .collect();
-        // Numeric masks depend only on (feature, valence): compute each once.
+        // Masks depend only on the vertex's case and its edge and face counts: build each
+        // distinct one once, so filling the rows allocates nothing per vertex.
+        let key = |v: usize| (cases[v], t.vertex_edges(v).len(), t.vertex_faces(v).len());
+        let mut library: HashMap<(VertexCase, usize, usize), LimitMask> = HashMap::new();
         let mut numeric: HashMap<(RingFeature, usize), LimitMask> = HashMap::new();
-        for (v, c) in cases.iter().enumerate() {
-            if let VertexCase::Numeric(feature, _) = *c {
-                let n = t.vertex_faces(v).len();
-                if let std::collections::hash_map::Entry::Vacant(e) = numeric.entry((feature, n)) {
-                    e.insert(ring_limit_mask(scheme, n, feature)?);
-                }
+        for v in 0..t.num_vertices() {
+            let k = key(v);
+            if library.contains_key(&k) {
+                continue;
             }
-        }
-        let mask_of = |v: usize, which: usize| -> RingMask {
-            let (ne, nf) = (t.vertex_edges(v).len(), t.vertex_faces(v).len());
-            let m = match cases[v] {
+            let (case, ne, nf) = k;
+            let m = match case {
                 VertexCase::Isolated => masks::corner(0, 0, 0.0),
                 VertexCase::Corner => {
                     masks::corner(ne, nf, if scheme == Scheme::Loop { 3.0 } else { 1.0 })
@@ -190,17 +189,27 @@ impl LimitStencilTable {
                     Scheme::Loop => masks::loop_smooth(nf),
                     _ => masks::catmark_smooth(nf),
                 },
-                VertexCase::Numeric(feature, k) => {
+                VertexCase::Numeric(feature, rot) => {
+                    if !numeric.contains_key(&(feature, nf)) {
+                        numeric.insert((feature, nf), ring_limit_mask(scheme, nf, feature)?);
+                    }
                     let m = &numeric[&(feature, nf)];
-                    return rotated([&m.position, &m.tangent1, &m.tangent2][which], k);
+                    LimitMask {
+                        position: rotated(&m.position, rot),
+                        tangent1: rotated(&m.tangent1, rot),
+                        tangent2: rotated(&m.tangent2, rot),
+                    }
                 }
             };
-            let [p, t1, t2] = [m.position, m.tangent1, m.tangent2];
-            [p, t1, t2].into_iter().nth(which).expect("which < 3")
+            library.insert(k, m);
+        }
+        let mask_of = |v: usize, which: usize| -> &RingMask {
+            let m = &library[&key(v)];
+            [&m.position, &m.tangent1, &m.tangent2][which]
         };
         let table = |which: usize| {
             StencilTable::build(t.num_vertices(), t.num_vertices(), |v, sink| {
-                emit(t, v, &mask_of(v, which), sink)
+                emit(t, v, mask_of(v, which), sink)
             })
         };
         Ok(LimitStencilTable {
