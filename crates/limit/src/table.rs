@@ -1,6 +1,7 @@
 //! [`LimitStencilTable`]: limit positions and tangents of every vertex of a level, as stencils.
 
 use std::collections::HashMap;
+use std::collections::hash_map::Entry;
 
 use glam::DVec3;
 use subd_mesh::Topology;
@@ -190,10 +191,10 @@ impl LimitStencilTable {
                     _ => masks::catmark_smooth(nf),
                 },
                 VertexCase::Numeric(feature, rot) => {
-                    if !numeric.contains_key(&(feature, nf)) {
-                        numeric.insert((feature, nf), ring_limit_mask(scheme, nf, feature)?);
-                    }
-                    let m = &numeric[&(feature, nf)];
+                    let m = match numeric.entry((feature, nf)) {
+                        Entry::Occupied(e) => e.into_mut(),
+                        Entry::Vacant(e) => e.insert(ring_limit_mask(scheme, nf, feature)?),
+                    };
                     LimitMask {
                         position: rotated(&m.position, rot),
                         tangent1: rotated(&m.tangent1, rot),
