@@ -36,6 +36,11 @@ pub(crate) struct LimitArgs {
     /// Output: `.txt` (one line per vertex) or a mesh (.obj, .ply, .glb) whose vertices are
     /// moved to their limit positions.
     output: PathBuf,
+    /// Also write the ACC approximation (Loop & Schaefer 2008: a bicubic Bézier geometry
+    /// patch and two tangent patches per face) to this JSON file (Catmull-Clark, closed
+    /// all-quad meshes).
+    #[arg(long, value_name = "FILE.json")]
+    acc: Option<PathBuf>,
     /// Print a JSON report on stdout.
     #[arg(long)]
     json: bool,
@@ -94,6 +99,23 @@ pub(crate) fn run(
     let table = base_limit(topo, scheme, &options)
         .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
     let limit = table.apply(&file.mesh.positions);
+    // ACC first, so that a mesh it does not cover fails before any file is written.
+    let acc = match &args.acc {
+        Some(path) => {
+            if scheme != Scheme::CatmullClark {
+                return Err(bad(format!(
+                    "{}: ACC patches approximate catmull-clark surfaces only",
+                    path.display()
+                )));
+            }
+            let patches = subd_limit::acc::acc_patches(topo, &file.mesh.positions)
+                .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
+            let json = serde_json::to_vec(&patches)
+                .map_err(|e| bad(format!("{}: {e}", path.display())))?;
+            Some((path, json))
+        }
+        None => None,
+    };
     if is_text {
         let body = text(&limit, args.normals);
         subd_io::atomic_write(&args.output, |w| w.write_all(body.as_bytes()))?;
@@ -102,6 +124,9 @@ pub(crate) fn run(
             .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
         mesh.hints = file.mesh.hints;
         subd_io::write_mesh(&args.output, &mesh, &subd_io::WriteOptions::default())?;
+    }
+    if let Some((path, json)) = acc {
+        subd_io::atomic_write(path, |w| w.write_all(&json))?;
     }
     if args.json {
         let report = LimitReport {

@@ -667,3 +667,66 @@ fn eval_loop_points_are_barycentric() {
         "{err}"
     );
 }
+
+#[test]
+fn limit_writes_acc_patches_as_json() {
+    let s = Scratch::new("acc");
+    let cube = meshes().join("catmark_cube.obj");
+    let (txt, acc) = (s.0.join("l.txt"), s.0.join("acc.json"));
+    let (code, _, err) = subd(&[
+        "limit",
+        "--scheme",
+        "catmull-clark",
+        cube.to_str().unwrap(),
+        txt.to_str().unwrap(),
+        "--acc",
+        acc.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let patches: serde_json::Value = serde_json::from_slice(&std::fs::read(&acc).unwrap()).unwrap();
+    let patches = patches.as_array().unwrap();
+    assert_eq!(patches.len(), 6);
+    // Each patch's first corner is the exact limit of its face's first vertex, which the
+    // text output lists: half the vertex on this cube.
+    let limits: Vec<Vec<f64>> = std::fs::read_to_string(&txt)
+        .unwrap()
+        .lines()
+        .map(|l| l.split_whitespace().map(|x| x.parse().unwrap()).collect())
+        .collect();
+    let text = std::fs::read_to_string(&cube).unwrap();
+    let first: usize = text
+        .lines()
+        .find(|l| l.starts_with("f "))
+        .unwrap()
+        .split_whitespace()
+        .nth(1)
+        .unwrap()
+        .split('/')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    let b00: Vec<f64> = patches[0]["geometry"][0]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    for k in 0..3 {
+        assert!((b00[k] - limits[first - 1][k]).abs() < 1e-12, "{b00:?}");
+    }
+    // Loop has no ACC: exit 2 and nothing written.
+    let (l2, a2) = (s.0.join("l2.txt"), s.0.join("a2.json"));
+    let tri = meshes().join("loop_cube.obj");
+    let (code, _, err) = subd(&[
+        "limit",
+        "--scheme",
+        "loop",
+        tri.to_str().unwrap(),
+        l2.to_str().unwrap(),
+        "--acc",
+        a2.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(!l2.exists() && !a2.exists());
+}
