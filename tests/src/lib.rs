@@ -246,3 +246,24 @@ pub fn mesh_strategy() -> impl Strategy<Value = RandomMesh> {
     )
         .prop_map(|(k, m, n, c, j)| random_mesh(k, m, n, &c, &j))
 }
+
+/// A closed pentagonal prism (two pentagons, five quads) with slightly irregular positions:
+/// after one Catmull-Clark step it has extraordinary vertices of valence 3 and 5.
+pub fn pentagonal_prism() -> (Topology, Vec<subd_mesh::DVec3>) {
+    let mut faces: Vec<Vec<u32>> = vec![(0..5).rev().collect(), (5..10).collect()];
+    for i in 0..5u32 {
+        let j = (i + 1) % 5;
+        faces.push(vec![i, j, 5 + j, 5 + i]);
+    }
+    let points = (0..10)
+        .map(|v| {
+            let a = std::f64::consts::TAU * (v % 5) as f64 / 5.0 + 0.1 * v as f64;
+            subd_mesh::DVec3::new(
+                a.cos() * (1.0 + 0.1 * v as f64),
+                a.sin(),
+                if v < 5 { -0.6 } else { 0.7 },
+            )
+        })
+        .collect();
+    (build(10, &faces), points)
+}

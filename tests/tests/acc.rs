@@ -11,22 +11,7 @@ use subd_schemes::{Options, Refinement, Scheme};
 /// A pentagonal prism (valence-3 corners, valence-5 cap centres once refined) refined
 /// `levels` times, as a base mesh.
 fn prism(levels: usize) -> (Topology, Vec<DVec3>) {
-    let mut faces: Vec<Vec<u32>> = vec![(0..5).rev().collect(), (5..10).collect()];
-    for i in 0..5u32 {
-        let j = (i + 1) % 5;
-        faces.push(vec![i, j, 5 + j, 5 + i]);
-    }
-    let topo = subd_tests::build(10, &faces);
-    let pts: Vec<DVec3> = (0..10)
-        .map(|v| {
-            let a = std::f64::consts::TAU * (v % 5) as f64 / 5.0 + 0.1 * v as f64;
-            DVec3::new(
-                a.cos() * (1.0 + 0.1 * v as f64),
-                a.sin(),
-                if v < 5 { -0.6 } else { 0.7 },
-            )
-        })
-        .collect();
+    let (topo, pts) = subd_tests::pentagonal_prism();
     let r = Refinement::new(&topo, Scheme::CatmullClark, &Options::default(), levels).unwrap();
     let p = r.refine_points(&pts).pop().unwrap();
     (r.into_topology(levels), p)

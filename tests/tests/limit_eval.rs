@@ -14,60 +14,56 @@ use subd_mesh::Topology;
 use subd_schemes::{Options, Refinement, Scheme};
 use subd_tests::osd_meshes;
 
-/// Catmull-Clark shapes the evaluator covers entirely (closed and smooth).
-fn smooth_shapes() -> Vec<(String, subd_mesh::Mesh, Options, LimitEvaluator)> {
+type Shape = (String, subd_mesh::Mesh, Options, LimitEvaluator);
+
+/// The shapes of `scheme` an evaluator can be built for; with `whole`, only those where
+/// every face is covered at its centre (u = v = 1/4 for Loop, 1/2 otherwise).
+fn shapes(scheme: Scheme, whole: bool) -> Vec<Shape> {
+    let prefix = if scheme == Scheme::Loop {
+        "loop_"
+    } else {
+        "catmark_"
+    };
+    let centre = if scheme == Scheme::Loop { 0.25 } else { 0.5 };
     let opts = ReadOptions {
         accept_inconsistent_orientation: true,
     };
     let mut out = Vec::new();
     for path in osd_meshes() {
         let name = path.file_stem().unwrap().to_string_lossy().to_string();
-        if !name.starts_with("catmark_") {
+        if !name.starts_with(prefix) {
             continue;
         }
         let mesh = read_mesh(&path, &opts).unwrap().mesh;
         let options = Options::from_hints(&mesh.hints);
-        let Ok(ev) = LimitEvaluator::new(&mesh.topology, Scheme::CatmullClark, &options) else {
+        let Ok(ev) = LimitEvaluator::new(&mesh.topology, scheme, &options) else {
             continue;
         };
         let pts = ev.prepare(&mesh.positions);
         let covered = (0..mesh.topology.num_faces()).all(|f| {
-            ev.evaluate(
-                &pts,
-                FaceParam {
-                    face: f,
-                    sub: 0,
-                    u: 0.5,
-                    v: 0.5,
-                },
-            )
-            .is_ok()
+            let at = FaceParam {
+                face: f,
+                sub: 0,
+                u: centre,
+                v: centre,
+            };
+            ev.evaluate(&pts, at).is_ok()
         });
-        if covered {
+        if covered || !whole {
             out.push((name, mesh, options, ev));
         }
     }
     out
 }
 
+/// Catmull-Clark shapes the evaluator covers entirely.
+fn smooth_shapes() -> Vec<Shape> {
+    shapes(Scheme::CatmullClark, true)
+}
+
 /// Catmull-Clark shapes the evaluator can be built for (some faces may not be covered).
-fn covered_shapes() -> Vec<(String, subd_mesh::Mesh, Options, LimitEvaluator)> {
-    let opts = ReadOptions {
-        accept_inconsistent_orientation: true,
-    };
-    let mut out = Vec::new();
-    for path in osd_meshes() {
-        let name = path.file_stem().unwrap().to_string_lossy().to_string();
-        if !name.starts_with("catmark_") {
-            continue;
-        }
-        let mesh = read_mesh(&path, &opts).unwrap().mesh;
-        let options = Options::from_hints(&mesh.hints);
-        if let Ok(ev) = LimitEvaluator::new(&mesh.topology, Scheme::CatmullClark, &options) {
-            out.push((name, mesh, options, ev));
-        }
-    }
-    out
+fn covered_shapes() -> Vec<Shape> {
+    shapes(Scheme::CatmullClark, false)
 }
 
 /// The level-`level` vertex at dyadic parameter `at` (a multiple of 2^-level, of the
@@ -193,22 +189,7 @@ fn dyadic_points_are_limits_of_refined_vertices() {
 /// A closed quad mesh with extraordinary vertices of valence 3 and 5, two edges apart or
 /// more: a pentagonal prism refined twice (its base positions are the level-2 points).
 fn prism_level2() -> (Topology, Vec<DVec3>) {
-    let mut faces: Vec<Vec<u32>> = vec![(0..5).rev().collect(), (5..10).collect()];
-    for i in 0..5u32 {
-        let j = (i + 1) % 5;
-        faces.push(vec![i, j, 5 + j, 5 + i]);
-    }
-    let topo = subd_tests::build(10, &faces);
-    let pts: Vec<DVec3> = (0..10)
-        .map(|v| {
-            let a = std::f64::consts::TAU * (v % 5) as f64 / 5.0 + 0.1 * v as f64;
-            DVec3::new(
-                a.cos() * (1.0 + 0.1 * v as f64),
-                a.sin(),
-                if v < 5 { -0.6 } else { 0.7 },
-            )
-        })
-        .collect();
+    let (topo, pts) = subd_tests::pentagonal_prism();
     let r = Refinement::new(&topo, Scheme::CatmullClark, &Options::default(), 2).unwrap();
     let p = r.refine_points(&pts).pop().unwrap();
     (r.topology(2).clone(), p)
@@ -347,39 +328,8 @@ fn normals_are_continuous_across_faces() {
 }
 
 /// Loop shapes the evaluator covers entirely.
-fn smooth_loop_shapes() -> Vec<(String, subd_mesh::Mesh, Options, LimitEvaluator)> {
-    let opts = ReadOptions {
-        accept_inconsistent_orientation: true,
-    };
-    let mut out = Vec::new();
-    for path in osd_meshes() {
-        let name = path.file_stem().unwrap().to_string_lossy().to_string();
-        if !name.starts_with("loop_") {
-            continue;
-        }
-        let mesh = read_mesh(&path, &opts).unwrap().mesh;
-        let options = Options::from_hints(&mesh.hints);
-        let Ok(ev) = LimitEvaluator::new(&mesh.topology, Scheme::Loop, &options) else {
-            continue;
-        };
-        let pts = ev.prepare(&mesh.positions);
-        let covered = (0..mesh.topology.num_faces()).all(|f| {
-            ev.evaluate(
-                &pts,
-                FaceParam {
-                    face: f,
-                    sub: 0,
-                    u: 0.25,
-                    v: 0.25,
-                },
-            )
-            .is_ok()
-        });
-        if covered {
-            out.push((name, mesh, options, ev));
-        }
-    }
-    out
+fn smooth_loop_shapes() -> Vec<Shape> {
+    shapes(Scheme::Loop, true)
 }
 
 /// The level-`level` vertex at dyadic barycentric parameter `(u, v)` of a Loop base face.

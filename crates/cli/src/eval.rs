@@ -102,10 +102,7 @@ pub(crate) fn run(
     refuse_overwrite(&args.input, &args.output)?;
     let file = subd_io::read_mesh(&args.input, &args.rules.read_options())?;
     print_warnings(err, &args.input, &file.warnings);
-    let scheme = match args.scheme {
-        LimitSchemeArg::CatmullClark => Scheme::CatmullClark,
-        LimitSchemeArg::Loop => Scheme::Loop,
-    };
+    let scheme = args.scheme.scheme();
     let options = args.rules.options(&file.mesh.hints);
     let topo = &file.mesh.topology;
     let ev = LimitEvaluator::new(topo, scheme, &options)

@@ -21,6 +21,15 @@ pub(crate) enum LimitSchemeArg {
     Loop,
 }
 
+impl LimitSchemeArg {
+    pub(crate) fn scheme(self) -> Scheme {
+        match self {
+            LimitSchemeArg::CatmullClark => Scheme::CatmullClark,
+            LimitSchemeArg::Loop => Scheme::Loop,
+        }
+    }
+}
+
 #[derive(Debug, Args)]
 pub(crate) struct LimitArgs {
     /// Subdivision scheme.
@@ -90,10 +99,7 @@ pub(crate) fn run(
     }
     let file = subd_io::read_mesh(&args.input, &args.rules.read_options())?;
     print_warnings(err, &args.input, &file.warnings);
-    let scheme = match args.scheme {
-        LimitSchemeArg::CatmullClark => Scheme::CatmullClark,
-        LimitSchemeArg::Loop => Scheme::Loop,
-    };
+    let scheme = args.scheme.scheme();
     let options = args.rules.options(&file.mesh.hints);
     let topo = &file.mesh.topology;
     let table = base_limit(topo, scheme, &options)

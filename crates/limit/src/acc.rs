@@ -25,6 +25,7 @@ use serde::Serialize;
 use subd_mesh::Topology;
 
 use crate::LimitError;
+use crate::patch::face_ring;
 
 /// The ACC patches of one quad face.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -90,26 +91,11 @@ impl AccPatch {
 /// face-opposite vertices), counter-clockwise. `None` unless `v` is interior and manifold
 /// with quads around it.
 fn ring_from(t: &Topology, v: usize, first: u32) -> Option<(Vec<u32>, Vec<u32>)> {
-    let faces = t.vertex_faces(v);
-    if t.is_boundary_vertex(v)
-        || t.is_non_manifold_vertex(v)
-        || faces.len() != t.vertex_edges(v).len()
-    {
-        return None;
-    }
-    let local = t.vertex_face_local_indices(v);
-    let n = faces.len();
-    let mut edges = Vec::with_capacity(n);
-    let mut diags = Vec::with_capacity(n);
-    for i in 0..n {
-        let fv = t.face_vertices(faces[i] as usize);
-        if fv.len() != 4 {
-            return None;
-        }
-        let c = local[i] as usize;
-        edges.push(fv[(c + 1) % 4]);
-        diags.push(fv[(c + 2) % 4]);
-    }
+    let f0 = *t.vertex_faces(v).first()? as usize;
+    let (mut edges, mut diags): (Vec<u32>, Vec<u32>) = face_ring::<3>(t, v, f0)?
+        .iter()
+        .map(|r| (r[0], r[1]))
+        .unzip();
     let k = edges.iter().position(|&e| e == first)?;
     edges.rotate_left(k);
     diags.rotate_left(k);

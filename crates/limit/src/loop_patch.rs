@@ -21,44 +21,22 @@
 // Basis functions and derivatives index several parallel arrays.
 #![allow(clippy::needless_range_loop)]
 
-use std::collections::HashMap;
-use std::sync::{Arc, Mutex, OnceLock};
+use std::sync::{Arc, OnceLock};
 
+use faer::Mat;
 use faer::linalg::solvers::Solve;
-use faer::{Mat, c64};
 use glam::DVec3;
 use subd_mesh::{Topology, TopologyBuilder};
 use subd_schemes::{Options, Refinement, Scheme};
 
 use crate::LimitError;
-use crate::patch::SurfacePoint;
-use crate::stam::Projected;
+use crate::patch::{SurfacePoint, face_ring};
+use crate::stam::{PerValence, Projected, SubpatchSubdivision, cached, steps_to_regular};
 use crate::table::LimitStencilTable;
 
-/// The ring of `v` from face `f`: per incident triangle counter-clockwise, (next, previous)
-/// vertex. `None` unless `v` is interior, manifold, with triangles around it.
+/// The ring of `v` from face `f`: per incident triangle counter-clockwise, (next, previous).
 fn tri_ring(t: &Topology, v: usize, f: usize) -> Option<Vec<[u32; 2]>> {
-    let faces = t.vertex_faces(v);
-    if t.is_boundary_vertex(v)
-        || t.is_non_manifold_vertex(v)
-        || faces.len() != t.vertex_edges(v).len()
-    {
-        return None;
-    }
-    let start = faces.iter().position(|&g| g as usize == f)?;
-    let local = t.vertex_face_local_indices(v);
-    let n = faces.len();
-    (0..n)
-        .map(|j| {
-            let i = (start + j) % n;
-            let fv = t.face_vertices(faces[i] as usize);
-            if fv.len() != 3 {
-                return None;
-            }
-            let c = local[i] as usize;
-            Some([fv[(c + 1) % 3], fv[(c + 2) % 3]])
-        })
-        .collect()
+    face_ring::<2>(t, v, f)
 }
 
 /// The n + 6 control points of triangle `f` from its corner `c` (module docs), or `None`.
@@ -243,21 +221,11 @@ pub fn box_spline() -> Result<&'static BoxSpline, LimitError> {
         .map_err(|e| LimitError::Analysis(e.clone()))
 }
 
-/// Subdivision matrices of a Loop corner patch of valence n and their eigenbasis.
+/// Subdivision matrices of a Loop corner patch of valence n (K = n + 6 control points; the
+/// regular sub-triangles 1, 2, 3 have 12 each) and their eigenbasis.
 #[derive(Debug)]
 pub struct LoopCornerMatrices {
-    a: Mat<f64>,
-    /// Rows giving the regular control points of sub-triangles 1, 2, 3 (index − 1).
-    abar: [Mat<f64>; 3],
-    eigen: Option<LoopEigenbasis>,
-}
-
-/// `A = V Λ V⁻¹`: eigenvalues, `Ā_k V` per sub-triangle (12 weights per eigenvector), `V⁻¹`.
-#[derive(Debug)]
-struct LoopEigenbasis {
-    values: Vec<c64>,
-    phi: [Vec<[c64; 12]>; 3],
-    v_inv: Mat<c64>,
+    sub: SubpatchSubdivision<12>,
 }
 
 impl LoopCornerMatrices {
@@ -322,51 +290,25 @@ impl LoopCornerMatrices {
             Ok(rows(&tri_corner_patch(child, j, 0).ok_or_else(bad)?))
         };
         let abar = [sub(1)?, sub(2)?, sub(3)?];
-        let eigen = loop_eigenbasis(&a, &abar);
-        Ok(LoopCornerMatrices { a, abar, eigen })
+        Ok(LoopCornerMatrices {
+            sub: SubpatchSubdivision::new(a, abar),
+        })
     }
 
     /// Whether evaluation uses the eigenbasis.
     pub fn uses_eigenbasis(&self) -> bool {
-        self.eigen.is_some()
+        self.sub.uses_eigenbasis()
     }
 
     /// Control points prepared for evaluation.
     pub fn project(&self, cp: &[DVec3]) -> Projected {
-        match &self.eigen {
-            Some(LoopEigenbasis { v_inv, .. }) => Projected::Eigen(
-                (0..cp.len())
-                    .map(|i| {
-                        cp.iter()
-                            .enumerate()
-                            .fold([c64::new(0.0, 0.0); 3], |mut acc, (j, p)| {
-                                let z = v_inv[(i, j)];
-                                acc[0] += z * p.x;
-                                acc[1] += z * p.y;
-                                acc[2] += z * p.z;
-                                acc
-                            })
-                    })
-                    .collect(),
-            ),
-            None => Projected::Points(cp.to_vec()),
-        }
+        self.sub.project(cp, true)
     }
 
     /// The surface at (u, v) ≠ (0, 0) of the corner patch (parameters of the module docs).
     pub fn evaluate(&self, c: &Projected, u: f64, v: f64) -> Result<SurfacePoint, LimitError> {
         let basis = box_spline()?;
-        // Steps m − 1 until u + v, scaled by 2^(m−1), lies in [1/2, 1].
-        let p = u + v;
-        let mut steps = (-p.log2()).floor().max(0.0) as i32;
-        let mut scale = 2f64.powi(steps);
-        if p * scale > 1.0 {
-            steps -= 1;
-            scale *= 0.5;
-        } else if p * scale < 0.5 {
-            steps += 1;
-            scale *= 2.0;
-        }
+        let (steps, scale) = steps_to_regular(u + v);
         let (u1, v1) = (u * scale, v * scale);
         // Sub-triangle and its parameters (s, t) with Jacobian ∂(s,t)/∂(u1,v1).
         let (sub, s, t, j) = if u1 >= 0.5 {
@@ -381,44 +323,7 @@ impl LoopCornerMatrices {
                 [[-2.0, 0.0], [0.0, -2.0]],
             )
         };
-        let w = basis.weights(s, t);
-        let mut out = [DVec3::ZERO; 6];
-        match c {
-            Projected::Eigen(chat) => {
-                let LoopEigenbasis { values, phi, .. } =
-                    self.eigen.as_ref().expect("projected on this eigenbasis");
-                let one = c64::new(1.0, 0.0);
-                for ((lam, ph), ch) in values.iter().zip(&phi[sub]).zip(chat) {
-                    let lp = lam.powi(steps);
-                    let outputs = if *lam == one { 1 } else { 6 };
-                    for (o, wd) in out.iter_mut().zip(&w).take(outputs) {
-                        let b = ph
-                            .iter()
-                            .zip(wd)
-                            .fold(c64::new(0.0, 0.0), |acc, (f, &x)| acc + *f * x);
-                        let f = lp * b;
-                        *o += DVec3::new((f * ch[0]).re, (f * ch[1]).re, (f * ch[2]).re);
-                    }
-                }
-            }
-            Projected::Points(cp) => {
-                let mut c = cp.clone();
-                let mut next = vec![DVec3::ZERO; c.len()];
-                for _ in 0..steps {
-                    for (i, o) in next.iter_mut().enumerate() {
-                        *o = (0..c.len()).fold(DVec3::ZERO, |acc, q| acc + self.a[(i, q)] * c[q]);
-                    }
-                    std::mem::swap(&mut c, &mut next);
-                }
-                let ab = &self.abar[sub];
-                for g in 0..12 {
-                    let q = (0..c.len()).fold(DVec3::ZERO, |acc, x| acc + ab[(g, x)] * c[x]);
-                    for (d, o) in out.iter_mut().enumerate() {
-                        *o += w[d][g] * q;
-                    }
-                }
-            }
-        }
+        let out = self.sub.combine(c, steps, sub, &basis.weights(s, t));
         // Chain rule: (s, t) = J (u1, v1) + const, (u1, v1) = scale (u, v).
         let (js, jt) = (j[0][0] * scale, j[1][1] * scale);
         Ok(SurfacePoint {
@@ -432,63 +337,10 @@ impl LoopCornerMatrices {
     }
 }
 
-/// `A = V Λ V⁻¹` with `Ā_k V` pre-multiplied; `None` when it does not reproduce `A`.
-fn loop_eigenbasis(a: &Mat<f64>, abar: &[Mat<f64>; 3]) -> Option<LoopEigenbasis> {
-    let k = a.nrows();
-    let evd = a.eigen().ok()?;
-    let one = c64::new(1.0, 0.0);
-    let values: Vec<c64> = (0..k)
-        .map(|i| evd.S()[i])
-        .map(|z| if (z - one).norm() < 1e-9 { one } else { z })
-        .collect();
-    let v: Mat<c64> = evd.U().to_owned();
-    let id = Mat::<c64>::from_fn(k, k, |i, j| if i == j { one } else { c64::new(0.0, 0.0) });
-    let v_inv = v.full_piv_lu().solve(&id);
-    let mut err = 0.0f64;
-    for i in 0..k {
-        for j in 0..k {
-            let (mut vv, mut rec) = (c64::new(0.0, 0.0), c64::new(0.0, 0.0));
-            for l in 0..k {
-                vv += v_inv[(i, l)] * v[(l, j)];
-                rec += v[(i, l)] * values[l] * v_inv[(l, j)];
-            }
-            let target = if i == j { 1.0 } else { 0.0 };
-            err = err.max((vv - c64::new(target, 0.0)).norm());
-            err = err.max((rec - c64::new(a[(i, j)], 0.0)).norm());
-        }
-    }
-    if err.is_nan() || err >= 1e-10 {
-        return None;
-    }
-    let phi = std::array::from_fn(|q| {
-        (0..k)
-            .map(|i| {
-                std::array::from_fn(|g| {
-                    (0..k).fold(c64::new(0.0, 0.0), |acc, j| {
-                        acc + v[(j, i)] * abar[q][(g, j)]
-                    })
-                })
-            })
-            .collect()
-    });
-    Some(LoopEigenbasis { values, phi, v_inv })
-}
-
 /// Loop corner-patch matrices per valence, built on first use and shared.
 pub fn loop_corner_matrices(n: usize) -> Result<Arc<LoopCornerMatrices>, LimitError> {
-    static CACHE: OnceLock<Mutex<HashMap<usize, Arc<LoopCornerMatrices>>>> = OnceLock::new();
-    let cache = CACHE.get_or_init(|| Mutex::new(HashMap::new()));
-    let poisoned = || LimitError::Analysis("Loop corner-patch cache poisoned by a panic".into());
-    if let Some(m) = cache.lock().map_err(|_| poisoned())?.get(&n) {
-        return Ok(m.clone());
-    }
-    let m = Arc::new(LoopCornerMatrices::new(n)?);
-    cache
-        .lock()
-        .map_err(|_| poisoned())?
-        .entry(n)
-        .or_insert_with(|| m.clone());
-    Ok(m)
+    static CACHE: PerValence<LoopCornerMatrices> = OnceLock::new();
+    cached(&CACHE, n, LoopCornerMatrices::new)
 }
 
 #[cfg(test)]

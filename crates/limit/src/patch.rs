@@ -117,10 +117,11 @@ pub fn eval_bicubic(grid: &[DVec3; 16], u: f64, v: f64) -> SurfacePoint {
     }
 }
 
-/// The ring of `v` starting at face `f`: for each incident face in counter-clockwise order,
-/// (next vertex, opposite vertex, previous vertex) in that face. `None` unless every face
-/// around `v` is a quad, `v` is interior and manifold, and `f` is incident to it.
-fn quad_ring(t: &Topology, v: usize, f: usize) -> Option<Vec<[u32; 3]>> {
+/// The ring of interior manifold vertex `v` starting at face `f`: for each incident face in
+/// counter-clockwise order, the face's vertices after `v` (so `[next, …, previous]`). `None`
+/// unless every face around `v` has `K + 1` vertices, `v` is interior and manifold, and `f`
+/// is incident to it.
+pub(crate) fn face_ring<const K: usize>(t: &Topology, v: usize, f: usize) -> Option<Vec<[u32; K]>> {
     let faces = t.vertex_faces(v);
     if t.is_boundary_vertex(v)
         || t.is_non_manifold_vertex(v)
@@ -135,13 +136,18 @@ fn quad_ring(t: &Topology, v: usize, f: usize) -> Option<Vec<[u32; 3]>> {
         .map(|j| {
             let i = (start + j) % n;
             let fv = t.face_vertices(faces[i] as usize);
-            if fv.len() != 4 {
+            if fv.len() != K + 1 {
                 return None;
             }
             let c = local[i] as usize;
-            Some([fv[(c + 1) % 4], fv[(c + 2) % 4], fv[(c + 3) % 4]])
+            Some(std::array::from_fn(|k| fv[(c + 1 + k) % (K + 1)]))
         })
         .collect()
+}
+
+/// [`face_ring`] of quads: (next, opposite, previous) per face.
+fn quad_ring(t: &Topology, v: usize, f: usize) -> Option<Vec<[u32; 3]>> {
+    face_ring::<3>(t, v, f)
 }
 
 /// The 2n + 8 control points of quad `f` seen from its corner `c` (see the module docs), or

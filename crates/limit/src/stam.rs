@@ -35,19 +35,31 @@ use crate::patch::{REGULAR_GRID, SurfacePoint, bicubic_weights, corner_patch};
 pub struct CornerPatchMatrices {
     /// Valence.
     pub n: usize,
-    /// `A`, (2n + 8) × (2n + 8): the corner quarter's control points from the patch's.
+    /// `A`, (2n + 8) × (2n + 8) (the corner quarter's control points from the patch's), the
+    /// three `Ā_k`, 16 × (2n + 8) (the B-spline control points of quarters k = 1, 2, 3, rows
+    /// in grid order), and their eigenbasis.
+    pub sub: SubpatchSubdivision<16>,
+}
+
+/// One subdivision step of a patch with an extraordinary corner: `A` maps its K control
+/// points to those of the corner sub-patch, `Ā_k` (k = 1, 2, 3) to the G control points of
+/// the three regular sub-patches; with the eigenbasis of `A` when it reproduces `A`. Shared
+/// by Catmull-Clark (G = 16) and Loop (G = 12).
+#[derive(Debug)]
+pub struct SubpatchSubdivision<const G: usize> {
+    /// `A`, K × K.
     pub a: Mat<f64>,
-    /// `Ā_k`, 16 × (2n + 8), for quarters k = 1, 2, 3 (index k − 1), rows in grid order.
+    /// `Ā_k`, G × K, for k = 1, 2, 3 (index k − 1).
     pub abar: [Mat<f64>; 3],
-    eigen: Option<Eigenbasis>,
+    eigen: Option<Eigenbasis<G>>,
 }
 
 #[derive(Debug)]
-struct Eigenbasis {
+struct Eigenbasis<const G: usize> {
     /// Eigenvalues λ_i.
     values: Vec<c64>,
-    /// `Ā_k V` per quarter: for each eigenvector i, its 16 B-spline control weights.
-    phi: [Vec<[c64; 16]>; 3],
+    /// `Ā_k V` per sub-patch: for each eigenvector i, its G control weights.
+    phi: [Vec<[c64; G]>; 3],
     /// `V⁻¹`, K × K.
     v_inv: Mat<c64>,
 }
@@ -106,8 +118,86 @@ impl CornerPatchMatrices {
             rows(&grid)
         };
         let abar = [quarter(1)?, quarter(2)?, quarter(3)?];
+        Ok(CornerPatchMatrices {
+            n,
+            sub: SubpatchSubdivision::new(a, abar),
+        })
+    }
+
+    /// Whether evaluation uses the eigenbasis (`false`: repeated application of `A`).
+    pub fn uses_eigenbasis(&self) -> bool {
+        self.sub.uses_eigenbasis()
+    }
+
+    /// Eigenvalues of `A`, largest modulus first (empty when the decomposition was rejected).
+    pub fn eigenvalues(&self) -> Vec<c64> {
+        self.sub.eigenvalues()
+    }
+
+    /// The surface point at corner-patch parameters (s, t) ∈ [0, 1]², (0, 0) at the
+    /// extraordinary vertex, from the 2n + 8 control points `cp`. `(0, 0)` itself is not a
+    /// patch point of any level; the caller takes the limit mask there.
+    pub fn evaluate(&self, cp: &[DVec3], s: f64, t: f64) -> SurfacePoint {
+        self.evaluate_with(cp, s, t, true)
+    }
+
+    /// [`Self::evaluate`] choosing the method: the eigenbasis or `A` applied `m − 1` times.
+    pub fn evaluate_with(&self, cp: &[DVec3], s: f64, t: f64, eigen: bool) -> SurfacePoint {
+        self.evaluate_projected(&self.sub.project(cp, eigen), s, t)
+    }
+
+    /// The control points prepared for evaluation: projected on the eigenbasis
+    /// (`ĉ = V⁻¹ C`) when there is one. Do this once per patch, then evaluate many points.
+    pub fn project(&self, cp: &[DVec3]) -> Projected {
+        self.sub.project(cp, true)
+    }
+
+    /// [`Self::evaluate`] from [`Self::project`]ed control points.
+    pub fn evaluate_projected(&self, c: &Projected, s: f64, t: f64) -> SurfacePoint {
+        debug_assert!(s > 0.0 || t > 0.0);
+        let (steps, scale) = steps_to_regular(s.max(t));
+        let (s1, t1) = (s * scale, t * scale);
+        let (quarter, u, v) = if t1 < 0.5 {
+            (0, 2.0 * s1 - 1.0, 2.0 * t1)
+        } else if s1 >= 0.5 {
+            (1, 2.0 * s1 - 1.0, 2.0 * t1 - 1.0)
+        } else {
+            (2, 2.0 * s1, 2.0 * t1 - 1.0)
+        };
+        let out = self.sub.combine(c, steps, quarter, &bicubic_weights(u, v));
+        SurfacePoint {
+            position: out[0],
+            du: out[1],
+            dv: out[2],
+            duu: out[3],
+            duv: out[4],
+            dvv: out[5],
+        }
+        .scaled(2.0 * scale)
+    }
+}
+
+/// The number of steps m − 1 after which a point at "distance" `p` from the extraordinary
+/// corner (max(s, t) for quads, u + v for triangles) lies in a regular sub-patch, i.e.
+/// `p · 2^(m−1)` ∈ [1/2, 1], and that power of two.
+pub(crate) fn steps_to_regular(p: f64) -> (i32, f64) {
+    let mut steps = (-p.log2()).floor().max(0.0) as i32;
+    let mut scale = 2f64.powi(steps);
+    if p * scale > 1.0 {
+        steps -= 1;
+        scale *= 0.5;
+    } else if p * scale < 0.5 {
+        steps += 1;
+        scale *= 2.0;
+    }
+    (steps, scale)
+}
+
+impl<const G: usize> SubpatchSubdivision<G> {
+    /// Stores `A` and `Ā_k` and decomposes `A`.
+    pub fn new(a: Mat<f64>, abar: [Mat<f64>; 3]) -> Self {
         let eigen = Eigenbasis::new(&a, &abar);
-        Ok(CornerPatchMatrices { n, a, abar, eigen })
+        SubpatchSubdivision { a, abar, eigen }
     }
 
     /// Whether evaluation uses the eigenbasis (`false`: repeated application of `A`).
@@ -125,29 +215,12 @@ impl CornerPatchMatrices {
         v
     }
 
-    /// The surface point at corner-patch parameters (s, t) ∈ [0, 1]², (0, 0) at the
-    /// extraordinary vertex, from the 2n + 8 control points `cp`. `(0, 0)` itself is not a
-    /// patch point of any level; the caller takes the limit mask there.
-    pub fn evaluate(&self, cp: &[DVec3], s: f64, t: f64) -> SurfacePoint {
-        self.evaluate_with(cp, s, t, self.eigen.is_some())
-    }
-
-    /// [`Self::evaluate`] choosing the method: the eigenbasis or `A` applied `m − 1` times.
-    pub fn evaluate_with(&self, cp: &[DVec3], s: f64, t: f64, eigen: bool) -> SurfacePoint {
-        self.evaluate_projected(&self.project_with(cp, eigen), s, t)
-    }
-
-    /// The control points prepared for evaluation: projected on the eigenbasis
-    /// (`ĉ = V⁻¹ C`) when there is one. Do this once per patch, then evaluate many points.
-    pub fn project(&self, cp: &[DVec3]) -> Projected {
-        self.project_with(cp, true)
-    }
-
-    fn project_with(&self, cp: &[DVec3], eigen: bool) -> Projected {
+    /// Control points prepared for evaluation: projected on the eigenbasis when there is one
+    /// and `eigen` asks for it, else kept for repeated subdivision.
+    pub fn project(&self, cp: &[DVec3], eigen: bool) -> Projected {
         match (&self.eigen, eigen) {
-            (Some(e), true) => {
-                let k = cp.len();
-                let chat = (0..k)
+            (Some(e), true) => Projected::Eigen(
+                (0..cp.len())
                     .map(|i| {
                         cp.iter()
                             .enumerate()
@@ -159,36 +232,15 @@ impl CornerPatchMatrices {
                                 acc
                             })
                     })
-                    .collect();
-                Projected::Eigen(chat)
-            }
+                    .collect(),
+            ),
             _ => Projected::Points(cp.to_vec()),
         }
     }
 
-    /// [`Self::evaluate`] from [`Self::project`]ed control points.
-    pub fn evaluate_projected(&self, c: &Projected, s: f64, t: f64) -> SurfacePoint {
-        debug_assert!(s > 0.0 || t > 0.0);
-        // Steps m − 1 until max(s, t) · 2^(m−1) lies in [1/2, 1].
-        let p = s.max(t);
-        let mut steps = (-p.log2()).floor().max(0.0) as i32;
-        let mut scale = 2f64.powi(steps);
-        if p * scale > 1.0 {
-            steps -= 1;
-            scale *= 0.5;
-        } else if p * scale < 0.5 {
-            steps += 1;
-            scale *= 2.0;
-        }
-        let (s1, t1) = (s * scale, t * scale);
-        let (quarter, u, v) = if t1 < 0.5 {
-            (0, 2.0 * s1 - 1.0, 2.0 * t1)
-        } else if s1 >= 0.5 {
-            (1, 2.0 * s1 - 1.0, 2.0 * t1 - 1.0)
-        } else {
-            (2, 2.0 * s1, 2.0 * t1 - 1.0)
-        };
-        let w = bicubic_weights(u, v);
+    /// Position and derivatives (in sub-patch parameters) after `steps` subdivisions, in
+    /// regular sub-patch `sub` (0..3 for k = 1..3), from its control weights `w`.
+    pub fn combine(&self, c: &Projected, steps: i32, sub: usize, w: &[[f64; G]; 6]) -> [DVec3; 6] {
         let mut out = [DVec3::ZERO; 6];
         match c {
             Projected::Eigen(chat) => {
@@ -197,14 +249,14 @@ impl CornerPatchMatrices {
                     .as_ref()
                     .expect("eigen projections come from this eigenbasis");
                 let one = c64::new(1.0, 0.0);
-                for ((lam, phi), ch) in e.values.iter().zip(&e.phi[quarter]).zip(chat) {
+                for ((lam, phi), ch) in e.values.iter().zip(&e.phi[sub]).zip(chat) {
                     let lp = lam.powi(steps);
                     // The eigenvalue-1 term is the constant (the limit point): derivatives
                     // of a constant are exactly zero, and leaving it out keeps derivatives
                     // near the vertex to full relative precision (its round-off would be
                     // scaled up by 2^m).
                     let outputs = if *lam == one { 1 } else { 6 };
-                    for (o, wd) in out.iter_mut().zip(&w).take(outputs) {
+                    for (o, wd) in out.iter_mut().zip(w).take(outputs) {
                         let b = phi
                             .iter()
                             .zip(wd)
@@ -223,8 +275,8 @@ impl CornerPatchMatrices {
                     }
                     std::mem::swap(&mut c, &mut next);
                 }
-                let ab = &self.abar[quarter];
-                for g in 0..16 {
+                let ab = &self.abar[sub];
+                for g in 0..G {
                     let q = (0..c.len()).fold(DVec3::ZERO, |acc, j| acc + ab[(g, j)] * c[j]);
                     for (d, o) in out.iter_mut().enumerate() {
                         *o += w[d][g] * q;
@@ -232,15 +284,7 @@ impl CornerPatchMatrices {
                 }
             }
         }
-        SurfacePoint {
-            position: out[0],
-            du: out[1],
-            dv: out[2],
-            duu: out[3],
-            duv: out[4],
-            dvv: out[5],
-        }
-        .scaled(2.0 * scale)
+        out
     }
 }
 
@@ -253,9 +297,9 @@ pub enum Projected {
     Points(Vec<DVec3>),
 }
 
-impl Eigenbasis {
+impl<const G: usize> Eigenbasis<G> {
     /// `A = V Λ V⁻¹`, kept only when it reproduces `A` and `V` is well conditioned.
-    fn new(a: &Mat<f64>, abar: &[Mat<f64>; 3]) -> Option<Eigenbasis> {
+    fn new(a: &Mat<f64>, abar: &[Mat<f64>; 3]) -> Option<Eigenbasis<G>> {
         let k = a.nrows();
         let evd = a.eigen().ok()?;
         // The dominant eigenvalue is exactly 1 (affine invariance); the solver's 1 ± ε raised
@@ -314,22 +358,31 @@ impl Eigenbasis {
 
 /// Corner-patch matrices per valence, built on first use and shared.
 pub fn corner_patch_matrices(n: usize) -> Result<Arc<CornerPatchMatrices>, LimitError> {
-    static CACHE: OnceLock<Mutex<HashMap<usize, Arc<CornerPatchMatrices>>>> = OnceLock::new();
-    let cache = CACHE.get_or_init(|| Mutex::new(HashMap::new()));
+    static CACHE: PerValence<CornerPatchMatrices> = OnceLock::new();
+    cached(&CACHE, n, CornerPatchMatrices::new)
+}
+
+/// A cache of per-valence matrices.
+pub(crate) type PerValence<T> = OnceLock<Mutex<HashMap<usize, Arc<T>>>>;
+
+/// The entry of `cache` for valence `n`, built with `build` on first use.
+pub(crate) fn cached<T>(
+    cache: &PerValence<T>,
+    n: usize,
+    build: impl FnOnce(usize) -> Result<T, LimitError>,
+) -> Result<Arc<T>, LimitError> {
+    let cache = cache.get_or_init(|| Mutex::new(HashMap::new()));
+    let poisoned = || LimitError::Analysis("matrix cache poisoned by a panic".into());
     if let Some(m) = cache.lock().map_err(|_| poisoned())?.get(&n) {
         return Ok(m.clone());
     }
-    let m = Arc::new(CornerPatchMatrices::new(n)?);
-    cache
+    let m = Arc::new(build(n)?);
+    Ok(cache
         .lock()
         .map_err(|_| poisoned())?
         .entry(n)
-        .or_insert_with(|| m.clone());
-    Ok(m)
-}
-
-fn poisoned() -> LimitError {
-    LimitError::Analysis("corner-patch cache poisoned by a panic".into())
+        .or_insert(m)
+        .clone())
 }
 
 #[cfg(test)]
