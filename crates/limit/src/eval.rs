@@ -20,12 +20,13 @@
 //! Catmull-Clark faces along straight infinitely sharp creases, regular boundaries (boundary
 //! vertices of valence 3) and sharp corners are B-spline patches with phantom points
 //! ([`crate::patch::sharp_regular_grid`]); faces with other sharp features are refined two
-//! levels like irregular faces.
+//! levels like irregular faces, and the level-2 faces that are still next to an irregular
+//! sharp feature (darts, crease or boundary vertices of irregular valence, semi-sharp creases
+//! not yet decayed, Loop creases and boundaries) are refined further, locally and only as
+//! deep as the point needs ([`crate::local`]).
 //!
-//! **Not yet covered** (an error, [`LimitError::Unsupported`]): the pieces next to an
-//! irregular sharp feature (darts, crease or boundary vertices of irregular valence,
-//! semi-sharp creases not yet decayed, holes), and Loop faces touching creases or
-//! boundaries.
+//! **Not on the surface** ([`LimitError::Unsupported`]): holes, and non-manifold
+//! configurations that a local cut cannot reproduce (repeated edge instances).
 
 use glam::DVec3;
 use subd_mesh::Topology;
@@ -79,6 +80,9 @@ enum Piece {
     },
     /// Refined two levels (base faces only).
     Refined,
+    /// Refined locally, as deep as the point needs (level-2 faces next to irregular sharp
+    /// features, [`crate::local`]).
+    Local,
     /// Not covered, with the reason.
     Unsupported(&'static str),
 }
@@ -109,9 +113,8 @@ fn loop_piece(t: &Topology, rules: &[subd_schemes::Rule], f: usize) -> Result<Pi
         return Ok(Piece::Unsupported("the face is a hole"));
     }
     if !smooth_neighbourhood(t, rules, f) {
-        return Ok(Piece::Unsupported(
-            "a crease, corner, dart, boundary or hole touches the face",
-        ));
+        // Creases, corners, darts, boundaries and holes nearby: refined.
+        return Ok(Piece::Refined);
     }
     let fv = t.face_vertices(f);
     let irregular: Vec<usize> = (0..3)
@@ -122,9 +125,7 @@ fn loop_piece(t: &Topology, rules: &[subd_schemes::Rule], f: usize) -> Result<Pi
             Some(cp) => Piece::LoopRegular(cp),
             None => Piece::Refined,
         },
-        [c] if t.vertex_faces(fv[*c] as usize).len() < 3 => {
-            Piece::Unsupported("interior Loop vertex of valence 2")
-        }
+        [c] if t.vertex_faces(fv[*c] as usize).len() < 3 => Piece::Refined,
         [c] => match tri_corner_patch(t, f, *c) {
             Some(cp) => Piece::LoopCorner {
                 corner: *c,
@@ -199,6 +200,7 @@ fn piece_kind(
 #[derive(Debug)]
 pub struct LimitEvaluator {
     scheme: Scheme,
+    options: Options,
     base: Topology,
     base_pieces: Vec<Piece>,
     /// Two levels of refinement, when some base face needs them.
@@ -273,7 +275,7 @@ impl LimitEvaluator {
                     };
                     for g in grand {
                         pieces[g] = match piece_of(t2, rules2, g, scheme)? {
-                            Piece::Refined => Piece::Unsupported("irregular after two levels"),
+                            Piece::Refined => Piece::Local,
                             p => p,
                         };
                     }
@@ -285,6 +287,7 @@ impl LimitEvaluator {
         };
         Ok(LimitEvaluator {
             scheme,
+            options: *options,
             base,
             base_pieces,
             refined,
@@ -379,6 +382,27 @@ impl LimitEvaluator {
                     (4 * c1 + k, s2, t2, 2.0 * scale1)
                 };
                 debug_assert!(f2 < r.topology(2).num_faces());
+                if let Piece::Local = self.level2_pieces[f2] {
+                    let p = crate::local::evaluate(
+                        r.topology(2),
+                        r.vertex_rules(2),
+                        &points.level2,
+                        f2,
+                        self.scheme,
+                        &self.options,
+                        s2,
+                        t2,
+                    )
+                    .map_err(|e| match e {
+                        // Name the base face, not the level-2 one.
+                        LimitError::Unsupported { reason, .. } => LimitError::Unsupported {
+                            face: at.face,
+                            reason,
+                        },
+                        e => e,
+                    })?;
+                    return Ok(p.scaled(scale));
+                }
                 let p = eval_piece(
                     &self.level2_pieces[f2],
                     &points.level2,
@@ -403,7 +427,7 @@ impl LimitEvaluator {
 
 /// The child of a quad holding (u, v) and the parameters in it: child j has the parent's
 /// corner j at its corner j (OpenSubdiv's order), `(0,0)` at its first vertex.
-fn quadrant(u: f64, v: f64) -> (usize, f64, f64) {
+pub(crate) fn quadrant(u: f64, v: f64) -> (usize, f64, f64) {
     match (u >= 0.5, v >= 0.5) {
         (false, false) => (0, 2.0 * u, 2.0 * v),
         (true, false) => (1, 2.0 * u - 1.0, 2.0 * v),
@@ -415,7 +439,7 @@ fn quadrant(u: f64, v: f64) -> (usize, f64, f64) {
 /// The child of a Loop triangle holding (u, v), its parameters there, and the scale of the
 /// map (negative for the middle child, which is turned around): children
 /// `(V0,E0,E2)`, `(E0,V1,E1)`, `(E2,E1,V2)`, `(E1,E2,E0)` in OpenSubdiv's order.
-fn tri_child(u: f64, v: f64) -> (usize, f64, f64, f64) {
+pub(crate) fn tri_child(u: f64, v: f64) -> (usize, f64, f64, f64) {
     if u >= 0.5 {
         (1, 2.0 * u - 1.0, 2.0 * v, 2.0)
     } else if v >= 0.5 {
@@ -425,6 +449,27 @@ fn tri_child(u: f64, v: f64) -> (usize, f64, f64, f64) {
     } else {
         (3, 1.0 - 2.0 * u, 1.0 - 2.0 * v, -2.0)
     }
+}
+
+/// Face `f` of `t` evaluated directly when it is a patch (B-spline, box spline, Stam corner),
+/// `None` when it needs refining; holes are an error.
+pub(crate) fn direct_evaluation(
+    t: &Topology,
+    rules: &[subd_schemes::Rule],
+    pts: &[DVec3],
+    f: usize,
+    scheme: Scheme,
+    s: f64,
+    tp: f64,
+) -> Result<Option<SurfacePoint>, LimitError> {
+    let piece = piece_of(t, rules, f, scheme)?;
+    if matches!(piece, Piece::Refined | Piece::Local) {
+        return Ok(None);
+    }
+    let projected = project_all(std::slice::from_ref(&piece), pts)
+        .pop()
+        .flatten();
+    eval_piece(&piece, pts, projected.as_ref(), f, s, tp).map(Some)
 }
 
 /// Evaluates one piece at (s, t) in its face's parameters.
@@ -512,7 +557,7 @@ fn eval_piece(
             };
             Ok(pull_back(&q, j))
         }
-        Piece::Refined => unreachable!("refined pieces are resolved by the caller"),
+        Piece::Refined | Piece::Local => unreachable!("refined pieces are resolved by the caller"),
         Piece::Unsupported(reason) => Err(LimitError::Unsupported { face, reason }),
     }
 }

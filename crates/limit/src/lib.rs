@@ -13,6 +13,8 @@
 //!   vertex, refining first as far as semi-sharp creases need to decay.
 //! * [`eval`]: exact evaluation at any (face, u, v) with derivatives — bicubic B-splines and
 //!   [`stam`]'s eigenbasis for Catmull-Clark, box splines and [`loop_patch`] for Loop.
+//!   Next to irregular sharp features the evaluator refines locally, as deep as the point
+//!   needs ([`local`]).
 //! * [`acc`]: Loop & Schaefer's bicubic approximation (geometry and tangent patches).
 //!
 //! ```
@@ -41,6 +43,7 @@
 pub mod acc;
 pub mod eigen;
 pub mod eval;
+pub mod local;
 pub mod loop_patch;
 pub mod masks;
 pub mod patch;

@@ -204,7 +204,7 @@ pub type GridPoint = Vec<(u32, f64)>;
 /// edges run straight through it (interior valence 4, or a boundary vertex with two faces);
 /// or a sharp corner with one face. Returns `false` for anything else (darts, semi-sharp
 /// features, irregular valences).
-fn regular_sharp_corner(t: &Topology, rules: &[Rule], v: usize) -> bool {
+pub fn regular_sharp_corner(t: &Topology, rules: &[Rule], v: usize) -> bool {
     use subd_mesh::tags::is_infinite;
     let (ve, vf) = (t.vertex_edges(v), t.vertex_faces(v));
     if t.is_non_manifold_vertex(v)

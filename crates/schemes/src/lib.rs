@@ -121,6 +121,14 @@ pub enum RefineError {
         /// The maximum.
         max: usize,
     },
+    /// A prepared level was given a rule list of the wrong length.
+    #[error("{rules} vertex rules given for {vertices} vertices")]
+    RuleCount {
+        /// Rules given.
+        rules: usize,
+        /// Vertices of the level.
+        vertices: usize,
+    },
     /// The refined mesh would not fit 32-bit indices.
     #[error("level {level} would have more than 2^32 face-vertices")]
     TooLarge {
@@ -181,6 +189,55 @@ impl Refinement {
             });
         }
         let (t0, rules0) = refine::prepare_base(base, scheme, options);
+        Self::refine_prepared(t0, rules0, scheme, options, levels)
+    }
+
+    /// Refines a level that is already prepared — its boundary and non-manifold tags
+    /// applied and the rule of every vertex known, as in the levels of another refinement —
+    /// `levels` more times. Unlike [`Self::new`] it does not re-derive base-level tags (a
+    /// non-manifold vertex of a refined level, for instance, is not a corner unless its tags
+    /// say so). Used to continue refining a piece cut out of a refined level.
+    ///
+    /// # Errors
+    /// As [`Self::new`]; also [`RefineError::RuleCount`] when `rules` does not have one rule
+    /// per vertex.
+    pub fn from_prepared(
+        level: Topology,
+        rules: Vec<Rule>,
+        scheme: Scheme,
+        options: &Options,
+        levels: usize,
+    ) -> Result<Self, RefineError> {
+        if rules.len() != level.num_vertices() {
+            return Err(RefineError::RuleCount {
+                rules: rules.len(),
+                vertices: level.num_vertices(),
+            });
+        }
+        if levels > MAX_LEVELS {
+            return Err(RefineError::TooManyLevels {
+                levels,
+                max: MAX_LEVELS,
+            });
+        }
+        if scheme == Scheme::Loop
+            && let Some(f) = (0..level.num_faces()).find(|&f| level.face_size(f) != 3)
+        {
+            return Err(RefineError::NotTriangle {
+                face: f,
+                size: level.face_size(f),
+            });
+        }
+        Self::refine_prepared(level, rules, scheme, options, levels)
+    }
+
+    fn refine_prepared(
+        t0: Topology,
+        rules0: Vec<Rule>,
+        scheme: Scheme,
+        options: &Options,
+        levels: usize,
+    ) -> Result<Self, RefineError> {
         let mut r = Refinement {
             scheme,
             options: *options,
