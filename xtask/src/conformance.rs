@@ -196,9 +196,8 @@ const EVAL_PARAMS: [(f64, f64); 14] = [
 /// (infinitely sharp patches on, legacy sharp corners off). Outside the 2^-10 squares at
 /// irregular corners OpenSubdiv's patches are exact B-splines: positions must agree to 1e-12
 /// of the bounding-box diagonal and unit normals to 1e-9 (scaled). Inside, OpenSubdiv has a Gregory
-/// end cap; the largest difference there is reported, not checked (for Loop, whose patches
-/// have no crease form in OpenSubdiv, the same holds for strips of width 2^-10 along sharp
-/// edges). Holes and uncovered faces are counted and left out. Where OpenSubdiv differs but
+/// end cap; the largest difference there is reported, not checked. Holes and uncovered faces
+/// are counted and left out. Where OpenSubdiv differs but
 /// subd's face equals uniform refinement at dyadic points, the point is counted as
 /// OpenSubdiv's inexactness, not a failure.
 fn compare_eval(
@@ -261,7 +260,6 @@ fn compare_eval(
     let mut ours = Vec::new();
     let mut queries = Vec::new();
     let mut inside = Vec::new();
-    let mut one_sided = Vec::new();
     let mut feature_dist = Vec::new();
     let mut ptex_face = Vec::new();
     let mut uncovered = 0usize;
@@ -320,35 +318,18 @@ fn compare_eval(
                         // Distance to each sharp edge (boundaries included) of the ptex face.
                         let fe = t0.face_edges(f);
                         let sharp = |k: usize| t0.edge_sharpness(fe[k] as usize) > 0.0;
-                        let edge_dist: Vec<f64> = if loop_scheme {
-                            [(0, v), (1, 1.0 - u - v), (2, u)]
-                                .into_iter()
-                                .filter(|&(k, _)| sharp(k))
-                                .map(|(_, d)| d)
-                                .collect()
+                        let edges: Vec<(usize, f64)> = if loop_scheme {
+                            vec![(0, v), (1, 1.0 - u - v), (2, u)]
                         } else if n == 4 {
-                            [(0, v), (1, 1.0 - u), (2, 1.0 - v), (3, u)]
-                                .into_iter()
-                                .filter(|&(k, _)| sharp(k))
-                                .map(|(_, d)| d)
-                                .collect()
+                            vec![(0, v), (1, 1.0 - u), (2, 1.0 - v), (3, u)]
                         } else {
-                            [(sub, v), ((sub + n - 1) % n, u)]
-                                .into_iter()
-                                .filter(|&(k, _)| sharp(k))
-                                .map(|(_, d)| d)
-                                .collect()
+                            vec![(sub, v), ((sub + n - 1) % n, u)]
                         };
-                        let strip = edge_dist.iter().copied().fold(f64::INFINITY, f64::min);
-                        // OpenSubdiv's Loop patches have no crease or boundary form: along
-                        // sharp edges it caps a strip of width 2^-10 as at irregular corners.
-                        let dist = if loop_scheme { dist.min(strip) } else { dist };
-                        // Exactly on a sharp edge the surface has one normal per side; subd
-                        // gives the face's side where the piece is a patch, but at an
-                        // irregular sharp vertex or on a Loop crease it gives the vertex's
-                        // limit normal (its tangent convention), so normals there are not
-                        // compared.
-                        one_sided.push(strip == 0.0);
+                        let strip = edges
+                            .iter()
+                            .filter(|&&(k, _)| sharp(k))
+                            .map(|&(_, d)| d)
+                            .fold(f64::INFINITY, f64::min);
                         inside.push((dist < near, dist));
                         // Derivative round-off grows with the depth of local refinement,
                         // which next to a sharp edge is driven by the distance to it.
@@ -420,10 +401,7 @@ fn compare_eval(
             err.max(d)
         };
         let on = t[1].cross(t[2]);
-        if on.length() > 1e-12 * t[1].length() * t[2].length()
-            && p.normal() != DVec3::ZERO
-            && !one_sided[i]
-        {
+        if on.length() > 1e-12 * t[1].length() * t[2].length() && p.normal() != DVec3::ZERO {
             let dn = (p.normal() - on.normalize()).abs().max_element()
                 * dist.min(feature_dist[i]).min(1.0);
             if dn > EVAL_NORMAL_TOLERANCE {
@@ -760,7 +738,7 @@ pub fn report(rows: &[Row]) -> bool {
             .map_or_else(|| "-".to_string(), |e| format!("{e:.3e}"));
         let excluded = r.excluded.map_or_else(String::new, |(n, e)| {
             if r.check == "eval" {
-                format!(" ({n} points not on the surface (holes) or not covered left out; in the 2^-10 end-cap squares and Loop crease strips |Δ|/diag ≤ {e:.1e})")
+                format!(" ({n} points not on the surface (holes) or not covered left out; in the 2^-10 end-cap squares |Δ|/diag ≤ {e:.1e})")
             } else {
                 format!(" ({n} vertices where OpenSubdiv is inexact left out; there |Δ|/diag ≤ {e:.1e})")
             }

@@ -32,7 +32,7 @@ use crate::patch::face_ring;
 pub struct AccPatch {
     /// Base face.
     pub face: usize,
-    /// Bicubic Bézier geometry patch, `geometry[4 j + i]` = b[i][j].
+    /// Bicubic Bézier geometry patch, `geometry[4 j + i]` = `b[i][j]`.
     pub geometry: [[f64; 3]; 16],
     /// u-tangent patch, bidegree 2 (u) × 3 (v): `tangent_u[3 j + i]`, i ∈ 0..3, j ∈ 0..4.
     pub tangent_u: [[f64; 3]; 12],

@@ -14,7 +14,8 @@
 //! exact either way (no end-cap approximation).
 //!
 //! Loop triangles (`(0,0) = v0`, `(1,0) = v1`, `(0,1) = v2`, barycentric
-//! `(1 − u − v, u, v)`) are quartic box-spline patches where regular and Stam's Loop
+//! `(1 − u − v, u, v)`) are quartic box-spline patches where regular (with phantom points
+//! along straight infinitely sharp creases and regular boundaries) and Stam's Loop
 //! eigenbasis at one extraordinary corner ([`crate::loop_patch`]).
 //!
 //! Catmull-Clark faces along straight infinitely sharp creases, regular boundaries (boundary
@@ -22,8 +23,8 @@
 //! ([`crate::patch::sharp_regular_grid`]); faces with other sharp features are refined two
 //! levels like irregular faces, and the level-2 faces that are still next to an irregular
 //! sharp feature (darts, crease or boundary vertices of irregular valence, semi-sharp creases
-//! not yet decayed, Loop creases and boundaries) are refined further, locally and only as
-//! deep as the point needs ([`crate::local`]).
+//! not yet decayed, Loop crease and boundary vertices of irregular valence) are refined
+//! further, locally and only as deep as the point needs ([`crate::local`]).
 //!
 //! **Not on the surface** ([`LimitError::Unsupported`]): holes, and non-manifold
 //! configurations that a local cut cannot reproduce (repeated edge instances).
@@ -33,7 +34,9 @@ use subd_mesh::Topology;
 use subd_schemes::{Options, Refinement, Scheme};
 
 use crate::LimitError;
-use crate::loop_patch::{LoopCornerMatrices, box_spline, loop_corner_matrices, tri_corner_patch};
+use crate::loop_patch::{
+    LoopCornerMatrices, box_spline, loop_corner_matrices, loop_sharp_regular, tri_corner_patch,
+};
 use crate::masks;
 use crate::patch::{
     GridPoint, REGULAR_GRID, SurfacePoint, corner_patch, eval_bicubic, sharp_regular_grid,
@@ -72,6 +75,9 @@ enum Piece {
     },
     /// Quartic box spline over 12 control points (Loop).
     LoopRegular(Vec<u32>),
+    /// Quartic box spline over 12 control points some of which are phantom points across
+    /// infinitely sharp edges or boundaries (Loop).
+    LoopSharpRegular(Box<[GridPoint; 12]>),
     /// Loop eigenbasis evaluation, extraordinary vertex at corner `corner`.
     LoopCorner {
         corner: usize,
@@ -113,8 +119,12 @@ fn loop_piece(t: &Topology, rules: &[subd_schemes::Rule], f: usize) -> Result<Pi
         return Ok(Piece::Unsupported("the face is a hole"));
     }
     if !smooth_neighbourhood(t, rules, f) {
-        // Creases, corners, darts, boundaries and holes nearby: refined.
-        return Ok(Piece::Refined);
+        // Straight infinitely sharp creases and regular boundaries are box splines with
+        // phantom points; other features nearby are refined.
+        return Ok(match loop_sharp_regular(t, rules, f) {
+            Some(g) => Piece::LoopSharpRegular(Box::new(g)),
+            None => Piece::Refined,
+        });
     }
     let fv = t.face_vertices(f);
     let irregular: Vec<usize> = (0..3)
@@ -472,6 +482,12 @@ pub(crate) fn direct_evaluation(
     eval_piece(&piece, pts, projected.as_ref(), f, s, tp).map(Some)
 }
 
+/// A grid point's position: a vertex or a phantom combination.
+fn combine(g: &GridPoint, pts: &[DVec3]) -> DVec3 {
+    g.iter()
+        .fold(DVec3::ZERO, |acc, &(v, w)| acc + w * pts[v as usize])
+}
+
 /// Evaluates one piece at (s, t) in its face's parameters.
 fn eval_piece(
     piece: &Piece,
@@ -487,11 +503,7 @@ fn eval_piece(
             Ok(eval_bicubic(&g, s, tp))
         }
         Piece::SharpRegular(grid) => {
-            let g: [DVec3; 16] = std::array::from_fn(|i| {
-                grid[i]
-                    .iter()
-                    .fold(DVec3::ZERO, |acc, &(v, w)| acc + w * pts[v as usize])
-            });
+            let g: [DVec3; 16] = std::array::from_fn(|i| combine(&grid[i], pts));
             Ok(eval_bicubic(&g, s, tp))
         }
         Piece::Corner {
@@ -518,6 +530,10 @@ fn eval_piece(
         }
         Piece::LoopRegular(cp) => {
             let c: Vec<DVec3> = cp.iter().map(|&i| pts[i as usize]).collect();
+            Ok(box_spline()?.evaluate(&c, s, tp))
+        }
+        Piece::LoopSharpRegular(grid) => {
+            let c: Vec<DVec3> = grid.iter().map(|g| combine(g, pts)).collect();
             Ok(box_spline()?.evaluate(&c, s, tp))
         }
         Piece::LoopCorner {

@@ -2,9 +2,8 @@
 //!
 //! A face whose neighbourhood never becomes a B-spline, box-spline or Stam patch under
 //! refinement (darts, crease and boundary vertices of irregular valence, semi-sharp creases
-//! that have not decayed yet, Loop creases and boundaries) is evaluated by refining a small
-//! piece of mesh around it, one level at a time, following the query point into the child
-//! face that holds it, until that child is a patch the evaluator knows (a point at distance
+//! that have not decayed yet) is evaluated by refining a small piece of mesh around it, one
+//! level at a time, following the query point into the child face that holds it, until that child is a patch the evaluator knows (a point at distance
 //! `d` from the irregular vertex needs about `log2(1/d)` levels). Every step is the
 //! refinement code's own uniform step, so the value is the limit surface itself, not an
 //! approximation.
@@ -26,7 +25,8 @@ use crate::patch::SurfacePoint;
 
 /// Levels of local refinement before a point that still is not on a known patch is taken
 /// as its face's nearest corner (the distance is then below `2^-MAX_LOCAL_LEVELS` of the
-/// starting face's size, under the resolution of `f64` parameters).
+/// starting face's size, under the resolution of `f64` parameters). Only points closer than
+/// that to an irregular vertex, but not exactly at it, get there.
 pub const MAX_LOCAL_LEVELS: usize = 60;
 
 /// A piece of a refined level around one face.
@@ -199,7 +199,8 @@ fn nearest_corner(scheme: Scheme, u: f64, v: f64) -> usize {
 }
 
 /// The limit at corner `c` of the neighbourhood's face: position and the limit tangents
-/// (their directions exact, their scale the masks' convention), second derivatives zero.
+/// (their directions exact, their scale the masks' convention; at an interior crease vertex
+/// those of the face's side of the crease), second derivatives zero.
 fn corner_limit(
     nb: &Neighbourhood,
     scheme: Scheme,
@@ -218,11 +219,31 @@ fn corner_limit(
             .zip(w)
             .fold(DVec3::ZERO, |acc, (&i, &wi)| acc + wi * points[i as usize])
     };
-    Ok(SurfacePoint {
-        position: row(&table.position),
-        du: row(&table.tangent1),
-        dv: row(&table.tangent2),
-        ..SurfacePoint::default()
+    // At an interior crease vertex, the tangent plane of the face's own side: follow the
+    // corner's child face down to the level the masks are taken at (child c of a face holds
+    // its corner c, for quads and triangles alike).
+    let mut face = nb.face;
+    for l in 0..levels {
+        face = match scheme {
+            Scheme::Loop => 4 * face + c,
+            _ => r.topology(l).face_offsets()[face] as usize + c,
+        };
+    }
+    let t = r.topology(levels);
+    let side = crate::table::crease_side_mask(t, v, r.vertex_rules(levels)[v], scheme, face);
+    Ok(match side {
+        Some(m) => SurfacePoint {
+            position: row(&table.position),
+            du: crate::table::apply_ring(t, v, &m.tangent1, &points),
+            dv: crate::table::apply_ring(t, v, &m.tangent2, &points),
+            ..SurfacePoint::default()
+        },
+        None => SurfacePoint {
+            position: row(&table.position),
+            du: row(&table.tangent1),
+            dv: row(&table.tangent2),
+            ..SurfacePoint::default()
+        },
     })
 }
 

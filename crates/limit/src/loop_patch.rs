@@ -27,10 +27,10 @@ use faer::Mat;
 use faer::linalg::solvers::Solve;
 use glam::DVec3;
 use subd_mesh::{Topology, TopologyBuilder};
-use subd_schemes::{Options, Refinement, Scheme};
+use subd_schemes::{Options, Refinement, Rule, Scheme};
 
 use crate::LimitError;
-use crate::patch::{SurfacePoint, face_ring};
+use crate::patch::{GridPoint, SurfacePoint, face_ring};
 use crate::stam::{PerValence, Projected, SubpatchSubdivision, cached, steps_to_regular};
 use crate::table::LimitStencilTable;
 
@@ -343,9 +343,206 @@ pub fn loop_corner_matrices(n: usize) -> Result<Arc<LoopCornerMatrices>, LimitEr
     cached(&CACHE, n, LoopCornerMatrices::new)
 }
 
+/// Lattice coordinates of the 12 control points of the regular patch in corner-patch order
+/// (module docs), on the triangle lattice with directions (1, 0), (0, 1), (−1, 1):
+/// x0, e_0 = x1, e_1 = x2, e_2 … e_5, A, B, C, D, E.
+const LATTICE: [(i32, i32); 12] = [
+    (0, 0),
+    (1, 0),
+    (0, 1),
+    (-1, 1),
+    (-1, 0),
+    (0, -1),
+    (1, -1),
+    (2, -1),
+    (2, 0),
+    (1, 1),
+    (0, 2),
+    (-1, 2),
+];
+
+/// The six lattice neighbours of a point, counter-clockwise.
+const LATTICE_RING: [(i32, i32); 6] = [(1, 0), (0, 1), (-1, 1), (-1, 0), (0, -1), (1, -1)];
+
+/// A vertex of triangle `f` is regular for a box-spline patch with phantom points: a smooth
+/// interior vertex of valence 6, or a crease vertex whose two infinitely sharp edges run
+/// straight through it (interior valence 6, edges opposite; or a boundary vertex with three
+/// faces). No semi-sharp edge, no vertex sharpness, no hole, only triangles.
+fn loop_regular_vertex(t: &Topology, rules: &[Rule], v: usize) -> bool {
+    use subd_mesh::tags::is_infinite;
+    let (ve, vf) = (t.vertex_edges(v), t.vertex_faces(v));
+    if t.is_non_manifold_vertex(v)
+        || t.vertex_sharpness(v) != 0.0
+        || vf
+            .iter()
+            .any(|&g| t.face_size(g as usize) != 3 || t.is_hole(g as usize))
+    {
+        return false;
+    }
+    let sharp: Vec<usize> = (0..ve.len())
+        .filter(|&i| t.edge_sharpness(ve[i] as usize) > 0.0)
+        .collect();
+    if sharp
+        .iter()
+        .any(|&i| !is_infinite(t.edge_sharpness(ve[i] as usize)))
+    {
+        return false;
+    }
+    match (rules[v], ve.len(), vf.len(), sharp.as_slice()) {
+        (Rule::Smooth, 6, 6, []) => true,
+        (Rule::Crease, 6, 6, [a, b]) => b - a == 3,
+        (Rule::Crease, 4, 3, [0, 3]) => true,
+        _ => false,
+    }
+}
+
+/// The edge joining `a` and `b`, if any.
+fn edge_between(t: &Topology, a: u32, b: u32) -> Option<usize> {
+    t.vertex_edges(a as usize)
+        .iter()
+        .map(|&e| e as usize)
+        .find(|&e| {
+            let [p, q] = t.edge_vertices(e);
+            (p == a && q == b) || (p == b && q == a)
+        })
+}
+
+/// The 12 box-spline control points (corner-patch order) of Loop triangle `f` whose corners
+/// are regular (smooth interior vertices of valence 6, or straight infinitely sharp crease
+/// and regular boundary vertices), with phantom points across
+/// infinitely sharp edges and boundaries, or `None` when the neighbourhood is not of that
+/// form.
+///
+/// The faces around the corners are laid out on the triangle lattice by crossing smooth
+/// edges only (each new triangle the parallelogram image of its neighbour); a lattice point
+/// on the far side of a sharp edge `(a, b)` from the triangle `(a, b, c)` is the phantom
+/// `a + b − c`. With it the box-spline rules reproduce Loop's crease rules: the edge point
+/// `3/8 (a + b) + 1/8 (c + a + b − c) = (a + b)/2`, and at a crease vertex the smooth
+/// valence-6 rule `5/8 x + 1/16 Σ` becomes `3/4 x + 1/8 (b₀ + b₁)`. The dyadic-point tests
+/// check the patches against refinement.
+pub fn loop_sharp_regular(t: &Topology, rules: &[Rule], f: usize) -> Option<[GridPoint; 12]> {
+    let fv = t.face_vertices(f);
+    if fv.len() != 3
+        || t.is_hole(f)
+        || fv
+            .iter()
+            .any(|&v| !loop_regular_vertex(t, rules, v as usize))
+    {
+        return None;
+    }
+    let region: Vec<u32> = fv
+        .iter()
+        .flat_map(|&v| t.vertex_faces(v as usize).iter().copied())
+        .collect();
+    let mut coords: Vec<(u32, (i32, i32))> =
+        vec![(fv[0], (0, 0)), (fv[1], (1, 0)), (fv[2], (0, 1))];
+    let mut visited = vec![f as u32];
+    let mut queue = vec![f];
+    let add = |coords: &mut Vec<(u32, (i32, i32))>, v: u32, c: (i32, i32)| -> bool {
+        match coords.iter().find(|&&(w, d)| w == v || d == c) {
+            Some(&(w, d)) => w == v && d == c,
+            None => {
+                coords.push((v, c));
+                true
+            }
+        }
+    };
+    let coord = |coords: &[(u32, (i32, i32))], v: u32| {
+        coords.iter().find(|&&(w, _)| w == v).map(|&(_, c)| c)
+    };
+    while let Some(g) = queue.pop() {
+        let gv = t.face_vertices(g);
+        let ge = t.face_edges(g);
+        for k in 0..3 {
+            let e = ge[k] as usize;
+            if t.edge_sharpness(e) > 0.0 {
+                continue;
+            }
+            let (a, b, c) = (gv[k], gv[(k + 1) % 3], gv[(k + 2) % 3]);
+            let ef = t.edge_faces(e);
+            if ef.len() != 2 {
+                return None;
+            }
+            let h = if ef[0] as usize == g { ef[1] } else { ef[0] };
+            if visited.contains(&h) || !region.contains(&h) {
+                continue;
+            }
+            let hv = t.face_vertices(h as usize);
+            // Consistent orientation: h runs b → a.
+            let i = hv.iter().position(|&x| x == b)?;
+            if hv[(i + 1) % 3] != a {
+                return None;
+            }
+            let d = hv[(i + 2) % 3];
+            let (ca, cb, cc) = (coord(&coords, a)?, coord(&coords, b)?, coord(&coords, c)?);
+            if !add(&mut coords, d, (ca.0 + cb.0 - cc.0, ca.1 + cb.1 - cc.1)) {
+                return None;
+            }
+            visited.push(h);
+            queue.push(h as usize);
+        }
+    }
+    let at = |c: (i32, i32)| coords.iter().find(|&&(_, d)| d == c).map(|&(v, _)| v);
+    let mut out: [GridPoint; 12] = std::array::from_fn(|_| Vec::new());
+    for (slot, &q) in out.iter_mut().zip(&LATTICE) {
+        if let Some(v) = at(q) {
+            *slot = vec![(v, 1.0)];
+            continue;
+        }
+        // A lattice triangle (q, a, b) across a sharp edge (a, b) from the real (a, b, c).
+        let phantom = (0..6).find_map(|k| {
+            let (d0, d1) = (LATTICE_RING[k], LATTICE_RING[(k + 1) % 6]);
+            let pa = (q.0 + d0.0, q.1 + d0.1);
+            let pb = (q.0 + d1.0, q.1 + d1.1);
+            let pc = (pa.0 + pb.0 - q.0, pa.1 + pb.1 - q.1);
+            let (a, b, c) = (at(pa)?, at(pb)?, at(pc)?);
+            let e = edge_between(t, a, b)?;
+            (t.edge_sharpness(e) > 0.0).then(|| vec![(a, 1.0), (b, 1.0), (c, -1.0)])
+        })?;
+        *slot = phantom;
+    }
+    Some(out)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// On a boundary triangle of a regular grid the phantom-point patch follows the Loop
+    /// boundary curve, the uniform cubic B-spline of the boundary vertices: at the middle of
+    /// the boundary edge b1 b2 it is (b0 + 23 b1 + 23 b2 + b3) / 48.
+    #[test]
+    fn boundary_patch_follows_the_cubic_b_spline_boundary() {
+        let (grid, id) = regular_grid(3);
+        let r = Refinement::new(&grid, Scheme::Loop, &Options::default(), 0).unwrap();
+        let (t, rules) = (r.topology(0), r.vertex_rules(0));
+        let f = (0..t.num_faces())
+            .find(|&f| t.face_vertices(f) == [id(0, -3), id(1, -3), id(0, -2)])
+            .unwrap();
+        let grid_points = loop_sharp_regular(t, rules, f).expect("a regular boundary patch");
+        assert!(grid_points.iter().any(|g| g.len() == 3), "no phantom point");
+        // A curved surface over the grid: z = x² − x y³ + 0.3 y.
+        let pos = |i: i32, j: i32| {
+            let (x, y) = (f64::from(i), f64::from(j));
+            DVec3::new(x, y, x * x - x * y * y * y + 0.3 * y)
+        };
+        let pts: Vec<DVec3> = (0..grid.num_vertices())
+            .map(|k| pos((k % 7) as i32 - 3, (k / 7) as i32 - 3))
+            .collect();
+        let cp: Vec<DVec3> = grid_points
+            .iter()
+            .map(|g| {
+                g.iter()
+                    .fold(DVec3::ZERO, |a, &(v, w)| a + w * pts[v as usize])
+            })
+            .collect();
+        let p = box_spline().unwrap().evaluate(&cp, 0.5, 0.0);
+        let expected = (pos(-1, -3) + 23.0 * pos(0, -3) + 23.0 * pos(1, -3) + pos(2, -3)) / 48.0;
+        assert!(
+            (p.position - expected).length() < 1e-13,
+            "{p:?} vs {expected}"
+        );
+    }
 
     #[test]
     fn box_spline_is_a_partition_of_unity_and_reproduces_linears() {

@@ -277,3 +277,60 @@ fn emit(t: &Topology, v: usize, m: &RingMask, sink: &mut RowSink) {
         sink.add(v as u32, m.vertex);
     }
 }
+
+/// At an interior crease vertex the surface has one tangent plane per side of the crease.
+/// The limit mask of vertex `v` (rule `rule`) whose cross tangent is taken over the side
+/// that holds face `f`; `None` where `v` is not an interior manifold crease vertex or `f` is
+/// already on the side the table's mask uses (the faces from the first crease edge to the
+/// second, counter-clockwise).
+pub(crate) fn crease_side_mask(
+    t: &Topology,
+    v: usize,
+    rule: Rule,
+    scheme: Scheme,
+    f: usize,
+) -> Option<LimitMask> {
+    let (ve, vf) = (t.vertex_edges(v), t.vertex_faces(v));
+    if rule != Rule::Crease
+        || t.is_boundary_vertex(v)
+        || t.is_non_manifold_vertex(v)
+        || ve.len() != vf.len()
+    {
+        return None;
+    }
+    let VertexCase::Crease(a, b) = classify(t, v, rule, scheme) else {
+        return None;
+    };
+    let k = vf.iter().position(|&g| g as usize == f)?;
+    if (a..b).contains(&k) {
+        return None;
+    }
+    // The other side, seen from the second crease edge: rotate it to position 0.
+    let (ne, nf) = (ve.len(), vf.len());
+    let ends = (0, a + ne - b);
+    let m = match scheme {
+        Scheme::Loop => masks::loop_crease(ne, ends),
+        _ => masks::catmark_crease(ne, nf, ends),
+    };
+    Some(LimitMask {
+        position: rotated(&m.position, b),
+        tangent1: rotated(&m.tangent1, b),
+        tangent2: rotated(&m.tangent2, b),
+    })
+}
+
+/// A ring mask of vertex `v` applied to `points` (the sum of the row [`emit`] writes).
+pub(crate) fn apply_ring(t: &Topology, v: usize, m: &RingMask, points: &[DVec3]) -> DVec3 {
+    let mut p = DVec3::ZERO;
+    if !m.faces.is_empty() {
+        let local = t.vertex_face_local_indices(v);
+        for (i, &f) in t.vertex_faces(v).iter().enumerate() {
+            let fv = t.face_vertices(f as usize);
+            p += m.faces[i] * points[fv[(local[i] as usize + 2) % fv.len()] as usize];
+        }
+    }
+    for (i, &e) in t.vertex_edges(v).iter().enumerate().take(m.edges.len()) {
+        p += m.edges[i] * points[t.edge_other_vertex(e as usize, v as u32) as usize];
+    }
+    p + m.vertex * points[v]
+}
