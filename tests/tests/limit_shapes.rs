@@ -164,3 +164,103 @@ fn darts_and_valence_two_converge_to_the_eigen_limit() {
         assert!(errors[6] < errors[0] * 1e-2, "{name}: {errors:?}");
     }
 }
+
+/// Refining only around the semi-sharp features (what `base_limit` does on meshes too large
+/// to refine whole) gives the limits of refining the whole mesh, on every shape with a
+/// semi-sharp feature or (Catmull-Clark) a face that is not a quad: positions and normals.
+#[test]
+fn local_decay_refinement_equals_global() {
+    let mut checked = 0;
+    for s in shapes() {
+        let (levels, _) = levels_for_exact_limit(&s.mesh.topology, s.scheme);
+        // Keep the global refinement this compares with small enough for a test.
+        if levels == 0 || s.mesh.topology.num_face_vertices() << (2 * levels) > 1 << 20 {
+            continue;
+        }
+        let global = match base_limit(&s.mesh.topology, s.scheme, &s.options) {
+            Ok(t) => t.apply(&s.mesh.positions),
+            Err(LimitError::TooDeep { .. }) => continue,
+            Err(e) => panic!("{}: {e}", s.name),
+        };
+        let local = match subd_limit::local::base_limit(&s.mesh.topology, s.scheme, &s.options) {
+            Ok(t) => t.apply(&s.mesh.positions),
+            // A non-manifold neighbourhood a cut cannot reproduce is refused, not guessed.
+            Err(LimitError::Unsupported { .. }) => continue,
+            Err(e) => panic!("{}: {e}", s.name),
+        };
+        let diag = bbox_diagonal(&s.mesh.positions);
+        let r0 = Refinement::new(&s.mesh.topology, s.scheme, &s.options, 0).unwrap();
+        for v in 0..s.mesh.topology.num_vertices() {
+            let d = (global.positions[v] - local.positions[v]).length() / diag;
+            assert!(d < 1e-13, "{} vertex {v}: {d:e}", s.name);
+            // A corner has no limit normal (its conventional one, from its first two edges,
+            // depends on the level the masks are taken at).
+            // Nor has an interior valence-2 vertex a tangent plane (three eigenvalues of
+            // modulus 1/4).
+            let t0 = r0.topology(0);
+            let valence2 = t0.vertex_faces(v).len() == 2 && !t0.is_boundary_vertex(v);
+            // At crease and boundary vertices the cross-tangent masks (OpenSubdiv's, which
+            // subd matches) are not eigenvectors of the crease rules except at regular
+            // vertices, so the normal they give depends on the level they are taken at; and
+            // at an interior crease the side they take follows where the vertex's edge
+            // order starts, which a cut need not keep.
+            let sharp = t0
+                .vertex_edges(v)
+                .iter()
+                .any(|&e| t0.edge_sharpness(e as usize) > 0.0 || t0.is_boundary_edge(e as usize));
+            if r0.vertex_rules(0)[v] == Rule::Corner || valence2 || sharp {
+                continue;
+            }
+            // Tangent lengths depend on the level the masks are taken at (a subdominant
+            // eigenvalue per level); their plane does not.
+            let dn = (global.normals[v] - local.normals[v]).length();
+            assert!(dn < 1e-10, "{} vertex {v} normal: {dn:e}", s.name);
+        }
+        checked += 1;
+    }
+    assert!(checked >= 15, "only {checked} shapes");
+    eprintln!("local decay refinement: {checked} shapes equal to global refinement");
+}
+
+/// A mesh too large to refine whole until a sharpness-7 crease decays (160,000 face-vertices
+/// × 4^7) still gets its exact limits: only the crease's neighbourhood is refined, and a
+/// vertex far from the crease keeps the plain limit mask of its level.
+#[test]
+fn large_mesh_with_a_semi_sharp_crease_gets_exact_limits() {
+    let n = 200u32;
+    let mut faces = Vec::new();
+    for j in 0..n {
+        for i in 0..n {
+            let v = j * (n + 1) + i;
+            faces.extend([v, v + 1, v + n + 2, v + n + 1]);
+        }
+    }
+    let mut topo = subd_mesh::TopologyBuilder::new(((n + 1) * (n + 1)) as usize)
+        .build(&vec![4; (n * n) as usize], &faces)
+        .unwrap();
+    let row = n / 2;
+    for i in 0..n {
+        let a = u64::from(row * (n + 1) + i);
+        topo.set_crease(a, a + 1, 7.0).unwrap();
+    }
+    let pts: Vec<DVec3> = (0..(n + 1) * (n + 1))
+        .map(|k| {
+            let (x, y) = (f64::from(k % (n + 1)), f64::from(k / (n + 1)));
+            DVec3::new(x, y, (0.1 * x).sin() * (0.13 * y).cos())
+        })
+        .collect();
+    let (levels, _) = levels_for_exact_limit(&topo, Scheme::CatmullClark);
+    assert_eq!(levels, 7);
+    assert!(topo.num_face_vertices() << (2 * levels) > subd_limit::MAX_DECAY_FACE_VERTICES);
+    let limit = base_limit(&topo, Scheme::CatmullClark, &Options::default())
+        .unwrap()
+        .apply(&pts);
+    let r0 = Refinement::new(&topo, Scheme::CatmullClark, &Options::default(), 0).unwrap();
+    let plain = LimitStencilTable::at_level(&r0, 0).unwrap().apply(&pts);
+    let far = (10 * (n + 1) + 10) as usize;
+    assert!((limit.positions[far] - plain.positions[far]).length() < 1e-15);
+    // On the crease the semi-sharp rules pull the limit away from the smooth one.
+    let on = (row * (n + 1) + n / 2) as usize;
+    assert!((limit.positions[on] - plain.positions[on]).length() > 1e-6);
+    assert!(limit.positions.iter().all(|p| p.is_finite()));
+}

@@ -126,7 +126,7 @@ pub fn levels_for_exact_limit(topology: &Topology, scheme: Scheme) -> (usize, f3
 }
 
 /// The rows `0..k` of `t`.
-fn first_rows(t: &StencilTable, k: usize) -> StencilTable {
+pub(crate) fn first_rows(t: &StencilTable, k: usize) -> StencilTable {
     let end = t.offsets()[k] as usize;
     StencilTable::from_csr(
         t.num_sources(),
@@ -140,7 +140,9 @@ fn first_rows(t: &StencilTable, k: usize) -> StencilTable {
 /// base vertices. Refines uniformly until semi-sharp creases and corners have decayed (and,
 /// for Catmull-Clark, until every face is a quad), takes the limit masks there
 /// ([`LimitStencilTable::at_level`]) and composes them back to the base mesh; base vertex
-/// `v` is vertex `v` at every level.
+/// `v` is vertex `v` at every level. Where refining the whole mesh that far would pass
+/// [`MAX_DECAY_FACE_VERTICES`], only the neighbourhoods of the semi-sharp features are
+/// refined ([`local::base_limit`], same limits).
 pub fn base_limit(
     topology: &Topology,
     scheme: Scheme,
@@ -149,16 +151,13 @@ pub fn base_limit(
     if scheme == Scheme::Bilinear {
         return Err(LimitError::Scheme);
     }
-    let (levels, sharpness) = levels_for_exact_limit(topology, scheme);
+    let (levels, _) = levels_for_exact_limit(topology, scheme);
     let estimate = topology
         .num_face_vertices()
         .saturating_mul(4usize.saturating_pow(levels as u32));
     if estimate > MAX_DECAY_FACE_VERTICES {
-        return Err(LimitError::TooDeep {
-            sharpness,
-            levels,
-            max: MAX_DECAY_FACE_VERTICES,
-        });
+        // Too large to refine whole: refine only around the semi-sharp features.
+        return local::base_limit(topology, scheme, options);
     }
     let r = Refinement::new(topology, scheme, options, levels)?;
     let at = LimitStencilTable::at_level(&r, levels)?;

@@ -18,7 +18,9 @@
 use glam::DVec3;
 use subd_mesh::tags::SHARPNESS_INFINITE;
 use subd_mesh::{BoundaryInterpolation, Topology, TopologyBuilder};
-use subd_schemes::{Options, Refinement, Rule, Scheme};
+use subd_schemes::{Options, Refinement, Rule, Scheme, StencilTable};
+
+use crate::LimitStencilTable;
 
 use crate::LimitError;
 use crate::patch::SurfacePoint;
@@ -55,10 +57,8 @@ impl Neighbourhood {
     }
 }
 
-/// Faces within two vertex-rings of face `f` of a prepared level `t` (f first), their
-/// vertices renumbered by first appearance, with the sharpness and hole tags of `t` and the
-/// vertex rules `rules`. The cut's outer boundary is made infinitely sharp and the rules of
-/// the vertices on it re-derived from their tags (they only feed children that are not used).
+/// Faces within two vertex-rings of face `f` of a prepared level `t` (f first) as a
+/// [`Neighbourhood`] with the positions `points`.
 fn cut_out(
     t: &Topology,
     rules: &[Rule],
@@ -80,88 +80,118 @@ fn cut_out(
         }
         frontier = end..faces.len();
     }
-    let mut vertex_map: Vec<(u32, u32)> = Vec::new();
-    let mut sizes = Vec::with_capacity(faces.len());
-    let mut face_vertices = Vec::new();
-    for &g in &faces {
-        let fv = t.face_vertices(g as usize);
-        sizes.push(fv.len() as u32);
-        for &v in fv {
-            let local = match vertex_map.iter().find(|&&(old, _)| old == v) {
-                Some(&(_, new)) => new,
-                None => {
-                    let new = vertex_map.len() as u32;
-                    vertex_map.push((v, new));
-                    new
-                }
-            };
-            face_vertices.push(local);
-        }
-    }
-    let mut sub = TopologyBuilder::new(vertex_map.len())
-        .accept_inconsistent_orientation(true)
-        .build(&sizes, &face_vertices)
-        .map_err(|e| LimitError::Analysis(format!("local neighbourhood of face {f}: {e}")))?;
-    for (i, &g) in faces.iter().enumerate() {
-        let g = g as usize;
-        sub.set_hole(i, t.is_hole(g));
-        let sub_edges = sub.face_edges(i).to_vec();
-        for (&se, &ge) in sub_edges.iter().zip(t.face_edges(g)) {
-            sub.set_edge_sharpness(se as usize, t.edge_sharpness(ge as usize));
-        }
-    }
-    for &(old, new) in &vertex_map {
-        sub.set_vertex_sharpness(new as usize, t.vertex_sharpness(old as usize));
-    }
-    for e in 0..sub.num_edges() {
-        if sub.is_boundary_edge(e) {
-            sub.set_edge_sharpness(e, SHARPNESS_INFINITE);
-        }
-    }
-    // Rebuilding from face lists merges repeated non-manifold edge instances that the
-    // refined level keeps apart; such a cut would refine differently, so it is refused.
-    let mut faithful = true;
-    let sub_rules: Vec<Rule> = vertex_map
-        .iter()
-        .map(|&(old, new)| {
-            let complete = t
-                .vertex_faces(old as usize)
-                .iter()
-                .all(|g| faces.contains(g));
-            if complete {
-                let (o, n) = (old as usize, new as usize);
-                if sub.vertex_edges(n).len() != t.vertex_edges(o).len()
-                    || sub.is_non_manifold_vertex(n) != t.is_non_manifold_vertex(o)
-                {
-                    faithful = false;
-                }
-                rules[o]
-            } else {
-                let ve = sub.vertex_edges(new as usize);
-                let sharp = ve
-                    .iter()
-                    .filter(|&&e| sub.edge_sharpness(e as usize) > 0.0)
-                    .count();
-                Rule::determine(sub.vertex_sharpness(new as usize), sharp)
-            }
-        })
-        .collect();
-    if !faithful {
-        return Err(LimitError::Unsupported {
-            face: f,
-            reason: "a non-manifold configuration that a local cut does not reproduce",
-        });
-    }
-    let points = vertex_map
-        .iter()
-        .map(|&(old, _)| points[old as usize])
-        .collect();
+    let cut = Cut::new(t, rules, &faces).map_err(|e| match e {
+        LimitError::Unsupported { reason, .. } => LimitError::Unsupported { face: f, reason },
+        e => e,
+    })?;
     Ok(Neighbourhood {
-        topology: sub,
-        rules: sub_rules,
-        points,
+        points: cut.vertices.iter().map(|&v| points[v as usize]).collect(),
+        topology: cut.topology,
+        rules: cut.rules,
         face: 0,
     })
+}
+
+/// A set of faces of a prepared level as a mesh of its own that continues the level's
+/// refinement: the faces in the given order, their vertices renumbered by first appearance,
+/// with the level's sharpness and hole tags and vertex rules. The cut's outer boundary is
+/// made infinitely sharp and the rules of the vertices on it re-derived from their tags;
+/// those vertices only feed children outside the part of the cut whose every incident face
+/// is present, where the refinement is exact.
+pub(crate) struct Cut {
+    /// The cut's topology.
+    pub topology: Topology,
+    /// Its vertex rules.
+    pub rules: Vec<Rule>,
+    /// The level's vertex of each cut vertex.
+    pub vertices: Vec<u32>,
+}
+
+impl Cut {
+    /// Cuts `faces` out of the prepared level `t` with vertex rules `rules`.
+    pub(crate) fn new(t: &Topology, rules: &[Rule], faces: &[u32]) -> Result<Cut, LimitError> {
+        use std::collections::HashMap;
+        let mut local: HashMap<u32, u32> = HashMap::with_capacity(2 * faces.len());
+        let mut vertices: Vec<u32> = Vec::new();
+        let mut sizes = Vec::with_capacity(faces.len());
+        let mut face_vertices = Vec::new();
+        for &g in faces {
+            let fv = t.face_vertices(g as usize);
+            sizes.push(fv.len() as u32);
+            for &v in fv {
+                let new = *local.entry(v).or_insert_with(|| {
+                    vertices.push(v);
+                    (vertices.len() - 1) as u32
+                });
+                face_vertices.push(new);
+            }
+        }
+        let mut sub = TopologyBuilder::new(vertices.len())
+            .accept_inconsistent_orientation(true)
+            .build(&sizes, &face_vertices)
+            .map_err(|e| LimitError::Analysis(format!("local neighbourhood: {e}")))?;
+        for (i, &g) in faces.iter().enumerate() {
+            let g = g as usize;
+            sub.set_hole(i, t.is_hole(g));
+            let sub_edges = sub.face_edges(i).to_vec();
+            for (&se, &ge) in sub_edges.iter().zip(t.face_edges(g)) {
+                sub.set_edge_sharpness(se as usize, t.edge_sharpness(ge as usize));
+            }
+        }
+        for (new, &old) in vertices.iter().enumerate() {
+            sub.set_vertex_sharpness(new, t.vertex_sharpness(old as usize));
+        }
+        for e in 0..sub.num_edges() {
+            if sub.is_boundary_edge(e) {
+                sub.set_edge_sharpness(e, SHARPNESS_INFINITE);
+            }
+        }
+        let in_cut: std::collections::HashSet<u32> = faces.iter().copied().collect();
+        let complete: Vec<bool> = vertices
+            .iter()
+            .map(|&old| {
+                t.vertex_faces(old as usize)
+                    .iter()
+                    .all(|g| in_cut.contains(g))
+            })
+            .collect();
+        // Rebuilding from face lists merges repeated non-manifold edge instances that the
+        // refined level keeps apart; such a cut would refine differently, so it is refused.
+        let mut faithful = true;
+        let sub_rules: Vec<Rule> = vertices
+            .iter()
+            .enumerate()
+            .map(|(n, &old)| {
+                let o = old as usize;
+                if complete[n] {
+                    if sub.vertex_edges(n).len() != t.vertex_edges(o).len()
+                        || sub.is_non_manifold_vertex(n) != t.is_non_manifold_vertex(o)
+                    {
+                        faithful = false;
+                    }
+                    rules[o]
+                } else {
+                    let sharp = sub
+                        .vertex_edges(n)
+                        .iter()
+                        .filter(|&&e| sub.edge_sharpness(e as usize) > 0.0)
+                        .count();
+                    Rule::determine(sub.vertex_sharpness(n), sharp)
+                }
+            })
+            .collect();
+        if !faithful {
+            return Err(LimitError::Unsupported {
+                face: faces[0] as usize,
+                reason: "a non-manifold configuration that a local cut does not reproduce",
+            });
+        }
+        Ok(Cut {
+            topology: sub,
+            rules: sub_rules,
+            vertices,
+        })
+    }
 }
 
 /// The corner of the face that (u, v) is exactly at, if any (quads: (0,0), (1,0), (1,1),
@@ -330,4 +360,154 @@ fn descend(
     }
     let c = nearest_corner(scheme, u, v);
     corner_limit(&nb, scheme, &options, c)
+}
+
+/// The limits [`crate::base_limit`] gives, for meshes too large to refine whole until
+/// semi-sharp features have decayed: only the vertices those features reach (a semi-sharp
+/// edge or vertex on a face around them) are refined that far, one level at a time, each
+/// level cut down to their 2-rings (so the work grows with the number of those vertices, not
+/// with 4^levels); every other vertex takes its limit mask at once (after one global level
+/// for Catmull-Clark non-quads).
+///
+/// # Errors
+/// As [`crate::base_limit`]; [`LimitError::TooDeep`] when a cut would pass a quarter of
+/// [`crate::MAX_DECAY_FACE_VERTICES`] face-vertices.
+pub fn base_limit(
+    topology: &Topology,
+    scheme: Scheme,
+    options: &Options,
+) -> Result<LimitStencilTable, LimitError> {
+    use subd_mesh::tags::is_semi_sharp;
+    let quads = scheme != Scheme::CatmullClark
+        || (0..topology.num_faces()).all(|f| topology.face_size(f) == 4);
+    let pre = usize::from(!quads);
+    let r = Refinement::new(topology, scheme, options, pre)?;
+    let (t, rules) = (r.topology(pre), r.vertex_rules(pre));
+    let (decay, sharpness) = crate::levels_for_exact_limit(t, scheme);
+    let direct = LimitStencilTable::at_level(&r, pre)?;
+    let nv = t.num_vertices();
+    let mut affected = vec![false; nv];
+    for f in 0..t.num_faces() {
+        let semi = t
+            .face_edges(f)
+            .iter()
+            .any(|&e| is_semi_sharp(t.edge_sharpness(e as usize)))
+            || t.face_vertices(f)
+                .iter()
+                .any(|&v| is_semi_sharp(t.vertex_sharpness(v as usize)));
+        if semi {
+            for &v in t.face_vertices(f) {
+                affected[v as usize] = true;
+            }
+        }
+    }
+    let options = Options {
+        boundary_interpolation: BoundaryInterpolation::EdgeOnly,
+        ..*options
+    };
+    // Refine one level at a time, each time cutting out only the 2-rings of the affected
+    // vertices (a vertex keeps its index at every level, and its limit depends on the faces
+    // around it only), and carry the cut vertices' stencils over `t`'s vertices along.
+    let targets: Vec<u32> = (0..nv as u32).filter(|&v| affected[v as usize]).collect();
+    let mut cut = Cut::new(t, rules, &two_rings(t, &targets))?;
+    let mut rows = select_rows(&StencilTable::identity(nv), &cut.vertices);
+    let mut targets_in_cut = positions_in(&cut.vertices, &targets);
+    for _ in 0..decay {
+        if cut.topology.num_face_vertices() > crate::MAX_DECAY_FACE_VERTICES / 4 {
+            return Err(LimitError::TooDeep {
+                sharpness,
+                levels: decay,
+                max: crate::MAX_DECAY_FACE_VERTICES,
+            });
+        }
+        let rc = Refinement::from_prepared(cut.topology, cut.rules, scheme, &options, 1)?;
+        let child_rows = rows.then(rc.stencils(1));
+        let next = Cut::new(
+            rc.topology(1),
+            rc.vertex_rules(1),
+            &two_rings(rc.topology(1), &targets_in_cut),
+        )?;
+        rows = select_rows(&child_rows, &next.vertices);
+        targets_in_cut = positions_in(&next.vertices, &targets_in_cut);
+        cut = next;
+    }
+    let rc = Refinement::from_prepared(cut.topology, cut.rules, scheme, &options, 0)?;
+    let cut_rows = LimitStencilTable::at_level(&rc, 0)?.after(&rows);
+    let mut local = vec![u32::MAX; nv];
+    for (&v, &i) in targets.iter().zip(&targets_in_cut) {
+        local[v as usize] = i;
+    }
+    let merge = |direct: &StencilTable, cut_table: &StencilTable| {
+        let mut offsets = Vec::with_capacity(nv + 1);
+        let (mut indices, mut weights) = (Vec::new(), Vec::new());
+        offsets.push(0u32);
+        for v in 0..nv {
+            if affected[v] {
+                let (idx, w) = cut_table.row(local[v] as usize);
+                indices.extend_from_slice(idx);
+                weights.extend_from_slice(w);
+            } else {
+                let (idx, w) = direct.row(v);
+                indices.extend_from_slice(idx);
+                weights.extend_from_slice(w);
+            }
+            offsets.push(indices.len() as u32);
+        }
+        StencilTable::from_csr(nv, offsets, indices, weights)
+    };
+    let mut table = LimitStencilTable {
+        position: merge(&direct.position, &cut_rows.position),
+        tangent1: merge(&direct.tangent1, &cut_rows.tangent1),
+        tangent2: merge(&direct.tangent2, &cut_rows.tangent2),
+    };
+    if pre == 1 {
+        table = table.after(r.stencils(1));
+    }
+    let base = topology.num_vertices();
+    Ok(LimitStencilTable {
+        position: crate::first_rows(&table.position, base),
+        tangent1: crate::first_rows(&table.tangent1, base),
+        tangent2: crate::first_rows(&table.tangent2, base),
+    })
+}
+
+/// Faces within two vertex-rings of the vertices `targets` of `t`, in face order.
+fn two_rings(t: &Topology, targets: &[u32]) -> Vec<u32> {
+    let mut take = vec![false; t.num_faces()];
+    for &v in targets {
+        for &g in t.vertex_faces(v as usize) {
+            for &w in t.face_vertices(g as usize) {
+                for &h in t.vertex_faces(w as usize) {
+                    take[h as usize] = true;
+                }
+            }
+        }
+    }
+    (0..t.num_faces() as u32)
+        .filter(|&f| take[f as usize])
+        .collect()
+}
+
+/// The rows `which` of `table`, in that order.
+fn select_rows(table: &StencilTable, which: &[u32]) -> StencilTable {
+    let mut offsets = Vec::with_capacity(which.len() + 1);
+    let (mut indices, mut weights) = (Vec::new(), Vec::new());
+    offsets.push(0u32);
+    for &r in which {
+        let (idx, w) = table.row(r as usize);
+        indices.extend_from_slice(idx);
+        weights.extend_from_slice(w);
+        offsets.push(indices.len() as u32);
+    }
+    StencilTable::from_csr(table.num_sources(), offsets, indices, weights)
+}
+
+/// The position in `list` of each of `items` (every item is in the list).
+fn positions_in(list: &[u32], items: &[u32]) -> Vec<u32> {
+    let map: std::collections::HashMap<u32, u32> = list
+        .iter()
+        .enumerate()
+        .map(|(i, &v)| (v, i as u32))
+        .collect();
+    items.iter().map(|v| map[v]).collect()
 }
