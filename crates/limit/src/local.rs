@@ -311,55 +311,43 @@ pub(crate) fn evaluate(
         static INLINE: Option<rayon::ThreadPool> =
             rayon::ThreadPoolBuilder::new().num_threads(1).build().ok();
     }
-    INLINE.with(|pool| match pool {
-        Some(pool) => pool.install(|| descend(t, rules, points, f, scheme, options, u, v)),
-        None => descend(t, rules, points, f, scheme, options, u, v),
-    })
-}
-
-/// [`evaluate`]'s descent.
-#[allow(clippy::too_many_arguments)]
-fn descend(
-    t: &Topology,
-    rules: &[Rule],
-    points: &[DVec3],
-    f: usize,
-    scheme: Scheme,
-    options: &Options,
-    u: f64,
-    v: f64,
-) -> Result<SurfacePoint, LimitError> {
-    // Boundary edges are already infinitely sharp and holes already tagged; the cut's
-    // artificial boundary must not turn faces into holes.
-    let options = Options {
-        boundary_interpolation: BoundaryInterpolation::EdgeOnly,
-        ..*options
+    let descend = || -> Result<SurfacePoint, LimitError> {
+        // Boundary edges are already infinitely sharp and holes already tagged; the cut's
+        // artificial boundary must not turn faces into holes.
+        let options = Options {
+            boundary_interpolation: BoundaryInterpolation::EdgeOnly,
+            ..*options
+        };
+        let mut nb = cut_out(t, rules, points, f)?;
+        let (mut u, mut v, mut scale) = (u, v, 1.0);
+        for depth in 0..MAX_LOCAL_LEVELS {
+            let r = nb.refine(scheme, &options, 1)?;
+            let (t0, rules0) = (r.topology(0), r.vertex_rules(0));
+            if let Some(p) =
+                crate::eval::direct_evaluation(t0, rules0, &nb.points, nb.face, scheme, u, v)?
+            {
+                return Ok(p.scaled(scale));
+            }
+            // At a corner: once the other corners are refined away (two levels) and nothing
+            // semi-sharp is left, the corner vertex is what keeps the face irregular for ever.
+            if let Some(c) = exact_corner(scheme, u, v)
+                && depth >= 2
+                && crate::levels_for_exact_limit(&nb.topology, scheme).0 == 0
+            {
+                return corner_limit(&nb, scheme, &options, c);
+            }
+            let child_points = r.refine_points(&nb.points).pop().expect("one level");
+            let (child, s, tt, k) = child_at(t0, scheme, nb.face, u, v);
+            nb = cut_out(r.topology(1), r.vertex_rules(1), &child_points, child)?;
+            (u, v, scale) = (s, tt, scale * k);
+        }
+        let c = nearest_corner(scheme, u, v);
+        corner_limit(&nb, scheme, &options, c)
     };
-    let mut nb = cut_out(t, rules, points, f)?;
-    let (mut u, mut v, mut scale) = (u, v, 1.0);
-    for depth in 0..MAX_LOCAL_LEVELS {
-        let r = nb.refine(scheme, &options, 1)?;
-        let (t0, rules0) = (r.topology(0), r.vertex_rules(0));
-        if let Some(p) =
-            crate::eval::direct_evaluation(t0, rules0, &nb.points, nb.face, scheme, u, v)?
-        {
-            return Ok(p.scaled(scale));
-        }
-        // At a corner: once the other corners are refined away (two levels) and nothing
-        // semi-sharp is left, the corner vertex is what keeps the face irregular for ever.
-        if let Some(c) = exact_corner(scheme, u, v)
-            && depth >= 2
-            && crate::levels_for_exact_limit(&nb.topology, scheme).0 == 0
-        {
-            return corner_limit(&nb, scheme, &options, c);
-        }
-        let child_points = r.refine_points(&nb.points).pop().expect("one level");
-        let (child, s, tt, k) = child_at(t0, scheme, nb.face, u, v);
-        nb = cut_out(r.topology(1), r.vertex_rules(1), &child_points, child)?;
-        (u, v, scale) = (s, tt, scale * k);
-    }
-    let c = nearest_corner(scheme, u, v);
-    corner_limit(&nb, scheme, &options, c)
+    INLINE.with(|pool| match pool {
+        Some(pool) => pool.install(descend),
+        None => descend(),
+    })
 }
 
 /// The limits [`crate::base_limit`] gives, for meshes too large to refine whole until

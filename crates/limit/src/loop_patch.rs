@@ -369,31 +369,17 @@ const LATTICE_RING: [(i32, i32); 6] = [(1, 0), (0, 1), (-1, 1), (-1, 0), (0, -1)
 /// straight through it (interior valence 6, edges opposite; or a boundary vertex with three
 /// faces). No semi-sharp edge, no vertex sharpness, no hole, only triangles.
 fn loop_regular_vertex(t: &Topology, rules: &[Rule], v: usize) -> bool {
-    use subd_mesh::tags::is_infinite;
-    let (ve, vf) = (t.vertex_edges(v), t.vertex_faces(v));
-    if t.is_non_manifold_vertex(v)
-        || t.vertex_sharpness(v) != 0.0
-        || vf
-            .iter()
-            .any(|&g| t.face_size(g as usize) != 3 || t.is_hole(g as usize))
-    {
+    let Some(sharp) = crate::patch::infinitely_sharp_edges(t, v, 3) else {
         return false;
-    }
-    let sharp: Vec<usize> = (0..ve.len())
-        .filter(|&i| t.edge_sharpness(ve[i] as usize) > 0.0)
-        .collect();
-    if sharp
-        .iter()
-        .any(|&i| !is_infinite(t.edge_sharpness(ve[i] as usize)))
-    {
-        return false;
-    }
-    match (rules[v], ve.len(), vf.len(), sharp.as_slice()) {
-        (Rule::Smooth, 6, 6, []) => true,
-        (Rule::Crease, 6, 6, [a, b]) => b - a == 3,
-        (Rule::Crease, 4, 3, [0, 3]) => true,
-        _ => false,
-    }
+    };
+    let (ne, nf) = (t.vertex_edges(v).len(), t.vertex_faces(v).len());
+    t.vertex_sharpness(v) == 0.0
+        && match (rules[v], ne, nf, sharp.as_slice()) {
+            (Rule::Smooth, 6, 6, []) => true,
+            (Rule::Crease, 6, 6, [a, b]) => b - a == 3,
+            (Rule::Crease, 4, 3, [0, 3]) => true,
+            _ => false,
+        }
 }
 
 /// The edge joining `a` and `b`, if any.

@@ -205,35 +205,42 @@ pub type GridPoint = Vec<(u32, f64)>;
 /// or a sharp corner with one face. Returns `false` for anything else (darts, semi-sharp
 /// features, irregular valences).
 pub fn regular_sharp_corner(t: &Topology, rules: &[Rule], v: usize) -> bool {
-    use subd_mesh::tags::is_infinite;
-    let (ve, vf) = (t.vertex_edges(v), t.vertex_faces(v));
-    if t.is_non_manifold_vertex(v)
-        || vf
-            .iter()
-            .any(|&g| t.face_size(g as usize) != 4 || t.is_hole(g as usize))
-    {
-        return false;
-    }
     let vs = t.vertex_sharpness(v);
-    if vs != 0.0 && !is_infinite(vs) {
+    let Some(sharp) = infinitely_sharp_edges(t, v, 4) else {
         return false;
-    }
-    let sharp: Vec<usize> = (0..ve.len())
-        .filter(|&i| t.edge_sharpness(ve[i] as usize) > 0.0)
-        .collect();
-    if sharp
-        .iter()
-        .any(|&i| !is_infinite(t.edge_sharpness(ve[i] as usize)))
-    {
-        return false;
-    }
-    match (rules[v], ve.len(), vf.len(), sharp.as_slice()) {
+    };
+    let (ne, nf) = (t.vertex_edges(v).len(), t.vertex_faces(v).len());
+    match (rules[v], ne, nf, sharp.as_slice()) {
         (Rule::Smooth, 4, 4, []) => vs == 0.0,
         (Rule::Crease, 4, 4, [a, b]) => b - a == 2 && vs == 0.0,
         (Rule::Crease, 3, 2, [0, 2]) => vs == 0.0,
         (Rule::Corner, 2, 1, [0, 1]) => true,
         _ => false,
     }
+}
+
+/// The positions (in vertex-edge order) of the sharp edges at `v`, when they are all
+/// infinitely sharp, `v` is manifold with no semi-sharp vertex sharpness, and every face
+/// around it has `size` vertices and is not a hole; `None` otherwise.
+pub(crate) fn infinitely_sharp_edges(t: &Topology, v: usize, size: usize) -> Option<Vec<usize>> {
+    use subd_mesh::tags::is_infinite;
+    let (ve, vf) = (t.vertex_edges(v), t.vertex_faces(v));
+    let vs = t.vertex_sharpness(v);
+    if t.is_non_manifold_vertex(v)
+        || (vs != 0.0 && !is_infinite(vs))
+        || vf
+            .iter()
+            .any(|&g| t.face_size(g as usize) != size || t.is_hole(g as usize))
+    {
+        return None;
+    }
+    let sharp: Vec<usize> = (0..ve.len())
+        .filter(|&i| t.edge_sharpness(ve[i] as usize) > 0.0)
+        .collect();
+    sharp
+        .iter()
+        .all(|&i| is_infinite(t.edge_sharpness(ve[i] as usize)))
+        .then_some(sharp)
 }
 
 /// The 16 B-spline control points (grid order `4 j + i`) of quad `f` whose corners are all
