@@ -371,6 +371,7 @@ fn compare_eval(
     // The column reports the largest normal difference divided by that factor.
     let (mut err, mut nerr, mut inside_err) = (0.0f64, 0.0f64, 0.0f64);
     let mut checked_faces = std::collections::HashMap::new();
+    let mut reference = None;
     let mut osd_inexact = 0usize;
     let (mut worst, mut worst_normal) = (None, None);
     for (i, (p, t)) in ours.iter().zip(&theirs).enumerate() {
@@ -384,8 +385,12 @@ fn compare_eval(
             // Where OpenSubdiv is not exact either (seen on Loop meshes with semi-sharp
             // creases next to holes), subd's face is checked against uniform refinement.
             let face = ptex_face[i];
+            let reference = reference
+                .get_or_insert_with(|| RefinedLimits::new(topo, positions, scheme, options));
             let verified = *checked_faces.entry(face).or_insert_with(|| {
-                verify_by_refinement(topo, positions, scheme, options, face, diag)
+                reference
+                    .as_ref()
+                    .is_some_and(|r| r.agrees(&ev, &pts, face, diag))
             });
             if verified {
                 osd_inexact += 1;
@@ -434,81 +439,61 @@ fn compare_eval(
     row
 }
 
-/// Whether subd's evaluation of ptex face `(f, sub)` (a quad or a Loop triangle) equals the
-/// limit of uniformly refined vertices at dyadic parameters, to 1e-12 of the diagonal —
-/// the independent check used where OpenSubdiv's patch evaluation is not exact.
-fn verify_by_refinement(
-    topo: &Topology,
-    positions: &[DVec3],
-    scheme: Scheme,
-    options: &Options,
-    (f, sub): (usize, usize),
-    diag: f64,
-) -> bool {
-    use subd_limit::eval::{FaceParam, LimitEvaluator};
-    let level = subd_limit::levels_for_exact_limit(topo, scheme).0.max(4);
-    let quad = scheme == Scheme::CatmullClark && topo.face_size(f) == 4;
-    if !(quad || scheme == Scheme::Loop) || topo.num_face_vertices() << (2 * level) > 1 << 23 {
-        return false;
-    }
-    let (Ok(ev), Ok(r)) = (
-        LimitEvaluator::new(topo, scheme, options),
-        Refinement::new(topo, scheme, options, level),
-    ) else {
-        return false;
-    };
-    let Ok(table) = subd_limit::LimitStencilTable::at_level(&r, level) else {
-        return false;
-    };
-    let limits = table.apply(&r.refine_points(positions)[level]);
-    let pts = ev.prepare(positions);
-    let params = [
-        (0.5, 0.5),
-        (0.25, 0.25),
-        (0.125, 0.1875),
-        (0.5, 0.25),
-        (0.0625, 0.375),
-    ];
-    params.iter().all(|&(u, v)| {
-        let (mut face, mut s, mut t) = (f, u, v);
-        for l in 0..level {
-            let (j, a, b) = if scheme == Scheme::Loop {
-                if s >= 0.5 {
-                    (1, 2.0 * s - 1.0, 2.0 * t)
-                } else if t >= 0.5 {
-                    (2, 2.0 * s, 2.0 * t - 1.0)
-                } else if s + t < 0.5 {
-                    (0, 2.0 * s, 2.0 * t)
-                } else {
-                    (3, 1.0 - 2.0 * s, 1.0 - 2.0 * t)
-                }
-            } else {
-                match (s >= 0.5, t >= 0.5) {
-                    (false, false) => (0, 2.0 * s, 2.0 * t),
-                    (true, false) => (1, 2.0 * s - 1.0, 2.0 * t),
-                    (true, true) => (2, 2.0 * s - 1.0, 2.0 * t - 1.0),
-                    (false, true) => (3, 2.0 * s, 2.0 * t - 1.0),
-                }
-            };
-            face = if scheme == Scheme::Loop {
-                4 * face + j
-            } else {
-                r.topology(l).face_offsets()[face] as usize + j
-            };
-            (s, t) = (a, b);
+/// Uniform refinement past semi-sharp decay (at least 4 levels) and the exact limits of its
+/// vertices: the independent reference used where OpenSubdiv's patch evaluation is not exact.
+struct RefinedLimits {
+    refinement: Refinement,
+    level: usize,
+    limits: subd_limit::LimitPoints,
+}
+
+impl RefinedLimits {
+    /// `None` where the mesh would be too large to refine that far here.
+    fn new(
+        topo: &Topology,
+        positions: &[DVec3],
+        scheme: Scheme,
+        options: &Options,
+    ) -> Option<RefinedLimits> {
+        let level = subd_limit::levels_for_exact_limit(topo, scheme).0.max(4);
+        if topo.num_face_vertices() << (2 * level) > 1 << 23 {
+            return None;
         }
-        let corner = match (s, t) {
-            (0.0, 0.0) => 0,
-            (1.0, 0.0) => 1,
-            (0.0, 1.0) if scheme == Scheme::Loop => 2,
-            (1.0, 1.0) => 2,
-            (0.0, 1.0) => 3,
-            _ => return false,
-        };
-        let vtx = r.topology(level).face_vertices(face)[corner] as usize;
-        ev.evaluate(&pts, FaceParam { face: f, sub, u, v })
-            .is_ok_and(|p| (p.position - limits.positions[vtx]).length() <= 1e-12 * diag)
-    })
+        let refinement = Refinement::new(topo, scheme, options, level).ok()?;
+        let table = subd_limit::LimitStencilTable::at_level(&refinement, level).ok()?;
+        let limits = table.apply(&refinement.refine_points(positions)[level]);
+        Some(RefinedLimits {
+            refinement,
+            level,
+            limits,
+        })
+    }
+
+    /// Whether subd's evaluation of ptex face `(f, sub)` equals the limit of the refined
+    /// vertices at dyadic parameters, to 1e-12 of the diagonal (quads and Loop triangles).
+    fn agrees(
+        &self,
+        ev: &subd_limit::eval::LimitEvaluator,
+        pts: &subd_limit::eval::PatchPoints,
+        (f, sub): (usize, usize),
+        diag: f64,
+    ) -> bool {
+        use subd_limit::eval::{FaceParam, dyadic_vertex};
+        let params = [
+            (0.5, 0.5),
+            (0.25, 0.25),
+            (0.125, 0.1875),
+            (0.5, 0.25),
+            (0.0625, 0.375),
+        ];
+        params.iter().all(|&(u, v)| {
+            let Some(vtx) = dyadic_vertex(&self.refinement, self.level, f, u, v) else {
+                return false;
+            };
+            ev.evaluate(pts, FaceParam { face: f, sub, u, v })
+                .is_ok_and(|p| (p.position - self.limits.positions[vtx]).length() <= 1e-12 * diag)
+        })
+    }
 }
 
 /// Limit positions, tangents and normals of every vertex of level N against OpenSubdiv's

@@ -435,6 +435,36 @@ impl LimitEvaluator {
     }
 }
 
+/// The vertex of level `level` of `r` at the dyadic parameter (u, v) of base face `face` (a
+/// quad for Catmull-Clark, a triangle for Loop), following the child faces that hold the
+/// point as [`LimitEvaluator::evaluate`] does; `None` when (u, v) is not a corner at that
+/// level (not a multiple of 2^-level) or the face is not a quad or triangle.
+pub fn dyadic_vertex(r: &Refinement, level: usize, face: usize, u: f64, v: f64) -> Option<usize> {
+    let loop_scheme = r.scheme() == Scheme::Loop;
+    if r.topology(0).face_size(face) != if loop_scheme { 3 } else { 4 } {
+        return None;
+    }
+    let (mut f, mut s, mut t) = (face, u, v);
+    for l in 0..level {
+        if loop_scheme {
+            let (j, a, b, _) = tri_child(s, t);
+            (f, s, t) = (4 * f + j, a, b);
+        } else {
+            let (j, a, b) = quadrant(s, t);
+            (f, s, t) = (r.topology(l).face_offsets()[f] as usize + j, a, b);
+        }
+    }
+    let corner = match (s, t) {
+        (0.0, 0.0) => 0,
+        (1.0, 0.0) => 1,
+        (0.0, 1.0) if loop_scheme => 2,
+        (1.0, 1.0) => 2,
+        (0.0, 1.0) => 3,
+        _ => return None,
+    };
+    Some(r.topology(level).face_vertices(f)[corner] as usize)
+}
+
 /// The child of a quad holding (u, v) and the parameters in it: child j has the parent's
 /// corner j at its corner j (OpenSubdiv's order), `(0,0)` at its first vertex.
 pub(crate) fn quadrant(u: f64, v: f64) -> (usize, f64, f64) {

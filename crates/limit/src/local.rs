@@ -426,22 +426,16 @@ pub fn base_limit(
         local[v as usize] = i;
     }
     let merge = |direct: &StencilTable, cut_table: &StencilTable| {
-        let mut offsets = Vec::with_capacity(nv + 1);
-        let (mut indices, mut weights) = (Vec::new(), Vec::new());
-        offsets.push(0u32);
-        for v in 0..nv {
-            if affected[v] {
-                let (idx, w) = cut_table.row(local[v] as usize);
-                indices.extend_from_slice(idx);
-                weights.extend_from_slice(w);
-            } else {
-                let (idx, w) = direct.row(v);
-                indices.extend_from_slice(idx);
-                weights.extend_from_slice(w);
-            }
-            offsets.push(indices.len() as u32);
-        }
-        StencilTable::from_csr(nv, offsets, indices, weights)
+        csr(
+            nv,
+            (0..nv).map(|v| {
+                if affected[v] {
+                    cut_table.row(local[v] as usize)
+                } else {
+                    direct.row(v)
+                }
+            }),
+        )
     };
     let mut table = LimitStencilTable {
         position: merge(&direct.position, &cut_rows.position),
@@ -478,16 +472,22 @@ fn two_rings(t: &Topology, targets: &[u32]) -> Vec<u32> {
 
 /// The rows `which` of `table`, in that order.
 fn select_rows(table: &StencilTable, which: &[u32]) -> StencilTable {
-    let mut offsets = Vec::with_capacity(which.len() + 1);
+    csr(
+        table.num_sources(),
+        which.iter().map(|&r| table.row(r as usize)),
+    )
+}
+
+/// A stencil table over `num_sources` sources from its rows.
+fn csr<'a>(num_sources: usize, rows: impl Iterator<Item = (&'a [u32], &'a [f64])>) -> StencilTable {
+    let mut offsets = vec![0u32];
     let (mut indices, mut weights) = (Vec::new(), Vec::new());
-    offsets.push(0u32);
-    for &r in which {
-        let (idx, w) = table.row(r as usize);
+    for (idx, w) in rows {
         indices.extend_from_slice(idx);
         weights.extend_from_slice(w);
         offsets.push(indices.len() as u32);
     }
-    StencilTable::from_csr(table.num_sources(), offsets, indices, weights)
+    StencilTable::from_csr(num_sources, offsets, indices, weights)
 }
 
 /// The position in `list` of each of `items` (every item is in the list).

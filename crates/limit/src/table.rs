@@ -258,23 +258,28 @@ impl LimitStencilTable {
 /// Writes a ring mask of vertex `v` as a stencil row: face terms first, then edge terms, then
 /// the vertex (OpenSubdiv's summation order); zero weights are left out.
 fn emit(t: &Topology, v: usize, m: &RingMask, sink: &mut RowSink) {
+    ring_terms(t, v, m, |i, w| sink.add(i, w));
+}
+
+/// The nonzero terms (vertex, weight) of ring mask `m` of vertex `v`, in [`emit`]'s order: a
+/// face weight goes to the face's vertex opposite `v`, an edge weight to the edge's other end.
+fn ring_terms(t: &Topology, v: usize, m: &RingMask, mut term: impl FnMut(u32, f64)) {
     if !m.faces.is_empty() {
         let local = t.vertex_face_local_indices(v);
         for (i, &f) in t.vertex_faces(v).iter().enumerate() {
             if m.faces[i] != 0.0 {
                 let fv = t.face_vertices(f as usize);
-                let opposite = fv[(local[i] as usize + 2) % fv.len()];
-                sink.add(opposite, m.faces[i]);
+                term(fv[(local[i] as usize + 2) % fv.len()], m.faces[i]);
             }
         }
     }
     for (i, &e) in t.vertex_edges(v).iter().enumerate() {
         if i < m.edges.len() && m.edges[i] != 0.0 {
-            sink.add(t.edge_other_vertex(e as usize, v as u32), m.edges[i]);
+            term(t.edge_other_vertex(e as usize, v as u32), m.edges[i]);
         }
     }
     if m.vertex != 0.0 {
-        sink.add(v as u32, m.vertex);
+        term(v as u32, m.vertex);
     }
 }
 
@@ -322,15 +327,6 @@ pub(crate) fn crease_side_mask(
 /// A ring mask of vertex `v` applied to `points` (the sum of the row [`emit`] writes).
 pub(crate) fn apply_ring(t: &Topology, v: usize, m: &RingMask, points: &[DVec3]) -> DVec3 {
     let mut p = DVec3::ZERO;
-    if !m.faces.is_empty() {
-        let local = t.vertex_face_local_indices(v);
-        for (i, &f) in t.vertex_faces(v).iter().enumerate() {
-            let fv = t.face_vertices(f as usize);
-            p += m.faces[i] * points[fv[(local[i] as usize + 2) % fv.len()] as usize];
-        }
-    }
-    for (i, &e) in t.vertex_edges(v).iter().enumerate().take(m.edges.len()) {
-        p += m.edges[i] * points[t.edge_other_vertex(e as usize, v as u32) as usize];
-    }
-    p + m.vertex * points[v]
+    ring_terms(t, v, m, |i, w| p += w * points[i as usize]);
+    p
 }

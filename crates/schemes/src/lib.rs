@@ -166,6 +166,25 @@ pub struct Refinement {
     stencils: Vec<OnceLock<StencilTable>>,
 }
 
+/// What every refinement checks first: the level count, and triangles for Loop.
+fn check_request(t: &Topology, scheme: Scheme, levels: usize) -> Result<(), RefineError> {
+    if levels > MAX_LEVELS {
+        return Err(RefineError::TooManyLevels {
+            levels,
+            max: MAX_LEVELS,
+        });
+    }
+    if scheme == Scheme::Loop
+        && let Some(f) = (0..t.num_faces()).find(|&f| t.face_size(f) != 3)
+    {
+        return Err(RefineError::NotTriangle {
+            face: f,
+            size: t.face_size(f),
+        });
+    }
+    Ok(())
+}
+
 impl Refinement {
     /// Refines `base` uniformly `levels` times.
     pub fn new(
@@ -174,20 +193,7 @@ impl Refinement {
         options: &Options,
         levels: usize,
     ) -> Result<Self, RefineError> {
-        if levels > MAX_LEVELS {
-            return Err(RefineError::TooManyLevels {
-                levels,
-                max: MAX_LEVELS,
-            });
-        }
-        if scheme == Scheme::Loop
-            && let Some(f) = (0..base.num_faces()).find(|&f| base.face_size(f) != 3)
-        {
-            return Err(RefineError::NotTriangle {
-                face: f,
-                size: base.face_size(f),
-            });
-        }
+        check_request(base, scheme, levels)?;
         let (t0, rules0) = refine::prepare_base(base, scheme, options);
         Self::refine_prepared(t0, rules0, scheme, options, levels)
     }
@@ -214,20 +220,7 @@ impl Refinement {
                 vertices: level.num_vertices(),
             });
         }
-        if levels > MAX_LEVELS {
-            return Err(RefineError::TooManyLevels {
-                levels,
-                max: MAX_LEVELS,
-            });
-        }
-        if scheme == Scheme::Loop
-            && let Some(f) = (0..level.num_faces()).find(|&f| level.face_size(f) != 3)
-        {
-            return Err(RefineError::NotTriangle {
-                face: f,
-                size: level.face_size(f),
-            });
-        }
+        check_request(&level, scheme, levels)?;
         Self::refine_prepared(level, rules, scheme, options, levels)
     }
 
