@@ -52,7 +52,7 @@ mod table;
 
 use subd_mesh::Topology;
 use subd_mesh::tags::is_semi_sharp;
-use subd_schemes::{Options, RefineError, Refinement, Scheme, StencilTable};
+use subd_schemes::{Options, RefineError, Refinement, Scheme, StencilTable, TwoPhase};
 use thiserror::Error;
 
 pub use masks::{LimitMask, RingMask};
@@ -107,6 +107,10 @@ pub enum LimitError {
     Analysis(String),
 }
 
+/// Decay levels past which [`two_phase_base_limit`] refines only around semi-sharp
+/// features (refining the whole mesh `4^levels` times over costs more than the cuts).
+const LOCAL_DECAY_LEVELS: usize = 3;
+
 /// Face-vertices the decay refinement of [`base_limit`] may create.
 pub const MAX_DECAY_FACE_VERTICES: usize = 1 << 26;
 
@@ -160,8 +164,59 @@ pub fn base_limit(
         return local::base_limit(topology, scheme, options);
     }
     let r = Refinement::new(topology, scheme, options, levels)?;
-    let at = LimitStencilTable::at_level(&r, levels)?;
-    let nv = topology.num_vertices();
+    limit_through(&r, levels)
+}
+
+/// The exact limit of every base vertex under the two-phase scheme of seed 000
+/// ([`subd_schemes::two_phase`]): phase 1, then ordinary Catmull-Clark to the limit — the
+/// Catmull-Clark limit masks of the phase-1 mesh (after semi-sharp decay), composed back to
+/// the base. On a closed quad mesh this is the paper's formula (2).
+///
+/// ```
+/// use subd_mesh::{DVec3, TopologyBuilder};
+/// use subd_schemes::{Options, TwoPhase};
+///
+/// // A cube (every vertex of valence 3), λ = 1/2: formula (2) of seed 000.
+/// let faces = [0, 1, 3, 2, 2, 3, 5, 4, 4, 5, 7, 6, 6, 7, 1, 0, 1, 7, 5, 3, 6, 0, 2, 4];
+/// let cube = TopologyBuilder::new(8).build(&[4; 6], &faces).unwrap();
+/// let tp = TwoPhase::uniform(8, 0.5).unwrap();
+/// let table = subd_limit::two_phase_base_limit(&cube, &tp, &Options::default()).unwrap();
+/// let (n, l) = (3.0, 0.5);
+/// let beta = n * (1.0 - l) * 10.0 / 13.0 + 2.5;
+/// let (cols, weights) = table.position.row(0);
+/// let w0 = weights[cols.iter().position(|&c| c == 0).unwrap()];
+/// assert!((w0 - (n * n * l + 7.0 * n / 4.0) / (n * (n + 5.0))).abs() < 1e-15);
+/// let w1 = weights[cols.iter().position(|&c| c == 1).unwrap()]; // an edge neighbour
+/// assert!((w1 - beta / (n * (n + 5.0))).abs() < 1e-15);
+/// ```
+///
+/// # Errors
+/// [`LimitError::Refine`] for a mesh the scheme refuses (a face that is not a quad, a
+/// wrong `λ` count), [`LimitError::TooDeep`] as for [`local::base_limit`].
+pub fn two_phase_base_limit(
+    topology: &Topology,
+    two_phase: &TwoPhase,
+    options: &Options,
+) -> Result<LimitStencilTable, LimitError> {
+    let (decay, _) = levels_for_exact_limit(topology, Scheme::CatmullClark);
+    let levels = decay.max(1);
+    let estimate = topology
+        .num_face_vertices()
+        .saturating_mul(4usize.saturating_pow(levels as u32));
+    if levels > 1 && (estimate > MAX_DECAY_FACE_VERTICES || levels > LOCAL_DECAY_LEVELS) {
+        // Phase 1 globally, then only around the semi-sharp features.
+        let r = Refinement::two_phase(topology, two_phase, options, 1)?;
+        return local::base_limit_after(&r, options);
+    }
+    let r = Refinement::two_phase(topology, two_phase, options, levels)?;
+    limit_through(&r, levels)
+}
+
+/// The limit masks of `r`'s level `levels`, restricted to the base vertices and composed
+/// back to the base.
+fn limit_through(r: &Refinement, levels: usize) -> Result<LimitStencilTable, LimitError> {
+    let at = LimitStencilTable::at_level(r, levels)?;
+    let nv = r.num_vertices(0);
     let mut t = LimitStencilTable {
         position: first_rows(&at.position, nv),
         tangent1: first_rows(&at.tangent1, nv),

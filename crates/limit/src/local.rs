@@ -365,14 +365,26 @@ pub fn base_limit(
     scheme: Scheme,
     options: &Options,
 ) -> Result<LimitStencilTable, LimitError> {
-    use subd_mesh::tags::is_semi_sharp;
     let quads = scheme != Scheme::CatmullClark
         || (0..topology.num_faces()).all(|f| topology.face_size(f) == 4);
     let pre = usize::from(!quads);
     let r = Refinement::new(topology, scheme, options, pre)?;
+    base_limit_after(&r, options)
+}
+
+/// [`base_limit`] continued from the last level of `r` (0 or 1 levels: Catmull-Clark's
+/// first level for non-quads, or phase 1 of the two-phase scheme), composed back to `r`'s
+/// base.
+pub(crate) fn base_limit_after(
+    r: &Refinement,
+    options: &Options,
+) -> Result<LimitStencilTable, LimitError> {
+    use subd_mesh::tags::is_semi_sharp;
+    let scheme = r.scheme();
+    let pre = r.num_levels();
     let (t, rules) = (r.topology(pre), r.vertex_rules(pre));
     let (decay, sharpness) = crate::levels_for_exact_limit(t, scheme);
-    let direct = LimitStencilTable::at_level(&r, pre)?;
+    let direct = LimitStencilTable::at_level(r, pre)?;
     let nv = t.num_vertices();
     let mut affected = vec![false; nv];
     for f in 0..t.num_faces() {
@@ -442,10 +454,10 @@ pub fn base_limit(
         tangent1: merge(&direct.tangent1, &cut_rows.tangent1),
         tangent2: merge(&direct.tangent2, &cut_rows.tangent2),
     };
-    if pre == 1 {
-        table = table.after(r.stencils(1));
+    for l in (1..=pre).rev() {
+        table = table.after(r.stencils(l));
     }
-    let base = topology.num_vertices();
+    let base = r.num_vertices(0);
     Ok(LimitStencilTable {
         position: crate::first_rows(&table.position, base),
         tangent1: crate::first_rows(&table.tangent1, base),

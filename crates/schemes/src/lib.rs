@@ -43,6 +43,7 @@
 mod refine;
 pub mod rules;
 pub mod stencil;
+pub mod two_phase;
 
 use std::sync::OnceLock;
 
@@ -53,6 +54,7 @@ use thiserror::Error;
 
 pub use rules::Rule;
 pub use stencil::{RowSink, StencilTable};
+pub use two_phase::TwoPhase;
 
 /// The most levels a refinement may ask for (OpenSubdiv's limit too).
 pub const MAX_LEVELS: usize = 15;
@@ -102,7 +104,7 @@ impl Options {
 }
 
 /// Why a refinement cannot be done.
-#[derive(Debug, Clone, PartialEq, Eq, Error)]
+#[derive(Debug, Clone, PartialEq, Error)]
 #[non_exhaustive]
 pub enum RefineError {
     /// Loop subdivision needs triangles.
@@ -128,6 +130,32 @@ pub enum RefineError {
         rules: usize,
         /// Vertices of the level.
         vertices: usize,
+    },
+    /// A two-phase shape parameter that is out of range or not a number.
+    #[error("vertex {vertex}: lambda {value} is {reason}")]
+    Lambda {
+        /// Base vertex.
+        vertex: usize,
+        /// Its `λ`.
+        value: f64,
+        /// What is wrong with it.
+        reason: &'static str,
+    },
+    /// A two-phase refinement given a `λ` list of the wrong length.
+    #[error("{given} lambda values given for {vertices} vertices")]
+    LambdaCount {
+        /// Values given.
+        given: usize,
+        /// Base vertices.
+        vertices: usize,
+    },
+    /// The two-phase scheme needs quads.
+    #[error("face {face} has {size} vertices; the two-phase scheme needs quads")]
+    NotQuad {
+        /// Face index.
+        face: usize,
+        /// Its size.
+        size: usize,
     },
     /// The refined mesh would not fit 32-bit indices.
     #[error("level {level} would have more than 2^32 face-vertices")]
@@ -164,6 +192,8 @@ pub struct Refinement {
     options: Options,
     levels: Vec<Level>,
     stencils: Vec<OnceLock<StencilTable>>,
+    /// `λ` per base vertex when the first step is the two-phase scheme's phase 1.
+    phase_one: Option<Vec<f64>>,
 }
 
 /// What every refinement checks first: the level count, and triangles for Loop.
@@ -241,6 +271,7 @@ impl Refinement {
                 rules: rules0,
             }],
             stencils: (0..levels).map(|_| OnceLock::new()).collect(),
+            phase_one: None,
         };
         for l in 1..=levels {
             let p = r.levels[l - 1]
@@ -271,6 +302,60 @@ impl Refinement {
             r.levels.push(level);
         }
         Ok(r)
+    }
+
+    /// Refines `base` with the two-phase modified Catmull-Clark scheme of seed 000: level 1
+    /// is phase 1 (the modified vertex rule with `two_phase`'s `λ`, see [`two_phase`]),
+    /// levels 2 and on are ordinary Catmull-Clark. Topology and vertex order are
+    /// Catmull-Clark's; [`Self::scheme`] reports [`Scheme::CatmullClark`] and
+    /// [`Self::phase_one_lambda`] the `λ`.
+    ///
+    /// ```
+    /// use subd_mesh::{DVec3, TopologyBuilder};
+    /// use subd_schemes::{Options, Refinement, TwoPhase};
+    ///
+    /// let faces = [0, 1, 3, 2, 2, 3, 5, 4, 4, 5, 7, 6, 6, 7, 1, 0, 1, 7, 5, 3, 6, 0, 2, 4];
+    /// let cube = TopologyBuilder::new(8).build(&[4; 6], &faces).unwrap();
+    /// let points: Vec<DVec3> = (0..8)
+    ///     .map(|i| DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64))
+    ///     .collect();
+    /// // λ = 1 freezes the vertices in phase 1.
+    /// let tp = TwoPhase::uniform(8, 1.0).unwrap();
+    /// let r = Refinement::two_phase(&cube, &tp, &Options::default(), 1).unwrap();
+    /// let level1 = r.refine_points(&points).pop().unwrap();
+    /// assert_eq!(level1[..8], points[..]);
+    /// ```
+    ///
+    /// # Errors
+    /// [`RefineError::NotQuad`] for a face that is not a quad, [`RefineError::LambdaCount`]
+    /// when there is not one `λ` per vertex, and as [`Self::new`].
+    pub fn two_phase(
+        base: &Topology,
+        two_phase: &TwoPhase,
+        options: &Options,
+        levels: usize,
+    ) -> Result<Self, RefineError> {
+        if let Some(f) = (0..base.num_faces()).find(|&f| base.face_size(f) != 4) {
+            return Err(RefineError::NotQuad {
+                face: f,
+                size: base.face_size(f),
+            });
+        }
+        let lambda = two_phase.lambda();
+        if lambda.len() != base.num_vertices() {
+            return Err(RefineError::LambdaCount {
+                given: lambda.len(),
+                vertices: base.num_vertices(),
+            });
+        }
+        let mut r = Self::new(base, Scheme::CatmullClark, options, levels)?;
+        r.phase_one = Some(lambda.to_vec());
+        Ok(r)
+    }
+
+    /// `λ` of every base vertex when this is a two-phase refinement.
+    pub fn phase_one_lambda(&self) -> Option<&[f64]> {
+        self.phase_one.as_deref()
     }
 
     /// The scheme.
@@ -347,6 +432,11 @@ impl Refinement {
             scheme: self.scheme,
             options: &self.options,
             layout: refine::Layout::new(p, self.scheme),
+            phase_one: if level == 1 {
+                self.phase_one.as_deref()
+            } else {
+                None
+            },
         }
     }
 

@@ -13,7 +13,7 @@ use subd_mesh::{BoundaryInterpolation, CreaseMethod, Topology, TriangleSubdivisi
 
 use crate::rules::{self, Rule};
 use crate::stencil::{RowSink, StencilTable};
-use crate::{Options, Scheme};
+use crate::{Options, Scheme, two_phase};
 
 /// Rows per parallel task when evaluating points.
 const CHUNK: usize = 4096;
@@ -306,6 +306,8 @@ pub(crate) struct Step<'a> {
     pub scheme: Scheme,
     pub options: &'a Options,
     pub layout: Layout,
+    /// `λ` per parent vertex when this step is phase 1 of the two-phase scheme.
+    pub phase_one: Option<&'a [f64]>,
 }
 
 impl Step<'_> {
@@ -408,6 +410,9 @@ impl Step<'_> {
         let p = self.parent;
         let prule = self.parent_rules[v];
         let crule = self.child_rules[v];
+        if let Some(lambda) = self.phase_one {
+            return self.phase_one_row(v, lambda[v], prule, crule, sink);
+        }
         let mask = match prule {
             Rule::Smooth | Rule::Dart => Mask::smooth(p, v, self.scheme),
             _ => {
@@ -467,6 +472,68 @@ impl Step<'_> {
             }
         }
         sink.vertex(v as u32, pw * pm.vertex() + cw * cm.vertex());
+    }
+
+    /// Phase 1 of the two-phase scheme at vertex `v` (seed 000 eq. (1); boundary and crease
+    /// rule derived in [`crate::two_phase`]), blended across a rule change as ordinary
+    /// Catmull-Clark blends its masks.
+    fn phase_one_row<S: MaskSink>(
+        &self,
+        v: usize,
+        lambda: f64,
+        prule: Rule,
+        crule: Rule,
+        sink: &mut S,
+    ) {
+        let p = self.parent;
+        let emit = |rule: Rule, sharpness: &dyn Fn(usize) -> f32, w: f64, sink: &mut S| {
+            match rule {
+                Rule::Smooth | Rule::Dart => {
+                    // λ v + (1 − λ)(α E + (1 − α) F), E and F means over edges and quads.
+                    let ve = p.vertex_edges(v);
+                    let we = w * (1.0 - lambda) * two_phase::ALPHA / ve.len() as f64;
+                    for &e in ve {
+                        sink.vertex(p.edge_other_vertex(e as usize, v as u32), we);
+                    }
+                    let vf = p.vertex_faces(v);
+                    let wf = w * (1.0 - lambda) * (1.0 - two_phase::ALPHA) / vf.len() as f64;
+                    for (&f, &c) in vf.iter().zip(p.vertex_face_local_indices(v)) {
+                        let fv = p.face_vertices(f as usize);
+                        sink.vertex(fv[(c as usize + fv.len() / 2) % fv.len()], wf);
+                    }
+                    sink.vertex(v as u32, w * lambda);
+                }
+                Rule::Crease => {
+                    let ve = p.vertex_edges(v);
+                    let (a, b) = rules::crease_pair(ve.len(), |i| sharpness(ve[i] as usize) > 0.0);
+                    let mu = two_phase::crease_vertex_weight(lambda);
+                    for i in [a, b] {
+                        sink.vertex(
+                            p.edge_other_vertex(ve[i] as usize, v as u32),
+                            w * 0.5 * (1.0 - mu),
+                        );
+                    }
+                    sink.vertex(v as u32, w * mu);
+                }
+                Rule::Corner => sink.vertex(v as u32, w),
+            }
+        };
+        let parent_sharpness = |e: usize| p.edge_sharpness(e);
+        if crule == prule || matches!(prule, Rule::Smooth | Rule::Dart) {
+            emit(prule, &parent_sharpness, 1.0, sink);
+        } else {
+            let method = self.options.crease_method;
+            let ps = p.vertex_sharpness(v);
+            let pw =
+                fractional_weight_at(p, v, ps, rules::child_vertex_sharpness(ps), method) as f64;
+            emit(prule, &parent_sharpness, pw, sink);
+            emit(
+                crule,
+                &|e: usize| half_sharpness(p, e, v, method),
+                1.0 - pw,
+                sink,
+            );
+        }
     }
 
     /// The stencil table of this step.
@@ -558,7 +625,9 @@ impl Step<'_> {
         let l = self.layout;
         let r32 = r as u32;
         if r32 < l.face_vertex_base {
-            if !matches!(self.parent_rules[r], Rule::Smooth | Rule::Dart) {
+            if self.phase_one.is_some()
+                || !matches!(self.parent_rules[r], Rule::Smooth | Rule::Dart)
+            {
                 return None;
             }
             let faces = p.vertex_faces(r);
