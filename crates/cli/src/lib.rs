@@ -16,7 +16,9 @@
 mod eval;
 mod info;
 mod limit;
+mod pia;
 mod refine;
+mod vertex_data;
 
 use std::ffi::OsString;
 use std::io::Write;
@@ -53,6 +55,9 @@ enum Command {
     /// The exact limit surface (position and unit normal) at given (face, u, v) parameters,
     /// in OpenSubdiv's parameterisation.
     Eval(eval::EvalArgs),
+    /// Progressive iterative interpolation: a control mesh with IN's topology whose limit
+    /// surface passes through IN's vertices (all, or those chosen with --moving/--fixed).
+    Pia(pia::PiaArgs),
 }
 
 /// A command's failure: exit code and one-line message.
@@ -120,6 +125,7 @@ where
         Command::Refine(a) => refine::run(&a, out, err),
         Command::Limit(a) => limit::run(&a, out, err),
         Command::Eval(a) => eval::run(&a, out, err),
+        Command::Pia(a) => pia::run(&a, out, err),
     };
     match result {
         Ok(()) => EXIT_OK,

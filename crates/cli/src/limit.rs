@@ -7,11 +7,12 @@ use std::time::Instant;
 
 use clap::{Args, ValueEnum};
 use serde::Serialize;
-use subd_limit::{LimitPoints, base_limit, levels_for_exact_limit};
+use subd_limit::{LimitPoints, base_limit, levels_for_exact_limit, two_phase_base_limit};
 use subd_mesh::Mesh;
 use subd_schemes::Scheme;
 
 use crate::refine::{RuleArgs, bad, refuse_overwrite};
+use crate::vertex_data::LambdaArgs;
 use crate::{Failure, print_warnings};
 
 /// The schemes with a limit surface other than the mesh itself.
@@ -30,11 +31,23 @@ impl LimitSchemeArg {
     }
 }
 
+/// Schemes of `subd limit`: those with limit masks, and the two-phase scheme.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub(crate) enum LimitCommandScheme {
+    CatmullClark,
+    Loop,
+    /// Seed 000's two-phase scheme: formula (2) on closed quad meshes (needs --lambda or
+    /// --lambda-file).
+    TwoPhase,
+}
+
 #[derive(Debug, Args)]
 pub(crate) struct LimitArgs {
     /// Subdivision scheme.
     #[arg(long, value_enum)]
-    scheme: LimitSchemeArg,
+    scheme: LimitCommandScheme,
+    #[command(flatten)]
+    lambda: LambdaArgs,
     #[command(flatten)]
     rules: RuleArgs,
     /// Also write unit normals (`.txt` output: `x y z nx ny nz` per line).
@@ -59,7 +72,7 @@ pub(crate) struct LimitArgs {
 struct LimitReport {
     input: String,
     output: String,
-    scheme: Scheme,
+    scheme: &'static str,
     vertices: usize,
     /// Uniform levels refined first (semi-sharp decay, Catmull-Clark non-quads).
     levels_refined: usize,
@@ -99,16 +112,31 @@ pub(crate) fn run(
     }
     let file = subd_io::read_mesh(&args.input, &args.rules.read_options())?;
     print_warnings(err, &args.input, &file.warnings);
-    let scheme = args.scheme.scheme();
     let options = args.rules.options(&file.mesh.hints);
     let topo = &file.mesh.topology;
-    let table = base_limit(topo, scheme, &options)
-        .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
+    let (scheme, name) = match args.scheme {
+        LimitCommandScheme::CatmullClark => (Scheme::CatmullClark, "catmull-clark"),
+        LimitCommandScheme::Loop => (Scheme::Loop, "loop"),
+        LimitCommandScheme::TwoPhase => (Scheme::CatmullClark, "two-phase"),
+    };
+    let table = match args.scheme {
+        LimitCommandScheme::TwoPhase => {
+            let tp = args.lambda.two_phase(&args.input, topo.num_vertices())?;
+            two_phase_base_limit(topo, &tp, &options)
+        }
+        _ if args.lambda.given() => {
+            return Err(bad(
+                "--lambda and --lambda-file apply to --scheme two-phase only".into(),
+            ));
+        }
+        _ => base_limit(topo, scheme, &options),
+    }
+    .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
     let limit = table.apply(&file.mesh.positions);
     // ACC first, so that a mesh it does not cover fails before any file is written.
     let acc = match &args.acc {
         Some(path) => {
-            if scheme != Scheme::CatmullClark {
+            if !matches!(args.scheme, LimitCommandScheme::CatmullClark) {
                 return Err(bad(format!(
                     "{}: ACC patches approximate catmull-clark surfaces only",
                     path.display()
@@ -138,9 +166,11 @@ pub(crate) fn run(
         let report = LimitReport {
             input: args.input.display().to_string(),
             output: args.output.display().to_string(),
-            scheme,
+            scheme: name,
             vertices: topo.num_vertices(),
-            levels_refined: levels_for_exact_limit(topo, scheme).0,
+            levels_refined: levels_for_exact_limit(topo, scheme)
+                .0
+                .max(usize::from(name == "two-phase")),
             seconds: t0.elapsed().as_secs_f64(),
             warnings: file.warnings.clone(),
         };

@@ -11,6 +11,7 @@ use subd_mesh::{
 };
 use subd_schemes::{Options, Refinement, Scheme};
 
+use crate::vertex_data::LambdaArgs;
 use crate::{EXIT_BAD_INPUT, Failure, print_warnings};
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
@@ -18,6 +19,8 @@ pub(crate) enum SchemeArg {
     CatmullClark,
     Loop,
     Bilinear,
+    /// Seed 000's two-phase modified Catmull-Clark (needs --lambda or --lambda-file).
+    TwoPhase,
 }
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
@@ -94,11 +97,23 @@ impl RuleArgs {
 }
 
 impl SchemeArg {
+    /// The refinement scheme (two-phase refines with Catmull-Clark's topology and rules
+    /// after its first step).
     pub(crate) fn scheme(self) -> Scheme {
         match self {
-            SchemeArg::CatmullClark => Scheme::CatmullClark,
+            SchemeArg::CatmullClark | SchemeArg::TwoPhase => Scheme::CatmullClark,
             SchemeArg::Loop => Scheme::Loop,
             SchemeArg::Bilinear => Scheme::Bilinear,
+        }
+    }
+
+    /// The name the command line uses.
+    pub(crate) fn name(self) -> &'static str {
+        match self {
+            SchemeArg::CatmullClark => "catmull-clark",
+            SchemeArg::Loop => "loop",
+            SchemeArg::Bilinear => "bilinear",
+            SchemeArg::TwoPhase => "two-phase",
         }
     }
 }
@@ -108,9 +123,11 @@ pub(crate) struct RefineArgs {
     /// Subdivision scheme.
     #[arg(long, value_enum)]
     scheme: SchemeArg,
-    /// Number of uniform refinement levels (0 to 15).
+    /// Number of uniform refinement levels (0 to 15; for two-phase, level 1 is phase 1).
     #[arg(long)]
     levels: usize,
+    #[command(flatten)]
+    lambda: LambdaArgs,
     #[command(flatten)]
     rules: RuleArgs,
     /// Input mesh (.obj or .ply).
@@ -142,7 +159,7 @@ struct Timings {
 struct RefineReport {
     input: String,
     output: String,
-    scheme: Scheme,
+    scheme: &'static str,
     levels: usize,
     boundary_interpolation: BoundaryInterpolation,
     crease_method: CreaseMethod,
@@ -215,11 +232,24 @@ pub(crate) fn run(
     let t_read = t_start.elapsed().as_secs_f64();
     let scheme = args.scheme.scheme();
     let options = args.rules.options(&file.mesh.hints);
+    let base = &file.mesh.topology;
+    let two_phase = match args.scheme {
+        SchemeArg::TwoPhase => Some(args.lambda.two_phase(&args.input, base.num_vertices())?),
+        _ if args.lambda.given() => {
+            return Err(bad(
+                "--lambda and --lambda-file apply to --scheme two-phase only".into(),
+            ));
+        }
+        _ => None,
+    };
 
     let progress = Progress::new(args.levels, args.json);
     let t0 = Instant::now();
-    let refinement = Refinement::new(&file.mesh.topology, scheme, &options, args.levels)
-        .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
+    let refinement = match &two_phase {
+        Some(tp) => Refinement::two_phase(base, tp, &options, args.levels),
+        None => Refinement::new(base, scheme, &options, args.levels),
+    }
+    .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
     progress.step("topology");
     let t_topology = t0.elapsed().as_secs_f64();
     let t1 = Instant::now();
@@ -253,11 +283,10 @@ pub(crate) fn run(
     let t_write = t2.elapsed().as_secs_f64();
 
     if args.json {
-        let base = &file.mesh.topology;
         let report = RefineReport {
             input: args.input.display().to_string(),
             output: args.output.display().to_string(),
-            scheme,
+            scheme: args.scheme.name(),
             levels: args.levels,
             boundary_interpolation: options.boundary_interpolation,
             crease_method: options.crease_method,

@@ -1,0 +1,277 @@
+//! `subd pia`: progressive iterative interpolation — a control mesh with the input's
+//! topology whose limit surface passes through the input's vertices.
+
+use std::io::{IsTerminal, Write};
+use std::path::PathBuf;
+use std::time::Instant;
+
+use clap::{Args, ValueEnum};
+use serde::Serialize;
+use subd_mesh::Mesh;
+use subd_pia::{Method, Moving, Pia, PiaOptions, PiaScheme, Solver, bbox_diagonal};
+use subd_schemes::Scheme;
+
+use crate::refine::{RuleArgs, bad, refuse_overwrite};
+use crate::vertex_data::{LambdaArgs, read_indices};
+use crate::{EXIT_FAILURE, Failure, print_warnings};
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub(crate) enum PiaSchemeArg {
+    /// Catmull-Clark limit surface (Chen et al. 2008).
+    CatmullClark,
+    /// Loop limit surface (Cheng et al. 2009).
+    Loop,
+    /// Seed 000's two-phase scheme with shape parameter λ (needs --lambda or --lambda-file).
+    TwoPhase,
+}
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub(crate) enum SolverArg {
+    /// The fastest valid solver (conjugate gradients, BiCGSTAB where the system has no
+    /// symmetric form).
+    Auto,
+    /// The paper's iteration: every moving vertex moves by its interpolation error.
+    Iterate,
+    /// The iteration with the optimal weight 2 / (λ_min + λ_max).
+    Weighted,
+    /// Conjugate gradients on the symmetrised system (BiCGSTAB where there is none).
+    Cg,
+    /// Sparse Cholesky / LU.
+    Direct,
+}
+
+#[derive(Debug, Args)]
+pub(crate) struct PiaArgs {
+    /// Scheme whose limit surface interpolates.
+    #[arg(long, value_enum)]
+    scheme: PiaSchemeArg,
+    #[command(flatten)]
+    lambda: LambdaArgs,
+    /// Only these vertices move (a file of 0-based indices); the others keep their
+    /// positions (local PIA).
+    #[arg(long, value_name = "FILE", conflicts_with = "fixed")]
+    moving: Option<PathBuf>,
+    /// These vertices keep their positions (a file of 0-based indices); the others move.
+    #[arg(long, value_name = "FILE")]
+    fixed: Option<PathBuf>,
+    /// Solver.
+    #[arg(long, value_enum, default_value = "auto")]
+    solver: SolverArg,
+    /// Stop when every moving vertex's limit is within tol × the bounding-box diagonal of
+    /// its target.
+    #[arg(long, default_value_t = 1e-10)]
+    tol: f64,
+    /// Most iterations.
+    #[arg(long, default_value_t = 10_000)]
+    max_iter: usize,
+    #[command(flatten)]
+    rules: RuleArgs,
+    /// Input mesh (.obj or .ply): its vertices are the targets.
+    input: PathBuf,
+    /// Output mesh (.obj, .ply or .glb): IN's topology and tags, the solved positions.
+    output: PathBuf,
+    /// Print a JSON report on stdout.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Serialize)]
+struct Seconds {
+    read: f64,
+    setup: f64,
+    solve: f64,
+    check: f64,
+    write: f64,
+    total: f64,
+}
+
+#[derive(Serialize)]
+struct PiaReport {
+    input: String,
+    output: String,
+    scheme: &'static str,
+    solver: Solver,
+    method: Method,
+    vertices: usize,
+    moving: usize,
+    iterations: usize,
+    converged: bool,
+    /// Max |limit − target| over the moving vertices, from a limit table built afresh for
+    /// the output mesh (model units).
+    max_error: f64,
+    /// `max_error` over the targets' bounding-box diagonal.
+    max_error_relative: f64,
+    tol: f64,
+    /// The solver's max interpolation error before the first iteration and after each.
+    history: Vec<f64>,
+    seconds: Seconds,
+    warnings: Vec<String>,
+}
+
+pub(crate) fn run(args: &PiaArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<(), Failure> {
+    let t_start = Instant::now();
+    refuse_overwrite(&args.input, &args.output)?;
+    if subd_io::Format::from_path(&args.output).is_none() {
+        return Err(bad(format!(
+            "{}: unsupported output extension (expected .obj, .ply or .glb)",
+            args.output.display()
+        )));
+    }
+    if args.tol.is_nan() || args.tol <= 0.0 {
+        return Err(bad(format!(
+            "--tol {}: must be a positive number",
+            args.tol
+        )));
+    }
+    let file = subd_io::read_mesh(&args.input, &args.rules.read_options())?;
+    print_warnings(err, &args.input, &file.warnings);
+    let t_read = t_start.elapsed().as_secs_f64();
+    let topo = &file.mesh.topology;
+    let nv = topo.num_vertices();
+    let options = args.rules.options(&file.mesh.hints);
+    let (scheme, name) = match args.scheme {
+        PiaSchemeArg::CatmullClark => (PiaScheme::CatmullClark, "catmull-clark"),
+        PiaSchemeArg::Loop => (PiaScheme::Loop, "loop"),
+        PiaSchemeArg::TwoPhase => (
+            PiaScheme::TwoPhase(args.lambda.two_phase(&args.input, nv)?),
+            "two-phase",
+        ),
+    };
+    if !matches!(args.scheme, PiaSchemeArg::TwoPhase) && args.lambda.given() {
+        return Err(bad(
+            "--lambda and --lambda-file apply to --scheme two-phase only".into(),
+        ));
+    }
+    let moving = match (&args.moving, &args.fixed) {
+        (Some(f), _) => Moving::Only(read_indices(f, nv)?),
+        (None, Some(f)) => Moving::AllBut(read_indices(f, nv)?),
+        (None, None) => Moving::All,
+    };
+    let solver = match args.solver {
+        SolverArg::Auto => Solver::Auto,
+        SolverArg::Iterate => Solver::Iterate,
+        SolverArg::Weighted => Solver::Weighted,
+        SolverArg::Cg => Solver::Cg,
+        SolverArg::Direct => Solver::Direct,
+    };
+    let at_input = |e: subd_pia::PiaError| bad(format!("{}: {e}", args.input.display()));
+
+    let spinner = Spinner::new(args.json);
+    let t0 = Instant::now();
+    let pia = Pia::new(topo, &scheme, &options).map_err(at_input)?;
+    let t_setup = t0.elapsed().as_secs_f64();
+    spinner.message("solving");
+    let t1 = Instant::now();
+    let opts = PiaOptions {
+        solver,
+        tol: args.tol,
+        max_iter: args.max_iter,
+    };
+    let result = pia
+        .solve(&file.mesh.positions, &moving, &opts)
+        .map_err(at_input)?;
+    let t_solve = t1.elapsed().as_secs_f64();
+
+    // The error of the output, measured with a limit table built afresh, not the solver's
+    // own residual.
+    spinner.message("checking");
+    let t2 = Instant::now();
+    let check = match &scheme {
+        PiaScheme::CatmullClark => subd_limit::base_limit(topo, Scheme::CatmullClark, &options),
+        PiaScheme::Loop => subd_limit::base_limit(topo, Scheme::Loop, &options),
+        PiaScheme::TwoPhase(tp) => subd_limit::two_phase_base_limit(topo, tp, &options),
+    }
+    .map_err(|e| at_input(e.into()))?;
+    let limit = check.position.apply_points(&result.points);
+    let flags = moving.flags(nv).map_err(at_input)?;
+    let max_error = (0..nv)
+        .filter(|&v| flags[v])
+        .map(|v| (limit[v] - file.mesh.positions[v]).length())
+        .fold(0.0, f64::max);
+    let diagonal = bbox_diagonal(&file.mesh.positions);
+    let relative = if diagonal > 0.0 {
+        max_error / diagonal
+    } else {
+        max_error
+    };
+    let t_check = t2.elapsed().as_secs_f64();
+    spinner.finish();
+    if !result.converged || relative.is_nan() || relative > args.tol * (1.0 + 1e-6) {
+        return Err(Failure {
+            code: EXIT_FAILURE,
+            message: format!(
+                "{}: {name} interpolation did not reach --tol {} in {} iterations ({:?}): max error {:e} of the diagonal; no output written (raise --max-iter or try another --solver)",
+                args.input.display(),
+                args.tol,
+                result.iterations,
+                result.method,
+                relative
+            ),
+        });
+    }
+
+    let t3 = Instant::now();
+    let mut mesh = Mesh::new(topo.clone(), result.points.clone())
+        .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
+    mesh.hints = file.mesh.hints;
+    subd_io::write_mesh(&args.output, &mesh, &subd_io::WriteOptions::default())?;
+    let t_write = t3.elapsed().as_secs_f64();
+
+    if args.json {
+        let report = PiaReport {
+            input: args.input.display().to_string(),
+            output: args.output.display().to_string(),
+            scheme: name,
+            solver,
+            method: result.method,
+            vertices: nv,
+            moving: result.moving,
+            iterations: result.iterations,
+            converged: result.converged,
+            max_error,
+            max_error_relative: relative,
+            tol: args.tol,
+            history: result.history,
+            seconds: Seconds {
+                read: t_read,
+                setup: t_setup,
+                solve: t_solve,
+                check: t_check,
+                write: t_write,
+                total: t_start.elapsed().as_secs_f64(),
+            },
+            warnings: file.warnings.clone(),
+        };
+        let _ = serde_json::to_writer(&mut *out, &report);
+        let _ = writeln!(out);
+    }
+    Ok(())
+}
+
+/// A spinner on a terminal (the solve has no known length); nothing when piped or when a
+/// JSON report was asked for.
+struct Spinner(Option<indicatif::ProgressBar>);
+
+impl Spinner {
+    fn new(json: bool) -> Spinner {
+        if json || !std::io::stderr().is_terminal() {
+            return Spinner(None);
+        }
+        let bar = indicatif::ProgressBar::new_spinner();
+        bar.set_message("limit stencils");
+        bar.enable_steady_tick(std::time::Duration::from_millis(100));
+        Spinner(Some(bar))
+    }
+
+    fn message(&self, m: &'static str) {
+        if let Some(b) = &self.0 {
+            b.set_message(m);
+        }
+    }
+
+    fn finish(&self) {
+        if let Some(b) = &self.0 {
+            b.finish_and_clear();
+        }
+    }
+}
