@@ -166,8 +166,133 @@ pub fn compare(
         rows.push(compare_eval(
             exe, name, topo, positions, scheme, options, diag,
         ));
+        rows.push(compare_pia(
+            exe, name, topo, positions, scheme, options, diag,
+        ));
     }
     rows
+}
+
+/// Tolerance of the PIA check: OpenSubdiv's limit of subd's interpolating mesh must hit the
+/// moving targets within this fraction of the bounding-box diagonal.
+const PIA_TOLERANCE: f64 = 1e-9;
+
+/// Local PIA (every third vertex fixed, the rest moving) with subd, then OpenSubdiv's
+/// `PrimvarRefiner::Limit` of the result: the moving vertices' limits must equal their
+/// targets. Vertices where OpenSubdiv's limit is not exact (darts, valence 2) are left out,
+/// and so are meshes whose limit matrix is singular (no interpolant exists).
+fn compare_pia(
+    exe: &Path,
+    name: &str,
+    topo: &Topology,
+    positions: &[DVec3],
+    scheme: Scheme,
+    options: &Options,
+    diag: f64,
+) -> Row {
+    use subd_pia::{Moving, Pia, PiaOptions, PiaScheme, Solver};
+    let mut row = Row {
+        mesh: name.to_string(),
+        check: "pia",
+        level: 0,
+        vertices: 0,
+        error: f64::INFINITY,
+        normal_error: None,
+        excluded: None,
+        note: None,
+        problem: None,
+    };
+    let level = subd_limit::levels_for_exact_limit(topo, scheme).0.max(1);
+    if topo.num_face_vertices() << (2 * level) > MAX_LIMIT_FACE_VERTICES {
+        row.error = 0.0;
+        row.note = Some("too deep for OpenSubdiv's limit, not checked".into());
+        return row;
+    }
+    row.level = level;
+    let pia_scheme = match scheme {
+        Scheme::Loop => PiaScheme::Loop,
+        _ => PiaScheme::CatmullClark,
+    };
+    let pia = match Pia::new(topo, &pia_scheme, options) {
+        Ok(p) => p,
+        Err(e) => {
+            row.problem = Some(format!("subd: {e}"));
+            return row;
+        }
+    };
+    let nv = topo.num_vertices();
+    let moving = Moving::AllBut((0..nv as u32).filter(|v| v % 3 == 1).collect());
+    let flags = moving.flags(nv).expect("indices in range");
+    let solved = [Solver::Auto, Solver::Direct]
+        .into_iter()
+        .find_map(|solver| {
+            let opts = PiaOptions {
+                solver,
+                tol: 1e-11,
+                max_iter: 5000,
+            };
+            pia.solve(positions, &moving, &opts)
+                .ok()
+                .filter(|r| r.converged)
+        });
+    let Some(result) = solved else {
+        row.error = 0.0;
+        row.note = Some("limit matrix singular: no interpolant, not checked".into());
+        return row;
+    };
+    let input = osd::encode(topo, &result.points, scheme, options, level as u32);
+    let theirs =
+        match osd::run(exe, &input, &["--limit-positions"]).and_then(|b| osd::decode_limit(&b)) {
+            Ok(l) => l,
+            Err(e) => {
+                row.problem = Some(format!("OpenSubdiv: {e}"));
+                return row;
+            }
+        };
+    let inexact = match Refinement::new(topo, scheme, options, level) {
+        Ok(r) => subd_limit::eigen_limit_vertices(&r, level),
+        Err(e) => {
+            row.problem = Some(format!("subd: {e}"));
+            return row;
+        }
+    };
+    let mut skip = vec![false; nv];
+    for &v in inexact.iter().filter(|&&v| v < nv) {
+        skip[v] = true;
+    }
+    let (mut err, mut worst, mut left_out) = (0.0f64, 0, 0);
+    for v in 0..nv {
+        if !flags[v] {
+            if result.points[v] != positions[v] {
+                row.problem = Some(format!("fixed vertex {v} moved"));
+            }
+            continue;
+        }
+        if skip[v] {
+            left_out += 1;
+            continue;
+        }
+        let d = (theirs.positions[v] - positions[v]).abs().max_element() / diag;
+        if d > err || d.is_nan() {
+            (err, worst) = (d, v);
+        }
+    }
+    row.vertices = nv - left_out;
+    row.error = err;
+    row.note = Some(format!(
+        "{:?}, {} iterations{}",
+        result.method,
+        result.iterations,
+        if left_out > 0 {
+            format!(", {left_out} moving vertices where OpenSubdiv's limit is inexact left out")
+        } else {
+            String::new()
+        }
+    ));
+    if row.problem.is_none() && (err.is_nan() || err > PIA_TOLERANCE) {
+        row.problem = Some(format!("worst vertex {worst}"));
+    }
+    row
 }
 
 /// OpenSubdiv's isolation level for the evaluation check.
