@@ -10,6 +10,7 @@ use clap::{Parser, Subcommand};
 mod bench;
 mod conformance;
 mod osd;
+mod pia_bench;
 mod random_mesh;
 
 #[derive(Parser)]
@@ -53,6 +54,9 @@ enum Task {
         /// Only the evaluation benchmark.
         #[arg(long)]
         eval_only: bool,
+        /// Only the PIA benchmark (solvers on the quad bench mesh, Loop on a scan).
+        #[arg(long)]
+        pia_only: bool,
     },
     /// (internal) The subd side of the evaluation benchmark, in its own process.
     #[command(hide = true)]
@@ -167,15 +171,29 @@ fn main() -> ExitCode {
             repeats,
             huge_pages,
             eval_only,
-        } => ensure_system_packages(OPENSUBDIV_PACKAGES)
-            .and_then(|_| {
-                if eval_only {
-                    Ok(())
-                } else {
-                    bench::run(levels, repeats, huge_pages)
-                }
-            })
-            .and_then(|_| bench::run_eval(repeats)),
+            pia_only,
+        } => {
+            if pia_only {
+                pia_bench::run(repeats)
+            } else {
+                ensure_system_packages(OPENSUBDIV_PACKAGES)
+                    .and_then(|_| {
+                        if eval_only {
+                            Ok(())
+                        } else {
+                            bench::run(levels, repeats, huge_pages)
+                        }
+                    })
+                    .and_then(|_| bench::run_eval(repeats))
+                    .and_then(|_| {
+                        if eval_only {
+                            Ok(())
+                        } else {
+                            pia_bench::run(repeats)
+                        }
+                    })
+            }
+        }
         Task::BenchEval { mesh, repeats } => bench::run_subd_eval(&mesh, repeats),
         Task::BenchRun {
             mesh,

@@ -111,7 +111,9 @@ pub(crate) fn solve(
     }
 }
 
-/// `x ← x + ω r` until the residual is small enough.
+/// `x ← x + ω r` until the residual is small enough. One pass per iteration: the residual
+/// of `x` and the next iterate are computed together (the next goes to a second buffer, as
+/// every row reads its neighbours' current values).
 fn richardson(
     s: &ReducedSystem,
     mut x: Vec<DVec3>,
@@ -119,22 +121,17 @@ fn richardson(
     method: Method,
     ctl: Controls,
 ) -> Outcome {
-    let mut r = vec![DVec3::ZERO; s.len()];
-    let mut res = s.residual(&x, &mut r);
-    let mut history = vec![res];
-    while res > ctl.threshold && history.len() <= ctl.max_iter {
-        axpy(&mut x, omega, &r);
-        res = s.residual(&x, &mut r);
+    let mut next = vec![DVec3::ZERO; s.len()];
+    let mut history = Vec::new();
+    loop {
+        let res = s.step(&x, omega, &mut next);
         history.push(res);
+        if res <= ctl.threshold || history.len() > ctl.max_iter {
+            break;
+        }
+        std::mem::swap(&mut x, &mut next);
     }
     Outcome { x, history, method }
-}
-
-/// `x += a · y` (scalar `a`), in parallel.
-fn axpy(x: &mut [DVec3], a: f64, y: &[DVec3]) {
-    x.par_chunks_mut(CHUNK)
-        .zip(y.par_chunks(CHUNK))
-        .for_each(|(x, y)| x.iter_mut().zip(y).for_each(|(x, y)| *x += a * *y));
 }
 
 /// `x += a ⊙ y` (one coefficient per coordinate), in parallel.
@@ -144,53 +141,53 @@ fn axpy3(x: &mut [DVec3], a: DVec3, y: &[DVec3]) {
         .for_each(|(x, y)| x.iter_mut().zip(y).for_each(|(x, y)| *x += a * *y));
 }
 
-/// Preconditioned conjugate gradients on `D x = C⁻¹ b` with the Jacobi preconditioner
-/// `diag(D)`, restarted from the true residual when the updated one has drifted. `None`
-/// when `D` shows a non-positive curvature (not positive definite).
-fn cg(s: &ReducedSystem, c: &[f64], mut x: Vec<DVec3>, ctl: Controls) -> Option<Outcome> {
+/// Conjugate gradients on the symmetric form of `M̄ = C D`: `S = C^{-1/2} M̄ C^{1/2}`
+/// (`= C^{1/2} D C^{1/2}`, symmetric, similar to `M̄`), solving `S y = C^{-1/2} b` with
+/// `x = C^{1/2} y`; the interpolation error is `C^{1/2}` times CG's residual. Restarted from
+/// the true residual when the updated one has drifted. `None` when `S` shows a
+/// non-positive curvature (not positive definite). Two passes per iteration besides the
+/// direction update: `q = S p` with `p·q`, and the updates of `y`, `r` with `r·r` and the
+/// error.
+fn cg(s: &ReducedSystem, c: &[f64], x: Vec<DVec3>, ctl: Controls) -> Option<Outcome> {
     let n = s.len();
-    let inv_dd: Vec<f64> = (0..n).map(|i| c[i] / s.diag[i]).collect();
+    let sc: Vec<f64> = c.iter().map(|c| c.sqrt()).collect();
+    let sym = s.scaled(&sc);
+    let mut y: Vec<DVec3> = x.iter().zip(&sc).map(|(x, s)| *x / *s).collect();
     let mut r = vec![DVec3::ZERO; n];
     let mut q = vec![DVec3::ZERO; n];
-    let mut z = vec![DVec3::ZERO; n];
+    let mut p = vec![DVec3::ZERO; n];
+    let mut x = x;
     let mut res = s.residual(&x, &mut r);
     let mut history = vec![res];
     let mut steps = 0usize;
     while res > ctl.threshold && steps < ctl.max_iter {
-        // (Re)start: r ← C⁻¹ (b − M̄ x), the residual of the symmetric system.
-        scale(&mut r, c, true);
-        precondition(&r, &inv_dd, &mut z);
-        let mut p = z.clone();
-        let mut rz = dot(&r, &z);
+        // (Re)start from r = C^{-1/2} (b − M̄ x).
+        scale(&mut r, &sc, true);
+        p.copy_from_slice(&r);
+        let mut rr = dot(&r, &r);
         loop {
-            s.apply(&p, &mut q);
-            scale(&mut q, c, true);
-            let pq = dot(&p, &q);
+            let pq = sym.apply_dot(&p, &mut q);
             if [pq.x, pq.y, pq.z]
                 .iter()
-                .zip([rz.x, rz.y, rz.z])
+                .zip([rr.x, rr.y, rr.z])
                 .any(|(&a, b)| b != 0.0 && a.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater))
             {
                 return None;
             }
-            let alpha = safe_div(rz, pq);
-            axpy3(&mut x, alpha, &p);
-            axpy3(&mut r, -alpha, &q);
+            let alpha = safe_div(rr, pq);
+            let (rr_new, error) = cg_update(&mut y, &mut r, alpha, &p, &q, &sc);
             steps += 1;
-            // The interpolation error is C r (C positive diagonal).
-            let updated = max_scaled(&r, c);
-            history.push(updated);
-            if updated <= ctl.threshold || steps >= ctl.max_iter {
+            history.push(error);
+            if error <= ctl.threshold || steps >= ctl.max_iter {
                 break;
             }
-            precondition(&r, &inv_dd, &mut z);
-            let rz_new = dot(&r, &z);
-            let beta = safe_div(rz_new, rz);
-            rz = rz_new;
+            let beta = safe_div(rr_new, rr);
+            rr = rr_new;
             p.par_chunks_mut(CHUNK)
-                .zip(z.par_chunks(CHUNK))
-                .for_each(|(p, z)| p.iter_mut().zip(z).for_each(|(p, z)| *p = *z + beta * *p));
+                .zip(r.par_chunks(CHUNK))
+                .for_each(|(p, r)| p.iter_mut().zip(r).for_each(|(p, r)| *p = *r + beta * *p));
         }
+        x = y.iter().zip(&sc).map(|(y, s)| *y * *s).collect();
         res = s.residual(&x, &mut r);
         *history.last_mut().expect("one step taken") = res;
     }
@@ -199,6 +196,38 @@ fn cg(s: &ReducedSystem, c: &[f64], mut x: Vec<DVec3>, ctl: Controls) -> Option<
         history,
         method: Method::Cg,
     })
+}
+
+/// One fused CG update: `y += α p`, `r −= α q`; returns `r·r` (blocks summed in order) and
+/// the interpolation error `max |C^{1/2} r|`.
+fn cg_update(
+    y: &mut [DVec3],
+    r: &mut [DVec3],
+    alpha: DVec3,
+    p: &[DVec3],
+    q: &[DVec3],
+    sc: &[f64],
+) -> (DVec3, f64) {
+    let partial: Vec<(DVec3, f64)> = y
+        .par_chunks_mut(CHUNK)
+        .zip(r.par_chunks_mut(CHUNK))
+        .zip(p.par_chunks(CHUNK))
+        .zip(q.par_chunks(CHUNK))
+        .zip(sc.par_chunks(CHUNK))
+        .map(|((((y, r), p), q), sc)| {
+            let (mut rr, mut m) = (DVec3::ZERO, 0.0f64);
+            for ((((y, r), p), q), &s) in y.iter_mut().zip(r.iter_mut()).zip(p).zip(q).zip(sc) {
+                *y += alpha * *p;
+                *r -= alpha * *q;
+                rr += *r * *r;
+                m = m.max(finite_or_inf((*r * s).length()));
+            }
+            (rr, m)
+        })
+        .collect();
+    partial
+        .into_iter()
+        .fold((DVec3::ZERO, 0.0), |(a, m), (b, n)| (a + b, m.max(n)))
 }
 
 /// `v_i ← v_i / c_i` (`divide`) or `v_i ← v_i c_i`.
@@ -222,18 +251,6 @@ fn precondition(r: &[DVec3], inv: &[f64], z: &mut [DVec3]) {
                 *z = *r * d;
             }
         });
-}
-
-/// `max_i |c_i r_i|`.
-fn max_scaled(r: &[DVec3], c: &[f64]) -> f64 {
-    r.par_chunks(CHUNK)
-        .zip(c.par_chunks(CHUNK))
-        .map(|(r, c)| {
-            r.iter()
-                .zip(c)
-                .fold(0.0f64, |m, (r, &c)| m.max(finite_or_inf((*r * c).length())))
-        })
-        .reduce(|| 0.0, f64::max)
 }
 
 /// Jacobi-preconditioned BiCGSTAB (van der Vorst 1992), three coordinates in lockstep,
@@ -376,7 +393,7 @@ fn direct(s: &ReducedSystem, x0: Vec<DVec3>) -> Result<Outcome, PiaError> {
 
 /// Estimates of the smallest and largest eigenvalue of `M̄` for the weighted iteration.
 ///
-/// Symmetrisable systems: 60 Lanczos steps on `C^{-1/2} M̄ C^{1/2}` (symmetric, similar to
+/// Symmetrisable systems: 30 Lanczos steps on `C^{-1/2} M̄ C^{1/2}` (symmetric, similar to
 /// `M̄`); the extreme Ritz values converge fast. Otherwise: `λ_max ≤ ‖M̄‖_∞` and `λ_min`
 /// from power iteration on `‖M̄‖_∞ I − M̄`. Either way `ω λ_max < 2`, so the weighted
 /// iteration converges whenever the plain one does.
@@ -393,7 +410,7 @@ pub(crate) fn extreme_eigenvalues(s: &ReducedSystem) -> (f64, f64) {
             apply_scalar(s, &u, y);
             y.iter_mut().zip(&sq).for_each(|(y, s)| *y /= s);
         };
-        let k = n.min(60);
+        let k = n.min(30);
         let mut q: Vec<f64> = (0..n).map(start).collect();
         let norm = q.iter().map(|x| x * x).sum::<f64>().sqrt();
         q.iter_mut().for_each(|x| *x /= norm);

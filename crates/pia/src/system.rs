@@ -44,42 +44,72 @@ impl ReducedSystem {
         for (k, &v) in moving.iter().enumerate() {
             index[v as usize] = k as u32;
         }
-        let rows: Vec<(Vec<(u32, f64)>, DVec3)> = moving
-            .par_iter()
-            .map(|&v| {
-                let (c, w) = limit.row(v as usize);
-                let mut row = Vec::with_capacity(c.len());
-                let mut b = targets[v as usize];
-                for (&j, &x) in c.iter().zip(w) {
-                    if x.abs() < DROP {
-                        continue;
+        // Blocks of rows in parallel, each into its own flat arrays (one scratch row per
+        // block, no allocation per row), then concatenated in order.
+        struct Block {
+            counts: Vec<u32>,
+            cols: Vec<u32>,
+            weights: Vec<f64>,
+            rhs: Vec<DVec3>,
+            diag: Vec<f64>,
+        }
+        let blocks: Vec<Block> = moving
+            .par_chunks(CHUNK)
+            .enumerate()
+            .map(|(k, rows)| {
+                let first = k * CHUNK;
+                let mut blk = Block {
+                    counts: Vec::with_capacity(rows.len()),
+                    cols: Vec::with_capacity(rows.len() * 10),
+                    weights: Vec::with_capacity(rows.len() * 10),
+                    rhs: Vec::with_capacity(rows.len()),
+                    diag: vec![0.0; rows.len()],
+                };
+                let mut row: Vec<(u32, f64)> = Vec::with_capacity(32);
+                for (r, &v) in rows.iter().enumerate() {
+                    let (c, w) = limit.row(v as usize);
+                    row.clear();
+                    let mut b = targets[v as usize];
+                    for (&j, &x) in c.iter().zip(w) {
+                        if x.abs() < DROP {
+                            continue;
+                        }
+                        match index[j as usize] {
+                            u32::MAX => b -= x * targets[j as usize],
+                            k => row.push((k, x)),
+                        }
                     }
-                    match index[j as usize] {
-                        u32::MAX => b -= x * targets[j as usize],
-                        k => row.push((k, x)),
+                    row.sort_unstable_by_key(|e| e.0);
+                    for &(j, x) in &row {
+                        if j as usize == first + r {
+                            blk.diag[r] = x;
+                        }
+                        blk.cols.push(j);
+                        blk.weights.push(x);
                     }
+                    blk.counts.push(row.len() as u32);
+                    blk.rhs.push(b);
                 }
-                row.sort_unstable_by_key(|e| e.0);
-                (row, b)
+                blk
             })
             .collect();
+        let nnz: usize = blocks.iter().map(|b| b.cols.len()).sum();
         let mut offsets = Vec::with_capacity(moving.len() + 1);
         offsets.push(0u32);
-        let nnz: usize = rows.iter().map(|r| r.0.len()).sum();
         let mut cols = Vec::with_capacity(nnz);
         let mut weights = Vec::with_capacity(nnz);
         let mut rhs = Vec::with_capacity(moving.len());
-        let mut diag = vec![0.0; moving.len()];
-        for (i, (row, b)) in rows.into_iter().enumerate() {
-            for (j, x) in row {
-                if j as usize == i {
-                    diag[i] = x;
-                }
-                cols.push(j);
-                weights.push(x);
+        let mut diag = Vec::with_capacity(moving.len());
+        let mut end = 0u32;
+        for blk in blocks {
+            for c in blk.counts {
+                end += c;
+                offsets.push(end);
             }
-            offsets.push(cols.len() as u32);
-            rhs.push(b);
+            cols.extend_from_slice(&blk.cols);
+            weights.extend_from_slice(&blk.weights);
+            rhs.extend_from_slice(&blk.rhs);
+            diag.extend_from_slice(&blk.diag);
         }
         ReducedSystem {
             offsets,
@@ -138,6 +168,80 @@ impl ReducedSystem {
             .reduce(|| 0.0, f64::max)
     }
 
+    /// One pass of the weighted iteration: `next = x + ω (b − M̄ x)`; returns
+    /// `max |b − M̄ x|` (the error of `x`).
+    pub fn step(&self, x: &[DVec3], omega: f64, next: &mut [DVec3]) -> f64 {
+        next.par_chunks_mut(CHUNK)
+            .enumerate()
+            .map(|(c, out)| {
+                let mut m = 0.0f64;
+                for (k, o) in out.iter_mut().enumerate() {
+                    let i = c * CHUNK + k;
+                    let (cols, w) = self.row(i);
+                    let mut acc = self.rhs[i];
+                    for (&j, &x_w) in cols.iter().zip(w) {
+                        acc -= x_w * x[j as usize];
+                    }
+                    *o = x[i] + omega * acc;
+                    m = m.max(finite_or_inf(acc.length()));
+                }
+                m
+            })
+            .reduce(|| 0.0, f64::max)
+    }
+
+    /// The same couplings with row `i`, column `j` weighted by `s_j / s_i`
+    /// (`S⁻¹ M̄ S` for the diagonal `S = diag(s)`); the right side is not carried over.
+    pub fn scaled(&self, s: &[f64]) -> ReducedSystem {
+        let n = self.len();
+        let blocks: Vec<Vec<f64>> = (0..n.div_ceil(CHUNK))
+            .into_par_iter()
+            .map(|b| {
+                let rows = b * CHUNK..((b + 1) * CHUNK).min(n);
+                let first = self.offsets[rows.start] as usize;
+                let mut out = Vec::with_capacity(self.offsets[rows.end] as usize - first);
+                for i in rows {
+                    let (c, w) = self.row(i);
+                    out.extend(c.iter().zip(w).map(|(&j, &x)| x * s[j as usize] / s[i]));
+                }
+                out
+            })
+            .collect();
+        let weights = blocks.concat();
+        let diag = (0..n).map(|i| self.diag[i]).collect();
+        ReducedSystem {
+            offsets: self.offsets.clone(),
+            cols: self.cols.clone(),
+            weights,
+            rhs: Vec::new(),
+            moving: Vec::new(),
+            diag,
+        }
+    }
+
+    /// `q = M̄ p`; returns `p·q` per coordinate, blocks summed in order.
+    pub fn apply_dot(&self, p: &[DVec3], q: &mut [DVec3]) -> DVec3 {
+        let partial: Vec<DVec3> = q
+            .par_chunks_mut(CHUNK)
+            .enumerate()
+            .map(|(c, out)| {
+                let mut d = DVec3::ZERO;
+                for (k, o) in out.iter_mut().enumerate() {
+                    let i = c * CHUNK + k;
+                    let (cols, w) = self.row(i);
+                    let mut acc = DVec3::ZERO;
+                    for (&j, &x_w) in cols.iter().zip(w) {
+                        acc += x_w * p[j as usize];
+                    }
+                    *o = acc;
+                    d += p[i] * acc;
+                }
+                d
+            })
+            .collect();
+        partial.into_iter().fold(DVec3::ZERO, |s, x| s + x)
+    }
+
     /// Largest absolute row sum (an upper bound of the spectral radius).
     pub fn inf_norm(&self) -> f64 {
         (0..self.len())
@@ -150,6 +254,50 @@ impl ReducedSystem {
     /// limit masks have the same structure on closed meshes). Found by propagating
     /// `c_j = c_i · M̄_ji / M̄_ij` over the coupling graph and checking every pair.
     pub fn symmetrizer(&self) -> Option<Vec<f64>> {
+        // The masks of subd's schemes weigh every edge neighbour alike up to the row's scale
+        // (D's largest off-diagonal entries are equal), so the row's largest off-diagonal
+        // weight is the candidate; checked in parallel, propagated only if that fails.
+        let candidate: Vec<f64> = (0..self.len())
+            .into_par_iter()
+            .with_min_len(CHUNK)
+            .map(|i| {
+                let (c, w) = self.row(i);
+                c.iter()
+                    .zip(w)
+                    .filter(|e| *e.0 as usize != i)
+                    .map(|e| e.1.abs())
+                    .fold(0.0, f64::max)
+            })
+            .collect();
+        if candidate.iter().all(|&c| c > 0.0) && self.symmetrizes(&candidate) {
+            return Some(candidate);
+        }
+        self.propagated_symmetrizer()
+    }
+
+    /// Whether `C⁻¹ M̄` is symmetric (relative 1e-11) with a positive diagonal.
+    fn symmetrizes(&self, c: &[f64]) -> bool {
+        (0..self.len())
+            .into_par_iter()
+            .with_min_len(CHUNK)
+            .all(|i| {
+                let (cols, w) = self.row(i);
+                positive(self.diag[i])
+                    && cols.iter().zip(w).all(|(&j, &mij)| {
+                        let (cj, wj) = self.row(j as usize);
+                        match cj.binary_search(&(i as u32)) {
+                            Ok(k) => {
+                                let (a, b) = (mij / c[i], wj[k] / c[j as usize]);
+                                (a - b).abs() <= 1e-11 * a.abs().max(b.abs())
+                            }
+                            Err(_) => false,
+                        }
+                    })
+            })
+    }
+
+    /// The symmetrizer by propagation over the coupling graph (any consistent scales).
+    fn propagated_symmetrizer(&self) -> Option<Vec<f64>> {
         let n = self.len();
         let transpose = |i: usize, j: usize| -> Option<f64> {
             let (c, w) = self.row(j);
@@ -232,4 +380,79 @@ pub(crate) fn finite_or_inf(x: f64) -> f64 {
 pub(crate) fn safe_div(a: DVec3, b: DVec3) -> DVec3 {
     let d = |x: f64, y: f64| if y != 0.0 { x / y } else { 0.0 };
     DVec3::new(d(a.x, b.x), d(a.y, b.y), d(a.z, b.z))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A system straight from dense rows (all vertices moving, zero targets).
+    fn system(rows: &[&[f64]]) -> ReducedSystem {
+        let n = rows.len();
+        let dense: Vec<Vec<(u32, f64)>> = rows
+            .iter()
+            .map(|r| {
+                r.iter()
+                    .enumerate()
+                    .filter(|e| *e.1 != 0.0)
+                    .map(|(j, &w)| (j as u32, w))
+                    .collect()
+            })
+            .collect();
+        let table = StencilTable::from_rows(n, &dense);
+        ReducedSystem::new(&table, &vec![DVec3::ZERO; n], &vec![true; n])
+    }
+
+    #[test]
+    fn symmetrizer_recovers_c_of_c_times_d() {
+        // D symmetric positive definite, C = diag(1, 2, 4): M̄ = C D.
+        let d = [[4.0, 1.0, 0.5], [1.0, 3.0, 1.0], [0.5, 1.0, 5.0]];
+        let c = [1.0, 2.0, 4.0];
+        let rows: Vec<Vec<f64>> = (0..3)
+            .map(|i| (0..3).map(|j| c[i] * d[i][j]).collect())
+            .collect();
+        let refs: Vec<&[f64]> = rows.iter().map(|r| r.as_slice()).collect();
+        let s = system(&refs);
+        let found = s.symmetrizer().expect("symmetrisable");
+        // Unique up to one scale.
+        for i in 0..3 {
+            assert!((found[i] / found[0] - c[i] / c[0]).abs() < 1e-14);
+        }
+        // A one-way coupling has no symmetric form.
+        let s = system(&[&[1.0, 0.5, 0.0], &[0.0, 1.0, 0.0], &[0.0, 0.2, 0.8]]);
+        assert!(s.symmetrizer().is_none());
+        // Nor do ratios that disagree around a cycle.
+        let s = system(&[&[2.0, 1.0, 1.0], &[1.0, 2.0, 2.0], &[1.0, 1.0, 2.0]]);
+        assert!(s.symmetrizer().is_none());
+    }
+
+    #[test]
+    fn fixed_vertices_move_to_the_right_side() {
+        // Vertex 1 fixed: b_0 = p_0 − M̄_01 p_1.
+        let rows: Vec<Vec<(u32, f64)>> = vec![vec![(0, 0.5), (1, 0.5)], vec![(0, 0.25), (1, 0.75)]];
+        let table = StencilTable::from_rows(2, &rows);
+        let p = [DVec3::X, DVec3::Y];
+        let s = ReducedSystem::new(&table, &p, &[true, false]);
+        assert_eq!(s.len(), 1);
+        assert_eq!(s.moving, [0]);
+        assert_eq!(s.rhs[0], DVec3::X - 0.5 * DVec3::Y);
+        assert_eq!(s.diag, [0.5]);
+    }
+
+    #[test]
+    fn dot_sums_blocks_in_order() {
+        let a: Vec<DVec3> = (0..10_000)
+            .map(|i| DVec3::splat((i as f64).sin()))
+            .collect();
+        let want = a
+            .chunks(CHUNK)
+            .map(|c| c.iter().map(|x| *x * *x).fold(DVec3::ZERO, |s, x| s + x))
+            .fold(DVec3::ZERO, |s, x| s + x);
+        let one = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap();
+        assert_eq!(one.install(|| dot(&a, &a)), want);
+        assert_eq!(dot(&a, &a), want);
+    }
 }

@@ -1,0 +1,217 @@
+//! The PIA lines of `cargo xtask bench`: time to an interpolation error of 1e-10 of the
+//! bounding-box diagonal for each solver on the ~100k-vertex closed quad bench mesh, and
+//! Loop PIA end to end on a real scan (the Stanford bunny as `pymeshfix` ships it: 50k
+//! vertices, open, with holes), fetched from PyPI into `target/` when it is not there yet.
+//! OpenSubdiv has no interpolation, so these lines have no OpenSubdiv column.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Instant;
+
+use subd_pia::{Moving, Pia, PiaOptions, PiaScheme, Solver};
+use subd_schemes::{Options, TwoPhase};
+
+use crate::bench::quad_bench_mesh;
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// Every solver on the quad bench mesh, Catmull-Clark and two-phase (λ = 0.5 and, nearer
+/// the lower end of the range where the paper's iteration slows down, 0.4), all threads.
+pub fn run(repeats: usize) -> Result<(), String> {
+    let mesh = quad_bench_mesh();
+    let nv = mesh.topology.num_vertices();
+    let threads = rayon::current_num_threads();
+    println!();
+    println!(
+        "PIA to max error 1e-10 × diagonal, closed quad torus, {nv} vertices (every vertex moves), {threads} threads, median of {repeats} runs; ratio = time / the paper's iteration's time"
+    );
+    println!(
+        "{:<14} {:<10} {:<10} {:>6} {:>10} {:>10} {:>7} {:>12}",
+        "scheme", "solver", "method", "iters", "setup s", "solve s", "ratio", "max error"
+    );
+    let schemes = [
+        ("catmull-clark", PiaScheme::CatmullClark),
+        (
+            "two-phase 0.5",
+            PiaScheme::TwoPhase(TwoPhase::uniform(nv, 0.5).map_err(|e| e.to_string())?),
+        ),
+        (
+            "two-phase 0.4",
+            PiaScheme::TwoPhase(TwoPhase::uniform(nv, 0.4).map_err(|e| e.to_string())?),
+        ),
+    ];
+    for (name, scheme) in schemes {
+        let setup = median(
+            (0..repeats)
+                .map(|_| {
+                    let t = Instant::now();
+                    let p = Pia::new(&mesh.topology, &scheme, &Options::default());
+                    let s = t.elapsed().as_secs_f64();
+                    p.map(|_| s).map_err(|e| e.to_string())
+                })
+                .collect::<Result<Vec<_>, _>>()?,
+        );
+        let pia =
+            Pia::new(&mesh.topology, &scheme, &Options::default()).map_err(|e| e.to_string())?;
+        let mut plain = None;
+        for (sname, solver) in [
+            ("iterate", Solver::Iterate),
+            ("weighted", Solver::Weighted),
+            ("cg", Solver::Cg),
+            ("direct", Solver::Direct),
+            ("auto", Solver::Auto),
+        ] {
+            let opts = PiaOptions {
+                solver,
+                tol: 1e-10,
+                max_iter: 100_000,
+            };
+            let mut times = Vec::new();
+            let mut last = None;
+            for _ in 0..repeats {
+                let t = Instant::now();
+                let r = pia
+                    .solve(&mesh.positions, &Moving::All, &opts)
+                    .map_err(|e| e.to_string())?;
+                times.push(t.elapsed().as_secs_f64());
+                last = Some(r);
+            }
+            let r = last.ok_or("no repeats")?;
+            let solve = median(times);
+            let base = *plain.get_or_insert(solve);
+            let err = r.history.last().copied().unwrap_or(f64::NAN)
+                / subd_pia::bbox_diagonal(&mesh.positions);
+            let method = format!("{:?}", r.method);
+            let method = method.split([' ', '{']).next().unwrap_or("").to_lowercase();
+            println!(
+                "{:<14} {:<10} {:<10} {:>6} {:>10.4} {:>10.4} {:>7.2} {:>12.2e}",
+                name,
+                sname,
+                method,
+                r.iterations,
+                setup,
+                solve,
+                solve / base,
+                err
+            );
+        }
+    }
+    scan()
+}
+
+/// Where the bunny scan lives once fetched.
+fn bunny_path() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/xtask/bench/StanfordBunny.ply")
+}
+
+/// Fetches `pymeshfix`'s wheel from PyPI with pip and unpacks its bunny scan.
+fn fetch_bunny(dest: &Path) -> Result<(), String> {
+    let dir = dest.parent().ok_or("no parent")?.join("pymeshfix");
+    std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
+    let status = Command::new("python3")
+        .args([
+            "-m",
+            "pip",
+            "download",
+            "--no-deps",
+            "--quiet",
+            "pymeshfix==0.18.1",
+            "-d",
+        ])
+        .arg(&dir)
+        .status()
+        .map_err(|e| format!("pip: {e}"))?;
+    if !status.success() {
+        return Err("pip download pymeshfix failed".into());
+    }
+    let script = "import sys, zipfile, glob\n\
+                  w = glob.glob(sys.argv[1] + '/pymeshfix-*.whl')[0]\n\
+                  open(sys.argv[2], 'wb').write(zipfile.ZipFile(w).read('pymeshfix/examples/StanfordBunny.ply'))\n";
+    let status = Command::new("python3")
+        .args(["-c", script])
+        .arg(&dir)
+        .arg(dest)
+        .status()
+        .map_err(|e| format!("python3: {e}"))?;
+    if status.success() {
+        Ok(())
+    } else {
+        Err("could not unpack StanfordBunny.ply".into())
+    }
+}
+
+/// Loop PIA on the bunny scan, end to end: read, limit stencils, solve, independent check,
+/// write.
+fn scan() -> Result<(), String> {
+    let path = bunny_path();
+    if !path.exists()
+        && let Err(e) = fetch_bunny(&path)
+    {
+        println!("(scan benchmark skipped: {e})");
+        return Ok(());
+    }
+    let t0 = Instant::now();
+    let file = subd_io::read_mesh(
+        &path,
+        &subd_io::ReadOptions {
+            accept_inconsistent_orientation: true,
+        },
+    )
+    .map_err(|e| e.to_string())?;
+    let t_read = t0.elapsed().as_secs_f64();
+    let topo = &file.mesh.topology;
+    let boundary = (0..topo.num_edges())
+        .filter(|&e| topo.is_boundary_edge(e))
+        .count();
+    let options = Options::from_hints(&file.mesh.hints);
+    let t1 = Instant::now();
+    let pia = Pia::new(topo, &PiaScheme::Loop, &options).map_err(|e| e.to_string())?;
+    let t_setup = t1.elapsed().as_secs_f64();
+    let t2 = Instant::now();
+    let r = pia
+        .solve(&file.mesh.positions, &Moving::All, &PiaOptions::default())
+        .map_err(|e| e.to_string())?;
+    let t_solve = t2.elapsed().as_secs_f64();
+    let t3 = Instant::now();
+    let check = subd_limit::base_limit(topo, subd_schemes::Scheme::Loop, &options)
+        .map_err(|e| e.to_string())?;
+    let limit = check.position.apply_points(&r.points);
+    let err = limit
+        .iter()
+        .zip(&file.mesh.positions)
+        .map(|(a, b)| (*a - *b).length())
+        .fold(0.0, f64::max)
+        / subd_pia::bbox_diagonal(&file.mesh.positions);
+    let t_check = t3.elapsed().as_secs_f64();
+    let out = path.with_file_name("StanfordBunny_pia.ply");
+    let t4 = Instant::now();
+    let mut mesh = file.mesh.clone();
+    mesh.positions = r.points.clone();
+    subd_io::write_mesh(&out, &mesh, &subd_io::WriteOptions::default())
+        .map_err(|e| e.to_string())?;
+    let t_write = t4.elapsed().as_secs_f64();
+    println!();
+    println!(
+        "Loop PIA on a scan (Stanford bunny from pymeshfix: {} vertices, {} triangles, {} boundary edges), default solver, tol 1e-10, {} threads",
+        topo.num_vertices(),
+        topo.num_faces(),
+        boundary,
+        rayon::current_num_threads()
+    );
+    println!(
+        "method {:?}, {} iterations, max error {:.2e} × diagonal; seconds: read {:.3}, setup {:.3}, solve {:.3}, check {:.3}, write {:.3}, total {:.3}",
+        r.method,
+        r.iterations,
+        err,
+        t_read,
+        t_setup,
+        t_solve,
+        t_check,
+        t_write,
+        t0.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
