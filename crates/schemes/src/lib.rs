@@ -6,6 +6,9 @@
 //! crease methods, corners, holes, the three boundary interpolation modes, non-manifold
 //! edges and vertices), and positions within 1e-12 of OpenSubdiv run in double precision.
 //!
+//! [`Refinement::two_phase`] adds the two-phase modified Catmull-Clark scheme of seed 000
+//! (see [`two_phase`]).
+//!
 //! Refinement is data: [`Refinement::new`] computes the topology of every level and a
 //! [`StencilTable`] per level (child vertices as weighted sums of parent vertices), which
 //! [`Refinement::composed`] chains into one table from the base mesh to any level. Apply a
@@ -182,8 +185,9 @@ struct Level {
 /// A uniform refinement: the topology of every level and the stencils between levels.
 ///
 /// The work OpenSubdiv's `TopologyRefiner` and `PrimvarRefiner` do is split the same way: the
-/// constructor derives every level's topology and vertex rules; [`Self::refine_points`] (or
-/// [`Self::refine_values`]) evaluates the masks level by level. Stencil tables and the last
+/// constructor derives every level's topology and vertex rules; [`Self::refine_points`]
+/// evaluates the masks level by level (any other primvar goes through the stencil tables,
+/// [`StencilTable::apply`]). Stencil tables and the last
 /// level's full topology (edges, rings, tags) are built on first request, so a refinement that
 /// only needs the final faces and positions does not pay for them.
 #[derive(Debug)]
