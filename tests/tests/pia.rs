@@ -502,6 +502,40 @@ fn solvers_report_what_ran_and_cg_beats_the_plain_iteration() {
     );
     assert!((omega - 2.0 / (lambda_min + lambda_max)).abs() < 1e-15);
     assert!(weighted.converged);
+    // Auto never takes more passes than the paper's iteration here, and near λ = 7/20 (where
+    // the iteration crawls) it hands over to CG.
+    let auto = run(Solver::Auto);
+    assert!(auto.converged && auto.iterations <= plain.iterations);
+    let nv = s.topology.num_vertices();
+    let slow = Pia::new(
+        &s.topology,
+        &PiaScheme::TwoPhase(TwoPhase::uniform(nv, 0.36).unwrap()),
+        &s.options,
+    )
+    .unwrap();
+    // Rough targets (every mode excited).
+    let rough: Vec<DVec3> = s
+        .points
+        .iter()
+        .enumerate()
+        .map(|(v, p)| {
+            *p + 0.1
+                * DVec3::new(
+                    rand01(v as u64),
+                    rand01(v as u64 + 500),
+                    rand01(v as u64 + 900),
+                )
+        })
+        .collect();
+    let r = slow
+        .solve(&rough, &Moving::All, &PiaOptions::default())
+        .unwrap();
+    assert!(
+        matches!(r.method, Method::IterateThenCg { .. }),
+        "{:?}",
+        r.method
+    );
+    assert!(r.converged);
     // The paper's iteration contracts monotonically here (ρ < 1, symmetric-like system).
     assert!(
         plain

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
 
-use subd_pia::{Moving, Pia, PiaOptions, PiaScheme, Solver};
+use subd_pia::{Method, Moving, Pia, PiaOptions, PiaScheme, Solver};
 use subd_schemes::{Options, TwoPhase};
 
 use crate::bench::quad_bench_mesh;
@@ -29,7 +29,7 @@ pub fn run(repeats: usize) -> Result<(), String> {
         "PIA to max error 1e-10 × diagonal, closed quad torus, {nv} vertices (every vertex moves), {threads} threads, median of {repeats} runs; ratio = time / the paper's iteration's time"
     );
     println!(
-        "{:<14} {:<10} {:<10} {:>6} {:>10} {:>10} {:>7} {:>12}",
+        "{:<14} {:<10} {:<14} {:>6} {:>10} {:>10} {:>7} {:>12}",
         "scheme", "solver", "method", "iters", "setup s", "solve s", "ratio", "max error"
     );
     let schemes = [
@@ -84,10 +84,20 @@ pub fn run(repeats: usize) -> Result<(), String> {
             let base = *plain.get_or_insert(solve);
             let err = r.history.last().copied().unwrap_or(f64::NAN)
                 / subd_pia::bbox_diagonal(&mesh.positions);
-            let method = format!("{:?}", r.method);
-            let method = method.split([' ', '{']).next().unwrap_or("").to_lowercase();
+            let method = match r.method {
+                Method::Iterate => "iterate".to_string(),
+                Method::Weighted { .. } => "weighted".into(),
+                Method::Cg => "cg".into(),
+                Method::Bicgstab => "bicgstab".into(),
+                Method::Cholesky => "cholesky".into(),
+                Method::Lu => "lu".into(),
+                Method::IterateThenCg { switched_after } => format!("{switched_after}it+cg"),
+                Method::IterateThenBicgstab { switched_after } => {
+                    format!("{switched_after}it+bicgstab")
+                }
+            };
             println!(
-                "{:<14} {:<10} {:<10} {:>6} {:>10.4} {:>10.4} {:>7.2} {:>12.2e}",
+                "{:<14} {:<10} {:<14} {:>6} {:>10.4} {:>10.4} {:>7.2} {:>12.2e}",
                 name,
                 sname,
                 method,

@@ -46,6 +46,7 @@ fn bench(c: &mut Criterion) {
         ("weighted", Solver::Weighted),
         ("cg", Solver::Cg),
         ("direct", Solver::Direct),
+        ("auto", Solver::Auto),
     ] {
         let options = PiaOptions {
             solver,

@@ -22,8 +22,10 @@ use crate::system::{CHUNK, ReducedSystem, dot, finite_or_inf, max_norm, safe_div
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Solver {
-    /// The fastest valid one: conjugate gradients (which itself falls back to BiCGSTAB
-    /// where the system has no symmetric form).
+    /// The fastest valid one: starts with the paper's iteration (cheapest per step, and
+    /// quick when the targets are smooth), and switches to conjugate gradients (BiCGSTAB
+    /// where the system has no symmetric form) from where it got, as soon as the observed
+    /// contraction predicts that the Krylov method finishes sooner.
     #[default]
     Auto,
     /// The paper's iteration: `x ← x + (b − M̄ x)`, every moving vertex moved by its
@@ -32,8 +34,8 @@ pub enum Solver {
     /// `x ← x + ω (b − M̄ x)` with `ω = 2 / (λ_min + λ_max)` from estimated extreme
     /// eigenvalues of `M̄`.
     Weighted,
-    /// Jacobi-preconditioned conjugate gradients on `D x = C⁻¹ b` where `M̄ = C D`
-    /// (seed 000 eqs. 17–18); BiCGSTAB when there is no such `C`.
+    /// Conjugate gradients on the symmetric form of `M̄ = C D` (seed 000 eqs. 17–18);
+    /// BiCGSTAB when there is no such `C`.
     Cg,
     /// Sparse Cholesky of `D` (LU of `M̄` when not symmetrisable), faer.
     Direct,
@@ -62,6 +64,16 @@ pub enum Method {
     Cholesky,
     /// Sparse LU.
     Lu,
+    /// [`Solver::Auto`]: the paper's iteration for `switched_after` steps, then CG.
+    IterateThenCg {
+        /// Steps of the paper's iteration before the switch.
+        switched_after: usize,
+    },
+    /// [`Solver::Auto`]: the paper's iteration for `switched_after` steps, then BiCGSTAB.
+    IterateThenBicgstab {
+        /// Steps of the paper's iteration before the switch.
+        switched_after: usize,
+    },
 }
 
 /// Stop rule shared by the solvers.
@@ -100,14 +112,86 @@ pub(crate) fn solve(
             };
             Ok(richardson(s, x0, omega, method, ctl))
         }
-        Solver::Auto | Solver::Cg => Ok(match s.symmetrizer() {
-            Some(c) => match cg(s, &c, x0.clone(), ctl) {
-                Some(o) => o,
-                None => bicgstab(s, x0, ctl),
-            },
-            None => bicgstab(s, x0, ctl),
-        }),
+        Solver::Cg => Ok(krylov(s, x0, ctl)),
+        Solver::Auto => Ok(auto(s, x0, ctl)),
         Solver::Direct => direct(s, x0),
+    }
+}
+
+/// CG on the symmetric form, BiCGSTAB where there is none or CG breaks down.
+fn krylov(s: &ReducedSystem, x0: Vec<DVec3>, ctl: Controls) -> Outcome {
+    match s.symmetrizer() {
+        Some(c) => match cg(s, &c, x0.clone(), ctl) {
+            Some(o) => o,
+            None => bicgstab(s, x0, ctl),
+        },
+        None => bicgstab(s, x0, ctl),
+    }
+}
+
+/// Cost of a Krylov step in passes of the paper's iteration (a matrix pass plus vector
+/// updates; BiCGSTAB has two matrix passes, CG one, so this errs toward iterating).
+const KRYLOV_STEP_COST: f64 = 2.0;
+/// Cost of starting a Krylov method (restricting, symmetrising, scaling) in iteration
+/// passes.
+const KRYLOV_SETUP_COST: f64 = 15.0;
+/// Iterations over which the contraction rate is measured.
+const WINDOW: usize = 2;
+
+/// [`Solver::Auto`]: the paper's iteration while it is predicted to be the cheaper way to
+/// the threshold, then the Krylov method from the current iterate.
+///
+/// With the observed contraction `ρ` per iteration over the last [`WINDOW`] steps, the
+/// iteration needs `ln(t/e) / ln ρ` more steps to go from error `e` to threshold `t`. Its
+/// slowest mode has eigenvalue `≈ 1 − ρ` and the largest is `≤ 1`, so CG's rate is about
+/// `(√κ − 1)/(√κ + 1)` with `κ = 1/(1 − ρ)`. Switch when the second, with its setup and its
+/// dearer steps, is cheaper. `ρ` only grows as the fast modes die out, so the decision is
+/// taken again after every step.
+fn auto(s: &ReducedSystem, mut x: Vec<DVec3>, ctl: Controls) -> Outcome {
+    let mut next = vec![DVec3::ZERO; s.len()];
+    let mut history: Vec<f64> = Vec::new();
+    loop {
+        let res = s.step(&x, 1.0, &mut next);
+        history.push(res);
+        let k = history.len();
+        if res <= ctl.threshold || k > ctl.max_iter {
+            return Outcome {
+                x,
+                history,
+                method: Method::Iterate,
+            };
+        }
+        if k > WINDOW {
+            let rho = (res / history[k - 1 - WINDOW]).powf(1.0 / WINDOW as f64);
+            let gain = (ctl.threshold / res).ln();
+            let iterate_left = if rho < 1.0 {
+                gain / rho.ln()
+            } else {
+                f64::INFINITY
+            };
+            let kappa = 1.0 / (1.0 - rho.min(1.0 - 1e-12));
+            let cg_rate = (kappa.sqrt() - 1.0) / (kappa.sqrt() + 1.0);
+            let krylov_left = KRYLOV_SETUP_COST + KRYLOV_STEP_COST * gain / cg_rate.ln();
+            if iterate_left > krylov_left || iterate_left.is_nan() {
+                let rest = Controls {
+                    threshold: ctl.threshold,
+                    max_iter: ctl.max_iter - (k - 1),
+                };
+                let tail = krylov(s, x, rest);
+                history.extend_from_slice(&tail.history[1..]);
+                let switched_after = k - 1;
+                let method = match tail.method {
+                    Method::Cg => Method::IterateThenCg { switched_after },
+                    _ => Method::IterateThenBicgstab { switched_after },
+                };
+                return Outcome {
+                    x: tail.x,
+                    history,
+                    method,
+                };
+            }
+        }
+        std::mem::swap(&mut x, &mut next);
     }
 }
 
