@@ -40,6 +40,23 @@ pub struct Row {
     pub problem: Option<String>,
 }
 
+impl Row {
+    /// A row not decided yet: infinite error, nothing found.
+    fn pending(mesh: &str, check: &'static str, level: usize) -> Row {
+        Row {
+            mesh: mesh.to_string(),
+            check,
+            level,
+            vertices: 0,
+            error: f64::INFINITY,
+            normal_error: None,
+            excluded: None,
+            note: None,
+            problem: None,
+        }
+    }
+}
+
 /// Levels to check: up to 3, fewer where the mesh would grow past [`MAX_VERTICES`].
 fn levels_for(topo: &Topology, scheme: Scheme) -> usize {
     let mut faces = topo.num_face_vertices() as f64;
@@ -70,15 +87,8 @@ pub fn compare(
 ) -> Vec<Row> {
     let levels = levels_for(topo, scheme);
     let fail = |level: usize, msg: String| Row {
-        mesh: name.to_string(),
-        check: "refine",
-        level,
-        vertices: 0,
-        error: f64::INFINITY,
-        normal_error: None,
-        excluded: None,
-        note: None,
         problem: Some(msg),
+        ..Row::pending(name, "refine", level)
     };
     let input = osd::encode(topo, positions, scheme, options, levels as u32);
     let osd_levels = match osd::run(exe, &input, &[]).and_then(|b| osd::decode(&b, levels)) {
@@ -191,17 +201,7 @@ fn compare_pia(
     diag: f64,
 ) -> Row {
     use subd_pia::{Moving, Pia, PiaOptions, PiaScheme, Solver};
-    let mut row = Row {
-        mesh: name.to_string(),
-        check: "pia",
-        level: 0,
-        vertices: 0,
-        error: f64::INFINITY,
-        normal_error: None,
-        excluded: None,
-        note: None,
-        problem: None,
-    };
+    let mut row = Row::pending(name, "pia", 0);
     let level = subd_limit::levels_for_exact_limit(topo, scheme).0.max(1);
     if topo.num_face_vertices() << (2 * level) > MAX_LIMIT_FACE_VERTICES {
         row.error = 0.0;
@@ -335,17 +335,7 @@ fn compare_eval(
     diag: f64,
 ) -> Row {
     use subd_limit::eval::{FaceParam, LimitEvaluator};
-    let mut row = Row {
-        mesh: name.to_string(),
-        check: "eval",
-        level: ISOLATION as usize,
-        vertices: 0,
-        error: f64::INFINITY,
-        normal_error: None,
-        excluded: None,
-        note: None,
-        problem: None,
-    };
+    let mut row = Row::pending(name, "eval", ISOLATION as usize);
     let ev = match LimitEvaluator::new(topo, scheme, options) {
         Ok(e) => e,
         Err(e) => {
@@ -640,17 +630,7 @@ fn compare_limit(
     while level > 1 && topo.num_face_vertices() << (2 * level) > MAX_LIMIT_FACE_VERTICES {
         level -= 1;
     }
-    let mut row = Row {
-        mesh: name.to_string(),
-        check: "limit",
-        level,
-        vertices: 0,
-        error: f64::INFINITY,
-        normal_error: None,
-        excluded: None,
-        note: None,
-        problem: None,
-    };
+    let mut row = Row::pending(name, "limit", level);
     let input = osd::encode(topo, positions, scheme, options, level as u32);
     // Where OpenSubdiv crashes computing tangents (see `overflow` below), compare positions.
     let mut with_tangents = true;

@@ -132,8 +132,7 @@ pub(crate) fn run(
             points: points.len(),
             seconds: t0.elapsed().as_secs_f64(),
         };
-        let _ = serde_json::to_writer(&mut *out, &report);
-        let _ = writeln!(out);
+        crate::print_json(out, &report);
     }
     Ok(())
 }

@@ -13,6 +13,8 @@
 //! assert!(String::from_utf8(err).unwrap().starts_with("subd: no-such-file.obj: cannot read"));
 //! ```
 
+mod analyze;
+mod curve;
 mod eval;
 mod info;
 mod limit;
@@ -58,6 +60,12 @@ enum Command {
     /// Progressive iterative interpolation: a control mesh with IN's topology whose limit
     /// surface passes through IN's vertices (all, or those chosen with --moving/--fixed).
     Pia(pia::PiaArgs),
+    /// Subdivision curves (linear and circle-average schemes) from a text point list, to
+    /// text or SVG.
+    Curve(curve::CurveArgs),
+    /// Convergence and smoothness of a univariate mask (Laurent polynomials), or the
+    /// eigenvalue test of a surface scheme at a valence.
+    Analyze(analyze::AnalyzeArgs),
 }
 
 /// A command's failure: exit code and one-line message.
@@ -80,6 +88,13 @@ impl From<subd_io::IoError> for Failure {
             message: e.to_string(),
         }
     }
+}
+
+/// Prints `report` as one line of JSON on `out` (a closed pipe is not an error worth
+/// reporting after the work is done).
+pub(crate) fn print_json(out: &mut dyn Write, report: &impl serde::Serialize) {
+    let _ = serde_json::to_writer(&mut *out, report);
+    let _ = writeln!(out);
 }
 
 /// Prints reader warnings for `path` on `err`, at most [`MAX_WARNINGS`] of them.
@@ -126,6 +141,8 @@ where
         Command::Limit(a) => limit::run(&a, out, err),
         Command::Eval(a) => eval::run(&a, out, err),
         Command::Pia(a) => pia::run(&a, out, err),
+        Command::Curve(a) => curve::run(&a, out, err),
+        Command::Analyze(a) => analyze::run(&a, out),
     };
     match result {
         Ok(()) => EXIT_OK,

@@ -174,8 +174,7 @@ pub(crate) fn run(
             seconds: t0.elapsed().as_secs_f64(),
             warnings: file.warnings.clone(),
         };
-        let _ = serde_json::to_writer(&mut *out, &report);
-        let _ = writeln!(out);
+        crate::print_json(out, &report);
     }
     Ok(())
 }

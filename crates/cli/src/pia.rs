@@ -242,8 +242,7 @@ pub(crate) fn run(args: &PiaArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
             },
             warnings: file.warnings.clone(),
         };
-        let _ = serde_json::to_writer(&mut *out, &report);
-        let _ = writeln!(out);
+        crate::print_json(out, &report);
     }
     Ok(())
 }

@@ -306,8 +306,7 @@ pub(crate) fn run(
             },
             warnings: file.warnings.clone(),
         };
-        let _ = serde_json::to_writer(&mut *out, &report);
-        let _ = writeln!(out);
+        crate::print_json(out, &report);
     }
     Ok(())
 }

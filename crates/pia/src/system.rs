@@ -149,29 +149,23 @@ impl ReducedSystem {
 
     /// `r = b − M̄ x`; returns `max |r_i|`.
     pub fn residual(&self, x: &[DVec3], r: &mut [DVec3]) -> f64 {
-        r.par_chunks_mut(CHUNK)
-            .enumerate()
-            .map(|(c, out)| {
-                let mut m = 0.0f64;
-                for (k, o) in out.iter_mut().enumerate() {
-                    let i = c * CHUNK + k;
-                    let (cols, w) = self.row(i);
-                    let mut acc = self.rhs[i];
-                    for (&j, &x_w) in cols.iter().zip(w) {
-                        acc -= x_w * x[j as usize];
-                    }
-                    *o = acc;
-                    m = m.max(finite_or_inf(acc.length()));
-                }
-                m
-            })
-            .reduce(|| 0.0, f64::max)
+        self.residual_into(x, r, |_, ri| ri)
     }
 
     /// One pass of the weighted iteration: `next = x + ω (b − M̄ x)`; returns
     /// `max |b − M̄ x|` (the error of `x`).
     pub fn step(&self, x: &[DVec3], omega: f64, next: &mut [DVec3]) -> f64 {
-        next.par_chunks_mut(CHUNK)
+        self.residual_into(x, next, |i, ri| x[i] + omega * ri)
+    }
+
+    /// Writes `f(i, r_i)` for the residual `r = b − M̄ x`, in parallel; returns `max |r_i|`.
+    fn residual_into(
+        &self,
+        x: &[DVec3],
+        out: &mut [DVec3],
+        f: impl Fn(usize, DVec3) -> DVec3 + Sync,
+    ) -> f64 {
+        out.par_chunks_mut(CHUNK)
             .enumerate()
             .map(|(c, out)| {
                 let mut m = 0.0f64;
@@ -182,7 +176,7 @@ impl ReducedSystem {
                     for (&j, &x_w) in cols.iter().zip(w) {
                         acc -= x_w * x[j as usize];
                     }
-                    *o = x[i] + omega * acc;
+                    *o = f(i, acc);
                     m = m.max(finite_or_inf(acc.length()));
                 }
                 m

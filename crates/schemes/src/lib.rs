@@ -43,6 +43,8 @@
 //! assert_eq!(level2.len(), r.topology(2).num_vertices());
 //! ```
 
+pub mod analysis;
+pub mod curve;
 mod refine;
 pub mod rules;
 pub mod stencil;

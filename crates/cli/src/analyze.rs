@@ -1,0 +1,189 @@
+//! `subd analyze`: convergence and smoothness of a univariate mask (Laurent polynomials), or
+//! the eigenvalue test of a surface scheme at a valence.
+
+use std::io::Write;
+
+use clap::{Args, ValueEnum};
+use serde::Serialize;
+use subd_schemes::Scheme;
+use subd_schemes::analysis::analyze;
+
+use crate::Failure;
+use crate::refine::bad;
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub(crate) enum SurfaceArg {
+    CatmullClark,
+    Loop,
+}
+
+#[derive(Debug, Args)]
+pub(crate) struct AnalyzeArgs {
+    /// Mask coefficients a_j, comma-separated, in order of increasing power of z (the
+    /// weights of one old point in the new ones; they sum to the arity).
+    #[arg(
+        long,
+        allow_hyphen_values = true,
+        required_unless_present = "surface",
+        conflicts_with = "surface"
+    )]
+    mask: Option<String>,
+    /// Arity of the mask: 2 (binary) or 3 (ternary).
+    #[arg(long, default_value_t = 2)]
+    arity: usize,
+    /// Most levels L of the difference scheme to try.
+    #[arg(long, default_value_t = 8)]
+    max_levels: usize,
+    /// Instead of a mask: the eigenvalue test of this surface scheme's local subdivision
+    /// matrix at an interior vertex of valence --valence.
+    #[arg(long, value_enum, requires = "valence")]
+    surface: Option<SurfaceArg>,
+    /// Valence for --surface.
+    #[arg(long)]
+    valence: Option<usize>,
+    /// Print a JSON report on stdout.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Serialize)]
+struct SurfaceReport {
+    scheme: &'static str,
+    valence: usize,
+    /// Eigenvalue moduli, largest first.
+    eigenvalues: Vec<f64>,
+    /// λ₁ = 1 > λ₂ = λ₃ > |λ₄|.
+    passes: bool,
+}
+
+pub(crate) fn run(args: &AnalyzeArgs, out: &mut dyn Write) -> Result<(), Failure> {
+    if let (Some(surface), Some(n)) = (args.surface, args.valence) {
+        return run_surface(surface, n, args.json, out);
+    }
+    let text = args.mask.as_deref().unwrap_or_default();
+    let coeffs: Vec<f64> = text
+        .split(|c: char| c == ',' || c.is_whitespace())
+        .filter(|t| !t.is_empty())
+        .enumerate()
+        .map(|(i, t)| {
+            parse_number(t).filter(|x| x.is_finite()).ok_or_else(|| {
+                bad(format!(
+                    "--mask: coefficient {i} ({t:?}) is not a finite number"
+                ))
+            })
+        })
+        .collect::<Result<_, _>>()?;
+    if coeffs.is_empty() {
+        return Err(bad("--mask: no coefficients".into()));
+    }
+    if !(2..=3).contains(&args.arity) {
+        return Err(bad(format!("--arity {}: must be 2 or 3", args.arity)));
+    }
+    let sum: f64 = coeffs.iter().sum();
+    if (sum - args.arity as f64).abs() > 1e-9 * coeffs.len() as f64 {
+        return Err(bad(format!(
+            "--mask: the coefficients sum to {sum}; a mask of arity {} must sum to {} (each old point's weights in the new points)",
+            args.arity, args.arity
+        )));
+    }
+    if args.max_levels == 0 || args.max_levels > 20 {
+        return Err(bad(format!(
+            "--max-levels {}: must be 1 to 20",
+            args.max_levels
+        )));
+    }
+    let v =
+        analyze(&coeffs, args.arity, args.max_levels).map_err(|e| bad(format!("--mask: {e}")))?;
+    if args.json {
+        crate::print_json(out, &v);
+        return Ok(());
+    }
+    let mut s = String::new();
+    use std::fmt::Write as _;
+    let _ = writeln!(
+        s,
+        "converges: {}",
+        if v.converges { "yes" } else { "not shown" }
+    );
+    match v.smoothness {
+        Some(k) => {
+            let _ = writeln!(s, "smoothness: C^{k} shown");
+        }
+        None => {
+            let _ = writeln!(s, "smoothness: none shown");
+        }
+    }
+    for (k, (norms, used)) in v.norms.iter().zip(&v.levels_used).enumerate() {
+        let list: Vec<String> = norms.iter().map(|n| format!("{n:.6}")).collect();
+        let _ = writeln!(
+            s,
+            "  derived mask of order {k}: ‖S_q^L‖∞ for L = 1.. = [{}]{}",
+            list.join(", "),
+            used.map_or_else(
+                || " (never < 1)".to_string(),
+                |l| format!(" (< 1 at L = {l})")
+            )
+        );
+    }
+    if !v.note.is_empty() {
+        let _ = writeln!(s, "note: {}", v.note);
+    }
+    let _ = out.write_all(s.as_bytes());
+    Ok(())
+}
+
+/// A number, or a fraction `p/q`.
+fn parse_number(t: &str) -> Option<f64> {
+    match t.split_once('/') {
+        Some((p, q)) => Some(p.trim().parse::<f64>().ok()? / q.trim().parse::<f64>().ok()?),
+        None => t.parse().ok(),
+    }
+}
+
+fn run_surface(
+    surface: SurfaceArg,
+    n: usize,
+    json: bool,
+    out: &mut dyn Write,
+) -> Result<(), Failure> {
+    let (scheme, name, min) = match surface {
+        SurfaceArg::CatmullClark => (Scheme::CatmullClark, "catmull-clark", 3),
+        SurfaceArg::Loop => (Scheme::Loop, "loop", 3),
+    };
+    if !(min..=64).contains(&n) {
+        return Err(bad(format!("--valence {n}: must be {min} to 64")));
+    }
+    let m = subd_limit::eigen::ring_matrix(scheme, n, subd_limit::eigen::RingFeature::Smooth)
+        .map_err(|e| bad(format!("--surface {name}: {e}")))?;
+    let ev =
+        subd_limit::eigen::eigenvalues(&m).map_err(|e| bad(format!("--surface {name}: {e}")))?;
+    let mods: Vec<f64> = ev.iter().map(|z| z.norm()).collect();
+    let tol = 1e-9;
+    let passes = mods.len() >= 4
+        && (ev[0].re - 1.0).abs() < tol
+        && ev[0].im.abs() < tol
+        && mods[1] < 1.0 - tol
+        && (mods[1] - mods[2]).abs() < tol
+        && mods[3] < mods[2] - tol;
+    if json {
+        crate::print_json(
+            out,
+            &SurfaceReport {
+                scheme: name,
+                valence: n,
+                eigenvalues: mods,
+                passes,
+            },
+        );
+        return Ok(());
+    }
+    let list: Vec<String> = mods.iter().take(6).map(|x| format!("{x:.6}")).collect();
+    let _ = writeln!(
+        out,
+        "{name}, valence {n}: |λ| = [{}{}]; λ1 = 1 > λ2 = λ3 > |λ4|: {}",
+        list.join(", "),
+        if mods.len() > 6 { ", …" } else { "" },
+        if passes { "yes" } else { "no" }
+    );
+    Ok(())
+}

@@ -1,0 +1,456 @@
+//! `subd curve`: subdivision curves from a text point list, to text or SVG.
+
+use std::fmt::Write as _;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use clap::{Args, ValueEnum};
+use glam::{DVec2, DVec3};
+use serde::Serialize;
+use subd_schemes::curve::{CircleScheme, CurveScheme, PointNormal};
+
+use crate::Failure;
+use crate::refine::{bad, refuse_overwrite};
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub(crate) enum CurveSchemeArg {
+    /// Chaikin corner cutting (quadratic B-spline).
+    Chaikin,
+    /// Uniform B-spline of order --order (default 4, cubic).
+    Bspline,
+    /// Interpolatory 4-point scheme, tension --omega (default 1/16).
+    FourPoint,
+    /// Two-parameter 4-point scheme, --omega (default 1/16) and --mu (default 0).
+    FourPoint2p,
+    /// 3-point ternary interpolatory scheme, --omega (default 1/4).
+    Ternary3pt,
+    /// Non-stationary tension scheme, --alpha0 (default 1: cubic B-spline).
+    Tension,
+    /// Sabin–Dodgson circle-preserving 4-point scheme (planar points).
+    CirclePreserving,
+    /// Variational interpolatory scheme (Kobbelt).
+    Variational,
+    /// Circle-average two-parameter 4-point scheme on point–normal pairs, --omega, --mu.
+    CircleFourPoint,
+    /// Circle-average 3-point ternary scheme on point–normal pairs, --omega.
+    CircleTernary,
+}
+
+impl CurveSchemeArg {
+    fn name(self) -> &'static str {
+        match self {
+            CurveSchemeArg::Chaikin => "chaikin",
+            CurveSchemeArg::Bspline => "bspline",
+            CurveSchemeArg::FourPoint => "four-point",
+            CurveSchemeArg::FourPoint2p => "four-point-2p",
+            CurveSchemeArg::Ternary3pt => "ternary-3pt",
+            CurveSchemeArg::Tension => "tension",
+            CurveSchemeArg::CirclePreserving => "circle-preserving",
+            CurveSchemeArg::Variational => "variational",
+            CurveSchemeArg::CircleFourPoint => "circle-four-point",
+            CurveSchemeArg::CircleTernary => "circle-ternary",
+        }
+    }
+}
+
+#[derive(Debug, Args)]
+pub(crate) struct CurveArgs {
+    /// Curve scheme.
+    #[arg(long, value_enum)]
+    scheme: CurveSchemeArg,
+    /// Number of subdivision levels.
+    #[arg(long)]
+    levels: usize,
+    /// The input polygon is closed.
+    #[arg(long)]
+    closed: bool,
+    /// Tension ω (four-point, four-point-2p, ternary-3pt, circle schemes).
+    #[arg(long, allow_hyphen_values = true)]
+    omega: Option<f64>,
+    /// Displacement μ (four-point-2p, circle-four-point).
+    #[arg(long, allow_hyphen_values = true)]
+    mu: Option<f64>,
+    /// B-spline order k ≥ 2 (bspline).
+    #[arg(long)]
+    order: Option<usize>,
+    /// Initial tension α₀ ≥ −1 (tension); cos(2π/N) turns a regular N-gon into a circle.
+    #[arg(long, allow_hyphen_values = true)]
+    alpha0: Option<f64>,
+    /// Input points (.txt or .csv): `x y`, `x y z`, or `x y nx ny` per line; `#` comments.
+    input: PathBuf,
+    /// Output: .txt or .csv (one point per line, with normals for the circle schemes) or
+    /// .svg (control polygon, result and normals).
+    output: PathBuf,
+    /// Print a JSON report on stdout.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Serialize)]
+struct CurveReport {
+    input: String,
+    output: String,
+    scheme: &'static str,
+    levels: usize,
+    closed: bool,
+    input_points: usize,
+    output_points: usize,
+    normals_estimated: bool,
+    seconds: f64,
+}
+
+/// Points read from a text file: positions (z = 0 for 2D), the column count, and normals
+/// when there were four columns.
+struct PointFile {
+    points: Vec<DVec3>,
+    columns: usize,
+    normals: Option<Vec<DVec2>>,
+}
+
+fn read_points(path: &Path) -> Result<PointFile, Failure> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| bad(format!("{}: cannot read: {e}", path.display())))?;
+    let mut points = Vec::new();
+    let mut normals = Vec::new();
+    let mut columns = 0;
+    for (i, line) in text.lines().enumerate() {
+        let at = |m: String| bad(format!("{}:{}: {m}", path.display(), i + 1));
+        let body = line.split('#').next().unwrap_or("").trim();
+        if body.is_empty() {
+            continue;
+        }
+        let vals: Vec<f64> = body
+            .split(|c: char| c == ',' || c.is_whitespace())
+            .filter(|t| !t.is_empty())
+            .map(|t| {
+                t.parse::<f64>()
+                    .ok()
+                    .filter(|x| x.is_finite())
+                    .ok_or_else(|| at(format!("{t:?} is not a finite number")))
+            })
+            .collect::<Result<_, _>>()?;
+        if !(2..=4).contains(&vals.len()) {
+            return Err(at(format!(
+                "{} values; expected `x y`, `x y z` or `x y nx ny`",
+                vals.len()
+            )));
+        }
+        if columns == 0 {
+            columns = vals.len();
+        } else if vals.len() != columns {
+            return Err(at(format!(
+                "{} values, but earlier lines have {columns}",
+                vals.len()
+            )));
+        }
+        points.push(DVec3::new(
+            vals[0],
+            vals[1],
+            if columns == 3 { vals[2] } else { 0.0 },
+        ));
+        if columns == 4 {
+            let n = DVec2::new(vals[2], vals[3]);
+            if n.length() == 0.0 {
+                return Err(at("the normal is zero".into()));
+            }
+            normals.push(n.normalize());
+        }
+    }
+    Ok(PointFile {
+        points,
+        columns,
+        normals: (columns == 4).then_some(normals),
+    })
+}
+
+/// Unit normals of a planar polygon: the perpendicular of the central difference (one-sided
+/// at open ends), on the outer side of a closed polygon (the right of a counter-clockwise
+/// one) and on the right of an open one.
+fn estimate_normals(p: &[DVec3], closed: bool) -> Vec<DVec2> {
+    let n = p.len();
+    let area: f64 = (0..n)
+        .map(|i| {
+            let (a, b) = (p[i], p[(i + 1) % n]);
+            a.x * b.y - b.x * a.y
+        })
+        .sum();
+    let flip = if closed && area < 0.0 { -1.0 } else { 1.0 };
+    (0..n)
+        .map(|i| {
+            let (prev, next) = if closed {
+                (p[(i + n - 1) % n], p[(i + 1) % n])
+            } else {
+                (p[i.saturating_sub(1)], p[(i + 1).min(n - 1)])
+            };
+            let t = (next - prev).truncate();
+            flip * DVec2::new(t.y, -t.x).normalize_or_zero()
+        })
+        .collect()
+}
+
+pub(crate) fn run(
+    args: &CurveArgs,
+    out: &mut dyn Write,
+    err: &mut dyn Write,
+) -> Result<(), Failure> {
+    let t0 = Instant::now();
+    refuse_overwrite(&args.input, &args.output)?;
+    let ext = args
+        .output
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .unwrap_or_default();
+    if !["txt", "csv", "svg"].contains(&ext.as_str()) {
+        return Err(bad(format!(
+            "{}: unsupported output extension (expected .txt, .csv or .svg)",
+            args.output.display()
+        )));
+    }
+    let scheme = args.scheme;
+    let name = scheme.name();
+    // Parameters a scheme does not take are refused, not ignored.
+    let takes = |flag: &str| match flag {
+        "omega" => matches!(
+            scheme,
+            CurveSchemeArg::FourPoint
+                | CurveSchemeArg::FourPoint2p
+                | CurveSchemeArg::Ternary3pt
+                | CurveSchemeArg::CircleFourPoint
+                | CurveSchemeArg::CircleTernary
+        ),
+        "mu" => matches!(
+            scheme,
+            CurveSchemeArg::FourPoint2p | CurveSchemeArg::CircleFourPoint
+        ),
+        "order" => scheme == CurveSchemeArg::Bspline,
+        _ => scheme == CurveSchemeArg::Tension,
+    };
+    for (flag, given) in [
+        ("omega", args.omega.is_some()),
+        ("mu", args.mu.is_some()),
+        ("order", args.order.is_some()),
+        ("alpha0", args.alpha0.is_some()),
+    ] {
+        if given && !takes(flag) {
+            return Err(bad(format!("--{flag} does not apply to --scheme {name}")));
+        }
+    }
+    let file = read_points(&args.input)?;
+    let omega = args.omega.unwrap_or(
+        if matches!(
+            scheme,
+            CurveSchemeArg::Ternary3pt | CurveSchemeArg::CircleTernary
+        ) {
+            0.25
+        } else {
+            1.0 / 16.0
+        },
+    );
+    let mu = args.mu.unwrap_or(0.0);
+    let at_input =
+        |e: subd_schemes::curve::CurveError| bad(format!("{}: {e}", args.input.display()));
+    let mut normals_estimated = false;
+    let (points, normals): (Vec<DVec3>, Option<Vec<DVec2>>) = match scheme {
+        CurveSchemeArg::CircleFourPoint | CurveSchemeArg::CircleTernary => {
+            if file.columns == 3 {
+                return Err(bad(format!(
+                    "{}: the circle-average schemes work on planar points (`x y` or `x y nx ny`), not `x y z`",
+                    args.input.display()
+                )));
+            }
+            let normals = match &file.normals {
+                Some(n) => n.clone(),
+                None => {
+                    normals_estimated = true;
+                    let _ = writeln!(
+                        err,
+                        "subd: warning: {}: no normals given; estimated from the polygon",
+                        args.input.display()
+                    );
+                    estimate_normals(&file.points, args.closed)
+                }
+            };
+            let pn: Vec<PointNormal> = file
+                .points
+                .iter()
+                .zip(&normals)
+                .map(|(p, n)| PointNormal {
+                    p: p.truncate(),
+                    n: *n,
+                })
+                .collect();
+            let cs = if scheme == CurveSchemeArg::CircleFourPoint {
+                CircleScheme::FourPoint { omega, mu }
+            } else {
+                CircleScheme::Ternary { omega }
+            };
+            let r = cs
+                .subdivide(&pn, args.closed, args.levels)
+                .map_err(at_input)?;
+            (
+                r.iter().map(|q| q.p.extend(0.0)).collect(),
+                Some(r.iter().map(|q| q.n).collect()),
+            )
+        }
+        _ => {
+            let cs = match scheme {
+                CurveSchemeArg::Chaikin => CurveScheme::Chaikin,
+                CurveSchemeArg::Bspline => CurveScheme::BSpline {
+                    order: args.order.unwrap_or(4),
+                },
+                CurveSchemeArg::FourPoint => CurveScheme::FourPoint { omega },
+                CurveSchemeArg::FourPoint2p => CurveScheme::FourPoint2 { omega, mu },
+                CurveSchemeArg::Ternary3pt => CurveScheme::Ternary3 { omega },
+                CurveSchemeArg::Tension => CurveScheme::Tension {
+                    alpha0: args.alpha0.unwrap_or(1.0),
+                },
+                CurveSchemeArg::CirclePreserving => CurveScheme::CirclePreserving,
+                _ => CurveScheme::Variational,
+            };
+            let r = cs
+                .subdivide(&file.points, args.closed, args.levels)
+                .map_err(at_input)?;
+            (r, None)
+        }
+    };
+    let three_d = file.columns == 3;
+    let body = if ext == "svg" {
+        svg(
+            &file.points,
+            &points,
+            normals.as_deref(),
+            args.closed,
+            name,
+            args.levels,
+        )
+    } else {
+        let sep = if ext == "csv" { "," } else { " " };
+        let mut s = String::with_capacity(points.len() * 48);
+        for (i, p) in points.iter().enumerate() {
+            let _ = write!(s, "{}{sep}{}", p.x, p.y);
+            if three_d {
+                let _ = write!(s, "{sep}{}", p.z);
+            }
+            if let Some(n) = &normals {
+                let _ = write!(s, "{sep}{}{sep}{}", n[i].x, n[i].y);
+            }
+            s.push('\n');
+        }
+        s
+    };
+    subd_io::atomic_write(&args.output, |w| w.write_all(body.as_bytes()))?;
+    if args.json {
+        crate::print_json(
+            out,
+            &CurveReport {
+                input: args.input.display().to_string(),
+                output: args.output.display().to_string(),
+                scheme: name,
+                levels: args.levels,
+                closed: args.closed,
+                input_points: file.points.len(),
+                output_points: points.len(),
+                normals_estimated,
+                seconds: t0.elapsed().as_secs_f64(),
+            },
+        );
+    }
+    Ok(())
+}
+
+/// An SVG figure (x, y; z dropped): the control polygon in grey with its points, the result
+/// in blue, and normals as short red ticks where there are normals (every one up to 400
+/// points, fewer beyond).
+fn svg(
+    control: &[DVec3],
+    result: &[DVec3],
+    normals: Option<&[DVec2]>,
+    closed: bool,
+    name: &str,
+    levels: usize,
+) -> String {
+    let (lo, hi) = control.iter().chain(result).fold(
+        (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+        |(lo, hi), p| (lo.min(p.truncate()), hi.max(p.truncate())),
+    );
+    let size = (hi - lo).max_element().max(1e-300);
+    let (w, margin) = (800.0, 40.0);
+    let scale = (w - 2.0 * margin) / size;
+    let height = (hi.y - lo.y) * scale + 2.0 * margin + 30.0;
+    // y grows downwards in SVG.
+    let map = |p: DVec2| {
+        DVec2::new(
+            margin + (p.x - lo.x) * scale,
+            margin + 30.0 + (hi.y - p.y) * scale,
+        )
+    };
+    let path = |pts: &[DVec3], close: bool| {
+        let mut d = String::new();
+        for (i, p) in pts.iter().enumerate() {
+            let q = map(p.truncate());
+            let _ = write!(
+                d,
+                "{}{:.3},{:.3} ",
+                if i == 0 { "M" } else { "L" },
+                q.x,
+                q.y
+            );
+        }
+        if close {
+            d.push('Z');
+        }
+        d
+    };
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{height:.0}" viewBox="0 0 {w} {height:.0}">"#
+    );
+    let _ = writeln!(s, r#"<rect width="100%" height="100%" fill="white"/>"#);
+    let _ = writeln!(
+        s,
+        r#"<text x="{margin}" y="24" font-family="sans-serif" font-size="16">{name}, {levels} levels: {} → {} points (grey: control polygon, blue: result{})</text>"#,
+        control.len(),
+        result.len(),
+        if normals.is_some() {
+            ", red: normals"
+        } else {
+            ""
+        }
+    );
+    let _ = writeln!(
+        s,
+        r##"<path d="{}" fill="none" stroke="#999" stroke-width="1.5" stroke-dasharray="6 4"/>"##,
+        path(control, closed)
+    );
+    for p in control {
+        let q = map(p.truncate());
+        let _ = writeln!(
+            s,
+            r##"<circle cx="{:.3}" cy="{:.3}" r="4" fill="#666"/>"##,
+            q.x, q.y
+        );
+    }
+    let _ = writeln!(
+        s,
+        r##"<path d="{}" fill="none" stroke="#1f5fbf" stroke-width="2"/>"##,
+        path(result, closed)
+    );
+    if let Some(ns) = normals {
+        let step = result.len().div_ceil(400).max(1);
+        let len = 0.04 * (w - 2.0 * margin);
+        for (p, n) in result.iter().zip(ns).step_by(step) {
+            let a = map(p.truncate());
+            let b = a + len * DVec2::new(n.x, -n.y);
+            let _ = writeln!(
+                s,
+                r##"<line x1="{:.3}" y1="{:.3}" x2="{:.3}" y2="{:.3}" stroke="#d33" stroke-width="1"/>"##,
+                a.x, a.y, b.x, b.y
+            );
+        }
+    }
+    s.push_str("</svg>\n");
+    s
+}
