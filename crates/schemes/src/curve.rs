@@ -39,6 +39,7 @@
 //! the circle, so the schemes reproduce circles.
 
 use glam::{DVec2, DVec3};
+use rayon::prelude::*;
 use thiserror::Error;
 
 /// Why a curve cannot be subdivided.
@@ -403,7 +404,10 @@ impl Polyline {
             let n = self.points.len() as i64;
             // New index i ↔ old parameter (i − d)/m; start at the point nearest parameter 0.
             let start = d.round() as i64;
-            let points = (0..m * n).map(|i| point(start + i)).collect();
+            let points = (0..m * n)
+                .into_par_iter()
+                .map(|i| point(start + i))
+                .collect();
             return Polyline {
                 points,
                 closed: true,
@@ -413,7 +417,7 @@ impl Polyline {
         }
         let (sl, sr) = (m as f64 * self.left.0 + d, m as f64 * self.right.0 + d);
         let (lo, hi) = (sl.ceil() as i64, sr.floor() as i64);
-        let points = (lo..=hi).map(point).collect();
+        let points = (lo..=hi).into_par_iter().map(point).collect();
         Polyline {
             points,
             closed: false,
@@ -486,23 +490,24 @@ impl Polyline {
         let p: Vec<DVec2> = self.points.iter().map(|q| q.truncate()).collect();
         let n = p.len();
         let count = if self.closed { n } else { n - 1 };
-        let mut out = Vec::with_capacity(n + count);
-        for i in 0..n {
-            out.push(self.points[i]);
-            if i >= count {
-                continue;
-            }
-            let (b, c) = (p[i], p[(i + 1) % n]);
-            let prev = (self.closed || i > 0).then(|| p[(i + n - 1) % n]);
-            let next = (self.closed || i + 2 < n).then(|| p[(i + 2) % n]);
-            let m = match (prev, next) {
-                (Some(a), Some(d)) => sabin_dodgson(a, b, c, d),
-                (None, Some(d)) => arc_point(b, c, signed_curvature(b, c, d), 0.0),
-                (Some(a), None) => arc_point(b, c, signed_curvature(a, b, c), 0.0),
-                (None, None) => 0.5 * (b + c),
-            };
-            out.push(m.extend(0.0));
-        }
+        let out: Vec<DVec3> = (0..n)
+            .into_par_iter()
+            .flat_map_iter(|i| {
+                let new = (i < count).then(|| {
+                    let (b, c) = (p[i], p[(i + 1) % n]);
+                    let prev = (self.closed || i > 0).then(|| p[(i + n - 1) % n]);
+                    let next = (self.closed || i + 2 < n).then(|| p[(i + 2) % n]);
+                    let m = match (prev, next) {
+                        (Some(a), Some(d)) => sabin_dodgson(a, b, c, d),
+                        (None, Some(d)) => arc_point(b, c, signed_curvature(b, c, d), 0.0),
+                        (Some(a), None) => arc_point(b, c, signed_curvature(a, b, c), 0.0),
+                        (None, None) => 0.5 * (b + c),
+                    };
+                    m.extend(0.0)
+                });
+                std::iter::once(self.points[i]).chain(new)
+            })
+            .collect();
         let len = out.len();
         Polyline {
             left: (0.0, out[0]),
@@ -741,35 +746,39 @@ impl CircleScheme {
         match *self {
             CircleScheme::FourPoint { omega, mu } => {
                 let count = if closed { n } else { n - 1 };
-                let mut out = Vec::with_capacity(2 * n as usize);
-                for i in 0..n {
-                    let end = !closed && (i == 0 || i == n - 1);
-                    let even = if mu == 0.0 || end {
-                        p[i as usize]
-                    } else {
-                        a(p[i as usize], a(at(i - 1), at(i + 1), 0.5), 2.0 * mu)
-                    };
-                    out.push(even);
-                    if i < count {
-                        let l = a(at(i - 1), at(i), 1.0 + 2.0 * omega);
-                        let r = a(at(i + 2), at(i + 1), 1.0 + 2.0 * omega);
-                        out.push(a(l, r, 0.5));
-                    }
-                }
-                out
+                (0..n)
+                    .into_par_iter()
+                    .flat_map_iter(|i| {
+                        let end = !closed && (i == 0 || i == n - 1);
+                        let even = if mu == 0.0 || end {
+                            p[i as usize]
+                        } else {
+                            a(p[i as usize], a(at(i - 1), at(i + 1), 0.5), 2.0 * mu)
+                        };
+                        let odd = (i < count).then(|| {
+                            let l = a(at(i - 1), at(i), 1.0 + 2.0 * omega);
+                            let r = a(at(i + 2), at(i + 1), 1.0 + 2.0 * omega);
+                            a(l, r, 0.5)
+                        });
+                        std::iter::once(even).chain(odd)
+                    })
+                    .collect()
             }
             CircleScheme::Ternary { omega } => {
                 let s = (4.0 / 3.0 - 2.0 * omega) / (1.0 - omega);
                 let count = if closed { n } else { n - 1 };
-                let mut out = Vec::with_capacity(3 * n as usize);
-                for i in 0..n {
-                    out.push(p[i as usize]);
-                    if i < count {
-                        out.push(a(a(at(i - 1), at(i), s), at(i + 1), omega));
-                        out.push(a(a(at(i + 2), at(i + 1), s), at(i), omega));
-                    }
-                }
-                out
+                (0..n)
+                    .into_par_iter()
+                    .flat_map_iter(|i| {
+                        let new = (i < count).then(|| {
+                            [
+                                a(a(at(i - 1), at(i), s), at(i + 1), omega),
+                                a(a(at(i + 2), at(i + 1), s), at(i), omega),
+                            ]
+                        });
+                        std::iter::once(p[i as usize]).chain(new.into_iter().flatten())
+                    })
+                    .collect()
             }
         }
     }
