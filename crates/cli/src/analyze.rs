@@ -6,7 +6,7 @@ use std::io::Write;
 use clap::{Args, ValueEnum};
 use serde::Serialize;
 use subd_schemes::Scheme;
-use subd_schemes::analysis::analyze;
+use subd_schemes::analysis::{Lattice, analyze, analyze_bivariate};
 
 use crate::Failure;
 use crate::refine::bad;
@@ -17,6 +17,12 @@ pub(crate) enum SurfaceArg {
     Loop,
 }
 
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub(crate) enum LatticeArg {
+    Quad,
+    ThreeDirection,
+}
+
 #[derive(Debug, Args)]
 pub(crate) struct AnalyzeArgs {
     /// Mask coefficients a_j, comma-separated, in order of increasing power of z (the
@@ -24,10 +30,17 @@ pub(crate) struct AnalyzeArgs {
     #[arg(
         long,
         allow_hyphen_values = true,
-        required_unless_present = "surface",
-        conflicts_with = "surface"
+        required_unless_present_any = ["surface", "mask2"],
+        conflicts_with_all = ["surface", "mask2"]
     )]
     mask: Option<String>,
+    /// A bivariate binary mask: rows separated by `;` (row j holds the coefficients of
+    /// z1^i z2^j for i = 0, 1, …), the four residue classes each summing to 1.
+    #[arg(long, allow_hyphen_values = true, conflicts_with = "surface")]
+    mask2: Option<String>,
+    /// Lattice of --mask2.
+    #[arg(long, value_enum, default_value = "quad")]
+    lattice: LatticeArg,
     /// Arity of the mask: 2 (binary) or 3 (ternary).
     #[arg(long, default_value_t = 2)]
     arity: usize,
@@ -59,6 +72,9 @@ struct SurfaceReport {
 pub(crate) fn run(args: &AnalyzeArgs, out: &mut dyn Write) -> Result<(), Failure> {
     if let (Some(surface), Some(n)) = (args.surface, args.valence) {
         return run_surface(surface, n, args.json, out);
+    }
+    if let Some(text) = &args.mask2 {
+        return run_bivariate(text, args, out);
     }
     let text = args.mask.as_deref().unwrap_or_default();
     let coeffs: Vec<f64> = text
@@ -129,6 +145,58 @@ pub(crate) fn run(args: &AnalyzeArgs, out: &mut dyn Write) -> Result<(), Failure
         let _ = writeln!(s, "note: {}", v.note);
     }
     let _ = out.write_all(s.as_bytes());
+    Ok(())
+}
+
+fn run_bivariate(text: &str, args: &AnalyzeArgs, out: &mut dyn Write) -> Result<(), Failure> {
+    let rows: Vec<Vec<f64>> = text
+        .split(';')
+        .enumerate()
+        .map(|(j, row)| {
+            row.split(|c: char| c == ',' || c.is_whitespace())
+                .filter(|t| !t.is_empty())
+                .map(|t| {
+                    parse_number(t).filter(|x| x.is_finite()).ok_or_else(|| {
+                        bad(format!("--mask2: row {j}: {t:?} is not a finite number"))
+                    })
+                })
+                .collect::<Result<Vec<f64>, _>>()
+        })
+        .collect::<Result<_, _>>()?;
+    let sum: f64 = rows.iter().flatten().sum();
+    if (sum - 4.0).abs() > 1e-9 * rows.iter().map(Vec::len).sum::<usize>().max(1) as f64 {
+        return Err(bad(format!(
+            "--mask2: the coefficients sum to {sum}; a bivariate binary mask must sum to 4"
+        )));
+    }
+    let lattice = match args.lattice {
+        LatticeArg::Quad => Lattice::Quad,
+        LatticeArg::ThreeDirection => Lattice::ThreeDirection,
+    };
+    let v = analyze_bivariate(&rows, lattice, args.max_levels)
+        .map_err(|e| bad(format!("--mask2: {e}")))?;
+    if args.json {
+        crate::print_json(out, &v);
+        return Ok(());
+    }
+    let _ = writeln!(
+        out,
+        "converges: {}\nsmoothness: {}",
+        if v.converges { "yes" } else { "not shown" },
+        v.smoothness
+            .map_or_else(|| "none shown".to_string(), |k| format!("C^{k} shown"))
+    );
+    for (k, n) in v.norms.iter().enumerate() {
+        let list: Vec<String> = n.iter().map(|x| format!("{x:.6}")).collect();
+        let _ = writeln!(
+            out,
+            "  C^{k} test: max_k ‖S_q^L‖∞ for L = 1.. = [{}]",
+            list.join(", ")
+        );
+    }
+    if !v.note.is_empty() {
+        let _ = writeln!(out, "note: {}", v.note);
+    }
     Ok(())
 }
 

@@ -1270,6 +1270,21 @@ fn analyze_reports_the_seeds_verdicts() {
     assert_eq!(code, 0);
     let j: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert_eq!(j["smoothness"], 1);
+    // Bivariate: the tensor-product cubic B-spline, C¹ shown.
+    let row = [1.0, 4.0, 6.0, 4.0, 1.0];
+    let mask2: Vec<String> = row
+        .iter()
+        .map(|y| {
+            row.iter()
+                .map(|x| format!("{}", x * y / 64.0))
+                .collect::<Vec<_>>()
+                .join(",")
+        })
+        .collect();
+    let (code, out, err) = subd(&["analyze", "--mask2", &mask2.join(";"), "--json"]);
+    assert_eq!(code, 0, "{err}");
+    let j: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(j["smoothness"], 1);
     // Surface eigenvalue test.
     let (code, out, _) = subd(&[
         "analyze",

@@ -14,6 +14,9 @@
 //! 3. `S_a` is `C^k` if `a = (σ/m)^k a_k` and `S_{a_k}` converges (a sufficient test; the
 //!    largest `k` for which it succeeds within the level limit is reported).
 //!
+//! [`analyze_bivariate`] does the same for factorable bivariate binary masks on quad and
+//! three-direction grids (seed 001 §7.2), up to C¹.
+//!
 //! ```
 //! use subd_schemes::analysis::analyze;
 //!
@@ -220,6 +223,291 @@ fn class_norm(c: &[f64], s: usize) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// The lattice of a bivariate binary mask.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Lattice {
+    /// Quad (tensor) grids: difference directions `z1`, `z2`.
+    Quad,
+    /// Three-direction (triangle) grids: directions `z1`, `z2`, `z1 z2`.
+    ThreeDirection,
+}
+
+/// The outcome of [`analyze_bivariate`].
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct BivariateVerdict {
+    /// The lattice.
+    pub lattice: Lattice,
+    /// Whether convergence (C⁰) was shown.
+    pub converges: bool,
+    /// `Some(1)` when C¹ was shown, `Some(0)` when only C⁰, `None` when neither.
+    pub smoothness: Option<usize>,
+    /// For C⁰ and (when the mask factors far enough) C¹: per level `L = 1, 2, …`, the largest
+    /// `‖S_{q_k}^L‖∞` over the difference directions `k`.
+    pub norms: Vec<Vec<f64>>,
+    /// Why the analysis stopped where it did.
+    pub note: String,
+}
+
+/// A bivariate polynomial: `c[j][i]` is the coefficient of `z1^i z2^j`.
+type Poly2 = Vec<Vec<f64>>;
+
+/// Convergence and C¹ of a factorable bivariate binary mask (seed 001 §7.2): `coeffs[j][i]`
+/// is `a_{ij}`, the weight of `z1^i z2^j` (rows are powers of `z2`); the four residue classes
+/// mod 2 must each sum to 1.
+///
+/// * **C⁰:** `a` must factor as `(1 + z1)(1 + z2) b` (quad) or `(1 + z1)(1 + z2)(1 + z1 z2) b`
+///   (three-direction). Differences along direction `k` (`w_k` = `z1`, `z2`, `z1 z2`) obey the
+///   scheme `q_k = a / (1 + w_k)`; the scheme converges if all of them contract:
+///   `max_k ‖S_{q_k}^L‖∞ < 1` for some `L`.
+/// * **C¹:** each directional derivative scheme `2 a / (1 + w_k)` must itself pass the C⁰
+///   test, which needs a second factor of every `(1 + w)`; where it is missing (the
+///   butterfly scheme, whose C¹ proof needs matrix-valued differences) C¹ is not shown.
+///
+/// ```
+/// use subd_schemes::analysis::{Lattice, analyze_bivariate};
+///
+/// // The tensor-product cubic B-spline: C¹ shown (it is C²).
+/// let b = [1.0, 4.0, 6.0, 4.0, 1.0];
+/// let rows: Vec<Vec<f64>> = b.iter().map(|&y| b.iter().map(|&x| x * y / 64.0).collect()).collect();
+/// let v = analyze_bivariate(&rows, Lattice::Quad, 6).unwrap();
+/// assert!(v.converges);
+/// assert_eq!(v.smoothness, Some(1));
+/// ```
+///
+/// # Errors
+/// [`AnalysisError::Mask`] for an empty mask, ragged rows or a coefficient that is not finite.
+pub fn analyze_bivariate(
+    coeffs: &[Vec<f64>],
+    lattice: Lattice,
+    max_levels: usize,
+) -> Result<BivariateVerdict, AnalysisError> {
+    let width = coeffs.first().map_or(0, Vec::len);
+    if width == 0 || coeffs.iter().any(|r| r.len() != width) {
+        return Err(AnalysisError::Mask(
+            "the mask must be a non-empty rectangle of coefficients (rows of equal length)".into(),
+        ));
+    }
+    if coeffs.iter().flatten().any(|c| !c.is_finite()) {
+        return Err(AnalysisError::Mask(
+            "a coefficient is not a finite number".into(),
+        ));
+    }
+    let scale = coeffs.iter().flatten().fold(0.0f64, |m, c| m.max(c.abs()));
+    let tol = 1e-10 * scale.max(1.0);
+    let mut v = BivariateVerdict {
+        lattice,
+        converges: false,
+        smoothness: None,
+        norms: Vec::new(),
+        note: String::new(),
+    };
+    let a: Poly2 = coeffs.to_vec();
+    for (r1, r2) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+        let s: f64 = a
+            .iter()
+            .skip(r2)
+            .step_by(2)
+            .flat_map(|row| row.iter().skip(r1).step_by(2))
+            .sum();
+        if (s - 1.0).abs() > tol {
+            v.note = format!(
+                "sum rule fails: residue class ({r1}, {r2}) sums to {s}, not 1; the scheme does not converge"
+            );
+            return Ok(v);
+        }
+    }
+    let directions: &[Dir] = match lattice {
+        Lattice::Quad => &[Dir::X, Dir::Y],
+        Lattice::ThreeDirection => &[Dir::X, Dir::Y, Dir::Diagonal],
+    };
+    // C⁰: the difference schemes along every direction.
+    let Some(diffs) = directions
+        .iter()
+        .map(|&d| divide2(&a, d, tol))
+        .collect::<Option<Vec<_>>>()
+    else {
+        v.note = format!(
+            "the mask does not factor as {}: not analysed",
+            lattice_factor(lattice)
+        );
+        return Ok(v);
+    };
+    let (norms, ok) = contract(&diffs, max_levels);
+    v.norms.push(norms);
+    if !ok {
+        v.note = format!("max_k ‖S_q^L‖∞ ≥ 1 for L = 1..{max_levels}: convergence not shown");
+        return Ok(v);
+    }
+    v.converges = true;
+    v.smoothness = Some(0);
+    // C¹: each derivative scheme 2a/(1 + w_k) = 2 q_k must pass the C⁰ test.
+    let mut second = Vec::new();
+    for q in &diffs {
+        let dq: Poly2 = q
+            .iter()
+            .map(|r| r.iter().map(|x| 2.0 * x).collect())
+            .collect();
+        match directions
+            .iter()
+            .map(|&d| divide2(&dq, d, tol))
+            .collect::<Option<Vec<_>>>()
+        {
+            Some(d) => second.extend(d),
+            None => {
+                v.note = format!(
+                    "C¹ not shown: the derivative schemes do not factor as {} again",
+                    lattice_factor(lattice)
+                );
+                return Ok(v);
+            }
+        }
+    }
+    let (norms, ok) = contract(&second, max_levels);
+    v.norms.push(norms);
+    if ok {
+        v.smoothness = Some(1);
+    } else {
+        v.note = format!(
+            "C¹ not shown: max_k ‖S_q^L‖∞ ≥ 1 for L = 1..{max_levels} for the derivative schemes"
+        );
+    }
+    Ok(v)
+}
+
+fn lattice_factor(l: Lattice) -> &'static str {
+    match l {
+        Lattice::Quad => "(1 + z1)(1 + z2) b",
+        Lattice::ThreeDirection => "(1 + z1)(1 + z2)(1 + z1 z2) b",
+    }
+}
+
+/// A difference direction.
+#[derive(Debug, Clone, Copy)]
+enum Dir {
+    X,
+    Y,
+    Diagonal,
+}
+
+/// `p / (1 + w)` for `w = z1`, `z2` or `z1 z2`, when exact within `tol`.
+fn divide2(p: &Poly2, d: Dir, tol: f64) -> Option<Poly2> {
+    let (h, w) = (p.len(), p[0].len());
+    // Each line along the direction is a univariate polynomial to divide by (1 + t).
+    let lines: Vec<Vec<(usize, usize)>> = match d {
+        Dir::X => (0..h).map(|j| (0..w).map(|i| (j, i)).collect()).collect(),
+        Dir::Y => (0..w).map(|i| (0..h).map(|j| (j, i)).collect()).collect(),
+        Dir::Diagonal => {
+            let mut l = Vec::new();
+            for start in (0..h).rev().map(|j| (j, 0)).chain((1..w).map(|i| (0, i))) {
+                let mut line = Vec::new();
+                let (mut j, mut i) = start;
+                while j < h && i < w {
+                    line.push((j, i));
+                    j += 1;
+                    i += 1;
+                }
+                l.push(line);
+            }
+            l
+        }
+    };
+    let (nh, nw) = match d {
+        Dir::X => (h, w.checked_sub(1)?),
+        Dir::Y => (h.checked_sub(1)?, w),
+        Dir::Diagonal => (h.checked_sub(1)?, w.checked_sub(1)?),
+    };
+    if nh == 0 || nw == 0 {
+        return None;
+    }
+    let mut out = vec![vec![0.0; nw]; nh];
+    for line in lines {
+        let vals: Vec<f64> = line.iter().map(|&(j, i)| p[j][i]).collect();
+        let q = divide_by_sigma(&vals, 2, tol).or_else(|| {
+            vals.iter()
+                .all(|x| x.abs() <= tol)
+                .then(|| vec![0.0; vals.len().saturating_sub(1)])
+        })?;
+        for (k, &x) in q.iter().enumerate() {
+            let (j, i) = line[k];
+            if j < nh && i < nw {
+                out[j][i] = x;
+            } else if x.abs() > tol {
+                return None;
+            }
+        }
+    }
+    Some(out)
+}
+
+/// `max_k ‖S_{q_k}^L‖∞` for `L = 1..=max_levels` until it drops below 1; whether it did.
+fn contract(qs: &[Poly2], max_levels: usize) -> (Vec<f64>, bool) {
+    let mut powers: Vec<Poly2> = qs.to_vec();
+    let mut norms = Vec::new();
+    for l in 1..=max_levels {
+        if l > 1 {
+            for (p, q) in powers.iter_mut().zip(qs) {
+                *p = multiply2(p, &upsample2(q, 1 << (l - 1)));
+            }
+        }
+        let n = powers
+            .iter()
+            .map(|p| class_norm2(p, 1 << l))
+            .fold(0.0, f64::max);
+        norms.push(n);
+        if n < 1.0 - 1e-12 {
+            return (norms, true);
+        }
+        if powers.iter().any(|p| p.len() * p[0].len() > 1 << 22) {
+            break;
+        }
+    }
+    (norms, false)
+}
+
+fn upsample2(q: &Poly2, s: usize) -> Poly2 {
+    let (h, w) = (q.len(), q[0].len());
+    let mut out = vec![vec![0.0; (w - 1) * s + 1]; (h - 1) * s + 1];
+    for j in 0..h {
+        for i in 0..w {
+            out[j * s][i * s] = q[j][i];
+        }
+    }
+    out
+}
+
+fn multiply2(a: &Poly2, b: &Poly2) -> Poly2 {
+    let (ha, wa, hb, wb) = (a.len(), a[0].len(), b.len(), b[0].len());
+    let mut out = vec![vec![0.0; wa + wb - 1]; ha + hb - 1];
+    for j in 0..ha {
+        for i in 0..wa {
+            let x = a[j][i];
+            if x == 0.0 {
+                continue;
+            }
+            for (l, row) in b.iter().enumerate() {
+                for (k, &y) in row.iter().enumerate() {
+                    if y != 0.0 {
+                        out[j + l][i + k] += x * y;
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+/// `max_{(r1, r2)} Σ |c_{r1 + s i, r2 + s j}|`.
+fn class_norm2(c: &Poly2, s: usize) -> f64 {
+    let mut sums = vec![0.0; s * s];
+    for (j, row) in c.iter().enumerate() {
+        for (i, &x) in row.iter().enumerate() {
+            sums[(j % s) * s + i % s] += x.abs();
+        }
+    }
+    sums.into_iter().fold(0.0, f64::max)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -286,6 +574,83 @@ mod tests {
             analyze(&four_point(1.0 / 16.0), 2, 10).unwrap().smoothness,
             Some(1)
         );
+    }
+
+    /// `(1 + z)^k / 2^(k − 1)` coefficients, as a row.
+    fn box1(k: usize) -> Vec<f64> {
+        bspline(k)
+    }
+
+    #[test]
+    fn bivariate_box_splines_and_butterfly() {
+        // Tensor-product B-splines: linear (C⁰ only by this test), cubic (C¹ shown).
+        let tensor = |k: usize| -> Vec<Vec<f64>> {
+            let b = box1(k);
+            b.iter()
+                .map(|&y| b.iter().map(|&x| x * y).collect())
+                .collect()
+        };
+        let v = analyze_bivariate(&tensor(2), Lattice::Quad, 6).unwrap();
+        assert!(v.converges && v.smoothness == Some(0), "{v:?}");
+        let v = analyze_bivariate(&tensor(4), Lattice::Quad, 6).unwrap();
+        assert_eq!(v.smoothness, Some(1), "{v:?}");
+        // Loop's regular mask is the three-direction quartic box spline
+        // (1 + z1)²(1 + z2)²(1 + z1 z2)² / 16: C¹ shown (it is C²).
+        let f = |p: &Poly2, d: (usize, usize)| {
+            let mut f = vec![vec![0.0; d.0 + 1]; d.1 + 1];
+            f[0][0] = 1.0;
+            f[d.1][d.0] = 1.0;
+            multiply2(p, &f)
+        };
+        let mut loop_mask: Poly2 = vec![vec![1.0 / 16.0]];
+        for _ in 0..2 {
+            loop_mask = f(&loop_mask, (1, 0));
+            loop_mask = f(&loop_mask, (0, 1));
+            loop_mask = f(&loop_mask, (1, 1));
+        }
+        let v = analyze_bivariate(&loop_mask, Lattice::ThreeDirection, 6).unwrap();
+        assert_eq!(v.smoothness, Some(1), "{v:?}");
+        // The butterfly scheme (w = 1/16): C⁰ shown; C¹ needs matrix differences.
+        let w = 1.0 / 16.0;
+        // Stencil of one old point's weights on the three-direction grid, centred at (3, 3):
+        // 1 at the centre, 1/2 + 2w... written out from the refinement rules.
+        let mut b = vec![vec![0.0; 7]; 7];
+        let mut put = |i: i32, j: i32, x: f64| b[(j + 3) as usize][(i + 3) as usize] += x;
+        put(0, 0, 1.0);
+        for (i, j) in [(1, 0), (0, 1), (1, 1), (-1, 0), (0, -1), (-1, -1)] {
+            put(i, j, 0.5);
+        }
+        for (i, j) in [(2, 1), (1, 2), (-1, 1), (-2, -1), (-1, -2), (1, -1)] {
+            put(i, j, 2.0 * w);
+        }
+        for (i, j) in [
+            (3, 1),
+            (3, 2),
+            (2, 3),
+            (1, 3),
+            (-1, 2),
+            (-2, 1),
+            (-3, -1),
+            (-3, -2),
+            (-2, -3),
+            (-1, -3),
+            (1, -2),
+            (2, -1),
+        ] {
+            put(i, j, -w);
+        }
+        let v = analyze_bivariate(&b, Lattice::ThreeDirection, 6).unwrap();
+        assert!(v.converges, "{v:?}");
+        assert_eq!(v.smoothness, Some(0), "{v:?}");
+        // Not factorable: refused politely.
+        let v = analyze_bivariate(
+            &[vec![1.0, 1.0], vec![1.0, 1.0]],
+            Lattice::ThreeDirection,
+            4,
+        )
+        .unwrap();
+        assert!(!v.converges);
+        assert!(analyze_bivariate(&[vec![1.0], vec![1.0, 2.0]], Lattice::Quad, 2).is_err());
     }
 
     #[test]
