@@ -225,32 +225,27 @@ fn axpy3(x: &mut [DVec3], a: DVec3, y: &[DVec3]) {
         .for_each(|(x, y)| x.iter_mut().zip(y).for_each(|(x, y)| *x += a * *y));
 }
 
-/// Conjugate gradients on the symmetric form of `M̄ = C D`: `S = C^{-1/2} M̄ C^{1/2}`
-/// (`= C^{1/2} D C^{1/2}`, symmetric, similar to `M̄`), solving `S y = C^{-1/2} b` with
-/// `x = C^{1/2} y`; the interpolation error is `C^{1/2}` times CG's residual. Restarted from
-/// the true residual when the updated one has drifted. `None` when `S` shows a
-/// non-positive curvature (not positive definite). Two passes per iteration besides the
-/// direction update: `q = S p` with `p·q`, and the updates of `y`, `r` with `r·r` and the
-/// error.
-fn cg(s: &ReducedSystem, c: &[f64], x: Vec<DVec3>, ctl: Controls) -> Option<Outcome> {
+/// Conjugate gradients for `M̄ = C D` in the inner product `⟨x, y⟩ = Σ x_i y_i / c_i`, in
+/// which `M̄` is self-adjoint (`⟨M̄x, y⟩ = xᵀ D y`) and, with `D` positive definite, positive:
+/// the iterates are those of CG on the symmetric `C^{-1/2} M̄ C^{1/2}`, without forming it,
+/// and the residual is the interpolation error itself. Restarted from the true residual when
+/// the updated one has drifted. `None` when a non-positive curvature shows that `D` is not
+/// positive definite. Three passes per iteration: `q = M̄ p` with `⟨p, q⟩`; the updates of
+/// `x` and `r` with `⟨r, r⟩` and `max |r_i|`; the new direction.
+fn cg(s: &ReducedSystem, c: &[f64], mut x: Vec<DVec3>, ctl: Controls) -> Option<Outcome> {
     let n = s.len();
-    let sc: Vec<f64> = c.iter().map(|c| c.sqrt()).collect();
-    let sym = s.scaled(&sc);
-    let mut y: Vec<DVec3> = x.iter().zip(&sc).map(|(x, s)| *x / *s).collect();
+    let weight: Vec<f64> = c.iter().map(|c| 1.0 / c).collect();
     let mut r = vec![DVec3::ZERO; n];
     let mut q = vec![DVec3::ZERO; n];
     let mut p = vec![DVec3::ZERO; n];
-    let mut x = x;
     let mut res = s.residual(&x, &mut r);
     let mut history = vec![res];
     let mut steps = 0usize;
     while res > ctl.threshold && steps < ctl.max_iter {
-        // (Re)start from r = C^{-1/2} (b − M̄ x).
-        scale(&mut r, &sc, true);
         p.copy_from_slice(&r);
-        let mut rr = dot(&r, &r);
+        let mut rr = weighted_dot(&r, &r, &weight);
         loop {
-            let pq = sym.apply_dot(&p, &mut q);
+            let pq = s.apply_weighted_dot(&weight, &p, &mut q);
             if [pq.x, pq.y, pq.z]
                 .iter()
                 .zip([rr.x, rr.y, rr.z])
@@ -259,7 +254,7 @@ fn cg(s: &ReducedSystem, c: &[f64], x: Vec<DVec3>, ctl: Controls) -> Option<Outc
                 return None;
             }
             let alpha = safe_div(rr, pq);
-            let (rr_new, error) = cg_update(&mut y, &mut r, alpha, &p, &q, &sc);
+            let (rr_new, error) = cg_update(&mut x, &mut r, alpha, &p, &q, &weight);
             steps += 1;
             history.push(error);
             if error <= ctl.threshold || steps >= ctl.max_iter {
@@ -271,7 +266,6 @@ fn cg(s: &ReducedSystem, c: &[f64], x: Vec<DVec3>, ctl: Controls) -> Option<Outc
                 .zip(r.par_chunks(CHUNK))
                 .for_each(|(p, r)| p.iter_mut().zip(r).for_each(|(p, r)| *p = *r + beta * *p));
         }
-        x = y.iter().zip(&sc).map(|(y, s)| *y * *s).collect();
         res = s.residual(&x, &mut r);
         *history.last_mut().expect("one step taken") = res;
     }
@@ -282,29 +276,45 @@ fn cg(s: &ReducedSystem, c: &[f64], x: Vec<DVec3>, ctl: Controls) -> Option<Outc
     })
 }
 
-/// One fused CG update: `y += α p`, `r −= α q`; returns `r·r` (blocks summed in order) and
-/// the interpolation error `max |C^{1/2} r|`.
+/// `Σ_i w_i a_i ⊙ b_i` in fixed-size blocks summed in order.
+fn weighted_dot(a: &[DVec3], b: &[DVec3], w: &[f64]) -> DVec3 {
+    let partial: Vec<DVec3> = a
+        .par_chunks(CHUNK)
+        .zip(b.par_chunks(CHUNK))
+        .zip(w.par_chunks(CHUNK))
+        .map(|((a, b), w)| {
+            a.iter()
+                .zip(b)
+                .zip(w)
+                .fold(DVec3::ZERO, |s, ((a, b), &w)| s + w * (*a * *b))
+        })
+        .collect();
+    partial.into_iter().fold(DVec3::ZERO, |s, x| s + x)
+}
+
+/// One fused CG update: `x += α p`, `r −= α q`; returns `⟨r, r⟩` (blocks summed in order)
+/// and the interpolation error `max |r_i|`.
 fn cg_update(
-    y: &mut [DVec3],
+    x: &mut [DVec3],
     r: &mut [DVec3],
     alpha: DVec3,
     p: &[DVec3],
     q: &[DVec3],
-    sc: &[f64],
+    weight: &[f64],
 ) -> (DVec3, f64) {
-    let partial: Vec<(DVec3, f64)> = y
+    let partial: Vec<(DVec3, f64)> = x
         .par_chunks_mut(CHUNK)
         .zip(r.par_chunks_mut(CHUNK))
         .zip(p.par_chunks(CHUNK))
         .zip(q.par_chunks(CHUNK))
-        .zip(sc.par_chunks(CHUNK))
-        .map(|((((y, r), p), q), sc)| {
+        .zip(weight.par_chunks(CHUNK))
+        .map(|((((x, r), p), q), w)| {
             let (mut rr, mut m) = (DVec3::ZERO, 0.0f64);
-            for ((((y, r), p), q), &s) in y.iter_mut().zip(r.iter_mut()).zip(p).zip(q).zip(sc) {
-                *y += alpha * *p;
+            for ((((x, r), p), q), &w) in x.iter_mut().zip(r.iter_mut()).zip(p).zip(q).zip(w) {
+                *x += alpha * *p;
                 *r -= alpha * *q;
-                rr += *r * *r;
-                m = m.max(finite_or_inf((*r * s).length()));
+                rr += w * (*r * *r);
+                m = m.max(finite_or_inf(r.length()));
             }
             (rr, m)
         })
@@ -312,17 +322,6 @@ fn cg_update(
     partial
         .into_iter()
         .fold((DVec3::ZERO, 0.0), |(a, m), (b, n)| (a + b, m.max(n)))
-}
-
-/// `v_i ← v_i / c_i` (`divide`) or `v_i ← v_i c_i`.
-fn scale(v: &mut [DVec3], c: &[f64], divide: bool) {
-    v.par_chunks_mut(CHUNK)
-        .zip(c.par_chunks(CHUNK))
-        .for_each(|(v, c)| {
-            v.iter_mut()
-                .zip(c)
-                .for_each(|(v, &c)| if divide { *v /= c } else { *v *= c })
-        });
 }
 
 /// `z_i = r_i · inv_i`.

@@ -184,37 +184,8 @@ impl ReducedSystem {
             .reduce(|| 0.0, f64::max)
     }
 
-    /// The same couplings with row `i`, column `j` weighted by `s_j / s_i`
-    /// (`S⁻¹ M̄ S` for the diagonal `S = diag(s)`); the right side is not carried over.
-    pub fn scaled(&self, s: &[f64]) -> ReducedSystem {
-        let n = self.len();
-        let blocks: Vec<Vec<f64>> = (0..n.div_ceil(CHUNK))
-            .into_par_iter()
-            .map(|b| {
-                let rows = b * CHUNK..((b + 1) * CHUNK).min(n);
-                let first = self.offsets[rows.start] as usize;
-                let mut out = Vec::with_capacity(self.offsets[rows.end] as usize - first);
-                for i in rows {
-                    let (c, w) = self.row(i);
-                    out.extend(c.iter().zip(w).map(|(&j, &x)| x * s[j as usize] / s[i]));
-                }
-                out
-            })
-            .collect();
-        let weights = blocks.concat();
-        let diag = (0..n).map(|i| self.diag[i]).collect();
-        ReducedSystem {
-            offsets: self.offsets.clone(),
-            cols: self.cols.clone(),
-            weights,
-            rhs: Vec::new(),
-            moving: Vec::new(),
-            diag,
-        }
-    }
-
-    /// `q = M̄ p`; returns `p·q` per coordinate, blocks summed in order.
-    pub fn apply_dot(&self, p: &[DVec3], q: &mut [DVec3]) -> DVec3 {
+    /// `q = M̄ p`; returns `Σ w_i p_i ⊙ q_i` per coordinate, blocks summed in order.
+    pub fn apply_weighted_dot(&self, w: &[f64], p: &[DVec3], q: &mut [DVec3]) -> DVec3 {
         let partial: Vec<DVec3> = q
             .par_chunks_mut(CHUNK)
             .enumerate()
@@ -222,13 +193,13 @@ impl ReducedSystem {
                 let mut d = DVec3::ZERO;
                 for (k, o) in out.iter_mut().enumerate() {
                     let i = c * CHUNK + k;
-                    let (cols, w) = self.row(i);
+                    let (cols, wt) = self.row(i);
                     let mut acc = DVec3::ZERO;
-                    for (&j, &x_w) in cols.iter().zip(w) {
+                    for (&j, &x_w) in cols.iter().zip(wt) {
                         acc += x_w * p[j as usize];
                     }
                     *o = acc;
-                    d += p[i] * acc;
+                    d += w[i] * (p[i] * acc);
                 }
                 d
             })
