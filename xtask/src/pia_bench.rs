@@ -11,12 +11,7 @@ use std::time::Instant;
 use subd_pia::{Method, Moving, Pia, PiaOptions, PiaScheme, Solver};
 use subd_schemes::{Options, TwoPhase};
 
-use crate::bench::quad_bench_mesh;
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
+use crate::bench::{median, quad_bench_mesh};
 
 /// Every solver on the quad bench mesh, Catmull-Clark and two-phase (λ = 0.5 and, nearer
 /// the lower end of the range where the paper's iteration slows down, 0.4), all threads.

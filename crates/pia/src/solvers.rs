@@ -488,8 +488,12 @@ pub(crate) fn extreme_eigenvalues(s: &ReducedSystem) -> (f64, f64) {
     let start = |i: usize| 1.0 + ((i * 7919) % 97) as f64 / 97.0;
     if let Some(c) = s.symmetrizer() {
         let sq: Vec<f64> = c.iter().map(|c| c.sqrt()).collect();
-        let op = |x: &[f64], y: &mut [f64]| {
-            let u: Vec<f64> = x.iter().zip(&sq).map(|(x, s)| x * s).collect();
+        // One scratch vector for every step (no allocation inside the Lanczos loop).
+        let mut u = vec![0.0; n];
+        let mut op = |x: &[f64], y: &mut [f64]| {
+            u.iter_mut()
+                .zip(x.iter().zip(&sq))
+                .for_each(|(u, (x, s))| *u = x * s);
             apply_scalar(s, &u, y);
             y.iter_mut().zip(&sq).for_each(|(y, s)| *y /= s);
         };
