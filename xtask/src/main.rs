@@ -79,6 +79,9 @@ enum Task {
         threads: usize,
         #[arg(long)]
         repeats: usize,
+        /// Turn off subd's huge-page advice for its large arrays.
+        #[arg(long)]
+        no_huge_page_advice: bool,
     },
     /// Run each cargo-fuzz target for a while (needs `cargo install cargo-fuzz` and a nightly
     /// toolchain).
@@ -201,7 +204,9 @@ fn main() -> ExitCode {
             levels,
             threads,
             repeats,
+            no_huge_page_advice,
         } => {
+            subd_schemes::memory::set_huge_pages(!no_huge_page_advice);
             let scheme = if scheme == "loop" {
                 subd_schemes::Scheme::Loop
             } else {

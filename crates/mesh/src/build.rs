@@ -2,6 +2,7 @@
 
 use crate::error::{BuildWarning, TopologyError};
 use crate::tags::Tags;
+use crate::topology::MAX_FACE_SIZE;
 use crate::topology::*;
 
 const NONE: u32 = u32::MAX;
@@ -82,6 +83,13 @@ impl TopologyBuilder {
                 return Err(TopologyError::FaceTooSmall {
                     face: f,
                     size: n as usize,
+                });
+            }
+            if n as usize > MAX_FACE_SIZE {
+                return Err(TopologyError::FaceTooLarge {
+                    face: f,
+                    size: n as usize,
+                    max: MAX_FACE_SIZE,
                 });
             }
             total += n as usize;
@@ -305,6 +313,13 @@ impl Topology {
                     size: b.saturating_sub(a),
                 });
             }
+            if b - a > MAX_FACE_SIZE {
+                return Err(TopologyError::FaceTooLarge {
+                    face: f,
+                    size: b - a,
+                    max: MAX_FACE_SIZE,
+                });
+            }
             for h in a..b {
                 let (v0, v1) = (
                     face_vertices[h],
@@ -395,7 +410,7 @@ pub(crate) fn assemble(
         edge_face_offsets.push(acc);
     }
     let mut edge_faces = vec![0u32; nh];
-    let mut edge_face_local = vec![0u32; nh];
+    let mut edge_face_local = vec![0u16; nh];
     {
         let mut fill = edge_face_offsets.clone();
         for h in 0..nh {
@@ -403,7 +418,7 @@ pub(crate) fn assemble(
             let e = face_edges[h] as usize;
             let slot = fill[e] as usize;
             edge_faces[slot] = f;
-            edge_face_local[slot] = (h - face_offsets[f as usize] as usize) as u32;
+            edge_face_local[slot] = (h - face_offsets[f as usize] as usize) as u16;
             fill[e] += 1;
         }
     }
@@ -422,7 +437,7 @@ pub(crate) fn assemble(
         vertex_face_offsets[i + 1] += vertex_face_offsets[i];
     }
     let mut vertex_faces = vec![0u32; nh];
-    let mut vertex_face_local = vec![0u32; nh];
+    let mut vertex_face_local = vec![0u16; nh];
     {
         let mut fill = vertex_face_offsets.clone();
         for h in 0..nh {
@@ -430,7 +445,7 @@ pub(crate) fn assemble(
             let f = half_face[h];
             let slot = fill[v] as usize;
             vertex_faces[slot] = f;
-            vertex_face_local[slot] = (h - face_offsets[f as usize] as usize) as u32;
+            vertex_face_local[slot] = (h - face_offsets[f as usize] as usize) as u16;
             fill[v] += 1;
         }
     }
@@ -501,7 +516,7 @@ impl Topology {
     /// Orders the faces and edges around every vertex counter-clockwise; a vertex whose
     /// neighbourhood is not a single fan is flagged non-manifold and keeps face order.
     fn order_vertex_fans(&mut self) {
-        let mut faces: Vec<(u32, u32)> = Vec::new();
+        let mut faces: Vec<(u32, u16)> = Vec::new();
         let mut edges: Vec<u32> = Vec::new();
         for v in 0..self.num_vertices() {
             if self.vertex_flags[v] & (VERTEX_NON_MANIFOLD | VERTEX_ISOLATED) != 0 {
@@ -527,7 +542,7 @@ impl Topology {
     /// boundary edge that leaves `v` in its face. Returns `false` when the faces and edges
     /// around `v` do not form a single fan. Mirrors the conditions of OpenSubdiv's
     /// `Vtr::Level::orderVertexFacesAndEdges` so the same vertices come out non-manifold.
-    fn walk_fan(&self, v: usize, faces: &mut Vec<(u32, u32)>, edges: &mut Vec<u32>) -> bool {
+    fn walk_fan(&self, v: usize, faces: &mut Vec<(u32, u16)>, edges: &mut Vec<u32>) -> bool {
         faces.clear();
         edges.clear();
         let vf = self.vertex_faces(v);
@@ -536,11 +551,11 @@ impl Topology {
         if nf == 0 || ne < 2 || ne > nf + 1 {
             return false;
         }
-        let corner_of = |f: usize| -> u32 {
+        let corner_of = |f: usize| -> u16 {
             self.face_vertices(f)
                 .iter()
                 .position(|&x| x as usize == v)
-                .unwrap_or(0) as u32
+                .unwrap_or(0) as u16
         };
         let (mut f, mut c, mut e_cur);
         if ne == nf {
@@ -590,7 +605,7 @@ impl Topology {
                     return false;
                 };
                 f = g;
-                c = pos as u32;
+                c = pos as u16;
                 faces.push((f as u32, c));
             }
             e_cur = e_next;

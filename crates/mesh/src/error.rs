@@ -25,6 +25,17 @@ pub enum TopologyError {
         /// Number of vertices the face was given.
         size: usize,
     },
+    /// A face has more vertices than local indices can address (OpenSubdiv's
+    /// `Vtr::VALENCE_LIMIT`, 16-bit local indices).
+    #[error("face {face} has {size} vertices; a face may have at most {max}")]
+    FaceTooLarge {
+        /// Face index.
+        face: usize,
+        /// Number of vertices the face was given.
+        size: usize,
+        /// The limit, [`crate::MAX_FACE_SIZE`].
+        max: usize,
+    },
     /// A face refers to a vertex that does not exist.
     #[error(
         "face {face} corner {corner} refers to vertex {index}, but there are only {num_vertices} vertices"

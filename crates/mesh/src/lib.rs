@@ -40,7 +40,7 @@ pub use error::{BuildWarning, TopologyError};
 pub use geometry::{Mesh, bounding_box, validate_positions};
 pub use glam::DVec3;
 pub use tags::{BoundaryInterpolation, CreaseMethod, SchemeHints, Tags, TriangleSubdivision};
-pub use topology::{Topology, TopologyParts};
+pub use topology::{MAX_FACE_SIZE, Topology, TopologyParts};
 
 #[cfg(doctest)]
 #[doc = include_str!("../README.md")]

@@ -70,6 +70,31 @@ impl Tags {
         }
     }
 
+    /// Tags from given arrays, each empty for "all smooth" / "no holes"; values sanitised.
+    /// Arrays that are already sane (the usual case for refined levels) are only read.
+    pub(crate) fn from_parts(
+        mut edge_sharpness: Vec<f32>,
+        mut vertex_sharpness: Vec<f32>,
+        mut face_hole: Vec<bool>,
+        (nv, ne, nf): (usize, usize, usize),
+    ) -> Self {
+        for (v, n) in [(&mut edge_sharpness, ne), (&mut vertex_sharpness, nv)] {
+            if v.is_empty() {
+                *v = vec![SHARPNESS_SMOOTH; n];
+            } else if v.iter().any(|&s| sanitize(s).to_bits() != s.to_bits()) {
+                v.iter_mut().for_each(|s| *s = sanitize(*s));
+            }
+        }
+        if face_hole.is_empty() {
+            face_hole = vec![false; nf];
+        }
+        Tags {
+            edge_sharpness,
+            vertex_sharpness,
+            face_hole,
+        }
+    }
+
     /// Crease sharpness of every edge, indexed by edge.
     pub fn edge_sharpness(&self) -> &[f32] {
         &self.edge_sharpness

@@ -18,6 +18,10 @@ pub(crate) const VERTEX_NON_MANIFOLD: u8 = 2;
 /// Vertex flag: no face uses the vertex.
 pub(crate) const VERTEX_ISOLATED: u8 = 4;
 
+/// The most vertices a face may have: local indices (a vertex's corner in a face, an edge's
+/// position in a face) are 16-bit, as OpenSubdiv's `Vtr::LocalIndex`, whose limit this is.
+pub const MAX_FACE_SIZE: usize = u16::MAX as usize;
+
 /// Adjacency of a polygon mesh in compressed-sparse-row (CSR) arrays.
 ///
 /// Built by [`crate::TopologyBuilder`] from face-vertex lists. All relations are flat `u32`
@@ -46,10 +50,10 @@ pub struct Topology {
     pub(crate) edge_vertices: Vec<[u32; 2]>,
     pub(crate) edge_face_offsets: Vec<u32>,
     pub(crate) edge_faces: Vec<u32>,
-    pub(crate) edge_face_local: Vec<u32>,
+    pub(crate) edge_face_local: Vec<u16>,
     pub(crate) vertex_face_offsets: Vec<u32>,
     pub(crate) vertex_faces: Vec<u32>,
-    pub(crate) vertex_face_local: Vec<u32>,
+    pub(crate) vertex_face_local: Vec<u16>,
     pub(crate) vertex_edge_offsets: Vec<u32>,
     pub(crate) vertex_edges: Vec<u32>,
     pub(crate) edge_flags: Vec<u8>,
@@ -149,7 +153,7 @@ impl Topology {
 
     /// For each face of [`Self::edge_faces`], the position of edge `e` within that face.
     #[inline]
-    pub fn edge_face_local_indices(&self, e: usize) -> &[u32] {
+    pub fn edge_face_local_indices(&self, e: usize) -> &[u16] {
         &self.edge_face_local[range(&self.edge_face_offsets, e)]
     }
 
@@ -161,7 +165,7 @@ impl Topology {
 
     /// For each face of [`Self::vertex_faces`], the corner of that face at which `v` sits.
     #[inline]
-    pub fn vertex_face_local_indices(&self, v: usize) -> &[u32] {
+    pub fn vertex_face_local_indices(&self, v: usize) -> &[u16] {
         &self.vertex_face_local[range(&self.vertex_face_offsets, v)]
     }
 
@@ -463,13 +467,13 @@ pub struct TopologyParts {
     /// Edge faces.
     pub edge_faces: Vec<u32>,
     /// Position of the edge in each of its faces.
-    pub edge_face_local: Vec<u32>,
+    pub edge_face_local: Vec<u16>,
     /// Vertex-face offsets (vertices + 1).
     pub vertex_face_offsets: Vec<u32>,
     /// Vertex faces.
     pub vertex_faces: Vec<u32>,
     /// Corner of the vertex in each of its faces.
-    pub vertex_face_local: Vec<u32>,
+    pub vertex_face_local: Vec<u16>,
     /// Vertex-edge offsets (vertices + 1).
     pub vertex_edge_offsets: Vec<u32>,
     /// Vertex edges.
@@ -480,13 +484,20 @@ pub struct TopologyParts {
     pub edge_non_manifold: Vec<bool>,
     /// Per vertex: non-manifold (faces not a single fan).
     pub vertex_non_manifold: Vec<bool>,
+    /// Crease sharpness per edge; empty for all smooth.
+    pub edge_sharpness: Vec<f32>,
+    /// Corner sharpness per vertex; empty for all smooth.
+    pub vertex_sharpness: Vec<f32>,
+    /// Hole flag per face; empty for none.
+    pub face_holes: Vec<bool>,
 }
 
 impl Topology {
     /// Assembles a topology from precomputed relations (see [`TopologyParts`]). The lengths
     /// of the arrays are checked; their contents are trusted, with full checks in debug
-    /// builds. Degenerate, boundary-vertex and isolated flags are derived here. Tags start
-    /// smooth.
+    /// builds. Degenerate, boundary-vertex and isolated flags are derived here. Tags are taken
+    /// from the parts (sanitised as [`Self::set_all_tags`] does); empty tag arrays mean smooth
+    /// and no holes.
     ///
     /// # Errors
     /// [`TopologyError::InconsistentEdges`] when the array lengths do not fit together.
@@ -509,6 +520,14 @@ impl Topology {
             && parts.edge_boundary.len() == ne
             && parts.edge_non_manifold.len() == ne
             && parts.vertex_non_manifold.len() == nv
+            && [
+                parts.edge_sharpness.len(),
+                parts.vertex_sharpness.len(),
+                parts.face_holes.len(),
+            ]
+            .into_iter()
+            .zip([ne, nv, nf])
+            .all(|(given, n)| given == 0 || given == n)
             && nv < u32::MAX as usize;
         if !ok {
             return Err(TopologyError::InconsistentEdges {
@@ -552,7 +571,12 @@ impl Topology {
             vertex_edges: parts.vertex_edges,
             edge_flags,
             vertex_flags,
-            tags: Tags::new(nv, ne, nf),
+            tags: Tags::from_parts(
+                parts.edge_sharpness,
+                parts.vertex_sharpness,
+                parts.face_holes,
+                (nv, ne, nf),
+            ),
         };
         debug_assert!(
             topo.check_relations().is_ok(),

@@ -161,6 +161,20 @@ fn invalid_input_is_rejected_with_the_element_named() {
         TopologyBuilder::new(3).build(&[2], &[0, 1]).unwrap_err(),
         TopologyError::FaceTooSmall { face: 0, size: 2 }
     );
+    // One face beyond the 16-bit local-index limit, after a valid triangle.
+    let big = subd_mesh::MAX_FACE_SIZE + 1;
+    let mut verts = vec![0u32, 1, 2];
+    verts.extend(0..big as u32);
+    assert_eq!(
+        TopologyBuilder::new(big)
+            .build(&[3, big as u32], &verts)
+            .unwrap_err(),
+        TopologyError::FaceTooLarge {
+            face: 1,
+            size: big,
+            max: 65535
+        }
+    );
     assert_eq!(
         TopologyBuilder::new(3)
             .build(&[3, 3], &[0, 1, 2, 0, 2, 7])

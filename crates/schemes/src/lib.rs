@@ -45,6 +45,7 @@
 
 pub mod analysis;
 pub mod curve;
+pub mod memory;
 mod refine;
 pub mod rules;
 pub mod stencil;

@@ -11,6 +11,7 @@ use rayon::prelude::*;
 use subd_mesh::tags::{SHARPNESS_INFINITE, is_infinite, is_semi_sharp};
 use subd_mesh::{BoundaryInterpolation, CreaseMethod, Topology, TriangleSubdivision};
 
+use crate::memory;
 use crate::rules::{self, Rule};
 use crate::stencil::{RowSink, StencilTable};
 use crate::{Options, Scheme, two_phase};
@@ -142,7 +143,7 @@ pub(crate) struct ChildFaces {
 
 /// Hole flags of the child faces: children of holes are holes.
 fn child_holes(p: &Topology, scheme: Scheme, num_child_faces: usize) -> Vec<bool> {
-    let mut holes = vec![false; num_child_faces];
+    let mut holes: Vec<bool> = memory::zeroed(num_child_faces);
     for f in 0..p.num_faces() {
         if p.is_hole(f) {
             let children = match scheme {
@@ -183,7 +184,7 @@ pub(crate) fn child_topology(
     let method = options.crease_method;
     let hb = layout.half_edge_base as usize;
     // Interior child edges are smooth; the halves of each parent edge decay.
-    let mut edge_sharpness = vec![0.0f32; child.num_edges()];
+    let mut edge_sharpness: Vec<f32> = memory::zeroed(child.edge_vertices.len());
     edge_sharpness[hb..]
         .par_chunks_mut(2)
         .enumerate()
@@ -193,16 +194,15 @@ pub(crate) fn child_topology(
             o[1] = half_sharpness(p, e, b as usize, method);
         });
     // Only vertex-children keep a (decayed) vertex sharpness.
-    let mut vertex_sharpness = vec![0.0f32; child.num_vertices()];
+    let mut vertex_sharpness: Vec<f32> = memory::zeroed(child.num_vertices);
     vertex_sharpness[..p.num_vertices()]
         .par_iter_mut()
         .enumerate()
         .for_each(|(v, o)| *o = rules::child_vertex_sharpness(p.vertex_sharpness(v)));
-    let holes = child_holes(p, scheme, child.num_faces());
-    child
-        .set_all_tags(edge_sharpness, vertex_sharpness, holes)
-        .expect("child tag arrays match the child topology");
-    child
+    child.face_holes = child_holes(p, scheme, child.face_offsets.len() - 1);
+    child.edge_sharpness = edge_sharpness;
+    child.vertex_sharpness = vertex_sharpness;
+    Topology::from_parts(child).expect("a split of a valid topology is valid")
 }
 
 /// The rule of every child vertex (`Vtr::Refinement::propagateComponentTags` and
@@ -214,14 +214,22 @@ pub(crate) fn child_rules(
     layout: Layout,
 ) -> Vec<Rule> {
     let method = options.crease_method;
-    let mut out = vec![Rule::Smooth; layout.num_child_vertices];
     let nv = p.num_vertices();
-    let (vertex_part, rest) = out.split_at_mut(nv);
-    vertex_part
-        .par_iter_mut()
-        .enumerate()
-        .for_each(|(v, slot)| {
-            let mut rule = parent_rules[v];
+    // Without semi-sharp features nothing is reclassified: vertex-children keep the parent's
+    // rule and edge-children are creases exactly on infinitely sharp edges.
+    let semi = p
+        .tags()
+        .edge_sharpness()
+        .par_iter()
+        .any(|&s| is_semi_sharp(s))
+        || p.tags()
+            .vertex_sharpness()
+            .par_iter()
+            .any(|&s| is_semi_sharp(s));
+    let mut out = memory::with_capacity(layout.num_child_vertices);
+    if semi {
+        out.par_extend((0..nv).into_par_iter().map(|v| {
+            let rule = parent_rules[v];
             let ps = p.vertex_sharpness(v);
             let cs = rules::child_vertex_sharpness(ps);
             let ve = p.vertex_edges(v);
@@ -235,14 +243,18 @@ pub(crate) fn child_rules(
                     .iter()
                     .filter(|&&e| half_sharpness(p, e as usize, v, method) > 0.0)
                     .count();
-                rule = Rule::determine(0.0, sharp);
+                Rule::determine(0.0, sharp)
+            } else {
+                rule
             }
-            *slot = rule;
-        });
-    let edge_part = &mut rest[(layout.edge_vertex_base as usize - nv)..];
-    edge_part.par_iter_mut().enumerate().for_each(|(e, slot)| {
+        }));
+    } else {
+        out.extend_from_slice(&parent_rules[..nv]);
+    }
+    out.resize(layout.edge_vertex_base as usize, Rule::Smooth);
+    out.par_extend((0..p.num_edges()).into_par_iter().map(|e| {
         let s = p.edge_sharpness(e);
-        *slot = if is_infinite(s) {
+        if is_infinite(s) {
             Rule::Crease
         } else if s > 0.0 {
             let [a, b] = p.edge_vertices(e);
@@ -251,8 +263,9 @@ pub(crate) fn child_rules(
             [Rule::Smooth, Rule::Dart, Rule::Crease][semi]
         } else {
             Rule::Smooth
-        };
-    });
+        }
+    }));
+    debug_assert_eq!(out.len(), layout.num_child_vertices);
     out
 }
 
@@ -551,56 +564,39 @@ impl Step<'_> {
     pub(crate) fn points(&self, src: &[DVec3]) -> Vec<DVec3> {
         let l = self.layout;
         let nv = l.face_vertex_base as usize;
-        let nfp = (l.edge_vertex_base - l.face_vertex_base) as usize;
-        // Zeroed memory straight from the allocator (no single-threaded fill), so its pages
-        // are first touched by the parallel writers below.
-        let mut out: Vec<DVec3> =
-            bytemuck::allocation::cast_vec(vec![0.0f64; 3 * l.num_child_vertices]);
-        let (vertex_part, rest) = out.split_at_mut(nv);
-        let (face_part, edge_part) = rest.split_at_mut(nfp);
-        face_part
-            .par_chunks_mut(CHUNK)
-            .enumerate()
-            .for_each(|(c, chunk)| {
-                for (k, o) in chunk.iter_mut().enumerate() {
-                    let mut s = PointSink {
-                        src,
-                        face_points: &[],
-                        acc: DVec3::ZERO,
-                    };
-                    self.row(nv + c * CHUNK + k, &mut s);
-                    *o = s.acc;
-                }
-            });
-        let face_points: &[DVec3] = face_part;
-        let fill = |first: usize, chunk: &mut [DVec3]| {
-            for (k, o) in chunk.iter_mut().enumerate() {
-                if let Some(q) = self.smooth_catmark_point(first + k, src, face_points) {
-                    *o = q;
-                    continue;
-                }
-                let mut s = PointSink {
-                    src,
-                    face_points,
-                    acc: DVec3::ZERO,
-                };
-                self.row(first + k, &mut s);
-                *o = s.acc;
-            }
+        let (fb, eb) = (nv, l.edge_vertex_base as usize);
+        let one = |r: usize, face_points: &[DVec3]| {
+            let mut s = PointSink {
+                src,
+                face_points,
+                acc: DVec3::ZERO,
+            };
+            self.row(r, &mut s);
+            s.acc
         };
-        rayon::join(
-            || {
-                vertex_part
-                    .par_chunks_mut(CHUNK)
-                    .enumerate()
-                    .for_each(|(c, chunk)| fill(c * CHUNK, chunk))
-            },
-            || {
-                edge_part
-                    .par_chunks_mut(CHUNK)
-                    .enumerate()
-                    .for_each(|(c, chunk)| fill(l.edge_vertex_base as usize + c * CHUNK, chunk))
-            },
+        // The output is written once, in place, by the parallel iterators (no zeroing pass);
+        // the face points go to a scratch array first because the vertex points before them
+        // read them.
+        let mut face_points = memory::with_capacity(eb - fb);
+        face_points.par_extend(
+            (fb..eb)
+                .into_par_iter()
+                .with_min_len(CHUNK)
+                .map(|r| one(r, &[])),
+        );
+        let face_points = face_points.as_slice();
+        let other = |r: usize| {
+            self.smooth_catmark_point(r, src, face_points)
+                .unwrap_or_else(|| one(r, face_points))
+        };
+        let mut out = memory::with_capacity(l.num_child_vertices);
+        out.par_extend((0..nv).into_par_iter().with_min_len(CHUNK).map(other));
+        out.par_extend(face_points.par_iter().with_min_len(CHUNK).copied());
+        out.par_extend(
+            (eb..l.num_child_vertices)
+                .into_par_iter()
+                .with_min_len(CHUNK)
+                .map(other),
         );
         out
     }

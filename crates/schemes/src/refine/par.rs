@@ -58,14 +58,14 @@ fn blocks(n: usize) -> impl Iterator<Item = Range<usize>> {
     (0..n.div_ceil(BLOCK)).map(move |i| i * BLOCK..((i + 1) * BLOCK).min(n))
 }
 
-/// A vector of `len` default values filled in parallel as [`fill`] does.
-pub(crate) fn build<T: Send + Default + Clone>(
+/// A vector of `len` elements (zeroed, huge-page advised when large) filled in parallel as [`fill`] does.
+pub(crate) fn build<T: Send + Sync + Clone + bytemuck::Zeroable>(
     len: usize,
     n: usize,
     start: impl Fn(usize) -> usize + Sync,
     f: impl Fn(Range<usize>, &mut [T]) + Sync,
 ) -> Vec<T> {
-    let mut out = vec![T::default(); len];
+    let mut out = crate::memory::zeroed(len);
     fill(&mut out, n, start, f);
     out
 }
