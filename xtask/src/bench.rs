@@ -154,8 +154,9 @@ fn measure(cmd: &mut Command, huge_pages: bool) -> Result<Measure, String> {
 }
 
 /// Runs the whole comparison and prints the table; with `huge_pages` both sides run under
-/// the same transparent-huge-page malloc setting.
-pub fn run(levels: usize, repeats: usize, huge_pages: bool) -> Result<(), String> {
+/// the same transparent-huge-page malloc setting; `advice` is subd's own huge-page advice
+/// for its large arrays (on by default in the library).
+pub fn run(levels: usize, repeats: usize, huge_pages: bool, advice: bool) -> Result<(), String> {
     let exe = osd::build_harness()?;
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/xtask/bench");
     std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
@@ -168,6 +169,10 @@ pub fn run(levels: usize, repeats: usize, huge_pages: bool) -> Result<(), String
         } else {
             ""
         }
+    );
+    println!(
+        "subd's huge-page advice for its large arrays: {}",
+        if advice { "on (default)" } else { "off" }
     );
     println!(
         "{:<8} {:>8} {:>5} {:>10} {:>10} {:>10} {:>7} {:>10} {:>7} {:>9} {:>9}",
@@ -213,19 +218,21 @@ pub fn run(levels: usize, repeats: usize, huge_pages: bool) -> Result<(), String
             )?;
             let subd = |t: usize| {
                 measure(
-                    Command::new(&me).args([
-                        "bench-run",
-                        "--mesh",
-                        path.to_str().unwrap(),
-                        "--scheme",
-                        name,
-                        "--levels",
-                        &level.to_string(),
-                        "--threads",
-                        &t.to_string(),
-                        "--repeats",
-                        &repeats.to_string(),
-                    ]),
+                    Command::new(&me)
+                        .args([
+                            "bench-run",
+                            "--mesh",
+                            path.to_str().unwrap(),
+                            "--scheme",
+                            name,
+                            "--levels",
+                            &level.to_string(),
+                            "--threads",
+                            &t.to_string(),
+                            "--repeats",
+                            &repeats.to_string(),
+                        ])
+                        .args((!advice).then_some("--no-huge-page-advice")),
                     huge_pages,
                 )
             };

@@ -51,6 +51,13 @@ enum Task {
         /// both sides where the kernel allows THP on request.
         #[arg(long)]
         huge_pages: bool,
+        /// Run subd with its huge-page advice for large arrays turned off
+        /// (`subd_schemes::memory::set_huge_pages(false)`).
+        #[arg(long)]
+        no_huge_page_advice: bool,
+        /// Only the refinement benchmark.
+        #[arg(long)]
+        refine_only: bool,
         /// Only the evaluation benchmark.
         #[arg(long)]
         eval_only: bool,
@@ -173,18 +180,23 @@ fn main() -> ExitCode {
             levels,
             repeats,
             huge_pages,
+            no_huge_page_advice,
+            refine_only,
             eval_only,
             pia_only,
         } => {
             if pia_only {
                 pia_bench::run(repeats)
+            } else if refine_only {
+                ensure_system_packages(OPENSUBDIV_PACKAGES)
+                    .and_then(|_| bench::run(levels, repeats, huge_pages, !no_huge_page_advice))
             } else {
                 ensure_system_packages(OPENSUBDIV_PACKAGES)
                     .and_then(|_| {
                         if eval_only {
                             Ok(())
                         } else {
-                            bench::run(levels, repeats, huge_pages)
+                            bench::run(levels, repeats, huge_pages, !no_huge_page_advice)
                         }
                     })
                     .and_then(|_| bench::run_eval(repeats))

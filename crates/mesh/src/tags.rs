@@ -5,6 +5,7 @@
 //! semi-sharp and decays by one per refinement level. Keeping `f32` is what lets a refinement
 //! agree with OpenSubdiv to 1e-12 (an `f64` port of a sharpness of 7.9 drifts by ~1e-7).
 
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// Sharpness at or above which an edge or vertex is infinitely sharp (OpenSubdiv's
@@ -81,8 +82,8 @@ impl Tags {
         for (v, n) in [(&mut edge_sharpness, ne), (&mut vertex_sharpness, nv)] {
             if v.is_empty() {
                 *v = vec![SHARPNESS_SMOOTH; n];
-            } else if v.iter().any(|&s| sanitize(s).to_bits() != s.to_bits()) {
-                v.iter_mut().for_each(|s| *s = sanitize(*s));
+            } else if v.par_iter().any(|&s| sanitize(s).to_bits() != s.to_bits()) {
+                v.par_iter_mut().for_each(|s| *s = sanitize(*s));
             }
         }
         if face_hole.is_empty() {

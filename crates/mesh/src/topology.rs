@@ -1,5 +1,7 @@
 //! The [`Topology`] type: flat, index-based adjacency of a polygon mesh.
 
+use rayon::prelude::*;
+
 use crate::error::TopologyError;
 use crate::tags::{self, Tags};
 
@@ -535,22 +537,24 @@ impl Topology {
                 detail: "topology parts do not agree in length",
             });
         }
+        // Refined levels reach millions of elements: the flags are derived in parallel.
         let mut edge_flags = vec![0u8; ne];
-        for (e, fl) in edge_flags.iter_mut().enumerate() {
+        edge_flags.par_iter_mut().enumerate().for_each(|(e, fl)| {
             let [a, b] = parts.edge_vertices[e];
             *fl = (parts.edge_boundary[e] as u8 * EDGE_BOUNDARY)
                 | (parts.edge_non_manifold[e] as u8 * EDGE_NON_MANIFOLD)
                 | ((a == b) as u8 * (EDGE_DEGENERATE | EDGE_NON_MANIFOLD));
-        }
+        });
         let mut vertex_flags = vec![0u8; nv];
-        for (v, fl) in vertex_flags.iter_mut().enumerate() {
+        vertex_flags.par_iter_mut().enumerate().for_each(|(v, fl)| {
             *fl = parts.vertex_non_manifold[v] as u8 * VERTEX_NON_MANIFOLD;
             if parts.vertex_face_offsets[v] == parts.vertex_face_offsets[v + 1] {
                 *fl |= VERTEX_ISOLATED;
             }
-        }
-        for (e, &[a, b]) in parts.edge_vertices.iter().enumerate() {
-            if edge_flags[e] & EDGE_BOUNDARY != 0 {
+        });
+        for (e, &fl) in edge_flags.iter().enumerate() {
+            if fl & EDGE_BOUNDARY != 0 {
+                let [a, b] = parts.edge_vertices[e];
                 vertex_flags[a as usize] |= VERTEX_BOUNDARY;
                 vertex_flags[b as usize] |= VERTEX_BOUNDARY;
             }

@@ -66,6 +66,65 @@ pub(crate) fn with_capacity<T>(len: usize) -> Vec<T> {
     v
 }
 
+/// A vector of `len` elements written once, in place, in parallel: first every index in
+/// `middle` by `first(i)`, then every other index by `rest(i, m)`, where `m` is the finished
+/// `middle` part (index `i` of `m` is element `middle.start + i`). For arrays whose later
+/// elements read a block in the middle (child vertex points read the face points), without a
+/// scratch copy of that block and without zeroing the array first. Large arrays get the
+/// huge-page advice.
+///
+/// # Panics
+/// If `middle` does not lie within `0..len` (before anything is written).
+pub(crate) fn build_around<T, F, R>(
+    len: usize,
+    middle: std::ops::Range<usize>,
+    min_chunk: usize,
+    first: F,
+    rest: R,
+) -> Vec<T>
+where
+    T: Copy + Send + Sync,
+    F: Fn(usize) -> T + Sync,
+    R: Fn(usize, &[T]) -> T + Sync,
+{
+    use rayon::prelude::*;
+    assert!(middle.start <= middle.end && middle.end <= len);
+    let mut v: Vec<T> = with_capacity(len);
+    let spare = &mut v.spare_capacity_mut()[..len];
+    let (head, tail) = spare.split_at_mut(middle.start);
+    let (mid, tail) = tail.split_at_mut(middle.end - middle.start);
+    mid.par_iter_mut()
+        .with_min_len(min_chunk)
+        .enumerate()
+        .for_each(|(i, o)| {
+            o.write(first(middle.start + i));
+        });
+    #[allow(unsafe_code)]
+    // SAFETY: every element of `mid` was written just above (the loop visits each once), so
+    // viewing it as initialised `T` is sound; `MaybeUninit<T>` has `T`'s layout.
+    let mid: &[T] = unsafe { std::slice::from_raw_parts(mid.as_ptr().cast::<T>(), mid.len()) };
+    head.par_iter_mut()
+        .with_min_len(min_chunk)
+        .enumerate()
+        .for_each(|(i, o)| {
+            o.write(rest(i, mid));
+        });
+    tail.par_iter_mut()
+        .with_min_len(min_chunk)
+        .enumerate()
+        .for_each(|(i, o)| {
+            o.write(rest(middle.end + i, mid));
+        });
+    #[allow(unsafe_code)]
+    // SAFETY: the three loops above wrote every index of `0..len` (head, middle and tail
+    // partition it), and `len` is within the capacity reserved by `with_capacity`. A panic in
+    // a closure unwinds before this point, leaving the length 0 (`T: Copy` needs no drop).
+    unsafe {
+        v.set_len(len)
+    };
+    v
+}
+
 /// Advises the kernel to back the 2 MiB-aligned interior of `[start, start + bytes)` with
 /// huge pages.
 #[cfg(target_os = "linux")]
@@ -91,6 +150,40 @@ fn advise_huge(_start: *const u8, _bytes: usize) {}
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn build_around_writes_every_element_from_its_closure() {
+        for (len, middle) in [
+            (0usize, 0..0),
+            (10, 3..7),
+            (10, 0..10),
+            (300_000, 100_000..150_000),
+        ] {
+            let m0 = middle.start;
+            let v = build_around(
+                len,
+                middle.clone(),
+                1000,
+                |i| i as u64 * 3,
+                |i, mid: &[u64]| {
+                    // The middle block is complete when the rest is written.
+                    assert_eq!(mid.len(), middle.len());
+                    assert!(
+                        mid.iter()
+                            .enumerate()
+                            .take(3)
+                            .all(|(k, &x)| x == (m0 + k) as u64 * 3)
+                    );
+                    i as u64 * 5
+                },
+            );
+            assert_eq!(v.len(), len);
+            for (i, &x) in v.iter().enumerate() {
+                let want = if middle.contains(&i) { 3 * i } else { 5 * i };
+                assert_eq!(x, want as u64);
+            }
+        }
+    }
 
     #[test]
     fn large_and_small_vectors_are_zeroed() {

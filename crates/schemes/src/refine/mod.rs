@@ -563,8 +563,7 @@ impl Step<'_> {
     /// row is computed alone, so the result does not depend on the number of threads.
     pub(crate) fn points(&self, src: &[DVec3]) -> Vec<DVec3> {
         let l = self.layout;
-        let nv = l.face_vertex_base as usize;
-        let (fb, eb) = (nv, l.edge_vertex_base as usize);
+        let (fb, eb) = (l.face_vertex_base as usize, l.edge_vertex_base as usize);
         let one = |r: usize, face_points: &[DVec3]| {
             let mut s = PointSink {
                 src,
@@ -574,31 +573,17 @@ impl Step<'_> {
             self.row(r, &mut s);
             s.acc
         };
-        // The output is written once, in place, by the parallel iterators (no zeroing pass);
-        // the face points go to a scratch array first because the vertex points before them
-        // read them.
-        let mut face_points = memory::with_capacity(eb - fb);
-        face_points.par_extend(
-            (fb..eb)
-                .into_par_iter()
-                .with_min_len(CHUNK)
-                .map(|r| one(r, &[])),
-        );
-        let face_points = face_points.as_slice();
-        let other = |r: usize| {
-            self.smooth_catmark_point(r, src, face_points)
-                .unwrap_or_else(|| one(r, face_points))
-        };
-        let mut out = memory::with_capacity(l.num_child_vertices);
-        out.par_extend((0..nv).into_par_iter().with_min_len(CHUNK).map(other));
-        out.par_extend(face_points.par_iter().with_min_len(CHUNK).copied());
-        out.par_extend(
-            (eb..l.num_child_vertices)
-                .into_par_iter()
-                .with_min_len(CHUNK)
-                .map(other),
-        );
-        out
+        // The output is written once, in place: face points first, then the rest from them.
+        memory::build_around(
+            l.num_child_vertices,
+            fb..eb,
+            CHUNK,
+            |r| one(r, &[]),
+            |r, face_points| {
+                self.smooth_catmark_point(r, src, face_points)
+                    .unwrap_or_else(|| one(r, face_points))
+            },
+        )
     }
 }
 

@@ -50,6 +50,55 @@ fn vertex_edge_end(p: &Topology, v: usize, i: usize) -> u32 {
     }
 }
 
+/// The four child faces of parent quad `f`, in the order of [`quad_face_block`]:
+/// `(V0, E0, F, E3)`, `(E0, V1, E1, F)`, `(F, E1, V2, E2)`, `(E3, F, E2, V3)`.
+#[inline]
+fn quad_child_vertices(p: &Topology, f: usize) -> [u32; 16] {
+    let (nv, nf) = (p.num_vertices() as u32, p.num_faces() as u32);
+    let (fv, fe) = (p.face_vertices(f), p.face_edges(f));
+    let fp = nv + f as u32;
+    let e = [0, 1, 2, 3].map(|k| nv + nf + fe[k]);
+    [
+        fv[0], e[0], fp, e[3], e[0], fv[1], e[1], fp, fp, e[1], fv[2], e[2], e[3], fp, e[2], fv[3],
+    ]
+}
+
+/// The edges of the four child faces of parent quad `f`, in the order of
+/// [`quad_face_block`]: child k lists (a_k, I_k, I_{k-1}, b_k) rotated by k, where a_k is the
+/// half of edge k at corner k, b_k the half of edge k-1 at corner k and I_k the interior edge
+/// from the face point to edge point k.
+#[inline]
+fn quad_child_edges(p: &Topology, f: usize) -> [u32; 16] {
+    let hb = p.num_face_vertices() as u32;
+    let base = p.face_offsets()[f];
+    let (fv, fe) = (p.face_vertices(f), p.face_edges(f));
+    let a = [0, 1, 2, 3].map(|k| hb + half(fe[k], end_at(p, fe[k], fv[k], true)));
+    let b = [0, 1, 2, 3].map(|k| {
+        let km1 = (k + 3) % 4;
+        hb + half(fe[km1], end_at(p, fe[km1], fv[k], false))
+    });
+    let i = [0, 1, 2, 3].map(|k| base + k);
+    [
+        a[0], i[0], i[3], b[0], b[1], a[1], i[1], i[0], i[1], b[2], a[2], i[2], i[3], i[2], b[3],
+        a[3],
+    ]
+}
+
+/// `true` when every face of `p` is a quad: then each parent face has a fixed-size block of
+/// children and the child arrays are written block by block, in place.
+fn all_quads(p: &Topology) -> bool {
+    p.num_face_vertices() == 4 * p.num_faces()
+        && p.face_offsets().par_windows(2).all(|w| w[1] - w[0] == 4)
+}
+
+/// A flat array made of one `N`-element block per parent face, written once, in place.
+fn per_face<B: bytemuck::Pod + Send>(nf: usize, block: impl Fn(usize) -> B + Sync) -> Vec<u32> {
+    let mut out: Vec<B> = memory::with_capacity(nf);
+    out.par_extend((0..nf).into_par_iter().with_min_len(1024).map(&block));
+    // A block is an array of `u32` (same alignment), so the buffer is reused as is.
+    bytemuck::allocation::cast_vec(out)
+}
+
 /// Child faces of the quad split for parent faces `faces`: (V_k, E_k, F, E_{k-1}) with
 /// edges (hNext, I_k, I_{k-1}, hPrev); a quad's child k is rotated so that the parent corner
 /// sits at position k. Writes the vertices into `verts` and, when given, the edges into
@@ -71,15 +120,19 @@ fn quad_face_block(
         let fe = p.face_edges(f);
         let n = fv.len();
         let base = off[f];
-        let rot_quad = n == 4;
+        if n == 4 {
+            let o = 4 * base as usize - origin;
+            verts[o..o + 16].copy_from_slice(&quad_child_vertices(p, f));
+            if let Some(out) = edges.as_deref_mut() {
+                out[o..o + 16].copy_from_slice(&quad_child_edges(p, f));
+            }
+            continue;
+        }
         for k in 0..n {
             let km1 = if k == 0 { n - 1 } else { k - 1 };
-            let rot = if rot_quad { k } else { 0 };
             let o = 4 * (base as usize + k) - origin;
             let vv = [fv[k], edge_point(fe[k]), face_point(f), edge_point(fe[km1])];
-            for j in 0..4 {
-                verts[o + (j + rot) % 4] = vv[j];
-            }
+            verts[o..o + 4].copy_from_slice(&vv);
             if let Some(out) = edges.as_deref_mut() {
                 let ee = [
                     hb + half(fe[k], end_at(p, fe[k], fv[k], true)),
@@ -87,9 +140,7 @@ fn quad_face_block(
                     base + km1 as u32,
                     hb + half(fe[km1], end_at(p, fe[km1], fv[k], false)),
                 ];
-                for j in 0..4 {
-                    out[o + (j + rot) % 4] = ee[j];
-                }
+                out[o..o + 4].copy_from_slice(&ee);
             }
         }
     }
@@ -99,41 +150,40 @@ fn quad_face_block(
 pub(crate) fn quad_faces(p: &Topology) -> (Vec<u32>, Vec<u32>) {
     let (nf, nh) = (p.num_faces(), p.num_face_vertices());
     let off = p.face_offsets();
-    let face_vertices = par::build(
-        4 * nh,
-        nf,
-        |f| 4 * off[f] as usize,
-        |r, out| quad_face_block(p, r, out, None),
-    );
+    let face_vertices = if all_quads(p) {
+        per_face(nf, |f| quad_child_vertices(p, f))
+    } else {
+        par::build(
+            4 * nh,
+            nf,
+            |f| 4 * off[f] as usize,
+            |r, out| quad_face_block(p, r, out, None),
+        )
+    };
     (uniform_offsets(nh, 4), face_vertices)
 }
 
 /// Face offsets and face-vertices of the triangle split alone.
 pub(crate) fn tri_faces(p: &Topology) -> (Vec<u32>, Vec<u32>) {
     let (nv, nf) = (p.num_vertices() as u32, p.num_faces());
-    let face_vertices = par::build(
-        12 * nf,
-        nf,
-        |f| 12 * f,
-        |r, out| {
-            for (i, f) in r.enumerate() {
-                let v = p.face_vertices(f);
-                let e = p.face_edges(f);
-                let (e0, e1, e2) = (nv + e[0], nv + e[1], nv + e[2]);
-                out[12 * i..12 * i + 12]
-                    .copy_from_slice(&[v[0], e0, e2, e0, v[1], e1, e2, e1, v[2], e1, e2, e0]);
-            }
-        },
-    );
+    let face_vertices = per_face(nf, |f| {
+        let v = p.face_vertices(f);
+        let e = p.face_edges(f);
+        let (e0, e1, e2) = (nv + e[0], nv + e[1], nv + e[2]);
+        [v[0], e0, e2, e0, v[1], e1, e2, e1, v[2], e1, e2, e0]
+    });
     (uniform_offsets(4 * nf, 3), face_vertices)
 }
 
 /// Offsets of `faces` faces of `size` vertices each.
 fn uniform_offsets(faces: usize, size: u32) -> Vec<u32> {
-    let mut out = memory::zeroed(faces + 1);
-    out.par_iter_mut()
-        .enumerate()
-        .for_each(|(i, o)| *o = size * i as u32);
+    let mut out = memory::with_capacity(faces + 1);
+    out.par_extend(
+        (0..faces + 1)
+            .into_par_iter()
+            .with_min_len(4096)
+            .map(|i| size * i as u32),
+    );
     out
 }
 
@@ -276,15 +326,23 @@ pub(crate) fn quad_split(p: &Topology) -> TopologyParts {
     let hb = nh as u32;
     let size = |f: usize| (off[f + 1] - off[f]) as usize;
 
-    let mut face_vertices = memory::zeroed(4 * nh);
-    let mut face_edges = memory::zeroed(4 * nh);
-    par::fill_pair(
-        &mut face_vertices,
-        &mut face_edges,
-        nf,
-        |f| 4 * off[f] as usize,
-        |r, verts, edges| quad_face_block(p, r, verts, Some(edges)),
-    );
+    let (face_vertices, face_edges) = if all_quads(p) {
+        (
+            per_face(nf, |f| quad_child_vertices(p, f)),
+            per_face(nf, |f| quad_child_edges(p, f)),
+        )
+    } else {
+        let mut face_vertices = memory::zeroed(4 * nh);
+        let mut face_edges = memory::zeroed(4 * nh);
+        par::fill_pair(
+            &mut face_vertices,
+            &mut face_edges,
+            nf,
+            |f| 4 * off[f] as usize,
+            |r, verts, edges| quad_face_block(p, r, verts, Some(edges)),
+        );
+        (face_vertices, face_edges)
+    };
     let face_offsets = uniform_offsets(nh, 4);
 
     // Edges: I_f[j] = (F, E_j) for the face edges, then H(e, k) = (E, V_{e.v[k]}).
@@ -532,35 +590,28 @@ pub(crate) fn tri_split(p: &Topology) -> TopologyParts {
     let edge_point = |e: usize| (nv + e) as u32;
     let hb = 3 * nf as u32;
     let (face_offsets, face_vertices) = tri_faces(p);
-    let face_edges = par::build(
-        12 * nf,
-        nf,
-        |f| 12 * f,
-        |r, out| {
-            for (o, f) in r.enumerate() {
-                let v = p.face_vertices(f);
-                let e = p.face_edges(f);
-                let i = 3 * f as u32;
-                // S_k: the half of edge k at its start corner; T_k: at its end corner.
-                let s = |k: usize| hb + half(e[k], end_at(p, e[k], v[k], true));
-                let t = |k: usize| hb + half(e[k], end_at(p, e[k], v[(k + 1) % 3], false));
-                out[12 * o..12 * o + 12].copy_from_slice(&[
-                    s(0),
-                    i,
-                    t(2),
-                    t(0),
-                    s(1),
-                    i + 1,
-                    i + 2,
-                    t(1),
-                    s(2),
-                    i + 2,
-                    i,
-                    i + 1,
-                ]);
-            }
-        },
-    );
+    let face_edges = per_face(nf, |f| {
+        let v = p.face_vertices(f);
+        let e = p.face_edges(f);
+        let i = 3 * f as u32;
+        // S_k: the half of edge k at its start corner; T_k: at its end corner.
+        let s = |k: usize| hb + half(e[k], end_at(p, e[k], v[k], true));
+        let t = |k: usize| hb + half(e[k], end_at(p, e[k], v[(k + 1) % 3], false));
+        [
+            s(0),
+            i,
+            t(2),
+            t(0),
+            s(1),
+            i + 1,
+            i + 2,
+            t(1),
+            s(2),
+            i + 2,
+            i,
+            i + 1,
+        ]
+    });
 
     let mut edge_vertices = memory::zeroed::<[u32; 2]>(3 * nf + 2 * ne);
     {
