@@ -646,3 +646,33 @@ fn two_phase_limits_near_deep_semi_sharp_creases_equal_global_refinement() {
         "{checked} shapes with deep semi-sharp creases"
     );
 }
+
+/// A `Pia` keeps its solver-ready matrix and symmetric form between solves: a local solve
+/// after a global one on the same `Pia` (its `C` cut from the whole matrix's) reaches the
+/// same interpolant as the local solve on a fresh `Pia` (its `C` found for the cut alone).
+#[test]
+fn repeated_solves_on_one_pia_agree_with_fresh_ones() {
+    for s in closed_quad_shapes()
+        .iter()
+        .chain(&open_or_creased_quad_shapes())
+    {
+        let fixed = fixed_every_third(s.points.len());
+        let opts = PiaOptions {
+            solver: Solver::Cg,
+            tol: 1e-12,
+            max_iter: 10_000,
+        };
+        let warm = Pia::new(&s.topology, &PiaScheme::CatmullClark, &s.options).unwrap();
+        let global = warm.solve(&s.points, &Moving::All, &opts).unwrap();
+        assert!(global.converged, "{}: global", s.name);
+        let local_warm = warm.solve(&s.points, &fixed, &opts).unwrap();
+        let fresh = Pia::new(&s.topology, &PiaScheme::CatmullClark, &s.options).unwrap();
+        let local_fresh = fresh.solve(&s.points, &fixed, &opts).unwrap();
+        assert!(local_warm.converged && local_fresh.converged, "{}", s.name);
+        assert_eq!(local_warm.moving, local_fresh.moving);
+        let diag = bbox_diagonal(&s.points);
+        for (a, b) in local_warm.points.iter().zip(&local_fresh.points) {
+            assert!((*a - *b).length() <= 1e-9 * diag, "{}: {a} vs {b}", s.name);
+        }
+    }
+}

@@ -44,6 +44,8 @@
 mod solvers;
 mod system;
 
+use std::sync::{Arc, OnceLock};
+
 use glam::DVec3;
 use subd_limit::LimitError;
 use subd_mesh::Topology;
@@ -51,7 +53,7 @@ use subd_schemes::{Options, Scheme, StencilTable, TwoPhase};
 use thiserror::Error;
 
 pub use solvers::{Method, Solver};
-use system::ReducedSystem;
+use system::{FullSystem, ReducedSystem};
 
 /// What can go wrong setting up or solving an interpolation.
 #[derive(Debug, Error)]
@@ -181,6 +183,8 @@ pub struct PiaResult {
 #[derive(Debug, Clone)]
 pub struct Pia {
     limit: StencilTable,
+    /// The limit matrix in the solvers' form, built on the first solve and kept.
+    full: OnceLock<Arc<FullSystem>>,
 }
 
 impl Pia {
@@ -202,9 +206,7 @@ impl Pia {
             PiaScheme::Loop => subd_limit::base_limit(topology, Scheme::Loop, options)?,
             PiaScheme::TwoPhase(tp) => subd_limit::two_phase_base_limit(topology, tp, options)?,
         };
-        Ok(Pia {
-            limit: table.position,
-        })
+        Ok(Pia::from_limit_table(table.position))
     }
 
     /// A problem from any square limit-position table (row `i`: the limit of vertex `i`).
@@ -217,7 +219,10 @@ impl Pia {
             limit.num_sources(),
             "a square limit table"
         );
-        Pia { limit }
+        Pia {
+            limit,
+            full: OnceLock::new(),
+        }
     }
 
     /// The limit-position table `B`.
@@ -313,7 +318,10 @@ impl Pia {
             return Err(PiaError::NotFinite(v));
         }
         let flags = moving.flags(n)?;
-        Ok(ReducedSystem::new(&self.limit, targets, &flags))
+        let full = self
+            .full
+            .get_or_init(|| Arc::new(FullSystem::new(&self.limit)));
+        Ok(ReducedSystem::from_full(full, targets, &flags))
     }
 }
 

@@ -342,7 +342,7 @@ fn precondition(r: &[DVec3], inv: &[f64], z: &mut [DVec3]) {
 fn bicgstab(s: &ReducedSystem, mut x: Vec<DVec3>, ctl: Controls) -> Outcome {
     let n = s.len();
     let inv_d: Vec<f64> = s
-        .diag
+        .diag()
         .iter()
         .map(|&d| if d != 0.0 { 1.0 / d } else { 1.0 })
         .collect();
@@ -421,7 +421,7 @@ fn direct(s: &ReducedSystem, x0: Vec<DVec3>) -> Result<Outcome, PiaError> {
     let mut r = vec![DVec3::ZERO; n];
     let first = s.residual(&x0, &mut r);
     let sym = s.symmetrizer();
-    let mut triplets = Vec::with_capacity(s.cols.len());
+    let mut triplets = Vec::with_capacity(s.matrix.cols.len());
     let mut rhs = Mat::<f64>::zeros(n, 3);
     let mut solved = None;
     if let Some(c) = &sym {

@@ -10,6 +10,8 @@
 //!
 //! and the residual `b − M̄ x` is exactly the paper's difference vector `D_P = p_P − v∞_P`.
 
+use std::sync::{Arc, OnceLock};
+
 use glam::DVec3;
 use rayon::prelude::*;
 use subd_schemes::StencilTable;
@@ -21,104 +23,199 @@ pub(crate) const CHUNK: usize = 2048;
 /// Entries below this magnitude are rounding noise of stencil composition, not couplings.
 const DROP: f64 = 1e-15;
 
-/// `M̄` in CSR form over the moving vertices (renumbered `0..n` in increasing vertex order),
-/// columns sorted within each row, and the right side `b`.
+/// A square sparse matrix in CSR form, columns sorted within each row, with its diagonal.
 #[derive(Debug, Clone)]
-pub(crate) struct ReducedSystem {
+pub(crate) struct Matrix {
     pub offsets: Vec<u32>,
     pub cols: Vec<u32>,
     pub weights: Vec<f64>,
+    pub diag: Vec<f64>,
+}
+
+/// The whole limit matrix in the solvers' form (rounding noise dropped, columns sorted), and
+/// its symmetric form once asked for: built once per [`crate::Pia`] and shared by every
+/// solve, so a second solve on the same mesh (new targets, another moving set) starts at
+/// once.
+#[derive(Debug)]
+pub(crate) struct FullSystem {
+    pub matrix: Arc<Matrix>,
+    symmetrizer: OnceLock<Option<Vec<f64>>>,
+}
+
+impl FullSystem {
+    pub fn new(limit: &StencilTable) -> FullSystem {
+        let all = vec![true; limit.num_rows()];
+        let zero = vec![DVec3::ZERO; limit.num_rows()];
+        let (matrix, _, _) = restrict(limit.num_rows(), |i| limit.row(i), &zero, &all);
+        FullSystem {
+            matrix: Arc::new(matrix),
+            symmetrizer: OnceLock::new(),
+        }
+    }
+
+    /// `C` of the whole matrix, computed on first request.
+    pub fn symmetrizer(&self) -> Option<&[f64]> {
+        self.symmetrizer
+            .get_or_init(|| self.matrix.symmetrizer())
+            .as_deref()
+    }
+}
+
+/// `M̄` over the moving vertices (renumbered `0..n` in increasing vertex order) and the
+/// right side `b`.
+#[derive(Debug, Clone)]
+pub(crate) struct ReducedSystem {
+    pub matrix: Arc<Matrix>,
     pub rhs: Vec<DVec3>,
     /// Base vertex of each unknown.
     pub moving: Vec<u32>,
-    /// Diagonal of `M̄`.
-    pub diag: Vec<f64>,
+    /// The whole system this one was cut from, whose symmetric form restricts to this one.
+    full: Option<Arc<FullSystem>>,
+}
+
+/// Restricts a square `limit` to the moving vertices: the matrix, the right side and the
+/// moving vertices. Rows are taken in parallel blocks (one scratch row per block), then
+/// concatenated in order.
+fn restrict<'a>(
+    nv: usize,
+    limit_row: impl Fn(usize) -> (&'a [u32], &'a [f64]) + Sync,
+    targets: &[DVec3],
+    is_moving: &[bool],
+) -> (Matrix, Vec<DVec3>, Vec<u32>) {
+    let mut index = vec![u32::MAX; nv];
+    let moving: Vec<u32> = (0..nv as u32).filter(|&v| is_moving[v as usize]).collect();
+    for (k, &v) in moving.iter().enumerate() {
+        index[v as usize] = k as u32;
+    }
+    struct Block {
+        counts: Vec<u32>,
+        cols: Vec<u32>,
+        weights: Vec<f64>,
+        rhs: Vec<DVec3>,
+        diag: Vec<f64>,
+    }
+    let blocks: Vec<Block> = moving
+        .par_chunks(CHUNK)
+        .enumerate()
+        .map(|(k, rows)| {
+            let first = k * CHUNK;
+            let mut blk = Block {
+                counts: Vec::with_capacity(rows.len()),
+                cols: Vec::with_capacity(rows.len() * 10),
+                weights: Vec::with_capacity(rows.len() * 10),
+                rhs: Vec::with_capacity(rows.len()),
+                diag: vec![0.0; rows.len()],
+            };
+            let mut row: Vec<(u32, f64)> = Vec::with_capacity(32);
+            for (r, &v) in rows.iter().enumerate() {
+                let (c, w) = limit_row(v as usize);
+                row.clear();
+                let mut b = targets[v as usize];
+                for (&j, &x) in c.iter().zip(w) {
+                    if x.abs() < DROP {
+                        continue;
+                    }
+                    match index[j as usize] {
+                        u32::MAX => b -= x * targets[j as usize],
+                        k => row.push((k, x)),
+                    }
+                }
+                row.sort_unstable_by_key(|e| e.0);
+                for &(j, x) in &row {
+                    if j as usize == first + r {
+                        blk.diag[r] = x;
+                    }
+                    blk.cols.push(j);
+                    blk.weights.push(x);
+                }
+                blk.counts.push(row.len() as u32);
+                blk.rhs.push(b);
+            }
+            blk
+        })
+        .collect();
+    let nnz: usize = blocks.iter().map(|b| b.cols.len()).sum();
+    let mut offsets = Vec::with_capacity(moving.len() + 1);
+    offsets.push(0u32);
+    let mut cols = Vec::with_capacity(nnz);
+    let mut weights = Vec::with_capacity(nnz);
+    let mut rhs = Vec::with_capacity(moving.len());
+    let mut diag = Vec::with_capacity(moving.len());
+    let mut end = 0u32;
+    for blk in blocks {
+        for c in blk.counts {
+            end += c;
+            offsets.push(end);
+        }
+        cols.extend_from_slice(&blk.cols);
+        weights.extend_from_slice(&blk.weights);
+        rhs.extend_from_slice(&blk.rhs);
+        diag.extend_from_slice(&blk.diag);
+    }
+    (
+        Matrix {
+            offsets,
+            cols,
+            weights,
+            diag,
+        },
+        rhs,
+        moving,
+    )
 }
 
 impl ReducedSystem {
     /// Restricts `limit` (square, one row per base vertex) to the moving vertices.
+    #[cfg(test)]
     pub fn new(limit: &StencilTable, targets: &[DVec3], is_moving: &[bool]) -> ReducedSystem {
-        let nv = limit.num_rows();
-        let mut index = vec![u32::MAX; nv];
-        let moving: Vec<u32> = (0..nv as u32).filter(|&v| is_moving[v as usize]).collect();
-        for (k, &v) in moving.iter().enumerate() {
-            index[v as usize] = k as u32;
-        }
-        // Blocks of rows in parallel, each into its own flat arrays (one scratch row per
-        // block, no allocation per row), then concatenated in order.
-        struct Block {
-            counts: Vec<u32>,
-            cols: Vec<u32>,
-            weights: Vec<f64>,
-            rhs: Vec<DVec3>,
-            diag: Vec<f64>,
-        }
-        let blocks: Vec<Block> = moving
-            .par_chunks(CHUNK)
-            .enumerate()
-            .map(|(k, rows)| {
-                let first = k * CHUNK;
-                let mut blk = Block {
-                    counts: Vec::with_capacity(rows.len()),
-                    cols: Vec::with_capacity(rows.len() * 10),
-                    weights: Vec::with_capacity(rows.len() * 10),
-                    rhs: Vec::with_capacity(rows.len()),
-                    diag: vec![0.0; rows.len()],
-                };
-                let mut row: Vec<(u32, f64)> = Vec::with_capacity(32);
-                for (r, &v) in rows.iter().enumerate() {
-                    let (c, w) = limit.row(v as usize);
-                    row.clear();
-                    let mut b = targets[v as usize];
-                    for (&j, &x) in c.iter().zip(w) {
-                        if x.abs() < DROP {
-                            continue;
-                        }
-                        match index[j as usize] {
-                            u32::MAX => b -= x * targets[j as usize],
-                            k => row.push((k, x)),
-                        }
-                    }
-                    row.sort_unstable_by_key(|e| e.0);
-                    for &(j, x) in &row {
-                        if j as usize == first + r {
-                            blk.diag[r] = x;
-                        }
-                        blk.cols.push(j);
-                        blk.weights.push(x);
-                    }
-                    blk.counts.push(row.len() as u32);
-                    blk.rhs.push(b);
-                }
-                blk
-            })
-            .collect();
-        let nnz: usize = blocks.iter().map(|b| b.cols.len()).sum();
-        let mut offsets = Vec::with_capacity(moving.len() + 1);
-        offsets.push(0u32);
-        let mut cols = Vec::with_capacity(nnz);
-        let mut weights = Vec::with_capacity(nnz);
-        let mut rhs = Vec::with_capacity(moving.len());
-        let mut diag = Vec::with_capacity(moving.len());
-        let mut end = 0u32;
-        for blk in blocks {
-            for c in blk.counts {
-                end += c;
-                offsets.push(end);
-            }
-            cols.extend_from_slice(&blk.cols);
-            weights.extend_from_slice(&blk.weights);
-            rhs.extend_from_slice(&blk.rhs);
-            diag.extend_from_slice(&blk.diag);
-        }
+        let (matrix, rhs, moving) =
+            restrict(limit.num_rows(), |i| limit.row(i), targets, is_moving);
         ReducedSystem {
-            offsets,
-            cols,
-            weights,
+            matrix: Arc::new(matrix),
             rhs,
             moving,
-            diag,
+            full: None,
         }
+    }
+
+    /// The system of `full` restricted to the moving vertices. With every vertex moving the
+    /// matrix is shared, not copied; otherwise the cut is taken from the full matrix, whose
+    /// rows are already clean and sorted.
+    pub fn from_full(
+        full: &Arc<FullSystem>,
+        targets: &[DVec3],
+        is_moving: &[bool],
+    ) -> ReducedSystem {
+        let m = &full.matrix;
+        if is_moving.iter().all(|&b| b) {
+            return ReducedSystem {
+                matrix: Arc::clone(m),
+                rhs: targets.to_vec(),
+                moving: (0..targets.len() as u32).collect(),
+                full: Some(Arc::clone(full)),
+            };
+        }
+        let (matrix, rhs, moving) = restrict(targets.len(), |i| m.row(i), targets, is_moving);
+        ReducedSystem {
+            matrix: Arc::new(matrix),
+            rhs,
+            moving,
+            full: Some(Arc::clone(full)),
+        }
+    }
+
+    /// `C` with `M̄ = C D`, `D` symmetric: cut from the whole system's when that has one,
+    /// else found for this system alone.
+    pub fn symmetrizer(&self) -> Option<Vec<f64>> {
+        if let Some(c) = self.full.as_ref().and_then(|f| f.symmetrizer()) {
+            return Some(self.moving.iter().map(|&v| c[v as usize]).collect());
+        }
+        self.matrix.symmetrizer()
+    }
+
+    /// Diagonal of `M̄`.
+    pub fn diag(&self) -> &[f64] {
+        &self.matrix.diag
     }
 
     /// Number of unknowns.
@@ -129,8 +226,7 @@ impl ReducedSystem {
     /// Row `i`: (columns, weights).
     #[inline]
     pub fn row(&self, i: usize) -> (&[u32], &[f64]) {
-        let (a, b) = (self.offsets[i] as usize, self.offsets[i + 1] as usize);
-        (&self.cols[a..b], &self.weights[a..b])
+        self.matrix.row(i)
     }
 
     /// `y = M̄ x`, in parallel.
@@ -212,6 +308,20 @@ impl ReducedSystem {
         (0..self.len())
             .map(|i| self.row(i).1.iter().map(|w| w.abs()).sum::<f64>())
             .fold(0.0, f64::max)
+    }
+}
+
+impl Matrix {
+    /// Number of rows.
+    pub fn len(&self) -> usize {
+        self.diag.len()
+    }
+
+    /// Row `i`: (columns, weights).
+    #[inline]
+    pub fn row(&self, i: usize) -> (&[u32], &[f64]) {
+        let (a, b) = (self.offsets[i] as usize, self.offsets[i + 1] as usize);
+        (&self.cols[a..b], &self.weights[a..b])
     }
 
     /// The positive diagonal `C` with `M̄ = C D`, `D` symmetric, when there is one
@@ -401,7 +511,7 @@ mod tests {
         assert_eq!(s.len(), 1);
         assert_eq!(s.moving, [0]);
         assert_eq!(s.rhs[0], DVec3::X - 0.5 * DVec3::Y);
-        assert_eq!(s.diag, [0.5]);
+        assert_eq!(s.diag(), [0.5]);
     }
 
     #[test]
