@@ -179,7 +179,9 @@ pub struct PiaResult {
 }
 
 /// A PIA problem: the limit-position matrix of a scheme on one mesh, ready to interpolate
-/// any targets.
+/// any targets. The first solve also prepares the matrix for the solvers (rounding noise
+/// dropped, rows sorted) and, when a Krylov solver runs, finds its symmetric form; both are
+/// kept, so later solves on the same `Pia` (other targets, other moving sets) start at once.
 #[derive(Debug, Clone)]
 pub struct Pia {
     limit: StencilTable,
