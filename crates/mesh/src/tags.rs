@@ -64,11 +64,12 @@ pub struct Tags {
 
 impl Tags {
     pub(crate) fn new(num_vertices: usize, num_edges: usize, num_faces: usize) -> Self {
-        Tags {
-            edge_sharpness: vec![SHARPNESS_SMOOTH; num_edges],
-            vertex_sharpness: vec![SHARPNESS_SMOOTH; num_vertices],
-            face_hole: vec![false; num_faces],
-        }
+        Tags::from_parts(
+            Vec::new(),
+            Vec::new(),
+            Vec::new(),
+            (num_vertices, num_edges, num_faces),
+        )
     }
 
     /// Tags from given arrays, each empty for "all smooth" / "no holes"; values sanitised.

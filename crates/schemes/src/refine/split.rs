@@ -91,7 +91,7 @@ fn all_quads(p: &Topology) -> bool {
         && p.face_offsets().par_windows(2).all(|w| w[1] - w[0] == 4)
 }
 
-/// A flat array made of one `N`-element block per parent face, written once, in place.
+/// A flat array made of one block (a `u32` array) per parent face, written once, in place.
 fn per_face<B: bytemuck::Pod + Send>(nf: usize, block: impl Fn(usize) -> B + Sync) -> Vec<u32> {
     let mut out: Vec<B> = memory::with_capacity(nf);
     out.par_extend((0..nf).into_par_iter().with_min_len(1024).map(&block));
