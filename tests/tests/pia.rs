@@ -271,6 +271,7 @@ fn two_phase_pia_converges_for_every_lambda_on_closed_quad_meshes() {
             Solver::Iterate,
             Solver::Weighted,
             Solver::Cg,
+            Solver::Chebyshev,
             Solver::Direct,
             Solver::Auto,
         ] {
@@ -475,7 +476,8 @@ fn solvers_report_what_ran_and_cg_beats_the_plain_iteration() {
     let cg = run(Solver::Cg);
     let weighted = run(Solver::Weighted);
     assert_eq!(plain.method, Method::Iterate);
-    assert_eq!(cg.method, Method::Cg);
+    // The torus's vertices are two-coloured along edges: CG is checkerboard-preconditioned.
+    assert_eq!(cg.method, Method::CheckerboardCg);
     assert!(
         cg.iterations * 3 < plain.iterations,
         "cg {} vs {}",
@@ -504,8 +506,25 @@ fn solvers_report_what_ran_and_cg_beats_the_plain_iteration() {
     assert!(weighted.converged);
     // Auto never takes more passes than the paper's iteration here, and near λ = 7/20 (where
     // the iteration crawls) it hands over to CG.
+    // Auto on an unprepared problem: the iteration, then (preconditioned) CG.
     let auto = run(Solver::Auto);
+    assert!(
+        matches!(auto.method, Method::IterateThenCg { .. } | Method::Iterate),
+        "{:?}",
+        auto.method
+    );
     assert!(auto.converged && auto.iterations <= plain.iterations);
+    // Prepared: Chebyshev on the checkerboard-preconditioned system (every vertex moves,
+    // closed and two-coloured), its history one entry per checkpoint.
+    assert!(pia.prepare());
+    let auto = run(Solver::Auto);
+    assert!(
+        matches!(auto.method, Method::Chebyshev { .. }),
+        "{:?}",
+        auto.method
+    );
+    assert!(auto.converged && auto.iterations < plain.iterations);
+    assert!(auto.history.len() <= auto.iterations + 1);
     let nv = s.topology.num_vertices();
     let slow = Pia::new(
         &s.topology,
@@ -527,8 +546,9 @@ fn solvers_report_what_ran_and_cg_beats_the_plain_iteration() {
                 )
         })
         .collect();
+    // With fixed vertices (no cached Chebyshev operator) auto starts with the iteration.
     let r = slow
-        .solve(&rough, &Moving::All, &PiaOptions::default())
+        .solve(&rough, &fixed_every_third(nv), &PiaOptions::default())
         .unwrap();
     assert!(
         matches!(r.method, Method::IterateThenCg { .. }),
@@ -550,7 +570,12 @@ fn solvers_report_what_ran_and_cg_beats_the_plain_iteration() {
 fn results_do_not_depend_on_the_thread_count() {
     let s = load(&subd_tests::osd_mesh_dir().join("catmark_car.obj"));
     let pia = Pia::new(&s.topology, &PiaScheme::CatmullClark, &s.options).unwrap();
-    for solver in [Solver::Iterate, Solver::Weighted, Solver::Cg] {
+    for solver in [
+        Solver::Iterate,
+        Solver::Weighted,
+        Solver::Cg,
+        Solver::Chebyshev,
+    ] {
         let opts = PiaOptions {
             solver,
             ..PiaOptions::default()

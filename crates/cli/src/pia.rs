@@ -27,8 +27,9 @@ pub(crate) enum PiaSchemeArg {
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
 pub(crate) enum SolverArg {
-    /// The fastest valid solver (conjugate gradients, BiCGSTAB where the system has no
-    /// symmetric form).
+    /// The fastest valid solver (Chebyshev on the checkerboard-preconditioned system for
+    /// closed two-coloured quad meshes with every vertex moving; otherwise conjugate
+    /// gradients, BiCGSTAB where the system has no symmetric form).
     Auto,
     /// The paper's iteration: every moving vertex moves by its interpolation error.
     Iterate,
@@ -36,6 +37,9 @@ pub(crate) enum SolverArg {
     Weighted,
     /// Conjugate gradients on the symmetrised system (BiCGSTAB where there is none).
     Cg,
+    /// Chebyshev iteration on the checkerboard-preconditioned system (Catmull-Clark and
+    /// two-phase on two-coloured closed quad meshes; CG elsewhere).
+    Chebyshev,
     /// Sparse Cholesky / LU.
     Direct,
 }
@@ -152,6 +156,7 @@ pub(crate) fn run(args: &PiaArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
         SolverArg::Iterate => Solver::Iterate,
         SolverArg::Weighted => Solver::Weighted,
         SolverArg::Cg => Solver::Cg,
+        SolverArg::Chebyshev => Solver::Chebyshev,
         SolverArg::Direct => Solver::Direct,
     };
     let at_input = |e: subd_pia::PiaError| bad(format!("{}: {e}", args.input.display()));

@@ -15,8 +15,10 @@
 //! * Solvers ([`Solver`]): the paper's iteration exactly as published, an optimally weighted
 //!   iteration, conjugate gradients on the symmetrised system (seed 000 eqs. 17–18: the
 //!   limit matrix is `C·D` with `C` positive diagonal and `D` symmetric; BiCGSTAB where no
-//!   such split exists, e.g. at boundaries and creases), and sparse direct factorisation.
-//!   Every solver reports the max interpolation error after each iteration.
+//!   such split exists, e.g. at boundaries and creases), a Chebyshev iteration on the
+//!   checkerboard-preconditioned system (two-coloured closed quad meshes; see
+//!   [`Solver::Chebyshev`]), and sparse direct factorisation. Every solver reports the max
+//!   interpolation error after each iteration (Chebyshev: after each checkpoint).
 //!
 //! The tolerance is relative to the bounding-box diagonal of the targets: a solve stops when
 //! `max_{i ∈ P} |v∞_i − p_i| ≤ tol · diagonal`.
@@ -41,6 +43,7 @@
 //! }
 //! ```
 
+mod checkerboard;
 mod solvers;
 mod system;
 
@@ -166,7 +169,8 @@ pub struct PiaResult {
     /// Max interpolation error over the moving vertices before the first iteration and
     /// after each one (model units).
     pub history: Vec<f64>,
-    /// Iterations run (`history.len() − 1`).
+    /// Iterations run (`history.len() − 1`, except for [`Method::Chebyshev`], whose history
+    /// holds the error at its checkpoints).
     pub iterations: usize,
     /// The method that ran.
     pub method: Method,
@@ -185,6 +189,9 @@ pub struct PiaResult {
 #[derive(Debug, Clone)]
 pub struct Pia {
     limit: StencilTable,
+    /// Checkerboard signs for the preconditioned CG (Catmull-Clark family, two-coloured
+    /// vertex graph).
+    signs: Option<Arc<Vec<f64>>>,
     /// The limit matrix in the solvers' form, built on the first solve and kept.
     full: OnceLock<Arc<FullSystem>>,
 }
@@ -208,7 +215,12 @@ impl Pia {
             PiaScheme::Loop => subd_limit::base_limit(topology, Scheme::Loop, options)?,
             PiaScheme::TwoPhase(tp) => subd_limit::two_phase_base_limit(topology, tp, options)?,
         };
-        Ok(Pia::from_limit_table(table.position))
+        let mut pia = Pia::from_limit_table(table.position);
+        // Loop's mask has no checkerboard structure (and triangles no two-colouring).
+        if !matches!(scheme, PiaScheme::Loop) {
+            pia.signs = checkerboard::checkerboard_signs(topology).map(Arc::new);
+        }
+        Ok(pia)
     }
 
     /// A problem from any square limit-position table (row `i`: the limit of vertex `i`).
@@ -223,6 +235,7 @@ impl Pia {
         );
         Pia {
             limit,
+            signs: None,
             full: OnceLock::new(),
         }
     }
@@ -270,13 +283,29 @@ impl Pia {
         let last = *out.history.last().unwrap_or(&0.0);
         Ok(PiaResult {
             points,
-            iterations: out.history.len().saturating_sub(1),
+            iterations: out.steps,
             converged: last <= threshold,
             history: out.history,
             method: out.method,
             threshold,
             moving: system.len(),
         })
+    }
+
+    /// Builds now what the solvers of a global solve (every vertex moving) keep for later
+    /// solves: the limit matrix in the solvers' form, its symmetric form and, for the
+    /// Catmull-Clark family on a two-coloured closed quad mesh, the checkerboard operator
+    /// of [`Solver::Chebyshev`] with its spectral interval. A prepared `Pia` solves with
+    /// Chebyshev under [`Solver::Auto`] (an unprepared one with CG, which needs nothing
+    /// built): for interactive editing or animation, where one mesh is solved many times.
+    /// Returns whether the Chebyshev operator is available.
+    pub fn prepare(&self) -> bool {
+        self.full_system().preconditioned().is_some()
+    }
+
+    fn full_system(&self) -> &Arc<FullSystem> {
+        self.full
+            .get_or_init(|| Arc::new(FullSystem::new(&self.limit, self.signs.clone())))
     }
 
     /// `M̄ = B[P, P]` as a dense matrix, for analysis of small meshes (spectral radius of
@@ -308,7 +337,11 @@ impl Pia {
         Ok(self.system(&zero, moving)?.symmetrizer().is_some())
     }
 
-    fn system(&self, targets: &[DVec3], moving: &Moving) -> Result<ReducedSystem, PiaError> {
+    pub(crate) fn system(
+        &self,
+        targets: &[DVec3],
+        moving: &Moving,
+    ) -> Result<ReducedSystem, PiaError> {
         let n = self.num_vertices();
         if targets.len() != n {
             return Err(PiaError::Targets {
@@ -320,10 +353,11 @@ impl Pia {
             return Err(PiaError::NotFinite(v));
         }
         let flags = moving.flags(n)?;
-        let full = self
-            .full
-            .get_or_init(|| Arc::new(FullSystem::new(&self.limit)));
-        Ok(ReducedSystem::from_full(full, targets, &flags))
+        Ok(ReducedSystem::from_full(
+            self.full_system(),
+            targets,
+            &flags,
+        ))
     }
 }
 

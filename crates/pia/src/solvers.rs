@@ -16,16 +16,20 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::PiaError;
+use crate::checkerboard::Preconditioned;
 use crate::system::{CHUNK, ReducedSystem, dot, finite_or_inf, max_norm, safe_div};
 
 /// Which solver to run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Solver {
-    /// The fastest valid one: starts with the paper's iteration (cheapest per step, and
-    /// quick when the targets are smooth), and switches to conjugate gradients (BiCGSTAB
-    /// where the system has no symmetric form) from where it got, as soon as the observed
-    /// contraction predicts that the Krylov method finishes sooner.
+    /// The fastest valid one. Every vertex moving on a [prepared](crate::Pia::prepare)
+    /// problem that has the checkerboard operator (closed two-coloured quad meshes,
+    /// Catmull-Clark and two-phase): [`Solver::Chebyshev`]. Otherwise it starts with the paper's iteration (cheapest per step, and quick when the
+    /// targets are smooth), and switches to conjugate gradients (checkerboard-preconditioned
+    /// where the mesh allows; BiCGSTAB where the system has no symmetric form) from where it
+    /// got, as soon as the observed contraction predicts that the Krylov method finishes
+    /// sooner.
     #[default]
     Auto,
     /// The paper's iteration: `x ← x + (b − M̄ x)`, every moving vertex moved by its
@@ -34,9 +38,16 @@ pub enum Solver {
     /// `x ← x + ω (b − M̄ x)` with `ω = 2 / (λ_min + λ_max)` from estimated extreme
     /// eigenvalues of `M̄`.
     Weighted,
-    /// Conjugate gradients on the symmetric form of `M̄ = C D` (seed 000 eqs. 17–18);
-    /// BiCGSTAB when there is no such `C`.
+    /// Conjugate gradients on the symmetric form of `M̄ = C D` (seed 000 eqs. 17–18),
+    /// preconditioned by the checkerboard-conjugated matrix where the mesh is two-coloured
+    /// ([`crate::checkerboard`]); BiCGSTAB when there is no such `C`.
     Cg,
+    /// Chebyshev iteration on the checkerboard-preconditioned system `S M̄ S M̄ x = S M̄ S b`
+    /// (Catmull-Clark and two-phase on two-coloured meshes with a symmetric form), one
+    /// matrix pass per step; CG where it does not apply. Its operator and spectral interval
+    /// are built on first use (about as long as a CG solve) and kept by the `Pia` when
+    /// every vertex moves, so it pays off from the second solve on.
+    Chebyshev,
     /// Sparse Cholesky of `D` (LU of `M̄` when not symmetrisable), faer.
     Direct,
 }
@@ -58,8 +69,18 @@ pub enum Method {
     },
     /// Conjugate gradients on the symmetrised system.
     Cg,
+    /// Conjugate gradients preconditioned by the checkerboard-conjugated limit matrix
+    /// (quad meshes whose vertices are two-coloured along edges; see [`Solver::Cg`]).
+    CheckerboardCg,
     /// BiCGSTAB (no symmetric form, or CG met a non-positive curvature).
     Bicgstab,
+    /// Chebyshev iteration on the checkerboard-preconditioned system.
+    Chebyshev {
+        /// Lower end of the interval used (estimated smallest eigenvalue, less a margin).
+        lambda_min: f64,
+        /// Upper end of the interval used.
+        lambda_max: f64,
+    },
     /// Sparse Cholesky of the symmetrised matrix.
     Cholesky,
     /// Sparse LU.
@@ -92,6 +113,22 @@ pub(crate) struct Outcome {
     pub x: Vec<DVec3>,
     pub history: Vec<f64>,
     pub method: Method,
+    /// Iterations run: `history.len() − 1`, except for Chebyshev, whose history holds the
+    /// error at its checkpoints only.
+    pub steps: usize,
+}
+
+impl Outcome {
+    /// An outcome whose history has an entry per iteration.
+    fn new(x: Vec<DVec3>, history: Vec<f64>, method: Method) -> Outcome {
+        let steps = history.len().saturating_sub(1);
+        Outcome {
+            x,
+            history,
+            method,
+            steps,
+        }
+    }
 }
 
 pub(crate) fn solve(
@@ -113,6 +150,23 @@ pub(crate) fn solve(
             Ok(richardson(s, x0, omega, method, ctl))
         }
         Solver::Cg => Ok(krylov(s, x0, ctl)),
+        Solver::Chebyshev => {
+            let local;
+            let pre = match s.whole_preconditioned(true) {
+                Some(p) => Some(p),
+                None => {
+                    local = match (s.signs(), s.symmetrizer()) {
+                        (Some(sg), Some(c)) => Preconditioned::new(&s.matrix, &c, &sg),
+                        _ => None,
+                    };
+                    local.as_ref()
+                }
+            };
+            match (pre, s.signs()) {
+                (Some(pre), Some(sg)) => Ok(chebyshev(s, pre, &sg, x0, ctl)),
+                _ => Ok(krylov(s, x0, ctl)),
+            }
+        }
         Solver::Auto => Ok(auto(s, x0, ctl)),
         Solver::Direct => direct(s, x0),
     }
@@ -121,7 +175,7 @@ pub(crate) fn solve(
 /// CG on the symmetric form, BiCGSTAB where there is none or CG breaks down.
 fn krylov(s: &ReducedSystem, x0: Vec<DVec3>, ctl: Controls) -> Outcome {
     match s.symmetrizer() {
-        Some(c) => match cg(s, &c, x0.clone(), ctl) {
+        Some(c) => match cg(s, &c, s.signs().as_deref(), x0.clone(), ctl) {
             Some(o) => o,
             None => bicgstab(s, x0, ctl),
         },
@@ -148,6 +202,9 @@ const WINDOW: usize = 2;
 /// dearer steps, is cheaper. `ρ` only grows as the fast modes die out, so the decision is
 /// taken again after every step.
 fn auto(s: &ReducedSystem, mut x: Vec<DVec3>, ctl: Controls) -> Outcome {
+    if let (Some(pre), Some(signs)) = (s.whole_preconditioned(false), s.signs()) {
+        return chebyshev(s, pre, &signs, x, ctl);
+    }
     let mut next = vec![DVec3::ZERO; s.len()];
     let mut history: Vec<f64> = Vec::new();
     loop {
@@ -155,11 +212,7 @@ fn auto(s: &ReducedSystem, mut x: Vec<DVec3>, ctl: Controls) -> Outcome {
         history.push(res);
         let k = history.len();
         if res <= ctl.threshold || k > ctl.max_iter {
-            return Outcome {
-                x,
-                history,
-                method: Method::Iterate,
-            };
+            return Outcome::new(x, history, Method::Iterate);
         }
         if k > WINDOW {
             let rho = (res / history[k - 1 - WINDOW]).powf(1.0 / WINDOW as f64);
@@ -181,14 +234,10 @@ fn auto(s: &ReducedSystem, mut x: Vec<DVec3>, ctl: Controls) -> Outcome {
                 history.extend_from_slice(&tail.history[1..]);
                 let switched_after = k - 1;
                 let method = match tail.method {
-                    Method::Cg => Method::IterateThenCg { switched_after },
+                    Method::Cg | Method::CheckerboardCg => Method::IterateThenCg { switched_after },
                     _ => Method::IterateThenBicgstab { switched_after },
                 };
-                return Outcome {
-                    x: tail.x,
-                    history,
-                    method,
-                };
+                return Outcome::new(tail.x, history, method);
             }
         }
         std::mem::swap(&mut x, &mut next);
@@ -215,7 +264,130 @@ fn richardson(
         }
         std::mem::swap(&mut x, &mut next);
     }
-    Outcome { x, history, method }
+    Outcome::new(x, history, method)
+}
+
+/// Relative widening of the estimated spectral interval of `K` at its lower and upper end:
+/// Lanczos' extreme Ritz values lie inside the spectrum, and a mode beyond the interval's
+/// upper end would grow.
+const INTERVAL_MARGIN: (f64, f64) = (0.05, 0.02);
+
+/// The first Chebyshev checkpoint comes after 1/this of the steps that the a-priori
+/// bound asks for (later ones after the steps the asymptotic rate asks for).
+const FIRST_CHECKPOINT: f64 = 4.0;
+
+/// Chebyshev iteration (Saad, *Iterative Methods for Sparse Linear Systems*, 2nd ed.,
+/// Alg. 12.1) on `K x = S M̄ S b`, `K = S M̄ S M̄`, over the interval of `pre`.
+///
+/// It needs no inner products, so a step is one pass over the rows of `K` (updating `x`,
+/// the preconditioned residual `z` and the direction together). The steps that the
+/// a-priori bound `‖e_k‖ ≤ ‖e_0‖ / T_k(σ)` (`T_k` the Chebyshev polynomial, `σ` the
+/// interval's centre over its half-width) needs for the threshold are run at once; then a
+/// checkpoint computes the true residual `b − M̄ x`, whose max-norm is the stop test and
+/// the history entry. Short of the threshold, the same recurrence goes on for the steps its
+/// asymptotic rate `e^{−acosh σ}` needs for the rest, and checks again.
+pub(crate) fn chebyshev(
+    s: &ReducedSystem,
+    pre: &Preconditioned,
+    signs: &[f64],
+    mut x: Vec<DVec3>,
+    ctl: Controls,
+) -> Outcome {
+    let n = s.len();
+    let lo = pre.lambda_min * (1.0 - INTERVAL_MARGIN.0);
+    let hi = pre.lambda_max * (1.0 + INTERVAL_MARGIN.1);
+    let (theta, delta) = ((hi + lo) / 2.0, (hi - lo) / 2.0);
+    let sigma = theta / delta;
+    let mut r = vec![DVec3::ZERO; n];
+    let mut z = vec![DVec3::ZERO; n];
+    let mut d = vec![DVec3::ZERO; n];
+    let mut d_next = vec![DVec3::ZERO; n];
+    let start = x.clone();
+    let mut res = s.residual(&x, &mut r);
+    let mut history = vec![res];
+    let mut steps = 0usize;
+    if res > ctl.threshold && ctl.max_iter > 0 {
+        // z = S M̄ S r; d = z / θ.
+        multiply_signs(&r, signs, &mut d);
+        s.apply(&d, &mut z);
+        z.par_chunks_mut(CHUNK)
+            .zip(d.par_chunks_mut(CHUNK))
+            .zip(signs.par_chunks(CHUNK))
+            .for_each(|((z, d), sg)| {
+                for ((z, d), &g) in z.iter_mut().zip(d.iter_mut()).zip(sg) {
+                    *z *= g;
+                    *d = *z / theta;
+                }
+            });
+        let rate = sigma.acosh();
+        // Smooth targets converge far sooner than the bound says: check early.
+        let mut block = ((res / ctl.threshold).acosh() / rate / FIRST_CHECKPOINT).ceil();
+        let mut rho = 1.0 / sigma;
+        loop {
+            let block_steps = (block as usize).clamp(1, ctl.max_iter - steps);
+            for _ in 0..block_steps {
+                let rho_next = 1.0 / (2.0 * sigma - rho);
+                let (keep, add) = (rho_next * rho, 2.0 * rho_next / delta);
+                chebyshev_pass(pre, &mut x, &mut z, &d, &mut d_next, keep, add);
+                std::mem::swap(&mut d, &mut d_next);
+                rho = rho_next;
+            }
+            steps += block_steps;
+            let last = res;
+            res = s.residual(&x, &mut r);
+            history.push(res);
+            if res <= ctl.threshold || steps >= ctl.max_iter {
+                break;
+            }
+            // A block that did not reduce the error means a wrong interval (an eigenvalue
+            // above it grows): start over with CG, which needs none.
+            if res.partial_cmp(&last) != Some(std::cmp::Ordering::Less) {
+                let mut cg = krylov(s, start, ctl);
+                cg.steps += steps;
+                return cg;
+            }
+            block = ((res / ctl.threshold).ln() / rate).ceil();
+        }
+    }
+    Outcome {
+        x,
+        history,
+        method: Method::Chebyshev {
+            lambda_min: lo,
+            lambda_max: hi,
+        },
+        steps,
+    }
+}
+
+/// One Chebyshev step over every row `i`: `x_i += d_i`, `z_i −= (K d)_i`,
+/// `d'_i = keep · d_i + add · z_i`.
+fn chebyshev_pass(
+    pre: &Preconditioned,
+    x: &mut [DVec3],
+    z: &mut [DVec3],
+    d: &[DVec3],
+    d_next: &mut [DVec3],
+    keep: f64,
+    add: f64,
+) {
+    x.par_chunks_mut(CHUNK)
+        .zip(z.par_chunks_mut(CHUNK))
+        .zip(d_next.par_chunks_mut(CHUNK))
+        .enumerate()
+        .for_each(|(c, ((x, z), dn))| {
+            for k in 0..x.len() {
+                let i = c * CHUNK + k;
+                let (cols, w) = pre.k.row(i);
+                let kd = cols
+                    .iter()
+                    .zip(w)
+                    .fold(DVec3::ZERO, |acc, (&j, &w)| acc + w * d[j as usize]);
+                x[k] += d[i];
+                z[k] -= kd;
+                dn[k] = keep * d[i] + add * z[k];
+            }
+        });
 }
 
 /// `x += a ⊙ y` (one coefficient per coordinate), in parallel.
@@ -230,50 +402,120 @@ fn axpy3(x: &mut [DVec3], a: DVec3, y: &[DVec3]) {
 /// the iterates are those of CG on the symmetric `C^{-1/2} M̄ C^{1/2}`, without forming it,
 /// and the residual is the interpolation error itself. Restarted from the true residual when
 /// the updated one has drifted. `None` when a non-positive curvature shows that `D` is not
-/// positive definite. Three passes per iteration: `q = M̄ p` with `⟨p, q⟩`; the updates of
-/// `x` and `r` with `⟨r, r⟩` and `max |r_i|`; the new direction.
-fn cg(s: &ReducedSystem, c: &[f64], mut x: Vec<DVec3>, ctl: Controls) -> Option<Outcome> {
+/// positive definite.
+///
+/// With checkerboard `signs` the method is preconditioned by `S M̄ S`
+/// ([`crate::checkerboard`]), self-adjoint and positive in the same inner product
+/// (`C⁻¹ S M̄ S = S D S`). Passes per step: `q = M̄ p` with `⟨p, q⟩`; the updates of `x` and
+/// `r` with `⟨r, r⟩` and `max |r_i|` (and `S r`); preconditioned, `M̄ S r` with
+/// `⟨r, S M̄ S r⟩`; the new direction.
+fn cg(
+    s: &ReducedSystem,
+    c: &[f64],
+    signs: Option<&[f64]>,
+    mut x: Vec<DVec3>,
+    ctl: Controls,
+) -> Option<Outcome> {
     let n = s.len();
     let weight: Vec<f64> = c.iter().map(|c| 1.0 / c).collect();
     let mut r = vec![DVec3::ZERO; n];
     let mut q = vec![DVec3::ZERO; n];
     let mut p = vec![DVec3::ZERO; n];
+    // Preconditioned only: `S r` and `M̄ S r`.
+    let (mut sr, mut msr) = match signs {
+        Some(_) => (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]),
+        None => (Vec::new(), Vec::new()),
+    };
+    let not_positive = |v: DVec3, scale: DVec3| {
+        [v.x, v.y, v.z]
+            .iter()
+            .zip([scale.x, scale.y, scale.z])
+            .any(|(&a, b)| b != 0.0 && a.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater))
+    };
     let mut res = s.residual(&x, &mut r);
     let mut history = vec![res];
     let mut steps = 0usize;
     while res > ctl.threshold && steps < ctl.max_iter {
-        p.copy_from_slice(&r);
-        let mut rr = weighted_dot(&r, &r, &weight);
+        // ρ = ⟨r, z⟩ with z = S M̄ S r (preconditioned) or z = r; first direction p = z.
+        let mut rho = match signs {
+            Some(sg) => {
+                multiply_signs(&r, sg, &mut sr);
+                let rho = s.apply_weighted_dot(&weight, &sr, &mut msr);
+                multiply_signs(&msr, sg, &mut p);
+                if not_positive(rho, weighted_dot(&r, &r, &weight)) {
+                    return None;
+                }
+                rho
+            }
+            None => {
+                p.copy_from_slice(&r);
+                weighted_dot(&r, &r, &weight)
+            }
+        };
         loop {
             let pq = s.apply_weighted_dot(&weight, &p, &mut q);
-            if [pq.x, pq.y, pq.z]
-                .iter()
-                .zip([rr.x, rr.y, rr.z])
-                .any(|(&a, b)| b != 0.0 && a.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater))
-            {
+            if not_positive(pq, rho) {
                 return None;
             }
-            let alpha = safe_div(rr, pq);
+            let alpha = safe_div(rho, pq);
             let (rr_new, error) = cg_update(&mut x, &mut r, alpha, &p, &q, &weight);
             steps += 1;
             history.push(error);
             if error <= ctl.threshold || steps >= ctl.max_iter {
                 break;
             }
-            let beta = safe_div(rr_new, rr);
-            rr = rr_new;
-            p.par_chunks_mut(CHUNK)
-                .zip(r.par_chunks(CHUNK))
-                .for_each(|(p, r)| p.iter_mut().zip(r).for_each(|(p, r)| *p = *r + beta * *p));
+            let rho_new = match signs {
+                Some(sg) => {
+                    multiply_signs(&r, sg, &mut sr);
+                    let rho_new = s.apply_weighted_dot(&weight, &sr, &mut msr);
+                    if not_positive(rho_new, rr_new) {
+                        return None;
+                    }
+                    rho_new
+                }
+                None => rr_new,
+            };
+            let beta = safe_div(rho_new, rho);
+            rho = rho_new;
+            match signs {
+                // p ← S M̄ S r + β p
+                Some(sg) => p
+                    .par_chunks_mut(CHUNK)
+                    .zip(msr.par_chunks(CHUNK))
+                    .zip(sg.par_chunks(CHUNK))
+                    .for_each(|((p, z), sg)| {
+                        for ((p, z), &g) in p.iter_mut().zip(z).zip(sg) {
+                            *p = g * *z + beta * *p;
+                        }
+                    }),
+                // p ← r + β p
+                None => p
+                    .par_chunks_mut(CHUNK)
+                    .zip(r.par_chunks(CHUNK))
+                    .for_each(|(p, r)| p.iter_mut().zip(r).for_each(|(p, r)| *p = *r + beta * *p)),
+            }
         }
         res = s.residual(&x, &mut r);
         *history.last_mut().expect("one step taken") = res;
     }
-    Some(Outcome {
-        x,
-        history,
-        method: Method::Cg,
-    })
+    let method = if signs.is_some() {
+        Method::CheckerboardCg
+    } else {
+        Method::Cg
+    };
+    Some(Outcome::new(x, history, method))
+}
+
+/// `out_i = s_i a_i`, in parallel.
+fn multiply_signs(a: &[DVec3], signs: &[f64], out: &mut [DVec3]) {
+    out.par_chunks_mut(CHUNK)
+        .zip(a.par_chunks(CHUNK))
+        .zip(signs.par_chunks(CHUNK))
+        .for_each(|((o, a), sg)| {
+            for ((o, a), &g) in o.iter_mut().zip(a).zip(sg) {
+                *o = g * *a;
+            }
+        });
 }
 
 /// `Σ_i w_i a_i ⊙ b_i` in fixed-size blocks summed in order.
@@ -407,11 +649,7 @@ fn bicgstab(s: &ReducedSystem, mut x: Vec<DVec3>, ctl: Controls) -> Outcome {
         res = s.residual(&x, &mut r);
         *history.last_mut().expect("one step taken") = res;
     }
-    Outcome {
-        x,
-        history,
-        method: Method::Bicgstab,
-    }
+    Outcome::new(x, history, Method::Bicgstab)
 }
 
 /// Sparse direct solve: Cholesky of the symmetrised `D` when there is one and it factors,
@@ -467,11 +705,11 @@ fn direct(s: &ReducedSystem, x0: Vec<DVec3>) -> Result<Outcome, PiaError> {
         .map(|i| DVec3::new(rhs[(i, 0)], rhs[(i, 1)], rhs[(i, 2)]))
         .collect();
     let last = s.residual(&x, &mut r);
-    Ok(Outcome {
+    Ok(Outcome::new(
         x,
-        history: vec![first, last],
-        method: solved.expect("one of the two ran"),
-    })
+        vec![first, last],
+        solved.expect("one of the two ran"),
+    ))
 }
 
 /// Estimates of the smallest and largest eigenvalue of `M̄` for the weighted iteration.
@@ -494,7 +732,7 @@ pub(crate) fn extreme_eigenvalues(s: &ReducedSystem) -> (f64, f64) {
             u.iter_mut()
                 .zip(x.iter().zip(&sq))
                 .for_each(|(u, (x, s))| *u = x * s);
-            apply_scalar(s, &u, y);
+            s.matrix.apply_scalar(&u, y);
             y.iter_mut().zip(&sq).for_each(|(y, s)| *y /= s);
         };
         let k = n.min(30);
@@ -522,23 +760,8 @@ pub(crate) fn extreme_eigenvalues(s: &ReducedSystem) -> (f64, f64) {
                 q[i] = w[i] / beta;
             }
         }
-        let m = alphas.len();
-        let t = Mat::<f64>::from_fn(m, m, |i, j| {
-            if i == j {
-                alphas[i]
-            } else if i == j + 1 {
-                betas[j]
-            } else if j == i + 1 {
-                betas[i]
-            } else {
-                0.0
-            }
-        });
-        if let Ok(ev) = t.self_adjoint_eigenvalues(Side::Lower)
-            && let (Some(&lo), Some(&hi)) = (ev.first(), ev.last())
-            && lo > 0.0
-        {
-            return (lo, hi);
+        if let Some(bounds) = ritz_extremes(&alphas, &betas) {
+            return bounds;
         }
     }
     let hi = s.inf_norm();
@@ -546,7 +769,7 @@ pub(crate) fn extreme_eigenvalues(s: &ReducedSystem) -> (f64, f64) {
     let mut y = vec![0.0; n];
     let mut mu = 0.0;
     for _ in 0..100 {
-        apply_scalar(s, &x, &mut y);
+        s.matrix.apply_scalar(&x, &mut y);
         for i in 0..n {
             y[i] = hi * x[i] - y[i];
         }
@@ -559,12 +782,24 @@ pub(crate) fn extreme_eigenvalues(s: &ReducedSystem) -> (f64, f64) {
     (lo, hi)
 }
 
-/// `y = M̄ x` for one scalar column.
-fn apply_scalar(s: &ReducedSystem, x: &[f64], y: &mut [f64]) {
-    y.par_chunks_mut(CHUNK).enumerate().for_each(|(c, out)| {
-        for (k, o) in out.iter_mut().enumerate() {
-            let (cols, w) = s.row(c * CHUNK + k);
-            *o = cols.iter().zip(w).map(|(&j, &w)| w * x[j as usize]).sum();
+/// Smallest and largest eigenvalue of the Lanczos tridiagonal matrix (diagonal `alphas`,
+/// off-diagonal `betas`), when the smallest is positive.
+pub(crate) fn ritz_extremes(alphas: &[f64], betas: &[f64]) -> Option<(f64, f64)> {
+    let m = alphas.len();
+    let t = Mat::<f64>::from_fn(m, m, |i, j| {
+        if i == j {
+            alphas[i]
+        } else if i == j + 1 {
+            betas[j]
+        } else if j == i + 1 {
+            betas[i]
+        } else {
+            0.0
         }
     });
+    let ev = t.self_adjoint_eigenvalues(Side::Lower).ok()?;
+    match (ev.first(), ev.last()) {
+        (Some(&lo), Some(&hi)) if lo > 0.0 => Some((lo, hi)),
+        _ => None,
+    }
 }

@@ -16,6 +16,8 @@ use glam::DVec3;
 use rayon::prelude::*;
 use subd_schemes::StencilTable;
 
+use crate::checkerboard::Preconditioned;
+
 /// Rows per parallel task; also the block size of the fixed-order reductions, so sums do
 /// not depend on the number of threads.
 pub(crate) const CHUNK: usize = 2048;
@@ -23,7 +25,8 @@ pub(crate) const CHUNK: usize = 2048;
 /// Entries below this magnitude are rounding noise of stencil composition, not couplings.
 const DROP: f64 = 1e-15;
 
-/// A square sparse matrix in CSR form, columns sorted within each row, with its diagonal.
+/// A square sparse matrix in CSR form, columns sorted within each row (except in the
+/// checkerboard operator `K`, which only takes part in products), with its diagonal.
 #[derive(Debug, Clone)]
 pub(crate) struct Matrix {
     pub offsets: Vec<u32>,
@@ -40,17 +43,37 @@ pub(crate) struct Matrix {
 pub(crate) struct FullSystem {
     pub matrix: Arc<Matrix>,
     symmetrizer: OnceLock<Option<Vec<f64>>>,
+    /// Checkerboard signs of the vertices for the preconditioner
+    /// ([`crate::checkerboard`]), where the scheme and mesh have them.
+    signs: Option<Arc<Vec<f64>>>,
+    /// The explicitly preconditioned operator and its spectral interval, computed on first
+    /// request.
+    preconditioned: OnceLock<Option<Preconditioned>>,
 }
 
 impl FullSystem {
-    pub fn new(limit: &StencilTable) -> FullSystem {
+    pub fn new(limit: &StencilTable, signs: Option<Arc<Vec<f64>>>) -> FullSystem {
         let all = vec![true; limit.num_rows()];
         let zero = vec![DVec3::ZERO; limit.num_rows()];
         let (matrix, _, _) = restrict(limit.num_rows(), |i| limit.row(i), &zero, &all);
         FullSystem {
             matrix: Arc::new(matrix),
             symmetrizer: OnceLock::new(),
+            signs,
+            preconditioned: OnceLock::new(),
         }
+    }
+
+    /// `K = S M̄ S M̄` of the whole matrix with its spectral interval, when the scheme has
+    /// checkerboard signs and the matrix a symmetric form; computed on first request.
+    pub fn preconditioned(&self) -> Option<&Preconditioned> {
+        self.preconditioned
+            .get_or_init(|| {
+                let signs = self.signs.as_ref()?;
+                let c = self.symmetrizer()?;
+                Preconditioned::new(&self.matrix, c, signs)
+            })
+            .as_ref()
     }
 
     /// `C` of the whole matrix, computed on first request.
@@ -88,11 +111,8 @@ fn restrict<'a>(
         index[v as usize] = k as u32;
     }
     struct Block {
-        counts: Vec<u32>,
-        cols: Vec<u32>,
-        weights: Vec<f64>,
+        rows: RowBlock,
         rhs: Vec<DVec3>,
-        diag: Vec<f64>,
     }
     let blocks: Vec<Block> = moving
         .par_chunks(CHUNK)
@@ -100,14 +120,11 @@ fn restrict<'a>(
         .map(|(k, rows)| {
             let first = k * CHUNK;
             let mut blk = Block {
-                counts: Vec::with_capacity(rows.len()),
-                cols: Vec::with_capacity(rows.len() * 10),
-                weights: Vec::with_capacity(rows.len() * 10),
+                rows: RowBlock::with_rows(rows.len()),
                 rhs: Vec::with_capacity(rows.len()),
-                diag: vec![0.0; rows.len()],
             };
             let mut row: Vec<(u32, f64)> = Vec::with_capacity(32);
-            for (r, &v) in rows.iter().enumerate() {
+            for &v in rows {
                 let (c, w) = limit_row(v as usize);
                 row.clear();
                 let mut b = targets[v as usize];
@@ -121,47 +138,55 @@ fn restrict<'a>(
                     }
                 }
                 row.sort_unstable_by_key(|e| e.0);
-                for &(j, x) in &row {
-                    if j as usize == first + r {
-                        blk.diag[r] = x;
-                    }
-                    blk.cols.push(j);
-                    blk.weights.push(x);
-                }
-                blk.counts.push(row.len() as u32);
+                blk.rows.push_row(first, &row);
                 blk.rhs.push(b);
             }
             blk
         })
         .collect();
-    let nnz: usize = blocks.iter().map(|b| b.cols.len()).sum();
-    let mut offsets = Vec::with_capacity(moving.len() + 1);
-    offsets.push(0u32);
-    let mut cols = Vec::with_capacity(nnz);
-    let mut weights = Vec::with_capacity(nnz);
     let mut rhs = Vec::with_capacity(moving.len());
-    let mut diag = Vec::with_capacity(moving.len());
-    let mut end = 0u32;
+    let mut rows = Vec::with_capacity(blocks.len());
     for blk in blocks {
-        for c in blk.counts {
-            end += c;
-            offsets.push(end);
-        }
-        cols.extend_from_slice(&blk.cols);
-        weights.extend_from_slice(&blk.weights);
         rhs.extend_from_slice(&blk.rhs);
-        diag.extend_from_slice(&blk.diag);
+        rows.push(blk.rows);
     }
-    (
-        Matrix {
-            offsets,
-            cols,
-            weights,
-            diag,
-        },
-        rhs,
-        moving,
-    )
+    (Matrix::from_blocks(rows), rhs, moving)
+}
+
+/// Consecutive rows of a [`Matrix`] built by one parallel task.
+pub(crate) struct RowBlock {
+    counts: Vec<u32>,
+    cols: Vec<u32>,
+    weights: Vec<f64>,
+    diag: Vec<f64>,
+}
+
+impl RowBlock {
+    /// An empty block for about `rows` rows.
+    pub fn with_rows(rows: usize) -> RowBlock {
+        RowBlock {
+            counts: Vec::with_capacity(rows),
+            cols: Vec::with_capacity(rows * 10),
+            weights: Vec::with_capacity(rows * 10),
+            diag: Vec::with_capacity(rows),
+        }
+    }
+
+    /// Appends the next row (sorted `(column, weight)` pairs); `first` is the global index
+    /// of the block's first row, to pick out the diagonal.
+    pub fn push_row(&mut self, first: usize, row: &[(u32, f64)]) {
+        let i = (first + self.counts.len()) as u32;
+        let mut d = 0.0;
+        for &(j, x) in row {
+            if j == i {
+                d = x;
+            }
+            self.cols.push(j);
+            self.weights.push(x);
+        }
+        self.diag.push(d);
+        self.counts.push(row.len() as u32);
+    }
 }
 
 impl ReducedSystem {
@@ -211,6 +236,27 @@ impl ReducedSystem {
             return Some(self.moving.iter().map(|&v| c[v as usize]).collect());
         }
         self.matrix.symmetrizer()
+    }
+
+    /// The whole system's preconditioned operator, when this system is the whole system
+    /// (every vertex moving) and it has one: built now if `build`, else only if it was
+    /// built before.
+    pub fn whole_preconditioned(&self, build: bool) -> Option<&Preconditioned> {
+        let full = self.full.as_ref()?;
+        if !Arc::ptr_eq(&full.matrix, &self.matrix) {
+            return None;
+        }
+        if build {
+            full.preconditioned()
+        } else {
+            full.preconditioned.get()?.as_ref()
+        }
+    }
+
+    /// Checkerboard signs of the unknowns, when the whole system has them.
+    pub fn signs(&self) -> Option<Vec<f64>> {
+        let signs = self.full.as_ref()?.signs.as_ref()?;
+        Some(self.moving.iter().map(|&v| signs[v as usize]).collect())
     }
 
     /// Diagonal of `M̄`.
@@ -312,6 +358,43 @@ impl ReducedSystem {
 }
 
 impl Matrix {
+    /// Concatenates consecutive blocks of rows.
+    pub fn from_blocks(blocks: Vec<RowBlock>) -> Matrix {
+        let nnz: usize = blocks.iter().map(|b| b.cols.len()).sum();
+        let rows: usize = blocks.iter().map(|b| b.counts.len()).sum();
+        let mut offsets = Vec::with_capacity(rows + 1);
+        offsets.push(0u32);
+        let mut cols = Vec::with_capacity(nnz);
+        let mut weights = Vec::with_capacity(nnz);
+        let mut diag = Vec::with_capacity(rows);
+        let mut end = 0u32;
+        for blk in blocks {
+            for c in blk.counts {
+                end += c;
+                offsets.push(end);
+            }
+            cols.extend_from_slice(&blk.cols);
+            weights.extend_from_slice(&blk.weights);
+            diag.extend_from_slice(&blk.diag);
+        }
+        Matrix {
+            offsets,
+            cols,
+            weights,
+            diag,
+        }
+    }
+
+    /// `y = A x` for one scalar column, in parallel.
+    pub fn apply_scalar(&self, x: &[f64], y: &mut [f64]) {
+        y.par_chunks_mut(CHUNK).enumerate().for_each(|(c, out)| {
+            for (k, o) in out.iter_mut().enumerate() {
+                let (cols, w) = self.row(c * CHUNK + k);
+                *o = cols.iter().zip(w).map(|(&j, &w)| w * x[j as usize]).sum();
+            }
+        });
+    }
+
     /// Number of rows.
     pub fn len(&self) -> usize {
         self.diag.len()
