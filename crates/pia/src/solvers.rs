@@ -17,7 +17,7 @@ use serde::Serialize;
 
 use crate::PiaError;
 use crate::checkerboard::Preconditioned;
-use crate::system::{CHUNK, ReducedSystem, dot, finite_or_inf, max_norm, safe_div};
+use crate::system::{CHUNK, Matrix, ReducedSystem, dot, finite_or_inf, max_norm, safe_div};
 
 /// Which solver to run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
@@ -277,15 +277,21 @@ const INTERVAL_MARGIN: (f64, f64) = (0.05, 0.02);
 const FIRST_CHECKPOINT: f64 = 4.0;
 
 /// Chebyshev iteration (Saad, *Iterative Methods for Sparse Linear Systems*, 2nd ed.,
-/// Alg. 12.1) on `K x = S M̄ S b`, `K = S M̄ S M̄`, over the interval of `pre`.
+/// Alg. 12.1) on `K x = f`, `K = S M̄ S M̄`, `f = S M̄ S b`, over the interval of `pre`,
+/// in its three-term form
 ///
-/// It needs no inner products, so a step is one pass over the rows of `K` (updating `x`,
-/// the preconditioned residual `z` and the direction together). The steps that the
-/// a-priori bound `‖e_k‖ ≤ ‖e_0‖ / T_k(σ)` (`T_k` the Chebyshev polynomial, `σ` the
-/// interval's centre over its half-width) needs for the threshold are run at once; then a
-/// checkpoint computes the true residual `b − M̄ x`, whose max-norm is the stop test and
-/// the history entry. Short of the threshold, the same recurrence goes on for the steps its
-/// asymptotic rate `e^{−acosh σ}` needs for the rest, and checks again.
+/// ```text
+/// x_{k+1} = x_k + ρ_k ρ_{k−1} (x_k − x_{k−1}) + (2 ρ_k / δ) (f − K x_k),   ρ_k = 1 / (2σ − ρ_{k−1})
+/// ```
+///
+/// (first step `x_1 = x_0 + (f − K x_0) / θ`; `θ`, `δ` the interval's centre and
+/// half-width, `σ = θ / δ`, `ρ_0 = 1/σ`). It needs no inner products, so a step is one
+/// pass over the rows of `K`, reading `x_k` and writing `x_{k+1}` over `x_{k−1}`. The
+/// steps that the a-priori bound `‖e_k‖ ≤ ‖e_0‖ / T_k(σ)` (`T_k` the Chebyshev
+/// polynomial) needs for the threshold are run at once (a quarter of them before the
+/// first check); then a checkpoint computes the true residual `b − M̄ x`, whose max-norm is
+/// the stop test and the history entry. Short of the threshold, the same recurrence goes
+/// on for the steps its asymptotic rate `e^{−acosh σ}` needs for the rest.
 pub(crate) fn chebyshev(
     s: &ReducedSystem,
     pre: &Preconditioned,
@@ -299,38 +305,37 @@ pub(crate) fn chebyshev(
     let (theta, delta) = ((hi + lo) / 2.0, (hi - lo) / 2.0);
     let sigma = theta / delta;
     let mut r = vec![DVec3::ZERO; n];
-    let mut z = vec![DVec3::ZERO; n];
-    let mut d = vec![DVec3::ZERO; n];
-    let mut d_next = vec![DVec3::ZERO; n];
     let start = x.clone();
     let mut res = s.residual(&x, &mut r);
     let mut history = vec![res];
     let mut steps = 0usize;
     if res > ctl.threshold && ctl.max_iter > 0 {
-        // z = S M̄ S r; d = z / θ.
-        multiply_signs(&r, signs, &mut d);
-        s.apply(&d, &mut z);
-        z.par_chunks_mut(CHUNK)
-            .zip(d.par_chunks_mut(CHUNK))
+        // f = S M̄ S b.
+        let mut f = vec![DVec3::ZERO; n];
+        multiply_signs(&s.rhs, signs, &mut r);
+        s.apply(&r, &mut f);
+        f.par_chunks_mut(CHUNK)
             .zip(signs.par_chunks(CHUNK))
-            .for_each(|((z, d), sg)| {
-                for ((z, d), &g) in z.iter_mut().zip(d.iter_mut()).zip(sg) {
-                    *z *= g;
-                    *d = *z / theta;
-                }
-            });
+            .for_each(|(f, sg)| f.iter_mut().zip(sg).for_each(|(f, &g)| *f *= g));
+        // x_{k−1}; overwritten by x_{k+1} in each pass.
+        let mut older = start.clone();
         let rate = sigma.acosh();
         // Smooth targets converge far sooner than the bound says: check early.
         let mut block = ((res / ctl.threshold).acosh() / rate / FIRST_CHECKPOINT).ceil();
         let mut rho = 1.0 / sigma;
         loop {
             let block_steps = (block as usize).clamp(1, ctl.max_iter - steps);
-            for _ in 0..block_steps {
-                let rho_next = 1.0 / (2.0 * sigma - rho);
-                let (keep, add) = (rho_next * rho, 2.0 * rho_next / delta);
-                chebyshev_pass(pre, &mut x, &mut z, &d, &mut d_next, keep, add);
-                std::mem::swap(&mut d, &mut d_next);
-                rho = rho_next;
+            for k in steps..steps + block_steps {
+                let (keep, add) = if k == 0 {
+                    (0.0, 1.0 / theta)
+                } else {
+                    let rho_next = 1.0 / (2.0 * sigma - rho);
+                    let coefficients = (rho_next * rho, 2.0 * rho_next / delta);
+                    rho = rho_next;
+                    coefficients
+                };
+                chebyshev_pass(&pre.k, &x, &mut older, &f, keep, add);
+                std::mem::swap(&mut x, &mut older);
             }
             steps += block_steps;
             let last = res;
@@ -360,32 +365,22 @@ pub(crate) fn chebyshev(
     }
 }
 
-/// One Chebyshev step over every row `i`: `x_i += d_i`, `z_i −= (K d)_i`,
-/// `d'_i = keep · d_i + add · z_i`.
-fn chebyshev_pass(
-    pre: &Preconditioned,
-    x: &mut [DVec3],
-    z: &mut [DVec3],
-    d: &[DVec3],
-    d_next: &mut [DVec3],
-    keep: f64,
-    add: f64,
-) {
-    x.par_chunks_mut(CHUNK)
-        .zip(z.par_chunks_mut(CHUNK))
-        .zip(d_next.par_chunks_mut(CHUNK))
+/// One Chebyshev step over every row `i`:
+/// `older_i ← x_i + keep · (x_i − older_i) + add · (f_i − (K x)_i)`.
+fn chebyshev_pass(k: &Matrix, x: &[DVec3], older: &mut [DVec3], f: &[DVec3], keep: f64, add: f64) {
+    older
+        .par_chunks_mut(CHUNK)
+        .zip(f.par_chunks(CHUNK))
         .enumerate()
-        .for_each(|(c, ((x, z), dn))| {
-            for k in 0..x.len() {
-                let i = c * CHUNK + k;
-                let (cols, w) = pre.k.row(i);
-                let kd = cols
+        .for_each(|(c, (older, f))| {
+            for (o, (old, f)) in older.iter_mut().zip(f).enumerate() {
+                let i = c * CHUNK + o;
+                let (cols, w) = k.row(i);
+                let kx = cols
                     .iter()
                     .zip(w)
-                    .fold(DVec3::ZERO, |acc, (&j, &w)| acc + w * d[j as usize]);
-                x[k] += d[i];
-                z[k] -= kd;
-                dn[k] = keep * d[i] + add * z[k];
+                    .fold(DVec3::ZERO, |acc, (&j, &w)| acc + w * x[j as usize]);
+                *old = x[i] + keep * (x[i] - *old) + add * (*f - kx);
             }
         });
 }
