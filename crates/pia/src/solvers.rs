@@ -151,20 +151,23 @@ pub(crate) fn solve(
         }
         Solver::Cg => Ok(krylov(s, x0, ctl)),
         Solver::Chebyshev => {
+            let Some(signs) = s.signs() else {
+                return Ok(krylov(s, x0, ctl));
+            };
+            // The whole system keeps its operator; a cut of it (fixed vertices) builds its own.
             let local;
             let pre = match s.whole_preconditioned(true) {
                 Some(p) => Some(p),
                 None => {
-                    local = match (s.signs(), s.symmetrizer()) {
-                        (Some(sg), Some(c)) => Preconditioned::new(&s.matrix, &c, &sg),
-                        _ => None,
-                    };
+                    local = s
+                        .symmetrizer()
+                        .and_then(|c| Preconditioned::new(&s.matrix, &c, &signs));
                     local.as_ref()
                 }
             };
-            match (pre, s.signs()) {
-                (Some(pre), Some(sg)) => Ok(chebyshev(s, pre, &sg, x0, ctl)),
-                _ => Ok(krylov(s, x0, ctl)),
+            match pre {
+                Some(pre) => Ok(chebyshev(s, pre, &signs, x0, ctl)),
+                None => Ok(krylov(s, x0, ctl)),
             }
         }
         Solver::Auto => Ok(auto(s, x0, ctl)),
@@ -312,7 +315,7 @@ pub(crate) fn chebyshev(
     if res > ctl.threshold && ctl.max_iter > 0 {
         // f = S M̄ S b.
         let mut f = vec![DVec3::ZERO; n];
-        multiply_signs(&s.rhs, signs, &mut r);
+        precondition(&s.rhs, signs, &mut r);
         s.apply(&r, &mut f);
         f.par_chunks_mut(CHUNK)
             .zip(signs.par_chunks(CHUNK))
@@ -434,9 +437,9 @@ fn cg(
         // ρ = ⟨r, z⟩ with z = S M̄ S r (preconditioned) or z = r; first direction p = z.
         let mut rho = match signs {
             Some(sg) => {
-                multiply_signs(&r, sg, &mut sr);
+                precondition(&r, sg, &mut sr);
                 let rho = s.apply_weighted_dot(&weight, &sr, &mut msr);
-                multiply_signs(&msr, sg, &mut p);
+                precondition(&msr, sg, &mut p);
                 if not_positive(rho, weighted_dot(&r, &r, &weight)) {
                     return None;
                 }
@@ -461,7 +464,7 @@ fn cg(
             }
             let rho_new = match signs {
                 Some(sg) => {
-                    multiply_signs(&r, sg, &mut sr);
+                    precondition(&r, sg, &mut sr);
                     let rho_new = s.apply_weighted_dot(&weight, &sr, &mut msr);
                     if not_positive(rho_new, rr_new) {
                         return None;
@@ -499,18 +502,6 @@ fn cg(
         Method::Cg
     };
     Some(Outcome::new(x, history, method))
-}
-
-/// `out_i = s_i a_i`, in parallel.
-fn multiply_signs(a: &[DVec3], signs: &[f64], out: &mut [DVec3]) {
-    out.par_chunks_mut(CHUNK)
-        .zip(a.par_chunks(CHUNK))
-        .zip(signs.par_chunks(CHUNK))
-        .for_each(|((o, a), sg)| {
-            for ((o, a), &g) in o.iter_mut().zip(a).zip(sg) {
-                *o = g * *a;
-            }
-        });
 }
 
 /// `Σ_i w_i a_i ⊙ b_i` in fixed-size blocks summed in order.
@@ -561,7 +552,7 @@ fn cg_update(
         .fold((DVec3::ZERO, 0.0), |(a, m), (b, n)| (a + b, m.max(n)))
 }
 
-/// `z_i = r_i · inv_i`.
+/// `z_i = r_i · inv_i` (a diagonal scaling: Jacobi's inverse diagonal, checkerboard signs).
 fn precondition(r: &[DVec3], inv: &[f64], z: &mut [DVec3]) {
     z.par_chunks_mut(CHUNK)
         .zip(r.par_chunks(CHUNK))
