@@ -97,3 +97,55 @@ fn derived_child_topology_matches_the_builder() {
         }
     }
 }
+
+/// What a refinement says of its last level without building the level's topology (the
+/// edge count, whether anything is sharp) is what the built topology shows, on every shape
+/// with every scheme that applies, and with Chaikin creases.
+#[test]
+fn last_level_counts_and_sharpness_without_its_topology() {
+    let opts = ReadOptions {
+        accept_inconsistent_orientation: true,
+    };
+    let (mut sharp, mut smooth) = (0, 0);
+    for path in osd_meshes() {
+        let name = path.file_stem().unwrap().to_string_lossy().to_string();
+        let file = read_mesh(&path, &opts).unwrap();
+        let base = &file.mesh.topology;
+        let schemes: &[Scheme] = if (0..base.num_faces()).all(|f| base.face_size(f) == 3) {
+            &[Scheme::Loop, Scheme::CatmullClark, Scheme::Bilinear]
+        } else {
+            &[Scheme::CatmullClark, Scheme::Bilinear]
+        };
+        for &scheme in schemes {
+            for chaikin in [false, true] {
+                let mut options = Options::from_hints(&file.mesh.hints);
+                if chaikin {
+                    options.crease_method = subd_mesh::CreaseMethod::Chaikin;
+                }
+                // Three levels decay the semi-sharp creases of most shapes away.
+                let deepest = if base.num_face_vertices() > 8000 {
+                    2
+                } else {
+                    3
+                };
+                for levels in 1..=deepest {
+                    let r = Refinement::new(base, scheme, &options, levels).unwrap();
+                    let (edges, has) = (r.num_edges(levels), r.has_sharpness(levels));
+                    let t = r.topology(levels);
+                    assert_eq!(edges, t.num_edges(), "{name} {scheme:?} L{levels} edges");
+                    let built = (0..t.num_edges()).any(|e| t.edge_sharpness(e) > 0.0)
+                        || (0..t.num_vertices()).any(|v| t.vertex_sharpness(v) > 0.0);
+                    assert_eq!(has, built, "{name} {scheme:?} L{levels} sharpness");
+                    assert_eq!(r.has_sharpness(levels), built, "{name} built, asked again");
+                    if built {
+                        sharp += 1;
+                    } else {
+                        smooth += 1;
+                    }
+                }
+            }
+        }
+    }
+    // The shapes cover both answers.
+    assert!(sharp > 0 && smooth > 0, "sharp {sharp}, smooth {smooth}");
+}

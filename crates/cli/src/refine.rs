@@ -260,16 +260,7 @@ pub(crate) fn run(
     let t_positions = t1.elapsed().as_secs_f64();
 
     let t2 = Instant::now();
-    let mut topology = refinement.into_topology(args.levels);
-    visible_tags(&mut topology, &options);
-    let out_counts = Counts {
-        vertices: topology.num_vertices(),
-        edges: Some(topology.num_edges()),
-        faces: topology.num_faces(),
-    };
-    let mut mesh = Mesh::new(topology, positions)
-        .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
-    mesh.hints = SchemeHints {
+    let hints = SchemeHints {
         boundary_interpolation: Some(options.boundary_interpolation),
         crease_method: Some(options.crease_method),
         triangle_subdivision: file
@@ -278,7 +269,35 @@ pub(crate) fn run(
             .triangle_subdivision
             .or(args.rules.triangles.map(|_| options.triangle_subdivision)),
     };
-    subd_io::write_mesh(&args.output, &mesh, &subd_io::WriteOptions::default())?;
+    let format = subd_io::Format::from_path(&args.output).expect("extension checked above");
+    let out_counts = if format == subd_io::Format::Glb || !refinement.has_sharpness(args.levels) {
+        // Polygons and holes are all the file holds: write them without building the
+        // level's edges (most of the time and memory of a deep refinement's output).
+        let (offsets, vertices) = refinement.faces(args.levels);
+        let mut view =
+            subd_io::MeshView::new(&positions, offsets, vertices, refinement.holes(args.levels))
+                .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
+        view.hints = hints;
+        subd_io::write_view(&args.output, &view, &subd_io::WriteOptions::default())?;
+        Counts {
+            vertices: positions.len(),
+            edges: Some(refinement.num_edges(args.levels)),
+            faces: view.num_faces(),
+        }
+    } else {
+        let mut topology = refinement.into_topology(args.levels);
+        visible_tags(&mut topology, &options);
+        let counts = Counts {
+            vertices: topology.num_vertices(),
+            edges: Some(topology.num_edges()),
+            faces: topology.num_faces(),
+        };
+        let mut mesh = Mesh::new(topology, positions)
+            .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
+        mesh.hints = hints;
+        subd_io::write_mesh(&args.output, &mesh, &subd_io::WriteOptions::default())?;
+        counts
+    };
     progress.finish();
     let t_write = t2.elapsed().as_secs_f64();
 

@@ -1299,3 +1299,77 @@ fn analyze_reports_the_seeds_verdicts() {
     assert_eq!(j["passes"], true);
     assert!((j["eigenvalues"][0].as_f64().unwrap() - 1.0).abs() < 1e-12);
 }
+
+/// `subd refine` writes a level it can describe by its polygons alone (any `.glb`; an
+/// `.obj` or `.ply` of a level without sharp edges or vertices) without building the
+/// level's edges. The file is byte for byte the one the library writes from the fully
+/// built level.
+#[test]
+fn refine_writes_polygon_levels_as_the_full_topology_would() {
+    use subd_io::{Format, WriteOptions, encode_mesh, read_mesh};
+    use subd_mesh::{Mesh, SchemeHints};
+    use subd_schemes::{Options, Refinement, Scheme};
+    let s = Scratch::new("polygon-levels");
+    let (mut compared, mut polygon_only) = (0, 0);
+    for name in [
+        "catmark_cube",
+        "catmark_hole_test1",
+        "catmark_hole_test2",
+        "catmark_nonquads",
+        "catmark_torus_creases0",
+        "catmark_edgeonly",
+        "bilinear_nonquads0",
+        "loop_icosahedron",
+        "loop_cube_creases0",
+    ] {
+        let input = meshes().join(format!("{name}.obj"));
+        let file = read_mesh(&input, &Default::default()).unwrap();
+        let (scheme, arg) = match &name[..4] {
+            "loop" => (Scheme::Loop, "loop"),
+            "bili" => (Scheme::Bilinear, "bilinear"),
+            _ => (Scheme::CatmullClark, "catmull-clark"),
+        };
+        let options = Options::from_hints(&file.mesh.hints);
+        let r = Refinement::new(&file.mesh.topology, scheme, &options, 2).unwrap();
+        let sharp = r.has_sharpness(2);
+        let positions = r.refine_points(&file.mesh.positions).pop().unwrap();
+        let mut mesh = Mesh::new(r.into_topology(2), positions).unwrap();
+        mesh.hints = SchemeHints {
+            boundary_interpolation: Some(options.boundary_interpolation),
+            crease_method: Some(options.crease_method),
+            triangle_subdivision: file.mesh.hints.triangle_subdivision,
+        };
+        for (ext, format) in [
+            ("obj", Format::Obj),
+            ("ply", Format::Ply),
+            ("glb", Format::Glb),
+        ] {
+            if sharp && format != Format::Glb {
+                continue;
+            }
+            let out = s.0.join(format!("{name}.{ext}"));
+            let (code, _, err) = subd(&[
+                "refine",
+                "--scheme",
+                arg,
+                "--levels",
+                "2",
+                input.to_str().unwrap(),
+                out.to_str().unwrap(),
+            ]);
+            assert_eq!(code, 0, "{name}: {err}");
+            let mut expected = Vec::new();
+            encode_mesh(&mut expected, &mesh, format, &WriteOptions::default()).unwrap();
+            assert!(
+                std::fs::read(&out).unwrap() == expected,
+                "{name}.{ext} differs"
+            );
+            compared += 1;
+            polygon_only += (!sharp) as usize;
+        }
+    }
+    assert!(
+        compared >= 15 && polygon_only >= 9,
+        "{compared} {polygon_only}"
+    );
+}

@@ -6,27 +6,30 @@
 //! usual choice for shading a subdivided mesh; a vertex with no well-defined normal gets
 //! +Z. glTF stores `f32`, so positions are rounded on output.
 
-use std::borrow::Cow;
 use std::io::Write;
 
 use gltf_json as json;
 use json::validation::Checked::Valid;
 use json::validation::USize64;
-use subd_mesh::{DVec3, Mesh};
+use rayon::prelude::*;
+use subd_mesh::DVec3;
+
+use crate::records::write_records;
+use crate::view::MeshView;
 
 /// Area-weighted vertex normals (Newell's method per polygon, hole faces skipped).
-pub fn vertex_normals(mesh: &Mesh) -> Vec<DVec3> {
-    let topo = &mesh.topology;
-    let mut normals = vec![DVec3::ZERO; topo.num_vertices()];
-    for f in 0..topo.num_faces() {
-        if topo.is_hole(f) {
+pub fn vertex_normals(mesh: &MeshView<'_>) -> Vec<DVec3> {
+    let positions = mesh.positions();
+    let mut normals = vec![DVec3::ZERO; positions.len()];
+    for f in 0..mesh.num_faces() {
+        if mesh.is_hole(f) {
             continue;
         }
-        let fv = topo.face_vertices(f);
+        let fv = mesh.face_vertices(f);
         let mut n = DVec3::ZERO;
         for i in 0..fv.len() {
-            let a = mesh.positions[fv[i] as usize];
-            let b = mesh.positions[fv[(i + 1) % fv.len()] as usize];
+            let a = positions[fv[i] as usize];
+            let b = positions[fv[(i + 1) % fv.len()] as usize];
             n += a.cross(b);
         }
         // `n` is twice the vector area: weighting by it gives area weighting.
@@ -34,19 +37,20 @@ pub fn vertex_normals(mesh: &Mesh) -> Vec<DVec3> {
             normals[v as usize] += n;
         }
     }
-    for n in &mut normals {
-        *n = n.try_normalize().unwrap_or(DVec3::Z);
-    }
+    normals
+        .par_iter_mut()
+        .with_min_len(4096)
+        .for_each(|n| *n = n.try_normalize().unwrap_or(DVec3::Z));
     normals
 }
 
-fn bounds(values: &[[f32; 3]]) -> (json::Value, json::Value) {
+fn bounds(values: &[DVec3]) -> (json::Value, json::Value) {
     let mut lo = [f32::INFINITY; 3];
     let mut hi = [f32::NEG_INFINITY; 3];
     for p in values {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
+        for (k, c) in to_f32(p).into_iter().enumerate() {
+            lo[k] = lo[k].min(c);
+            hi[k] = hi[k].max(c);
         }
     }
     if values.is_empty() {
@@ -59,39 +63,23 @@ fn bounds(values: &[[f32; 3]]) -> (json::Value, json::Value) {
     )
 }
 
-/// Writes `mesh` as a binary glTF 2.0 file.
-pub fn write_glb(w: &mut dyn Write, mesh: &Mesh) -> std::io::Result<()> {
-    let topo = &mesh.topology;
-    let positions: Vec<[f32; 3]> = mesh
-        .positions
-        .iter()
-        .map(|p| [p.x as f32, p.y as f32, p.z as f32])
-        .collect();
-    let normals: Vec<[f32; 3]> = vertex_normals(mesh)
-        .iter()
-        .map(|n| [n.x as f32, n.y as f32, n.z as f32])
-        .collect();
-    let mut indices: Vec<u32> = Vec::with_capacity(topo.num_face_vertices() * 3 / 2);
-    for f in 0..topo.num_faces() {
-        if topo.is_hole(f) {
-            continue;
-        }
-        let fv = topo.face_vertices(f);
-        for i in 1..fv.len() - 1 {
-            indices.extend_from_slice(&[fv[0], fv[i], fv[i + 1]]);
-        }
-    }
+fn to_f32(p: &DVec3) -> [f32; 3] {
+    [p.x as f32, p.y as f32, p.z as f32]
+}
 
-    let mut bin: Vec<u8> = Vec::with_capacity(positions.len() * 24 + indices.len() * 4);
-    for p in positions.iter().chain(normals.iter()) {
-        for c in p {
-            bin.extend_from_slice(&c.to_le_bytes());
-        }
-    }
-    for i in &indices {
-        bin.extend_from_slice(&i.to_le_bytes());
-    }
+/// Writes `mesh` as a binary glTF 2.0 file. The arrays are encoded by all threads straight
+/// into the output, so besides the normals nothing the size of the mesh is held.
+pub fn write_glb(w: &mut dyn Write, mesh: &MeshView<'_>) -> std::io::Result<()> {
+    let positions = mesh.positions();
+    let normals = vertex_normals(mesh);
+    let num_indices: usize = (0..mesh.num_faces())
+        .filter(|&f| !mesh.is_hole(f))
+        .map(|f| 3 * (mesh.face_vertices(f).len() - 2))
+        .sum();
+
+    // Every element is 4 bytes, so the BIN chunk needs no padding.
     let vec3_len = positions.len() * 12;
+    let bin_len = 2 * vec3_len + num_indices * 4;
 
     let mut root = json::Root {
         asset: json::Asset {
@@ -101,7 +89,7 @@ pub fn write_glb(w: &mut dyn Write, mesh: &Mesh) -> std::io::Result<()> {
         ..Default::default()
     };
     let buffer = root.push(json::Buffer {
-        byte_length: USize64::from(bin.len()),
+        byte_length: USize64::from(bin_len),
         extensions: Default::default(),
         extras: Default::default(),
         uri: None,
@@ -127,7 +115,7 @@ pub fn write_glb(w: &mut dyn Write, mesh: &Mesh) -> std::io::Result<()> {
     let idx_view = view(
         &mut root,
         2 * vec3_len,
-        indices.len() * 4,
+        num_indices * 4,
         json::buffer::Target::ElementArrayBuffer,
     );
     let accessor = |root: &mut json::Root,
@@ -161,10 +149,10 @@ pub fn write_glb(w: &mut dyn Write, mesh: &Mesh) -> std::io::Result<()> {
         positions.len(),
         C::F32,
         T::Vec3,
-        Some(bounds(&positions)),
+        Some(bounds(positions)),
     );
     let nrm_acc = accessor(&mut root, nrm_view, normals.len(), C::F32, T::Vec3, None);
-    let idx_acc = accessor(&mut root, idx_view, indices.len(), C::U32, T::Scalar, None);
+    let idx_acc = accessor(&mut root, idx_view, num_indices, C::U32, T::Scalar, None);
     let primitive = json::mesh::Primitive {
         attributes: [
             (Valid(json::mesh::Semantic::Positions), pos_acc),
@@ -202,17 +190,38 @@ pub fn write_glb(w: &mut dyn Write, mesh: &Mesh) -> std::io::Result<()> {
     while json_padded.len() % 4 != 0 {
         json_padded.push(b' ');
     }
-    while bin.len() % 4 != 0 {
-        bin.push(0);
+    // The GLB container (glTF 2.0 §4.4: a 12-byte header, then chunks of length, type and
+    // data) is framed here rather than by `gltf::binary::Glb`, which wants the whole BIN
+    // chunk as one slice: a copy of every array, hundreds of megabytes for a deep
+    // refinement.
+    let total = 12 + 8 + json_padded.len() + 8 + bin_len;
+    let total = u32::try_from(total)
+        .map_err(|_| std::io::Error::other("the mesh is too large for a .glb file (4 GiB)"))?;
+    w.write_all(b"glTF")?;
+    w.write_all(&2u32.to_le_bytes())?;
+    w.write_all(&total.to_le_bytes())?;
+    w.write_all(&(json_padded.len() as u32).to_le_bytes())?;
+    w.write_all(b"JSON")?;
+    w.write_all(&json_padded)?;
+    w.write_all(&(bin_len as u32).to_le_bytes())?;
+    w.write_all(b"BIN\0")?;
+    for vectors in [positions, &normals[..]] {
+        write_records(w, vectors.len(), |i, b| {
+            for c in to_f32(&vectors[i]) {
+                b.extend_from_slice(&c.to_le_bytes());
+            }
+        })?;
     }
-    let glb = gltf::binary::Glb {
-        header: gltf::binary::Header {
-            magic: *b"glTF",
-            version: 2,
-            length: (12 + 8 + json_padded.len() + 8 + bin.len()) as u32,
-        },
-        json: Cow::Owned(json_padded),
-        bin: Some(Cow::Owned(bin)),
-    };
-    glb.to_writer(w).map_err(std::io::Error::other)
+    // Polygons as fans from their first corner.
+    write_records(w, mesh.num_faces(), |f, b| {
+        if mesh.is_hole(f) {
+            return;
+        }
+        let fv = mesh.face_vertices(f);
+        for i in 1..fv.len() - 1 {
+            for v in [fv[0], fv[i], fv[i + 1]] {
+                b.extend_from_slice(&v.to_le_bytes());
+            }
+        }
+    })
 }

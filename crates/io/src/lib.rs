@@ -23,6 +23,8 @@ pub mod error;
 pub mod glb;
 pub mod obj;
 pub mod ply;
+mod records;
+pub mod view;
 
 use std::io::Write;
 use std::path::Path;
@@ -30,6 +32,7 @@ use std::path::Path;
 pub use error::{IoError, ReadError};
 pub use ply::PlyEncoding;
 use subd_mesh::Mesh;
+pub use view::{MeshView, ViewError};
 
 /// A mesh file format.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -129,20 +132,37 @@ pub fn encode_mesh(
     format: Format,
     options: &WriteOptions,
 ) -> std::io::Result<()> {
+    encode_view(w, &MeshView::from_mesh(mesh), format, options)
+}
+
+/// Encodes the polygons, positions and tags of `view` in `format` into `w`.
+pub fn encode_view(
+    w: &mut dyn Write,
+    view: &MeshView<'_>,
+    format: Format,
+    options: &WriteOptions,
+) -> std::io::Result<()> {
     match format {
-        Format::Obj => obj::write_obj(w, mesh, &options.extra_obj_tags),
-        Format::Ply => ply::write_ply(w, mesh, options.ply_encoding),
-        Format::Glb => glb::write_glb(w, mesh),
+        Format::Obj => obj::write_obj(w, view, &options.extra_obj_tags),
+        Format::Ply => ply::write_ply(w, view, options.ply_encoding),
+        Format::Glb => glb::write_glb(w, view),
     }
 }
 
 /// Writes a mesh file atomically, choosing the format by extension (`.obj`, `.ply`, `.glb`).
 pub fn write_mesh(path: &Path, mesh: &Mesh, options: &WriteOptions) -> Result<(), IoError> {
+    write_view(path, &MeshView::from_mesh(mesh), options)
+}
+
+/// Writes the polygons, positions and tags of `view` atomically, choosing the format by
+/// extension (`.obj`, `.ply`, `.glb`): for callers that have face lists but no edge
+/// topology.
+pub fn write_view(path: &Path, view: &MeshView<'_>, options: &WriteOptions) -> Result<(), IoError> {
     let format = Format::from_path(path).ok_or_else(|| IoError::UnknownFormat {
         path: path.to_path_buf(),
         expected: ".obj, .ply or .glb",
     })?;
-    atomic_write(path, |w| encode_mesh(w, mesh, format, options))
+    atomic_write(path, |w| encode_view(w, view, format, options))
 }
 
 /// Writes a file atomically: `write` fills a temporary file in the target's directory, which

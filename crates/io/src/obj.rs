@@ -24,6 +24,8 @@ use subd_mesh::{
 };
 
 use crate::error::ReadError;
+use crate::records::write_records;
+use crate::view::MeshView;
 use crate::{MeshFile, ReadOptions};
 
 /// One `t` line.
@@ -435,29 +437,32 @@ fn apply_tag(
 
 /// Writes `mesh` as OBJ with OpenSubdiv's tag lines (0-based indices in tags), plus the
 /// verbatim `extra_tags`. Coordinates are written with Rust's shortest round-trip formatting,
-/// so reading the file back gives the same `f64` values.
-pub fn write_obj(w: &mut dyn Write, mesh: &Mesh, extra_tags: &[String]) -> std::io::Result<()> {
-    let topo = &mesh.topology;
+/// so reading the file back gives the same `f64` values. Lines are formatted by all threads
+/// and written in order.
+pub fn write_obj(
+    w: &mut dyn Write,
+    mesh: &MeshView<'_>,
+    extra_tags: &[String],
+) -> std::io::Result<()> {
+    let positions = mesh.positions();
     writeln!(w, "# written by subd {}", env!("CARGO_PKG_VERSION"))?;
     writeln!(
         w,
         "# {} vertices, {} faces; tag indices are 0-based (OpenSubdiv shape convention)",
-        topo.num_vertices(),
-        topo.num_faces()
+        positions.len(),
+        mesh.num_faces()
     )?;
-    for p in &mesh.positions {
-        writeln!(w, "v {} {} {}", p.x, p.y, p.z)?;
-    }
-    let mut line = String::new();
-    for f in 0..topo.num_faces() {
-        use std::fmt::Write as _;
-        line.clear();
-        line.push('f');
-        for &v in topo.face_vertices(f) {
-            let _ = write!(line, " {}", v as u64 + 1);
+    write_records(w, positions.len(), |i, b| {
+        let p = positions[i];
+        let _ = writeln!(b, "v {} {} {}", p.x, p.y, p.z);
+    })?;
+    write_records(w, mesh.num_faces(), |f, b| {
+        b.push(b'f');
+        for &v in mesh.face_vertices(f) {
+            let _ = write!(b, " {}", v as u64 + 1);
         }
-        writeln!(w, "{line}")?;
-    }
+        b.push(b'\n');
+    })?;
     write_tags(w, mesh)?;
     for t in extra_tags {
         writeln!(w, "{t}")?;
@@ -465,8 +470,7 @@ pub fn write_obj(w: &mut dyn Write, mesh: &Mesh, extra_tags: &[String]) -> std::
     Ok(())
 }
 
-fn write_tags(w: &mut dyn Write, mesh: &Mesh) -> std::io::Result<()> {
-    let topo = &mesh.topology;
+fn write_tags(w: &mut dyn Write, mesh: &MeshView<'_>) -> std::io::Result<()> {
     if let Some(b) = mesh.hints.boundary_interpolation {
         writeln!(w, "t interpolateboundary 1/0/0 {}", b.to_shape_tag())?;
     }
@@ -484,23 +488,14 @@ fn write_tags(w: &mut dyn Write, mesh: &Mesh) -> std::io::Result<()> {
         };
         writeln!(w, "t smoothtriangles 0/0/1 {s}")?;
     }
-    for e in 0..topo.num_edges() {
-        let s = topo.edge_sharpness(e);
-        if s > 0.0 {
-            let [a, b] = topo.edge_vertices(e);
-            writeln!(w, "t crease 2/1/0 {a} {b} {s}")?;
-        }
+    for &([a, b], s) in mesh.creases() {
+        writeln!(w, "t crease 2/1/0 {a} {b} {s}")?;
     }
-    for v in 0..topo.num_vertices() {
-        let s = topo.vertex_sharpness(v);
-        if s > 0.0 {
-            writeln!(w, "t corner 1/1/0 {v} {s}")?;
-        }
+    for &(v, s) in mesh.corners() {
+        writeln!(w, "t corner 1/1/0 {v} {s}")?;
     }
-    for f in 0..topo.num_faces() {
-        if topo.is_hole(f) {
-            writeln!(w, "t hole 1/0/0 {f}")?;
-        }
+    for f in mesh.hole_faces() {
+        writeln!(w, "t hole 1/0/0 {f}")?;
     }
     Ok(())
 }

@@ -19,6 +19,8 @@ use subd_mesh::{
 };
 
 use crate::error::ReadError;
+use crate::records::write_records;
+use crate::view::MeshView;
 use crate::{MeshFile, ReadOptions};
 
 /// PLY encoding to write.
@@ -566,18 +568,19 @@ pub fn parse_ply(bytes: &[u8], options: &ReadOptions) -> Result<MeshFile, ReadEr
 }
 
 /// Writes `mesh` as PLY: positions as `double`, faces as a `uchar`/`uint` count list of
-/// `int` indices, and subd's tag elements when the mesh has tags.
-pub fn write_ply(w: &mut dyn Write, mesh: &Mesh, encoding: PlyEncoding) -> std::io::Result<()> {
-    let topo = &mesh.topology;
-    let creases: Vec<usize> = (0..topo.num_edges())
-        .filter(|&e| topo.edge_sharpness(e) > 0.0)
-        .collect();
-    let corners: Vec<usize> = (0..topo.num_vertices())
-        .filter(|&v| topo.vertex_sharpness(v) > 0.0)
-        .collect();
-    let holes: Vec<usize> = (0..topo.num_faces()).filter(|&f| topo.is_hole(f)).collect();
-    let wide_lists = topo.face_sizes().any(|n| n > 255);
-    let index_ty = if topo.num_vertices() > i32::MAX as usize {
+/// `int` indices, and subd's tag elements when the mesh has tags. Records are encoded by
+/// all threads and written in order.
+pub fn write_ply(
+    w: &mut dyn Write,
+    mesh: &MeshView<'_>,
+    encoding: PlyEncoding,
+) -> std::io::Result<()> {
+    let positions = mesh.positions();
+    let (creases, corners) = (mesh.creases(), mesh.corners());
+    let holes = mesh.hole_faces();
+    let nf = mesh.num_faces();
+    let wide_lists = (0..nf).any(|f| mesh.face_vertices(f).len() > 255);
+    let index_ty = if positions.len() > i32::MAX as usize {
         "uint"
     } else {
         "int"
@@ -611,11 +614,11 @@ pub fn write_ply(w: &mut dyn Write, mesh: &Mesh, encoding: PlyEncoding) -> std::
         };
         writeln!(w, "comment subd smoothtriangles {s}")?;
     }
-    writeln!(w, "element vertex {}", topo.num_vertices())?;
+    writeln!(w, "element vertex {}", positions.len())?;
     for c in ["x", "y", "z"] {
         writeln!(w, "property double {c}")?;
     }
-    writeln!(w, "element face {}", topo.num_faces())?;
+    writeln!(w, "element face {nf}")?;
     writeln!(
         w,
         "property list {} {index_ty} vertex_indices",
@@ -639,76 +642,59 @@ pub fn write_ply(w: &mut dyn Write, mesh: &Mesh, encoding: PlyEncoding) -> std::
     writeln!(w, "end_header")?;
     match encoding {
         PlyEncoding::Ascii => {
-            for p in &mesh.positions {
-                writeln!(w, "{} {} {}", p.x, p.y, p.z)?;
-            }
-            let mut line = String::new();
-            for f in 0..topo.num_faces() {
-                use std::fmt::Write as _;
-                line.clear();
-                let fv = topo.face_vertices(f);
-                let _ = write!(line, "{}", fv.len());
+            write_records(w, positions.len(), |i, b| {
+                let p = positions[i];
+                let _ = writeln!(b, "{} {} {}", p.x, p.y, p.z);
+            })?;
+            write_records(w, nf, |f, b| {
+                let fv = mesh.face_vertices(f);
+                let _ = write!(b, "{}", fv.len());
                 for &v in fv {
-                    let _ = write!(line, " {v}");
+                    let _ = write!(b, " {v}");
                 }
-                writeln!(w, "{line}")?;
+                b.push(b'\n');
+            })?;
+            for &([a, b], s) in creases {
+                writeln!(w, "{a} {b} {s}")?;
             }
-            for &e in &creases {
-                let [a, b] = topo.edge_vertices(e);
-                writeln!(w, "{a} {b} {}", topo.edge_sharpness(e))?;
-            }
-            for &v in &corners {
-                writeln!(w, "{v} {}", topo.vertex_sharpness(v))?;
+            for &(v, s) in corners {
+                writeln!(w, "{v} {s}")?;
             }
             for &f in &holes {
                 writeln!(w, "{f}")?;
             }
         }
         PlyEncoding::BinaryLittleEndian => {
-            let mut buf: Vec<u8> = Vec::with_capacity(1 << 16);
-            let flush =
-                |buf: &mut Vec<u8>, w: &mut dyn Write, force: bool| -> std::io::Result<()> {
-                    if force || buf.len() >= 1 << 16 {
-                        w.write_all(buf)?;
-                        buf.clear();
-                    }
-                    Ok(())
-                };
-            for p in &mesh.positions {
-                for c in p.to_array() {
-                    buf.extend_from_slice(&c.to_le_bytes());
+            write_records(w, positions.len(), |i, b| {
+                for c in positions[i].to_array() {
+                    b.extend_from_slice(&c.to_le_bytes());
                 }
-                flush(&mut buf, w, false)?;
-            }
-            for f in 0..topo.num_faces() {
-                let fv = topo.face_vertices(f);
+            })?;
+            write_records(w, nf, |f, b| {
+                let fv = mesh.face_vertices(f);
                 if wide_lists {
-                    buf.extend_from_slice(&(fv.len() as u32).to_le_bytes());
+                    b.extend_from_slice(&(fv.len() as u32).to_le_bytes());
                 } else {
-                    buf.push(fv.len() as u8);
+                    b.push(fv.len() as u8);
                 }
                 for &v in fv {
-                    buf.extend_from_slice(&v.to_le_bytes());
+                    b.extend_from_slice(&v.to_le_bytes());
                 }
-                flush(&mut buf, w, false)?;
-            }
-            for &e in &creases {
-                let [a, b] = topo.edge_vertices(e);
+            })?;
+            let mut buf: Vec<u8> = Vec::new();
+            for &([a, b], s) in creases {
                 buf.extend_from_slice(&a.to_le_bytes());
                 buf.extend_from_slice(&b.to_le_bytes());
-                buf.extend_from_slice(&topo.edge_sharpness(e).to_le_bytes());
-                flush(&mut buf, w, false)?;
+                buf.extend_from_slice(&s.to_le_bytes());
             }
-            for &v in &corners {
-                buf.extend_from_slice(&(v as u32).to_le_bytes());
-                buf.extend_from_slice(&topo.vertex_sharpness(v).to_le_bytes());
-                flush(&mut buf, w, false)?;
+            for &(v, s) in corners {
+                buf.extend_from_slice(&v.to_le_bytes());
+                buf.extend_from_slice(&s.to_le_bytes());
             }
             for &f in &holes {
                 buf.extend_from_slice(&(f as u32).to_le_bytes());
-                flush(&mut buf, w, false)?;
             }
-            flush(&mut buf, w, true)?;
+            w.write_all(&buf)?;
         }
     }
     Ok(())

@@ -385,6 +385,31 @@ impl Refinement {
         self.levels[level].num_vertices
     }
 
+    /// Number of edges of `level`, without building its topology: each parent edge has two
+    /// halves, and each parent face adds one interior edge per corner (Catmull-Clark,
+    /// bilinear) or three (Loop).
+    pub fn num_edges(&self, level: usize) -> usize {
+        if let Some(t) = self.levels[level].topology.get() {
+            return t.num_edges();
+        }
+        // Only the last level can be unbuilt, and it is not the base level.
+        let p = self.topology(level - 1);
+        refine::Layout::new(p, self.scheme).half_edge_base as usize + 2 * p.num_edges()
+    }
+
+    /// Whether any edge or vertex of `level` has a crease or corner sharpness above zero
+    /// (boundary and non-manifold edges count: the refinement makes them infinitely
+    /// sharp), without building the level's topology. When it is `false`, the level's
+    /// only tags are its holes ([`Self::holes`]), so [`Self::faces`] describes it whole.
+    pub fn has_sharpness(&self, level: usize) -> bool {
+        if let Some(t) = self.levels[level].topology.get() {
+            let tags = t.tags();
+            return tags.edge_sharpness().iter().any(|&s| s > 0.0)
+                || tags.vertex_sharpness().iter().any(|&s| s > 0.0);
+        }
+        refine::child_has_sharpness(self.topology(level - 1), &self.options)
+    }
+
     /// Face offsets and face-vertex indices of `level`, without building its full topology.
     pub fn faces(&self, level: usize) -> (&[u32], &[u32]) {
         match &self.levels[level].faces {

@@ -133,6 +133,22 @@ impl Layout {
     }
 }
 
+/// Whether any edge or vertex of the child of `p` will have a sharpness above zero: the
+/// same values [`child_topology`] assigns (halves of parent edges decay, vertex children
+/// keep a decayed vertex sharpness, everything else is smooth), without the split.
+pub(crate) fn child_has_sharpness(p: &Topology, options: &Options) -> bool {
+    let method = options.crease_method;
+    let edges = (0..p.num_edges()).into_par_iter().any(|e| {
+        let [a, b] = p.edge_vertices(e);
+        half_sharpness(p, e, a as usize, method) > 0.0
+            || half_sharpness(p, e, b as usize, method) > 0.0
+    });
+    edges
+        || (0..p.num_vertices())
+            .into_par_iter()
+            .any(|v| rules::child_vertex_sharpness(p.vertex_sharpness(v)) > 0.0)
+}
+
 /// Faces of a child level without the other relations: what a last level needs for output.
 #[derive(Debug, Clone)]
 pub(crate) struct ChildFaces {
