@@ -307,21 +307,14 @@ pub(crate) fn chebyshev(
     let hi = pre.lambda_max * (1.0 + INTERVAL_MARGIN.1);
     let (theta, delta) = ((hi + lo) / 2.0, (hi - lo) / 2.0);
     let sigma = theta / delta;
-    let mut r = vec![DVec3::ZERO; n];
-    let start = x.clone();
-    let mut res = s.residual(&x, &mut r);
+    let mut res = s.residual_max(&x);
     let mut history = vec![res];
     let mut steps = 0usize;
     if res > ctl.threshold && ctl.max_iter > 0 {
-        // f = S M̄ S b.
         let mut f = vec![DVec3::ZERO; n];
-        precondition(&s.rhs, signs, &mut r);
-        s.apply(&r, &mut f);
-        f.par_chunks_mut(CHUNK)
-            .zip(signs.par_chunks(CHUNK))
-            .for_each(|(f, sg)| f.iter_mut().zip(sg).for_each(|(f, &g)| *f *= g));
-        // x_{k−1}; overwritten by x_{k+1} in each pass.
-        let mut older = start.clone();
+        s.apply_conjugated(signs, &s.rhs, &mut f);
+        // x_{k−1}; overwritten by x_{k+1} in each pass (the first step does not read it).
+        let mut older = vec![DVec3::ZERO; n];
         let rate = sigma.acosh();
         // Smooth targets converge far sooner than the bound says: check early.
         let mut block = ((res / ctl.threshold).acosh() / rate / FIRST_CHECKPOINT).ceil();
@@ -342,15 +335,16 @@ pub(crate) fn chebyshev(
             }
             steps += block_steps;
             let last = res;
-            res = s.residual(&x, &mut r);
+            res = s.residual_max(&x);
             history.push(res);
             if res <= ctl.threshold || steps >= ctl.max_iter {
                 break;
             }
             // A block that did not reduce the error means a wrong interval (an eigenvalue
-            // above it grows): start over with CG, which needs none.
+            // above it grows): start over with CG, which needs none, from the right side
+            // (the targets when every vertex moves), as the iterate may have grown.
             if res.partial_cmp(&last) != Some(std::cmp::Ordering::Less) {
-                let mut cg = krylov(s, start, ctl);
+                let mut cg = krylov(s, s.rhs.clone(), ctl);
                 cg.steps += steps;
                 return cg;
             }

@@ -300,6 +300,40 @@ impl ReducedSystem {
         self.residual_into(x, next, |i, ri| x[i] + omega * ri)
     }
 
+    /// `max |b − M̄ x|_i` without storing the residual.
+    pub fn residual_max(&self, x: &[DVec3]) -> f64 {
+        (0..self.len().div_ceil(CHUNK))
+            .into_par_iter()
+            .map(|c| {
+                let mut m = 0.0f64;
+                for i in c * CHUNK..((c + 1) * CHUNK).min(self.len()) {
+                    let (cols, w) = self.row(i);
+                    let mut acc = self.rhs[i];
+                    for (&j, &x_w) in cols.iter().zip(w) {
+                        acc -= x_w * x[j as usize];
+                    }
+                    m = m.max(finite_or_inf(acc.length()));
+                }
+                m
+            })
+            .reduce(|| 0.0, f64::max)
+    }
+
+    /// `y = S M̄ S x` for the diagonal of signs `S`, in one pass.
+    pub fn apply_conjugated(&self, signs: &[f64], x: &[DVec3], y: &mut [DVec3]) {
+        y.par_chunks_mut(CHUNK).enumerate().for_each(|(c, out)| {
+            for (k, o) in out.iter_mut().enumerate() {
+                let i = c * CHUNK + k;
+                let (cols, w) = self.row(i);
+                let mut acc = DVec3::ZERO;
+                for (&j, &x_w) in cols.iter().zip(w) {
+                    acc += (x_w * signs[j as usize]) * x[j as usize];
+                }
+                *o = signs[i] * acc;
+            }
+        });
+    }
+
     /// Writes `f(i, r_i)` for the residual `r = b − M̄ x`, in parallel; returns `max |r_i|`.
     fn residual_into(
         &self,
