@@ -99,14 +99,14 @@ fn derived_child_topology_matches_the_builder() {
 }
 
 /// What a refinement says of its last level without building the level's topology (the
-/// edge count, whether anything is sharp) is what the built topology shows, on every shape
-/// with every scheme that applies, and with Chaikin creases.
+/// edge count, whether anything is sharp, the tags a file must carry) is what the built
+/// topology shows, on every shape with every scheme that applies, and with Chaikin creases.
 #[test]
 fn last_level_counts_and_sharpness_without_its_topology() {
     let opts = ReadOptions {
         accept_inconsistent_orientation: true,
     };
-    let (mut sharp, mut smooth) = (0, 0);
+    let (mut sharp, mut smooth, mut explicit) = (0, 0, 0);
     for path in osd_meshes() {
         let name = path.file_stem().unwrap().to_string_lossy().to_string();
         let file = read_mesh(&path, &opts).unwrap();
@@ -131,7 +131,32 @@ fn last_level_counts_and_sharpness_without_its_topology() {
                 for levels in 1..=deepest {
                     let r = Refinement::new(base, scheme, &options, levels).unwrap();
                     let (edges, has) = (r.num_edges(levels), r.has_sharpness(levels));
+                    let tags = r.explicit_tags(levels);
                     let t = r.topology(levels);
+                    // From the built level: every sharp edge and vertex but the implied.
+                    assert_eq!(
+                        tags,
+                        r.explicit_tags(levels),
+                        "{name} {scheme:?} L{levels} explicit tags"
+                    );
+                    let implied_vertex = |v: usize| {
+                        t.is_non_manifold_vertex(v)
+                            || t.is_isolated_vertex(v)
+                            || (t.vertex_faces(v).len() == 1
+                                && t.valence(v) == 2
+                                && options.boundary_interpolation
+                                    == subd_mesh::BoundaryInterpolation::EdgeAndCorner)
+                    };
+                    let explicit_edges = (0..t.num_edges())
+                        .filter(|&e| t.edge_sharpness(e) > 0.0)
+                        .filter(|&e| !t.is_boundary_edge(e) && !t.is_non_manifold_edge(e))
+                        .count();
+                    let explicit_vertices = (0..t.num_vertices())
+                        .filter(|&v| t.vertex_sharpness(v) > 0.0 && !implied_vertex(v))
+                        .count();
+                    assert_eq!(tags.creases.len(), explicit_edges, "{name} L{levels}");
+                    assert_eq!(tags.corners.len(), explicit_vertices, "{name} L{levels}");
+                    explicit += tags.creases.len() + tags.corners.len();
                     assert_eq!(edges, t.num_edges(), "{name} {scheme:?} L{levels} edges");
                     let built = (0..t.num_edges()).any(|e| t.edge_sharpness(e) > 0.0)
                         || (0..t.num_vertices()).any(|v| t.vertex_sharpness(v) > 0.0);
@@ -148,4 +173,5 @@ fn last_level_counts_and_sharpness_without_its_topology() {
     }
     // The shapes cover both answers.
     assert!(sharp > 0 && smooth > 0, "sharp {sharp}, smooth {smooth}");
+    assert!(explicit > 1000, "{explicit} explicit tags");
 }

@@ -6,9 +6,7 @@ use std::time::Instant;
 
 use clap::{Args, ValueEnum};
 use serde::Serialize;
-use subd_mesh::{
-    BoundaryInterpolation, CreaseMethod, Mesh, SchemeHints, Topology, TriangleSubdivision,
-};
+use subd_mesh::{BoundaryInterpolation, CreaseMethod, SchemeHints, TriangleSubdivision};
 use subd_schemes::{Options, Refinement, Scheme};
 
 use crate::vertex_data::LambdaArgs;
@@ -193,27 +191,6 @@ pub(crate) fn bad(message: String) -> Failure {
     }
 }
 
-/// The tags worth writing at the refined level: the ones the user gave and their decayed
-/// children. Sharpness the boundary rules imply (boundary and non-manifold edges,
-/// non-manifold vertices, corners under edge-and-corner) is left out, since any reader
-/// applies those rules again.
-fn visible_tags(t: &mut Topology, options: &Options) {
-    for e in 0..t.num_edges() {
-        if t.is_boundary_edge(e) || t.is_non_manifold_edge(e) {
-            t.set_edge_sharpness(e, 0.0);
-        }
-    }
-    for v in 0..t.num_vertices() {
-        let corner = t.vertex_faces(v).len() == 1 && t.valence(v) == 2;
-        if t.is_non_manifold_vertex(v)
-            || t.is_isolated_vertex(v)
-            || (corner && options.boundary_interpolation == BoundaryInterpolation::EdgeAndCorner)
-        {
-            t.set_vertex_sharpness(v, 0.0);
-        }
-    }
-}
-
 pub(crate) fn run(
     args: &RefineArgs,
     out: &mut dyn Write,
@@ -269,34 +246,21 @@ pub(crate) fn run(
             .triangle_subdivision
             .or(args.rules.triangles.map(|_| options.triangle_subdivision)),
     };
-    let format = subd_io::Format::from_path(&args.output).expect("extension checked above");
-    let out_counts = if format == subd_io::Format::Glb || !refinement.has_sharpness(args.levels) {
-        // Polygons and holes are all the file holds: write them without building the
-        // level's edges (most of the time and memory of a deep refinement's output).
-        let (offsets, vertices) = refinement.faces(args.levels);
-        let mut view =
-            subd_io::MeshView::new(&positions, offsets, vertices, refinement.holes(args.levels))
-                .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
-        view.hints = hints;
-        subd_io::write_view(&args.output, &view, &subd_io::WriteOptions::default())?;
-        Counts {
-            vertices: positions.len(),
-            edges: Some(refinement.num_edges(args.levels)),
-            faces: view.num_faces(),
-        }
-    } else {
-        let mut topology = refinement.into_topology(args.levels);
-        visible_tags(&mut topology, &options);
-        let counts = Counts {
-            vertices: topology.num_vertices(),
-            edges: Some(topology.num_edges()),
-            faces: topology.num_faces(),
-        };
-        let mut mesh = Mesh::new(topology, positions)
+    // Polygons, holes and the tags a reader cannot infer are all the file holds: they are
+    // written without building the output level's edges (most of the time and memory of a
+    // deep refinement's output).
+    let (offsets, vertices) = refinement.faces(args.levels);
+    let tags = refinement.explicit_tags(args.levels);
+    let mut view =
+        subd_io::MeshView::new(&positions, offsets, vertices, refinement.holes(args.levels))
+            .and_then(|v| v.with_tags(tags.creases, tags.corners))
             .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
-        mesh.hints = hints;
-        subd_io::write_mesh(&args.output, &mesh, &subd_io::WriteOptions::default())?;
-        counts
+    view.hints = hints;
+    subd_io::write_view(&args.output, &view, &subd_io::WriteOptions::default())?;
+    let out_counts = Counts {
+        vertices: positions.len(),
+        edges: Some(refinement.num_edges(args.levels)),
+        faces: view.num_faces(),
     };
     progress.finish();
     let t_write = t2.elapsed().as_secs_f64();

@@ -65,6 +65,19 @@ pub use two_phase::TwoPhase;
 /// The most levels a refinement may ask for (OpenSubdiv's limit too).
 pub const MAX_LEVELS: usize = 15;
 
+/// The sharpness of a refined level as a mesh file records it: every edge (as its two end
+/// vertices) and every vertex with a sharpness above zero, in edge and vertex order, except
+/// what the boundary rules imply and any reader applies again — boundary and non-manifold
+/// edges, non-manifold and isolated vertices, and one-face corners under edge-and-corner
+/// interpolation ([`Refinement::explicit_tags`]).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ExplicitTags {
+    /// Crease tags: end vertices and sharpness.
+    pub creases: Vec<([u32; 2], f32)>,
+    /// Corner tags: vertex and sharpness.
+    pub corners: Vec<(u32, f32)>,
+}
+
 /// A surface subdivision scheme.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -408,6 +421,15 @@ impl Refinement {
                 || tags.vertex_sharpness().iter().any(|&s| s > 0.0);
         }
         refine::child_has_sharpness(self.topology(level - 1), &self.options)
+    }
+
+    /// The crease and corner tags of `level` that a file must carry (see [`ExplicitTags`]),
+    /// without building the level's topology.
+    pub fn explicit_tags(&self, level: usize) -> ExplicitTags {
+        if let Some(t) = self.levels[level].topology.get() {
+            return refine::explicit_tags(t, &self.options);
+        }
+        refine::child_explicit_tags(self.topology(level - 1), self.scheme, &self.options)
     }
 
     /// Face offsets and face-vertex indices of `level`, without building its full topology.

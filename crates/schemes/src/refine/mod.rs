@@ -149,6 +149,68 @@ pub(crate) fn child_has_sharpness(p: &Topology, options: &Options) -> bool {
             .any(|v| rules::child_vertex_sharpness(p.vertex_sharpness(v)) > 0.0)
 }
 
+/// Whether the boundary rules make vertex `v` of `t` sharp whatever its tags say: a
+/// non-manifold or isolated vertex, or a one-face corner under edge-and-corner interpolation.
+fn implied_sharp_vertex(t: &Topology, v: usize, options: &Options) -> bool {
+    let corner = t.vertex_faces(v).len() == 1 && t.valence(v) == 2;
+    nm_vertex(t, v)
+        || (corner && options.boundary_interpolation == BoundaryInterpolation::EdgeAndCorner)
+}
+
+/// [`crate::ExplicitTags`] of a built level.
+pub(crate) fn explicit_tags(t: &Topology, options: &Options) -> crate::ExplicitTags {
+    crate::ExplicitTags {
+        creases: (0..t.num_edges())
+            .filter(|&e| {
+                t.edge_sharpness(e) > 0.0 && !t.is_boundary_edge(e) && !t.is_non_manifold_edge(e)
+            })
+            .map(|e| (t.edge_vertices(e), t.edge_sharpness(e)))
+            .collect(),
+        corners: (0..t.num_vertices())
+            .filter(|&v| t.vertex_sharpness(v) > 0.0 && !implied_sharp_vertex(t, v, options))
+            .map(|v| (v as u32, t.vertex_sharpness(v)))
+            .collect(),
+    }
+}
+
+/// [`crate::ExplicitTags`] of the child of `p`, from `p` alone: the values and order
+/// [`child_topology`] would give. Only halves of parent edges can be sharp (half `k` of
+/// edge `e` joins the edge point to end `k`, in edge order after the interior edges), and
+/// they are boundary or non-manifold exactly when their parent edge is; only vertex
+/// children keep a vertex sharpness, with their parent's face and edge counts and kind.
+pub(crate) fn child_explicit_tags(
+    p: &Topology,
+    scheme: Scheme,
+    options: &Options,
+) -> crate::ExplicitTags {
+    let method = options.crease_method;
+    let edge_point_base = Layout::new(p, scheme).edge_vertex_base;
+    let mut creases = Vec::new();
+    for e in 0..p.num_edges() {
+        if p.edge_sharpness(e) <= 0.0 || p.is_boundary_edge(e) || p.is_non_manifold_edge(e) {
+            continue;
+        }
+        let ep = edge_point_base + e as u32;
+        for u in p.edge_vertices(e) {
+            let s = half_sharpness(p, e, u as usize, method);
+            if s > 0.0 {
+                creases.push(([ep, u], s));
+            }
+        }
+    }
+    let corners = (0..p.num_vertices())
+        .filter(|&v| !implied_sharp_vertex(p, v, options))
+        .map(|v| {
+            (
+                v as u32,
+                rules::child_vertex_sharpness(p.vertex_sharpness(v)),
+            )
+        })
+        .filter(|&(_, s)| s > 0.0)
+        .collect();
+    crate::ExplicitTags { creases, corners }
+}
+
 /// Faces of a child level without the other relations: what a last level needs for output.
 #[derive(Debug, Clone)]
 pub(crate) struct ChildFaces {
