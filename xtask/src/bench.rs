@@ -155,15 +155,23 @@ fn measure(cmd: &mut Command, huge_pages: bool) -> Result<Measure, String> {
 
 /// Runs the whole comparison and prints the table; with `huge_pages` both sides run under
 /// the same transparent-huge-page malloc setting; `advice` is subd's own huge-page advice
-/// for its large arrays (on by default in the library).
-pub fn run(levels: usize, repeats: usize, huge_pages: bool, advice: bool) -> Result<(), String> {
+/// for its large arrays (on by default in the library). Each level is measured in `rounds`
+/// back-to-back rounds of OpenSubdiv, subd on one thread and subd on all threads; the table
+/// shows medians over rounds, and each ratio is the median of the rounds' ratios.
+pub fn run(
+    levels: usize,
+    repeats: usize,
+    rounds: usize,
+    huge_pages: bool,
+    advice: bool,
+) -> Result<(), String> {
     let exe = osd::build_harness()?;
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/xtask/bench");
     std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
     let me = std::env::current_exe().map_err(|e| e.to_string())?;
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
     println!(
-        "subd vs OpenSubdiv 3.5 (Far, double), uniform refinement, median of {repeats} runs; ratio = subd time / OpenSubdiv time{}",
+        "subd vs OpenSubdiv 3.5 (Far, double), uniform refinement; {rounds} rounds of (OpenSubdiv, subd 1 thread, subd all threads) back to back, each the median of {repeats} runs; times: median over rounds; ratio = subd time / OpenSubdiv time, median of the rounds' ratios{}",
         if huge_pages {
             "; both with GLIBC_TUNABLES=glibc.malloc.hugetlb=1"
         } else {
@@ -210,12 +218,14 @@ pub fn run(levels: usize, repeats: usize, huge_pages: bool, advice: bool) -> Res
             );
             let input_path = dir.join(format!("{name}_{level}.bin"));
             std::fs::write(&input_path, &input).map_err(|e| e.to_string())?;
-            let osd = measure(
-                Command::new(&exe)
-                    .args(["--bench", &repeats.to_string()])
-                    .stdin(std::fs::File::open(&input_path).map_err(|e| e.to_string())?),
-                huge_pages,
-            )?;
+            let osd = || {
+                measure(
+                    Command::new(&exe)
+                        .args(["--bench", &repeats.to_string()])
+                        .stdin(std::fs::File::open(&input_path).map_err(|e| e.to_string())?),
+                    huge_pages,
+                )
+            };
             let subd = |t: usize| {
                 measure(
                     Command::new(&me)
@@ -236,8 +246,12 @@ pub fn run(levels: usize, repeats: usize, huge_pages: bool, advice: bool) -> Res
                     huge_pages,
                 )
             };
-            let one = subd(1)?;
-            let all = subd(threads)?;
+            let mut runs = Vec::with_capacity(rounds);
+            for _ in 0..rounds {
+                runs.push([osd()?, subd(1)?, subd(threads)?]);
+            }
+            let med = |f: &dyn Fn(&[Measure; 3]) -> f64| median(runs.iter().map(f).collect());
+            let peak = |k: usize| runs.iter().map(|r| r[k].peak).fold(0.0, f64::max);
             let out_faces = mesh.topology.num_face_vertices()
                 * 4usize.pow(level as u32 - 1)
                 * if scheme == Scheme::Loop { 4 } else { 1 }
@@ -248,13 +262,13 @@ pub fn run(levels: usize, repeats: usize, huge_pages: bool, advice: bool) -> Res
                 mesh.topology.num_faces(),
                 level,
                 out_faces,
-                osd.seconds,
-                one.seconds,
-                one.seconds / osd.seconds,
-                all.seconds,
-                all.seconds / osd.seconds,
-                osd.peak,
-                one.peak.max(all.peak)
+                med(&|r| r[0].seconds),
+                med(&|r| r[1].seconds),
+                med(&|r| r[1].seconds / r[0].seconds),
+                med(&|r| r[2].seconds),
+                med(&|r| r[2].seconds / r[0].seconds),
+                peak(0),
+                peak(1).max(peak(2))
             );
         }
     }

@@ -46,6 +46,11 @@ enum Task {
         /// Runs per measurement (the median is reported).
         #[arg(long, default_value_t = 5)]
         repeats: usize,
+        /// Refinement: rounds of (OpenSubdiv, subd 1 thread, subd all threads) run back to
+        /// back; times are medians over rounds, ratios the medians of each round's ratio, so
+        /// a slow spell of a shared machine hits both sides of a ratio.
+        #[arg(long, default_value_t = 3)]
+        rounds: usize,
         /// Run both OpenSubdiv and subd with glibc's transparent-huge-page malloc
         /// (`GLIBC_TUNABLES=glibc.malloc.hugetlb=1`), which removes most page-fault time from
         /// both sides where the kernel allows THP on request.
@@ -179,6 +184,7 @@ fn main() -> ExitCode {
         Task::Bench {
             levels,
             repeats,
+            rounds,
             huge_pages,
             no_huge_page_advice,
             refine_only,
@@ -188,15 +194,28 @@ fn main() -> ExitCode {
             if pia_only {
                 pia_bench::run(repeats)
             } else if refine_only {
-                ensure_system_packages(OPENSUBDIV_PACKAGES)
-                    .and_then(|_| bench::run(levels, repeats, huge_pages, !no_huge_page_advice))
+                ensure_system_packages(OPENSUBDIV_PACKAGES).and_then(|_| {
+                    bench::run(
+                        levels,
+                        repeats,
+                        rounds.max(1),
+                        huge_pages,
+                        !no_huge_page_advice,
+                    )
+                })
             } else {
                 ensure_system_packages(OPENSUBDIV_PACKAGES)
                     .and_then(|_| {
                         if eval_only {
                             Ok(())
                         } else {
-                            bench::run(levels, repeats, huge_pages, !no_huge_page_advice)
+                            bench::run(
+                                levels,
+                                repeats,
+                                rounds.max(1),
+                                huge_pages,
+                                !no_huge_page_advice,
+                            )
                         }
                     })
                     .and_then(|_| bench::run_eval(repeats))
