@@ -191,33 +191,22 @@ fn main() -> ExitCode {
             eval_only,
             pia_only,
         } => {
+            let refinement = || {
+                bench::run(
+                    levels,
+                    repeats,
+                    rounds.max(1),
+                    huge_pages,
+                    !no_huge_page_advice,
+                )
+            };
             if pia_only {
                 pia_bench::run(repeats)
             } else if refine_only {
-                ensure_system_packages(OPENSUBDIV_PACKAGES).and_then(|_| {
-                    bench::run(
-                        levels,
-                        repeats,
-                        rounds.max(1),
-                        huge_pages,
-                        !no_huge_page_advice,
-                    )
-                })
+                ensure_system_packages(OPENSUBDIV_PACKAGES).and_then(|_| refinement())
             } else {
                 ensure_system_packages(OPENSUBDIV_PACKAGES)
-                    .and_then(|_| {
-                        if eval_only {
-                            Ok(())
-                        } else {
-                            bench::run(
-                                levels,
-                                repeats,
-                                rounds.max(1),
-                                huge_pages,
-                                !no_huge_page_advice,
-                            )
-                        }
-                    })
+                    .and_then(|_| if eval_only { Ok(()) } else { refinement() })
                     .and_then(|_| bench::run_eval(repeats))
                     .and_then(|_| {
                         if eval_only {

@@ -300,6 +300,17 @@ impl ReducedSystem {
         self.residual_into(x, next, |i, ri| x[i] + omega * ri)
     }
 
+    /// `(b − M̄ x)_i`.
+    #[inline]
+    fn row_residual(&self, i: usize, x: &[DVec3]) -> DVec3 {
+        let (cols, w) = self.row(i);
+        let mut acc = self.rhs[i];
+        for (&j, &x_w) in cols.iter().zip(w) {
+            acc -= x_w * x[j as usize];
+        }
+        acc
+    }
+
     /// `max |b − M̄ x|_i` without storing the residual.
     pub fn residual_max(&self, x: &[DVec3]) -> f64 {
         (0..self.len().div_ceil(CHUNK))
@@ -307,12 +318,7 @@ impl ReducedSystem {
             .map(|c| {
                 let mut m = 0.0f64;
                 for i in c * CHUNK..((c + 1) * CHUNK).min(self.len()) {
-                    let (cols, w) = self.row(i);
-                    let mut acc = self.rhs[i];
-                    for (&j, &x_w) in cols.iter().zip(w) {
-                        acc -= x_w * x[j as usize];
-                    }
-                    m = m.max(finite_or_inf(acc.length()));
+                    m = m.max(finite_or_inf(self.row_residual(i, x).length()));
                 }
                 m
             })
@@ -347,11 +353,7 @@ impl ReducedSystem {
                 let mut m = 0.0f64;
                 for (k, o) in out.iter_mut().enumerate() {
                     let i = c * CHUNK + k;
-                    let (cols, w) = self.row(i);
-                    let mut acc = self.rhs[i];
-                    for (&j, &x_w) in cols.iter().zip(w) {
-                        acc -= x_w * x[j as usize];
-                    }
+                    let acc = self.row_residual(i, x);
                     *o = f(i, acc);
                     m = m.max(finite_or_inf(acc.length()));
                 }
