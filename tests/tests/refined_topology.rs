@@ -175,3 +175,82 @@ fn last_level_counts_and_sharpness_without_its_topology() {
     assert!(sharp > 0 && smooth > 0, "sharp {sharp}, smooth {smooth}");
     assert!(explicit > 1000, "{explicit} explicit tags");
 }
+
+/// On closed, smooth, all-quad meshes the last Catmull-Clark level is derived from the level
+/// two above, without building the level in between. Its faces, rules and points equal,
+/// bit for bit, those of the path through the built level (forced afterwards on the same
+/// refinement), and the deeper refinement that builds it.
+#[test]
+fn last_level_from_its_grandparent_equals_the_built_path() {
+    let opts = ReadOptions {
+        accept_inconsistent_orientation: true,
+    };
+    let mut fused = Vec::new();
+    for path in osd_meshes() {
+        let name = path.file_stem().unwrap().to_string_lossy().to_string();
+        let file = read_mesh(&path, &opts).unwrap();
+        let base = &file.mesh.topology;
+        if base.num_face_vertices() > 8000 {
+            continue;
+        }
+        for smooth_triangles in [false, true] {
+            let mut options = Options::from_hints(&file.mesh.hints);
+            if smooth_triangles {
+                options.triangle_subdivision = subd_mesh::TriangleSubdivision::Smooth;
+            }
+            for levels in 2..=3 {
+                let r = Refinement::new(base, Scheme::CatmullClark, &options, levels).unwrap();
+                if r.has_topology(levels - 1) {
+                    continue;
+                }
+                fused.push(format!("{name} L{levels}"));
+                let (edges, tags) = (r.num_edges(levels), r.explicit_tags(levels));
+                let points = r.refine_points(&file.mesh.positions);
+                assert!(
+                    !r.has_topology(levels - 1),
+                    "{name}: points need no level {}",
+                    levels - 1
+                );
+                // The same refinement through the built levels.
+                let t = r.topology(levels);
+                assert!(r.has_topology(levels - 1));
+                let (offsets, vertices) = r.faces(levels);
+                assert_eq!(offsets, t.face_offsets(), "{name} L{levels} offsets");
+                assert_eq!(vertices, t.all_face_vertices(), "{name} L{levels} faces");
+                assert!(r.holes(levels).iter().all(|&h| !h));
+                assert_eq!(edges, t.num_edges(), "{name} L{levels} edges");
+                assert_eq!(tags, r.explicit_tags(levels), "{name} L{levels} tags");
+                let built = r.refine_points(&file.mesh.positions);
+                assert_eq!(points, built, "{name} L{levels} points");
+                // A refinement one level deeper builds level `levels` and derives its rules
+                // from the built level above.
+                let deeper =
+                    Refinement::new(base, Scheme::CatmullClark, &options, levels + 1).unwrap();
+                assert!(deeper.has_topology(levels - 1));
+                assert_eq!(
+                    r.vertex_rules(levels),
+                    deeper.vertex_rules(levels),
+                    "{name} L{levels} rules"
+                );
+                assert_eq!(
+                    r.topology(levels),
+                    deeper.topology(levels),
+                    "{name} L{levels} topology"
+                );
+                assert_eq!(
+                    points,
+                    deeper.refine_points(&file.mesh.positions)[..=levels],
+                    "{name} L{levels} deeper points"
+                );
+                // Stencils go through the built level too, and agree.
+                let via_stencils = r.composed(levels).apply_points(&file.mesh.positions);
+                for (a, b) in via_stencils.iter().zip(&points[levels]) {
+                    assert!((*a - *b).length() <= 1e-12 * (1.0 + b.length()), "{name}");
+                }
+            }
+        }
+    }
+    // Closed smooth quad shapes exist among OpenSubdiv's, at level 2 from an all-quad base
+    // and at level 3 from any closed smooth base.
+    assert!(fused.len() >= 6, "fused cases: {fused:?}");
+}

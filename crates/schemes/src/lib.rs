@@ -187,8 +187,8 @@ pub enum RefineError {
 /// One level of a refinement.
 #[derive(Debug)]
 struct Level {
-    /// Full topology with tags; built eagerly below the last level (the next level needs it)
-    /// and on first request for the last.
+    /// Full topology with tags; built eagerly below the last level (the next level needs it),
+    /// on first request for the last and for a level whose child comes from its parent.
     topology: OnceLock<Topology>,
     /// Face lists of the last level, available without building its full topology.
     faces: Option<refine::ChildFaces>,
@@ -196,6 +196,9 @@ struct Level {
     rules: Vec<Rule>,
     /// Number of vertices.
     num_vertices: usize,
+    /// Faces, rules and points of this level come from the level two above
+    /// ([`refine::grandchild_points`]): the level above is not built unless asked for.
+    from_grandparent: bool,
 }
 
 /// A uniform refinement: the topology of every level and the stencils between levels.
@@ -205,7 +208,11 @@ struct Level {
 /// evaluates the masks level by level (any other primvar goes through the stencil tables,
 /// [`StencilTable::apply`]). Stencil tables and the last
 /// level's full topology (edges, rings, tags) are built on first request, so a refinement that
-/// only needs the final faces and positions does not pay for them.
+/// only needs the final faces and positions does not pay for them. On a closed, smooth,
+/// all-quad Catmull-Clark mesh (no boundary, crease, corner, hole or non-manifold part — the
+/// bench torus, most character meshes after one level) the level before the last is not
+/// built either: the last level's faces, rules and points are derived from the level two
+/// above, with the same results bit for bit ([`Self::has_topology`]).
 #[derive(Debug)]
 pub struct Refinement {
     scheme: Scheme,
@@ -289,6 +296,7 @@ impl Refinement {
                 topology: OnceLock::from(t0),
                 faces: None,
                 rules: rules0,
+                from_grandparent: false,
             }],
             stencils: (0..levels).map(|_| OnceLock::new()).collect(),
             phase_one: None,
@@ -304,12 +312,47 @@ impl Refinement {
             }
             let layout = refine::Layout::new(p, scheme);
             let rules = refine::child_rules(p, &r.levels[l - 1].rules, options, layout);
+            if l + 1 == levels
+                && scheme == Scheme::CatmullClark
+                && refine::fusion_applies(p, &r.levels[l - 1].rules)
+            {
+                // The last two levels of a closed smooth quad mesh: the last one straight
+                // from this parent, its own parent left unbuilt.
+                let (nv, nf, ne) = refine::fused_child_counts(p);
+                if 16 * nf as u64 + 4 * ne as u64 >= u32::MAX as u64 {
+                    return Err(RefineError::TooLarge { level: levels });
+                }
+                let (offsets, vertices) = refine::grandchild_faces(p);
+                let num_faces = offsets.len() - 1;
+                let last = Level {
+                    num_vertices: nv + nf + ne,
+                    topology: OnceLock::new(),
+                    faces: Some(refine::ChildFaces {
+                        offsets,
+                        vertices,
+                        holes: memory::zeroed(num_faces),
+                    }),
+                    // Closed and smooth stays closed and smooth: no creases, no corners.
+                    rules: vec![Rule::Smooth; nv + nf + ne],
+                    from_grandparent: true,
+                };
+                r.levels.push(Level {
+                    num_vertices: layout.num_child_vertices,
+                    topology: OnceLock::new(),
+                    faces: None,
+                    rules,
+                    from_grandparent: false,
+                });
+                r.levels.push(last);
+                break;
+            }
             let level = if l < levels {
                 Level {
                     num_vertices: layout.num_child_vertices,
                     topology: OnceLock::from(refine::child_topology(p, scheme, options, layout)),
                     faces: None,
                     rules,
+                    from_grandparent: false,
                 }
             } else {
                 Level {
@@ -317,6 +360,7 @@ impl Refinement {
                     topology: OnceLock::new(),
                     faces: Some(refine::child_faces(p, scheme)),
                     rules,
+                    from_grandparent: false,
                 }
             };
             r.levels.push(level);
@@ -405,6 +449,11 @@ impl Refinement {
         if let Some(t) = self.levels[level].topology.get() {
             return t.num_edges();
         }
+        if self.levels[level].from_grandparent && !self.has_topology(level - 1) {
+            // Each quad of the closed parent has 4 interior child edges; each edge 2 halves.
+            let (_, nf, ne) = refine::fused_child_counts(self.topology(level - 2));
+            return 4 * nf + 2 * ne;
+        }
         // Only the last level can be unbuilt, and it is not the base level.
         let p = self.topology(level - 1);
         refine::Layout::new(p, self.scheme).half_edge_base as usize + 2 * p.num_edges()
@@ -420,6 +469,9 @@ impl Refinement {
             return tags.edge_sharpness().iter().any(|&s| s > 0.0)
                 || tags.vertex_sharpness().iter().any(|&s| s > 0.0);
         }
+        if self.levels[level].from_grandparent {
+            return false;
+        }
         refine::child_has_sharpness(self.topology(level - 1), &self.options)
     }
 
@@ -428,6 +480,9 @@ impl Refinement {
     pub fn explicit_tags(&self, level: usize) -> ExplicitTags {
         if let Some(t) = self.levels[level].topology.get() {
             return refine::explicit_tags(t, &self.options);
+        }
+        if self.levels[level].from_grandparent {
+            return ExplicitTags::default();
         }
         refine::child_explicit_tags(self.topology(level - 1), self.scheme, &self.options)
     }
@@ -452,13 +507,36 @@ impl Refinement {
     }
 
     /// Topology of `level` (0 = base, with the boundary rules applied to its tags), built on
-    /// first request for the last level.
+    /// first request where it is not built yet ([`Self::has_topology`]).
     pub fn topology(&self, level: usize) -> &Topology {
         self.levels[level].topology.get_or_init(|| {
             let p = self.topology(level - 1);
             let layout = refine::Layout::new(p, self.scheme);
             refine::child_topology(p, self.scheme, &self.options, layout)
         })
+    }
+
+    /// Whether the full topology of `level` is built. The last level is built only on
+    /// request; so is the level before it on a closed, smooth, all-quad Catmull-Clark mesh,
+    /// whose last level is then derived from the level two above (every result is the same
+    /// as with the level built, bit for bit).
+    ///
+    /// ```
+    /// use subd_mesh::TopologyBuilder;
+    /// use subd_schemes::{Options, Refinement, Scheme};
+    ///
+    /// // A cube: closed, smooth, all quads.
+    /// let faces = [0, 1, 3, 2, 2, 3, 5, 4, 4, 5, 7, 6, 6, 7, 1, 0, 1, 7, 5, 3, 6, 0, 2, 4];
+    /// let cube = TopologyBuilder::new(8).build(&[4; 6], &faces).unwrap();
+    /// let r = Refinement::new(&cube, Scheme::CatmullClark, &Options::default(), 3).unwrap();
+    /// assert!(r.has_topology(1));
+    /// assert!(!r.has_topology(2) && !r.has_topology(3));
+    /// assert_eq!(r.faces(3).1.len(), 4 * 6 * 64);
+    /// assert_eq!(r.topology(3).num_faces(), 6 * 64); // builds levels 2 and 3
+    /// assert!(r.has_topology(2));
+    /// ```
+    pub fn has_topology(&self, level: usize) -> bool {
+        self.levels[level].topology.get().is_some()
     }
 
     /// Takes the topology of `level` out of the refinement (building it if needed), without
@@ -522,7 +600,12 @@ impl Refinement {
         );
         let mut out = vec![base.to_vec()];
         for l in 1..self.levels.len() {
-            let next = self.step(l).points(out.last().expect("level 0"));
+            let src = out.last().expect("level 0");
+            let next = if self.levels[l].from_grandparent && !self.has_topology(l - 1) {
+                refine::grandchild_points(self.topology(l - 2), src)
+            } else {
+                self.step(l).points(src)
+            };
             out.push(next);
         }
         out

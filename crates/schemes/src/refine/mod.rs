@@ -3,8 +3,14 @@
 //! vertices from parent vertices — evaluated directly into positions, or recorded as a
 //! [`StencilTable`].
 
+mod fused;
 mod par;
 mod split;
+
+pub(crate) use fused::{
+    applies as fusion_applies, child_counts as fused_child_counts, grandchild_faces,
+    grandchild_points,
+};
 
 use glam::DVec3;
 use rayon::prelude::*;

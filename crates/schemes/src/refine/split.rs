@@ -53,7 +53,7 @@ fn vertex_edge_end(p: &Topology, v: usize, i: usize) -> u32 {
 /// The four child faces of parent quad `f`, in the order of [`quad_face_block`]:
 /// `(V0, E0, F, E3)`, `(E0, V1, E1, F)`, `(F, E1, V2, E2)`, `(E3, F, E2, V3)`.
 #[inline]
-fn quad_child_vertices(p: &Topology, f: usize) -> [u32; 16] {
+pub(super) fn quad_child_vertices(p: &Topology, f: usize) -> [u32; 16] {
     let (nv, nf) = (p.num_vertices() as u32, p.num_faces() as u32);
     let (fv, fe) = (p.face_vertices(f), p.face_edges(f));
     let fp = nv + f as u32;
@@ -68,7 +68,7 @@ fn quad_child_vertices(p: &Topology, f: usize) -> [u32; 16] {
 /// half of edge k at corner k, b_k the half of edge k-1 at corner k and I_k the interior edge
 /// from the face point to edge point k.
 #[inline]
-fn quad_child_edges(p: &Topology, f: usize) -> [u32; 16] {
+pub(super) fn quad_child_edges(p: &Topology, f: usize) -> [u32; 16] {
     let hb = p.num_face_vertices() as u32;
     let base = p.face_offsets()[f];
     let (fv, fe) = (p.face_vertices(f), p.face_edges(f));
@@ -86,13 +86,16 @@ fn quad_child_edges(p: &Topology, f: usize) -> [u32; 16] {
 
 /// `true` when every face of `p` is a quad: then each parent face has a fixed-size block of
 /// children and the child arrays are written block by block, in place.
-fn all_quads(p: &Topology) -> bool {
+pub(super) fn all_quads(p: &Topology) -> bool {
     p.num_face_vertices() == 4 * p.num_faces()
         && p.face_offsets().par_windows(2).all(|w| w[1] - w[0] == 4)
 }
 
 /// A flat array made of one block (a `u32` array) per parent face, written once, in place.
-fn per_face<B: bytemuck::Pod + Send>(nf: usize, block: impl Fn(usize) -> B + Sync) -> Vec<u32> {
+pub(super) fn per_face<B: bytemuck::Pod + Send>(
+    nf: usize,
+    block: impl Fn(usize) -> B + Sync,
+) -> Vec<u32> {
     let mut out: Vec<B> = memory::with_capacity(nf);
     out.par_extend((0..nf).into_par_iter().with_min_len(1024).map(&block));
     // A block is an array of `u32` (same alignment), so the buffer is reused as is.
@@ -176,7 +179,7 @@ pub(crate) fn tri_faces(p: &Topology) -> (Vec<u32>, Vec<u32>) {
 }
 
 /// Offsets of `faces` faces of `size` vertices each.
-fn uniform_offsets(faces: usize, size: u32) -> Vec<u32> {
+pub(super) fn uniform_offsets(faces: usize, size: u32) -> Vec<u32> {
     let mut out = memory::with_capacity(faces + 1);
     out.par_extend(
         (0..faces + 1)
