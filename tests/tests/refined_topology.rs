@@ -176,8 +176,8 @@ fn last_level_counts_and_sharpness_without_its_topology() {
     assert!(explicit > 1000, "{explicit} explicit tags");
 }
 
-/// On closed, smooth, all-quad meshes the last Catmull-Clark level is derived from the level
-/// two above, without building the level in between. Its faces, rules and points equal,
+/// On closed, smooth meshes the last Catmull-Clark (all quads) or Loop level is derived from
+/// the level two above, without building the level in between. Its faces, rules and points equal,
 /// bit for bit, those of the path through the built level (forced afterwards on the same
 /// refinement), and the deeper refinement that builds it.
 #[test]
@@ -193,17 +193,22 @@ fn last_level_from_its_grandparent_equals_the_built_path() {
         if base.num_face_vertices() > 8000 {
             continue;
         }
-        for smooth_triangles in [false, true] {
+        let schemes: &[Scheme] = if (0..base.num_faces()).all(|f| base.face_size(f) == 3) {
+            &[Scheme::CatmullClark, Scheme::Loop]
+        } else {
+            &[Scheme::CatmullClark]
+        };
+        for (&scheme, smooth_triangles) in schemes.iter().flat_map(|s| [(s, false), (s, true)]) {
             let mut options = Options::from_hints(&file.mesh.hints);
             if smooth_triangles {
                 options.triangle_subdivision = subd_mesh::TriangleSubdivision::Smooth;
             }
             for levels in 2..=3 {
-                let r = Refinement::new(base, Scheme::CatmullClark, &options, levels).unwrap();
+                let r = Refinement::new(base, scheme, &options, levels).unwrap();
                 if r.has_topology(levels - 1) {
                     continue;
                 }
-                fused.push(format!("{name} L{levels}"));
+                fused.push(format!("{name} {scheme:?} L{levels}"));
                 let (edges, tags) = (r.num_edges(levels), r.explicit_tags(levels));
                 let points = r.refine_points(&file.mesh.positions);
                 assert!(
@@ -224,8 +229,7 @@ fn last_level_from_its_grandparent_equals_the_built_path() {
                 assert_eq!(points, built, "{name} L{levels} points");
                 // A refinement one level deeper builds level `levels` and derives its rules
                 // from the built level above.
-                let deeper =
-                    Refinement::new(base, Scheme::CatmullClark, &options, levels + 1).unwrap();
+                let deeper = Refinement::new(base, scheme, &options, levels + 1).unwrap();
                 assert!(deeper.has_topology(levels - 1));
                 assert_eq!(
                     r.vertex_rules(levels),
@@ -253,4 +257,8 @@ fn last_level_from_its_grandparent_equals_the_built_path() {
     // Closed smooth quad shapes exist among OpenSubdiv's, at level 2 from an all-quad base
     // and at level 3 from any closed smooth base.
     assert!(fused.len() >= 6, "fused cases: {fused:?}");
+    assert!(
+        fused.iter().any(|c| c.contains("Loop")),
+        "no Loop case: {fused:?}"
+    );
 }

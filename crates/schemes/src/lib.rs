@@ -208,9 +208,9 @@ struct Level {
 /// evaluates the masks level by level (any other primvar goes through the stencil tables,
 /// [`StencilTable::apply`]). Stencil tables and the last
 /// level's full topology (edges, rings, tags) are built on first request, so a refinement that
-/// only needs the final faces and positions does not pay for them. On a closed, smooth,
-/// all-quad Catmull-Clark mesh (no boundary, crease, corner, hole or non-manifold part — the
-/// bench torus, most character meshes after one level) the level before the last is not
+/// only needs the final faces and positions does not pay for them. On a closed, smooth
+/// mesh refined by Catmull-Clark (all quads, as every level after the first is) or Loop (no
+/// boundary, crease, corner, hole or non-manifold part) the level before the last is not
 /// built either: the last level's faces, rules and points are derived from the level two
 /// above, with the same results bit for bit ([`Self::has_topology`]).
 #[derive(Debug)]
@@ -312,20 +312,21 @@ impl Refinement {
             }
             let layout = refine::Layout::new(p, scheme);
             let rules = refine::child_rules(p, &r.levels[l - 1].rules, options, layout);
-            if l + 1 == levels
-                && scheme == Scheme::CatmullClark
-                && refine::fusion_applies(p, &r.levels[l - 1].rules)
-            {
-                // The last two levels of a closed smooth quad mesh: the last one straight
-                // from this parent, its own parent left unbuilt.
-                let (nv, nf, ne) = refine::fused_child_counts(p);
-                if 16 * nf as u64 + 4 * ne as u64 >= u32::MAX as u64 {
+            if l + 1 == levels && refine::fusion_applies(p, &r.levels[l - 1].rules, scheme) {
+                // The last two levels of a closed smooth mesh: the last one straight from
+                // this parent, its own parent left unbuilt.
+                let (nv, nf, ne) = refine::fused_child_counts(p, scheme);
+                // Face-vertices of the middle level: 4 per quad, 3 per triangle.
+                let size = if scheme == Scheme::Loop { 3 } else { 4 };
+                if 4 * (size * nf) as u64 + 4 * ne as u64 >= u32::MAX as u64 {
                     return Err(RefineError::TooLarge { level: levels });
                 }
-                let (offsets, vertices) = refine::grandchild_faces(p);
+                let (offsets, vertices) = refine::grandchild_faces(p, scheme);
+                // Children of the middle level's vertices, faces (quad split only), edges.
+                let num_vertices = nv + if scheme == Scheme::Loop { 0 } else { nf } + ne;
                 let num_faces = offsets.len() - 1;
                 let last = Level {
-                    num_vertices: nv + nf + ne,
+                    num_vertices,
                     topology: OnceLock::new(),
                     faces: Some(refine::ChildFaces {
                         offsets,
@@ -333,7 +334,7 @@ impl Refinement {
                         holes: memory::zeroed(num_faces),
                     }),
                     // Closed and smooth stays closed and smooth: no creases, no corners.
-                    rules: vec![Rule::Smooth; nv + nf + ne],
+                    rules: vec![Rule::Smooth; num_vertices],
                     from_grandparent: true,
                 };
                 r.levels.push(Level {
@@ -450,9 +451,7 @@ impl Refinement {
             return t.num_edges();
         }
         if self.levels[level].from_grandparent && !self.has_topology(level - 1) {
-            // Each quad of the closed parent has 4 interior child edges; each edge 2 halves.
-            let (_, nf, ne) = refine::fused_child_counts(self.topology(level - 2));
-            return 4 * nf + 2 * ne;
+            return refine::grandchild_num_edges(self.topology(level - 2), self.scheme);
         }
         // Only the last level can be unbuilt, and it is not the base level.
         let p = self.topology(level - 1);
@@ -517,7 +516,8 @@ impl Refinement {
     }
 
     /// Whether the full topology of `level` is built. The last level is built only on
-    /// request; so is the level before it on a closed, smooth, all-quad Catmull-Clark mesh,
+    /// request; so is the level before it on a closed, smooth Catmull-Clark (all-quad) or Loop
+    /// mesh,
     /// whose last level is then derived from the level two above (every result is the same
     /// as with the level built, bit for bit).
     ///
@@ -602,7 +602,7 @@ impl Refinement {
         for l in 1..self.levels.len() {
             let src = out.last().expect("level 0");
             let next = if self.levels[l].from_grandparent && !self.has_topology(l - 1) {
-                refine::grandchild_points(self.topology(l - 2), src)
+                refine::grandchild_points(self.topology(l - 2), self.scheme, src)
             } else {
                 self.step(l).points(src)
             };

@@ -1,34 +1,44 @@
-//! The last Catmull-Clark level built from its grandparent, skipping its parent's topology.
+//! The last Catmull-Clark or Loop level built from its grandparent, skipping its parent's
+//! topology.
 //!
-//! On a closed, smooth, all-quad level `G` (no boundary, no sharpness, no holes, no
-//! non-manifold or degenerate parts), the next level `M` is again closed, smooth and all
-//! quads, and every relation of `M` is a closed form of `G`'s: its faces are the rotated
-//! children of [`split::quad_child_vertices`], its edges the face-interior edges and edge
-//! halves of [`split`], and each vertex of `M` is a child of a vertex, face or edge of `G`
-//! with neighbours that `G`'s relations name directly. The level after `M` — faces, rules
-//! and points — therefore needs `G`'s topology and `M`'s points only. Building `M`'s full
-//! topology (edges, edge-faces, vertex-faces, vertex-edges: most of the memory and
-//! time of a uniform refinement) only to read it once is skipped; `M`'s topology is still
-//! built if anyone asks for it.
+//! On a closed, smooth level `G` of quads (Catmull-Clark) or triangles (Loop) — no
+//! boundary, no sharpness, no holes, no non-manifold or degenerate parts — the next level
+//! `M` is again closed, smooth and of the same face size, and every relation of `M` is a
+//! closed form of `G`'s: its faces are the children that [`split`] lists per parent face,
+//! its edges the face-interior edges and edge halves of the split, and each vertex of `M`
+//! is a child of a vertex, face or edge of `G` with neighbours that `G`'s relations name
+//! directly. The level after `M` — faces, rules and points — therefore needs `G`'s topology
+//! and `M`'s points only. Building `M`'s full topology (edges, edge-faces, vertex-faces,
+//! vertex-edges: most of the memory and time of a uniform refinement) only to read it once
+//! is skipped; `M`'s topology is still built if anyone asks for it.
 //!
 //! Every child is computed with the same operations in the same order as the general path
 //! ([`super::Step::points`] over `M`'s built topology), so the results are identical bit
-//! for bit; the relation orders below are those of [`split::quad_split`].
+//! for bit; the relation orders below are those of [`split::quad_split`] and
+//! [`split::tri_split`].
 
 use glam::DVec3;
 use rayon::prelude::*;
 use subd_mesh::Topology;
 
-use super::{CHUNK, split};
+use super::{CHUNK, loop_smooth_weights, split};
+use crate::Scheme;
 use crate::memory;
 use crate::rules::Rule;
 
-/// Whether the level after the child of `g` can be built from `g` directly: `g` is all
-/// quads, closed and manifold (every edge has two faces and two distinct ends, no vertex
-/// is non-manifold or isolated), has no sharpness and no holes, and every vertex is smooth.
-pub(crate) fn applies(g: &Topology, rules: &[Rule]) -> bool {
+/// Whether the level after the child of `g` can be built from `g` directly: the scheme is
+/// Catmull-Clark on an all-quad `g` or Loop (all triangles), and `g` is closed and
+/// manifold (every edge has two faces and two distinct ends, no vertex is non-manifold or
+/// isolated), has no sharpness and no holes, and every vertex is smooth.
+pub(crate) fn applies(g: &Topology, rules: &[Rule], scheme: Scheme) -> bool {
     let (nv, ne) = (g.num_vertices(), g.num_edges());
-    split::all_quads(g)
+    let faces = match scheme {
+        Scheme::CatmullClark => split::all_quads(g),
+        // Loop refines triangles only (checked before refining).
+        Scheme::Loop => true,
+        Scheme::Bilinear => false,
+    };
+    faces
         && !g.tags().holes().par_iter().any(|&h| h)
         && rules.par_iter().all(|&r| r == Rule::Smooth)
         && (0..ne).into_par_iter().with_min_len(CHUNK).all(|e| {
@@ -43,18 +53,46 @@ pub(crate) fn applies(g: &Topology, rules: &[Rule]) -> bool {
         })
 }
 
-/// Counts of the child `M` of a closed all-quad level `g`: (vertices, faces, edges).
-pub(crate) fn child_counts(g: &Topology) -> (usize, usize, usize) {
+/// Counts of the child `M` of a closed level `g` that [`applies`]: (vertices, faces,
+/// edges).
+pub(crate) fn child_counts(g: &Topology, scheme: Scheme) -> (usize, usize, usize) {
     let (nv, nf, ne) = (g.num_vertices(), g.num_faces(), g.num_edges());
-    (nv + nf + ne, 4 * nf, 4 * nf + 2 * ne)
+    match scheme {
+        Scheme::Loop => (nv + ne, 4 * nf, 3 * nf + 2 * ne),
+        _ => (nv + nf + ne, 4 * nf, 4 * nf + 2 * ne),
+    }
 }
 
-/// Face-vertex lists of the grandchildren of `g` (16 quads per face of `g`, in the order
+/// Number of edges of the grandchild of `g`: the interior edges of `M`'s faces (4 per
+/// quad, 3 per triangle) and two halves per edge of `M`.
+pub(crate) fn grandchild_num_edges(g: &Topology, scheme: Scheme) -> usize {
+    let (_, nf, ne) = child_counts(g, scheme);
+    let interior = if scheme == Scheme::Loop { 3 } else { 4 };
+    interior * nf + 2 * ne
+}
+
+/// Face offsets and face-vertex lists of the grandchild of `g`.
+pub(crate) fn grandchild_faces(g: &Topology, scheme: Scheme) -> (Vec<u32>, Vec<u32>) {
+    match scheme {
+        Scheme::Loop => grandchild_triangles(g),
+        _ => grandchild_quads(g),
+    }
+}
+
+/// Points of the grandchild of `g` from `src`, the points of its child `M`.
+pub(crate) fn grandchild_points(g: &Topology, scheme: Scheme, src: &[DVec3]) -> Vec<DVec3> {
+    match scheme {
+        Scheme::Loop => loop_grandchild_points(g, src),
+        _ => catmark_grandchild_points(g, src),
+    }
+}
+
+/// Face-vertex lists of the Catmull-Clark grandchildren of `g` (16 quads per face of `g`, in the order
 /// the split of the built child gives them): each child quad of `g` split again by the
 /// same rule, from its vertices and edges as [`split::quad_child_vertices`] and
 /// [`split::quad_child_edges`] list them.
-pub(crate) fn grandchild_faces(g: &Topology) -> (Vec<u32>, Vec<u32>) {
-    let (nv_m, nf_m, _) = child_counts(g);
+fn grandchild_quads(g: &Topology) -> (Vec<u32>, Vec<u32>) {
+    let (nv_m, nf_m, _) = child_counts(g, Scheme::CatmullClark);
     let (nv_m, nf_m) = (nv_m as u32, nf_m as u32);
     let vertices = split::per_face(g.num_faces(), |f| {
         let cv = split::quad_child_vertices(g, f);
@@ -74,11 +112,12 @@ pub(crate) fn grandchild_faces(g: &Topology) -> (Vec<u32>, Vec<u32>) {
     (split::uniform_offsets(16 * g.num_faces(), 4), vertices)
 }
 
-/// Points of the grandchild level of `g` from `src`, the points of its child `M`: face
-/// points of `M`'s faces first, then the smooth vertex and edge rules, which read them.
-pub(crate) fn grandchild_points(g: &Topology, src: &[DVec3]) -> Vec<DVec3> {
+/// Catmull-Clark points of the grandchild level of `g` from `src`, the points of its child
+/// `M`: face points of `M`'s faces first, then the smooth vertex and edge rules, which read
+/// them.
+fn catmark_grandchild_points(g: &Topology, src: &[DVec3]) -> Vec<DVec3> {
     let (nv, nf) = (g.num_vertices(), g.num_faces());
-    let (nv_m, nf_m, ne_m) = child_counts(g);
+    let (nv_m, nf_m, ne_m) = child_counts(g, Scheme::CatmullClark);
     assert_eq!(src.len(), nv_m, "one point per vertex of the child level");
     let nh = 4 * nf;
     let face_point = |f: usize| (nv + f) as u32;
@@ -179,6 +218,117 @@ pub(crate) fn grandchild_points(g: &Topology, src: &[DVec3]) -> Vec<DVec3> {
             acc += 0.25 * src[b as usize];
             acc += 0.25 * face_points[f0];
             acc += 0.25 * face_points[f1];
+            acc
+        },
+    )
+}
+
+/// Face-vertex lists of the Loop grandchildren of `g` (16 triangles per triangle of `g`):
+/// each child triangle split again by [`split::tri_child_vertices`]'s rule, from its
+/// vertices and edges as [`split::tri_child_vertices`] and [`split::tri_child_edges`] list
+/// them.
+fn grandchild_triangles(g: &Topology) -> (Vec<u32>, Vec<u32>) {
+    let (nv_m, _, _) = child_counts(g, Scheme::Loop);
+    let nv_m = nv_m as u32;
+    let vertices = split::per_face(g.num_faces(), |f| {
+        let cv = split::tri_child_vertices(g, f);
+        let ce = split::tri_child_edges(g, f);
+        let mut out = [0u32; 48];
+        for k in 0..4 {
+            let v = &cv[3 * k..3 * k + 3];
+            let [e0, e1, e2] = [0, 1, 2].map(|j| nv_m + ce[3 * k + j]);
+            out[12 * k..12 * k + 12]
+                .copy_from_slice(&[v[0], e0, e2, e0, v[1], e1, e2, e1, v[2], e1, e2, e0]);
+        }
+        out
+    });
+    (split::uniform_offsets(16 * g.num_faces(), 3), vertices)
+}
+
+/// Loop points of the grandchild level of `g` from `src`, the points of its child `M`:
+/// the smooth vertex rule of every vertex of `M`, then the smooth edge rule of every edge.
+fn loop_grandchild_points(g: &Topology, src: &[DVec3]) -> Vec<DVec3> {
+    let (nv, nf) = (g.num_vertices(), g.num_faces());
+    let (nv_m, _, ne_m) = child_counts(g, Scheme::Loop);
+    assert_eq!(src.len(), nv_m, "one point per vertex of the child level");
+    let edge_point = |e: usize| nv + e;
+    let third = |f: usize, k: usize| edge_point(g.face_edges(f)[k % 3] as usize);
+    let interior = 3 * nf;
+    memory::build_around(
+        nv_m + ne_m,
+        0..0,
+        CHUNK,
+        |_| DVec3::ZERO,
+        |r, _| {
+            if r < nv_m {
+                let mut acc = DVec3::ZERO;
+                return if r < nv {
+                    // Child of vertex `v`: the halves of its edges end at the edge points.
+                    let (ew, vw) = loop_smooth_weights(g.vertex_faces(r).len());
+                    for &e in g.vertex_edges(r) {
+                        acc += ew * src[edge_point(e as usize)];
+                    }
+                    acc + vw * src[r]
+                } else {
+                    // Child of edge `E` (six faces, valence 6): the far ends of its halves
+                    // and of the interior edges of each adjacent face, in the split's order.
+                    let e = r - nv;
+                    let ev = g.edge_vertices(e);
+                    let ef = g.edge_faces(e);
+                    let el = g.edge_face_local_indices(e);
+                    let (f0, l0) = (ef[0] as usize, el[0] as usize);
+                    let rev = usize::from(g.face_vertices(f0)[l0] != ev[0]);
+                    let (ew, vw) = loop_smooth_weights(6);
+                    let ring = [
+                        ev[1 - rev] as usize,
+                        third(f0, l0 + 1),
+                        third(f0, l0 + 2),
+                        ev[rev] as usize,
+                        third(ef[1] as usize, el[1] as usize + 1),
+                        third(ef[1] as usize, el[1] as usize + 2),
+                    ];
+                    for o in ring {
+                        acc += ew * src[o];
+                    }
+                    acc + vw * src[r]
+                };
+            }
+            // Edge points of `M`'s edges: the three interior edges of each triangle of `g`
+            // (edge `j` from `E_j` to `E_{j+2}`, between corner `j` and the middle child),
+            // then the two halves of each edge of `g`. The far vertex of each adjacent child
+            // triangle sits before the edge's position in it.
+            let e = r - nv_m;
+            let (a, b, o0, o1) = if e < interior {
+                let (f, j) = (e / 3, e % 3);
+                (
+                    third(f, j),
+                    third(f, j + 2),
+                    g.face_vertices(f)[j] as usize,
+                    third(f, j + 1),
+                )
+            } else {
+                let (pe, k) = ((e - interior) / 2, (e - interior) % 2);
+                let end = g.edge_vertices(pe)[k];
+                let ef = g.edge_faces(pe);
+                let el = g.edge_face_local_indices(pe);
+                // The half lies in corner child `m` of each adjacent parent face, at the
+                // parent edge's local index `l`: `m = l` at the edge's start corner, with far
+                // vertex `E_{l-1}`, else `m = l + 1`, with far vertex `E_{l+1}`.
+                let far = |i: usize| {
+                    let (pf, l) = (ef[i] as usize, el[i] as usize);
+                    if g.face_vertices(pf)[l] == end {
+                        third(pf, l + 2)
+                    } else {
+                        third(pf, l + 1)
+                    }
+                };
+                (edge_point(pe), end as usize, far(0), far(1))
+            };
+            let mut acc = DVec3::ZERO;
+            acc += 0.375 * src[a];
+            acc += 0.375 * src[b];
+            acc += 0.125 * src[o0];
+            acc += 0.125 * src[o1];
             acc
         },
     )

@@ -9,7 +9,7 @@ mod split;
 
 pub(crate) use fused::{
     applies as fusion_applies, child_counts as fused_child_counts, grandchild_faces,
-    grandchild_points,
+    grandchild_num_edges, grandchild_points,
 };
 
 use glam::DVec3;

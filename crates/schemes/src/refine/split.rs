@@ -168,14 +168,46 @@ pub(crate) fn quad_faces(p: &Topology) -> (Vec<u32>, Vec<u32>) {
 
 /// Face offsets and face-vertices of the triangle split alone.
 pub(crate) fn tri_faces(p: &Topology) -> (Vec<u32>, Vec<u32>) {
-    let (nv, nf) = (p.num_vertices() as u32, p.num_faces());
-    let face_vertices = per_face(nf, |f| {
-        let v = p.face_vertices(f);
-        let e = p.face_edges(f);
-        let (e0, e1, e2) = (nv + e[0], nv + e[1], nv + e[2]);
-        [v[0], e0, e2, e0, v[1], e1, e2, e1, v[2], e1, e2, e0]
-    });
-    (uniform_offsets(4 * nf, 3), face_vertices)
+    let face_vertices = per_face(p.num_faces(), |f| tri_child_vertices(p, f));
+    (uniform_offsets(4 * p.num_faces(), 3), face_vertices)
+}
+
+/// The four child triangles of parent triangle `f`: the corners `(V0, E0, E2)`,
+/// `(E0, V1, E1)`, `(E2, E1, V2)`, then the middle `(E1, E2, E0)`.
+#[inline]
+pub(super) fn tri_child_vertices(p: &Topology, f: usize) -> [u32; 12] {
+    let nv = p.num_vertices() as u32;
+    let v = p.face_vertices(f);
+    let e = p.face_edges(f);
+    let (e0, e1, e2) = (nv + e[0], nv + e[1], nv + e[2]);
+    [v[0], e0, e2, e0, v[1], e1, e2, e1, v[2], e1, e2, e0]
+}
+
+/// The edges of the four child triangles of parent triangle `f`, in the order of
+/// [`tri_child_vertices`] (edge `k` of a child joins its vertices `k` and `k + 1`).
+#[inline]
+pub(super) fn tri_child_edges(p: &Topology, f: usize) -> [u32; 12] {
+    let hb = 3 * p.num_faces() as u32;
+    let v = p.face_vertices(f);
+    let e = p.face_edges(f);
+    let i = 3 * f as u32;
+    // S_k: the half of edge k at its start corner; T_k: at its end corner.
+    let s = |k: usize| hb + half(e[k], end_at(p, e[k], v[k], true));
+    let t = |k: usize| hb + half(e[k], end_at(p, e[k], v[(k + 1) % 3], false));
+    [
+        s(0),
+        i,
+        t(2),
+        t(0),
+        s(1),
+        i + 1,
+        i + 2,
+        t(1),
+        s(2),
+        i + 2,
+        i,
+        i + 1,
+    ]
 }
 
 /// Offsets of `faces` faces of `size` vertices each.
@@ -593,28 +625,7 @@ pub(crate) fn tri_split(p: &Topology) -> TopologyParts {
     let edge_point = |e: usize| (nv + e) as u32;
     let hb = 3 * nf as u32;
     let (face_offsets, face_vertices) = tri_faces(p);
-    let face_edges = per_face(nf, |f| {
-        let v = p.face_vertices(f);
-        let e = p.face_edges(f);
-        let i = 3 * f as u32;
-        // S_k: the half of edge k at its start corner; T_k: at its end corner.
-        let s = |k: usize| hb + half(e[k], end_at(p, e[k], v[k], true));
-        let t = |k: usize| hb + half(e[k], end_at(p, e[k], v[(k + 1) % 3], false));
-        [
-            s(0),
-            i,
-            t(2),
-            t(0),
-            s(1),
-            i + 1,
-            i + 2,
-            t(1),
-            s(2),
-            i + 2,
-            i,
-            i + 1,
-        ]
-    });
+    let face_edges = per_face(nf, |f| tri_child_edges(p, f));
 
     let mut edge_vertices = memory::zeroed::<[u32; 2]>(3 * nf + 2 * ne);
     {
