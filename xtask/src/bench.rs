@@ -84,8 +84,9 @@ pub(crate) fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
-/// The subd side, run in a child process: refine `mesh` to `levels` with `threads` threads,
-/// `repeats` times, and print one JSON line.
+/// The subd side, run in a child process: from `mesh`'s face lists, build the base topology
+/// and refine it to `levels` with `threads` threads, `repeats` times, and print one JSON
+/// line.
 pub fn run_subd(
     mesh: &Path,
     scheme: Scheme,
@@ -99,13 +100,23 @@ pub fn run_subd(
         .num_threads(threads)
         .build()
         .map_err(|e| e.to_string())?;
-    let (topo, pos) = (&file.mesh.topology, &file.mesh.positions);
+    let (base, pos) = (&file.mesh.topology, &file.mesh.positions);
+    // The face lists as OpenSubdiv's side gets them: its timing starts with
+    // `TopologyRefinerFactory::Create`, which builds the base topology from them, so this
+    // side's starts with `TopologyBuilder::build`.
+    let sizes: Vec<u32> = (0..base.num_faces())
+        .map(|f| base.face_size(f) as u32)
+        .collect();
+    let indices = base.all_face_vertices().to_vec();
     let (mut total, mut refine, mut points) = (Vec::new(), Vec::new(), Vec::new());
     let mut check = 0.0;
     for _ in 0..repeats {
         pool.install(|| {
             let t0 = Instant::now();
-            let r = Refinement::new(topo, scheme, &Options::default(), levels).expect("refine");
+            let topo = TopologyBuilder::new(base.num_vertices())
+                .build(&sizes, &indices)
+                .expect("valid base");
+            let r = Refinement::new(&topo, scheme, &Options::default(), levels).expect("refine");
             let t1 = Instant::now();
             let p = r.refine_points(pos);
             let t2 = Instant::now();
