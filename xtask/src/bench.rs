@@ -107,14 +107,13 @@ pub fn run_subd(
     let sizes: Vec<u32> = (0..base.num_faces())
         .map(|f| base.face_size(f) as u32)
         .collect();
-    let indices = base.all_face_vertices().to_vec();
     let (mut total, mut refine, mut points) = (Vec::new(), Vec::new(), Vec::new());
     let mut check = 0.0;
     for _ in 0..repeats {
         pool.install(|| {
             let t0 = Instant::now();
             let topo = TopologyBuilder::new(base.num_vertices())
-                .build(&sizes, &indices)
+                .build(&sizes, base.all_face_vertices())
                 .expect("valid base");
             let r = Refinement::new(&topo, scheme, &Options::default(), levels).expect("refine");
             let t1 = Instant::now();

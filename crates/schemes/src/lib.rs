@@ -188,7 +188,8 @@ pub enum RefineError {
 #[derive(Debug)]
 struct Level {
     /// Full topology with tags; built eagerly below the last level (the next level needs it),
-    /// on first request for the last and for a level whose child comes from its parent.
+    /// on first request for the last, and for the level before it when the last comes from
+    /// its grandparent.
     topology: OnceLock<Topology>,
     /// Face lists of the last level, available without building its full topology.
     faces: Option<refine::ChildFaces>,
@@ -315,15 +316,11 @@ impl Refinement {
             if l + 1 == levels && refine::fusion_applies(p, &r.levels[l - 1].rules, scheme) {
                 // The last two levels of a closed smooth mesh: the last one straight from
                 // this parent, its own parent left unbuilt.
-                let (nv, nf, ne) = refine::fused_child_counts(p, scheme);
-                // Face-vertices of the middle level: 4 per quad, 3 per triangle.
-                let size = if scheme == Scheme::Loop { 3 } else { 4 };
-                if 4 * (size * nf) as u64 + 4 * ne as u64 >= u32::MAX as u64 {
+                if refine::fused_child_too_large(p, scheme) {
                     return Err(RefineError::TooLarge { level: levels });
                 }
                 let (offsets, vertices) = refine::grandchild_faces(p, scheme);
-                // Children of the middle level's vertices, faces (quad split only), edges.
-                let num_vertices = nv + if scheme == Scheme::Loop { 0 } else { nf } + ne;
+                let num_vertices = refine::grandchild_num_vertices(p, scheme);
                 let num_faces = offsets.len() - 1;
                 let last = Level {
                     num_vertices,
@@ -517,9 +514,8 @@ impl Refinement {
 
     /// Whether the full topology of `level` is built. The last level is built only on
     /// request; so is the level before it on a closed, smooth Catmull-Clark (all-quad) or Loop
-    /// mesh,
-    /// whose last level is then derived from the level two above (every result is the same
-    /// as with the level built, bit for bit).
+    /// mesh, whose last level is then derived from the level two above (every result is the
+    /// same as with the level built, bit for bit).
     ///
     /// ```
     /// use subd_mesh::TopologyBuilder;

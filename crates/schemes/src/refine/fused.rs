@@ -53,9 +53,14 @@ pub(crate) fn applies(g: &Topology, rules: &[Rule], scheme: Scheme) -> bool {
         })
 }
 
+/// Face size of every level that [`applies`] accepts, and of its children.
+fn face_size(scheme: Scheme) -> usize {
+    if scheme == Scheme::Loop { 3 } else { 4 }
+}
+
 /// Counts of the child `M` of a closed level `g` that [`applies`]: (vertices, faces,
 /// edges).
-pub(crate) fn child_counts(g: &Topology, scheme: Scheme) -> (usize, usize, usize) {
+fn child_counts(g: &Topology, scheme: Scheme) -> (usize, usize, usize) {
     let (nv, nf, ne) = (g.num_vertices(), g.num_faces(), g.num_edges());
     match scheme {
         Scheme::Loop => (nv + ne, 4 * nf, 3 * nf + 2 * ne),
@@ -63,12 +68,25 @@ pub(crate) fn child_counts(g: &Topology, scheme: Scheme) -> (usize, usize, usize
     }
 }
 
-/// Number of edges of the grandchild of `g`: the interior edges of `M`'s faces (4 per
-/// quad, 3 per triangle) and two halves per edge of `M`.
+/// Whether `M` is too large to refine: the bound `Refinement::new` puts on every parent
+/// level (its child's face-vertices and edges must stay below `u32::MAX`).
+pub(crate) fn child_too_large(g: &Topology, scheme: Scheme) -> bool {
+    let (_, nf, ne) = child_counts(g, scheme);
+    4 * (face_size(scheme) * nf) as u64 + 4 * ne as u64 >= u32::MAX as u64
+}
+
+/// Number of vertices of the grandchild of `g`: children of `M`'s vertices, faces (quad
+/// split only) and edges.
+pub(crate) fn grandchild_num_vertices(g: &Topology, scheme: Scheme) -> usize {
+    let (nv, nf, ne) = child_counts(g, scheme);
+    nv + if scheme == Scheme::Loop { 0 } else { nf } + ne
+}
+
+/// Number of edges of the grandchild of `g`: the interior edges of `M`'s faces (one per
+/// face-vertex) and two halves per edge of `M`.
 pub(crate) fn grandchild_num_edges(g: &Topology, scheme: Scheme) -> usize {
     let (_, nf, ne) = child_counts(g, scheme);
-    let interior = if scheme == Scheme::Loop { 3 } else { 4 };
-    interior * nf + 2 * ne
+    face_size(scheme) * nf + 2 * ne
 }
 
 /// Face offsets and face-vertex lists of the grandchild of `g`.

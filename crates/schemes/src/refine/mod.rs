@@ -8,8 +8,8 @@ mod par;
 mod split;
 
 pub(crate) use fused::{
-    applies as fusion_applies, child_counts as fused_child_counts, grandchild_faces,
-    grandchild_num_edges, grandchild_points,
+    applies as fusion_applies, child_too_large as fused_child_too_large, grandchild_faces,
+    grandchild_num_edges, grandchild_num_vertices, grandchild_points,
 };
 
 use glam::DVec3;
