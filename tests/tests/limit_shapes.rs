@@ -264,3 +264,45 @@ fn large_mesh_with_a_semi_sharp_crease_gets_exact_limits() {
     assert!((limit.positions[on] - plain.positions[on]).length() > 1e-6);
     assert!(limit.positions.iter().all(|p| p.is_finite()));
 }
+
+/// The positions-only tables ([`subd_limit::base_limit_positions`],
+/// [`subd_limit::two_phase_base_limit_positions`]) are the position tables of the full ones,
+/// row for row and bit for bit, on every shape (two-phase on the all-quad ones, with a
+/// `λ` that varies by vertex).
+#[test]
+fn positions_alone_equal_the_full_tables() {
+    let (mut checked, mut two_phase) = (0, 0);
+    for s in shapes() {
+        let t = &s.mesh.topology;
+        // Deep semi-sharp decay only repeats the same composition at more levels.
+        if levels_for_exact_limit(t, s.scheme).0 > 2 {
+            continue;
+        }
+        let full = match base_limit(t, s.scheme, &s.options) {
+            Ok(f) => f,
+            Err(LimitError::TooDeep { .. }) => continue,
+            Err(e) => panic!("{}: {e}", s.name),
+        };
+        let positions = subd_limit::base_limit_positions(t, s.scheme, &s.options).unwrap();
+        assert_eq!(positions, full.position, "{}", s.name);
+        checked += 1;
+        if s.scheme == Scheme::CatmullClark && (0..t.num_faces()).all(|f| t.face_size(f) == 4) {
+            let lambda: Vec<f64> = (0..t.num_vertices())
+                .map(|v| 0.4 + 0.6 * ((v * 7) % 10) as f64 / 10.0)
+                .collect();
+            let tp = subd_schemes::TwoPhase::new(lambda).unwrap();
+            let full = match subd_limit::two_phase_base_limit(t, &tp, &s.options) {
+                Ok(f) => f,
+                Err(LimitError::TooDeep { .. }) => continue,
+                Err(e) => panic!("{} two-phase: {e}", s.name),
+            };
+            let positions = subd_limit::two_phase_base_limit_positions(t, &tp, &s.options).unwrap();
+            assert_eq!(positions, full.position, "{} two-phase", s.name);
+            two_phase += 1;
+        }
+    }
+    assert!(
+        checked >= 40 && two_phase >= 10,
+        "{checked} shapes, {two_phase} two-phase"
+    );
+}

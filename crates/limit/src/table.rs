@@ -4,6 +4,7 @@ use std::collections::HashMap;
 use std::collections::hash_map::Entry;
 
 use glam::DVec3;
+use rayon::prelude::*;
 use subd_mesh::Topology;
 use subd_mesh::tags::is_infinite;
 use subd_schemes::{Refinement, RowSink, Rule, Scheme, StencilTable, rules};
@@ -137,17 +138,18 @@ fn rotated(m: &RingMask, k: usize) -> RingMask {
     }
 }
 
-impl LimitStencilTable {
-    /// Limit masks of every vertex of `level` of `refinement`, in terms of the vertices of
-    /// that level. Each vertex takes the mask of its rule at that level, as OpenSubdiv's
-    /// `PrimvarRefiner::Limit` does (so semi-sharp features still present at that level count
-    /// as sharp), except where OpenSubdiv is not exact: an interior Catmull-Clark vertex of
-    /// valence 2 and a dart on an infinitely sharp edge get their true limit, from the eigen
-    /// analysis of their local subdivision matrix ([`crate::eigen`]).
-    ///
-    /// Catmull-Clark needs quads at that level (any level ≥ 1 is all quads); Bilinear has no
-    /// limit masks.
-    pub fn at_level(refinement: &Refinement, level: usize) -> Result<Self, LimitError> {
+/// The limit mask of every vertex of one level: masks depend only on the vertex's case and
+/// its edge and face counts, so each distinct one is built once and vertices point at it
+/// (filling the rows then allocates and hashes nothing per vertex).
+struct LevelMasks<'a> {
+    topology: &'a Topology,
+    library: Vec<LimitMask>,
+    /// Index into `library` per vertex.
+    mask: Vec<u32>,
+}
+
+impl<'a> LevelMasks<'a> {
+    fn new(refinement: &'a Refinement, level: usize) -> Result<LevelMasks<'a>, LimitError> {
         let scheme = refinement.scheme();
         if scheme == Scheme::Bilinear {
             return Err(LimitError::Scheme);
@@ -163,61 +165,120 @@ impl LimitStencilTable {
             });
         }
         let rules = refinement.vertex_rules(level);
-        let cases: Vec<VertexCase> = (0..t.num_vertices())
-            .map(|v| classify(t, v, rules[v], scheme))
+        let keys: Vec<(VertexCase, usize, usize)> = (0..t.num_vertices())
+            .into_par_iter()
+            .with_min_len(4096)
+            .map(|v| {
+                (
+                    classify(t, v, rules[v], scheme),
+                    t.vertex_edges(v).len(),
+                    t.vertex_faces(v).len(),
+                )
+            })
             .collect();
-        // Masks depend only on the vertex's case and its edge and face counts: build each
-        // distinct one once, so filling the rows allocates nothing per vertex.
-        let key = |v: usize| (cases[v], t.vertex_edges(v).len(), t.vertex_faces(v).len());
-        let mut library: HashMap<(VertexCase, usize, usize), LimitMask> = HashMap::new();
+        let mut index: HashMap<(VertexCase, usize, usize), u32> = HashMap::new();
         let mut numeric: HashMap<(RingFeature, usize), LimitMask> = HashMap::new();
-        for v in 0..t.num_vertices() {
-            let k = key(v);
-            if library.contains_key(&k) {
+        let mut library = Vec::new();
+        let mut mask = Vec::with_capacity(keys.len());
+        let mut last: Option<((VertexCase, usize, usize), u32)> = None;
+        for &k in &keys {
+            // Neighbouring vertices mostly share a case: skip the hash then.
+            if let Some((lk, li)) = last
+                && lk == k
+            {
+                mask.push(li);
                 continue;
             }
-            let (case, ne, nf) = k;
-            let m = match case {
-                VertexCase::Isolated => masks::corner(0, 0, 0.0),
-                VertexCase::Corner => {
-                    masks::corner(ne, nf, if scheme == Scheme::Loop { 3.0 } else { 1.0 })
-                }
-                VertexCase::Crease(a, b) => match scheme {
-                    Scheme::Loop => masks::loop_crease(ne, (a, b)),
-                    _ => masks::catmark_crease(ne, nf, (a, b)),
-                },
-                VertexCase::Smooth => match scheme {
-                    Scheme::Loop => masks::loop_smooth(nf),
-                    _ => masks::catmark_smooth(nf),
-                },
-                VertexCase::Numeric(feature, rot) => {
-                    let m = match numeric.entry((feature, nf)) {
-                        Entry::Occupied(e) => e.into_mut(),
-                        Entry::Vacant(e) => e.insert(ring_limit_mask(scheme, nf, feature)?),
-                    };
-                    LimitMask {
-                        position: rotated(&m.position, rot),
-                        tangent1: rotated(&m.tangent1, rot),
-                        tangent2: rotated(&m.tangent2, rot),
-                    }
+            let id = match index.entry(k) {
+                Entry::Occupied(e) => *e.get(),
+                Entry::Vacant(e) => {
+                    let (case, ne, nf) = k;
+                    library.push(case_mask(scheme, case, ne, nf, &mut numeric)?);
+                    *e.insert((library.len() - 1) as u32)
                 }
             };
-            library.insert(k, m);
+            last = Some((k, id));
+            mask.push(id);
         }
-        let mask_of = |v: usize, which: usize| -> &RingMask {
-            let m = &library[&key(v)];
-            [&m.position, &m.tangent1, &m.tangent2][which]
-        };
-        let table = |which: usize| {
-            StencilTable::build(t.num_vertices(), t.num_vertices(), |v, sink| {
-                emit(t, v, mask_of(v, which), sink)
-            })
-        };
-        Ok(LimitStencilTable {
-            position: table(0),
-            tangent1: table(1),
-            tangent2: table(2),
+        Ok(LevelMasks {
+            topology: t,
+            library,
+            mask,
         })
+    }
+
+    /// The table of one of the masks (`which` picks position or a tangent).
+    fn table(&self, which: impl Fn(&LimitMask) -> &RingMask + Sync) -> StencilTable {
+        let t = self.topology;
+        StencilTable::build(t.num_vertices(), t.num_vertices(), |v, sink| {
+            emit(t, v, which(&self.library[self.mask[v] as usize]), sink)
+        })
+    }
+}
+
+/// The limit mask of a vertex case with `ne` edges and `nf` faces (numeric masks are shared
+/// between rotations through `numeric`).
+fn case_mask(
+    scheme: Scheme,
+    case: VertexCase,
+    ne: usize,
+    nf: usize,
+    numeric: &mut HashMap<(RingFeature, usize), LimitMask>,
+) -> Result<LimitMask, LimitError> {
+    Ok(match case {
+        VertexCase::Isolated => masks::corner(0, 0, 0.0),
+        VertexCase::Corner => masks::corner(ne, nf, if scheme == Scheme::Loop { 3.0 } else { 1.0 }),
+        VertexCase::Crease(a, b) => match scheme {
+            Scheme::Loop => masks::loop_crease(ne, (a, b)),
+            _ => masks::catmark_crease(ne, nf, (a, b)),
+        },
+        VertexCase::Smooth => match scheme {
+            Scheme::Loop => masks::loop_smooth(nf),
+            _ => masks::catmark_smooth(nf),
+        },
+        VertexCase::Numeric(feature, rot) => {
+            let m = match numeric.entry((feature, nf)) {
+                Entry::Occupied(e) => e.into_mut(),
+                Entry::Vacant(e) => e.insert(ring_limit_mask(scheme, nf, feature)?),
+            };
+            LimitMask {
+                position: rotated(&m.position, rot),
+                tangent1: rotated(&m.tangent1, rot),
+                tangent2: rotated(&m.tangent2, rot),
+            }
+        }
+    })
+}
+
+impl LimitStencilTable {
+    /// Limit masks of every vertex of `level` of `refinement`, in terms of the vertices of
+    /// that level. Each vertex takes the mask of its rule at that level, as OpenSubdiv's
+    /// `PrimvarRefiner::Limit` does (so semi-sharp features still present at that level count
+    /// as sharp), except where OpenSubdiv is not exact: an interior Catmull-Clark vertex of
+    /// valence 2 and a dart on an infinitely sharp edge get their true limit, from the eigen
+    /// analysis of their local subdivision matrix ([`crate::eigen`]).
+    ///
+    /// Catmull-Clark needs quads at that level (any level ≥ 1 is all quads); Bilinear has no
+    /// limit masks.
+    pub fn at_level(refinement: &Refinement, level: usize) -> Result<Self, LimitError> {
+        let masks = LevelMasks::new(refinement, level)?;
+        Ok(LimitStencilTable {
+            position: masks.table(|m| &m.position),
+            tangent1: masks.table(|m| &m.tangent1),
+            tangent2: masks.table(|m| &m.tangent2),
+        })
+    }
+
+    /// The limit positions of [`LimitStencilTable::at_level`] alone (same rows, bit for
+    /// bit), for callers that need no tangents, such as interpolation: a third of the work.
+    ///
+    /// # Errors
+    /// As [`LimitStencilTable::at_level`].
+    pub fn positions_at_level(
+        refinement: &Refinement,
+        level: usize,
+    ) -> Result<StencilTable, LimitError> {
+        Ok(LevelMasks::new(refinement, level)?.table(|m| &m.position))
     }
 
     /// Number of rows (vertices).

@@ -47,7 +47,7 @@ mod checkerboard;
 mod solvers;
 mod system;
 
-use std::sync::{Arc, OnceLock};
+use std::sync::Arc;
 
 use glam::DVec3;
 use subd_limit::LimitError;
@@ -183,22 +183,22 @@ pub struct PiaResult {
 }
 
 /// A PIA problem: the limit-position matrix of a scheme on one mesh, ready to interpolate
-/// any targets. The first solve also prepares the matrix for the solvers (rounding noise
-/// dropped, rows sorted) and, when a Krylov solver runs, finds its symmetric form; both are
-/// kept, so later solves on the same `Pia` (other targets, other moving sets) start at once.
+/// any targets. It holds the matrix in the form every solver reads (rounding noise of
+/// stencil composition dropped, rows sorted); the first solve that needs more (the symmetric
+/// form for the Krylov and direct solvers, the Chebyshev operator) builds it and keeps it,
+/// so later solves on the same `Pia` (other targets, other moving sets) start at once.
 #[derive(Debug, Clone)]
 pub struct Pia {
     limit: StencilTable,
-    /// Checkerboard signs for the preconditioned CG (Catmull-Clark family, two-coloured
-    /// vertex graph).
-    signs: Option<Arc<Vec<f64>>>,
-    /// The limit matrix in the solvers' form, built on the first solve and kept.
-    full: OnceLock<Arc<FullSystem>>,
+    /// The limit matrix in the solvers' form, with the checkerboard signs for the
+    /// preconditioned solvers (Catmull-Clark family, two-coloured vertex graph).
+    full: Arc<FullSystem>,
 }
 
 impl Pia {
-    /// The limit matrix of `scheme` on `topology` (exact limit stencils of
-    /// [`subd_limit::base_limit`] / [`subd_limit::two_phase_base_limit`]).
+    /// The limit matrix of `scheme` on `topology` (the exact limit-position stencils of
+    /// [`subd_limit::base_limit_positions`] / [`subd_limit::two_phase_base_limit_positions`]),
+    /// in the solvers' form.
     ///
     /// # Errors
     /// [`PiaError::Limit`] when the scheme does not apply (Loop on a non-triangle,
@@ -210,17 +210,19 @@ impl Pia {
     ) -> Result<Pia, PiaError> {
         let table = match scheme {
             PiaScheme::CatmullClark => {
-                subd_limit::base_limit(topology, Scheme::CatmullClark, options)?
+                subd_limit::base_limit_positions(topology, Scheme::CatmullClark, options)?
             }
-            PiaScheme::Loop => subd_limit::base_limit(topology, Scheme::Loop, options)?,
-            PiaScheme::TwoPhase(tp) => subd_limit::two_phase_base_limit(topology, tp, options)?,
+            PiaScheme::Loop => subd_limit::base_limit_positions(topology, Scheme::Loop, options)?,
+            PiaScheme::TwoPhase(tp) => {
+                subd_limit::two_phase_base_limit_positions(topology, tp, options)?
+            }
         };
-        let mut pia = Pia::from_limit_table(table.position);
         // Loop's mask has no checkerboard structure (and triangles no two-colouring).
-        if !matches!(scheme, PiaScheme::Loop) {
-            pia.signs = checkerboard::checkerboard_signs(topology).map(Arc::new);
-        }
-        Ok(pia)
+        let signs = match scheme {
+            PiaScheme::Loop => None,
+            _ => checkerboard::checkerboard_signs(topology).map(Arc::new),
+        };
+        Ok(Pia::with_signs(table, signs))
     }
 
     /// A problem from any square limit-position table (row `i`: the limit of vertex `i`).
@@ -228,16 +230,17 @@ impl Pia {
     /// # Panics
     /// If the table is not square.
     pub fn from_limit_table(limit: StencilTable) -> Pia {
+        Pia::with_signs(limit, None)
+    }
+
+    fn with_signs(limit: StencilTable, signs: Option<Arc<Vec<f64>>>) -> Pia {
         assert_eq!(
             limit.num_rows(),
             limit.num_sources(),
             "a square limit table"
         );
-        Pia {
-            limit,
-            signs: None,
-            full: OnceLock::new(),
-        }
+        let full = Arc::new(FullSystem::new(&limit, signs));
+        Pia { limit, full }
     }
 
     /// The limit-position table `B`.
@@ -293,19 +296,15 @@ impl Pia {
     }
 
     /// Builds now what the solvers of a global solve (every vertex moving) keep for later
-    /// solves: the limit matrix in the solvers' form, its symmetric form and, for the
-    /// Catmull-Clark family on a two-coloured closed quad mesh, the checkerboard operator
-    /// of [`Solver::Chebyshev`] with its spectral interval. A prepared `Pia` solves with
-    /// Chebyshev under [`Solver::Auto`] (an unprepared one with CG, which needs nothing
-    /// built): for interactive editing or animation, where one mesh is solved many times.
+    /// solves: the symmetric form of the limit matrix and, for the Catmull-Clark family on
+    /// a two-coloured closed quad mesh, the checkerboard operator of [`Solver::Chebyshev`]
+    /// with its spectral interval. A prepared `Pia` solves with Chebyshev under
+    /// [`Solver::Auto`] (an unprepared one with checkerboard CG, which needs only the
+    /// symmetric form): for interactive editing or animation, where one mesh is solved many
+    /// times.
     /// Returns whether the Chebyshev operator is available.
     pub fn prepare(&self) -> bool {
-        self.full_system().preconditioned().is_some()
-    }
-
-    fn full_system(&self) -> &Arc<FullSystem> {
-        self.full
-            .get_or_init(|| Arc::new(FullSystem::new(&self.limit, self.signs.clone())))
+        self.full.preconditioned().is_some()
     }
 
     /// `M̄ = B[P, P]` as a dense matrix, for analysis of small meshes (spectral radius of
@@ -353,11 +352,7 @@ impl Pia {
             return Err(PiaError::NotFinite(v));
         }
         let flags = moving.flags(n)?;
-        Ok(ReducedSystem::from_full(
-            self.full_system(),
-            targets,
-            &flags,
-        ))
+        Ok(ReducedSystem::from_full(&self.full, targets, &flags))
     }
 }
 

@@ -469,25 +469,40 @@ impl Matrix {
         self.propagated_symmetrizer()
     }
 
-    /// Whether `C⁻¹ M̄` is symmetric (relative 1e-11) with a positive diagonal.
+    /// Whether `C⁻¹ M̄` is symmetric (relative 1e-11) with a positive diagonal. Each entry
+    /// above the diagonal is matched with its transpose (rows are sorted, so a binary
+    /// search); equal counts above and below then leave no unmatched entry below.
     fn symmetrizes(&self, c: &[f64]) -> bool {
-        (0..self.len())
+        let counts = (0..self.len())
             .into_par_iter()
             .with_min_len(CHUNK)
-            .all(|i| {
+            .map(|i| {
                 let (cols, w) = self.row(i);
-                positive(self.diag[i])
-                    && cols.iter().zip(w).all(|(&j, &mij)| {
-                        let (cj, wj) = self.row(j as usize);
-                        match cj.binary_search(&(i as u32)) {
-                            Ok(k) => {
-                                let (a, b) = (mij / c[i], wj[k] / c[j as usize]);
-                                (a - b).abs() <= 1e-11 * a.abs().max(b.abs())
-                            }
-                            Err(_) => false,
-                        }
-                    })
+                if !positive(self.diag[i]) {
+                    return None;
+                }
+                let (mut above, mut below) = (0usize, 0usize);
+                for (&j, &mij) in cols.iter().zip(w) {
+                    let j = j as usize;
+                    if j < i {
+                        below += 1;
+                        continue;
+                    }
+                    if j == i {
+                        continue;
+                    }
+                    above += 1;
+                    let (cj, wj) = self.row(j);
+                    let k = cj.binary_search(&(i as u32)).ok()?;
+                    let (a, b) = (mij / c[i], wj[k] / c[j]);
+                    if (a - b).abs() > 1e-11 * a.abs().max(b.abs()) {
+                        return None;
+                    }
+                }
+                Some((above, below))
             })
+            .try_reduce(|| (0, 0), |a, b| Some((a.0 + b.0, a.1 + b.1)));
+        matches!(counts, Some((above, below)) if above == below)
     }
 
     /// The symmetrizer by propagation over the coupling graph (any consistent scales).

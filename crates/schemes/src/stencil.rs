@@ -6,6 +6,9 @@ use rayon::prelude::*;
 /// Rows per parallel task: large enough to amortise scheduling, small enough to balance.
 const CHUNK_ROWS: usize = 4096;
 
+/// One chunk of rows of a table being built: row sizes, sources, weights.
+type Chunk = (Vec<u32>, Vec<u32>, Vec<f64>);
+
 /// A sparse matrix in compressed-sparse-row form: row `i` gives child value `i` as a weighted
 /// sum of source values, `child[i] = Σ_k weights[k] · source[indices[k]]`.
 ///
@@ -230,31 +233,39 @@ impl StencilTable {
     where
         F: Fn(usize, &mut RowSink) + Sync,
     {
-        let chunks: Vec<(Vec<u32>, Vec<u32>, Vec<f64>)> = (0..num_rows.div_ceil(CHUNK_ROWS))
+        let num_chunks = num_rows.div_ceil(CHUNK_ROWS);
+        // A few runs of consecutive chunks per thread, each with one scratch pair over the
+        // sources (`map_init` would allocate and clear one per rayon job, many more than
+        // threads); the chunks themselves, not the runs, fix the output.
+        let per_run = num_chunks.div_ceil(2 * rayon::current_num_threads()).max(1);
+        let runs: Vec<Vec<Chunk>> = (0..num_chunks.div_ceil(per_run))
             .into_par_iter()
-            .map_init(
-                || (vec![u32::MAX; num_sources], vec![0u32; num_sources]),
-                |(stamp, pos), c| {
-                    let rows = c * CHUNK_ROWS..((c + 1) * CHUNK_ROWS).min(num_rows);
-                    let mut counts = Vec::with_capacity(rows.len());
-                    let mut indices = Vec::with_capacity(rows.len() * 8);
-                    let mut weights = Vec::with_capacity(rows.len() * 8);
-                    for r in rows {
-                        let start = indices.len();
-                        let mut sink = RowSink {
-                            stamp,
-                            pos,
-                            row: r as u32,
-                            indices: &mut indices,
-                            weights: &mut weights,
-                        };
-                        fill(r, &mut sink);
-                        counts.push((indices.len() - start) as u32);
-                    }
-                    (counts, indices, weights)
-                },
-            )
+            .map(|run| {
+                let (mut stamp, mut pos) = (vec![u32::MAX; num_sources], vec![0u32; num_sources]);
+                (run * per_run..((run + 1) * per_run).min(num_chunks))
+                    .map(|c| {
+                        let rows = c * CHUNK_ROWS..((c + 1) * CHUNK_ROWS).min(num_rows);
+                        let mut counts = Vec::with_capacity(rows.len());
+                        let mut indices = Vec::with_capacity(rows.len() * 8);
+                        let mut weights = Vec::with_capacity(rows.len() * 8);
+                        for r in rows {
+                            let start = indices.len();
+                            let mut sink = RowSink {
+                                stamp: &mut stamp,
+                                pos: &mut pos,
+                                row: r as u32,
+                                indices: &mut indices,
+                                weights: &mut weights,
+                            };
+                            fill(r, &mut sink);
+                            counts.push((indices.len() - start) as u32);
+                        }
+                        (counts, indices, weights)
+                    })
+                    .collect()
+            })
             .collect();
+        let chunks: Vec<Chunk> = runs.into_iter().flatten().collect();
         let total: usize = chunks.iter().map(|c| c.1.len()).sum();
         let mut offsets = Vec::with_capacity(num_rows + 1);
         offsets.push(0u32);
