@@ -411,8 +411,8 @@ fn axpy3(x: &mut [DVec3], a: DVec3, y: &[DVec3]) {
 /// With checkerboard `signs` the method is preconditioned by `S M̄ S`
 /// ([`crate::checkerboard`]), self-adjoint and positive in the same inner product
 /// (`C⁻¹ S M̄ S = S D S`). Passes per step: `q = M̄ p` with `⟨p, q⟩`; the updates of `x` and
-/// `r` with `⟨r, r⟩` and `max |r_i|` (and `S r`); preconditioned, `M̄ S r` with
-/// `⟨r, S M̄ S r⟩`; the new direction.
+/// `r` with `⟨r, r⟩` and `max |r_i|`; preconditioned, `M̄ S r` (the signs applied as it
+/// gathers) with `⟨r, S M̄ S r⟩`; the new direction.
 fn cg(
     s: &ReducedSystem,
     c: &[f64],
@@ -425,10 +425,10 @@ fn cg(
     let mut r = vec![DVec3::ZERO; n];
     let mut q = vec![DVec3::ZERO; n];
     let mut p = vec![DVec3::ZERO; n];
-    // Preconditioned only: `S r` and `M̄ S r`.
-    let (mut sr, mut msr) = match signs {
-        Some(_) => (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]),
-        None => (Vec::new(), Vec::new()),
+    // Preconditioned only: `M̄ S r`.
+    let mut msr = match signs {
+        Some(_) => vec![DVec3::ZERO; n],
+        None => Vec::new(),
     };
     let not_positive = |v: DVec3, scale: DVec3| {
         [v.x, v.y, v.z]
@@ -443,8 +443,7 @@ fn cg(
         // ρ = ⟨r, z⟩ with z = S M̄ S r (preconditioned) or z = r; first direction p = z.
         let mut rho = match signs {
             Some(sg) => {
-                precondition(&r, sg, &mut sr);
-                let rho = s.apply_weighted_dot(&weight, &sr, &mut msr);
+                let rho = s.apply_signed_weighted_dot(&weight, sg, &r, &mut msr);
                 precondition(&msr, sg, &mut p);
                 if not_positive(rho, weighted_dot(&r, &r, &weight)) {
                     return None;
@@ -470,8 +469,7 @@ fn cg(
             }
             let rho_new = match signs {
                 Some(sg) => {
-                    precondition(&r, sg, &mut sr);
-                    let rho_new = s.apply_weighted_dot(&weight, &sr, &mut msr);
+                    let rho_new = s.apply_signed_weighted_dot(&weight, sg, &r, &mut msr);
                     if not_positive(rho_new, rr_new) {
                         return None;
                     }

@@ -385,6 +385,37 @@ impl ReducedSystem {
         partial.into_iter().fold(DVec3::ZERO, |s, x| s + x)
     }
 
+    /// `q = M̄ S r` for the diagonal of signs `S`; returns `Σ w_i (S r)_i ⊙ q_i` per
+    /// coordinate, blocks summed in order: [`ReducedSystem::apply_weighted_dot`] of `S r`
+    /// without forming it (signs are `±1`, so the products are the same to the bit).
+    pub fn apply_signed_weighted_dot(
+        &self,
+        w: &[f64],
+        signs: &[f64],
+        r: &[DVec3],
+        q: &mut [DVec3],
+    ) -> DVec3 {
+        let partial: Vec<DVec3> = q
+            .par_chunks_mut(CHUNK)
+            .enumerate()
+            .map(|(c, out)| {
+                let mut d = DVec3::ZERO;
+                for (k, o) in out.iter_mut().enumerate() {
+                    let i = c * CHUNK + k;
+                    let (cols, wt) = self.row(i);
+                    let mut acc = DVec3::ZERO;
+                    for (&j, &x_w) in cols.iter().zip(wt) {
+                        acc += x_w * (signs[j as usize] * r[j as usize]);
+                    }
+                    *o = acc;
+                    d += w[i] * ((signs[i] * r[i]) * acc);
+                }
+                d
+            })
+            .collect();
+        partial.into_iter().fold(DVec3::ZERO, |s, x| s + x)
+    }
+
     /// Largest absolute row sum (an upper bound of the spectral radius).
     pub fn inf_norm(&self) -> f64 {
         (0..self.len())
