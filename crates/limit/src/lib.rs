@@ -49,6 +49,7 @@ pub mod masks;
 pub mod patch;
 pub mod stam;
 mod table;
+mod two_phase_closed;
 
 use subd_mesh::Topology;
 use subd_mesh::tags::is_semi_sharp;
@@ -249,8 +250,10 @@ pub fn two_phase_base_limit(
     }
 }
 
-/// The limit positions of [`two_phase_base_limit`] alone (the same rows), for callers that
-/// need no tangents, such as interpolation: about a third of the work.
+/// The limit positions of [`two_phase_base_limit`] alone, for callers that need no tangents,
+/// such as interpolation. On a closed smooth quad mesh with no vertex of valence 2 the rows
+/// come from the paper's formula (2) directly (no refinement; the same weights up to
+/// rounding), elsewhere from [`two_phase_base_limit`]'s path without its tangents.
 ///
 /// # Errors
 /// As [`two_phase_base_limit`].
@@ -259,6 +262,9 @@ pub fn two_phase_base_limit_positions(
     two_phase: &TwoPhase,
     options: &Options,
 ) -> Result<StencilTable, LimitError> {
+    if two_phase_closed::applies(topology, two_phase) {
+        return Ok(two_phase_closed::positions(topology, two_phase));
+    }
     match two_phase_levels(topology) {
         TwoPhaseLevels::Local => {
             let r = Refinement::two_phase(topology, two_phase, options, 1)?;
@@ -309,7 +315,7 @@ fn limit_through(r: &Refinement, levels: usize) -> Result<LimitStencilTable, Lim
 }
 
 /// [`limit_through`] for the positions alone.
-fn positions_through(r: &Refinement, levels: usize) -> Result<StencilTable, LimitError> {
+pub(crate) fn positions_through(r: &Refinement, levels: usize) -> Result<StencilTable, LimitError> {
     let at = LimitStencilTable::positions_at_level(r, levels)?;
     let nv = r.num_vertices(0);
     // At level 0 the table is the base's already: no copy.
