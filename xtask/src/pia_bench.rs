@@ -21,7 +21,7 @@ pub fn run(repeats: usize) -> Result<(), String> {
     let threads = rayon::current_num_threads();
     println!();
     println!(
-        "PIA to max error 1e-10 × diagonal, closed quad torus, {nv} vertices (every vertex moves), {threads} threads, median of {repeats} runs; ratio = time / the paper's iteration's time; 'prepare' is Pia::prepare (solver matrix, symmetric form, Chebyshev operator, built once), 'solve' the median of repeated solves on one prepared Pia, 'cold' the first solve on a fresh unprepared one"
+        "PIA to max error 1e-10 × diagonal, closed quad torus, {nv} vertices (every vertex moves), {threads} threads, median of {repeats} runs; ratio = time / the paper's iteration's time; 'setup' is Pia::new (limit-position stencils in the solvers' form), 'prepare' Pia::prepare (symmetric form, Chebyshev operator, built once), 'solve' the median of repeated solves on one prepared Pia, 'cold' the first solve on a fresh unprepared one"
     );
     println!(
         "{:<14} {:<10} {:<14} {:>6} {:>10} {:>10} {:>10} {:>7} {:>10} {:>7} {:>12}",
@@ -88,7 +88,7 @@ pub fn run(repeats: usize) -> Result<(), String> {
                 max_iter: 100_000,
             };
             // Cold: the first solve on a fresh, unprepared `Pia`, which also builds what this
-            // solver needs (solver matrix, symmetric form, Chebyshev operator).
+            // solver needs beyond the limit matrix (symmetric form, Chebyshev operator).
             let fresh = Pia::new(&mesh.topology, &scheme, &Options::default())
                 .map_err(|e| e.to_string())?;
             let t = Instant::now();

@@ -177,17 +177,19 @@ pub(crate) fn run(args: &PiaArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
         .map_err(at_input)?;
     let t_solve = t1.elapsed().as_secs_f64();
 
-    // The error of the output, measured with a limit table built afresh, not the solver's
-    // own residual.
+    // The error of the output, measured with a limit table built afresh and applied to the
+    // written positions, not the solver's own residual.
     spinner.message("checking");
     let t2 = Instant::now();
     let check = match &scheme {
-        PiaScheme::CatmullClark => subd_limit::base_limit(topo, Scheme::CatmullClark, &options),
-        PiaScheme::Loop => subd_limit::base_limit(topo, Scheme::Loop, &options),
-        PiaScheme::TwoPhase(tp) => subd_limit::two_phase_base_limit(topo, tp, &options),
+        PiaScheme::CatmullClark => {
+            subd_limit::base_limit_positions(topo, Scheme::CatmullClark, &options)
+        }
+        PiaScheme::Loop => subd_limit::base_limit_positions(topo, Scheme::Loop, &options),
+        PiaScheme::TwoPhase(tp) => subd_limit::two_phase_base_limit_positions(topo, tp, &options),
     }
     .map_err(|e| at_input(e.into()))?;
-    let limit = check.position.apply_points(&result.points);
+    let limit = check.apply_points(&result.points);
     let flags = moving.flags(nv).map_err(at_input)?;
     let max_error = (0..nv)
         .filter(|&v| flags[v])
