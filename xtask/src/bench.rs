@@ -18,38 +18,10 @@ use crate::osd;
 /// grid in which every 8th quad pair is merged into a hexagon (two valence-3 vertices each),
 /// refined once with Catmull-Clark (the hexagon centres become valence-6 vertices).
 pub fn quad_bench_mesh() -> Mesh {
-    let (m, n) = (160u32, 160u32);
-    let id = |i: u32, j: u32| (i % m) * n + (j % n);
-    let positions = subd_mesh::primitives::torus(m, n, 3.0, 1.0).positions;
-    let mut sizes = Vec::new();
-    let mut idx = Vec::new();
-    for i in 0..m {
-        let mut j = 0;
-        while j < n {
-            if i % 8 == 0 && j % 8 == 0 {
-                // Quads (i,j) and (i,j+1) merged: drop their shared edge.
-                idx.extend_from_slice(&[
-                    id(i, j),
-                    id(i + 1, j),
-                    id(i + 1, j + 1),
-                    id(i + 1, j + 2),
-                    id(i, j + 2),
-                    id(i, j + 1),
-                ]);
-                sizes.push(6);
-                j += 2;
-            } else {
-                idx.extend_from_slice(&[id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
-                sizes.push(4);
-                j += 1;
-            }
-        }
-    }
-    let base = TopologyBuilder::new(positions.len())
-        .build(&sizes, &idx)
-        .expect("valid torus");
-    let r = Refinement::new(&base, Scheme::CatmullClark, &Options::default(), 1).expect("refine");
-    let pts = r.refine_points(&positions).pop().expect("level 1");
+    let base = subd_mesh::primitives::torus_with_hexagons(160, 160, 8, 3.0, 1.0);
+    let r = Refinement::new(&base.topology, Scheme::CatmullClark, &Options::default(), 1)
+        .expect("refine");
+    let pts = r.refine_points(&base.positions).pop().expect("level 1");
     Mesh::new(r.into_topology(1), pts).expect("finite")
 }
 

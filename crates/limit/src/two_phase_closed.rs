@@ -101,32 +101,12 @@ mod tests {
             .collect()
     }
 
-    /// A closed quad mesh with valences 3, 4, 5 and 6: a torus grid with one quad pair merged
-    /// into a hexagon, refined once by Catmull-Clark.
+    /// A closed quad mesh with valences 3, 4 and 6: a torus grid with quad pairs merged into
+    /// hexagons, refined once by Catmull-Clark.
     fn mixed_torus() -> Topology {
-        let (m, n) = (6u32, 8u32);
-        let id = |i: u32, j: u32| (i % m) * n + (j % n);
-        let (mut sizes, mut idx) = (Vec::new(), Vec::new());
-        for i in 0..m {
-            let mut j = 0;
-            while j < n {
-                if i == 2 && j == 2 {
-                    idx.extend([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
-                    idx.extend([id(i + 1, j + 2), id(i, j + 2), id(i, j + 1)]);
-                    sizes.push(6);
-                    j += 2;
-                } else {
-                    idx.extend([id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
-                    sizes.push(4);
-                    j += 1;
-                }
-            }
-        }
-        let base = TopologyBuilder::new((m * n) as usize)
-            .build(&sizes, &idx)
-            .unwrap();
+        let base = subd_mesh::primitives::torus_with_hexagons(6, 8, 4, 3.0, 1.0);
         let r = Refinement::new(
-            &base,
+            &base.topology,
             subd_schemes::Scheme::CatmullClark,
             &Options::default(),
             1,

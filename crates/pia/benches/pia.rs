@@ -3,7 +3,7 @@
 //! prepared `Pia`, and the default solver cold (a fresh `Pia` per solve).
 
 use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
-use subd_mesh::{DVec3, Topology, TopologyBuilder};
+use subd_mesh::{DVec3, Topology};
 use subd_pia::{Moving, Pia, PiaOptions, PiaScheme, Solver};
 use subd_schemes::{Options, Refinement, Scheme};
 
@@ -11,36 +11,10 @@ use subd_schemes::{Options, Refinement, Scheme};
 /// once with Catmull-Clark: 101,600 quads, 800 valence-3 and 400 valence-6 vertices (the
 /// construction of `xtask/src/bench.rs`).
 fn torus() -> (Topology, Vec<DVec3>) {
-    let (m, n) = (160u32, 160u32);
-    let id = |i: u32, j: u32| (i % m) * n + (j % n);
-    let positions = subd_mesh::primitives::torus(m, n, 3.0, 1.0).positions;
-    let (mut sizes, mut idx) = (Vec::new(), Vec::new());
-    for i in 0..m {
-        let mut j = 0;
-        while j < n {
-            if i % 8 == 0 && j % 8 == 0 {
-                idx.extend([
-                    id(i, j),
-                    id(i + 1, j),
-                    id(i + 1, j + 1),
-                    id(i + 1, j + 2),
-                    id(i, j + 2),
-                    id(i, j + 1),
-                ]);
-                sizes.push(6);
-                j += 2;
-            } else {
-                idx.extend([id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
-                sizes.push(4);
-                j += 1;
-            }
-        }
-    }
-    let base = TopologyBuilder::new(positions.len())
-        .build(&sizes, &idx)
-        .expect("a torus");
-    let r = Refinement::new(&base, Scheme::CatmullClark, &Options::default(), 1).expect("refine");
-    let points = r.refine_points(&positions).pop().expect("level 1");
+    let base = subd_mesh::primitives::torus_with_hexagons(160, 160, 8, 3.0, 1.0);
+    let r = Refinement::new(&base.topology, Scheme::CatmullClark, &Options::default(), 1)
+        .expect("refine");
+    let points = r.refine_points(&base.positions).pop().expect("level 1");
     (r.into_topology(1), points)
 }
 

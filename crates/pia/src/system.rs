@@ -364,25 +364,7 @@ impl ReducedSystem {
 
     /// `q = M̄ p`; returns `Σ w_i p_i ⊙ q_i` per coordinate, blocks summed in order.
     pub fn apply_weighted_dot(&self, w: &[f64], p: &[DVec3], q: &mut [DVec3]) -> DVec3 {
-        let partial: Vec<DVec3> = q
-            .par_chunks_mut(CHUNK)
-            .enumerate()
-            .map(|(c, out)| {
-                let mut d = DVec3::ZERO;
-                for (k, o) in out.iter_mut().enumerate() {
-                    let i = c * CHUNK + k;
-                    let (cols, wt) = self.row(i);
-                    let mut acc = DVec3::ZERO;
-                    for (&j, &x_w) in cols.iter().zip(wt) {
-                        acc += x_w * p[j as usize];
-                    }
-                    *o = acc;
-                    d += w[i] * (p[i] * acc);
-                }
-                d
-            })
-            .collect();
-        partial.into_iter().fold(DVec3::ZERO, |s, x| s + x)
+        self.weighted_dot_pass(w, |j| p[j], q)
     }
 
     /// `q = M̄ S r` for the diagonal of signs `S`; returns `Σ w_i (S r)_i ⊙ q_i` per
@@ -395,6 +377,17 @@ impl ReducedSystem {
         r: &[DVec3],
         q: &mut [DVec3],
     ) -> DVec3 {
+        self.weighted_dot_pass(w, |j| signs[j] * r[j], q)
+    }
+
+    /// `q = M̄ p` for `p_j = input(j)`, with `Σ w_i p_i ⊙ q_i` per coordinate.
+    #[inline]
+    fn weighted_dot_pass(
+        &self,
+        w: &[f64],
+        input: impl Fn(usize) -> DVec3 + Sync,
+        q: &mut [DVec3],
+    ) -> DVec3 {
         let partial: Vec<DVec3> = q
             .par_chunks_mut(CHUNK)
             .enumerate()
@@ -405,10 +398,10 @@ impl ReducedSystem {
                     let (cols, wt) = self.row(i);
                     let mut acc = DVec3::ZERO;
                     for (&j, &x_w) in cols.iter().zip(wt) {
-                        acc += x_w * (signs[j as usize] * r[j as usize]);
+                        acc += x_w * input(j as usize);
                     }
                     *o = acc;
-                    d += w[i] * ((signs[i] * r[i]) * acc);
+                    d += w[i] * (input(i) * acc);
                 }
                 d
             })
