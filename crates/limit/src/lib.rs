@@ -153,15 +153,10 @@ pub fn base_limit(
     scheme: Scheme,
     options: &Options,
 ) -> Result<LimitStencilTable, LimitError> {
-    if scheme == Scheme::Bilinear {
-        return Err(LimitError::Scheme);
+    match whole_refinement(topology, scheme, options)? {
+        Some((r, levels)) => limit_through(&r, levels),
+        None => local::base_limit(topology, scheme, options),
     }
-    let Some(levels) = whole_levels(topology, scheme) else {
-        // Too large to refine whole: refine only around the semi-sharp features.
-        return local::base_limit(topology, scheme, options);
-    };
-    let r = Refinement::new(topology, scheme, options, levels)?;
-    limit_through(&r, levels)
 }
 
 /// The limit positions of [`base_limit`] alone (the same rows), for callers that need no
@@ -186,24 +181,34 @@ pub fn base_limit_positions(
     scheme: Scheme,
     options: &Options,
 ) -> Result<StencilTable, LimitError> {
+    match whole_refinement(topology, scheme, options)? {
+        Some((r, levels)) => positions_through(&r, levels),
+        None => Ok(local::base_limit(topology, scheme, options)?.position),
+    }
+}
+
+/// The uniform refinement [`base_limit`] takes its masks from, with its depth; `None` when
+/// refining the whole mesh that far would pass [`MAX_DECAY_FACE_VERTICES`] (then only the
+/// neighbourhoods of the semi-sharp features are refined).
+fn whole_refinement(
+    topology: &Topology,
+    scheme: Scheme,
+    options: &Options,
+) -> Result<Option<(Refinement, usize)>, LimitError> {
     if scheme == Scheme::Bilinear {
         return Err(LimitError::Scheme);
     }
-    let Some(levels) = whole_levels(topology, scheme) else {
-        return Ok(local::base_limit(topology, scheme, options)?.position);
-    };
-    let r = Refinement::new(topology, scheme, options, levels)?;
-    positions_through(&r, levels)
-}
-
-/// The levels [`base_limit`] refines the whole mesh by, or `None` when that would pass
-/// [`MAX_DECAY_FACE_VERTICES`].
-fn whole_levels(topology: &Topology, scheme: Scheme) -> Option<usize> {
     let (levels, _) = levels_for_exact_limit(topology, scheme);
     let estimate = topology
         .num_face_vertices()
         .saturating_mul(4usize.saturating_pow(levels as u32));
-    (estimate <= MAX_DECAY_FACE_VERTICES).then_some(levels)
+    if estimate > MAX_DECAY_FACE_VERTICES {
+        return Ok(None);
+    }
+    Ok(Some((
+        Refinement::new(topology, scheme, options, levels)?,
+        levels,
+    )))
 }
 
 /// The exact limit of every base vertex under the two-phase scheme of seed 000
@@ -237,16 +242,9 @@ pub fn two_phase_base_limit(
     two_phase: &TwoPhase,
     options: &Options,
 ) -> Result<LimitStencilTable, LimitError> {
-    match two_phase_levels(topology) {
-        TwoPhaseLevels::Local => {
-            // Phase 1 globally, then only around the semi-sharp features.
-            let r = Refinement::two_phase(topology, two_phase, options, 1)?;
-            local::base_limit_after(&r, options)
-        }
-        TwoPhaseLevels::Whole(levels) => {
-            let r = Refinement::two_phase(topology, two_phase, options, levels)?;
-            limit_through(&r, levels)
-        }
+    match two_phase_refinement(topology, two_phase, options)? {
+        (r, Some(levels)) => limit_through(&r, levels),
+        (r, None) => local::base_limit_after(&r, options),
     }
 }
 
@@ -265,37 +263,34 @@ pub fn two_phase_base_limit_positions(
     if two_phase_closed::applies(topology, two_phase) {
         return Ok(two_phase_closed::positions(topology, two_phase));
     }
-    match two_phase_levels(topology) {
-        TwoPhaseLevels::Local => {
-            let r = Refinement::two_phase(topology, two_phase, options, 1)?;
-            Ok(local::base_limit_after(&r, options)?.position)
-        }
-        TwoPhaseLevels::Whole(levels) => {
-            let r = Refinement::two_phase(topology, two_phase, options, levels)?;
-            positions_through(&r, levels)
-        }
+    match two_phase_refinement(topology, two_phase, options)? {
+        (r, Some(levels)) => positions_through(&r, levels),
+        (r, None) => Ok(local::base_limit_after(&r, options)?.position),
     }
 }
 
-/// How [`two_phase_base_limit`] refines.
-enum TwoPhaseLevels {
-    /// Phase 1 and this many levels in all, over the whole mesh.
-    Whole(usize),
-    /// Phase 1 over the whole mesh, then only around the semi-sharp features.
-    Local,
-}
-
-fn two_phase_levels(topology: &Topology) -> TwoPhaseLevels {
+/// The refinement [`two_phase_base_limit`] takes its masks from: phase 1 and the levels
+/// semi-sharp features need to decay, over the whole mesh (with their count); or phase 1
+/// alone (`None`) when refining further would pass [`MAX_DECAY_FACE_VERTICES`] or
+/// [`LOCAL_DECAY_LEVELS`], the rest then refined only around the features.
+fn two_phase_refinement(
+    topology: &Topology,
+    two_phase: &TwoPhase,
+    options: &Options,
+) -> Result<(Refinement, Option<usize>), LimitError> {
     let (decay, _) = levels_for_exact_limit(topology, Scheme::CatmullClark);
     let levels = decay.max(1);
     let estimate = topology
         .num_face_vertices()
         .saturating_mul(4usize.saturating_pow(levels as u32));
     if levels > 1 && (estimate > MAX_DECAY_FACE_VERTICES || levels > LOCAL_DECAY_LEVELS) {
-        TwoPhaseLevels::Local
-    } else {
-        TwoPhaseLevels::Whole(levels)
+        return Ok((
+            Refinement::two_phase(topology, two_phase, options, 1)?,
+            None,
+        ));
     }
+    let r = Refinement::two_phase(topology, two_phase, options, levels)?;
+    Ok((r, Some(levels)))
 }
 
 /// The limit masks of `r`'s level `levels`, restricted to the base vertices and composed

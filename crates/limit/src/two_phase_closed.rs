@@ -22,15 +22,14 @@ use subd_mesh::Topology;
 use subd_schemes::two_phase::ALPHA;
 use subd_schemes::{StencilTable, TwoPhase};
 
-/// Vertices per parallel block of the qualification checks.
+/// Faces or vertices per parallel block of the qualification checks.
 const CHUNK: usize = 4096;
 
-/// Whether formula (2) gives every vertex's two-phase limit: all faces quads with four
-/// distinct vertices, no holes, every edge between two faces and smooth, every vertex
-/// manifold, smooth and of valence at least 3.
+/// Whether formula (2) gives every vertex's two-phase limit: one `λ` per vertex, the mesh
+/// closed and smooth ([`Topology::is_closed_and_smooth`]), all faces quads with four distinct
+/// vertices, every vertex of valence at least 3.
 pub(crate) fn applies(t: &Topology, two_phase: &TwoPhase) -> bool {
     two_phase.lambda().len() == t.num_vertices()
-        && !t.tags().holes().iter().any(|&h| h)
         && (0..t.num_faces())
             .into_par_iter()
             .with_min_len(CHUNK)
@@ -44,20 +43,11 @@ pub(crate) fn applies(t: &Topology, two_phase: &TwoPhase) -> bool {
                     && fv[1] != fv[3]
                     && fv[2] != fv[3]
             })
-        && (0..t.num_edges())
-            .into_par_iter()
-            .with_min_len(CHUNK)
-            .all(|e| t.edge_faces(e).len() == 2 && t.edge_sharpness(e) == 0.0)
         && (0..t.num_vertices())
             .into_par_iter()
             .with_min_len(CHUNK)
-            .all(|v| {
-                let n = t.vertex_faces(v).len();
-                !t.is_non_manifold_vertex(v)
-                    && t.vertex_sharpness(v) == 0.0
-                    && n >= 3
-                    && t.vertex_edges(v).len() == n
-            })
+            .all(|v| t.vertex_faces(v).len() >= 3)
+        && t.is_closed_and_smooth()
 }
 
 /// The limit-position table of formula (2), rows in the order of the general path's limit

@@ -290,6 +290,40 @@ impl Topology {
         }
     }
 
+    /// `true` when the mesh is closed, manifold and smooth: every edge has two faces and two
+    /// distinct ends and no crease sharpness, every vertex is used, manifold, with as many
+    /// faces as edges and no corner sharpness, and no face is a hole. On such a mesh every
+    /// vertex takes its scheme's smooth interior rule wherever its valence allows, so
+    /// closed-form shortcuts (fused refinement levels, closed-form limits) apply.
+    ///
+    /// ```
+    /// let torus = subd_mesh::primitives::torus(4, 4, 3.0, 1.0);
+    /// assert!(torus.topology.is_closed_and_smooth());
+    /// let quad = subd_mesh::TopologyBuilder::new(4).build(&[4], &[0, 1, 2, 3]).unwrap();
+    /// assert!(!quad.is_closed_and_smooth());
+    /// ```
+    pub fn is_closed_and_smooth(&self) -> bool {
+        const CHUNK: usize = 4096;
+        !self.tags.face_hole.par_iter().any(|&h| h)
+            && (0..self.num_edges())
+                .into_par_iter()
+                .with_min_len(CHUNK)
+                .all(|e| {
+                    !self.is_degenerate_edge(e)
+                        && self.edge_faces(e).len() == 2
+                        && self.edge_sharpness(e) == 0.0
+                })
+            && (0..self.num_vertices())
+                .into_par_iter()
+                .with_min_len(CHUNK)
+                .all(|v| {
+                    !self.is_non_manifold_vertex(v)
+                        && !self.is_isolated_vertex(v)
+                        && self.vertex_sharpness(v) == 0.0
+                        && self.vertex_faces(v).len() == self.vertex_edges(v).len()
+                })
+    }
+
     /// Tags: crease and corner sharpness, holes.
     #[inline]
     pub fn tags(&self) -> &Tags {

@@ -423,13 +423,9 @@ fn cg(
     let n = s.len();
     let weight: Vec<f64> = c.iter().map(|c| 1.0 / c).collect();
     let mut r = vec![DVec3::ZERO; n];
+    // `M̄ p`, and (preconditioned) `M̄ S r` once the step has used `M̄ p`.
     let mut q = vec![DVec3::ZERO; n];
     let mut p = vec![DVec3::ZERO; n];
-    // Preconditioned only: `M̄ S r`.
-    let mut msr = match signs {
-        Some(_) => vec![DVec3::ZERO; n],
-        None => Vec::new(),
-    };
     let not_positive = |v: DVec3, scale: DVec3| {
         [v.x, v.y, v.z]
             .iter()
@@ -443,8 +439,8 @@ fn cg(
         // ρ = ⟨r, z⟩ with z = S M̄ S r (preconditioned) or z = r; first direction p = z.
         let mut rho = match signs {
             Some(sg) => {
-                let rho = s.apply_signed_weighted_dot(&weight, sg, &r, &mut msr);
-                precondition(&msr, sg, &mut p);
+                let rho = s.apply_signed_weighted_dot(&weight, sg, &r, &mut q);
+                precondition(&q, sg, &mut p);
                 if not_positive(rho, weighted_dot(&r, &r, &weight)) {
                     return None;
                 }
@@ -469,7 +465,7 @@ fn cg(
             }
             let rho_new = match signs {
                 Some(sg) => {
-                    let rho_new = s.apply_signed_weighted_dot(&weight, sg, &r, &mut msr);
+                    let rho_new = s.apply_signed_weighted_dot(&weight, sg, &r, &mut q);
                     if not_positive(rho_new, rr_new) {
                         return None;
                     }
@@ -483,7 +479,7 @@ fn cg(
                 // p ← S M̄ S r + β p
                 Some(sg) => p
                     .par_chunks_mut(CHUNK)
-                    .zip(msr.par_chunks(CHUNK))
+                    .zip(q.par_chunks(CHUNK))
                     .zip(sg.par_chunks(CHUNK))
                     .for_each(|((p, z), sg)| {
                         for ((p, z), &g) in p.iter_mut().zip(z).zip(sg) {

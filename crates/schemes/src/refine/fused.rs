@@ -31,26 +31,13 @@ use crate::rules::Rule;
 /// manifold (every edge has two faces and two distinct ends, no vertex is non-manifold or
 /// isolated), has no sharpness and no holes, and every vertex is smooth.
 pub(crate) fn applies(g: &Topology, rules: &[Rule], scheme: Scheme) -> bool {
-    let (nv, ne) = (g.num_vertices(), g.num_edges());
     let faces = match scheme {
         Scheme::CatmullClark => split::all_quads(g),
         // Loop refines triangles only (checked before refining).
         Scheme::Loop => true,
         Scheme::Bilinear => false,
     };
-    faces
-        && !g.tags().holes().par_iter().any(|&h| h)
-        && rules.par_iter().all(|&r| r == Rule::Smooth)
-        && (0..ne).into_par_iter().with_min_len(CHUNK).all(|e| {
-            let [a, b] = g.edge_vertices(e);
-            a != b && g.edge_faces(e).len() == 2 && g.edge_sharpness(e) == 0.0
-        })
-        && (0..nv).into_par_iter().with_min_len(CHUNK).all(|v| {
-            !g.is_non_manifold_vertex(v)
-                && !g.is_isolated_vertex(v)
-                && g.vertex_sharpness(v) == 0.0
-                && g.vertex_faces(v).len() == g.vertex_edges(v).len()
-        })
+    faces && rules.par_iter().all(|&r| r == Rule::Smooth) && g.is_closed_and_smooth()
 }
 
 /// Face size of every level that [`applies`] accepts, and of its children.
