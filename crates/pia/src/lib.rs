@@ -222,7 +222,23 @@ impl Pia {
             PiaScheme::Loop => None,
             _ => checkerboard::checkerboard_signs(topology).map(Arc::new),
         };
-        Ok(Pia::with_signs(table, signs))
+        let face_size = match scheme {
+            PiaScheme::Loop => 3,
+            _ => 4,
+        };
+        let classical = has_classical_masks(topology, face_size);
+        // Rows of the classical masks: the vertex, its edge neighbours and (quads) its
+        // face-diagonal vertices.
+        let row_len = |v: usize| 1 + (face_size - 2) * topology.vertex_edges(v).len();
+        let full = FullSystem::new(
+            &table,
+            signs,
+            classical.then_some(&row_len as &(dyn Fn(usize) -> usize + Sync)),
+        );
+        Ok(Pia {
+            limit: table,
+            full: Arc::new(full),
+        })
     }
 
     /// A problem from any square limit-position table (row `i`: the limit of vertex `i`).
@@ -239,7 +255,7 @@ impl Pia {
             limit.num_sources(),
             "a square limit table"
         );
-        let full = Arc::new(FullSystem::new(&limit, signs));
+        let full = Arc::new(FullSystem::new(&limit, signs, None));
         Pia { limit, full }
     }
 
@@ -333,7 +349,8 @@ impl Pia {
     /// [`PiaError::Vertex`] for a bad index in `moving`.
     pub fn is_symmetrizable(&self, moving: &Moving) -> Result<bool, PiaError> {
         let zero = vec![DVec3::ZERO; self.num_vertices()];
-        Ok(self.system(&zero, moving)?.symmetrizer().is_some())
+        // Always the pairwise check (the solvers take the form from theory where they can).
+        Ok(self.system(&zero, moving)?.matrix.symmetrizer().is_some())
     }
 
     pub(crate) fn system(
@@ -354,6 +371,32 @@ impl Pia {
         let flags = moving.flags(n)?;
         Ok(ReducedSystem::from_full(&self.full, targets, &flags))
     }
+}
+
+/// Whether every limit row is the scheme's classical smooth mask: the mesh closed and
+/// smooth ([`Topology::is_closed_and_smooth`]), every face of `face_size` distinct vertices
+/// (quads for Catmull-Clark and two-phase, triangles for Loop), every vertex of valence at
+/// least 3. Row `i` is then `c_i` times one weight for each edge neighbour, another for
+/// each face-diagonal vertex and one for the vertex itself: Catmull-Clark 4, 1 and `n²`
+/// over `n (n + 5)`; two-phase `β_n` and `3 β_n / 10` (formula (2); the ratio does not
+/// depend on `λ`, seed 000 eqs. 17–18); Loop one weight for the whole ring. Scaled by the
+/// edge weight, `D` holds 1 at edge neighbours and `1/4` or `3/10` at diagonal ones on
+/// every row alike, so `M̄ = C D` with `D` symmetric by construction.
+fn has_classical_masks(t: &Topology, face_size: usize) -> bool {
+    use rayon::prelude::*;
+    const CHUNK: usize = 4096;
+    (0..t.num_faces())
+        .into_par_iter()
+        .with_min_len(CHUNK)
+        .all(|f| {
+            let fv = t.face_vertices(f);
+            fv.len() == face_size && (1..fv.len()).all(|k| !fv[..k].contains(&fv[k]))
+        })
+        && (0..t.num_vertices())
+            .into_par_iter()
+            .with_min_len(CHUNK)
+            .all(|v| t.vertex_faces(v).len() >= 3)
+        && t.is_closed_and_smooth()
 }
 
 /// Length of the diagonal of the axis-aligned bounding box of `points`.

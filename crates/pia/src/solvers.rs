@@ -410,9 +410,13 @@ fn axpy3(x: &mut [DVec3], a: DVec3, y: &[DVec3]) {
 ///
 /// With checkerboard `signs` the method is preconditioned by `S M̄ S`
 /// ([`crate::checkerboard`]), self-adjoint and positive in the same inner product
-/// (`C⁻¹ S M̄ S = S D S`). Passes per step: `q = M̄ p` with `⟨p, q⟩`; the updates of `x` and
-/// `r` with `⟨r, r⟩` and `max |r_i|`; preconditioned, `M̄ S r` (the signs applied as it
-/// gathers) with `⟨r, S M̄ S r⟩`; the new direction.
+/// (`C⁻¹ S M̄ S = S D S`). A step is two matrix passes and one vector sweep:
+/// * the sweep: `x += α p`, `r̃ −= α S q` with `max |r_i|` and `⟨r, r⟩`. The residual is
+///   kept signed, `r̃ = S r`, so that the preconditioner's pass gathers plain values;
+/// * (preconditioned) `z = S M̄ r̃ = S M̄ S r` with `⟨r, z⟩`;
+/// * the new direction `p ← z + β p` together with `q ← M̄ z + β q`, which equals `M̄ p` by
+///   linearity, and `⟨p, q⟩`: no separate pass for `M̄ p`. The drift this recurrence adds
+///   is caught by the true residual at the end, which restarts the method if needed.
 fn cg(
     s: &ReducedSystem,
     c: &[f64],
@@ -422,78 +426,55 @@ fn cg(
 ) -> Option<Outcome> {
     let n = s.len();
     let weight: Vec<f64> = c.iter().map(|c| 1.0 / c).collect();
+    // The signed residual S r (r itself without signs), the preconditioned residual
+    // (only with signs), the direction and its product with M̄.
     let mut r = vec![DVec3::ZERO; n];
-    // `M̄ p`, and (preconditioned) `M̄ S r` once the step has used `M̄ p`.
-    let mut q = vec![DVec3::ZERO; n];
+    let mut z = if signs.is_some() {
+        vec![DVec3::ZERO; n]
+    } else {
+        Vec::new()
+    };
     let mut p = vec![DVec3::ZERO; n];
+    let mut q = vec![DVec3::ZERO; n];
     let not_positive = |v: DVec3, scale: DVec3| {
         [v.x, v.y, v.z]
             .iter()
             .zip([scale.x, scale.y, scale.z])
             .any(|(&a, b)| b != 0.0 && a.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater))
     };
-    let mut res = s.residual(&x, &mut r);
+    let mut res = s.signed_residual(signs, &x, &mut r);
     let mut history = vec![res];
     let mut steps = 0usize;
     while res > ctl.threshold && steps < ctl.max_iter {
-        // ρ = ⟨r, z⟩ with z = S M̄ S r (preconditioned) or z = r; first direction p = z.
-        let mut rho = match signs {
-            Some(sg) => {
-                let rho = s.apply_signed_weighted_dot(&weight, sg, &r, &mut q);
-                precondition(&q, sg, &mut p);
-                if not_positive(rho, weighted_dot(&r, &r, &weight)) {
-                    return None;
-                }
-                rho
-            }
-            None => {
-                p.copy_from_slice(&r);
-                weighted_dot(&r, &r, &weight)
-            }
-        };
+        let mut rr = weighted_dot(&r, &r, &weight);
+        // ρ of the step before (none on the first step, whose direction is z itself).
+        let mut rho: Option<DVec3> = None;
         loop {
-            let pq = s.apply_weighted_dot(&weight, &p, &mut q);
-            if not_positive(pq, rho) {
+            // ρ = ⟨r, z⟩ with z = S M̄ S r (preconditioned) or z = r.
+            let rho_new = match signs {
+                Some(sg) => s.precondition_pass(&weight, sg, &r, &mut z),
+                None => rr,
+            };
+            if not_positive(rho_new, rr) {
                 return None;
             }
-            let alpha = safe_div(rho, pq);
-            let (rr_new, error) = cg_update(&mut x, &mut r, alpha, &p, &q, &weight);
+            let beta = rho.map(|old| safe_div(rho_new, old));
+            rho = Some(rho_new);
+            let direction = if signs.is_some() { &z } else { &r };
+            let pq = s.direction_pass(&weight, direction, beta, &mut p, &mut q);
+            if not_positive(pq, rho_new) {
+                return None;
+            }
+            let alpha = safe_div(rho_new, pq);
+            let (rr_new, error) = cg_update(&mut x, &mut r, alpha, &p, &q, signs, &weight);
             steps += 1;
             history.push(error);
             if error <= ctl.threshold || steps >= ctl.max_iter {
                 break;
             }
-            let rho_new = match signs {
-                Some(sg) => {
-                    let rho_new = s.apply_signed_weighted_dot(&weight, sg, &r, &mut q);
-                    if not_positive(rho_new, rr_new) {
-                        return None;
-                    }
-                    rho_new
-                }
-                None => rr_new,
-            };
-            let beta = safe_div(rho_new, rho);
-            rho = rho_new;
-            match signs {
-                // p ← S M̄ S r + β p
-                Some(sg) => p
-                    .par_chunks_mut(CHUNK)
-                    .zip(q.par_chunks(CHUNK))
-                    .zip(sg.par_chunks(CHUNK))
-                    .for_each(|((p, z), sg)| {
-                        for ((p, z), &g) in p.iter_mut().zip(z).zip(sg) {
-                            *p = g * *z + beta * *p;
-                        }
-                    }),
-                // p ← r + β p
-                None => p
-                    .par_chunks_mut(CHUNK)
-                    .zip(r.par_chunks(CHUNK))
-                    .for_each(|(p, r)| p.iter_mut().zip(r).for_each(|(p, r)| *p = *r + beta * *p)),
-            }
+            rr = rr_new;
         }
-        res = s.residual(&x, &mut r);
+        res = s.signed_residual(signs, &x, &mut r);
         *history.last_mut().expect("one step taken") = res;
     }
     let method = if signs.is_some() {
@@ -520,14 +501,16 @@ fn weighted_dot(a: &[DVec3], b: &[DVec3], w: &[f64]) -> DVec3 {
     partial.into_iter().fold(DVec3::ZERO, |s, x| s + x)
 }
 
-/// One fused CG update: `x += α p`, `r −= α q`; returns `⟨r, r⟩` (blocks summed in order)
-/// and the interpolation error `max |r_i|`.
+/// One fused CG update: `x += α p`, `r̃ −= α S q` (`S` the diagonal of `signs`, the
+/// identity when `None`); returns `⟨r, r⟩` (blocks summed in order) and the interpolation
+/// error `max |r_i|`.
 fn cg_update(
     x: &mut [DVec3],
     r: &mut [DVec3],
     alpha: DVec3,
     p: &[DVec3],
     q: &[DVec3],
+    signs: Option<&[f64]>,
     weight: &[f64],
 ) -> (DVec3, f64) {
     let partial: Vec<(DVec3, f64)> = x
@@ -536,11 +519,24 @@ fn cg_update(
         .zip(p.par_chunks(CHUNK))
         .zip(q.par_chunks(CHUNK))
         .zip(weight.par_chunks(CHUNK))
-        .map(|((((x, r), p), q), w)| {
+        .enumerate()
+        .map(|(c, ((((x, r), p), q), w))| {
+            let sg = signs.map(|s| &s[c * CHUNK..]);
             let (mut rr, mut m) = (DVec3::ZERO, 0.0f64);
-            for ((((x, r), p), q), &w) in x.iter_mut().zip(r.iter_mut()).zip(p).zip(q).zip(w) {
+            for (k, ((((x, r), p), q), &w)) in x
+                .iter_mut()
+                .zip(r.iter_mut())
+                .zip(p)
+                .zip(q)
+                .zip(w)
+                .enumerate()
+            {
                 *x += alpha * *p;
-                *r -= alpha * *q;
+                let step = alpha * *q;
+                *r -= match sg {
+                    Some(sg) => sg[k] * step,
+                    None => step,
+                };
                 rr += w * (*r * *r);
                 m = m.max(finite_or_inf(r.length()));
             }

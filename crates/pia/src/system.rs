@@ -33,6 +33,9 @@ pub(crate) struct Matrix {
     pub cols: Vec<u32>,
     pub weights: Vec<f64>,
     pub diag: Vec<f64>,
+    /// Largest off-diagonal `|weight|` of each row (0 for a row without one): the
+    /// candidate symmetrizer ([`Matrix::symmetrizer`]).
+    pub off_diag_max: Vec<f64>,
 }
 
 /// The whole limit matrix in the solvers' form (rounding noise dropped, columns sorted), and
@@ -52,13 +55,37 @@ pub(crate) struct FullSystem {
 }
 
 impl FullSystem {
-    pub fn new(limit: &StencilTable, signs: Option<Arc<Vec<f64>>>) -> FullSystem {
+    /// The solvers' form of `limit`. `classical_row_len`, where the caller knows every row
+    /// to be a classical smooth limit mask (see [`crate::Pia::new`]), gives the number of
+    /// entries that mask has at each vertex: rows of exactly that length have each ring
+    /// vertex once, so their largest off-diagonal weight is the symmetrizer's entry and
+    /// the symmetric form is known without the pairwise check.
+    pub fn new(
+        limit: &StencilTable,
+        signs: Option<Arc<Vec<f64>>>,
+        classical_row_len: Option<&(dyn Fn(usize) -> usize + Sync)>,
+    ) -> FullSystem {
         let all = vec![true; limit.num_rows()];
         let zero = vec![DVec3::ZERO; limit.num_rows()];
         let (matrix, _, _) = restrict(limit.num_rows(), |i| limit.row(i), &zero, &all);
+        let symmetrizer = OnceLock::new();
+        if let Some(len) = classical_row_len
+            && (0..matrix.len())
+                .into_par_iter()
+                .with_min_len(CHUNK)
+                .all(|i| {
+                    matrix.row(i).0.len() == len(i)
+                        && positive(matrix.diag[i])
+                        && positive(matrix.off_diag_max[i])
+                })
+        {
+            symmetrizer
+                .set(Some(matrix.off_diag_max.clone()))
+                .expect("a fresh cell");
+        }
         FullSystem {
             matrix: Arc::new(matrix),
-            symmetrizer: OnceLock::new(),
+            symmetrizer,
             signs,
             preconditioned: OnceLock::new(),
         }
@@ -74,6 +101,12 @@ impl FullSystem {
                 Preconditioned::new(&self.matrix, c, signs)
             })
             .as_ref()
+    }
+
+    /// Whether the symmetric form was known at construction (classical masks).
+    #[cfg(test)]
+    pub fn symmetric_form_known(&self) -> bool {
+        self.symmetrizer.get().is_some()
     }
 
     /// `C` of the whole matrix, computed on first request.
@@ -159,6 +192,7 @@ pub(crate) struct RowBlock {
     cols: Vec<u32>,
     weights: Vec<f64>,
     diag: Vec<f64>,
+    off_diag_max: Vec<f64>,
 }
 
 impl RowBlock {
@@ -169,6 +203,7 @@ impl RowBlock {
             cols: Vec::with_capacity(rows * 10),
             weights: Vec::with_capacity(rows * 10),
             diag: Vec::with_capacity(rows),
+            off_diag_max: Vec::with_capacity(rows),
         }
     }
 
@@ -176,15 +211,18 @@ impl RowBlock {
     /// of the block's first row, to pick out the diagonal.
     pub fn push_row(&mut self, first: usize, row: &[(u32, f64)]) {
         let i = (first + self.counts.len()) as u32;
-        let mut d = 0.0;
+        let (mut d, mut off) = (0.0, 0.0f64);
         for &(j, x) in row {
             if j == i {
                 d = x;
+            } else {
+                off = off.max(x.abs());
             }
             self.cols.push(j);
             self.weights.push(x);
         }
         self.diag.push(d);
+        self.off_diag_max.push(off);
         self.counts.push(row.len() as u32);
     }
 }
@@ -279,12 +317,7 @@ impl ReducedSystem {
     pub fn apply(&self, x: &[DVec3], y: &mut [DVec3]) {
         y.par_chunks_mut(CHUNK).enumerate().for_each(|(c, out)| {
             for (k, o) in out.iter_mut().enumerate() {
-                let (cols, w) = self.row(c * CHUNK + k);
-                let mut acc = DVec3::ZERO;
-                for (&j, &x_w) in cols.iter().zip(w) {
-                    acc += x_w * x[j as usize];
-                }
-                *o = acc;
+                *o = self.gather(c * CHUNK + k, |j| x[j]);
             }
         });
     }
@@ -330,12 +363,7 @@ impl ReducedSystem {
         y.par_chunks_mut(CHUNK).enumerate().for_each(|(c, out)| {
             for (k, o) in out.iter_mut().enumerate() {
                 let i = c * CHUNK + k;
-                let (cols, w) = self.row(i);
-                let mut acc = DVec3::ZERO;
-                for (&j, &x_w) in cols.iter().zip(w) {
-                    acc += (x_w * signs[j as usize]) * x[j as usize];
-                }
-                *o = signs[i] * acc;
+                *o = signs[i] * self.gather(i, |j| signs[j] * x[j]);
             }
         });
     }
@@ -362,46 +390,79 @@ impl ReducedSystem {
             .reduce(|| 0.0, f64::max)
     }
 
-    /// `q = M̄ p`; returns `Σ w_i p_i ⊙ q_i` per coordinate, blocks summed in order.
-    pub fn apply_weighted_dot(&self, w: &[f64], p: &[DVec3], q: &mut [DVec3]) -> DVec3 {
-        self.weighted_dot_pass(w, |j| p[j], q)
+    /// `(M̄ x)_i` for `x_j = input(j)`.
+    #[inline]
+    fn gather(&self, i: usize, input: impl Fn(usize) -> DVec3) -> DVec3 {
+        let (cols, w) = self.row(i);
+        let mut acc = DVec3::ZERO;
+        for (&j, &x_w) in cols.iter().zip(w) {
+            acc += x_w * input(j as usize);
+        }
+        acc
     }
 
-    /// `q = M̄ S r` for the diagonal of signs `S`; returns `Σ w_i (S r)_i ⊙ q_i` per
-    /// coordinate, blocks summed in order: [`ReducedSystem::apply_weighted_dot`] of `S r`
-    /// without forming it (signs are `±1`, so the products are the same to the bit).
-    pub fn apply_signed_weighted_dot(
+    /// `r̃ = S (b − M̄ x)` for the diagonal of signs `S` (the identity when `None`); returns
+    /// `max |r_i|` (the signs leave it unchanged).
+    pub fn signed_residual(&self, signs: Option<&[f64]>, x: &[DVec3], r: &mut [DVec3]) -> f64 {
+        match signs {
+            Some(sg) => self.residual_into(x, r, |i, ri| sg[i] * ri),
+            None => self.residual(x, r),
+        }
+    }
+
+    /// The checkerboard preconditioner applied to the signed residual `r̃ = S r`:
+    /// `u = M̄ r̃`, written as `z = S u` (so `z = S M̄ S r`); returns `⟨r, z⟩ = Σ w_i r̃_i ⊙ u_i`
+    /// per coordinate, blocks summed in order. One pass, gathering plain `r̃`.
+    pub fn precondition_pass(
         &self,
         w: &[f64],
         signs: &[f64],
-        r: &[DVec3],
-        q: &mut [DVec3],
+        r_signed: &[DVec3],
+        z: &mut [DVec3],
     ) -> DVec3 {
-        self.weighted_dot_pass(w, |j| signs[j] * r[j], q)
-    }
-
-    /// `q = M̄ p` for `p_j = input(j)`, with `Σ w_i p_i ⊙ q_i` per coordinate.
-    #[inline]
-    fn weighted_dot_pass(
-        &self,
-        w: &[f64],
-        input: impl Fn(usize) -> DVec3 + Sync,
-        q: &mut [DVec3],
-    ) -> DVec3 {
-        let partial: Vec<DVec3> = q
+        let partial: Vec<DVec3> = z
             .par_chunks_mut(CHUNK)
             .enumerate()
             .map(|(c, out)| {
                 let mut d = DVec3::ZERO;
                 for (k, o) in out.iter_mut().enumerate() {
                     let i = c * CHUNK + k;
-                    let (cols, wt) = self.row(i);
-                    let mut acc = DVec3::ZERO;
-                    for (&j, &x_w) in cols.iter().zip(wt) {
-                        acc += x_w * input(j as usize);
-                    }
-                    *o = acc;
-                    d += w[i] * (input(i) * acc);
+                    let u = self.gather(i, |j| r_signed[j]);
+                    *o = signs[i] * u;
+                    d += w[i] * (r_signed[i] * u);
+                }
+                d
+            })
+            .collect();
+        partial.into_iter().fold(DVec3::ZERO, |s, x| s + x)
+    }
+
+    /// CG's new direction and its product in one pass: `p ← z + β ⊙ p` and
+    /// `q ← M̄ z + β ⊙ q`, which is `M̄ p` by linearity when `q` held `M̄ p` (`β = None`:
+    /// the first direction, `p = z`); returns `⟨p, q⟩ = Σ w_i p_i ⊙ q_i` per coordinate,
+    /// blocks summed in order.
+    pub fn direction_pass(
+        &self,
+        w: &[f64],
+        z: &[DVec3],
+        beta: Option<DVec3>,
+        p: &mut [DVec3],
+        q: &mut [DVec3],
+    ) -> DVec3 {
+        let partial: Vec<DVec3> = p
+            .par_chunks_mut(CHUNK)
+            .zip(q.par_chunks_mut(CHUNK))
+            .enumerate()
+            .map(|(c, (p, q))| {
+                let mut d = DVec3::ZERO;
+                for (k, (p, q)) in p.iter_mut().zip(q).enumerate() {
+                    let i = c * CHUNK + k;
+                    let mz = self.gather(i, |j| z[j]);
+                    (*p, *q) = match beta {
+                        Some(b) => (z[i] + b * *p, mz + b * *q),
+                        None => (z[i], mz),
+                    };
+                    d += w[i] * (*p * *q);
                 }
                 d
             })
@@ -427,6 +488,7 @@ impl Matrix {
         let mut cols = Vec::with_capacity(nnz);
         let mut weights = Vec::with_capacity(nnz);
         let mut diag = Vec::with_capacity(rows);
+        let mut off_diag_max = Vec::with_capacity(rows);
         let mut end = 0u32;
         for blk in blocks {
             for c in blk.counts {
@@ -436,12 +498,14 @@ impl Matrix {
             cols.extend_from_slice(&blk.cols);
             weights.extend_from_slice(&blk.weights);
             diag.extend_from_slice(&blk.diag);
+            off_diag_max.extend_from_slice(&blk.off_diag_max);
         }
         Matrix {
             offsets,
             cols,
             weights,
             diag,
+            off_diag_max,
         }
     }
 
@@ -475,27 +539,16 @@ impl Matrix {
         // The masks of subd's schemes weigh every edge neighbour alike up to the row's scale
         // (D's largest off-diagonal entries are equal), so the row's largest off-diagonal
         // weight is the candidate; checked in parallel, propagated only if that fails.
-        let candidate: Vec<f64> = (0..self.len())
-            .into_par_iter()
-            .with_min_len(CHUNK)
-            .map(|i| {
-                let (c, w) = self.row(i);
-                c.iter()
-                    .zip(w)
-                    .filter(|e| *e.0 as usize != i)
-                    .map(|e| e.1.abs())
-                    .fold(0.0, f64::max)
-            })
-            .collect();
-        if candidate.iter().all(|&c| c > 0.0) && self.symmetrizes(&candidate) {
-            return Some(candidate);
+        let candidate = &self.off_diag_max;
+        if candidate.iter().all(|&c| c > 0.0) && self.symmetrizes(candidate) {
+            return Some(candidate.clone());
         }
         self.propagated_symmetrizer()
     }
 
     /// Whether `C⁻¹ M̄` is symmetric (relative 1e-11) with a positive diagonal. Each entry
-    /// above the diagonal is matched with its transpose (rows are sorted, so a binary
-    /// search); equal counts above and below then leave no unmatched entry below.
+    /// above the diagonal is matched with its transpose (a scan of the short sorted row);
+    /// equal counts above and below then leave no unmatched entry below.
     fn symmetrizes(&self, c: &[f64]) -> bool {
         let counts = (0..self.len())
             .into_par_iter()
@@ -517,8 +570,9 @@ impl Matrix {
                     }
                     above += 1;
                     let (cj, wj) = self.row(j);
-                    let k = cj.binary_search(&(i as u32)).ok()?;
-                    let (a, b) = (mij / c[i], wj[k] / c[j]);
+                    let k = cj.iter().position(|&c| c == i as u32)?;
+                    // M̄_ij / c_i = M̄_ji / c_j, scaled by c_i c_j > 0 (no divisions).
+                    let (a, b) = (mij * c[j], wj[k] * c[i]);
                     if (a - b).abs() > 1e-11 * a.abs().max(b.abs()) {
                         return None;
                     }
@@ -657,6 +711,65 @@ mod tests {
         // Nor do ratios that disagree around a cycle.
         let s = system(&[&[2.0, 1.0, 1.0], &[1.0, 2.0, 2.0], &[1.0, 1.0, 2.0]]);
         assert!(s.symmetrizer().is_none());
+    }
+
+    #[test]
+    fn classical_masks_have_the_symmetric_form_the_pairwise_check_finds() {
+        use crate::{Pia, PiaScheme};
+        use subd_mesh::TopologyBuilder;
+        use subd_schemes::{Options, Refinement, Scheme, TwoPhase};
+
+        // Quads with valence 3, 4 and 6 vertices.
+        let base = subd_mesh::primitives::torus_with_hexagons(8, 12, 4, 3.0, 1.0);
+        let quads = Refinement::new(&base.topology, Scheme::CatmullClark, &Options::default(), 1)
+            .unwrap()
+            .into_topology(1);
+        let nv = quads.num_vertices();
+        let lambda = (0..nv).map(|v| 0.36 + 0.64 * ((v * 37) % 101) as f64 / 101.0);
+        let two_phase = PiaScheme::TwoPhase(TwoPhase::new(lambda.collect()).unwrap());
+        // Triangles: a torus grid split along one diagonal (valence 6) and an octahedron
+        // (valence 4).
+        let (m, n) = (6u32, 8u32);
+        let id = |i: u32, j: u32| (i % m) * n + j % n;
+        let mut tris = Vec::new();
+        for i in 0..m {
+            for j in 0..n {
+                tris.extend([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+                tris.extend([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+            }
+        }
+        let torus_tris = TopologyBuilder::new((m * n) as usize)
+            .build(&vec![3; tris.len() / 3], &tris)
+            .unwrap();
+        let octahedron = TopologyBuilder::new(6)
+            .build(
+                &[3; 8],
+                &[
+                    0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4, 2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 3, 5,
+                ],
+            )
+            .unwrap();
+        let cases = [
+            (&quads, PiaScheme::CatmullClark),
+            (&quads, two_phase),
+            (&torus_tris, PiaScheme::Loop),
+            (&octahedron, PiaScheme::Loop),
+        ];
+        for (t, scheme) in &cases {
+            let pia = Pia::new(t, scheme, &Options::default()).unwrap();
+            assert!(pia.full.symmetric_form_known(), "{scheme:?}");
+            let c = pia.full.symmetrizer().unwrap();
+            assert!(pia.full.matrix.symmetrizes(c), "{scheme:?}");
+        }
+        // Hexagons (not classical): found by the check when first asked for.
+        let pia = Pia::new(
+            &base.topology,
+            &PiaScheme::CatmullClark,
+            &Options::default(),
+        )
+        .unwrap();
+        assert!(!pia.full.symmetric_form_known());
+        assert!(pia.full.symmetrizer().is_some());
     }
 
     #[test]
