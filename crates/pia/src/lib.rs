@@ -184,9 +184,12 @@ pub struct PiaResult {
 
 /// A PIA problem: the limit-position matrix of a scheme on one mesh, ready to interpolate
 /// any targets. It holds the matrix in the form every solver reads (rounding noise of
-/// stencil composition dropped, rows sorted); the first solve that needs more (the symmetric
-/// form for the Krylov and direct solvers, the Chebyshev operator) builds it and keeps it,
-/// so later solves on the same `Pia` (other targets, other moving sets) start at once.
+/// stencil composition dropped, rows sorted). Where every row is the scheme's classical
+/// smooth mask (closed smooth meshes of quads, or triangles for Loop) the symmetric form of
+/// the Krylov and direct solvers is known from the start; elsewhere the first solve that
+/// needs it finds and checks it. That solve, or [`Pia::prepare`], also builds the Chebyshev
+/// operator where it applies. Both are kept, so later solves on the same `Pia` (other
+/// targets, other moving sets) start at once.
 #[derive(Debug, Clone)]
 pub struct Pia {
     limit: StencilTable,
