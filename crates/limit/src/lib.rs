@@ -47,6 +47,7 @@ pub mod local;
 pub mod loop_patch;
 pub mod masks;
 pub mod patch;
+mod smooth_closed;
 pub mod stam;
 mod table;
 mod two_phase_closed;
@@ -160,7 +161,10 @@ pub fn base_limit(
 }
 
 /// The limit positions of [`base_limit`] alone (the same rows), for callers that need no
-/// tangents, such as interpolation: about a third of the work.
+/// tangents, such as interpolation: about a third of the work. On closed smooth meshes of
+/// quads (Catmull-Clark) or triangles (Loop) with no vertex of valence 2
+/// ([`Topology::is_closed_smooth_uniform`]) the rows are written straight from the
+/// classical smooth masks, without building level 0's rules.
 ///
 /// ```
 /// use subd_mesh::TopologyBuilder;
@@ -181,6 +185,9 @@ pub fn base_limit_positions(
     scheme: Scheme,
     options: &Options,
 ) -> Result<StencilTable, LimitError> {
+    if smooth_closed::applies(topology, scheme) {
+        return Ok(smooth_closed::positions(topology, scheme));
+    }
     match whole_refinement(topology, scheme, options)? {
         Some((r, levels)) => positions_through(&r, levels),
         None => Ok(local::base_limit(topology, scheme, options)?.position),

@@ -318,7 +318,7 @@ impl LimitStencilTable {
 
 /// Writes a ring mask of vertex `v` as a stencil row: face terms first, then edge terms, then
 /// the vertex (OpenSubdiv's summation order); zero weights are left out.
-fn emit(t: &Topology, v: usize, m: &RingMask, sink: &mut RowSink) {
+pub(crate) fn emit(t: &Topology, v: usize, m: &RingMask, sink: &mut RowSink) {
     ring_terms(t, v, m, |i, w| sink.add(i, w));
 }
 

@@ -17,37 +17,15 @@
 //! phase 1 do not depend on `λ`). Valence 2 is left to the general path, whose limit there
 //! comes from the eigen analysis.
 
-use rayon::prelude::*;
 use subd_mesh::Topology;
 use subd_schemes::two_phase::ALPHA;
 use subd_schemes::{StencilTable, TwoPhase};
 
-/// Faces or vertices per parallel block of the qualification checks.
-const CHUNK: usize = 4096;
-
 /// Whether formula (2) gives every vertex's two-phase limit: one `λ` per vertex, the mesh
-/// closed and smooth ([`Topology::is_closed_and_smooth`]), all faces quads with four distinct
-/// vertices, every vertex of valence at least 3.
+/// closed and smooth, all faces quads with four distinct vertices, every vertex of valence
+/// at least 3 ([`Topology::is_closed_smooth_uniform`]).
 pub(crate) fn applies(t: &Topology, two_phase: &TwoPhase) -> bool {
-    two_phase.lambda().len() == t.num_vertices()
-        && (0..t.num_faces())
-            .into_par_iter()
-            .with_min_len(CHUNK)
-            .all(|f| {
-                let fv = t.face_vertices(f);
-                fv.len() == 4
-                    && fv[0] != fv[1]
-                    && fv[0] != fv[2]
-                    && fv[0] != fv[3]
-                    && fv[1] != fv[2]
-                    && fv[1] != fv[3]
-                    && fv[2] != fv[3]
-            })
-        && (0..t.num_vertices())
-            .into_par_iter()
-            .with_min_len(CHUNK)
-            .all(|v| t.vertex_faces(v).len() >= 3)
-        && t.is_closed_and_smooth()
+    two_phase.lambda().len() == t.num_vertices() && t.is_closed_smooth_uniform(4)
 }
 
 /// The limit-position table of formula (2), rows in the order of the general path's limit

@@ -324,6 +324,33 @@ impl Topology {
                 })
     }
 
+    /// `true` when the mesh is [closed and smooth](Topology::is_closed_and_smooth), every
+    /// face has `face_size` distinct vertices and every vertex has at least 3 faces. On such
+    /// a mesh (quads for Catmull-Clark, triangles for Loop) every vertex's limit is its
+    /// scheme's classical smooth mask over its one-ring, so limit stencils can be written
+    /// straight from the topology.
+    ///
+    /// ```
+    /// let torus = subd_mesh::primitives::torus(4, 4, 3.0, 1.0);
+    /// assert!(torus.topology.is_closed_smooth_uniform(4));
+    /// assert!(!torus.topology.is_closed_smooth_uniform(3));
+    /// ```
+    pub fn is_closed_smooth_uniform(&self, face_size: usize) -> bool {
+        const CHUNK: usize = 4096;
+        (0..self.num_faces())
+            .into_par_iter()
+            .with_min_len(CHUNK)
+            .all(|f| {
+                let fv = self.face_vertices(f);
+                fv.len() == face_size && (1..fv.len()).all(|k| !fv[..k].contains(&fv[k]))
+            })
+            && (0..self.num_vertices())
+                .into_par_iter()
+                .with_min_len(CHUNK)
+                .all(|v| self.vertex_faces(v).len() >= 3)
+            && self.is_closed_and_smooth()
+    }
+
     /// Tags: crease and corner sharpness, holes.
     #[inline]
     pub fn tags(&self) -> &Tags {

@@ -229,7 +229,14 @@ impl Pia {
             PiaScheme::Loop => 3,
             _ => 4,
         };
-        let classical = has_classical_masks(topology, face_size);
+        // Where every vertex takes its scheme's classical smooth mask, row `i` is `c_i` times
+        // one weight for each edge neighbour, another for each face-diagonal vertex and one
+        // for the vertex itself: Catmull-Clark 4, 1 and `n²` over `n (n + 5)`; two-phase
+        // `β_n` and `3 β_n / 10` (formula (2); the ratio does not depend on `λ`, seed 000
+        // eqs. 17–18); Loop one weight for the whole ring. Scaled by the edge weight, `D`
+        // holds 1 at edge neighbours and `1/4` or `3/10` at diagonal ones on every row
+        // alike: `M̄ = C D` with `D` symmetric by construction.
+        let classical = topology.is_closed_smooth_uniform(face_size);
         // Rows of the classical masks: the vertex, its edge neighbours and (quads) its
         // face-diagonal vertices.
         let row_len = |v: usize| 1 + (face_size - 2) * topology.vertex_edges(v).len();
@@ -374,32 +381,6 @@ impl Pia {
         let flags = moving.flags(n)?;
         Ok(ReducedSystem::from_full(&self.full, targets, &flags))
     }
-}
-
-/// Whether every limit row is the scheme's classical smooth mask: the mesh closed and
-/// smooth ([`Topology::is_closed_and_smooth`]), every face of `face_size` distinct vertices
-/// (quads for Catmull-Clark and two-phase, triangles for Loop), every vertex of valence at
-/// least 3. Row `i` is then `c_i` times one weight for each edge neighbour, another for
-/// each face-diagonal vertex and one for the vertex itself: Catmull-Clark 4, 1 and `n²`
-/// over `n (n + 5)`; two-phase `β_n` and `3 β_n / 10` (formula (2); the ratio does not
-/// depend on `λ`, seed 000 eqs. 17–18); Loop one weight for the whole ring. Scaled by the
-/// edge weight, `D` holds 1 at edge neighbours and `1/4` or `3/10` at diagonal ones on
-/// every row alike, so `M̄ = C D` with `D` symmetric by construction.
-fn has_classical_masks(t: &Topology, face_size: usize) -> bool {
-    use rayon::prelude::*;
-    const CHUNK: usize = 4096;
-    (0..t.num_faces())
-        .into_par_iter()
-        .with_min_len(CHUNK)
-        .all(|f| {
-            let fv = t.face_vertices(f);
-            fv.len() == face_size && (1..fv.len()).all(|k| !fv[..k].contains(&fv[k]))
-        })
-        && (0..t.num_vertices())
-            .into_par_iter()
-            .with_min_len(CHUNK)
-            .all(|v| t.vertex_faces(v).len() >= 3)
-        && t.is_closed_and_smooth()
 }
 
 /// Length of the diagonal of the axis-aligned bounding box of `points`.
