@@ -411,12 +411,12 @@ fn axpy3(x: &mut [DVec3], a: DVec3, y: &[DVec3]) {
 /// With checkerboard `signs` the method is preconditioned by `S M̄ S`
 /// ([`crate::checkerboard`]), self-adjoint and positive in the same inner product
 /// (`C⁻¹ S M̄ S = S D S`). A step is two matrix passes and one vector sweep:
-/// * the sweep: `x += α p`, `r̃ −= α S q` with `max |r_i|` and `⟨r, r⟩`. The residual is
-///   kept signed, `r̃ = S r`, so that the preconditioner's pass gathers plain values;
-/// * (preconditioned) `z = S M̄ r̃ = S M̄ S r` with `⟨r, z⟩`;
+/// * (preconditioned) `z = S M̄ r̃ = S M̄ S r` with `⟨r, z⟩`. The residual is kept signed,
+///   `r̃ = S r` (the same max-norm), so that this pass gathers plain values;
 /// * the new direction `p ← z + β p` together with `q ← M̄ z + β q`, which equals `M̄ p` by
 ///   linearity, and `⟨p, q⟩`: no separate pass for `M̄ p`. The drift this recurrence adds
-///   is caught by the true residual at the end, which restarts the method if needed.
+///   is caught by the true residual at the end, which restarts the method if needed;
+/// * the sweep: `x += α p`, `r̃ −= α S q` with `max |r_i|` and `⟨r, r⟩`.
 fn cg(
     s: &ReducedSystem,
     c: &[f64],
