@@ -14,7 +14,7 @@ use std::sync::{Arc, OnceLock};
 
 use glam::DVec3;
 use rayon::prelude::*;
-use subd_schemes::StencilTable;
+use subd_schemes::{StencilTable, memory};
 
 use crate::checkerboard::Preconditioned;
 
@@ -66,8 +66,7 @@ impl FullSystem {
         classical_row_len: Option<&(dyn Fn(usize) -> usize + Sync)>,
     ) -> FullSystem {
         let all = vec![true; limit.num_rows()];
-        let zero = vec![DVec3::ZERO; limit.num_rows()];
-        let (matrix, _, _) = restrict(limit.num_rows(), |i| limit.row(i), &zero, &all);
+        let (matrix, _, _) = restrict(limit.num_rows(), |i| limit.row(i), None, &all);
         let symmetrizer = OnceLock::new();
         if let Some(len) = classical_row_len
             && (0..matrix.len())
@@ -129,13 +128,15 @@ pub(crate) struct ReducedSystem {
     full: Option<Arc<FullSystem>>,
 }
 
-/// Restricts a square `limit` to the moving vertices: the matrix, the right side and the
-/// moving vertices. Rows are taken in parallel blocks (one scratch row per block), then
-/// concatenated in order.
+/// Restricts a square `limit` to the moving vertices: the matrix (rounding noise dropped,
+/// columns renumbered and sorted), the right side when `targets` are given (empty
+/// otherwise) and the moving vertices. One parallel pass counts each row's entries, a
+/// second writes the rows straight into arrays of the final size (no per-block buffers
+/// copied together afterwards).
 fn restrict<'a>(
     nv: usize,
     limit_row: impl Fn(usize) -> (&'a [u32], &'a [f64]) + Sync,
-    targets: &[DVec3],
+    targets: Option<&[DVec3]>,
     is_moving: &[bool],
 ) -> (Matrix, Vec<DVec3>, Vec<u32>) {
     let mut index = vec![u32::MAX; nv];
@@ -143,47 +144,100 @@ fn restrict<'a>(
     for (k, &v) in moving.iter().enumerate() {
         index[v as usize] = k as u32;
     }
-    struct Block {
-        rows: RowBlock,
-        rhs: Vec<DVec3>,
+    let n = moving.len();
+    // The row's entries that stay: couplings between moving vertices, renumbered.
+    let kept = |v: u32| {
+        let (c, w) = limit_row(v as usize);
+        c.iter()
+            .zip(w)
+            .filter(|e| e.1.abs() >= DROP)
+            .filter_map(|(&j, &x)| match index[j as usize] {
+                u32::MAX => None,
+                k => Some((k, x)),
+            })
+    };
+    let counts: Vec<u32> = moving
+        .par_iter()
+        .with_min_len(CHUNK)
+        .map(|&v| kept(v).count() as u32)
+        .collect();
+    let mut offsets = Vec::with_capacity(n + 1);
+    offsets.push(0u32);
+    let mut end = 0u32;
+    for &c in &counts {
+        end += c;
+        offsets.push(end);
     }
-    let blocks: Vec<Block> = moving
-        .par_chunks(CHUNK)
+    let mut cols: Vec<u32> = memory::zeroed(end as usize);
+    let mut weights: Vec<f64> = memory::zeroed(end as usize);
+    let (mut diag, mut off_diag_max) = (vec![0.0; n], vec![0.0; n]);
+    // Each block of CHUNK rows gets its own part of the entry arrays.
+    let mut parts = Vec::with_capacity(n.div_ceil(CHUNK));
+    let (mut cols_rest, mut weights_rest) = (&mut cols[..], &mut weights[..]);
+    for first in (0..n).step_by(CHUNK) {
+        let len = (offsets[(first + CHUNK).min(n)] - offsets[first]) as usize;
+        let (c, c_rest) = std::mem::take(&mut cols_rest).split_at_mut(len);
+        let (w, w_rest) = std::mem::take(&mut weights_rest).split_at_mut(len);
+        parts.push((c, w));
+        (cols_rest, weights_rest) = (c_rest, w_rest);
+    }
+    parts
+        .into_par_iter()
+        .zip(diag.par_chunks_mut(CHUNK))
+        .zip(off_diag_max.par_chunks_mut(CHUNK))
         .enumerate()
-        .map(|(k, rows)| {
-            let first = k * CHUNK;
-            let mut blk = Block {
-                rows: RowBlock::with_rows(rows.len()),
-                rhs: Vec::with_capacity(rows.len()),
-            };
+        .for_each(|(b, (((cols, weights), diag), off))| {
+            let first = b * CHUNK;
             let mut row: Vec<(u32, f64)> = Vec::with_capacity(32);
-            for &v in rows {
-                let (c, w) = limit_row(v as usize);
+            let mut at = 0;
+            for (r, &v) in moving[first..first + diag.len()].iter().enumerate() {
                 row.clear();
+                row.extend(kept(v));
+                row.sort_unstable_by_key(|e| e.0);
+                (diag[r], off[r]) = row_stats((first + r) as u32, &row);
+                for &(j, x) in &row {
+                    cols[at] = j;
+                    weights[at] = x;
+                    at += 1;
+                }
+            }
+        });
+    let rhs = match targets {
+        Some(targets) => moving
+            .par_iter()
+            .with_min_len(CHUNK)
+            .map(|&v| {
+                let (c, w) = limit_row(v as usize);
                 let mut b = targets[v as usize];
                 for (&j, &x) in c.iter().zip(w) {
-                    if x.abs() < DROP {
-                        continue;
-                    }
-                    match index[j as usize] {
-                        u32::MAX => b -= x * targets[j as usize],
-                        k => row.push((k, x)),
+                    if x.abs() >= DROP && index[j as usize] == u32::MAX {
+                        b -= x * targets[j as usize];
                     }
                 }
-                row.sort_unstable_by_key(|e| e.0);
-                blk.rows.push_row(first, &row);
-                blk.rhs.push(b);
-            }
-            blk
-        })
-        .collect();
-    let mut rhs = Vec::with_capacity(moving.len());
-    let mut rows = Vec::with_capacity(blocks.len());
-    for blk in blocks {
-        rhs.extend_from_slice(&blk.rhs);
-        rows.push(blk.rows);
-    }
-    (Matrix::from_blocks(rows), rhs, moving)
+                b
+            })
+            .collect(),
+        None => Vec::new(),
+    };
+    let matrix = Matrix {
+        offsets,
+        cols,
+        weights,
+        diag,
+        off_diag_max,
+    };
+    (matrix, rhs, moving)
+}
+
+/// The diagonal entry and the largest off-diagonal `|weight|` of row `i`.
+fn row_stats(i: u32, row: &[(u32, f64)]) -> (f64, f64) {
+    row.iter().fold((0.0, 0.0f64), |(d, off), &(j, x)| {
+        if j == i {
+            (x, off)
+        } else {
+            (d, off.max(x.abs()))
+        }
+    })
 }
 
 /// Consecutive rows of a [`Matrix`] built by one parallel task.
@@ -211,13 +265,8 @@ impl RowBlock {
     /// of the block's first row, to pick out the diagonal.
     pub fn push_row(&mut self, first: usize, row: &[(u32, f64)]) {
         let i = (first + self.counts.len()) as u32;
-        let (mut d, mut off) = (0.0, 0.0f64);
+        let (d, off) = row_stats(i, row);
         for &(j, x) in row {
-            if j == i {
-                d = x;
-            } else {
-                off = off.max(x.abs());
-            }
             self.cols.push(j);
             self.weights.push(x);
         }
@@ -232,7 +281,7 @@ impl ReducedSystem {
     #[cfg(test)]
     pub fn new(limit: &StencilTable, targets: &[DVec3], is_moving: &[bool]) -> ReducedSystem {
         let (matrix, rhs, moving) =
-            restrict(limit.num_rows(), |i| limit.row(i), targets, is_moving);
+            restrict(limit.num_rows(), |i| limit.row(i), Some(targets), is_moving);
         ReducedSystem {
             matrix: Arc::new(matrix),
             rhs,
@@ -258,7 +307,7 @@ impl ReducedSystem {
                 full: Some(Arc::clone(full)),
             };
         }
-        let (matrix, rhs, moving) = restrict(targets.len(), |i| m.row(i), targets, is_moving);
+        let (matrix, rhs, moving) = restrict(targets.len(), |i| m.row(i), Some(targets), is_moving);
         ReducedSystem {
             matrix: Arc::new(matrix),
             rhs,

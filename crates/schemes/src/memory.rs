@@ -44,7 +44,12 @@ pub fn huge_pages() -> bool {
 ///
 /// The large case allocates without zeroing, advises, and then zeroes: `calloc` would clear
 /// memory it reuses from the heap before the advice could take effect, taking 4 KiB faults.
-pub(crate) fn zeroed<T: bytemuck::Zeroable + Clone + Send + Sync>(len: usize) -> Vec<T> {
+///
+/// ```
+/// let v: Vec<f64> = subd_schemes::memory::zeroed(1 << 20);
+/// assert!(v.len() == 1 << 20 && v.iter().all(|&x| x == 0.0));
+/// ```
+pub fn zeroed<T: bytemuck::Zeroable + Clone + Send + Sync>(len: usize) -> Vec<T> {
     let bytes = len.saturating_mul(std::mem::size_of::<T>());
     if !huge_pages() || bytes < HUGE_PAGE_MIN_BYTES {
         return bytemuck::allocation::zeroed_vec(len);
