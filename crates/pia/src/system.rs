@@ -161,15 +161,15 @@ fn restrict<'a>(
         .with_min_len(CHUNK)
         .map(|&v| kept(v).count() as u32)
         .collect();
-    let mut offsets = Vec::with_capacity(n + 1);
-    offsets.push(0u32);
-    let mut end = 0u32;
-    for &c in &counts {
-        end += c;
-        offsets.push(end);
-    }
-    let mut cols: Vec<u32> = memory::zeroed(end as usize);
-    let mut weights: Vec<f64> = memory::zeroed(end as usize);
+    let offsets: Vec<u32> = std::iter::once(0)
+        .chain(counts.iter().scan(0u32, |end, &c| {
+            *end += c;
+            Some(*end)
+        }))
+        .collect();
+    let nnz = offsets[n] as usize;
+    let mut cols: Vec<u32> = memory::zeroed(nnz);
+    let mut weights: Vec<f64> = memory::zeroed(nnz);
     let (mut diag, mut off_diag_max) = (vec![0.0; n], vec![0.0; n]);
     // Each block of CHUNK rows gets its own part of the entry arrays.
     let mut parts = Vec::with_capacity(n.div_ceil(CHUNK));
