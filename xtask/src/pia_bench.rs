@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
 
-use subd_pia::{Method, Moving, Pia, PiaOptions, PiaScheme, Solver};
+use subd_pia::{Method, Moving, Pia, PiaError, PiaOptions, PiaScheme, Solver};
 use subd_schemes::{Options, TwoPhase};
 
 use crate::bench::{median, quad_bench_mesh};
@@ -21,7 +21,7 @@ pub fn run(repeats: usize) -> Result<(), String> {
     let threads = rayon::current_num_threads();
     println!();
     println!(
-        "PIA to max error 1e-10 × diagonal, closed quad torus, {nv} vertices (every vertex moves), {threads} threads, median of {repeats} runs; ratio = time / the paper's iteration's time; 'setup' is Pia::new (limit-position stencils in the solvers' form), 'prepare' Pia::prepare (symmetric form, Chebyshev operator, built once), 'solve' the median of repeated solves on one prepared Pia, 'cold' the first solve on a fresh unprepared one (median over as many fresh ones)"
+        "PIA to max error 1e-10 × diagonal, closed quad torus, {nv} vertices (every vertex moves), {threads} threads, median of {repeats} runs; ratio = time / the paper's iteration's time; 'setup' is Pia::new (limit-position stencils in the solvers' form), 'prepare' Pia::prepare (Chebyshev operator, and the symmetric form where setup did not know it; built once), 'solve' the median of repeated solves on one prepared Pia, 'cold' the first solve on a fresh unprepared one (median over as many fresh ones)"
     );
     println!(
         "{:<14} {:<10} {:<14} {:>6} {:>10} {:>10} {:>10} {:>7} {:>10} {:>7} {:>12}",
@@ -59,19 +59,12 @@ pub fn run(repeats: usize) -> Result<(), String> {
                 })
                 .collect::<Result<Vec<_>, _>>()?,
         );
-        let prepare = median(
-            (0..repeats)
-                .map(|_| {
-                    let p = Pia::new(&mesh.topology, &scheme, &Options::default())
-                        .map_err(|e| e.to_string())?;
-                    let t = Instant::now();
-                    p.prepare();
-                    Ok(t.elapsed().as_secs_f64())
-                })
-                .collect::<Result<Vec<_>, String>>()?,
-        );
-        let pia =
-            Pia::new(&mesh.topology, &scheme, &Options::default()).map_err(|e| e.to_string())?;
+        let fresh = || Pia::new(&mesh.topology, &scheme, &Options::default());
+        let prepare = median_on_fresh(repeats, fresh, |p| {
+            p.prepare();
+            Ok(())
+        })?;
+        let pia = fresh().map_err(|e| e.to_string())?;
         pia.prepare();
         let (mut plain, mut plain_cold) = (None, None);
         for (sname, solver) in [
@@ -88,21 +81,11 @@ pub fn run(repeats: usize) -> Result<(), String> {
                 max_iter: 100_000,
             };
             // Cold: the first solve on a fresh, unprepared `Pia`, which also builds what this
-            // solver needs beyond the limit matrix (symmetric form, Chebyshev operator);
-            // median over `repeats` fresh ones.
-            let cold = median(
-                (0..repeats)
-                    .map(|_| {
-                        let fresh = Pia::new(&mesh.topology, &scheme, &Options::default())
-                            .map_err(|e| e.to_string())?;
-                        let t = Instant::now();
-                        fresh
-                            .solve(&mesh.positions, &Moving::All, &opts)
-                            .map_err(|e| e.to_string())?;
-                        Ok(t.elapsed().as_secs_f64())
-                    })
-                    .collect::<Result<Vec<_>, String>>()?,
-            );
+            // solver needs beyond the limit matrix (the symmetric form where setup did not
+            // know it, the Chebyshev operator); median over `repeats` fresh ones.
+            let cold = median_on_fresh(repeats, fresh, |p| {
+                p.solve(&mesh.positions, &Moving::All, &opts).map(|_| ())
+            })?;
             let base_cold = *plain_cold.get_or_insert(cold);
             let mut times = Vec::new();
             let mut last = None;
@@ -191,6 +174,24 @@ fn fetch_bunny(dest: &Path) -> Result<(), String> {
     } else {
         Err("could not unpack StanfordBunny.ply".into())
     }
+}
+
+/// The median time of `work` over `repeats` fresh `Pia`s (each built by `new`, outside the
+/// timing).
+fn median_on_fresh(
+    repeats: usize,
+    new: impl Fn() -> Result<Pia, PiaError>,
+    work: impl Fn(&Pia) -> Result<(), PiaError>,
+) -> Result<f64, String> {
+    let times = (0..repeats)
+        .map(|_| {
+            let p = new().map_err(|e| e.to_string())?;
+            let t = Instant::now();
+            work(&p).map_err(|e| e.to_string())?;
+            Ok(t.elapsed().as_secs_f64())
+        })
+        .collect::<Result<Vec<_>, String>>()?;
+    Ok(median(times))
 }
 
 /// Loop PIA on the bunny scan, end to end: read, limit stencils, solve, independent check,

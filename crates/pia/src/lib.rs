@@ -256,16 +256,12 @@ impl Pia {
     /// # Panics
     /// If the table is not square.
     pub fn from_limit_table(limit: StencilTable) -> Pia {
-        Pia::with_signs(limit, None)
-    }
-
-    fn with_signs(limit: StencilTable, signs: Option<Arc<Vec<f64>>>) -> Pia {
         assert_eq!(
             limit.num_rows(),
             limit.num_sources(),
             "a square limit table"
         );
-        let full = Arc::new(FullSystem::new(&limit, signs, None));
+        let full = Arc::new(FullSystem::new(&limit, None, None));
         Pia { limit, full }
     }
 
