@@ -223,7 +223,7 @@ impl Pia {
         // Loop's mask has no checkerboard structure (and triangles no two-colouring).
         let signs = match scheme {
             PiaScheme::Loop => None,
-            _ => checkerboard::checkerboard_signs(topology).map(Arc::new),
+            _ => checkerboard::checkerboard_signs(topology),
         };
         let face_size = match scheme {
             PiaScheme::Loop => 3,

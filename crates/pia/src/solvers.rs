@@ -40,10 +40,11 @@ pub enum Solver {
     /// eigenvalues of `M̄`.
     Weighted,
     /// Conjugate gradients on the symmetric form of `M̄ = C D` (seed 000 eqs. 17–18),
-    /// preconditioned by the checkerboard-conjugated matrix where the mesh is two-coloured
-    /// ([`crate::checkerboard`]); BiCGSTAB when there is no such `C`.
+    /// preconditioned by the checkerboard-conjugated, diagonally scaled matrix `T M̄ T` where
+    /// the mesh is two-coloured ([`crate::checkerboard`]); BiCGSTAB when there is no such
+    /// `C`.
     Cg,
-    /// Chebyshev iteration on the checkerboard-preconditioned system `S M̄ S M̄ x = S M̄ S b`
+    /// Chebyshev iteration on the checkerboard-preconditioned system `T M̄ T M̄ x = T M̄ T b`
     /// (Catmull-Clark and two-phase on two-coloured meshes with a symmetric form), one
     /// matrix pass per step; CG where it does not apply. Its operator and spectral interval
     /// are built on first use (about as long as a CG solve) and kept by the `Pia` when
@@ -70,8 +71,9 @@ pub enum Method {
     },
     /// Conjugate gradients on the symmetrised system.
     Cg,
-    /// Conjugate gradients preconditioned by the checkerboard-conjugated limit matrix
-    /// (quad meshes whose vertices are two-coloured along edges; see [`Solver::Cg`]).
+    /// Conjugate gradients preconditioned by the checkerboard-conjugated, diagonally scaled
+    /// limit matrix (quad meshes whose vertices are two-coloured along edges; see
+    /// [`Solver::Cg`]).
     CheckerboardCg,
     /// BiCGSTAB (no symmetric form, or CG met a non-positive curvature).
     Bicgstab,
@@ -152,7 +154,7 @@ pub(crate) fn solve(
         }
         Solver::Cg => Ok(krylov(s, x0, ctl)),
         Solver::Chebyshev => {
-            let Some(signs) = s.signs() else {
+            let Some(t) = s.conjugation() else {
                 return Ok(krylov(s, x0, ctl));
             };
             // The whole system keeps its operator; a cut of it (fixed vertices) builds its own.
@@ -162,12 +164,12 @@ pub(crate) fn solve(
                 None => {
                     local = s
                         .symmetrizer()
-                        .and_then(|c| Preconditioned::new(&s.matrix, &c, &signs));
+                        .and_then(|c| Preconditioned::new(&s.matrix, &c, &t));
                     local.as_ref()
                 }
             };
             match pre {
-                Some(pre) => Ok(chebyshev(s, pre, &signs, x0, ctl)),
+                Some(pre) => Ok(chebyshev(s, pre, &t, x0, ctl)),
                 None => Ok(krylov(s, x0, ctl)),
             }
         }
@@ -179,7 +181,7 @@ pub(crate) fn solve(
 /// CG on the symmetric form, BiCGSTAB where there is none or CG breaks down.
 fn krylov(s: &ReducedSystem, x0: Vec<DVec3>, ctl: Controls) -> Outcome {
     match s.symmetrizer() {
-        Some(c) => match cg(s, &c, s.signs().as_deref(), x0.clone(), ctl) {
+        Some(c) => match cg(s, &c, s.conjugation().as_deref(), x0.clone(), ctl) {
             Some(o) => o,
             None => bicgstab(s, x0, ctl),
         },
@@ -206,16 +208,15 @@ const WINDOW: usize = 2;
 /// dearer steps, is cheaper. `ρ` only grows as the fast modes die out, so the decision is
 /// taken again after every step.
 fn auto(s: &ReducedSystem, mut x: Vec<DVec3>, ctl: Controls) -> Outcome {
-    let signs = s.signs();
-    if let Some(signs) = &signs {
+    if let Some(t) = s.conjugation() {
         if let Some(pre) = s.whole_preconditioned(false) {
-            return chebyshev(s, pre, signs, x, ctl);
+            return chebyshev(s, pre, &t, x, ctl);
         }
-        // Checkerboard CG needs 10–15 steps of two passes where the iteration needs ~100
-        // passes or more (on regular regions its rate is about 1/7 per step against 8/9 per
-        // pass): start with it rather than probing the iteration first.
+        // Checkerboard CG needs 8–13 steps of two passes where the iteration needs ~100
+        // passes or more (its rate is about 1/7 per step against 8/9 per pass): start with
+        // it rather than probing the iteration first.
         if let Some(c) = s.symmetrizer()
-            && let Some(o) = cg(s, &c, Some(signs), x.clone(), ctl)
+            && let Some(o) = cg(s, &c, Some(&t), x.clone(), ctl)
         {
             return o;
         }
@@ -292,7 +293,7 @@ const INTERVAL_MARGIN: (f64, f64) = (0.05, 0.02);
 const FIRST_CHECKPOINT: f64 = 4.0;
 
 /// Chebyshev iteration (Saad, *Iterative Methods for Sparse Linear Systems*, 2nd ed.,
-/// Alg. 12.1) on `K x = f`, `K = S M̄ S M̄`, `f = S M̄ S b`, over the interval of `pre`,
+/// Alg. 12.1) on `K x = f`, `K = T M̄ T M̄`, `f = T M̄ T b`, over the interval of `pre`,
 /// in its three-term form
 ///
 /// ```text
@@ -310,7 +311,7 @@ const FIRST_CHECKPOINT: f64 = 4.0;
 pub(crate) fn chebyshev(
     s: &ReducedSystem,
     pre: &Preconditioned,
-    signs: &[f64],
+    t: &[f64],
     mut x: Vec<DVec3>,
     ctl: Controls,
 ) -> Outcome {
@@ -324,7 +325,7 @@ pub(crate) fn chebyshev(
     let mut steps = 0usize;
     if res > ctl.threshold && ctl.max_iter > 0 {
         let mut f = vec![DVec3::ZERO; n];
-        s.apply_conjugated(signs, &s.rhs, &mut f);
+        s.apply_conjugated(t, &s.rhs, &mut f);
         // x_{k−1}; overwritten by x_{k+1} in each pass (the first step does not read it).
         let mut older = vec![DVec3::ZERO; n];
         let rate = sigma.acosh();
@@ -408,28 +409,28 @@ fn axpy3(x: &mut [DVec3], a: DVec3, y: &[DVec3]) {
 /// the updated one has drifted. `None` when a non-positive curvature shows that `D` is not
 /// positive definite.
 ///
-/// With checkerboard `signs` the method is preconditioned by `S M̄ S`
+/// With the checkerboard scaling `t` (`T = S Δ⁻¹`) the method is preconditioned by `T M̄ T`
 /// ([`crate::checkerboard`]), self-adjoint and positive in the same inner product
-/// (`C⁻¹ S M̄ S = S D S`). A step is two matrix passes and one vector sweep:
-/// * (preconditioned) `z = S M̄ r̃ = S M̄ S r` with `⟨r, z⟩`. The residual is kept signed,
-///   `r̃ = S r` (the same max-norm), so that this pass gathers plain values;
+/// (`C⁻¹ T M̄ T = T D T`). A step is two matrix passes and one vector sweep:
+/// * (preconditioned) `z = T M̄ r̃ = T M̄ T r` with `⟨r, z⟩`. The residual is kept
+///   scaled, `r̃ = T r`, so that this pass gathers plain values;
 /// * the new direction `p ← z + β p` together with `q ← M̄ z + β q`, which equals `M̄ p` by
 ///   linearity, and `⟨p, q⟩`: no separate pass for `M̄ p`. The drift this recurrence adds
 ///   is caught by the true residual at the end, which restarts the method if needed;
-/// * the sweep: `x += α p`, `r̃ −= α S q` with `max |r_i|` and `⟨r, r⟩`.
+/// * the sweep: `x += α p`, `r̃ −= α T q` with `max |r_i|` and `⟨r, r⟩`.
 fn cg(
     s: &ReducedSystem,
     c: &[f64],
-    signs: Option<&[f64]>,
+    t: Option<&[f64]>,
     mut x: Vec<DVec3>,
     ctl: Controls,
 ) -> Option<Outcome> {
     let n = s.len();
     let weight: Vec<f64> = c.iter().map(|c| 1.0 / c).collect();
-    // The signed residual S r (r itself without signs), the preconditioned residual
-    // (only with signs), the direction and its product with M̄.
+    // The scaled residual T r (r itself without T), the preconditioned residual (only
+    // with T), the direction and its product with M̄.
     let mut r = vec![DVec3::ZERO; n];
-    let mut z = if signs.is_some() {
+    let mut z = if t.is_some() {
         vec![DVec3::ZERO; n]
     } else {
         Vec::new()
@@ -442,7 +443,7 @@ fn cg(
             .zip([scale.x, scale.y, scale.z])
             .any(|(&a, b)| b != 0.0 && a.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater))
     };
-    let mut res = s.signed_residual(signs, &x, &mut r);
+    let mut res = s.scaled_residual(t, &x, &mut r);
     let mut history = vec![res];
     let mut steps = 0usize;
     while res > ctl.threshold && steps < ctl.max_iter {
@@ -450,9 +451,9 @@ fn cg(
         // ρ of the step before (none on the first step, whose direction is z itself).
         let mut rho: Option<DVec3> = None;
         loop {
-            // ρ = ⟨r, z⟩ with z = S M̄ S r (preconditioned) or z = r.
-            let rho_new = match signs {
-                Some(sg) => s.precondition_pass(&weight, sg, &r, &mut z),
+            // ρ = ⟨r, z⟩ with z = T M̄ T r (preconditioned) or z = r.
+            let rho_new = match t {
+                Some(t) => s.precondition_pass(&weight, t, &r, &mut z),
                 None => rr,
             };
             if not_positive(rho_new, rr) {
@@ -460,13 +461,13 @@ fn cg(
             }
             let beta = rho.map(|old| safe_div(rho_new, old));
             rho = Some(rho_new);
-            let direction = if signs.is_some() { &z } else { &r };
+            let direction = if t.is_some() { &z } else { &r };
             let pq = s.direction_pass(&weight, direction, beta, &mut p, &mut q);
             if not_positive(pq, rho_new) {
                 return None;
             }
             let alpha = safe_div(rho_new, pq);
-            let (rr_new, error) = cg_update(&mut x, &mut r, alpha, &p, &q, signs, &weight);
+            let (rr_new, error) = cg_update(&mut x, &mut r, alpha, &p, &q, t, &weight);
             steps += 1;
             history.push(error);
             if error <= ctl.threshold || steps >= ctl.max_iter {
@@ -474,10 +475,10 @@ fn cg(
             }
             rr = rr_new;
         }
-        res = s.signed_residual(signs, &x, &mut r);
+        res = s.scaled_residual(t, &x, &mut r);
         *history.last_mut().expect("one step taken") = res;
     }
-    let method = if signs.is_some() {
+    let method = if t.is_some() {
         Method::CheckerboardCg
     } else {
         Method::Cg
@@ -501,16 +502,16 @@ fn weighted_dot(a: &[DVec3], b: &[DVec3], w: &[f64]) -> DVec3 {
     partial.into_iter().fold(DVec3::ZERO, |s, x| s + x)
 }
 
-/// One fused CG update: `x += α p`, `r̃ −= α S q` (`S` the diagonal of `signs`, the
-/// identity when `None`); returns `⟨r, r⟩` (blocks summed in order) and the interpolation
-/// error `max |r_i|`.
+/// One fused CG update: `x += α p`, `r̃ −= α T q` (`T` the diagonal of `t`, the identity
+/// when `None`); returns `⟨r, r⟩` (blocks summed in order) and the interpolation error
+/// `max |r_i|`, both of the unscaled `r = T⁻¹ r̃`.
 fn cg_update(
     x: &mut [DVec3],
     r: &mut [DVec3],
     alpha: DVec3,
     p: &[DVec3],
     q: &[DVec3],
-    signs: Option<&[f64]>,
+    t: Option<&[f64]>,
     weight: &[f64],
 ) -> (DVec3, f64) {
     let partial: Vec<(DVec3, f64)> = x
@@ -521,7 +522,7 @@ fn cg_update(
         .zip(weight.par_chunks(CHUNK))
         .enumerate()
         .map(|(c, ((((x, r), p), q), w))| {
-            let sg = signs.map(|s| &s[c * CHUNK..]);
+            let t = t.map(|t| &t[c * CHUNK..]);
             let (mut rr, mut m) = (DVec3::ZERO, 0.0f64);
             for (k, ((((x, r), p), q), &w)) in x
                 .iter_mut()
@@ -533,12 +534,18 @@ fn cg_update(
             {
                 *x += alpha * *p;
                 let step = alpha * *q;
-                *r -= match sg {
-                    Some(sg) => sg[k] * step,
-                    None => step,
+                let unscaled = match t {
+                    Some(t) => {
+                        *r -= t[k] * step;
+                        *r / t[k]
+                    }
+                    None => {
+                        *r -= step;
+                        *r
+                    }
                 };
-                rr += w * (*r * *r);
-                m = m.max(finite_or_inf(r.length()));
+                rr += w * (unscaled * unscaled);
+                m = m.max(finite_or_inf(unscaled.length()));
             }
             (rr, m)
         })

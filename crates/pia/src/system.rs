@@ -16,7 +16,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 use subd_schemes::{StencilTable, memory};
 
-use crate::checkerboard::Preconditioned;
+use crate::checkerboard::{self, Preconditioned};
 
 /// Rows per parallel task; also the block size of the fixed-order reductions, so sums do
 /// not depend on the number of threads.
@@ -46,9 +46,10 @@ pub(crate) struct Matrix {
 pub(crate) struct FullSystem {
     pub matrix: Arc<Matrix>,
     symmetrizer: OnceLock<Option<Vec<f64>>>,
-    /// Checkerboard signs of the vertices for the preconditioner
-    /// ([`crate::checkerboard`]), where the scheme and mesh have them.
-    signs: Option<Arc<Vec<f64>>>,
+    /// The checkerboard preconditioner's scaling `T = S Δ⁻¹` (signs over the diagonal
+    /// of `M̄`, [`crate::checkerboard`]), where the scheme and mesh have the signs and
+    /// every diagonal entry is positive.
+    conjugation: Option<Arc<Vec<f64>>>,
     /// The explicitly preconditioned operator and its spectral interval, computed on first
     /// request.
     preconditioned: OnceLock<Option<Preconditioned>>,
@@ -59,10 +60,11 @@ impl FullSystem {
     /// to be a classical smooth limit mask (see [`crate::Pia::new`]), gives the number of
     /// entries that mask has at each vertex: rows of exactly that length have each ring
     /// vertex once, so their largest off-diagonal weight is the symmetrizer's entry and
-    /// the symmetric form is known without the pairwise check.
+    /// the symmetric form is known without the pairwise check. `signs` are the vertices'
+    /// checkerboard signs, where the scheme and mesh have them.
     pub fn new(
         limit: &StencilTable,
-        signs: Option<Arc<Vec<f64>>>,
+        signs: Option<Vec<f64>>,
         classical_row_len: Option<&(dyn Fn(usize) -> usize + Sync)>,
     ) -> FullSystem {
         let all = vec![true; limit.num_rows()];
@@ -82,22 +84,24 @@ impl FullSystem {
                 .set(Some(matrix.off_diag_max.clone()))
                 .expect("a fresh cell");
         }
+        let conjugation = signs.and_then(|s| checkerboard::conjugation(&s, &matrix.diag));
         FullSystem {
             matrix: Arc::new(matrix),
             symmetrizer,
-            signs,
+            conjugation: conjugation.map(Arc::new),
             preconditioned: OnceLock::new(),
         }
     }
 
-    /// `K = S M̄ S M̄` of the whole matrix with its spectral interval, when the scheme has
-    /// checkerboard signs and the matrix a symmetric form; computed on first request.
+    /// `K = T M̄ T M̄` of the whole matrix with its spectral interval, when the scheme has
+    /// the checkerboard scaling `T` and the matrix a symmetric form; computed on first
+    /// request.
     pub fn preconditioned(&self) -> Option<&Preconditioned> {
         self.preconditioned
             .get_or_init(|| {
-                let signs = self.signs.as_ref()?;
+                let t = self.conjugation.as_ref()?;
                 let c = self.symmetrizer()?;
-                Preconditioned::new(&self.matrix, c, signs)
+                Preconditioned::new(&self.matrix, c, t)
             })
             .as_ref()
     }
@@ -340,10 +344,11 @@ impl ReducedSystem {
         }
     }
 
-    /// Checkerboard signs of the unknowns, when the whole system has them.
-    pub fn signs(&self) -> Option<Vec<f64>> {
-        let signs = self.full.as_ref()?.signs.as_ref()?;
-        Some(self.moving.iter().map(|&v| signs[v as usize]).collect())
+    /// The checkerboard preconditioner's scaling `T = S Δ⁻¹` of the unknowns, when the
+    /// whole system has it (a cut keeps its rows, so its diagonal is the whole one's).
+    pub fn conjugation(&self) -> Option<Vec<f64>> {
+        let t = self.full.as_ref()?.conjugation.as_ref()?;
+        Some(self.moving.iter().map(|&v| t[v as usize]).collect())
     }
 
     /// Diagonal of `M̄`.
@@ -407,12 +412,12 @@ impl ReducedSystem {
             .reduce(|| 0.0, f64::max)
     }
 
-    /// `y = S M̄ S x` for the diagonal of signs `S`, in one pass.
-    pub fn apply_conjugated(&self, signs: &[f64], x: &[DVec3], y: &mut [DVec3]) {
+    /// `y = T M̄ T x` for the diagonal `T` of `t`, in one pass.
+    pub fn apply_conjugated(&self, t: &[f64], x: &[DVec3], y: &mut [DVec3]) {
         y.par_chunks_mut(CHUNK).enumerate().for_each(|(c, out)| {
             for (k, o) in out.iter_mut().enumerate() {
                 let i = c * CHUNK + k;
-                *o = signs[i] * self.gather(i, |j| signs[j] * x[j]);
+                *o = t[i] * self.gather(i, |j| t[j] * x[j]);
             }
         });
     }
@@ -450,23 +455,24 @@ impl ReducedSystem {
         acc
     }
 
-    /// `r̃ = S (b − M̄ x)` for the diagonal of signs `S` (the identity when `None`); returns
-    /// `max |r_i|` (the signs leave it unchanged).
-    pub fn signed_residual(&self, signs: Option<&[f64]>, x: &[DVec3], r: &mut [DVec3]) -> f64 {
-        match signs {
-            Some(sg) => self.residual_into(x, r, |i, ri| sg[i] * ri),
+    /// `r̃ = T (b − M̄ x)` for the diagonal `T` of `t` (the identity when `None`); returns
+    /// `max |r_i|` of the unscaled residual.
+    pub fn scaled_residual(&self, t: Option<&[f64]>, x: &[DVec3], r: &mut [DVec3]) -> f64 {
+        match t {
+            Some(t) => self.residual_into(x, r, |i, ri| t[i] * ri),
             None => self.residual(x, r),
         }
     }
 
-    /// The checkerboard preconditioner applied to the signed residual `r̃ = S r`:
-    /// `u = M̄ r̃`, written as `z = S u` (so `z = S M̄ S r`); returns `⟨r, z⟩ = Σ w_i r̃_i ⊙ u_i`
-    /// per coordinate, blocks summed in order. One pass, gathering plain `r̃`.
+    /// The checkerboard preconditioner applied to the scaled residual `r̃ = T r`:
+    /// `u = M̄ r̃`, written as `z = T u` (so `z = T M̄ T r`); returns
+    /// `⟨r, z⟩ = Σ w_i r̃_i ⊙ u_i` per coordinate, blocks summed in order. One pass,
+    /// gathering plain `r̃`.
     pub fn precondition_pass(
         &self,
         w: &[f64],
-        signs: &[f64],
-        r_signed: &[DVec3],
+        t: &[f64],
+        r_scaled: &[DVec3],
         z: &mut [DVec3],
     ) -> DVec3 {
         let partial: Vec<DVec3> = z
@@ -476,9 +482,9 @@ impl ReducedSystem {
                 let mut d = DVec3::ZERO;
                 for (k, o) in out.iter_mut().enumerate() {
                     let i = c * CHUNK + k;
-                    let u = self.gather(i, |j| r_signed[j]);
-                    *o = signs[i] * u;
-                    d += w[i] * (r_signed[i] * u);
+                    let u = self.gather(i, |j| r_scaled[j]);
+                    *o = t[i] * u;
+                    d += w[i] * (r_scaled[i] * u);
                 }
                 d
             })
