@@ -301,11 +301,17 @@ impl Pia {
             max_iter: options.max_iter,
         };
         let out = solvers::solve(&system, x0, options.solver, ctl)?;
-        let mut points = targets.to_vec();
-        for (&v, &x) in system.moving.iter().zip(&out.x) {
-            points[v as usize] = x;
-        }
         let last = *out.history.last().unwrap_or(&0.0);
+        // Every vertex moving: the unknowns are the points, in order.
+        let points = if system.len() == targets.len() {
+            out.x
+        } else {
+            let mut points = targets.to_vec();
+            for (&v, &x) in system.moving.iter().zip(&out.x) {
+                points[v as usize] = x;
+            }
+            points
+        };
         Ok(PiaResult {
             points,
             iterations: out.steps,

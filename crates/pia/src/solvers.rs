@@ -15,6 +15,8 @@ use glam::DVec3;
 use rayon::prelude::*;
 use serde::Serialize;
 
+use subd_schemes::memory;
+
 use crate::PiaError;
 use crate::checkerboard::Preconditioned;
 use crate::system::{CHUNK, Matrix, ReducedSystem, dot, finite_or_inf, max_norm, safe_div};
@@ -427,33 +429,31 @@ fn cg(
 ) -> Option<Outcome> {
     let n = s.len();
     let weight: Vec<f64> = c.iter().map(|c| 1.0 / c).collect();
-    // The scaled residual T r (r itself without T), the preconditioned residual (only
-    // with T), the direction and its product with M̄.
-    let mut r = vec![DVec3::ZERO; n];
-    let mut z = if t.is_some() {
-        vec![DVec3::ZERO; n]
-    } else {
-        Vec::new()
-    };
-    let mut p = vec![DVec3::ZERO; n];
-    let mut q = vec![DVec3::ZERO; n];
+    // The scaled residual T r (r itself without T), the direction, its product with M̄
+    // and the preconditioned residual (only with T), in one allocation: large enough for
+    // huge pages (`subd_schemes::memory`), one page fault per 2 MiB instead of per 4 KiB,
+    // which on a first solve took about a fifth of CG's time.
+    let mut work: Vec<DVec3> = memory::zeroed(if t.is_some() { 4 * n } else { 3 * n });
+    let (r, rest) = work.split_at_mut(n);
+    let (p, rest) = rest.split_at_mut(n);
+    let (q, z) = rest.split_at_mut(n);
     let not_positive = |v: DVec3, scale: DVec3| {
         [v.x, v.y, v.z]
             .iter()
             .zip([scale.x, scale.y, scale.z])
             .any(|(&a, b)| b != 0.0 && a.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater))
     };
-    let mut res = s.scaled_residual(t, &x, &mut r);
+    let mut res = s.scaled_residual(t, &x, r);
     let mut history = vec![res];
     let mut steps = 0usize;
     while res > ctl.threshold && steps < ctl.max_iter {
-        let mut rr = weighted_dot(&r, &r, &weight);
+        let mut rr = weighted_dot(r, r, &weight);
         // ρ of the step before (none on the first step, whose direction is z itself).
         let mut rho: Option<DVec3> = None;
         loop {
             // ρ = ⟨r, z⟩ with z = T M̄ T r (preconditioned) or z = r.
             let rho_new = match t {
-                Some(t) => s.precondition_pass(&weight, t, &r, &mut z),
+                Some(t) => s.precondition_pass(&weight, t, r, z),
                 None => rr,
             };
             if not_positive(rho_new, rr) {
@@ -461,13 +461,13 @@ fn cg(
             }
             let beta = rho.map(|old| safe_div(rho_new, old));
             rho = Some(rho_new);
-            let direction = if t.is_some() { &z } else { &r };
-            let pq = s.direction_pass(&weight, direction, beta, &mut p, &mut q);
+            let direction: &[DVec3] = if t.is_some() { z } else { r };
+            let pq = s.direction_pass(&weight, direction, beta, p, q);
             if not_positive(pq, rho_new) {
                 return None;
             }
             let alpha = safe_div(rho_new, pq);
-            let (rr_new, error) = cg_update(&mut x, &mut r, alpha, &p, &q, t, &weight);
+            let (rr_new, error) = cg_update(&mut x, r, alpha, p, q, t, &weight);
             steps += 1;
             history.push(error);
             if error <= ctl.threshold || steps >= ctl.max_iter {
@@ -475,7 +475,7 @@ fn cg(
             }
             rr = rr_new;
         }
-        res = s.scaled_residual(t, &x, &mut r);
+        res = s.scaled_residual(t, &x, r);
         *history.last_mut().expect("one step taken") = res;
     }
     let method = if t.is_some() {

@@ -10,6 +10,7 @@
 //!
 //! and the residual `b − M̄ x` is exactly the paper's difference vector `D_P = p_P − v∞_P`.
 
+use std::borrow::Cow;
 use std::sync::{Arc, OnceLock};
 
 use glam::DVec3;
@@ -322,11 +323,21 @@ impl ReducedSystem {
 
     /// `C` with `M̄ = C D`, `D` symmetric: cut from the whole system's when that has one,
     /// else found for this system alone.
-    pub fn symmetrizer(&self) -> Option<Vec<f64>> {
+    pub fn symmetrizer(&self) -> Option<Cow<'_, [f64]>> {
         if let Some(c) = self.full.as_ref().and_then(|f| f.symmetrizer()) {
-            return Some(self.moving.iter().map(|&v| c[v as usize]).collect());
+            return Some(self.cut(c));
         }
-        self.matrix.symmetrizer()
+        self.matrix.symmetrizer().map(Cow::Owned)
+    }
+
+    /// A per-vertex array of the whole system restricted to the unknowns: borrowed when
+    /// every vertex is one.
+    fn cut<'a>(&self, whole: &'a [f64]) -> Cow<'a, [f64]> {
+        if self.moving.len() == whole.len() {
+            Cow::Borrowed(whole)
+        } else {
+            Cow::Owned(self.moving.iter().map(|&v| whole[v as usize]).collect())
+        }
     }
 
     /// The whole system's preconditioned operator, when this system is the whole system
@@ -346,9 +357,9 @@ impl ReducedSystem {
 
     /// The checkerboard preconditioner's scaling `T = S Δ⁻¹` of the unknowns, when the
     /// whole system has it (a cut keeps its rows, so its diagonal is the whole one's).
-    pub fn conjugation(&self) -> Option<Vec<f64>> {
+    pub fn conjugation(&self) -> Option<Cow<'_, [f64]>> {
         let t = self.full.as_ref()?.conjugation.as_ref()?;
-        Some(self.moving.iter().map(|&v| t[v as usize]).collect())
+        Some(self.cut(t))
     }
 
     /// Diagonal of `M̄`.
