@@ -64,29 +64,52 @@ pub fn run(repeats: usize) -> Result<(), String> {
             p.prepare();
             Ok(())
         })?;
-        let pia = fresh().map_err(|e| e.to_string())?;
-        pia.prepare();
-        let (mut plain, mut plain_cold) = (None, None);
-        for (sname, solver) in [
+        let solvers = [
             ("iterate", Solver::Iterate),
             ("weighted", Solver::Weighted),
             ("cg", Solver::Cg),
             ("chebyshev", Solver::Chebyshev),
             ("direct", Solver::Direct),
             ("auto", Solver::Auto),
-        ] {
-            let opts = PiaOptions {
-                solver,
-                tol: 1e-10,
-                max_iter: 100_000,
-            };
-            // Cold: the first solve on a fresh, unprepared `Pia`, which also builds what this
-            // solver needs beyond the limit matrix (the symmetric form where setup did not
-            // know it, the Chebyshev operator); median over `repeats` fresh ones.
-            let cold = median_on_fresh(repeats, fresh, |p| {
-                p.solve(&mesh.positions, &Moving::All, &opts).map(|_| ())
-            })?;
-            let base_cold = *plain_cold.get_or_insert(cold);
+        ];
+        let options = |solver| PiaOptions {
+            solver,
+            tol: 1e-10,
+            max_iter: 100_000,
+        };
+        // Cold: the first solve on a fresh, unprepared `Pia`, which also builds what this
+        // solver needs beyond the limit matrix (the symmetric form where setup did not know
+        // it, the Chebyshev operator); median over `repeats` fresh ones. Taken in rounds of
+        // every solver, each round in its own shuffled order, so that every solver meets the
+        // machine and the allocator in the same mix of states (in a fixed order, the solver
+        // timed after `direct`, which frees hundreds of megabytes, pays for page faults the
+        // others do not).
+        let mut cold_times = vec![Vec::new(); solvers.len()];
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        for _ in 0..repeats {
+            let mut order: Vec<usize> = (0..solvers.len()).collect();
+            for k in (1..order.len()).rev() {
+                // Fisher-Yates with a fixed-seed LCG (Knuth's MMIX constants): the same
+                // orders on every run.
+                seed = seed
+                    .wrapping_mul(6_364_136_223_846_793_005)
+                    .wrapping_add(1_442_695_040_888_963_407);
+                order.swap(k, (seed >> 33) as usize % (k + 1));
+            }
+            for i in order {
+                let opts = options(solvers[i].1);
+                cold_times[i].push(median_on_fresh(1, fresh, |p| {
+                    p.solve(&mesh.positions, &Moving::All, &opts).map(|_| ())
+                })?);
+            }
+        }
+        let cold: Vec<f64> = cold_times.into_iter().map(median).collect();
+        let pia = fresh().map_err(|e| e.to_string())?;
+        pia.prepare();
+        let mut plain = None;
+        for (i, &(sname, solver)) in solvers.iter().enumerate() {
+            let opts = options(solver);
+            let (cold, base_cold) = (cold[i], cold[0]);
             let mut times = Vec::new();
             let mut last = None;
             for _ in 0..repeats {
