@@ -1,4 +1,5 @@
-//! The checkerboard preconditioner for the Catmull-Clark family.
+//! The checkerboard preconditioner for the Catmull-Clark family: its derivation (the module
+//! holds no public items; the solvers use it through [`crate::Solver`]).
 //!
 //! On a regular quad grid the Catmull-Clark limit mask is the tensor product of the 1D
 //! mask `(1, 4, 1)/6`, whose symbol `a(θ) = (2 + cos θ)/3` lies in `[1/3, 1]`: `M̄` has

@@ -43,7 +43,7 @@
 //! }
 //! ```
 
-mod checkerboard;
+pub mod checkerboard;
 mod solvers;
 mod system;
 
@@ -193,7 +193,7 @@ pub struct PiaResult {
 #[derive(Debug, Clone)]
 pub struct Pia {
     limit: StencilTable,
-    /// The limit matrix in the solvers' form, with the checkerboard signs for the
+    /// The limit matrix in the solvers' form, with the checkerboard scaling for the
     /// preconditioned solvers (Catmull-Clark family, two-coloured vertex graph).
     full: Arc<FullSystem>,
 }

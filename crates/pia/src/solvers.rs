@@ -14,7 +14,6 @@ use faer::{Mat, Side};
 use glam::DVec3;
 use rayon::prelude::*;
 use serde::Serialize;
-
 use subd_schemes::memory;
 
 use crate::PiaError;
