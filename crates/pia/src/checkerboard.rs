@@ -68,9 +68,9 @@ pub(crate) struct Preconditioned {
 
 impl Preconditioned {
     /// `K` for `M̄ = m` (symmetrizer `c`, scaling `t`, see [`conjugation`]) and its
-    /// spectral interval; `None`
-    /// when the Lanczos estimate finds no positive interval (`D` not positive definite) or
-    /// one too wide for Chebyshev to pay off (condition above [`MAX_CONDITION`]).
+    /// spectral interval; `None` when the Lanczos estimate finds no positive interval (`D`
+    /// not positive definite) or one too wide for Chebyshev to pay off (condition above
+    /// [`MAX_CONDITION`]).
     pub fn new(m: &Matrix, c: &[f64], t: &[f64]) -> Option<Preconditioned> {
         let k = product(m, t);
         let weight: Vec<f64> = c.iter().map(|c| 1.0 / c).collect();
@@ -86,8 +86,9 @@ impl Preconditioned {
     }
 }
 
-/// `K = T M̄ T M̄` for `T` the diagonal of `scale`: `K_ij = t_i Σ_k t_k M̄_ik M̄_kj`, rows in parallel blocks with one dense
-/// accumulator per worker. Columns stay in the order they are met (only products use `K`).
+/// `K = T M̄ T M̄` for `T` the diagonal of `scale`: `K_ij = t_i Σ_k t_k M̄_ik M̄_kj`, rows
+/// in parallel blocks with one dense accumulator per worker. Columns stay in the order
+/// they are met (only products use `K`).
 fn product(m: &Matrix, scale: &[f64]) -> Matrix {
     let n = m.len();
     // A few block ranges per thread, each with its own scratch (`map_init` would build

@@ -554,7 +554,7 @@ fn cg_update(
         .fold((DVec3::ZERO, 0.0), |(a, m), (b, n)| (a + b, m.max(n)))
 }
 
-/// `z_i = r_i · inv_i` (a diagonal scaling: Jacobi's inverse diagonal, checkerboard signs).
+/// `z_i = r_i · inv_i` (a diagonal scaling: BiCGSTAB's Jacobi preconditioner).
 fn precondition(r: &[DVec3], inv: &[f64], z: &mut [DVec3]) {
     z.par_chunks_mut(CHUNK)
         .zip(r.par_chunks(CHUNK))
