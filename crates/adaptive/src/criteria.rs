@@ -1,0 +1,572 @@
+//! What decides that a face is refined: one small trait, [`Criterion`], and one type per
+//! rule. Criteria compose by union — a face is refined when any criterion selects it — and
+//! are evaluated level by level on the faces that exist there. Vertex-based criteria
+//! (flatness, curvature) look at the faces present around a vertex; a vertex's ring only
+//! grows as the hierarchy is completed, and the hierarchy is iterated until no criterion
+//! selects anything new, so the result does not depend on the order faces are visited.
+
+use glam::DVec3;
+use rayon::prelude::*;
+use subd_limit::eval::{FaceParam, LimitEvaluator, PatchPoints};
+use subd_mesh::Topology;
+use subd_schemes::{Options, Scheme};
+
+use crate::AdaptiveError;
+use crate::level::{SparseLevel, WHOLE_FACE};
+
+/// The faces of one level of the hierarchy as a criterion sees them.
+pub struct LevelView<'a> {
+    pub(crate) level: usize,
+    pub(crate) data: &'a SparseLevel,
+}
+
+impl LevelView<'_> {
+    /// The level (0 = base).
+    pub fn level(&self) -> usize {
+        self.level
+    }
+
+    /// The faces of this level that exist, as a topology (with the uniform level's tags).
+    pub fn topology(&self) -> &Topology {
+        &self.data.topology
+    }
+
+    /// Positions of the topology's vertices: exactly uniform refinement's at this level.
+    pub fn points(&self) -> &[DVec3] {
+        &self.data.points
+    }
+
+    /// The base face that face `f` descends from.
+    pub fn base_face(&self, f: usize) -> usize {
+        self.data.base_face[f] as usize
+    }
+
+    /// Index of face `f` in uniform refinement's level.
+    pub fn uniform_face(&self, f: usize) -> u64 {
+        self.data.face_key[f]
+    }
+
+    /// Whether every face around vertex `v` in uniform refinement is present.
+    pub fn is_complete_vertex(&self, v: usize) -> bool {
+        self.data.is_complete(v)
+    }
+
+    /// Where face `f` lies on the limit surface: its base face, the sub-face of a
+    /// Catmull-Clark base face that is not a quad, and `(u, v)` at each corner; `None` for a
+    /// whole base face that is not a quad (Catmull-Clark level 0).
+    pub fn domain(&self, f: usize) -> Option<(usize, usize, &[[f64; 2]])> {
+        let sub = self.data.sub_face[f];
+        (sub != WHOLE_FACE).then(|| (self.base_face(f), sub as usize, self.data.params(f)))
+    }
+}
+
+/// A rule that selects faces to refine.
+pub trait Criterion: Send + Sync {
+    /// Sets `selected[f]` for every face `f` of `level` this criterion refines (and leaves
+    /// the other entries as they are).
+    ///
+    /// # Errors
+    /// Whatever the criterion cannot evaluate (for instance the limit surface on a face the
+    /// evaluator does not cover).
+    fn select(&self, level: &LevelView<'_>, selected: &mut [bool]) -> Result<(), AdaptiveError>;
+}
+
+/// Checks an angle threshold in degrees and returns it in radians.
+fn angle_threshold(name: &'static str, degrees: f64) -> Result<f64, AdaptiveError> {
+    if !(degrees.is_finite() && (0.0..=180.0).contains(&degrees)) {
+        return Err(AdaptiveError::Threshold {
+            name,
+            value: degrees,
+            reason: "must be a number of degrees in [0, 180]",
+        });
+    }
+    Ok(degrees.to_radians())
+}
+
+/// Unit normal of every face (Newell's method; zero for a degenerate face).
+fn face_normals(t: &Topology, p: &[DVec3]) -> Vec<DVec3> {
+    (0..t.num_faces())
+        .into_par_iter()
+        .map(|f| newell(t.face_vertices(f).iter().map(|&v| p[v as usize])).normalize_or_zero())
+        .collect()
+}
+
+/// Newell's normal of a polygon (twice the area vector).
+pub(crate) fn newell(corners: impl Iterator<Item = DVec3> + Clone) -> DVec3 {
+    let mut n = DVec3::ZERO;
+    let first = corners.clone().next().unwrap_or(DVec3::ZERO);
+    let mut prev: Option<DVec3> = None;
+    for c in corners {
+        if let Some(a) = prev {
+            n += (a - first).cross(c - first);
+        }
+        prev = Some(c);
+    }
+    n
+}
+
+fn angle_between(a: DVec3, b: DVec3) -> f64 {
+    a.dot(b).clamp(-1.0, 1.0).acos()
+}
+
+/// Seed 002 §2.2's flatness: `ε(v)` is the largest angle between the normals of two faces
+/// at `v`. A vertex with `ε(v) < ε_T` is dead, an edge between two dead vertices is dead,
+/// and a face with two or more dead edges is dead; every other face is refined.
+#[derive(Clone, Copy, Debug)]
+pub struct Flatness {
+    threshold: f64,
+}
+
+impl Flatness {
+    /// Flatness with threshold `ε_T` in degrees.
+    ///
+    /// # Errors
+    /// [`AdaptiveError::Threshold`] unless `degrees` is in `[0, 180]`.
+    pub fn new(degrees: f64) -> Result<Self, AdaptiveError> {
+        Ok(Flatness {
+            threshold: angle_threshold("flatness", degrees)?,
+        })
+    }
+
+    /// `ε(v)` of every vertex of a level, over the faces present (radians).
+    pub fn vertex_flatness(t: &Topology, p: &[DVec3]) -> Vec<f64> {
+        let normals = face_normals(t, p);
+        (0..t.num_vertices())
+            .into_par_iter()
+            .map(|v| {
+                let vf = t.vertex_faces(v);
+                let mut worst = 0.0f64;
+                for (i, &a) in vf.iter().enumerate() {
+                    for &b in &vf[i + 1..] {
+                        let (na, nb) = (normals[a as usize], normals[b as usize]);
+                        if na != DVec3::ZERO && nb != DVec3::ZERO {
+                            worst = worst.max(angle_between(na, nb));
+                        }
+                    }
+                }
+                worst
+            })
+            .collect()
+    }
+}
+
+impl Criterion for Flatness {
+    fn select(&self, level: &LevelView<'_>, selected: &mut [bool]) -> Result<(), AdaptiveError> {
+        let t = level.topology();
+        let eps = Flatness::vertex_flatness(t, level.points());
+        let dead: Vec<bool> = eps.iter().map(|&e| e < self.threshold).collect();
+        selected.par_iter_mut().enumerate().for_each(|(f, s)| {
+            let fv = t.face_vertices(f);
+            let n = fv.len();
+            let dead_edges = (0..n)
+                .filter(|&i| dead[fv[i] as usize] && dead[fv[(i + 1) % n] as usize])
+                .count();
+            if dead_edges < 2 {
+                *s = true;
+            }
+        });
+        Ok(())
+    }
+}
+
+/// User selection (seed 002 §2.1): every descendant of the chosen base faces is refined.
+#[derive(Clone, Debug)]
+pub struct FaceSelection {
+    base_faces: Vec<bool>,
+}
+
+impl FaceSelection {
+    /// The base faces `faces` of a mesh with `num_faces` faces.
+    ///
+    /// # Errors
+    /// [`AdaptiveError::SelectionIndex`] for an index out of range.
+    pub fn from_faces(num_faces: usize, faces: &[u64]) -> Result<Self, AdaptiveError> {
+        let mut base_faces = vec![false; num_faces];
+        for &f in faces {
+            if f >= num_faces as u64 {
+                return Err(AdaptiveError::SelectionIndex {
+                    what: "face",
+                    index: f,
+                    count: num_faces,
+                });
+            }
+            base_faces[f as usize] = true;
+        }
+        Ok(FaceSelection { base_faces })
+    }
+
+    /// The base faces with two or more of the chosen `vertices` (seed 002 §2.1: "any
+    /// triangle with at least two selected vertices is refined").
+    ///
+    /// # Errors
+    /// [`AdaptiveError::SelectionIndex`] for an index out of range.
+    pub fn from_vertices(base: &Topology, vertices: &[u64]) -> Result<Self, AdaptiveError> {
+        let nv = base.num_vertices();
+        let mut chosen = vec![false; nv];
+        for &v in vertices {
+            if v >= nv as u64 {
+                return Err(AdaptiveError::SelectionIndex {
+                    what: "vertex",
+                    index: v,
+                    count: nv,
+                });
+            }
+            chosen[v as usize] = true;
+        }
+        let base_faces = (0..base.num_faces())
+            .map(|f| {
+                base.face_vertices(f)
+                    .iter()
+                    .filter(|&&v| chosen[v as usize])
+                    .count()
+                    >= 2
+            })
+            .collect();
+        Ok(FaceSelection { base_faces })
+    }
+
+    /// Number of base faces selected.
+    pub fn num_selected(&self) -> usize {
+        self.base_faces.iter().filter(|&&b| b).count()
+    }
+}
+
+impl Criterion for FaceSelection {
+    fn select(&self, level: &LevelView<'_>, selected: &mut [bool]) -> Result<(), AdaptiveError> {
+        for (f, s) in selected.iter_mut().enumerate() {
+            if self.base_faces.get(level.base_face(f)) == Some(&true) {
+                *s = true;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Every face (uniform refinement, up to the level cap).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct EveryFace;
+
+impl Criterion for EveryFace {
+    fn select(&self, _level: &LevelView<'_>, selected: &mut [bool]) -> Result<(), AdaptiveError> {
+        selected.fill(true);
+        Ok(())
+    }
+}
+
+/// Gaussian curvature by angle defect: a face is refined when one of its vertices has
+/// `|K| · d² > threshold`, with `K = (2π − Σ θ) / (A / k)` (`π` instead of `2π` on a
+/// boundary; `θ` the face angles at the vertex, `A / k` each face's area shared among its
+/// `k` corners) and `d` the base mesh's bounding-box diagonal, so the threshold does not
+/// depend on the model's scale (a sphere has `K d² = 12`). Only vertices whose every face is
+/// present are measured.
+#[derive(Clone, Copy, Debug)]
+pub struct GaussianCurvature {
+    threshold: f64,
+    diagonal: f64,
+}
+
+impl GaussianCurvature {
+    /// Curvature threshold `threshold` (dimensionless, see the type) on a mesh with
+    /// bounding-box diagonal `diagonal`.
+    ///
+    /// # Errors
+    /// [`AdaptiveError::Threshold`] unless `threshold ≥ 0` and `diagonal > 0`.
+    pub fn new(threshold: f64, diagonal: f64) -> Result<Self, AdaptiveError> {
+        if !(threshold.is_finite() && threshold >= 0.0) {
+            return Err(AdaptiveError::Threshold {
+                name: "curvature",
+                value: threshold,
+                reason: "must be a number ≥ 0",
+            });
+        }
+        if !(diagonal.is_finite() && diagonal > 0.0) {
+            return Err(AdaptiveError::Threshold {
+                name: "bounding-box diagonal",
+                value: diagonal,
+                reason: "must be positive",
+            });
+        }
+        Ok(GaussianCurvature {
+            threshold,
+            diagonal,
+        })
+    }
+
+    /// `K` at vertex `v` (`None` where its ring is incomplete, it is non-manifold, or its
+    /// faces have no area).
+    pub fn at_vertex(level: &LevelView<'_>, v: usize) -> Option<f64> {
+        let t = level.topology();
+        if !level.is_complete_vertex(v) || t.is_non_manifold_vertex(v) {
+            return None;
+        }
+        let p = level.points();
+        let (mut angles, mut area) = (0.0, 0.0);
+        for (&f, &c) in t.vertex_faces(v).iter().zip(t.vertex_face_local_indices(v)) {
+            let fv = t.face_vertices(f as usize);
+            let n = fv.len();
+            let c = c as usize;
+            let at = p[fv[c] as usize];
+            let a = p[fv[(c + 1) % n] as usize] - at;
+            let b = p[fv[(c + n - 1) % n] as usize] - at;
+            angles += angle_between(a.normalize_or_zero(), b.normalize_or_zero());
+            area += 0.5 * newell(fv.iter().map(|&w| p[w as usize])).length() / n as f64;
+        }
+        let full = if t.is_boundary_vertex(v) {
+            std::f64::consts::PI
+        } else {
+            2.0 * std::f64::consts::PI
+        };
+        (area > 0.0).then(|| (full - angles) / area)
+    }
+}
+
+impl Criterion for GaussianCurvature {
+    fn select(&self, level: &LevelView<'_>, selected: &mut [bool]) -> Result<(), AdaptiveError> {
+        let t = level.topology();
+        let d2 = self.diagonal * self.diagonal;
+        let hot: Vec<bool> = (0..t.num_vertices())
+            .into_par_iter()
+            .map(|v| {
+                GaussianCurvature::at_vertex(level, v)
+                    .is_some_and(|k| k.abs() * d2 > self.threshold)
+            })
+            .collect();
+        selected.par_iter_mut().enumerate().for_each(|(f, s)| {
+            if t.face_vertices(f).iter().any(|&v| hot[v as usize]) {
+                *s = true;
+            }
+        });
+        Ok(())
+    }
+}
+
+/// Dihedral angle: both faces of an edge whose normals differ by more than the threshold are
+/// refined.
+#[derive(Clone, Copy, Debug)]
+pub struct DihedralAngle {
+    threshold: f64,
+}
+
+impl DihedralAngle {
+    /// Threshold in degrees.
+    ///
+    /// # Errors
+    /// [`AdaptiveError::Threshold`] unless `degrees` is in `[0, 180]`.
+    pub fn new(degrees: f64) -> Result<Self, AdaptiveError> {
+        Ok(DihedralAngle {
+            threshold: angle_threshold("dihedral", degrees)?,
+        })
+    }
+}
+
+impl Criterion for DihedralAngle {
+    fn select(&self, level: &LevelView<'_>, selected: &mut [bool]) -> Result<(), AdaptiveError> {
+        let t = level.topology();
+        let normals = face_normals(t, level.points());
+        selected.par_iter_mut().enumerate().for_each(|(f, s)| {
+            let n = normals[f];
+            let bent = t.face_edges(f).iter().any(|&e| {
+                let ef = t.edge_faces(e as usize);
+                ef.len() == 2 && {
+                    let g = if ef[0] as usize == f { ef[1] } else { ef[0] };
+                    let m = normals[g as usize];
+                    n != DVec3::ZERO && m != DVec3::ZERO && angle_between(n, m) > self.threshold
+                }
+            });
+            if bent {
+                *s = true;
+            }
+        });
+        Ok(())
+    }
+}
+
+/// The exact limit surface, for measuring how far a face is from it.
+pub struct LimitSurface {
+    evaluator: LimitEvaluator,
+    points: PatchPoints,
+}
+
+impl LimitSurface {
+    /// The limit surface of `points` on `base` under `scheme` and `options`.
+    ///
+    /// # Errors
+    /// As [`LimitEvaluator::new`].
+    pub fn new(
+        base: &Topology,
+        points: &[DVec3],
+        scheme: Scheme,
+        options: &Options,
+    ) -> Result<Self, AdaptiveError> {
+        let evaluator = LimitEvaluator::new(base, scheme, options)?;
+        let points = evaluator.prepare(points);
+        Ok(LimitSurface { evaluator, points })
+    }
+
+    /// Position on the limit surface at `(u, v)` of sub-face `sub` of base face `face`.
+    ///
+    /// # Errors
+    /// As [`LimitEvaluator::evaluate`].
+    pub fn position(
+        &self,
+        face: usize,
+        sub: usize,
+        u: f64,
+        v: f64,
+    ) -> Result<DVec3, AdaptiveError> {
+        // Rounding can put a midpoint's parameter a hair outside [0, 1].
+        let (u, v) = (u.clamp(0.0, 1.0), v.clamp(0.0, 1.0));
+        Ok(self
+            .evaluator
+            .evaluate(&self.points, FaceParam { face, sub, u, v })?
+            .position)
+    }
+
+    /// The largest distance to the limit surface over samples of a triangle or quad (its
+    /// corners, edge midpoints and centre, interpolated linearly or bilinearly in position
+    /// and parameters alike).
+    ///
+    /// # Errors
+    /// As [`LimitEvaluator::evaluate`].
+    pub fn face_distance(
+        &self,
+        face: usize,
+        sub: usize,
+        positions: &[DVec3],
+        params: &[[f64; 2]],
+    ) -> Result<f64, AdaptiveError> {
+        let mut worst = 0.0f64;
+        for (w, n) in sample_weights(positions.len()) {
+            let (mut p, mut uv) = (DVec3::ZERO, [0.0, 0.0]);
+            for i in 0..n {
+                p += w[i] * positions[i];
+                uv[0] += w[i] * params[i][0];
+                uv[1] += w[i] * params[i][1];
+            }
+            worst = worst.max((p - self.position(face, sub, uv[0], uv[1])?).length());
+        }
+        Ok(worst)
+    }
+
+    /// [`Self::face_distance`] of a whole Catmull-Clark base face that is not a quad: each
+    /// sub-face is the quad (corner, edge midpoint, centroid, edge midpoint).
+    ///
+    /// # Errors
+    /// As [`LimitEvaluator::evaluate`].
+    pub fn polygon_distance(&self, face: usize, corners: &[DVec3]) -> Result<f64, AdaptiveError> {
+        let n = corners.len();
+        let centroid = corners.iter().sum::<DVec3>() / n as f64;
+        let unit = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+        let mut worst = 0.0f64;
+        for k in 0..n {
+            let quad = [
+                corners[k],
+                0.5 * (corners[k] + corners[(k + 1) % n]),
+                centroid,
+                0.5 * (corners[(k + n - 1) % n] + corners[k]),
+            ];
+            worst = worst.max(self.face_distance(face, k, &quad, &unit)?);
+        }
+        Ok(worst)
+    }
+}
+
+/// Sample weights over a face's corners: corners, edge midpoints and centre.
+fn sample_weights(n: usize) -> impl Iterator<Item = ([f64; 4], usize)> {
+    let k = n.min(4);
+    let mut out = Vec::with_capacity(2 * k + 1);
+    for i in 0..k {
+        let mut w = [0.0; 4];
+        w[i] = 1.0;
+        out.push((w, k));
+        let mut m = [0.0; 4];
+        m[i] = 0.5;
+        m[(i + 1) % k] = 0.5;
+        out.push((m, k));
+    }
+    out.push(([1.0 / k as f64; 4], k));
+    out.into_iter()
+}
+
+/// Distance to the exact limit surface: a face is refined while its largest sampled distance
+/// to the limit surface (at the same parameters, see [`LimitSurface::face_distance`])
+/// exceeds the tolerance. With `limit_corners` the face is measured with its corners on the
+/// limit surface (the output of `--limit`), otherwise at their positions at its level.
+pub struct LimitDistance {
+    surface: LimitSurface,
+    tolerance: f64,
+    limit_corners: bool,
+}
+
+impl LimitDistance {
+    /// Refine while the distance exceeds `tolerance` (absolute, in model units).
+    ///
+    /// # Errors
+    /// [`AdaptiveError::Threshold`] unless `tolerance > 0`.
+    pub fn new(
+        surface: LimitSurface,
+        tolerance: f64,
+        limit_corners: bool,
+    ) -> Result<Self, AdaptiveError> {
+        if !(tolerance.is_finite() && tolerance > 0.0) {
+            return Err(AdaptiveError::Threshold {
+                name: "max-distance",
+                value: tolerance,
+                reason: "must be a positive number",
+            });
+        }
+        Ok(LimitDistance {
+            surface,
+            tolerance,
+            limit_corners,
+        })
+    }
+
+    /// The limit surface it measures against.
+    pub fn surface(&self) -> &LimitSurface {
+        &self.surface
+    }
+}
+
+impl Criterion for LimitDistance {
+    fn select(&self, level: &LevelView<'_>, selected: &mut [bool]) -> Result<(), AdaptiveError> {
+        let t = level.topology();
+        let far: Vec<bool> = (0..t.num_faces())
+            .into_par_iter()
+            .map(|f| -> Result<bool, AdaptiveError> {
+                if t.is_hole(f) {
+                    return Ok(false);
+                }
+                let fv = t.face_vertices(f);
+                let mut corners: Vec<DVec3> =
+                    fv.iter().map(|&v| level.points()[v as usize]).collect();
+                let d = match level.domain(f) {
+                    Some((face, sub, params)) => {
+                        if self.limit_corners {
+                            for (c, uv) in corners.iter_mut().zip(params) {
+                                *c = self.surface.position(face, sub, uv[0], uv[1])?;
+                            }
+                        }
+                        self.surface.face_distance(face, sub, &corners, params)?
+                    }
+                    None => {
+                        let face = level.base_face(f);
+                        if self.limit_corners {
+                            for (k, c) in corners.iter_mut().enumerate() {
+                                *c = self.surface.position(face, k, 0.0, 0.0)?;
+                            }
+                        }
+                        self.surface.polygon_distance(face, &corners)?
+                    }
+                };
+                Ok(d > self.tolerance)
+            })
+            .collect::<Result<_, _>>()?;
+        for (s, far) in selected.iter_mut().zip(far) {
+            if far {
+                *s = true;
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,333 @@
+//! Adaptive (selective) refinement for subd: Loop and Catmull-Clark refined only where the
+//! surface needs it, without cracks, and without changing the surface.
+//!
+//! * [`AdaptiveRefinement`] builds a *restricted* hierarchy: per level, the faces of uniform
+//!   refinement whose parents were refined, in flat index-based arrays (each face knows its
+//!   parent, each vertex and edge its child). A balancing closure refines neighbours so that
+//!   faces sharing an edge or a vertex differ by at most one level, and so that refining a
+//!   face at level `l` makes every vertex its level-`l` masks read available.
+//! * **Exact positions.** Every vertex of the hierarchy is computed by `subd-schemes`'
+//!   [`Refinement`](subd_schemes::Refinement) from its complete ring, in the uniform level's
+//!   order, so it *is* the vertex of uniform refinement at its level — the same operations,
+//!   bit for bit — with creases, semi-sharp decay, corners, boundaries, holes and non-manifold
+//!   input treated as uniform refinement treats them. Each element carries its uniform index
+//!   ([`AdaptiveMesh::vertex_uniform`]). Selecting every face gives uniform refinement.
+//!   Seed 002 instead leaves "dead" vertices where they are while their neighbours move on:
+//!   its adaptive surface is not the Loop surface of the input, and two selections give two
+//!   different surfaces. Here the selection decides only how finely the one subdivision
+//!   surface is sampled, so results of different criteria can be compared, mixed, and
+//!   measured against the limit surface ([`Positions::Limit`] puts every vertex on it).
+//! * [`AdaptiveRefinement::mesh`] closes the leaves into a conforming mesh with transition
+//!   patterns (a triangle or quad split from the leaf's corners and the edge points of its split edges): every edge has as many faces as it has in uniform refinement,
+//!   so a closed input gives a closed, manifold output with no hanging vertex
+//!   ([`AdaptiveMesh::conformity`] checks it).
+//! * [`criteria`]: seed 002's flatness with its dead vertex / edge / face rules, user face
+//!   or vertex selection, Gaussian curvature, dihedral angle and distance to the exact limit
+//!   surface, each one type behind the [`Criterion`] trait; they compose by union, under a
+//!   level cap.
+//!
+//! ```
+//! use subd_adaptive::{AdaptiveRefinement, Flatness, Positions};
+//! use subd_mesh::{DVec3, TopologyBuilder};
+//! use subd_schemes::{Options, Scheme};
+//!
+//! // A cube: refine where it is not flat (everywhere at first, then near the corners).
+//! let fv = [0, 1, 3, 2, 2, 3, 5, 4, 4, 5, 7, 6, 6, 7, 1, 0, 1, 7, 5, 3, 6, 0, 2, 4];
+//! let cube = TopologyBuilder::new(8).build(&[4; 6], &fv).unwrap();
+//! let p: Vec<DVec3> = (0..8)
+//!     .map(|i| DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64))
+//!     .collect();
+//! let flat = Flatness::new(20.0).unwrap();
+//! let a = AdaptiveRefinement::new(&cube, &p, Scheme::CatmullClark, &Options::default(), &[&flat], 4)
+//!     .unwrap();
+//! let mesh = a.mesh(Positions::Limit).unwrap();
+//! assert!(mesh.num_faces() < 6 * 256); // uniform level 4 has 1536
+//! assert!(mesh.conformity().conforming);
+//! ```
+
+mod conform;
+pub mod criteria;
+mod hierarchy;
+mod level;
+mod limit;
+mod submesh;
+mod uniform;
+
+use glam::DVec3;
+use serde::Serialize;
+use subd_limit::LimitError;
+use subd_mesh::TopologyBuilder;
+use subd_schemes::RefineError;
+use thiserror::Error;
+
+pub use criteria::{
+    Criterion, DihedralAngle, EveryFace, FaceSelection, Flatness, GaussianCurvature, LevelView,
+    LimitDistance, LimitSurface,
+};
+pub use hierarchy::{AdaptiveRefinement, Positions};
+pub use uniform::UniformCounts;
+
+/// The deepest level adaptive refinement goes to (uniform refinement's limit too).
+pub const MAX_LEVELS: usize = subd_schemes::MAX_LEVELS;
+
+/// Why adaptive refinement cannot be done.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum AdaptiveError {
+    /// The refinement itself failed (Loop on a face that is not a triangle, a mesh too large).
+    #[error(transparent)]
+    Refine(#[from] RefineError),
+    /// A limit computation or evaluation failed.
+    #[error(transparent)]
+    Limit(#[from] LimitError),
+    /// Not one position per base vertex.
+    #[error("{given} positions given for {vertices} vertices")]
+    PointCount {
+        /// Positions given.
+        given: usize,
+        /// Base vertices.
+        vertices: usize,
+    },
+    /// A threshold out of range or not a number.
+    #[error("{name} {value}: {reason}")]
+    Threshold {
+        /// The criterion.
+        name: &'static str,
+        /// The value given.
+        value: f64,
+        /// What is wrong with it.
+        reason: &'static str,
+    },
+    /// A selected face or vertex that the mesh does not have.
+    #[error("{what} {index} is out of range (the mesh has {count})")]
+    SelectionIndex {
+        /// `face` or `vertex`.
+        what: &'static str,
+        /// The index given.
+        index: u64,
+        /// How many the mesh has.
+        count: usize,
+    },
+    /// Too many levels.
+    #[error("{levels} levels requested; at most {max} are supported")]
+    TooManyLevels {
+        /// Requested.
+        levels: usize,
+        /// The maximum.
+        max: usize,
+    },
+    /// An invariant of the hierarchy did not hold (a bug, reported rather than hidden).
+    #[error("internal error: {0}")]
+    Internal(&'static str),
+}
+
+/// Where an edge of the output mesh comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EdgeOrigin {
+    /// An edge of uniform refinement (or part of one: a leaf edge that finer levels split).
+    Uniform {
+        /// Its level.
+        level: u8,
+        /// Its index in that uniform level.
+        index: u64,
+        /// The faces it has in uniform refinement.
+        faces: u32,
+    },
+    /// A diagonal a transition pattern adds inside a leaf (two faces).
+    Diagonal,
+}
+
+/// The conforming mesh of an adaptive refinement.
+#[derive(Clone, Debug)]
+pub struct AdaptiveMesh {
+    /// Vertex positions.
+    pub positions: Vec<DVec3>,
+    /// Unit limit normals (with [`Positions::Limit`]; empty otherwise).
+    pub normals: Vec<DVec3>,
+    /// Face offsets into [`Self::face_vertices`] (faces + 1).
+    pub face_offsets: Vec<u32>,
+    /// Face-vertex indices.
+    pub face_vertices: Vec<u32>,
+    /// Level of each face (a transition face has its leaf's level).
+    pub face_levels: Vec<u8>,
+    /// Hole flag of each face.
+    pub holes: Vec<bool>,
+    /// Whether each face is part of a transition pattern.
+    pub transition: Vec<bool>,
+    /// The level each vertex's position comes from (its finest level in the hierarchy).
+    pub vertex_levels: Vec<u8>,
+    /// Each vertex's index in uniform refinement at [`Self::vertex_levels`].
+    pub vertex_uniform: Vec<u64>,
+    /// Origin of the edge from each face-vertex to the next one of its face.
+    pub edge_origins: Vec<EdgeOrigin>,
+    /// Base face and sub-face (`u16::MAX` for a whole Catmull-Clark base face that is not a
+    /// quad) of each face.
+    pub face_domains: Vec<(u32, u16)>,
+    /// `(u, v)` on the base face of each face-vertex (NaN on a whole non-quad base face).
+    pub corner_params: Vec<[f64; 2]>,
+}
+
+/// What [`AdaptiveMesh::conformity`] finds.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Conformity {
+    /// Every edge of uniform refinement that the mesh uses (or a piece of it) is used by as
+    /// many faces as it has in uniform refinement, and every diagonal of a transition
+    /// pattern by two: no crack, no hanging vertex.
+    pub conforming: bool,
+    /// Uniform edges and diagonals that are not.
+    pub mismatched_edges: usize,
+    /// Edges with one face (of the mesh as a file describes it: edges between the same two
+    /// vertices are one).
+    pub boundary_edges: usize,
+    /// Non-manifold edges.
+    pub nonmanifold_edges: usize,
+    /// Largest level difference between two faces sharing an edge.
+    pub max_level_difference_edge: u8,
+    /// Largest level difference between two faces sharing a vertex.
+    pub max_level_difference_vertex: u8,
+}
+
+impl AdaptiveMesh {
+    /// Number of faces.
+    pub fn num_faces(&self) -> usize {
+        self.face_offsets.len() - 1
+    }
+
+    /// The vertices of face `f`.
+    pub fn face(&self, f: usize) -> &[u32] {
+        &self.face_vertices[self.face_offsets[f] as usize..self.face_offsets[f + 1] as usize]
+    }
+
+    /// Faces per level.
+    pub fn faces_per_level(&self) -> Vec<usize> {
+        let depth = self.face_levels.iter().copied().max().unwrap_or(0) as usize;
+        let mut count = vec![0; depth + 1];
+        for &l in &self.face_levels {
+            count[l as usize] += 1;
+        }
+        count
+    }
+
+    /// Checks that the mesh is conforming (see [`Conformity`]) and measures level
+    /// differences across edges and vertices.
+    pub fn conformity(&self) -> Conformity {
+        let sizes: Vec<u32> = self.face_offsets.windows(2).map(|w| w[1] - w[0]).collect();
+        let topo = match TopologyBuilder::new(self.positions.len())
+            .accept_inconsistent_orientation(true)
+            .build(&sizes, &self.face_vertices)
+        {
+            Ok(t) => t,
+            Err(_) => {
+                return Conformity {
+                    mismatched_edges: usize::MAX,
+                    ..Conformity::default()
+                };
+            }
+        };
+        // Each uniform edge (or piece of one) must be used by as many face sides as it has
+        // faces in uniform refinement: one side short is a crack or a hanging vertex. Counted
+        // per origin, not per vertex pair, since uniform refinement itself can have two edges
+        // between the same two vertices (two faces on the same three vertices, refined).
+        let mut uses: std::collections::HashMap<(u8, u64), (u32, u32)> =
+            std::collections::HashMap::new();
+        let mut diagonals: std::collections::HashMap<(u32, u32), u32> =
+            std::collections::HashMap::new();
+        for f in 0..self.num_faces() {
+            let fv = self.face(f);
+            let first = self.face_offsets[f] as usize;
+            for i in 0..fv.len() {
+                match self.edge_origins[first + i] {
+                    EdgeOrigin::Uniform {
+                        level,
+                        index,
+                        faces,
+                    } => uses.entry((level, index)).or_insert((0, faces)).0 += 1,
+                    EdgeOrigin::Diagonal => {
+                        let (a, b) = (fv[i], fv[(i + 1) % fv.len()]);
+                        *diagonals.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+                    }
+                }
+            }
+        }
+        let mut report = Conformity {
+            mismatched_edges: uses.values().filter(|(n, want)| n != want).count()
+                + diagonals.values().filter(|&&n| n % 2 != 0).count(),
+            ..Conformity::default()
+        };
+        for e in 0..topo.num_edges() {
+            report.boundary_edges += usize::from(topo.is_boundary_edge(e));
+            report.nonmanifold_edges += usize::from(topo.is_non_manifold_edge(e));
+            let levels = topo
+                .edge_faces(e)
+                .iter()
+                .map(|&f| self.face_levels[f as usize]);
+            report.max_level_difference_edge = report.max_level_difference_edge.max(spread(levels));
+        }
+        for v in 0..topo.num_vertices() {
+            let levels = topo
+                .vertex_faces(v)
+                .iter()
+                .map(|&f| self.face_levels[f as usize]);
+            report.max_level_difference_vertex =
+                report.max_level_difference_vertex.max(spread(levels));
+        }
+        report.conforming = report.mismatched_edges == 0;
+        report
+    }
+
+    /// The smallest angle of any face that is not a hole, in degrees.
+    pub fn min_angle_degrees(&self) -> f64 {
+        (0..self.num_faces())
+            .filter(|&f| !self.holes[f])
+            .map(|f| {
+                let p: Vec<DVec3> = self
+                    .face(f)
+                    .iter()
+                    .map(|&v| self.positions[v as usize])
+                    .collect();
+                conform::min_angle(&p)
+            })
+            .fold(f64::INFINITY, f64::min)
+            .to_degrees()
+    }
+
+    /// The largest sampled distance of any face that is not a hole to the limit surface,
+    /// at the same parameters ([`LimitSurface::face_distance`]).
+    ///
+    /// # Errors
+    /// As [`LimitSurface::position`].
+    pub fn max_limit_distance(&self, surface: &LimitSurface) -> Result<f64, AdaptiveError> {
+        use rayon::prelude::*;
+        (0..self.num_faces())
+            .into_par_iter()
+            .filter(|&f| !self.holes[f])
+            .map(|f| {
+                let range = self.face_offsets[f] as usize..self.face_offsets[f + 1] as usize;
+                let p: Vec<DVec3> = self.face_vertices[range.clone()]
+                    .iter()
+                    .map(|&v| self.positions[v as usize])
+                    .collect();
+                let (face, sub) = self.face_domains[f];
+                if sub == u16::MAX {
+                    surface.polygon_distance(face as usize, &p)
+                } else {
+                    surface.face_distance(
+                        face as usize,
+                        sub as usize,
+                        &p,
+                        &self.corner_params[range],
+                    )
+                }
+            })
+            .try_reduce(|| 0.0, |a, b| Ok(a.max(b)))
+    }
+}
+
+fn spread(levels: impl Iterator<Item = u8>) -> u8 {
+    let (lo, hi) = levels.fold((u8::MAX, 0u8), |(lo, hi), l| (lo.min(l), hi.max(l)));
+    hi.saturating_sub(lo)
+}
+
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

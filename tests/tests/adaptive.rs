@@ -1,0 +1,260 @@
+//! Adaptive refinement on every OpenSubdiv shape, checked against uniform refinement: every
+//! vertex of every level of the hierarchy is the uniform level's vertex of the same index
+//! (positions to 1e-15 of the bounding box), selecting every face gives the uniform faces,
+//! the conforming mesh is conforming with level differences ≤ 1, and `Positions::Limit`
+//! gives the limit masks of a uniform refinement deep enough for every vertex.
+
+use std::collections::HashSet;
+
+use glam::DVec3;
+use subd_adaptive::{
+    AdaptiveError, AdaptiveRefinement, Criterion, LevelView, Positions, UniformCounts,
+};
+use subd_io::{ReadOptions, read_mesh};
+use subd_limit::{LimitStencilTable, levels_for_exact_limit};
+use subd_schemes::{Options, Refinement, Rule, Scheme};
+use subd_tests::osd_meshes;
+
+/// Selects a face of level `l` when a hash of its uniform index falls under `p`: a
+/// reproducible, scattered selection.
+struct Scattered {
+    seed: u64,
+    p: f64,
+}
+
+fn mix(mut x: u64) -> u64 {
+    x ^= x >> 33;
+    x = x.wrapping_mul(0xff51_afd7_ed55_8ccd);
+    x ^= x >> 33;
+    x = x.wrapping_mul(0xc4ce_b9fe_1a85_ec53);
+    x ^ (x >> 33)
+}
+
+impl Criterion for Scattered {
+    fn select(&self, level: &LevelView<'_>, selected: &mut [bool]) -> Result<(), AdaptiveError> {
+        for (f, s) in selected.iter_mut().enumerate() {
+            let h = mix(self.seed ^ mix(level.uniform_face(f) ^ ((level.level() as u64) << 56)));
+            if ((h >> 11) as f64 / (1u64 << 53) as f64) < self.p {
+                *s = true;
+            }
+        }
+        Ok(())
+    }
+}
+
+struct Shape {
+    name: String,
+    scheme: Scheme,
+    options: Options,
+    mesh: subd_mesh::Mesh,
+}
+
+fn shapes() -> Vec<Shape> {
+    let opts = ReadOptions {
+        accept_inconsistent_orientation: true,
+    };
+    osd_meshes()
+        .into_iter()
+        .filter_map(|path| {
+            let name = path.file_stem()?.to_string_lossy().to_string();
+            let scheme = if name.starts_with("loop_") {
+                Scheme::Loop
+            } else if name.starts_with("catmark_") {
+                Scheme::CatmullClark
+            } else {
+                return None;
+            };
+            let file = read_mesh(&path, &opts).ok()?;
+            Some(Shape {
+                name,
+                scheme,
+                options: Options::from_hints(&file.mesh.hints),
+                mesh: file.mesh,
+            })
+        })
+        .collect()
+}
+
+fn diagonal(p: &[DVec3]) -> f64 {
+    let (lo, hi) = p.iter().fold(
+        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+        |(a, b), &q| (a.min(q), b.max(q)),
+    );
+    (hi - lo).length().max(1e-300)
+}
+
+/// Every vertex of every level equals uniform refinement's, and the mesh is conforming.
+fn check_exact(s: &Shape, a: &AdaptiveRefinement, uniform: &[Vec<DVec3>]) {
+    let d = diagonal(&s.mesh.positions);
+    for l in 0..=a.depth() {
+        for (k, p) in a.level_vertices(l) {
+            let q = uniform[l][k as usize];
+            assert!(
+                (p - q).length() <= 1e-15 * d,
+                "{}: level {l} vertex {k}: {p} vs uniform {q}",
+                s.name
+            );
+        }
+    }
+    let mesh = a.mesh(Positions::Refined).unwrap();
+    let c = mesh.conformity();
+    assert!(c.conforming, "{}: {c:?}", s.name);
+    assert!(c.max_level_difference_vertex <= 1, "{}: {c:?}", s.name);
+    assert!(c.max_level_difference_edge <= 1, "{}: {c:?}", s.name);
+    for (v, (&l, &k)) in mesh
+        .vertex_levels
+        .iter()
+        .zip(&mesh.vertex_uniform)
+        .enumerate()
+    {
+        assert_eq!(
+            mesh.positions[v], uniform[l as usize][k as usize],
+            "{}",
+            s.name
+        );
+    }
+}
+
+#[test]
+fn scattered_selections_give_uniform_vertices_on_every_shape() {
+    let levels = 3;
+    let mut checked = 0;
+    for s in shapes() {
+        let r = Refinement::new(&s.mesh.topology, s.scheme, &s.options, levels).unwrap();
+        let uniform = r.refine_points(&s.mesh.positions);
+        for seed in 0..2 {
+            let pick = Scattered { seed, p: 0.35 };
+            let a = AdaptiveRefinement::new(
+                &s.mesh.topology,
+                &s.mesh.positions,
+                s.scheme,
+                &s.options,
+                &[&pick],
+                levels,
+            )
+            .unwrap_or_else(|e| panic!("{}: {e}", s.name));
+            check_exact(&s, &a, &uniform);
+            checked += 1;
+        }
+    }
+    assert!(checked > 100, "{checked} runs");
+}
+
+#[test]
+fn selecting_every_face_is_uniform_refinement() {
+    let levels = 2;
+    for s in shapes() {
+        let r = Refinement::new(&s.mesh.topology, s.scheme, &s.options, levels).unwrap();
+        let a = AdaptiveRefinement::new(
+            &s.mesh.topology,
+            &s.mesh.positions,
+            s.scheme,
+            &s.options,
+            &[],
+            levels,
+        )
+        .unwrap();
+        let mesh = a.mesh(Positions::Refined).unwrap();
+        let UniformCounts {
+            faces, vertices, ..
+        } = a.uniform_counts(levels);
+        assert_eq!(mesh.num_faces() as u64, faces, "{}", s.name);
+        assert_eq!(
+            mesh.positions.len() as u64,
+            vertices - isolated(&r, levels),
+            "{}",
+            s.name
+        );
+        // The same faces: compare them as lists of uniform vertex indices.
+        let (off, fv) = r.faces(levels);
+        let want: HashSet<Vec<u32>> = (0..off.len() - 1)
+            .map(|f| fv[off[f] as usize..off[f + 1] as usize].to_vec())
+            .collect();
+        let got: HashSet<Vec<u32>> = (0..mesh.num_faces())
+            .map(|f| {
+                mesh.face(f)
+                    .iter()
+                    .map(|&v| mesh.vertex_uniform[v as usize] as u32)
+                    .collect()
+            })
+            .collect();
+        assert_eq!(got, want, "{}", s.name);
+        assert!(mesh.vertex_levels.iter().all(|&l| l as usize == levels));
+        assert!(!mesh.transition.iter().any(|&t| t));
+    }
+}
+
+/// Vertices of `level` that no face uses (isolated base vertices keep their children).
+fn isolated(r: &Refinement, level: usize) -> u64 {
+    let t = r.topology(level);
+    (0..t.num_vertices())
+        .filter(|&v| t.vertex_faces(v).is_empty())
+        .count() as u64
+}
+
+/// `Positions::Limit` against the limit masks of a uniform refinement deep enough for every
+/// vertex (semi-sharp decay included): positions to 1e-12 of the bounding box, normals of
+/// smooth vertices to 1e-9.
+#[test]
+fn limit_positions_are_the_uniform_limit() {
+    let levels = 2;
+    let mut checked = 0;
+    for s in shapes() {
+        let (decay, _) = levels_for_exact_limit(&s.mesh.topology, s.scheme);
+        let deep = levels + decay.max(1);
+        if s.mesh.topology.num_face_vertices() << (2 * deep) > 4_000_000 {
+            continue;
+        }
+        let pick = Scattered { seed: 7, p: 0.4 };
+        let a = AdaptiveRefinement::new(
+            &s.mesh.topology,
+            &s.mesh.positions,
+            s.scheme,
+            &s.options,
+            &[&pick],
+            levels,
+        )
+        .unwrap();
+        let mesh = match a.mesh(Positions::Limit) {
+            Ok(m) => m,
+            Err(e) => panic!("{}: {e}", s.name),
+        };
+        let r = Refinement::new(&s.mesh.topology, s.scheme, &s.options, deep).unwrap();
+        let pts = r.refine_points(&s.mesh.positions).pop().unwrap();
+        let limit = LimitStencilTable::at_level(&r, deep).unwrap().apply(&pts);
+        let rules = r.vertex_rules(deep);
+        let d = diagonal(&s.mesh.positions);
+        let counts: Vec<u64> = (0..=levels).map(|l| a.uniform_counts(l).vertices).collect();
+        for v in 0..mesh.positions.len() {
+            let (l, k) = (
+                mesh.vertex_levels[v] as usize,
+                mesh.vertex_uniform[v] as usize,
+            );
+            // Vertex k of level l keeps index k at every deeper level.
+            assert!((k as u64) < counts[l]);
+            let want = limit.positions[k];
+            assert!(
+                (mesh.positions[v] - want).length() <= 1e-12 * d,
+                "{}: level {l} vertex {k}: {} vs {want}",
+                s.name,
+                mesh.positions[v]
+            );
+            // Skip vertices whose tangents are parallel (no normal to compare).
+            let (t1, t2) = (limit.tangent1[k], limit.tangent2[k]);
+            let scale = t1.length().max(t2.length());
+            let spans = t1.cross(t2).length() > 1e-6 * scale * scale;
+            let manifold = !r.topology(deep).is_non_manifold_vertex(k);
+            if manifold && spans && rules[k] == Rule::Smooth {
+                assert!(
+                    (mesh.normals[v] - limit.normals[k]).length() <= 1e-9,
+                    "{}: normal of level {l} vertex {k}: {} vs {}",
+                    s.name,
+                    mesh.normals[v],
+                    limit.normals[k]
+                );
+            }
+        }
+        checked += 1;
+    }
+    assert!(checked > 50, "{checked} shapes");
+}
