@@ -258,3 +258,53 @@ fn limit_positions_are_the_uniform_limit() {
     }
     assert!(checked > 50, "{checked} shapes");
 }
+
+/// The parameters the mesh records for each corner put it where the exact evaluator puts the
+/// limit surface: with `Positions::Limit`, every corner of every face is the evaluator's
+/// point at the corner's (face, sub-face, u, v), to 1e-12 of the bounding box.
+#[test]
+fn corner_parameters_locate_the_limit_surface() {
+    let mut checked = 0;
+    for s in shapes() {
+        let Ok(surface) =
+            subd_adaptive::LimitSurface::new(&s.mesh.topology, &s.mesh.positions, s.scheme, &s.options)
+        else {
+            continue;
+        };
+        let pick = Scattered { seed: 3, p: 0.5 };
+        let a = AdaptiveRefinement::new(
+            &s.mesh.topology,
+            &s.mesh.positions,
+            s.scheme,
+            &s.options,
+            &[&pick],
+            2,
+        )
+        .unwrap();
+        let mesh = a.mesh(Positions::Limit).unwrap();
+        let d = diagonal(&s.mesh.positions);
+        let mut all = true;
+        // Every seventh face: the evaluator refines locally next to irregular sharp
+        // features, which is slow point by point.
+        for f in (0..mesh.num_faces()).filter(|&f| !mesh.holes[f] && f % 7 == 0) {
+            let (face, sub) = mesh.face_domains[f];
+            let first = mesh.face_offsets[f] as usize;
+            for (i, &v) in mesh.face(f).iter().enumerate() {
+                let uv = mesh.corner_params[first + i];
+                let sub = if sub == u16::MAX { i } else { sub as usize };
+                let (u, w) = if uv[0].is_nan() { (0.0, 0.0) } else { (uv[0], uv[1]) };
+                match surface.position(face as usize, sub, u, w) {
+                    Ok(p) => assert!(
+                        (p - mesh.positions[v as usize]).length() <= 1e-12 * d,
+                        "{}: face {f} corner {i}: evaluator {p} vs {}",
+                        s.name,
+                        mesh.positions[v as usize]
+                    ),
+                    Err(_) => all = false,
+                }
+            }
+        }
+        checked += usize::from(all);
+    }
+    assert!(checked > 40, "{checked} shapes");
+}

@@ -315,8 +315,10 @@ impl SparseLevel {
                     0.25 * (d[0][0] + d[1][0] + d[2][0] + d[3][0]),
                     0.25 * (d[0][1] + d[1][1] + d[2][1] + d[3][1]),
                 ];
+                // Child k of a quad is (V_k, E_k, F, E_{k-1}) rotated to put V_k at corner k.
                 let (prev, next_k) = ((k + 3) % 4, (k + 1) % 4);
-                corner_params.extend([d[k], mid(d[k], d[next_k]), centre, mid(d[prev], d[k])]);
+                let around = [d[k], mid(d[k], d[next_k]), centre, mid(d[prev], d[k])];
+                corner_params.extend((0..4).map(|i| around[(i + 4 - k) % 4]));
             }
         }
         let child = SparseLevel {

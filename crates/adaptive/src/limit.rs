@@ -11,13 +11,15 @@
 //! contain every face the edge point's own ring is made from.
 
 use glam::DVec3;
-use subd_limit::LimitStencilTable;
 use subd_schemes::{Refinement, Scheme};
 
 use crate::AdaptiveError;
 use crate::hierarchy::AdaptiveRefinement;
 use crate::level::Origin;
 use crate::submesh::NONE;
+
+/// Decay levels up to which a piece is refined whole for its limits.
+const LOCAL_DECAY: usize = 2;
 
 /// Where an output vertex's limit is taken.
 #[derive(Clone, Copy, Debug)]
@@ -59,43 +61,11 @@ pub(crate) fn limit_points(
     let mut positions = vec![DVec3::ZERO; instances.len()];
     let mut normals = vec![DVec3::ZERO; instances.len()];
     for (l, anchors) in by_level.iter().enumerate() {
-        // Anchors whose rings still carry semi-sharp features are refined apart, so their
-        // decay does not multiply the work of the rest.
-        let lv = &h.levels[l];
-        let (sharp, plain): (Vec<_>, Vec<_>) = anchors
-            .iter()
-            .partition(|(a, _)| anchor_rings(lv, *a).any(|v| ring_is_semi_sharp(lv, v)));
-        for group in [plain, sharp] {
-            if !group.is_empty() {
-                level_limits(h, l, &group, &mut positions, &mut normals)?;
-            }
+        if !anchors.is_empty() {
+            level_limits(h, l, anchors, &mut positions, &mut normals)?;
         }
     }
     Ok((positions, normals))
-}
-
-/// The vertices whose rings an anchor's limit reads.
-fn anchor_rings(lv: &crate::level::SparseLevel, a: Anchor) -> impl Iterator<Item = u32> {
-    match a {
-        Anchor::Vertex(v) => [v, NONE],
-        Anchor::EdgePoint(e) => lv.topology.edge_vertices(e as usize),
-    }
-    .into_iter()
-    .filter(|&v| v != NONE)
-}
-
-/// Whether a face around `v` has a semi-sharp edge or vertex.
-fn ring_is_semi_sharp(lv: &crate::level::SparseLevel, v: u32) -> bool {
-    use subd_mesh::tags::is_semi_sharp;
-    let t = &lv.topology;
-    t.vertex_faces(v as usize).iter().any(|&f| {
-        t.face_edges(f as usize)
-            .iter()
-            .any(|&e| is_semi_sharp(t.edge_sharpness(e as usize)))
-            || t.face_vertices(f as usize)
-                .iter()
-                .any(|&w| is_semi_sharp(t.vertex_sharpness(w as usize)))
-    })
 }
 
 /// The limits of the anchors of level `l`, written to the anchors' output slots.
@@ -144,16 +114,30 @@ fn level_limits(
         local_edge[e as usize] = i as u32;
     }
     let (nv, nf) = (cut.topology.num_vertices(), cut.topology.num_faces());
-    let edge_point_base = if h.scheme == Scheme::Loop {
-        nv
+    let edge_point_base = if h.scheme == Scheme::Loop { nv } else { nv + nf };
+    // Edge points exist one level down: refine the cut once and take the limits there.
+    let (topology, pts) = if edge_points {
+        let r = Refinement::from_prepared(cut.topology, rules, h.scheme, &h.options, 1)?;
+        let pts = r.refine_points(&points).pop().expect("one level");
+        (r.into_topology(1), pts)
     } else {
-        nv + nf
+        (cut.topology, points)
     };
-    let (decay, _) = subd_limit::levels_for_exact_limit(&cut.topology, h.scheme);
-    let levels = decay.max(usize::from(edge_points));
-    let r = Refinement::from_prepared(cut.topology, rules, h.scheme, &h.options, levels)?;
-    let pts = r.refine_points(&points).pop().expect("level 0 at least");
-    let table = LimitStencilTable::at_level(&r, levels)?;
+    // subd-limit's exact limits of every vertex of the piece (refining only around semi-sharp
+    // features, as far as they need to decay). Re-deriving the piece's tags changes only
+    // vertices on its cut, whose limits are not read.
+    // Past a couple of decay levels refining the whole piece costs 4^levels; subd-limit's
+    // local path refines only around the semi-sharp features.
+    let (decay, _) = subd_limit::levels_for_exact_limit(&topology, h.scheme);
+    let exact = if decay <= LOCAL_DECAY {
+        subd_limit::base_limit(&topology, h.scheme, &h.options)
+    } else {
+        subd_limit::local::base_limit(&topology, h.scheme, &h.options)
+    };
+    let table = match exact {
+        Err(e @ subd_limit::LimitError::Unsupported { .. }) => whole_limit(h, topology, &pts, e)?,
+        other => other?,
+    };
     let apply = |t: &subd_schemes::StencilTable, row: usize| -> DVec3 {
         let (idx, w) = t.row(row);
         idx.iter()
@@ -173,4 +157,29 @@ fn level_limits(
         normals[slot] = t1.cross(t2).normalize_or_zero();
     }
     Ok(())
+}
+
+/// The limits [`subd_limit::base_limit`] gives, by refining the whole piece until semi-sharp
+/// features have decayed: for the non-manifold pieces its local refinement does not
+/// reproduce. The piece's tags are prepared as `base_limit` prepares them.
+fn whole_limit(
+    h: &AdaptiveRefinement,
+    topology: subd_mesh::Topology,
+    pts: &[DVec3],
+    refused: subd_limit::LimitError,
+) -> Result<subd_limit::LimitStencilTable, AdaptiveError> {
+    let (levels, _) = subd_limit::levels_for_exact_limit(&topology, h.scheme);
+    let size = topology
+        .num_face_vertices()
+        .saturating_mul(4usize.saturating_pow(levels as u32));
+    if size > subd_limit::MAX_DECAY_FACE_VERTICES {
+        return Err(refused.into());
+    }
+    let r = Refinement::new(&topology, h.scheme, &h.options, levels)?;
+    let mut table = subd_limit::LimitStencilTable::at_level(&r, levels)?;
+    for l in (1..=levels).rev() {
+        table = table.after(r.stencils(l));
+    }
+    debug_assert_eq!(table.position.num_sources(), pts.len());
+    Ok(table)
 }

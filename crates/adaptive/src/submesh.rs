@@ -27,9 +27,10 @@ pub(crate) struct SubMesh {
 
 /// Cuts `faces` (indices into `src`, each once) out of `src`. Vertices and edges are numbered
 /// by first appearance in `faces`; face-edges, edge-faces, vertex-faces and vertex-edges are
-/// the source's, filtered to the cut, in the source's order. A vertex that lost faces is
-/// flagged non-manifold (its partial ring need not be one fan); nothing the caller keeps
-/// reads such a vertex's ring.
+/// the source's, filtered to the cut, in the source's order. A manifold vertex that lost
+/// faces keeps them as the boundary fan they form when they are one run of its ring, and is
+/// flagged non-manifold otherwise (as a mesh built from the cut's face lists would have it);
+/// nothing the caller keeps reads such a vertex's ring.
 pub(crate) fn cut(src: &Topology, faces: &[u32]) -> SubMesh {
     let mut vmap = vec![NONE; src.num_vertices()];
     let mut emap = vec![NONE; src.num_edges()];
@@ -99,27 +100,51 @@ pub(crate) fn cut(src: &Topology, faces: &[u32]) -> SubMesh {
     let mut complete = Vec::with_capacity(vertices.len());
     for &v in &vertices {
         let v = v as usize;
-        let start = vertex_faces.len();
-        for (&g, &c) in src
-            .vertex_faces(v)
-            .iter()
-            .zip(src.vertex_face_local_indices(v))
-        {
-            if fmap[g as usize] != NONE {
-                vertex_faces.push(fmap[g as usize]);
-                vertex_face_local.push(c);
+        let (vf, vl, ve) = (
+            src.vertex_faces(v),
+            src.vertex_face_local_indices(v),
+            src.vertex_edges(v),
+        );
+        let kept: Vec<usize> = (0..vf.len())
+            .filter(|&i| fmap[vf[i] as usize] != NONE)
+            .collect();
+        let whole = kept.len() == vf.len();
+        let arc = if whole || src.is_non_manifold_vertex(v) {
+            None
+        } else {
+            single_arc(&kept, vf.len(), ve.len() == vf.len())
+        };
+        match arc {
+            Some(first) => {
+                // One contiguous run of the ring: a boundary fan of the cut, starting at the
+                // run's first face (whose leaving edge is now a boundary edge).
+                let (n, ne) = (vf.len(), ve.len());
+                for j in 0..kept.len() {
+                    let i = (first + j) % n;
+                    vertex_faces.push(fmap[vf[i] as usize]);
+                    vertex_face_local.push(vl[i]);
+                }
+                for j in 0..=kept.len() {
+                    vertex_edges.push(emap[ve[(first + j) % ne] as usize]);
+                }
+                vertex_non_manifold.push(false);
+            }
+            None => {
+                for &i in &kept {
+                    vertex_faces.push(fmap[vf[i] as usize]);
+                    vertex_face_local.push(vl[i]);
+                }
+                for &e in ve {
+                    if emap[e as usize] != NONE {
+                        vertex_edges.push(emap[e as usize]);
+                    }
+                }
+                vertex_non_manifold.push(src.is_non_manifold_vertex(v) || !whole);
             }
         }
         vertex_face_offsets.push(vertex_faces.len() as u32);
-        for &e in src.vertex_edges(v) {
-            if emap[e as usize] != NONE {
-                vertex_edges.push(emap[e as usize]);
-            }
-        }
         vertex_edge_offsets.push(vertex_edges.len() as u32);
-        let whole = vertex_faces.len() - start == src.vertex_faces(v).len();
         complete.push(whole);
-        vertex_non_manifold.push(src.is_non_manifold_vertex(v) || !whole);
     }
 
     let tags = src.tags();
@@ -174,6 +199,26 @@ pub(crate) fn cut(src: &Topology, faces: &[u32]) -> SubMesh {
     }
 }
 
+/// The start (ring position) of the single run of consecutive ring positions `kept`
+/// (increasing) in a ring of `n` faces, cyclic when `closed`; `None` for several runs.
+fn single_arc(kept: &[usize], n: usize, closed: bool) -> Option<usize> {
+    let gaps: Vec<usize> = (0..kept.len())
+        .filter(|&j| {
+            let next = kept[(j + 1) % kept.len()];
+            if j + 1 == kept.len() {
+                !closed || (kept[j] + 1) % n != next
+            } else {
+                kept[j] + 1 != next
+            }
+        })
+        .collect();
+    match gaps.as_slice() {
+        // One break in the (cyclic or linear) sequence: the run starts after it.
+        [g] => Some(kept[(g + 1) % kept.len()]),
+        _ => None,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -212,10 +257,37 @@ mod tests {
             .map(|&e| s.edges[e as usize])
             .collect();
         assert_eq!(src_edges, cut_edges);
-        // Vertex 2 lost face 2: incomplete, flagged.
+        // Vertex 2 lost face 2: incomplete, a boundary fan of the cut.
         let local2 = s.vertices.iter().position(|&v| v == 2).unwrap();
         assert!(!s.complete[local2]);
-        assert!(s.topology.is_non_manifold_vertex(local2));
+        assert!(!s.topology.is_non_manifold_vertex(local2));
+        assert!(s.topology.is_boundary_vertex(local2));
+        // Vertex 6 lost face 2 of its four; every flag agrees with a rebuild from face lists.
+        let six = s.vertices.iter().position(|&v| v == 6).unwrap();
+        assert!(!s.complete[six]);
+        let rebuilt = TopologyBuilder::new(s.topology.num_vertices())
+            .build(
+                &vec![4; s.topology.num_faces()],
+                s.topology.all_face_vertices(),
+            )
+            .unwrap();
+        for v in 0..s.topology.num_vertices() {
+            assert_eq!(
+                s.topology.is_non_manifold_vertex(v),
+                rebuilt.is_non_manifold_vertex(v),
+                "vertex {v}"
+            );
+            assert_eq!(s.topology.vertex_faces(v).len(), rebuilt.vertex_faces(v).len());
+        }
+        for v in 0..s.topology.num_vertices() {
+            if !s.topology.is_non_manifold_vertex(v) {
+                // A manifold fan: each vertex edge leaves the vertex in the face at its place.
+                let (vf, ve) = (s.topology.vertex_faces(v), s.topology.vertex_edges(v));
+                for (i, (&f, &c)) in vf.iter().zip(s.topology.vertex_face_local_indices(v)).enumerate() {
+                    assert_eq!(s.topology.face_edges(f as usize)[c as usize], ve[i]);
+                }
+            }
+        }
         assert_eq!(s.topology.num_faces(), 5);
     }
 }

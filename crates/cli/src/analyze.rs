@@ -9,7 +9,7 @@ use subd_schemes::Scheme;
 use subd_schemes::analysis::{Lattice, analyze, analyze_bivariate};
 
 use crate::Failure;
-use crate::refine::bad;
+use crate::failure::bad;
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
 pub(crate) enum SurfaceArg {

@@ -11,7 +11,7 @@ use serde::Serialize;
 use subd_schemes::curve::{CircleScheme, CurveScheme, PointNormal};
 
 use crate::Failure;
-use crate::refine::{bad, refuse_overwrite};
+use crate::failure::{bad, refuse_overwrite};
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub(crate) enum CurveSchemeArg {

@@ -11,7 +11,8 @@ use subd_limit::eval::{FaceParam, LimitEvaluator};
 use subd_schemes::Scheme;
 
 use crate::limit::LimitSchemeArg;
-use crate::refine::{RuleArgs, bad, refuse_overwrite};
+use crate::failure::{bad, refuse_overwrite};
+use crate::rule_args::RuleArgs;
 use crate::{Failure, print_warnings};
 
 #[derive(Debug, Args)]

@@ -13,19 +13,25 @@
 //! assert!(String::from_utf8(err).unwrap().starts_with("subd: no-such-file.obj: cannot read"));
 //! ```
 
+mod adaptive;
 mod analyze;
 mod curve;
+mod failure;
 mod eval;
 mod info;
 mod limit;
 mod pia;
+mod progress;
 mod refine;
+mod rule_args;
 mod vertex_data;
 
 use std::ffi::OsString;
 use std::io::Write;
 
 use clap::{Parser, Subcommand};
+
+pub use failure::Failure;
 
 /// Exit code for success.
 pub const EXIT_OK: i32 = 0;
@@ -57,6 +63,10 @@ enum Command {
     /// The exact limit surface (position and unit normal) at given (face, u, v) parameters,
     /// in OpenSubdiv's parameterisation.
     Eval(eval::EvalArgs),
+    /// Adaptive Loop or Catmull-Clark refinement: only where criteria select (flatness,
+    /// distance to the limit, curvature, dihedral angle, chosen faces or vertices), closed
+    /// into a crack-free mesh whose every vertex is uniform refinement's (or the limit's).
+    Adaptive(adaptive::AdaptiveArgs),
     /// Progressive iterative interpolation: a control mesh with IN's topology whose limit
     /// surface passes through IN's vertices (all, or those chosen with --moving/--fixed).
     Pia(pia::PiaArgs),
@@ -66,28 +76,6 @@ enum Command {
     /// Convergence and smoothness of a univariate mask (Laurent polynomials), or the
     /// eigenvalue test of a surface scheme at a valence.
     Analyze(analyze::AnalyzeArgs),
-}
-
-/// A command's failure: exit code and one-line message.
-#[derive(Debug)]
-pub struct Failure {
-    /// Process exit code.
-    pub code: i32,
-    /// One-line message (without the `subd: ` prefix).
-    pub message: String,
-}
-
-impl From<subd_io::IoError> for Failure {
-    fn from(e: subd_io::IoError) -> Self {
-        let code = match e {
-            subd_io::IoError::Write { .. } => EXIT_FAILURE,
-            _ => EXIT_BAD_INPUT,
-        };
-        Failure {
-            code,
-            message: e.to_string(),
-        }
-    }
 }
 
 /// Prints `report` as one line of JSON on `out` (a closed pipe is not an error worth
@@ -141,6 +129,7 @@ where
         Command::Limit(a) => limit::run(&a, out, err),
         Command::Eval(a) => eval::run(&a, out, err),
         Command::Pia(a) => pia::run(&a, out, err),
+        Command::Adaptive(a) => adaptive::run(&a, out, err),
         Command::Curve(a) => curve::run(&a, out, err),
         Command::Analyze(a) => analyze::run(&a, out),
     };

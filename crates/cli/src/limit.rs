@@ -11,7 +11,8 @@ use subd_limit::{LimitPoints, base_limit, levels_for_exact_limit, two_phase_base
 use subd_mesh::Mesh;
 use subd_schemes::Scheme;
 
-use crate::refine::{RuleArgs, bad, refuse_overwrite};
+use crate::failure::{bad, refuse_overwrite};
+use crate::rule_args::RuleArgs;
 use crate::vertex_data::LambdaArgs;
 use crate::{Failure, print_warnings};
 

@@ -1,7 +1,7 @@
 //! `subd pia`: progressive iterative interpolation — a control mesh with the input's
 //! topology whose limit surface passes through the input's vertices.
 
-use std::io::{IsTerminal, Write};
+use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -11,7 +11,9 @@ use subd_mesh::Mesh;
 use subd_pia::{Method, Moving, Pia, PiaOptions, PiaScheme, Solver, bbox_diagonal};
 use subd_schemes::Scheme;
 
-use crate::refine::{RuleArgs, bad, refuse_overwrite};
+use crate::failure::{bad, refuse_overwrite};
+use crate::progress::Spinner;
+use crate::rule_args::RuleArgs;
 use crate::vertex_data::{LambdaArgs, read_indices};
 use crate::{EXIT_FAILURE, Failure, print_warnings};
 
@@ -147,8 +149,8 @@ pub(crate) fn run(args: &PiaArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
         ));
     }
     let moving = match (&args.moving, &args.fixed) {
-        (Some(f), _) => Moving::Only(read_indices(f, nv)?),
-        (None, Some(f)) => Moving::AllBut(read_indices(f, nv)?),
+        (Some(f), _) => Moving::Only(read_indices(f, nv, "vertex")?),
+        (None, Some(f)) => Moving::AllBut(read_indices(f, nv, "vertex")?),
         (None, None) => Moving::All,
     };
     let solver = match args.solver {
@@ -161,7 +163,7 @@ pub(crate) fn run(args: &PiaArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
     };
     let at_input = |e: subd_pia::PiaError| bad(format!("{}: {e}", args.input.display()));
 
-    let spinner = Spinner::new(args.json);
+    let spinner = Spinner::new(args.json, "limit stencils");
     let t0 = Instant::now();
     let pia = Pia::new(topo, &scheme, &options).map_err(at_input)?;
     let t_setup = t0.elapsed().as_secs_f64();
@@ -252,32 +254,4 @@ pub(crate) fn run(args: &PiaArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
         crate::print_json(out, &report);
     }
     Ok(())
-}
-
-/// A spinner on a terminal (the solve has no known length); nothing when piped or when a
-/// JSON report was asked for.
-struct Spinner(Option<indicatif::ProgressBar>);
-
-impl Spinner {
-    fn new(json: bool) -> Spinner {
-        if json || !std::io::stderr().is_terminal() {
-            return Spinner(None);
-        }
-        let bar = indicatif::ProgressBar::new_spinner();
-        bar.set_message("limit stencils");
-        bar.enable_steady_tick(std::time::Duration::from_millis(100));
-        Spinner(Some(bar))
-    }
-
-    fn message(&self, m: &'static str) {
-        if let Some(b) = &self.0 {
-            b.set_message(m);
-        }
-    }
-
-    fn finish(&self) {
-        if let Some(b) = &self.0 {
-            b.finish_and_clear();
-        }
-    }
 }

@@ -7,10 +7,12 @@ use std::time::Instant;
 use clap::{Args, ValueEnum};
 use serde::Serialize;
 use subd_mesh::{BoundaryInterpolation, CreaseMethod, SchemeHints, TriangleSubdivision};
-use subd_schemes::{Options, Refinement, Scheme};
+use subd_schemes::{Refinement, Scheme};
 
+use crate::failure::{bad, refuse_overwrite};
+use crate::rule_args::RuleArgs;
 use crate::vertex_data::LambdaArgs;
-use crate::{EXIT_BAD_INPUT, Failure, print_warnings};
+use crate::{Failure, print_warnings};
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
 pub(crate) enum SchemeArg {
@@ -19,79 +21,6 @@ pub(crate) enum SchemeArg {
     Bilinear,
     /// Seed 000's two-phase modified Catmull-Clark (needs --lambda or --lambda-file).
     TwoPhase,
-}
-
-#[derive(Debug, Clone, Copy, ValueEnum)]
-pub(crate) enum BoundaryArg {
-    None,
-    EdgeOnly,
-    EdgeAndCorner,
-}
-
-#[derive(Debug, Clone, Copy, ValueEnum)]
-pub(crate) enum CreaseArg {
-    Uniform,
-    Chaikin,
-}
-
-#[derive(Debug, Clone, Copy, ValueEnum)]
-pub(crate) enum TriangleArg {
-    Catmark,
-    Smooth,
-}
-
-/// The rule options a command shares: defaults from the file's tags, overridden here.
-#[derive(Debug, Args)]
-pub(crate) struct RuleArgs {
-    /// Boundary interpolation (default: the file's `t interpolateboundary` tag, else
-    /// edge-only).
-    #[arg(long, value_enum)]
-    boundary: Option<BoundaryArg>,
-    /// Crease method for semi-sharp creases (default: the file's `t creasemethod` tag, else
-    /// uniform).
-    #[arg(long, value_enum)]
-    crease_method: Option<CreaseArg>,
-    /// Catmull-Clark triangle rule (default: the file's `t smoothtriangles` tag, else
-    /// catmark).
-    #[arg(long, value_enum)]
-    triangles: Option<TriangleArg>,
-    /// Accept faces whose windings disagree across a shared edge (treated as non-manifold).
-    #[arg(long)]
-    pub(crate) accept_inconsistent_orientation: bool,
-}
-
-impl RuleArgs {
-    /// The options for `hints` (a file's tags) with this command line's overrides.
-    pub(crate) fn options(&self, hints: &SchemeHints) -> Options {
-        let mut options = Options::from_hints(hints);
-        if let Some(b) = self.boundary {
-            options.boundary_interpolation = match b {
-                BoundaryArg::None => BoundaryInterpolation::None,
-                BoundaryArg::EdgeOnly => BoundaryInterpolation::EdgeOnly,
-                BoundaryArg::EdgeAndCorner => BoundaryInterpolation::EdgeAndCorner,
-            };
-        }
-        if let Some(c) = self.crease_method {
-            options.crease_method = match c {
-                CreaseArg::Uniform => CreaseMethod::Uniform,
-                CreaseArg::Chaikin => CreaseMethod::Chaikin,
-            };
-        }
-        if let Some(t) = self.triangles {
-            options.triangle_subdivision = match t {
-                TriangleArg::Catmark => TriangleSubdivision::Catmark,
-                TriangleArg::Smooth => TriangleSubdivision::Smooth,
-            };
-        }
-        options
-    }
-
-    /// Reader options.
-    pub(crate) fn read_options(&self) -> subd_io::ReadOptions {
-        subd_io::ReadOptions {
-            accept_inconsistent_orientation: self.accept_inconsistent_orientation,
-        }
-    }
 }
 
 impl SchemeArg {
@@ -166,29 +95,6 @@ struct RefineReport {
     output_counts: Counts,
     seconds: Timings,
     warnings: Vec<String>,
-}
-
-/// Refuses an output path that names the input file.
-pub(crate) fn refuse_overwrite(
-    input: &std::path::Path,
-    output: &std::path::Path,
-) -> Result<(), Failure> {
-    if let (Ok(a), Ok(b)) = (input.canonicalize(), output.canonicalize())
-        && a == b
-    {
-        return Err(bad(format!(
-            "{}: the output would overwrite the input",
-            output.display()
-        )));
-    }
-    Ok(())
-}
-
-pub(crate) fn bad(message: String) -> Failure {
-    Failure {
-        code: EXIT_BAD_INPUT,
-        message,
-    }
 }
 
 pub(crate) fn run(

@@ -1,5 +1,6 @@
 //! Per-vertex inputs given on the command line or in text files: the two-phase scheme's
-//! `λ` (`--lambda`, `--lambda-file`) and vertex index lists (`--moving`, `--fixed`).
+//! `λ` (`--lambda`, `--lambda-file`) and index lists (`--moving`, `--fixed`, `--select-faces`,
+//! `--select-vertices`).
 //!
 //! Files are whitespace-separated numbers; `#` starts a comment. Errors name the file and
 //! the line.
@@ -11,7 +12,7 @@ use subd_schemes::TwoPhase;
 use subd_schemes::two_phase::{LAMBDA_MAX, LAMBDA_MIN};
 
 use crate::Failure;
-use crate::refine::bad;
+use crate::failure::bad;
 
 /// The two-phase scheme's shape parameter.
 #[derive(Debug, Args)]
@@ -105,20 +106,21 @@ fn read_lambda_file(path: &Path, num_vertices: usize) -> Result<Vec<f64>, Failur
     Ok(values)
 }
 
-/// A file of vertex indices (0-based), each below `num_vertices`.
-pub(crate) fn read_indices(path: &Path, num_vertices: usize) -> Result<Vec<u32>, Failure> {
+/// A file of 0-based indices of `what` (`vertex` or `face`), each below `count`.
+pub(crate) fn read_indices(path: &Path, count: usize, what: &str) -> Result<Vec<u32>, Failure> {
     let tokens = numbers(path)?;
     let mut out = Vec::with_capacity(tokens.len());
     for (line, tok) in &tokens {
         let v: u64 = tok.parse().map_err(|_| {
             bad(format!(
-                "{}:{line}: {tok:?} is not a vertex index (a non-negative integer)",
+                "{}:{line}: {tok:?} is not a {what} index (a non-negative integer)",
                 path.display()
             ))
         })?;
-        if v >= num_vertices as u64 {
+        if v >= count as u64 {
+            let plural = if what == "vertex" { "vertices" } else { "faces" };
             return Err(bad(format!(
-                "{}:{line}: vertex {v} does not exist (the mesh has {num_vertices} vertices)",
+                "{}:{line}: {what} {v} does not exist (the mesh has {count} {plural})",
                 path.display()
             )));
         }

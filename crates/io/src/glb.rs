@@ -71,7 +71,10 @@ fn to_f32(p: &DVec3) -> [f32; 3] {
 /// into the output, so besides the normals nothing the size of the mesh is held.
 pub fn write_glb(w: &mut dyn Write, mesh: &MeshView<'_>) -> std::io::Result<()> {
     let positions = mesh.positions();
-    let normals = vertex_normals(mesh);
+    let normals = match mesh.normals() {
+        Some(n) => n.to_vec(),
+        None => vertex_normals(mesh),
+    };
     let num_indices: usize = (0..mesh.num_faces())
         .filter(|&f| !mesh.is_hole(f))
         .map(|f| 3 * (mesh.face_vertices(f).len() - 2))

@@ -456,10 +456,21 @@ pub fn write_obj(
         let p = positions[i];
         let _ = writeln!(b, "v {} {} {}", p.x, p.y, p.z);
     })?;
+    if let Some(normals) = mesh.normals() {
+        write_records(w, normals.len(), |i, b| {
+            let n = normals[i];
+            let _ = writeln!(b, "vn {} {} {}", n.x, n.y, n.z);
+        })?;
+    }
+    let with_normals = mesh.normals().is_some();
     write_records(w, mesh.num_faces(), |f, b| {
         b.push(b'f');
         for &v in mesh.face_vertices(f) {
-            let _ = write!(b, " {}", v as u64 + 1);
+            if with_normals {
+                let _ = write!(b, " {0}//{0}", v as u64 + 1);
+            } else {
+                let _ = write!(b, " {}", v as u64 + 1);
+            }
         }
         b.push(b'\n');
     })?;

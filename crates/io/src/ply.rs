@@ -618,12 +618,22 @@ pub fn write_ply(
     for c in ["x", "y", "z"] {
         writeln!(w, "property double {c}")?;
     }
+    let normals = mesh.normals();
+    if normals.is_some() {
+        for c in ["nx", "ny", "nz"] {
+            writeln!(w, "property double {c}")?;
+        }
+    }
     writeln!(w, "element face {nf}")?;
     writeln!(
         w,
         "property list {} {index_ty} vertex_indices",
         if wide_lists { "uint" } else { "uchar" }
     )?;
+    let levels = mesh.face_levels();
+    if levels.is_some() {
+        writeln!(w, "property uchar level")?;
+    }
     if !creases.is_empty() {
         writeln!(w, "element crease {}", creases.len())?;
         writeln!(
@@ -644,13 +654,21 @@ pub fn write_ply(
         PlyEncoding::Ascii => {
             write_records(w, positions.len(), |i, b| {
                 let p = positions[i];
-                let _ = writeln!(b, "{} {} {}", p.x, p.y, p.z);
+                let _ = write!(b, "{} {} {}", p.x, p.y, p.z);
+                if let Some(n) = normals {
+                    let n = n[i];
+                    let _ = write!(b, " {} {} {}", n.x, n.y, n.z);
+                }
+                b.push(b'\n');
             })?;
             write_records(w, nf, |f, b| {
                 let fv = mesh.face_vertices(f);
                 let _ = write!(b, "{}", fv.len());
                 for &v in fv {
                     let _ = write!(b, " {v}");
+                }
+                if let Some(l) = levels {
+                    let _ = write!(b, " {}", l[f]);
                 }
                 b.push(b'\n');
             })?;
@@ -669,6 +687,11 @@ pub fn write_ply(
                 for c in positions[i].to_array() {
                     b.extend_from_slice(&c.to_le_bytes());
                 }
+                if let Some(n) = normals {
+                    for c in n[i].to_array() {
+                        b.extend_from_slice(&c.to_le_bytes());
+                    }
+                }
             })?;
             write_records(w, nf, |f, b| {
                 let fv = mesh.face_vertices(f);
@@ -679,6 +702,9 @@ pub fn write_ply(
                 }
                 for &v in fv {
                     b.extend_from_slice(&v.to_le_bytes());
+                }
+                if let Some(l) = levels {
+                    b.push(l[f]);
                 }
             })?;
             let mut buf: Vec<u8> = Vec::new();

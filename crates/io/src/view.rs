@@ -53,6 +53,16 @@ pub enum ViewError {
         /// Faces.
         faces: usize,
     },
+    /// Normals or face levels, when given, must be one per vertex or per face.
+    #[error("{given} {what} given for {expected}")]
+    Count {
+        /// `normals` or `face levels`.
+        what: &'static str,
+        /// How many were given.
+        given: usize,
+        /// How many are needed.
+        expected: usize,
+    },
     /// A crease or corner tag names a vertex without a position, or has a sharpness that
     /// is not a positive number.
     #[error("{what} tag {index} is invalid (vertex beyond the positions or sharpness not > 0)")]
@@ -73,6 +83,8 @@ pub struct MeshView<'a> {
     holes: &'a [bool],
     creases: Cow<'a, [([u32; 2], f32)]>,
     corners: Cow<'a, [(u32, f32)]>,
+    normals: Option<&'a [DVec3]>,
+    face_levels: Option<&'a [u8]>,
     /// Scheme hints written as tags (OBJ) or comments (PLY).
     pub hints: SchemeHints,
 }
@@ -142,8 +154,58 @@ impl<'a> MeshView<'a> {
             holes,
             creases: Cow::Borrowed(&[]),
             corners: Cow::Borrowed(&[]),
+            normals: None,
+            face_levels: None,
             hints: SchemeHints::default(),
         })
+    }
+
+    /// Adds one unit normal per vertex, written instead of normals derived from the faces:
+    /// OBJ `vn` lines, PLY `nx ny nz` vertex properties, the glTF `NORMAL` attribute.
+    ///
+    /// # Errors
+    /// [`ViewError::Count`] unless there is one normal per position, [`ViewError::NonFinite`]
+    /// for a normal with a NaN or infinite coordinate.
+    pub fn with_normals(mut self, normals: &'a [DVec3]) -> Result<MeshView<'a>, ViewError> {
+        if normals.len() != self.positions.len() {
+            return Err(ViewError::Count {
+                what: "normals",
+                given: normals.len(),
+                expected: self.positions.len(),
+            });
+        }
+        if let Some(vertex) = normals.iter().position(|n| !n.is_finite()) {
+            return Err(ViewError::NonFinite { vertex });
+        }
+        self.normals = Some(normals);
+        Ok(self)
+    }
+
+    /// Adds a refinement level per face, written as the PLY face property `level` (`uchar`);
+    /// OBJ and glTF files have no place for it.
+    ///
+    /// # Errors
+    /// [`ViewError::Count`] unless there is one level per face.
+    pub fn with_face_levels(mut self, levels: &'a [u8]) -> Result<MeshView<'a>, ViewError> {
+        if levels.len() != self.num_faces() {
+            return Err(ViewError::Count {
+                what: "face levels",
+                given: levels.len(),
+                expected: self.num_faces(),
+            });
+        }
+        self.face_levels = Some(levels);
+        Ok(self)
+    }
+
+    /// The per-vertex normals given with [`Self::with_normals`].
+    pub fn normals(&self) -> Option<&[DVec3]> {
+        self.normals
+    }
+
+    /// The per-face levels given with [`Self::with_face_levels`].
+    pub fn face_levels(&self) -> Option<&[u8]> {
+        self.face_levels
     }
 
     /// Adds crease tags (edge end points and sharpness) and corner tags (vertex and
@@ -198,6 +260,8 @@ impl<'a> MeshView<'a> {
             holes: topo.tags().holes(),
             creases: Cow::Owned(creases),
             corners: Cow::Owned(corners),
+            normals: None,
+            face_levels: None,
             hints: mesh.hints,
         }
     }

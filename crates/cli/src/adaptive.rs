@@ -1,0 +1,368 @@
+//! `subd adaptive`: selective Loop or Catmull-Clark refinement, crack-free, every vertex a
+//! vertex of uniform refinement (or, with `--limit`, of the limit surface).
+
+use std::io::Write;
+use std::path::PathBuf;
+use std::time::Instant;
+
+use clap::{Args, ValueEnum};
+use serde::Serialize;
+use subd_adaptive::{
+    AdaptiveError, AdaptiveMesh, AdaptiveRefinement, Conformity, Criterion, DihedralAngle,
+    FaceSelection, Flatness, GaussianCurvature, LimitDistance, LimitSurface, Positions,
+};
+use subd_mesh::{BoundaryInterpolation, CreaseMethod, SchemeHints, TriangleSubdivision};
+use subd_schemes::Scheme;
+
+use crate::failure::{bad, refuse_overwrite};
+use crate::progress::Spinner;
+use crate::rule_args::RuleArgs;
+use crate::vertex_data::read_indices;
+use crate::{Failure, print_warnings};
+
+/// Level cap when `--levels` is not given.
+const DEFAULT_LEVELS: usize = 4;
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub(crate) enum AdaptiveScheme {
+    Loop,
+    CatmullClark,
+}
+
+#[derive(Debug, Args)]
+pub(crate) struct AdaptiveArgs {
+    /// Subdivision scheme.
+    #[arg(long, value_enum)]
+    scheme: AdaptiveScheme,
+    /// Seed 002's flatness: refine every face that is not dead, a vertex being dead when the
+    /// largest angle between its faces' normals is below DEG degrees.
+    #[arg(long, value_name = "DEG")]
+    flatness: Option<f64>,
+    /// Refine until every face is within D × the bounding-box diagonal of the exact limit
+    /// surface (sampled at corners, edge midpoints and centre).
+    #[arg(long, value_name = "D")]
+    max_distance: Option<f64>,
+    /// Refine faces at a vertex whose Gaussian curvature (angle defect over area) times the
+    /// squared bounding-box diagonal exceeds K (a sphere: 12).
+    #[arg(long, value_name = "K")]
+    curvature: Option<f64>,
+    /// Refine both faces of an edge whose dihedral angle exceeds DEG degrees.
+    #[arg(long, value_name = "DEG")]
+    dihedral: Option<f64>,
+    /// Refine the descendants of the base faces listed in F (0-based indices).
+    #[arg(long, value_name = "F")]
+    select_faces: Option<PathBuf>,
+    /// Refine the descendants of the base faces with two or more of the vertices listed in F.
+    #[arg(long, value_name = "F")]
+    select_vertices: Option<PathBuf>,
+    /// Level cap (0 to 15; default 4). With no criterion, every face is refined to it.
+    #[arg(long)]
+    levels: Option<usize>,
+    /// Put every vertex at its exact limit position and write limit normals.
+    #[arg(long)]
+    limit: bool,
+    #[command(flatten)]
+    rules: RuleArgs,
+    /// Input mesh (.obj or .ply).
+    input: PathBuf,
+    /// Output mesh (.obj, .ply with a per-face `level`, or .glb).
+    output: PathBuf,
+    /// Print a JSON report on stdout.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Serialize)]
+struct CriteriaReport {
+    flatness: Option<f64>,
+    max_distance: Option<f64>,
+    curvature: Option<f64>,
+    dihedral: Option<f64>,
+    select_faces: Option<String>,
+    select_vertices: Option<String>,
+}
+
+#[derive(Serialize)]
+struct Timings {
+    read: f64,
+    hierarchy: f64,
+    mesh: f64,
+    report: f64,
+    write: f64,
+    total: f64,
+}
+
+#[derive(Serialize)]
+struct AdaptiveReport {
+    input: String,
+    output: String,
+    scheme: &'static str,
+    levels: usize,
+    depth: usize,
+    limit: bool,
+    boundary_interpolation: BoundaryInterpolation,
+    crease_method: CreaseMethod,
+    triangle_subdivision: TriangleSubdivision,
+    criteria: CriteriaReport,
+    input_faces: usize,
+    input_boundary_edges: usize,
+    faces: usize,
+    vertices: usize,
+    faces_per_level: Vec<usize>,
+    transition_faces: usize,
+    uniform_faces: u64,
+    face_ratio: f64,
+    level_builds: usize,
+    #[serde(flatten)]
+    conformity: Conformity,
+    min_angle_degrees: f64,
+    /// Absolute, and relative to the bounding-box diagonal; `null` where the exact
+    /// evaluator does not cover the mesh.
+    max_distance_to_limit: Option<f64>,
+    max_distance_to_limit_relative: Option<f64>,
+    bbox_diagonal: f64,
+    seconds: Timings,
+    warnings: Vec<String>,
+}
+
+fn in_range(name: &str, value: f64, ok: bool, what: &str) -> Result<(), Failure> {
+    if value.is_nan() || !ok {
+        return Err(bad(format!("--{name} {value}: {what}")));
+    }
+    Ok(())
+}
+
+pub(crate) fn run(
+    args: &AdaptiveArgs,
+    out: &mut dyn Write,
+    err: &mut dyn Write,
+) -> Result<(), Failure> {
+    let t_start = Instant::now();
+    refuse_overwrite(&args.input, &args.output)?;
+    if subd_io::Format::from_path(&args.output).is_none() {
+        return Err(bad(format!(
+            "{}: unsupported output extension (expected .obj, .ply or .glb)",
+            args.output.display()
+        )));
+    }
+    // Thresholds are checked before any work.
+    if let Some(d) = args.flatness {
+        in_range("flatness", d, (0.0..=180.0).contains(&d), "expected degrees in [0, 180]")?;
+    }
+    if let Some(d) = args.dihedral {
+        in_range("dihedral", d, (0.0..=180.0).contains(&d), "expected degrees in [0, 180]")?;
+    }
+    if let Some(d) = args.max_distance {
+        in_range("max-distance", d, d.is_finite() && d > 0.0, "expected a positive number")?;
+    }
+    if let Some(k) = args.curvature {
+        in_range("curvature", k, k.is_finite() && k >= 0.0, "expected a number ≥ 0")?;
+    }
+    let levels = args.levels.unwrap_or(DEFAULT_LEVELS);
+    if levels > subd_adaptive::MAX_LEVELS {
+        return Err(bad(format!(
+            "--levels {levels}: at most {} levels are supported",
+            subd_adaptive::MAX_LEVELS
+        )));
+    }
+
+    let file = subd_io::read_mesh(&args.input, &args.rules.read_options())?;
+    print_warnings(err, &args.input, &file.warnings);
+    let t_read = t_start.elapsed().as_secs_f64();
+    let mesh = &file.mesh;
+    let base = &mesh.topology;
+    let scheme = match args.scheme {
+        AdaptiveScheme::Loop => Scheme::Loop,
+        AdaptiveScheme::CatmullClark => Scheme::CatmullClark,
+    };
+    let options = args.rules.options(&mesh.hints);
+    let input_err = |e: AdaptiveError| bad(format!("{}: {e}", args.input.display()));
+    if scheme == Scheme::Loop
+        && let Some(f) = (0..base.num_faces()).find(|&f| base.face_size(f) != 3)
+    {
+        return Err(bad(format!(
+            "{}: face {f} has {} vertices; the Loop scheme needs triangles",
+            args.input.display(),
+            base.face_size(f)
+        )));
+    }
+    let diagonal = mesh
+        .bounding_box()
+        .map_or(0.0, |(lo, hi)| (hi - lo).length());
+
+    let mut criteria: Vec<Box<dyn Criterion>> = Vec::new();
+    if let Some(d) = args.flatness {
+        criteria.push(Box::new(Flatness::new(d).map_err(input_err)?));
+    }
+    if let Some(d) = args.dihedral {
+        criteria.push(Box::new(DihedralAngle::new(d).map_err(input_err)?));
+    }
+    if let Some(k) = args.curvature {
+        criteria.push(Box::new(GaussianCurvature::new(k, diagonal).map_err(input_err)?));
+    }
+    if let Some(f) = &args.select_faces {
+        let faces = read_indices(f, base.num_faces(), "face")?;
+        let faces: Vec<u64> = faces.into_iter().map(u64::from).collect();
+        criteria.push(Box::new(
+            FaceSelection::from_faces(base.num_faces(), &faces).map_err(input_err)?,
+        ));
+    }
+    if let Some(f) = &args.select_vertices {
+        let vertices = read_indices(f, base.num_vertices(), "vertex")?;
+        let vertices: Vec<u64> = vertices.into_iter().map(u64::from).collect();
+        criteria.push(Box::new(
+            FaceSelection::from_vertices(base, &vertices).map_err(input_err)?,
+        ));
+    }
+    let surface = || LimitSurface::new(base, &mesh.positions, scheme, &options);
+    let distance = match args.max_distance {
+        Some(d) => {
+            let s = surface().map_err(input_err)?;
+            Some(LimitDistance::new(s, d * diagonal, args.limit).map_err(input_err)?)
+        }
+        None => None,
+    };
+
+    let spinner = Spinner::new(args.json, "refining");
+    let t0 = Instant::now();
+    let mut refs: Vec<&dyn Criterion> = criteria.iter().map(|c| c.as_ref()).collect();
+    if let Some(d) = &distance {
+        refs.push(d);
+    }
+    let hierarchy = AdaptiveRefinement::with_progress(
+        base,
+        &mesh.positions,
+        scheme,
+        &options,
+        &refs,
+        levels,
+        &mut |level, faces| spinner.message(format!("level {level}: {faces} faces")),
+    )
+    .map_err(input_err)?;
+    let t_hierarchy = t0.elapsed().as_secs_f64();
+    spinner.message("conforming mesh");
+    let t1 = Instant::now();
+    let positions = if args.limit {
+        Positions::Limit
+    } else {
+        Positions::Refined
+    };
+    let result = hierarchy.mesh(positions).map_err(input_err)?;
+    let t_mesh = t1.elapsed().as_secs_f64();
+
+    let t2 = Instant::now();
+    let report = if args.json {
+        spinner.message("measuring");
+        let own;
+        let s = match &distance {
+            Some(d) => Ok(d.surface()),
+            None => {
+                own = surface();
+                own.as_ref().map_err(|_| ())
+            }
+        };
+        Some(measure(&result, s.ok()))
+    } else {
+        None
+    };
+    let t_report = t2.elapsed().as_secs_f64();
+
+    spinner.message("writing");
+    let t3 = Instant::now();
+    write(args, &result, &options)?;
+    spinner.finish();
+    let t_write = t3.elapsed().as_secs_f64();
+
+    if let Some((conformity, min_angle, distance)) = report {
+        let depth = hierarchy.depth();
+        let uniform_faces = hierarchy.uniform_counts(depth).faces;
+        let input_boundary_edges = (0..base.num_edges())
+            .filter(|&e| base.is_boundary_edge(e))
+            .count();
+        let report = AdaptiveReport {
+            input: args.input.display().to_string(),
+            output: args.output.display().to_string(),
+            scheme: match scheme {
+                Scheme::Loop => "loop",
+                _ => "catmull-clark",
+            },
+            levels,
+            depth,
+            limit: args.limit,
+            boundary_interpolation: options.boundary_interpolation,
+            crease_method: options.crease_method,
+            triangle_subdivision: options.triangle_subdivision,
+            criteria: CriteriaReport {
+                flatness: args.flatness,
+                max_distance: args.max_distance,
+                curvature: args.curvature,
+                dihedral: args.dihedral,
+                select_faces: args.select_faces.as_ref().map(|p| p.display().to_string()),
+                select_vertices: args
+                    .select_vertices
+                    .as_ref()
+                    .map(|p| p.display().to_string()),
+            },
+            input_faces: base.num_faces(),
+            input_boundary_edges,
+            faces: result.num_faces(),
+            vertices: result.positions.len(),
+            faces_per_level: result.faces_per_level(),
+            transition_faces: result.transition.iter().filter(|&&t| t).count(),
+            uniform_faces,
+            face_ratio: result.num_faces() as f64 / uniform_faces.max(1) as f64,
+            level_builds: hierarchy.level_builds(),
+            conformity,
+            min_angle_degrees: min_angle,
+            max_distance_to_limit: distance,
+            max_distance_to_limit_relative: distance.map(|d| d / diagonal),
+            bbox_diagonal: diagonal,
+            seconds: Timings {
+                read: t_read,
+                hierarchy: t_hierarchy,
+                mesh: t_mesh,
+                report: t_report,
+                write: t_write,
+                total: t_start.elapsed().as_secs_f64(),
+            },
+            warnings: file.warnings.clone(),
+        };
+        crate::print_json(out, &report);
+    }
+    Ok(())
+}
+
+/// Conformity, smallest angle and largest sampled distance to the limit (`None` where the
+/// exact evaluator does not cover the mesh).
+fn measure(mesh: &AdaptiveMesh, surface: Option<&LimitSurface>) -> (Conformity, f64, Option<f64>) {
+    let conformity = mesh.conformity();
+    let min_angle = mesh.min_angle_degrees();
+    let distance = surface.and_then(|s| mesh.max_limit_distance(s).ok());
+    (conformity, min_angle, distance)
+}
+
+fn write(
+    args: &AdaptiveArgs,
+    mesh: &AdaptiveMesh,
+    options: &subd_schemes::Options,
+) -> Result<(), Failure> {
+    let fail = |e: subd_io::ViewError| bad(format!("{}: {e}", args.input.display()));
+    let mut view = subd_io::MeshView::new(
+        &mesh.positions,
+        &mesh.face_offsets,
+        &mesh.face_vertices,
+        &mesh.holes,
+    )
+    .and_then(|v| v.with_face_levels(&mesh.face_levels))
+    .map_err(fail)?;
+    if !mesh.normals.is_empty() {
+        view = view.with_normals(&mesh.normals).map_err(fail)?;
+    }
+    view.hints = SchemeHints {
+        boundary_interpolation: Some(options.boundary_interpolation),
+        crease_method: Some(options.crease_method),
+        triangle_subdivision: Some(options.triangle_subdivision),
+    };
+    subd_io::write_view(&args.output, &view, &subd_io::WriteOptions::default())?;
+    Ok(())
+}

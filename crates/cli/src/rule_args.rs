@@ -1,0 +1,81 @@
+//! The rule options every surface command shares (`--boundary`, `--crease-method`,
+//! `--triangles`, `--accept-inconsistent-orientation`): defaults from the file's tags,
+//! overridden on the command line.
+
+use clap::{Args, ValueEnum};
+use subd_mesh::{BoundaryInterpolation, CreaseMethod, SchemeHints, TriangleSubdivision};
+use subd_schemes::Options;
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub(crate) enum BoundaryArg {
+    None,
+    EdgeOnly,
+    EdgeAndCorner,
+}
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub(crate) enum CreaseArg {
+    Uniform,
+    Chaikin,
+}
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub(crate) enum TriangleArg {
+    Catmark,
+    Smooth,
+}
+
+/// The rule options a command shares: defaults from the file's tags, overridden here.
+#[derive(Debug, Args)]
+pub(crate) struct RuleArgs {
+    /// Boundary interpolation (default: the file's `t interpolateboundary` tag, else
+    /// edge-only).
+    #[arg(long, value_enum)]
+    boundary: Option<BoundaryArg>,
+    /// Crease method for semi-sharp creases (default: the file's `t creasemethod` tag, else
+    /// uniform).
+    #[arg(long, value_enum)]
+    crease_method: Option<CreaseArg>,
+    /// Catmull-Clark triangle rule (default: the file's `t smoothtriangles` tag, else
+    /// catmark).
+    #[arg(long, value_enum)]
+    pub(crate) triangles: Option<TriangleArg>,
+    /// Accept faces whose windings disagree across a shared edge (treated as non-manifold).
+    #[arg(long)]
+    pub(crate) accept_inconsistent_orientation: bool,
+}
+
+impl RuleArgs {
+    /// The options for `hints` (a file's tags) with this command line's overrides.
+    pub(crate) fn options(&self, hints: &SchemeHints) -> Options {
+        let mut options = Options::from_hints(hints);
+        if let Some(b) = self.boundary {
+            options.boundary_interpolation = match b {
+                BoundaryArg::None => BoundaryInterpolation::None,
+                BoundaryArg::EdgeOnly => BoundaryInterpolation::EdgeOnly,
+                BoundaryArg::EdgeAndCorner => BoundaryInterpolation::EdgeAndCorner,
+            };
+        }
+        if let Some(c) = self.crease_method {
+            options.crease_method = match c {
+                CreaseArg::Uniform => CreaseMethod::Uniform,
+                CreaseArg::Chaikin => CreaseMethod::Chaikin,
+            };
+        }
+        if let Some(t) = self.triangles {
+            options.triangle_subdivision = match t {
+                TriangleArg::Catmark => TriangleSubdivision::Catmark,
+                TriangleArg::Smooth => TriangleSubdivision::Smooth,
+            };
+        }
+        options
+    }
+
+    /// Reader options.
+    pub(crate) fn read_options(&self) -> subd_io::ReadOptions {
+        subd_io::ReadOptions {
+            accept_inconsistent_orientation: self.accept_inconsistent_orientation,
+        }
+    }
+}
+
