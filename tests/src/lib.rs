@@ -4,7 +4,8 @@
 use std::path::{Path, PathBuf};
 
 use proptest::prelude::*;
-use subd_mesh::{Topology, TopologyBuilder};
+use subd_mesh::{CreaseMethod, Topology, TopologyBuilder};
+use subd_schemes::{Options, Scheme};
 
 /// Directory of OpenSubdiv's regression shapes (`<repo>/../shared/meshes/osd`), overridable
 /// with the `SUBD_MESHES` environment variable (pointing at the `meshes` directory).
@@ -266,4 +267,100 @@ pub fn pentagonal_prism() -> (Topology, Vec<subd_mesh::DVec3>) {
         })
         .collect();
     (build(10, &faces), points)
+}
+
+/// A refinement case for property tests: a random mesh with positions, crease and corner
+/// tags, a scheme and a crease method.
+#[derive(Debug, Clone)]
+pub struct TaggedCase {
+    /// The mesh (fan-triangulated for Loop).
+    pub mesh: RandomMesh,
+    /// Positions in [-1, 1]³.
+    pub positions: Vec<subd_mesh::DVec3>,
+    /// Crease tags: edge (modulo the edge count) and sharpness.
+    pub creases: Vec<(usize, f32)>,
+    /// Corner tags: vertex (modulo the vertex count) and sharpness.
+    pub corners: Vec<(usize, f32)>,
+    /// Scheme.
+    pub scheme: Scheme,
+    /// Chaikin crease method instead of uniform.
+    pub chaikin: bool,
+}
+
+/// Sharpness values the cases draw from: semi-sharp, integer and infinite.
+const SHARPNESS: [f32; 6] = [0.3, 1.0, 1.7, 2.5, 4.2, 10.0];
+
+impl TaggedCase {
+    /// The topology of `faces` (the case's faces, or a relabelling of them) with the case's
+    /// tags.
+    pub fn topology(&self, faces: &[Vec<u32>]) -> Topology {
+        let mut t = build(self.mesh.num_vertices, faces);
+        let (ne, nv) = (t.num_edges(), t.num_vertices());
+        for &(e, s) in &self.creases {
+            t.set_edge_sharpness(e % ne, s);
+        }
+        for &(v, s) in &self.corners {
+            t.set_vertex_sharpness(v % nv, s);
+        }
+        t
+    }
+
+    /// The case's options.
+    pub fn options(&self) -> Options {
+        Options {
+            crease_method: if self.chaikin {
+                CreaseMethod::Chaikin
+            } else {
+                CreaseMethod::Uniform
+            },
+            ..Options::default()
+        }
+    }
+}
+
+/// Strategy for [`TaggedCase`] with one of `schemes`.
+pub fn tagged_case_strategy(schemes: &'static [Scheme]) -> impl Strategy<Value = TaggedCase> {
+    (
+        mesh_strategy(),
+        0..schemes.len(),
+        any::<bool>(),
+        prop::collection::vec((any::<u16>(), 0usize..6), 0..12),
+        prop::collection::vec((any::<u16>(), 0usize..6), 0..4),
+        any::<u64>(),
+    )
+        .prop_map(move |(mut mesh, s, chaikin, creases, corners, seed)| {
+            let scheme = schemes[s];
+            if scheme == Scheme::Loop {
+                // Fan-triangulate every face for Loop.
+                mesh.faces = mesh
+                    .faces
+                    .iter()
+                    .flat_map(|f| (1..f.len() - 1).map(move |i| vec![f[0], f[i], f[i + 1]]))
+                    .collect();
+            }
+            let mut state = seed | 1;
+            let mut rnd = || {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                (state >> 11) as f64 / (1u64 << 53) as f64
+            };
+            let positions = (0..mesh.num_vertices)
+                .map(|_| subd_mesh::DVec3::new(rnd(), rnd(), rnd()) * 2.0 - subd_mesh::DVec3::ONE)
+                .collect();
+            TaggedCase {
+                creases: creases
+                    .into_iter()
+                    .map(|(e, s)| (e as usize, SHARPNESS[s]))
+                    .collect(),
+                corners: corners
+                    .into_iter()
+                    .map(|(v, s)| (v as usize, SHARPNESS[s]))
+                    .collect(),
+                mesh,
+                positions,
+                scheme,
+                chaikin,
+            }
+        })
 }

@@ -266,9 +266,12 @@ fn limit_positions_are_the_uniform_limit() {
 fn corner_parameters_locate_the_limit_surface() {
     let mut checked = 0;
     for s in shapes() {
-        let Ok(surface) =
-            subd_adaptive::LimitSurface::new(&s.mesh.topology, &s.mesh.positions, s.scheme, &s.options)
-        else {
+        let Ok(surface) = subd_adaptive::LimitSurface::new(
+            &s.mesh.topology,
+            &s.mesh.positions,
+            s.scheme,
+            &s.options,
+        ) else {
             continue;
         };
         let pick = Scattered { seed: 3, p: 0.5 };
@@ -292,7 +295,11 @@ fn corner_parameters_locate_the_limit_surface() {
             for (i, &v) in mesh.face(f).iter().enumerate() {
                 let uv = mesh.corner_params[first + i];
                 let sub = if sub == u16::MAX { i } else { sub as usize };
-                let (u, w) = if uv[0].is_nan() { (0.0, 0.0) } else { (uv[0], uv[1]) };
+                let (u, w) = if uv[0].is_nan() {
+                    (0.0, 0.0)
+                } else {
+                    (uv[0], uv[1])
+                };
                 match surface.position(face as usize, sub, u, w) {
                     Ok(p) => assert!(
                         (p - mesh.positions[v as usize]).length() <= 1e-12 * d,

@@ -4,90 +4,20 @@
 //! change a bit.
 
 use proptest::prelude::*;
-use subd_mesh::{CreaseMethod, DVec3, Topology, TopologyBuilder};
+use subd_mesh::{DVec3, Topology, TopologyBuilder};
 use subd_schemes::{Options, Refinement, Scheme};
-use subd_tests::{RandomMesh, build, mesh_strategy, random_mesh};
-
-/// A refinement case: mesh, positions, tags and options.
-#[derive(Debug, Clone)]
-struct Case {
-    mesh: RandomMesh,
-    positions: Vec<DVec3>,
-    creases: Vec<(usize, f32)>,
-    corners: Vec<(usize, f32)>,
-    scheme: Scheme,
-    chaikin: bool,
-}
-
-const SHARPNESS: [f32; 6] = [0.3, 1.0, 1.7, 2.5, 4.2, 10.0];
+use subd_tests::{TaggedCase as Case, build, random_mesh, tagged_case_strategy};
 
 fn case_strategy() -> impl Strategy<Value = Case> {
-    (
-        mesh_strategy(),
-        0u8..3,
-        any::<bool>(),
-        prop::collection::vec((any::<u16>(), 0usize..6), 0..12),
-        prop::collection::vec((any::<u16>(), 0usize..6), 0..4),
-        any::<u64>(),
-    )
-        .prop_map(|(mut mesh, s, chaikin, creases, corners, seed)| {
-            let scheme = [Scheme::CatmullClark, Scheme::Loop, Scheme::Bilinear][s as usize];
-            if scheme == Scheme::Loop {
-                // Fan-triangulate every face for Loop.
-                mesh.faces = mesh
-                    .faces
-                    .iter()
-                    .flat_map(|f| (1..f.len() - 1).map(move |i| vec![f[0], f[i], f[i + 1]]))
-                    .collect();
-            }
-            let mut state = seed | 1;
-            let mut rnd = || {
-                state ^= state << 13;
-                state ^= state >> 7;
-                state ^= state << 17;
-                (state >> 11) as f64 / (1u64 << 53) as f64
-            };
-            let positions = (0..mesh.num_vertices)
-                .map(|_| DVec3::new(rnd(), rnd(), rnd()) * 2.0 - DVec3::ONE)
-                .collect();
-            Case {
-                creases: creases
-                    .into_iter()
-                    .map(|(e, s)| (e as usize, SHARPNESS[s]))
-                    .collect(),
-                corners: corners
-                    .into_iter()
-                    .map(|(v, s)| (v as usize, SHARPNESS[s]))
-                    .collect(),
-                mesh,
-                positions,
-                scheme,
-                chaikin,
-            }
-        })
+    tagged_case_strategy(&[Scheme::CatmullClark, Scheme::Loop, Scheme::Bilinear])
 }
 
 fn topology(c: &Case, faces: &[Vec<u32>]) -> Topology {
-    let mut t = build(c.mesh.num_vertices, faces);
-    let (ne, nv) = (t.num_edges(), t.num_vertices());
-    for &(e, s) in &c.creases {
-        t.set_edge_sharpness(e % ne, s);
-    }
-    for &(v, s) in &c.corners {
-        t.set_vertex_sharpness(v % nv, s);
-    }
-    t
+    c.topology(faces)
 }
 
 fn options(c: &Case) -> Options {
-    Options {
-        crease_method: if c.chaikin {
-            CreaseMethod::Chaikin
-        } else {
-            CreaseMethod::Uniform
-        },
-        ..Options::default()
-    }
+    c.options()
 }
 
 fn max_diff(a: &[DVec3], b: &[DVec3]) -> f64 {

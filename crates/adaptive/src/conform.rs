@@ -235,6 +235,7 @@ impl AdaptiveRefinement {
             face_offsets: vec![0],
             face_vertices: Vec::new(),
             face_levels: Vec::new(),
+            face_uniform: Vec::new(),
             holes: Vec::new(),
             transition: Vec::new(),
             edge_origins: Vec::new(),
@@ -318,6 +319,7 @@ impl AdaptiveRefinement {
             }
             out.face_offsets.push(out.face_vertices.len() as u32);
             out.face_levels.push(leaf.level as u8);
+            out.face_uniform.push(lv.face_key[f]);
             out.holes.push(t.is_hole(f));
             out.transition.push(transition);
             out.face_domains.push((lv.base_face[f], lv.sub_face[f]));

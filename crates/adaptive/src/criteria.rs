@@ -11,8 +11,8 @@ use subd_limit::eval::{FaceParam, LimitEvaluator, PatchPoints};
 use subd_mesh::Topology;
 use subd_schemes::{Options, Scheme};
 
-use crate::AdaptiveError;
 use crate::level::{SparseLevel, WHOLE_FACE};
+use crate::{AdaptiveError, AdaptiveMesh, Positions};
 
 /// The faces of one level of the hierarchy as a criterion sees them.
 pub struct LevelView<'a> {
@@ -69,6 +69,23 @@ pub trait Criterion: Send + Sync {
     /// Whatever the criterion cannot evaluate (for instance the limit surface on a face the
     /// evaluator does not cover).
     fn select(&self, level: &LevelView<'_>, selected: &mut [bool]) -> Result<(), AdaptiveError>;
+
+    /// A criterion that also judges the conforming mesh (the transition faces the leaves are
+    /// cut into) names the positions it judges it with; `None` (the default) for one that
+    /// judges the hierarchy's faces only.
+    fn output_positions(&self) -> Option<Positions> {
+        None
+    }
+
+    /// The faces of the conforming mesh `mesh` (built with [`Self::output_positions`]) this
+    /// criterion rejects: their leaves are refined and the mesh built again. The default
+    /// rejects none.
+    ///
+    /// # Errors
+    /// As [`Self::select`].
+    fn reject(&self, mesh: &AdaptiveMesh) -> Result<Vec<bool>, AdaptiveError> {
+        Ok(vec![false; mesh.num_faces()])
+    }
 }
 
 /// Checks an angle threshold in degrees and returns it in radians.
@@ -491,7 +508,9 @@ fn sample_weights(n: usize) -> impl Iterator<Item = ([f64; 4], usize)> {
 /// Distance to the exact limit surface: a face is refined while its largest sampled distance
 /// to the limit surface (at the same parameters, see [`LimitSurface::face_distance`])
 /// exceeds the tolerance. With `limit_corners` the face is measured with its corners on the
-/// limit surface (the output of `--limit`), otherwise at their positions at its level.
+/// limit surface (the output of `--limit`), otherwise at their positions at its level. The
+/// transition faces of the conforming mesh are measured too ([`Criterion::reject`]), so
+/// every face of the result is within the tolerance (up to the level cap).
 pub struct LimitDistance {
     surface: LimitSurface,
     tolerance: f64,
@@ -568,5 +587,25 @@ impl Criterion for LimitDistance {
             }
         }
         Ok(())
+    }
+
+    fn output_positions(&self) -> Option<Positions> {
+        Some(if self.limit_corners {
+            Positions::Limit
+        } else {
+            Positions::Refined
+        })
+    }
+
+    fn reject(&self, mesh: &AdaptiveMesh) -> Result<Vec<bool>, AdaptiveError> {
+        (0..mesh.num_faces())
+            .into_par_iter()
+            .map(|f| {
+                if !mesh.transition[f] || mesh.holes[f] {
+                    return Ok(false);
+                }
+                Ok(mesh.face_distance(&self.surface, f)? > self.tolerance)
+            })
+            .collect()
     }
 }

@@ -126,40 +126,64 @@ impl AdaptiveRefinement {
         } else {
             criteria.to_vec()
         };
-        let uniform = UniformLayout::new(base, scheme, max_level);
+        let mut uniform = UniformLayout::new(base, scheme, max_level);
         let mut levels = vec![SparseLevel::base(base, points, scheme, options)?];
         let mut requests: Vec<HashSet<u64>> = vec![HashSet::new(); max_level];
         let mut level_builds = 1;
         let mut l = 0;
-        while l < max_level {
-            let sel = decide(&levels[l], l, &criteria, &requests[l], scheme)?;
-            if l > 0 {
-                let before = requests[l - 1].len();
-                request_support(&levels[l - 1], &levels[l], &sel, &mut requests[l - 1]);
-                if requests[l - 1].len() > before {
-                    levels.truncate(l);
-                    l -= 1;
+        loop {
+            while l < max_level {
+                let sel = decide(&levels[l], l, &criteria, &requests[l], scheme)?;
+                if l > 0 {
+                    let before = requests[l - 1].len();
+                    request_support(&levels[l - 1], &levels[l], &sel, &mut requests[l - 1]);
+                    if requests[l - 1].len() > before {
+                        levels.truncate(l);
+                        l -= 1;
+                        continue;
+                    }
+                }
+                let any = sel.iter().any(|&s| s);
+                levels[l].refined = sel;
+                if !any {
+                    break;
+                }
+                let child = levels[l].refine(l + 1, scheme, options, &uniform)?;
+                level_builds += 1;
+                progress(l + 1, child.num_faces());
+                levels.push(child);
+                l += 1;
+            }
+            // Criteria that judge the conforming mesh: refine the leaves of the faces they
+            // reject, and go back to the coarsest such level.
+            let mut h = AdaptiveRefinement {
+                scheme,
+                options: *options,
+                levels,
+                uniform,
+                level_builds,
+            };
+            let mut restart = None;
+            for c in &criteria {
+                let Some(positions) = c.output_positions() else {
                     continue;
+                };
+                let mesh = h.mesh(positions)?;
+                for (f, rejected) in c.reject(&mesh)?.into_iter().enumerate() {
+                    let level = mesh.face_levels[f] as usize;
+                    if rejected && level < max_level && requests[level].insert(mesh.face_uniform[f])
+                    {
+                        restart = Some(restart.map_or(level, |r: usize| r.min(level)));
+                    }
                 }
             }
-            let any = sel.iter().any(|&s| s);
-            levels[l].refined = sel;
-            if !any {
-                break;
-            }
-            let child = levels[l].refine(l + 1, scheme, options, &uniform)?;
-            level_builds += 1;
-            progress(l + 1, child.num_faces());
-            levels.push(child);
-            l += 1;
+            let Some(r) = restart else {
+                return Ok(h);
+            };
+            h.levels.truncate(r + 1);
+            (levels, uniform, level_builds) = (h.levels, h.uniform, h.level_builds);
+            l = r;
         }
-        Ok(AdaptiveRefinement {
-            scheme,
-            options: *options,
-            levels,
-            uniform,
-            level_builds,
-        })
     }
 
     /// The scheme.

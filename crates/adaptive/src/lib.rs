@@ -150,6 +150,8 @@ pub struct AdaptiveMesh {
     pub face_vertices: Vec<u32>,
     /// Level of each face (a transition face has its leaf's level).
     pub face_levels: Vec<u8>,
+    /// Index in uniform refinement at [`Self::face_levels`] of each face's leaf.
+    pub face_uniform: Vec<u64>,
     /// Hole flag of each face.
     pub holes: Vec<bool>,
     /// Whether each face is part of a transition pattern.
@@ -301,25 +303,26 @@ impl AdaptiveMesh {
         (0..self.num_faces())
             .into_par_iter()
             .filter(|&f| !self.holes[f])
-            .map(|f| {
-                let range = self.face_offsets[f] as usize..self.face_offsets[f + 1] as usize;
-                let p: Vec<DVec3> = self.face_vertices[range.clone()]
-                    .iter()
-                    .map(|&v| self.positions[v as usize])
-                    .collect();
-                let (face, sub) = self.face_domains[f];
-                if sub == u16::MAX {
-                    surface.polygon_distance(face as usize, &p)
-                } else {
-                    surface.face_distance(
-                        face as usize,
-                        sub as usize,
-                        &p,
-                        &self.corner_params[range],
-                    )
-                }
-            })
+            .map(|f| self.face_distance(surface, f))
             .try_reduce(|| 0.0, |a, b| Ok(a.max(b)))
+    }
+
+    /// The largest sampled distance of face `f` to the limit surface.
+    ///
+    /// # Errors
+    /// As [`LimitSurface::position`].
+    pub fn face_distance(&self, surface: &LimitSurface, f: usize) -> Result<f64, AdaptiveError> {
+        let range = self.face_offsets[f] as usize..self.face_offsets[f + 1] as usize;
+        let p: Vec<DVec3> = self.face_vertices[range.clone()]
+            .iter()
+            .map(|&v| self.positions[v as usize])
+            .collect();
+        let (face, sub) = self.face_domains[f];
+        if sub == u16::MAX {
+            surface.polygon_distance(face as usize, &p)
+        } else {
+            surface.face_distance(face as usize, sub as usize, &p, &self.corner_params[range])
+        }
     }
 }
 

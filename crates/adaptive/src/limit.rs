@@ -114,7 +114,11 @@ fn level_limits(
         local_edge[e as usize] = i as u32;
     }
     let (nv, nf) = (cut.topology.num_vertices(), cut.topology.num_faces());
-    let edge_point_base = if h.scheme == Scheme::Loop { nv } else { nv + nf };
+    let edge_point_base = if h.scheme == Scheme::Loop {
+        nv
+    } else {
+        nv + nf
+    };
     // Edge points exist one level down: refine the cut once and take the limits there.
     let (topology, pts) = if edge_points {
         let r = Refinement::from_prepared(cut.topology, rules, h.scheme, &h.options, 1)?;

@@ -277,13 +277,20 @@ mod tests {
                 rebuilt.is_non_manifold_vertex(v),
                 "vertex {v}"
             );
-            assert_eq!(s.topology.vertex_faces(v).len(), rebuilt.vertex_faces(v).len());
+            assert_eq!(
+                s.topology.vertex_faces(v).len(),
+                rebuilt.vertex_faces(v).len()
+            );
         }
         for v in 0..s.topology.num_vertices() {
             if !s.topology.is_non_manifold_vertex(v) {
                 // A manifold fan: each vertex edge leaves the vertex in the face at its place.
                 let (vf, ve) = (s.topology.vertex_faces(v), s.topology.vertex_edges(v));
-                for (i, (&f, &c)) in vf.iter().zip(s.topology.vertex_face_local_indices(v)).enumerate() {
+                for (i, (&f, &c)) in vf
+                    .iter()
+                    .zip(s.topology.vertex_face_local_indices(v))
+                    .enumerate()
+                {
                     assert_eq!(s.topology.face_edges(f as usize)[c as usize], ve[i]);
                 }
             }

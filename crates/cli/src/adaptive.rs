@@ -147,16 +147,36 @@ pub(crate) fn run(
     }
     // Thresholds are checked before any work.
     if let Some(d) = args.flatness {
-        in_range("flatness", d, (0.0..=180.0).contains(&d), "expected degrees in [0, 180]")?;
+        in_range(
+            "flatness",
+            d,
+            (0.0..=180.0).contains(&d),
+            "expected degrees in [0, 180]",
+        )?;
     }
     if let Some(d) = args.dihedral {
-        in_range("dihedral", d, (0.0..=180.0).contains(&d), "expected degrees in [0, 180]")?;
+        in_range(
+            "dihedral",
+            d,
+            (0.0..=180.0).contains(&d),
+            "expected degrees in [0, 180]",
+        )?;
     }
     if let Some(d) = args.max_distance {
-        in_range("max-distance", d, d.is_finite() && d > 0.0, "expected a positive number")?;
+        in_range(
+            "max-distance",
+            d,
+            d.is_finite() && d > 0.0,
+            "expected a positive number",
+        )?;
     }
     if let Some(k) = args.curvature {
-        in_range("curvature", k, k.is_finite() && k >= 0.0, "expected a number ≥ 0")?;
+        in_range(
+            "curvature",
+            k,
+            k.is_finite() && k >= 0.0,
+            "expected a number ≥ 0",
+        )?;
     }
     let levels = args.levels.unwrap_or(DEFAULT_LEVELS);
     if levels > subd_adaptive::MAX_LEVELS {
@@ -198,7 +218,9 @@ pub(crate) fn run(
         criteria.push(Box::new(DihedralAngle::new(d).map_err(input_err)?));
     }
     if let Some(k) = args.curvature {
-        criteria.push(Box::new(GaussianCurvature::new(k, diagonal).map_err(input_err)?));
+        criteria.push(Box::new(
+            GaussianCurvature::new(k, diagonal).map_err(input_err)?,
+        ));
     }
     if let Some(f) = &args.select_faces {
         let faces = read_indices(f, base.num_faces(), "face")?;

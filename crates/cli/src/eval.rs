@@ -10,8 +10,8 @@ use serde::Serialize;
 use subd_limit::eval::{FaceParam, LimitEvaluator};
 use subd_schemes::Scheme;
 
-use crate::limit::LimitSchemeArg;
 use crate::failure::{bad, refuse_overwrite};
+use crate::limit::LimitSchemeArg;
 use crate::rule_args::RuleArgs;
 use crate::{Failure, print_warnings};
 

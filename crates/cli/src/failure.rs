@@ -47,4 +47,3 @@ pub(crate) fn bad(message: String) -> Failure {
         message,
     }
 }
-

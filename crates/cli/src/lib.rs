@@ -16,8 +16,8 @@
 mod adaptive;
 mod analyze;
 mod curve;
-mod failure;
 mod eval;
+mod failure;
 mod info;
 mod limit;
 mod pia;

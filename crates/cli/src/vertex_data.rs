@@ -118,7 +118,11 @@ pub(crate) fn read_indices(path: &Path, count: usize, what: &str) -> Result<Vec<
             ))
         })?;
         if v >= count as u64 {
-            let plural = if what == "vertex" { "vertices" } else { "faces" };
+            let plural = if what == "vertex" {
+                "vertices"
+            } else {
+                "faces"
+            };
             return Err(bad(format!(
                 "{}:{line}: {what} {v} does not exist (the mesh has {count} {plural})",
                 path.display()

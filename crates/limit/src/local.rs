@@ -344,6 +344,12 @@ pub(crate) fn evaluate(
         let c = nearest_corner(scheme, u, v);
         corner_limit(&nb, scheme, &options, c)
     };
+    // Inside a pool's worker (a caller evaluating in parallel) the work runs where it is:
+    // installing into another pool would let the blocked worker steal its own pool's next
+    // evaluation meanwhile, nesting evaluations on one stack until it overflows.
+    if rayon::current_thread_index().is_some() {
+        return descend();
+    }
     INLINE.with(|pool| match pool {
         Some(pool) => pool.install(descend),
         None => descend(),
