@@ -86,9 +86,9 @@ fn diagonal(p: &[DVec3]) -> f64 {
 /// Every vertex of every level equals uniform refinement's, and the mesh is conforming.
 fn check_exact(s: &Shape, a: &AdaptiveRefinement, uniform: &[Vec<DVec3>]) {
     let d = diagonal(&s.mesh.positions);
-    for l in 0..=a.depth() {
+    for (l, level) in uniform.iter().enumerate().take(a.depth() + 1) {
         for (k, p) in a.level_vertices(l) {
-            let q = uniform[l][k as usize];
+            let q = level[k as usize];
             assert!(
                 (p - q).length() <= 1e-15 * d,
                 "{}: level {l} vertex {k}: {p} vs uniform {q}",

@@ -601,11 +601,186 @@ impl Criterion for LimitDistance {
         (0..mesh.num_faces())
             .into_par_iter()
             .map(|f| {
-                if !mesh.transition[f] || mesh.holes[f] {
+                // With limit corners a leaf is measured as the criterion saw it; otherwise
+                // its corners may have moved on to finer levels.
+                if mesh.holes[f] || (self.limit_corners && !mesh.transition[f]) {
                     return Ok(false);
                 }
                 Ok(mesh.face_distance(&self.surface, f)? > self.tolerance)
             })
             .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::AdaptiveRefinement;
+    use subd_mesh::TopologyBuilder;
+
+    /// A flat 4 × 4 grid of triangles (each quad split along its diagonal) with vertex 12
+    /// (an interior vertex) lifted.
+    fn bump(height: f64) -> (Topology, Vec<DVec3>) {
+        let mut fv = Vec::new();
+        for j in 0..4u32 {
+            for i in 0..4u32 {
+                let v = j * 5 + i;
+                fv.extend([v, v + 1, v + 6, v, v + 6, v + 5]);
+            }
+        }
+        let t = TopologyBuilder::new(25).build(&[3; 32], &fv).unwrap();
+        let p = (0..25)
+            .map(|v| {
+                let z = if v == 12 { height } else { 0.0 };
+                DVec3::new((v % 5) as f64, (v / 5) as f64, z)
+            })
+            .collect();
+        (t, p)
+    }
+
+    fn level0<'a>(a: &'a AdaptiveRefinement) -> LevelView<'a> {
+        a.level_view(0)
+    }
+
+    fn selected(c: &dyn Criterion, t: &Topology, p: &[DVec3]) -> Vec<bool> {
+        let a = AdaptiveRefinement::new(t, p, Scheme::Loop, &Options::default(), &[], 0).unwrap();
+        let mut s = vec![false; t.num_faces()];
+        c.select(&level0(&a), &mut s).unwrap();
+        s
+    }
+
+    #[test]
+    fn flatness_kills_flat_vertices_edges_and_faces_as_seed_002_says() {
+        let (t, p) = bump(1.0);
+        let eps = Flatness::vertex_flatness(&t, &p);
+        // Only vertex 12 and its ring see a bent normal; far vertices are flat.
+        assert_eq!(eps[0], 0.0);
+        assert!(eps[12] > 0.5);
+        let ring: Vec<u32> = t.vertex_ring(12).collect();
+        for &w in &ring {
+            assert!(eps[w as usize] > 0.1, "ring vertex {w}");
+        }
+        // A triangle is refined unless two of its edges are dead, i.e. unless at most one
+        // of its vertices is live (dead edges need two dead ends).
+        let live: Vec<bool> = eps.iter().map(|&e| e >= 10f64.to_radians()).collect();
+        let s = selected(&Flatness::new(10.0).unwrap(), &t, &p);
+        for (f, &picked) in s.iter().enumerate() {
+            let fv = t.face_vertices(f);
+            let dead_edges = (0..3)
+                .filter(|&i| !live[fv[i] as usize] && !live[fv[(i + 1) % 3] as usize])
+                .count();
+            assert_eq!(picked, dead_edges < 2, "face {f}");
+        }
+        assert!(s.iter().any(|&x| x) && !s.iter().all(|&x| x));
+        // A flat mesh has no live vertex.
+        let (t, p) = bump(0.0);
+        assert!(
+            !selected(&Flatness::new(1.0).unwrap(), &t, &p)
+                .iter()
+                .any(|&x| x)
+        );
+        assert!(Flatness::new(f64::NAN).is_err() && Flatness::new(181.0).is_err());
+    }
+
+    #[test]
+    fn dihedral_angle_selects_both_faces_of_a_bent_edge() {
+        let (t, p) = bump(1.0);
+        // Normals of the faces at vertex 12 tilt by atan(1) = 45° against flat neighbours.
+        let s = selected(&DihedralAngle::new(30.0).unwrap(), &t, &p);
+        for (f, &picked) in s.iter().enumerate() {
+            let touches = t.face_vertices(f).contains(&12)
+                || t.face_edges(f).iter().any(|&e| {
+                    t.edge_faces(e as usize)
+                        .iter()
+                        .any(|&g| t.face_vertices(g as usize).contains(&12))
+                });
+            if !touches {
+                assert!(!picked, "face {f} is flat with flat neighbours");
+            }
+        }
+        assert!(t.vertex_faces(12).iter().all(|&f| s[f as usize]));
+        assert!(
+            !selected(&DihedralAngle::new(80.0).unwrap(), &t, &p)
+                .iter()
+                .any(|&x| x)
+        );
+    }
+
+    #[test]
+    fn angle_defect_of_an_octahedron_is_the_sphere_curvature_sum() {
+        // Octahedron: 4 faces of 60° at each vertex, defect 2π − 4π/3 = 2π/3, six vertices
+        // sum to 4π (Gauss–Bonnet for a sphere).
+        let fv = [
+            0, 1, 2, 0, 2, 3, 0, 3, 4, 0, 4, 1, 5, 2, 1, 5, 3, 2, 5, 4, 3, 5, 1, 4,
+        ];
+        let t = TopologyBuilder::new(6).build(&[3; 8], &fv).unwrap();
+        let p = [
+            DVec3::Z,
+            DVec3::X,
+            DVec3::Y,
+            -DVec3::X,
+            -DVec3::Y,
+            -DVec3::Z,
+        ];
+        let a = AdaptiveRefinement::new(&t, &p, Scheme::Loop, &Options::default(), &[], 0).unwrap();
+        let view = level0(&a);
+        let area = 3f64.sqrt() / 2.0; // each face: an equilateral triangle of side √2
+        for v in 0..6 {
+            let k = GaussianCurvature::at_vertex(&view, v).unwrap();
+            let want = (2.0 * std::f64::consts::PI / 3.0) / (4.0 * area / 3.0);
+            assert!((k - want).abs() < 1e-12, "vertex {v}: {k} vs {want}");
+        }
+        let d = 2.0 * 3f64.sqrt();
+        let hot = GaussianCurvature::new(1.0, d).unwrap();
+        let mut s = vec![false; 8];
+        hot.select(&view, &mut s).unwrap();
+        assert!(s.iter().all(|&x| x));
+        let cold = GaussianCurvature::new(1e6, d).unwrap();
+        let mut s = vec![false; 8];
+        cold.select(&view, &mut s).unwrap();
+        assert!(!s.iter().any(|&x| x));
+        assert!(GaussianCurvature::new(-1.0, d).is_err());
+    }
+
+    #[test]
+    fn a_vertex_selection_takes_faces_with_two_selected_vertices() {
+        let (t, _) = bump(0.0);
+        // Vertices 0 and 6 share faces 0 (0, 1, 6) and 1 (0, 6, 5); 24 alone selects nothing.
+        let s = FaceSelection::from_vertices(&t, &[0, 6, 24]).unwrap();
+        assert_eq!(s.num_selected(), 2);
+        assert!(FaceSelection::from_vertices(&t, &[25]).is_err());
+        assert!(FaceSelection::from_faces(32, &[32]).is_err());
+    }
+
+    #[test]
+    fn the_distance_criterion_meets_its_tolerance_on_every_face() {
+        let fv = [
+            0, 1, 2, 0, 2, 3, 0, 3, 4, 0, 4, 1, 5, 2, 1, 5, 3, 2, 5, 4, 3, 5, 1, 4,
+        ];
+        let t = TopologyBuilder::new(6).build(&[3; 8], &fv).unwrap();
+        let p = [
+            DVec3::Z,
+            DVec3::X,
+            DVec3::Y,
+            -DVec3::X,
+            -DVec3::Y,
+            -DVec3::Z,
+        ];
+        let o = Options::default();
+        for limit in [false, true] {
+            let surface = LimitSurface::new(&t, &p, Scheme::Loop, &o).unwrap();
+            let tol = 2e-3;
+            let c = LimitDistance::new(surface, tol, limit).unwrap();
+            let a = AdaptiveRefinement::new(&t, &p, Scheme::Loop, &o, &[&c], 8).unwrap();
+            let positions = if limit {
+                Positions::Limit
+            } else {
+                Positions::Refined
+            };
+            let mesh = a.mesh(positions).unwrap();
+            let d = mesh.max_limit_distance(c.surface()).unwrap();
+            assert!(d <= tol, "limit {limit}: {d}");
+            assert!(a.depth() < 8);
+        }
     }
 }

@@ -36,18 +36,18 @@ pub(crate) struct AdaptiveArgs {
     scheme: AdaptiveScheme,
     /// Seed 002's flatness: refine every face that is not dead, a vertex being dead when the
     /// largest angle between its faces' normals is below DEG degrees.
-    #[arg(long, value_name = "DEG")]
+    #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
     flatness: Option<f64>,
     /// Refine until every face is within D × the bounding-box diagonal of the exact limit
     /// surface (sampled at corners, edge midpoints and centre).
-    #[arg(long, value_name = "D")]
+    #[arg(long, value_name = "D", allow_negative_numbers = true)]
     max_distance: Option<f64>,
     /// Refine faces at a vertex whose Gaussian curvature (angle defect over area) times the
     /// squared bounding-box diagonal exceeds K (a sphere: 12).
-    #[arg(long, value_name = "K")]
+    #[arg(long, value_name = "K", allow_negative_numbers = true)]
     curvature: Option<f64>,
     /// Refine both faces of an edge whose dihedral angle exceeds DEG degrees.
-    #[arg(long, value_name = "DEG")]
+    #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
     dihedral: Option<f64>,
     /// Refine the descendants of the base faces listed in F (0-based indices).
     #[arg(long, value_name = "F")]
