@@ -7,40 +7,11 @@
 use std::collections::HashSet;
 
 use glam::DVec3;
-use subd_adaptive::{
-    AdaptiveError, AdaptiveRefinement, Criterion, LevelView, Positions, UniformCounts,
-};
+use subd_adaptive::{AdaptiveRefinement, Positions, RandomSelection, UniformCounts};
 use subd_io::{ReadOptions, read_mesh};
 use subd_limit::{LimitStencilTable, levels_for_exact_limit};
 use subd_schemes::{Options, Refinement, Rule, Scheme};
 use subd_tests::osd_meshes;
-
-/// Selects a face of level `l` when a hash of its uniform index falls under `p`: a
-/// reproducible, scattered selection.
-struct Scattered {
-    seed: u64,
-    p: f64,
-}
-
-fn mix(mut x: u64) -> u64 {
-    x ^= x >> 33;
-    x = x.wrapping_mul(0xff51_afd7_ed55_8ccd);
-    x ^= x >> 33;
-    x = x.wrapping_mul(0xc4ce_b9fe_1a85_ec53);
-    x ^ (x >> 33)
-}
-
-impl Criterion for Scattered {
-    fn select(&self, level: &LevelView<'_>, selected: &mut [bool]) -> Result<(), AdaptiveError> {
-        for (f, s) in selected.iter_mut().enumerate() {
-            let h = mix(self.seed ^ mix(level.uniform_face(f) ^ ((level.level() as u64) << 56)));
-            if ((h >> 11) as f64 / (1u64 << 53) as f64) < self.p {
-                *s = true;
-            }
-        }
-        Ok(())
-    }
-}
 
 struct Shape {
     name: String,
@@ -123,7 +94,7 @@ fn scattered_selections_give_uniform_vertices_on_every_shape() {
         let r = Refinement::new(&s.mesh.topology, s.scheme, &s.options, levels).unwrap();
         let uniform = r.refine_points(&s.mesh.positions);
         for seed in 0..2 {
-            let pick = Scattered { seed, p: 0.35 };
+            let pick = RandomSelection::new(seed, 0.35).unwrap();
             let a = AdaptiveRefinement::new(
                 &s.mesh.topology,
                 &s.mesh.positions,
@@ -205,7 +176,7 @@ fn limit_positions_are_the_uniform_limit() {
         if s.mesh.topology.num_face_vertices() << (2 * deep) > 4_000_000 {
             continue;
         }
-        let pick = Scattered { seed: 7, p: 0.4 };
+        let pick = RandomSelection::new(7, 0.4).unwrap();
         let a = AdaptiveRefinement::new(
             &s.mesh.topology,
             &s.mesh.positions,
@@ -274,7 +245,7 @@ fn corner_parameters_locate_the_limit_surface() {
         ) else {
             continue;
         };
-        let pick = Scattered { seed: 3, p: 0.5 };
+        let pick = RandomSelection::new(3, 0.5).unwrap();
         let a = AdaptiveRefinement::new(
             &s.mesh.topology,
             &s.mesh.positions,

@@ -19,24 +19,6 @@ fn cases() -> impl Strategy<Value = TaggedCase> {
     tagged_case_strategy(&[Scheme::CatmullClark, Scheme::Loop])
 }
 
-/// Selects faces by a hash of (level, uniform index): scattered and reproducible.
-struct Scattered(u64);
-
-impl Criterion for Scattered {
-    fn select(&self, level: &LevelView<'_>, selected: &mut [bool]) -> Result<(), AdaptiveError> {
-        for (f, s) in selected.iter_mut().enumerate() {
-            let mut x = self.0 ^ level.uniform_face(f) ^ ((level.level() as u64) << 48);
-            x ^= x >> 33;
-            x = x.wrapping_mul(0xff51_afd7_ed55_8ccd);
-            x ^= x >> 29;
-            if x % 5 < 2 {
-                *s = true;
-            }
-        }
-        Ok(())
-    }
-}
-
 fn adaptive(c: &TaggedCase, criteria: &[&dyn Criterion], levels: usize) -> AdaptiveRefinement {
     let t = c.topology(&c.mesh.faces);
     AdaptiveRefinement::new(&t, &c.positions, c.scheme, &c.options(), criteria, levels).unwrap()
@@ -67,7 +49,7 @@ proptest! {
         let uniform = Refinement::new(&t, c.scheme, &c.options(), levels)
             .unwrap()
             .refine_points(&c.positions);
-        let a = adaptive(&c, &[&Scattered(seed)], levels);
+        let a = adaptive(&c, &[&RandomSelection::new(seed, 0.4).unwrap()], levels);
         for (l, level) in uniform.iter().enumerate().take(a.depth() + 1) {
             for (k, p) in a.level_vertices(l) {
                 prop_assert_eq!(p, level[k as usize], "level {} vertex {}", l, k);

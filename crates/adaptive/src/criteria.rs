@@ -259,6 +259,52 @@ impl Criterion for FaceSelection {
     }
 }
 
+/// A reproducible pseudo-random selection: a face is refined when a hash of its level, its
+/// uniform index and the seed falls below `fraction`. For stress tests and benchmarks: it
+/// depends on neither labels nor geometry, only on where a face is in uniform refinement.
+#[derive(Clone, Copy, Debug)]
+pub struct RandomSelection {
+    seed: u64,
+    fraction: f64,
+}
+
+impl RandomSelection {
+    /// Refine about `fraction` (in `[0, 1]`) of the faces of every level.
+    ///
+    /// # Errors
+    /// [`AdaptiveError::Threshold`] for a fraction outside `[0, 1]`.
+    pub fn new(seed: u64, fraction: f64) -> Result<Self, AdaptiveError> {
+        if !(0.0..=1.0).contains(&fraction) {
+            return Err(AdaptiveError::Threshold {
+                name: "fraction",
+                value: fraction,
+                reason: "must be in [0, 1]",
+            });
+        }
+        Ok(RandomSelection { seed, fraction })
+    }
+}
+
+/// SplitMix64's finaliser: a well-mixed 64-bit hash.
+fn mix(mut x: u64) -> u64 {
+    x = (x ^ (x >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    x = (x ^ (x >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    x ^ (x >> 31)
+}
+
+impl Criterion for RandomSelection {
+    fn select(&self, level: &LevelView<'_>, selected: &mut [bool]) -> Result<(), AdaptiveError> {
+        let salt = mix(self.seed ^ mix(level.level() as u64 + 1));
+        for (f, s) in selected.iter_mut().enumerate() {
+            let h = mix(salt ^ level.uniform_face(f));
+            if ((h >> 11) as f64) < self.fraction * (1u64 << 53) as f64 {
+                *s = true;
+            }
+        }
+        Ok(())
+    }
+}
+
 /// Every face (uniform refinement, up to the level cap).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct EveryFace;

@@ -62,7 +62,7 @@ use thiserror::Error;
 
 pub use criteria::{
     Criterion, DihedralAngle, EveryFace, FaceSelection, Flatness, GaussianCurvature, LevelView,
-    LimitDistance, LimitSurface,
+    LimitDistance, LimitSurface, RandomSelection,
 };
 pub use hierarchy::{AdaptiveRefinement, Positions};
 pub use uniform::UniformCounts;
