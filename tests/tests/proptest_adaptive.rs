@@ -8,8 +8,8 @@ use std::collections::BTreeSet;
 
 use proptest::prelude::*;
 use subd_adaptive::{
-    AdaptiveError, AdaptiveMesh, AdaptiveRefinement, Criterion, FaceSelection, Flatness, LevelView,
-    Positions,
+    AdaptiveMesh, AdaptiveRefinement, Criterion, FaceSelection, Flatness, Positions,
+    RandomSelection,
 };
 use subd_mesh::DVec3;
 use subd_schemes::{Refinement, Scheme};

@@ -108,7 +108,7 @@ pub fn run_subd(
     Ok(())
 }
 
-fn json_number(line: &str, key: &str) -> Option<f64> {
+pub(crate) fn json_number(line: &str, key: &str) -> Option<f64> {
     let k = format!("\"{key}\":");
     let rest = &line[line.find(&k)? + k.len()..];
     let end = rest.find([',', '}']).unwrap_or(rest.len());

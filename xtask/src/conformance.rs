@@ -169,7 +169,13 @@ pub fn compare(
     }
     if scheme != Scheme::Bilinear {
         rows.push(compare_adaptive(
-            name, topo, positions, scheme, options, &osd_levels, diag,
+            name,
+            topo,
+            positions,
+            scheme,
+            options,
+            &osd_levels,
+            diag,
         ));
         rows.push(compare_limit(
             exe, name, topo, positions, scheme, options, diag,
@@ -222,7 +228,12 @@ fn compare_adaptive(
                 return row;
             }
         };
-        for (v, (&l, &k)) in mesh.vertex_levels.iter().zip(&mesh.vertex_uniform).enumerate() {
+        for (v, (&l, &k)) in mesh
+            .vertex_levels
+            .iter()
+            .zip(&mesh.vertex_uniform)
+            .enumerate()
+        {
             let theirs = if l == 0 {
                 positions.get(k as usize)
             } else {

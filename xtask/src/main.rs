@@ -7,6 +7,7 @@ use std::process::{Command, ExitCode};
 
 use clap::{Parser, Subcommand};
 
+mod adaptive_bench;
 mod bench;
 mod conformance;
 mod osd;
@@ -69,6 +70,10 @@ enum Task {
         /// Only the PIA benchmark (solvers on the quad bench mesh, Loop on a scan).
         #[arg(long)]
         pia_only: bool,
+        /// Only the adaptive benchmark (seed 002's Table 1, faces for a given accuracy,
+        /// speed against uniform refinement).
+        #[arg(long)]
+        adaptive_only: bool,
     },
     /// (internal) The subd side of the evaluation benchmark, in its own process.
     #[command(hide = true)]
@@ -190,6 +195,7 @@ fn main() -> ExitCode {
             refine_only,
             eval_only,
             pia_only,
+            adaptive_only,
         } => {
             let refinement = || {
                 bench::run(
@@ -202,6 +208,9 @@ fn main() -> ExitCode {
             };
             if pia_only {
                 pia_bench::run(repeats)
+            } else if adaptive_only {
+                ensure_system_packages(OPENSUBDIV_PACKAGES)
+                    .and_then(|_| adaptive_bench::run(repeats))
             } else if refine_only {
                 ensure_system_packages(OPENSUBDIV_PACKAGES).and_then(|_| refinement())
             } else {
@@ -212,7 +221,7 @@ fn main() -> ExitCode {
                         if eval_only {
                             Ok(())
                         } else {
-                            pia_bench::run(repeats)
+                            pia_bench::run(repeats).and_then(|_| adaptive_bench::run(repeats))
                         }
                     })
             }

@@ -156,6 +156,20 @@ pub fn run(repeats: usize) -> Result<(), String> {
     scan()
 }
 
+/// The bunny scan, fetched first when it is not there yet.
+pub(crate) fn scan_mesh() -> Result<subd_mesh::Mesh, String> {
+    let path = bunny_path();
+    if !path.exists() {
+        fetch_bunny(&path)?;
+    }
+    let opts = subd_io::ReadOptions {
+        accept_inconsistent_orientation: true,
+    };
+    Ok(subd_io::read_mesh(&path, &opts)
+        .map_err(|e| e.to_string())?
+        .mesh)
+}
+
 /// Where the bunny scan lives once fetched.
 fn bunny_path() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/xtask/bench/StanfordBunny.ply")

@@ -147,31 +147,48 @@ impl Flatness {
 
     /// `ε(v)` of every vertex of a level, over the faces present (radians).
     pub fn vertex_flatness(t: &Topology, p: &[DVec3]) -> Vec<f64> {
-        let normals = face_normals(t, p);
-        (0..t.num_vertices())
-            .into_par_iter()
-            .map(|v| {
-                let vf = t.vertex_faces(v);
-                let mut worst = 0.0f64;
-                for (i, &a) in vf.iter().enumerate() {
-                    for &b in &vf[i + 1..] {
-                        let (na, nb) = (normals[a as usize], normals[b as usize]);
-                        if na != DVec3::ZERO && nb != DVec3::ZERO {
-                            worst = worst.max(angle_between(na, nb));
-                        }
-                    }
-                }
-                worst
-            })
+        min_normal_dots(t, p)
+            .into_iter()
+            .map(|d| d.clamp(-1.0, 1.0).acos())
             .collect()
     }
+}
+
+/// The smallest dot product between the unit normals of two faces at each vertex (1 where
+/// fewer than two faces have a normal): the cosine of seed 002's `ε(v)`.
+fn min_normal_dots(t: &Topology, p: &[DVec3]) -> Vec<f64> {
+    let normals = face_normals(t, p);
+    (0..t.num_vertices())
+        .into_par_iter()
+        .map(|v| {
+            let vf = t.vertex_faces(v);
+            let mut least = 1.0f64;
+            for (i, &a) in vf.iter().enumerate() {
+                let na = normals[a as usize];
+                if na == DVec3::ZERO {
+                    continue;
+                }
+                for &b in &vf[i + 1..] {
+                    let nb = normals[b as usize];
+                    if nb != DVec3::ZERO {
+                        least = least.min(na.dot(nb));
+                    }
+                }
+            }
+            least
+        })
+        .collect()
 }
 
 impl Criterion for Flatness {
     fn select(&self, level: &LevelView<'_>, selected: &mut [bool]) -> Result<(), AdaptiveError> {
         let t = level.topology();
-        let eps = Flatness::vertex_flatness(t, level.points());
-        let dead: Vec<bool> = eps.iter().map(|&e| e < self.threshold).collect();
+        // ε(v) < ε_T exactly when cos ε(v) > cos ε_T (acos decreases): no acos per vertex.
+        let cos_t = self.threshold.cos();
+        let dead: Vec<bool> = min_normal_dots(t, level.points())
+            .into_iter()
+            .map(|d| d.clamp(-1.0, 1.0) > cos_t)
+            .collect();
         selected.par_iter_mut().enumerate().for_each(|(f, s)| {
             let fv = t.face_vertices(f);
             let n = fv.len();

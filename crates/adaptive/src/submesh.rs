@@ -98,6 +98,7 @@ pub(crate) fn cut(src: &Topology, faces: &[u32]) -> SubMesh {
     let mut vertex_edges = Vec::new();
     let mut vertex_non_manifold = Vec::with_capacity(vertices.len());
     let mut complete = Vec::with_capacity(vertices.len());
+    let mut kept: Vec<usize> = Vec::new();
     for &v in &vertices {
         let v = v as usize;
         let (vf, vl, ve) = (
@@ -105,9 +106,8 @@ pub(crate) fn cut(src: &Topology, faces: &[u32]) -> SubMesh {
             src.vertex_face_local_indices(v),
             src.vertex_edges(v),
         );
-        let kept: Vec<usize> = (0..vf.len())
-            .filter(|&i| fmap[vf[i] as usize] != NONE)
-            .collect();
+        kept.clear();
+        kept.extend((0..vf.len()).filter(|&i| fmap[vf[i] as usize] != NONE));
         let whole = kept.len() == vf.len();
         let arc = if whole || src.is_non_manifold_vertex(v) {
             None
@@ -202,21 +202,23 @@ pub(crate) fn cut(src: &Topology, faces: &[u32]) -> SubMesh {
 /// The start (ring position) of the single run of consecutive ring positions `kept`
 /// (increasing) in a ring of `n` faces, cyclic when `closed`; `None` for several runs.
 fn single_arc(kept: &[usize], n: usize, closed: bool) -> Option<usize> {
-    let gaps: Vec<usize> = (0..kept.len())
-        .filter(|&j| {
-            let next = kept[(j + 1) % kept.len()];
-            if j + 1 == kept.len() {
-                !closed || (kept[j] + 1) % n != next
-            } else {
-                kept[j] + 1 != next
-            }
-        })
-        .collect();
-    match gaps.as_slice() {
-        // One break in the (cyclic or linear) sequence: the run starts after it.
-        [g] => Some(kept[(g + 1) % kept.len()]),
-        _ => None,
+    let k = kept.len();
+    // Breaks between consecutive kept positions; the last wraps around on a closed ring.
+    let mut breaks = 0;
+    let mut after = 0;
+    for j in 0..k {
+        let broken = if j + 1 == k {
+            !closed || (kept[j] + 1) % n != kept[0]
+        } else {
+            kept[j] + 1 != kept[j + 1]
+        };
+        if broken {
+            breaks += 1;
+            after = (j + 1) % k;
+        }
     }
+    // One break in the (cyclic or linear) sequence: the run starts after it.
+    (breaks == 1).then(|| kept[after])
 }
 
 #[cfg(test)]
