@@ -364,3 +364,84 @@ pub fn tagged_case_strategy(schemes: &'static [Scheme]) -> impl Strategy<Value =
             }
         })
 }
+
+/// An OpenSubdiv shape with a surface scheme (`catmark_*`, `loop_*`), read with its options.
+#[derive(Debug, Clone)]
+pub struct SurfaceShape {
+    /// File stem.
+    pub name: String,
+    /// Catmull-Clark or Loop, from the name.
+    pub scheme: Scheme,
+    /// The options its tags ask for.
+    pub options: Options,
+    /// Topology and positions.
+    pub mesh: subd_mesh::Mesh,
+}
+
+/// Every Catmull-Clark and Loop shape of the OpenSubdiv directory that reads (windings that
+/// disagree accepted as non-manifold edges, as OpenSubdiv accepts them), in name order.
+pub fn surface_shapes() -> Vec<SurfaceShape> {
+    let opts = subd_io::ReadOptions {
+        accept_inconsistent_orientation: true,
+    };
+    osd_meshes()
+        .into_iter()
+        .filter_map(|path| {
+            let name = path.file_stem()?.to_string_lossy().to_string();
+            let scheme = if name.starts_with("loop_") {
+                Scheme::Loop
+            } else if name.starts_with("catmark_") {
+                Scheme::CatmullClark
+            } else {
+                return None;
+            };
+            let file = subd_io::read_mesh(&path, &opts).ok()?;
+            Some(SurfaceShape {
+                name,
+                scheme,
+                options: Options::from_hints(&file.mesh.hints),
+                mesh: file.mesh,
+            })
+        })
+        .collect()
+}
+
+/// A random relabelling of a case's vertices (a shuffle seeded by `seed`): the permutation
+/// (old vertex → new), the case's topology, the relabelled topology with the same tags, and
+/// the relabelled positions.
+pub fn relabelled(
+    c: &TaggedCase,
+    seed: u64,
+) -> (Vec<u32>, Topology, Topology, Vec<subd_mesh::DVec3>) {
+    let nv = c.mesh.num_vertices;
+    let mut perm: Vec<u32> = (0..nv as u32).collect();
+    let mut state = seed | 1;
+    for i in (1..nv).rev() {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        perm.swap(i, (state % (i as u64 + 1)) as usize);
+    }
+    let t = c.topology(&c.mesh.faces);
+    let faces: Vec<Vec<u32>> = c
+        .mesh
+        .faces
+        .iter()
+        .map(|f| f.iter().map(|&v| perm[v as usize]).collect())
+        .collect();
+    let mut u = build(nv, &faces);
+    // Carry the tags over through the permutation.
+    for e in 0..t.num_edges() {
+        let [x, y] = t.edge_vertices(e);
+        let g = u
+            .find_edge(perm[x as usize], perm[y as usize])
+            .expect("a relabelled edge") as usize;
+        u.set_edge_sharpness(g, t.edge_sharpness(e));
+    }
+    let mut pos = vec![subd_mesh::DVec3::ZERO; nv];
+    for (v, &w) in perm.iter().enumerate() {
+        u.set_vertex_sharpness(w as usize, t.vertex_sharpness(v));
+        pos[w as usize] = c.positions[v];
+    }
+    (perm, t, u, pos)
+}

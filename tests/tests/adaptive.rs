@@ -8,42 +8,12 @@ use std::collections::HashSet;
 
 use glam::DVec3;
 use subd_adaptive::{AdaptiveRefinement, Positions, RandomSelection, UniformCounts};
-use subd_io::{ReadOptions, read_mesh};
 use subd_limit::{LimitStencilTable, levels_for_exact_limit};
-use subd_schemes::{Options, Refinement, Rule, Scheme};
-use subd_tests::osd_meshes;
+use subd_schemes::{Refinement, Rule};
+use subd_tests::{SurfaceShape, surface_shapes};
 
-struct Shape {
-    name: String,
-    scheme: Scheme,
-    options: Options,
-    mesh: subd_mesh::Mesh,
-}
-
-fn shapes() -> Vec<Shape> {
-    let opts = ReadOptions {
-        accept_inconsistent_orientation: true,
-    };
-    osd_meshes()
-        .into_iter()
-        .filter_map(|path| {
-            let name = path.file_stem()?.to_string_lossy().to_string();
-            let scheme = if name.starts_with("loop_") {
-                Scheme::Loop
-            } else if name.starts_with("catmark_") {
-                Scheme::CatmullClark
-            } else {
-                return None;
-            };
-            let file = read_mesh(&path, &opts).ok()?;
-            Some(Shape {
-                name,
-                scheme,
-                options: Options::from_hints(&file.mesh.hints),
-                mesh: file.mesh,
-            })
-        })
-        .collect()
+fn shapes() -> Vec<SurfaceShape> {
+    surface_shapes()
 }
 
 fn diagonal(p: &[DVec3]) -> f64 {
@@ -55,7 +25,7 @@ fn diagonal(p: &[DVec3]) -> f64 {
 }
 
 /// Every vertex of every level equals uniform refinement's, and the mesh is conforming.
-fn check_exact(s: &Shape, a: &AdaptiveRefinement, uniform: &[Vec<DVec3>]) {
+fn check_exact(s: &SurfaceShape, a: &AdaptiveRefinement, uniform: &[Vec<DVec3>]) {
     let d = diagonal(&s.mesh.positions);
     for (l, level) in uniform.iter().enumerate().take(a.depth() + 1) {
         for (k, p) in a.level_vertices(l) {

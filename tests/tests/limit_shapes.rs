@@ -7,10 +7,9 @@
 #![allow(clippy::needless_range_loop)]
 
 use glam::DVec3;
-use subd_io::{ReadOptions, read_mesh};
 use subd_limit::{LimitError, LimitStencilTable, base_limit, levels_for_exact_limit, masks};
 use subd_schemes::{Options, Refinement, Rule, Scheme};
-use subd_tests::osd_meshes;
+use subd_tests::{SurfaceShape, surface_shapes};
 
 fn bbox_diagonal(p: &[DVec3]) -> f64 {
     let (lo, hi) = p.iter().fold(
@@ -20,37 +19,8 @@ fn bbox_diagonal(p: &[DVec3]) -> f64 {
     (hi - lo).length().max(1e-300)
 }
 
-struct Shape {
-    name: String,
-    scheme: Scheme,
-    options: Options,
-    mesh: subd_mesh::Mesh,
-}
-
-fn shapes() -> Vec<Shape> {
-    let opts = ReadOptions {
-        accept_inconsistent_orientation: true,
-    };
-    osd_meshes()
-        .into_iter()
-        .filter_map(|path| {
-            let name = path.file_stem()?.to_string_lossy().to_string();
-            let scheme = if name.starts_with("loop_") {
-                Scheme::Loop
-            } else if name.starts_with("catmark_") {
-                Scheme::CatmullClark
-            } else {
-                return None;
-            };
-            let file = read_mesh(&path, &opts).ok()?;
-            Some(Shape {
-                name,
-                scheme,
-                options: Options::from_hints(&file.mesh.hints),
-                mesh: file.mesh,
-            })
-        })
-        .collect()
+fn shapes() -> Vec<SurfaceShape> {
+    surface_shapes()
 }
 
 /// The limit from the base mesh equals the limit taken two levels further down, for every

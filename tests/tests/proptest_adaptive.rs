@@ -13,7 +13,7 @@ use subd_adaptive::{
 };
 use subd_mesh::DVec3;
 use subd_schemes::{Refinement, Scheme};
-use subd_tests::{TaggedCase, build, random_mesh, tagged_case_strategy};
+use subd_tests::{TaggedCase, build, random_mesh, relabelled, tagged_case_strategy};
 
 fn cases() -> impl Strategy<Value = TaggedCase> {
     tagged_case_strategy(&[Scheme::CatmullClark, Scheme::Loop])
@@ -84,26 +84,7 @@ proptest! {
 
     #[test]
     fn relabelling_vertices_relabels_the_result(c in cases(), seed in any::<u64>(), flat in 5.0f64..40.0) {
-        let nv = c.mesh.num_vertices;
-        let mut perm: Vec<u32> = (0..nv as u32).collect();
-        let mut state = seed | 1;
-        for i in (1..nv).rev() {
-            state ^= state << 13; state ^= state >> 7; state ^= state << 17;
-            perm.swap(i, (state % (i as u64 + 1)) as usize);
-        }
-        let t = c.topology(&c.mesh.faces);
-        let faces: Vec<Vec<u32>> = c.mesh.faces.iter().map(|f| f.iter().map(|&v| perm[v as usize]).collect()).collect();
-        let mut u = build(nv, &faces);
-        for e in 0..t.num_edges() {
-            let [x, y] = t.edge_vertices(e);
-            let g = u.find_edge(perm[x as usize], perm[y as usize]).unwrap() as usize;
-            u.set_edge_sharpness(g, t.edge_sharpness(e));
-        }
-        let mut pos = vec![DVec3::ZERO; nv];
-        for (v, &w) in perm.iter().enumerate() {
-            u.set_vertex_sharpness(w as usize, t.vertex_sharpness(v));
-            pos[w as usize] = c.positions[v];
-        }
+        let (_, t, u, pos) = relabelled(&c, seed);
         // Geometric criteria and face selections do not depend on labels.
         let flatness = Flatness::new(flat).unwrap();
         let picked: Vec<u64> = (0..t.num_faces() as u64).filter(|f| (f ^ seed) % 3 == 0).collect();

@@ -6,7 +6,7 @@
 use proptest::prelude::*;
 use subd_mesh::{DVec3, Topology, TopologyBuilder};
 use subd_schemes::{Options, Refinement, Scheme};
-use subd_tests::{TaggedCase as Case, build, random_mesh, tagged_case_strategy};
+use subd_tests::{TaggedCase as Case, build, random_mesh, relabelled, tagged_case_strategy};
 
 fn case_strategy() -> impl Strategy<Value = Case> {
     tagged_case_strategy(&[Scheme::CatmullClark, Scheme::Loop, Scheme::Bilinear])
@@ -59,26 +59,7 @@ proptest! {
     #[test]
     fn relabelling_vertices_permutes_the_result(c in case_strategy(), seed in any::<u64>()) {
         let nv = c.mesh.num_vertices;
-        let mut perm: Vec<u32> = (0..nv as u32).collect();
-        let mut state = seed | 1;
-        for i in (1..nv).rev() {
-            state ^= state << 13; state ^= state >> 7; state ^= state << 17;
-            perm.swap(i, (state % (i as u64 + 1)) as usize);
-        }
-        let t = topology(&c, &c.mesh.faces);
-        let faces: Vec<Vec<u32>> = c.mesh.faces.iter().map(|f| f.iter().map(|&v| perm[v as usize]).collect()).collect();
-        let mut u = build(nv, &faces);
-        // Carry the tags over through the permutation.
-        for e in 0..t.num_edges() {
-            let [x, y] = t.edge_vertices(e);
-            let f = u.find_edge(perm[x as usize], perm[y as usize]).unwrap() as usize;
-            u.set_edge_sharpness(f, t.edge_sharpness(e));
-        }
-        let mut pos = vec![DVec3::ZERO; nv];
-        for (v, &w) in perm.iter().enumerate() {
-            u.set_vertex_sharpness(w as usize, t.vertex_sharpness(v));
-            pos[w as usize] = c.positions[v];
-        }
+        let (perm, t, u, pos) = relabelled(&c, seed);
         let a = Refinement::new(&t, c.scheme, &options(&c), 2).unwrap().refine_points(&c.positions);
         let b = Refinement::new(&u, c.scheme, &options(&c), 2).unwrap().refine_points(&pos);
         // Edges are numbered by first appearance in face order, which relabelling keeps, so

@@ -701,6 +701,25 @@ mod tests {
         (t, p)
     }
 
+    /// The unit octahedron.
+    fn octahedron() -> (Topology, [DVec3; 6]) {
+        let fv = [
+            0, 1, 2, 0, 2, 3, 0, 3, 4, 0, 4, 1, 5, 2, 1, 5, 3, 2, 5, 4, 3, 5, 1, 4,
+        ];
+        let t = TopologyBuilder::new(6).build(&[3; 8], &fv).unwrap();
+        (
+            t,
+            [
+                DVec3::Z,
+                DVec3::X,
+                DVec3::Y,
+                -DVec3::X,
+                -DVec3::Y,
+                -DVec3::Z,
+            ],
+        )
+    }
+
     fn level0<'a>(a: &'a AdaptiveRefinement) -> LevelView<'a> {
         a.level_view(0)
     }
@@ -773,18 +792,7 @@ mod tests {
     fn angle_defect_of_an_octahedron_is_the_sphere_curvature_sum() {
         // Octahedron: 4 faces of 60° at each vertex, defect 2π − 4π/3 = 2π/3, six vertices
         // sum to 4π (Gauss–Bonnet for a sphere).
-        let fv = [
-            0, 1, 2, 0, 2, 3, 0, 3, 4, 0, 4, 1, 5, 2, 1, 5, 3, 2, 5, 4, 3, 5, 1, 4,
-        ];
-        let t = TopologyBuilder::new(6).build(&[3; 8], &fv).unwrap();
-        let p = [
-            DVec3::Z,
-            DVec3::X,
-            DVec3::Y,
-            -DVec3::X,
-            -DVec3::Y,
-            -DVec3::Z,
-        ];
+        let (t, p) = octahedron();
         let a = AdaptiveRefinement::new(&t, &p, Scheme::Loop, &Options::default(), &[], 0).unwrap();
         let view = level0(&a);
         let area = 3f64.sqrt() / 2.0; // each face: an equilateral triangle of side √2
@@ -817,18 +825,7 @@ mod tests {
 
     #[test]
     fn the_distance_criterion_meets_its_tolerance_on_every_face() {
-        let fv = [
-            0, 1, 2, 0, 2, 3, 0, 3, 4, 0, 4, 1, 5, 2, 1, 5, 3, 2, 5, 4, 3, 5, 1, 4,
-        ];
-        let t = TopologyBuilder::new(6).build(&[3; 8], &fv).unwrap();
-        let p = [
-            DVec3::Z,
-            DVec3::X,
-            DVec3::Y,
-            -DVec3::X,
-            -DVec3::Y,
-            -DVec3::Z,
-        ];
+        let (t, p) = octahedron();
         let o = Options::default();
         for limit in [false, true] {
             let surface = LimitSurface::new(&t, &p, Scheme::Loop, &o).unwrap();
