@@ -445,3 +445,23 @@ pub fn relabelled(
     }
     (perm, t, u, pos)
 }
+
+/// A random torus mesh (quads, triangles and fans) of `m` × `n` cells with every seventh edge
+/// a 1.7 crease and wavy positions: a mesh large enough for the parallel loops to split.
+pub fn creased_torus(m: u32, n: u32) -> (Topology, Vec<subd_mesh::DVec3>) {
+    let mesh = random_mesh(0, m, n, &[0, 1, 2, 3, 0, 2, 1], &[(0.0, 0.0)]);
+    let mut t = build(mesh.num_vertices, &mesh.faces);
+    for e in (0..t.num_edges()).step_by(7) {
+        t.set_edge_sharpness(e, 1.7);
+    }
+    let positions = (0..mesh.num_vertices)
+        .map(|i| {
+            subd_mesh::DVec3::new(
+                (i as f64 * 0.37).sin(),
+                (i as f64 * 0.11).cos(),
+                (i as f64 * 0.05).sin(),
+            )
+        })
+        .collect();
+    (t, positions)
+}

@@ -13,7 +13,7 @@ use subd_adaptive::{
 };
 use subd_mesh::DVec3;
 use subd_schemes::{Refinement, Scheme};
-use subd_tests::{TaggedCase, build, random_mesh, relabelled, tagged_case_strategy};
+use subd_tests::{TaggedCase, creased_torus, relabelled, tagged_case_strategy};
 
 fn cases() -> impl Strategy<Value = TaggedCase> {
     tagged_case_strategy(&[Scheme::CatmullClark, Scheme::Loop])
@@ -102,20 +102,7 @@ proptest! {
 /// large enough to be split across threads.
 #[test]
 fn one_thread_equals_many_threads() {
-    let mesh = random_mesh(0, 50, 60, &[0, 1, 2, 3, 0, 2, 1], &[(0.0, 0.0)]);
-    let mut t = build(mesh.num_vertices, &mesh.faces);
-    for e in (0..t.num_edges()).step_by(7) {
-        t.set_edge_sharpness(e, 1.7);
-    }
-    let positions: Vec<DVec3> = (0..mesh.num_vertices)
-        .map(|i| {
-            DVec3::new(
-                (i as f64 * 0.37).sin(),
-                (i as f64 * 0.11).cos(),
-                (i as f64 * 0.05).sin(),
-            )
-        })
-        .collect();
+    let (t, positions) = creased_torus(50, 60);
     let run = |threads: usize| {
         rayon::ThreadPoolBuilder::new()
             .num_threads(threads)

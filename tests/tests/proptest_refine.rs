@@ -6,7 +6,9 @@
 use proptest::prelude::*;
 use subd_mesh::{DVec3, Topology, TopologyBuilder};
 use subd_schemes::{Options, Refinement, Scheme};
-use subd_tests::{TaggedCase as Case, build, random_mesh, relabelled, tagged_case_strategy};
+use subd_tests::{
+    TaggedCase as Case, build, creased_torus, random_mesh, relabelled, tagged_case_strategy,
+};
 
 fn case_strategy() -> impl Strategy<Value = Case> {
     tagged_case_strategy(&[Scheme::CatmullClark, Scheme::Loop, Scheme::Bilinear])
@@ -93,20 +95,7 @@ proptest! {
 /// enough to be split across threads.
 #[test]
 fn one_thread_equals_many_threads() {
-    let mesh = random_mesh(0, 60, 70, &[0, 1, 2, 3, 0, 2, 1], &[(0.0, 0.0)]);
-    let mut t = build(mesh.num_vertices, &mesh.faces);
-    for e in (0..t.num_edges()).step_by(7) {
-        t.set_edge_sharpness(e, 1.7);
-    }
-    let positions: Vec<DVec3> = (0..mesh.num_vertices)
-        .map(|i| {
-            DVec3::new(
-                (i as f64 * 0.37).sin(),
-                (i as f64 * 0.11).cos(),
-                (i as f64 * 0.05).sin(),
-            )
-        })
-        .collect();
+    let (t, positions) = creased_torus(60, 70);
     let run = |threads: usize| {
         rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
