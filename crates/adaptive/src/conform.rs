@@ -138,9 +138,17 @@ pub(crate) fn min_angle(p: &[DVec3]) -> f64 {
 struct Leaf {
     level: usize,
     face: usize,
-    corners: Vec<u32>,
-    /// Output vertex of the edge point of each edge, or `NONE`.
-    edge_points: Vec<u32>,
+    /// Where its corners' and edge points' output vertices start in the flat id arrays.
+    first: usize,
+    /// Whether any of its edges is split.
+    split: bool,
+}
+
+/// Output vertices of every leaf's corners and of its edges' edge points (`NONE` for an edge
+/// that is not split), leaf after leaf.
+struct LeafIds<'a> {
+    corners: &'a [u32],
+    edge_points: &'a [u32],
 }
 
 impl AdaptiveRefinement {
@@ -179,36 +187,34 @@ impl AdaptiveRefinement {
             ids[l][w]
         };
         let mut leaves = Vec::new();
+        let (mut corner_ids, mut edge_ids) = (Vec::new(), Vec::new());
         for (l, lv) in self.levels.iter().enumerate() {
             let t = &lv.topology;
             for f in (0..t.num_faces()).filter(|&f| !lv.refined[f]) {
-                let corners = t
-                    .face_vertices(f)
-                    .iter()
-                    .map(|&v| id_of(l, v as usize))
-                    .collect();
-                let edge_points = t
-                    .face_edges(f)
-                    .iter()
-                    .map(|&e| {
-                        let split = l < depth
-                            && t.edge_faces(e as usize)
-                                .iter()
-                                .any(|&g| g as usize != f && lv.refined[g as usize]);
-                        if split {
-                            let child = lv.edge_child[e as usize];
-                            debug_assert_ne!(child, NONE);
-                            id_of(l + 1, child as usize)
-                        } else {
-                            NONE
-                        }
-                    })
-                    .collect();
+                let first = corner_ids.len();
+                for &v in t.face_vertices(f) {
+                    corner_ids.push(id_of(l, v as usize));
+                }
+                let mut split = false;
+                for &e in t.face_edges(f) {
+                    let across_refined = l < depth
+                        && t.edge_faces(e as usize)
+                            .iter()
+                            .any(|&g| g as usize != f && lv.refined[g as usize]);
+                    edge_ids.push(if across_refined {
+                        split = true;
+                        let child = lv.edge_child[e as usize];
+                        debug_assert_ne!(child, NONE);
+                        id_of(l + 1, child as usize)
+                    } else {
+                        NONE
+                    });
+                }
                 leaves.push(Leaf {
                     level: l,
                     face: f,
-                    corners,
-                    edge_points,
+                    first,
+                    split,
                 });
             }
         }
@@ -242,25 +248,52 @@ impl AdaptiveRefinement {
             face_domains: Vec::new(),
             corner_params: Vec::new(),
         };
+        let ids = LeafIds {
+            corners: &corner_ids,
+            edge_points: &edge_ids,
+        };
+        out.face_offsets.reserve(leaves.len());
+        out.face_vertices.reserve(corner_ids.len());
         for leaf in &leaves {
-            self.emit(leaf, &mut out);
+            self.emit(leaf, &ids, &mut out);
         }
         Ok(out)
     }
 
     /// Appends the polygons of `leaf` to `out`.
-    fn emit(&self, leaf: &Leaf, out: &mut AdaptiveMesh) {
+    fn emit(&self, leaf: &Leaf, ids: &LeafIds<'_>, out: &mut AdaptiveMesh) {
         let lv = &self.levels[leaf.level];
         let t = &lv.topology;
         let f = leaf.face;
-        let n = leaf.corners.len();
-        let split: Vec<bool> = leaf.edge_points.iter().map(|&e| e != NONE).collect();
         let params = lv.params(f);
         let fv = t.face_vertices(f);
         let fe = t.face_edges(f);
+        let n = fv.len();
+        let corners = &ids.corners[leaf.first..leaf.first + n];
+        let edge_points = &ids.edge_points[leaf.first..leaf.first + n];
+        if !leaf.split {
+            // The common case: the leaf itself, its edges uniform edges of its level.
+            out.face_vertices.extend_from_slice(corners);
+            for &e in fe {
+                out.edge_origins.push(EdgeOrigin::Uniform {
+                    level: leaf.level as u8,
+                    index: lv.edge_key[e as usize],
+                    faces: lv.edge_full[e as usize],
+                });
+            }
+            out.corner_params.extend_from_slice(params);
+            out.face_offsets.push(out.face_vertices.len() as u32);
+            out.face_levels.push(leaf.level as u8);
+            out.face_uniform.push(lv.face_key[f]);
+            out.holes.push(t.is_hole(f));
+            out.transition.push(false);
+            out.face_domains.push((lv.base_face[f], lv.sub_face[f]));
+            return;
+        }
+        let split: Vec<bool> = edge_points.iter().map(|&e| e != NONE).collect();
         let vertex = |p: Point| match p {
-            C(i) => leaf.corners[i],
-            E(i) => leaf.edge_points[i],
+            C(i) => corners[i],
+            E(i) => edge_points[i],
         };
         let param = |p: Point| match p {
             C(i) => params[i],
