@@ -132,12 +132,9 @@ fn in_range(name: &str, value: f64, ok: bool, what: &str) -> Result<(), Failure>
     Ok(())
 }
 
-pub(crate) fn run(
-    args: &AdaptiveArgs,
-    out: &mut dyn Write,
-    err: &mut dyn Write,
-) -> Result<(), Failure> {
-    let t_start = Instant::now();
+/// Checks what can be checked before reading the input: the output's extension, the
+/// thresholds and the level cap (returned).
+fn check_arguments(args: &AdaptiveArgs) -> Result<usize, Failure> {
     refuse_overwrite(&args.input, &args.output)?;
     if subd_io::Format::from_path(&args.output).is_none() {
         return Err(bad(format!(
@@ -145,38 +142,20 @@ pub(crate) fn run(
             args.output.display()
         )));
     }
-    // Thresholds are checked before any work.
+    let degrees = |d: f64| (0.0..=180.0).contains(&d);
     if let Some(d) = args.flatness {
-        in_range(
-            "flatness",
-            d,
-            (0.0..=180.0).contains(&d),
-            "expected degrees in [0, 180]",
-        )?;
+        in_range("flatness", d, degrees(d), "expected degrees in [0, 180]")?;
     }
     if let Some(d) = args.dihedral {
-        in_range(
-            "dihedral",
-            d,
-            (0.0..=180.0).contains(&d),
-            "expected degrees in [0, 180]",
-        )?;
+        in_range("dihedral", d, degrees(d), "expected degrees in [0, 180]")?;
     }
     if let Some(d) = args.max_distance {
-        in_range(
-            "max-distance",
-            d,
-            d.is_finite() && d > 0.0,
-            "expected a positive number",
-        )?;
+        let ok = d.is_finite() && d > 0.0;
+        in_range("max-distance", d, ok, "expected a positive number")?;
     }
     if let Some(k) = args.curvature {
-        in_range(
-            "curvature",
-            k,
-            k.is_finite() && k >= 0.0,
-            "expected a number ≥ 0",
-        )?;
+        let ok = k.is_finite() && k >= 0.0;
+        in_range("curvature", k, ok, "expected a number ≥ 0")?;
     }
     let levels = args.levels.unwrap_or(DEFAULT_LEVELS);
     if levels > subd_adaptive::MAX_LEVELS {
@@ -185,7 +164,83 @@ pub(crate) fn run(
             subd_adaptive::MAX_LEVELS
         )));
     }
+    Ok(levels)
+}
 
+/// The criteria the command line asks for; the distance criterion apart, since the report
+/// measures with its limit surface.
+struct Selection {
+    others: Vec<Box<dyn Criterion>>,
+    distance: Option<LimitDistance>,
+}
+
+impl Selection {
+    fn new(
+        args: &AdaptiveArgs,
+        mesh: &subd_mesh::Mesh,
+        scheme: Scheme,
+        options: &subd_schemes::Options,
+        diagonal: f64,
+    ) -> Result<Selection, Failure> {
+        let base = &mesh.topology;
+        let input_err = |e: AdaptiveError| bad(format!("{}: {e}", args.input.display()));
+        let mut others: Vec<Box<dyn Criterion>> = Vec::new();
+        if let Some(d) = args.flatness {
+            others.push(Box::new(Flatness::new(d).map_err(input_err)?));
+        }
+        if let Some(d) = args.dihedral {
+            others.push(Box::new(DihedralAngle::new(d).map_err(input_err)?));
+        }
+        if let Some(k) = args.curvature {
+            others.push(Box::new(
+                GaussianCurvature::new(k, diagonal).map_err(input_err)?,
+            ));
+        }
+        if let Some(f) = &args.select_faces {
+            let faces: Vec<u64> = read_indices(f, base.num_faces(), "face")?
+                .into_iter()
+                .map(u64::from)
+                .collect();
+            others.push(Box::new(
+                FaceSelection::from_faces(base.num_faces(), &faces).map_err(input_err)?,
+            ));
+        }
+        if let Some(f) = &args.select_vertices {
+            let vertices: Vec<u64> = read_indices(f, base.num_vertices(), "vertex")?
+                .into_iter()
+                .map(u64::from)
+                .collect();
+            others.push(Box::new(
+                FaceSelection::from_vertices(base, &vertices).map_err(input_err)?,
+            ));
+        }
+        let distance = match args.max_distance {
+            Some(d) => {
+                let s =
+                    LimitSurface::new(base, &mesh.positions, scheme, options).map_err(input_err)?;
+                Some(LimitDistance::new(s, d * diagonal, args.limit).map_err(input_err)?)
+            }
+            None => None,
+        };
+        Ok(Selection { others, distance })
+    }
+
+    fn criteria(&self) -> Vec<&dyn Criterion> {
+        let mut all: Vec<&dyn Criterion> = self.others.iter().map(|c| c.as_ref()).collect();
+        if let Some(d) = &self.distance {
+            all.push(d);
+        }
+        all
+    }
+}
+
+pub(crate) fn run(
+    args: &AdaptiveArgs,
+    out: &mut dyn Write,
+    err: &mut dyn Write,
+) -> Result<(), Failure> {
+    let t_start = Instant::now();
+    let levels = check_arguments(args)?;
     let file = subd_io::read_mesh(&args.input, &args.rules.read_options())?;
     print_warnings(err, &args.input, &file.warnings);
     let t_read = t_start.elapsed().as_secs_f64();
@@ -209,54 +264,16 @@ pub(crate) fn run(
     let diagonal = mesh
         .bounding_box()
         .map_or(0.0, |(lo, hi)| (hi - lo).length());
-
-    let mut criteria: Vec<Box<dyn Criterion>> = Vec::new();
-    if let Some(d) = args.flatness {
-        criteria.push(Box::new(Flatness::new(d).map_err(input_err)?));
-    }
-    if let Some(d) = args.dihedral {
-        criteria.push(Box::new(DihedralAngle::new(d).map_err(input_err)?));
-    }
-    if let Some(k) = args.curvature {
-        criteria.push(Box::new(
-            GaussianCurvature::new(k, diagonal).map_err(input_err)?,
-        ));
-    }
-    if let Some(f) = &args.select_faces {
-        let faces = read_indices(f, base.num_faces(), "face")?;
-        let faces: Vec<u64> = faces.into_iter().map(u64::from).collect();
-        criteria.push(Box::new(
-            FaceSelection::from_faces(base.num_faces(), &faces).map_err(input_err)?,
-        ));
-    }
-    if let Some(f) = &args.select_vertices {
-        let vertices = read_indices(f, base.num_vertices(), "vertex")?;
-        let vertices: Vec<u64> = vertices.into_iter().map(u64::from).collect();
-        criteria.push(Box::new(
-            FaceSelection::from_vertices(base, &vertices).map_err(input_err)?,
-        ));
-    }
-    let surface = || LimitSurface::new(base, &mesh.positions, scheme, &options);
-    let distance = match args.max_distance {
-        Some(d) => {
-            let s = surface().map_err(input_err)?;
-            Some(LimitDistance::new(s, d * diagonal, args.limit).map_err(input_err)?)
-        }
-        None => None,
-    };
+    let selection = Selection::new(args, mesh, scheme, &options, diagonal)?;
 
     let spinner = Spinner::new(args.json, "refining");
     let t0 = Instant::now();
-    let mut refs: Vec<&dyn Criterion> = criteria.iter().map(|c| c.as_ref()).collect();
-    if let Some(d) = &distance {
-        refs.push(d);
-    }
     let hierarchy = AdaptiveRefinement::with_progress(
         base,
         &mesh.positions,
         scheme,
         &options,
-        &refs,
+        &selection.criteria(),
         levels,
         &mut |level, faces| spinner.message(format!("level {level}: {faces} faces")),
     )
@@ -273,17 +290,17 @@ pub(crate) fn run(
     let t_mesh = t1.elapsed().as_secs_f64();
 
     let t2 = Instant::now();
-    let report = if args.json {
+    let measured = if args.json {
         spinner.message("measuring");
         let own;
-        let s = match &distance {
-            Some(d) => Ok(d.surface()),
+        let surface = match &selection.distance {
+            Some(d) => Some(d.surface()),
             None => {
-                own = surface();
-                own.as_ref().map_err(|_| ())
+                own = LimitSurface::new(base, &mesh.positions, scheme, &options);
+                own.as_ref().ok()
             }
         };
-        Some(measure(&result, s.ok()))
+        Some(measure(&result, surface))
     } else {
         None
     };
@@ -295,20 +312,59 @@ pub(crate) fn run(
     spinner.finish();
     let t_write = t3.elapsed().as_secs_f64();
 
-    if let Some((conformity, min_angle, distance)) = report {
+    if let Some(measured) = measured {
+        let seconds = Timings {
+            read: t_read,
+            hierarchy: t_hierarchy,
+            mesh: t_mesh,
+            report: t_report,
+            write: t_write,
+            total: t_start.elapsed().as_secs_f64(),
+        };
+        let context = ReportContext {
+            args,
+            base,
+            options: &options,
+            levels,
+            diagonal,
+            warnings: &file.warnings,
+        };
+        let report = context.report(&hierarchy, &result, measured, seconds);
+        crate::print_json(out, &report);
+    }
+    Ok(())
+}
+
+/// What the JSON report says besides the hierarchy and the mesh.
+struct ReportContext<'a> {
+    args: &'a AdaptiveArgs,
+    base: &'a subd_mesh::Topology,
+    options: &'a subd_schemes::Options,
+    levels: usize,
+    diagonal: f64,
+    warnings: &'a [String],
+}
+
+impl ReportContext<'_> {
+    fn report(
+        &self,
+        hierarchy: &AdaptiveRefinement,
+        result: &AdaptiveMesh,
+        (conformity, min_angle, distance): (Conformity, f64, Option<f64>),
+        seconds: Timings,
+    ) -> AdaptiveReport {
+        let (args, base, options) = (self.args, self.base, self.options);
         let depth = hierarchy.depth();
         let uniform_faces = hierarchy.uniform_counts(depth).faces;
-        let input_boundary_edges = (0..base.num_edges())
-            .filter(|&e| base.is_boundary_edge(e))
-            .count();
-        let report = AdaptiveReport {
+        let path = |p: &Option<PathBuf>| p.as_ref().map(|p| p.display().to_string());
+        AdaptiveReport {
             input: args.input.display().to_string(),
             output: args.output.display().to_string(),
-            scheme: match scheme {
+            scheme: match hierarchy.scheme() {
                 Scheme::Loop => "loop",
                 _ => "catmull-clark",
             },
-            levels,
+            levels: self.levels,
             depth,
             limit: args.limit,
             boundary_interpolation: options.boundary_interpolation,
@@ -319,14 +375,13 @@ pub(crate) fn run(
                 max_distance: args.max_distance,
                 curvature: args.curvature,
                 dihedral: args.dihedral,
-                select_faces: args.select_faces.as_ref().map(|p| p.display().to_string()),
-                select_vertices: args
-                    .select_vertices
-                    .as_ref()
-                    .map(|p| p.display().to_string()),
+                select_faces: path(&args.select_faces),
+                select_vertices: path(&args.select_vertices),
             },
             input_faces: base.num_faces(),
-            input_boundary_edges,
+            input_boundary_edges: (0..base.num_edges())
+                .filter(|&e| base.is_boundary_edge(e))
+                .count(),
             faces: result.num_faces(),
             vertices: result.positions.len(),
             faces_per_level: result.faces_per_level(),
@@ -337,21 +392,12 @@ pub(crate) fn run(
             conformity,
             min_angle_degrees: min_angle,
             max_distance_to_limit: distance,
-            max_distance_to_limit_relative: distance.map(|d| d / diagonal),
-            bbox_diagonal: diagonal,
-            seconds: Timings {
-                read: t_read,
-                hierarchy: t_hierarchy,
-                mesh: t_mesh,
-                report: t_report,
-                write: t_write,
-                total: t_start.elapsed().as_secs_f64(),
-            },
-            warnings: file.warnings.clone(),
-        };
-        crate::print_json(out, &report);
+            max_distance_to_limit_relative: distance.map(|d| d / self.diagonal),
+            bbox_diagonal: self.diagonal,
+            seconds,
+            warnings: self.warnings.to_vec(),
+        }
     }
-    Ok(())
 }
 
 /// Conformity, smallest angle and largest sampled distance to the limit (`None` where the
