@@ -17,11 +17,7 @@ fn shapes() -> Vec<SurfaceShape> {
 }
 
 fn diagonal(p: &[DVec3]) -> f64 {
-    let (lo, hi) = p.iter().fold(
-        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-        |(a, b), &q| (a.min(q), b.max(q)),
-    );
-    (hi - lo).length().max(1e-300)
+    subd_pia::bbox_diagonal(p).max(1e-300)
 }
 
 /// Every vertex of every level equals uniform refinement's, and the mesh is conforming.

@@ -158,16 +158,22 @@ pub fn run(repeats: usize) -> Result<(), String> {
 
 /// The bunny scan, fetched first when it is not there yet.
 pub(crate) fn scan_mesh() -> Result<subd_mesh::Mesh, String> {
-    let path = bunny_path();
-    if !path.exists() {
-        fetch_bunny(&path)?;
-    }
+    let path = bunny()?;
     let opts = subd_io::ReadOptions {
         accept_inconsistent_orientation: true,
     };
     Ok(subd_io::read_mesh(&path, &opts)
         .map_err(|e| e.to_string())?
         .mesh)
+}
+
+/// The bunny scan's path, fetched first when it is not there yet.
+fn bunny() -> Result<PathBuf, String> {
+    let path = bunny_path();
+    if !path.exists() {
+        fetch_bunny(&path)?;
+    }
+    Ok(path)
 }
 
 /// Where the bunny scan lives once fetched.
@@ -232,13 +238,13 @@ fn median_on_fresh(
 /// Loop PIA on the bunny scan, end to end: read, limit stencils, solve, independent check,
 /// write.
 fn scan() -> Result<(), String> {
-    let path = bunny_path();
-    if !path.exists()
-        && let Err(e) = fetch_bunny(&path)
-    {
-        println!("(scan benchmark skipped: {e})");
-        return Ok(());
-    }
+    let path = match bunny() {
+        Ok(p) => p,
+        Err(e) => {
+            println!("(scan benchmark skipped: {e})");
+            return Ok(());
+        }
+    };
     let t0 = Instant::now();
     let file = subd_io::read_mesh(
         &path,

@@ -282,14 +282,11 @@ impl AdaptiveRefinement {
                 });
             }
             out.corner_params.extend_from_slice(params);
-            out.face_offsets.push(out.face_vertices.len() as u32);
-            out.face_levels.push(leaf.level as u8);
-            out.face_uniform.push(lv.face_key[f]);
-            out.holes.push(t.is_hole(f));
-            out.transition.push(false);
-            out.face_domains.push((lv.base_face[f], lv.sub_face[f]));
+            self.close_face(out, leaf, false);
             return;
         }
+        // The closure refines a whole non-quad base face before any of its edges is split.
+        debug_assert_ne!(lv.sub_face[f], WHOLE_FACE);
         let split: Vec<bool> = edge_points.iter().map(|&e| e != NONE).collect();
         let vertex = |p: Point| match p {
             C(i) => corners[i],
@@ -330,32 +327,30 @@ impl AdaptiveRefinement {
                 _ => EdgeOrigin::Diagonal,
             }
         };
-        let polygons = if lv.sub_face[f] == WHOLE_FACE {
-            // A Catmull-Clark base face that is not a quad: never split (the closure refines
-            // it first).
-            vec![(0..n).map(C).collect()]
-        } else {
-            let pos = |p: Point| out.positions[vertex(p) as usize];
-            pattern(self.scheme, n, &split, &pos)
-        };
-        let transition = polygons.len() > 1;
+        let pos = |p: Point| out.positions[vertex(p) as usize];
+        let polygons = pattern(self.scheme, n, &split, &pos);
         for poly in polygons {
             let m = poly.len();
             for i in 0..m {
                 out.face_vertices.push(vertex(poly[i]));
                 out.edge_origins.push(origin(poly[i], poly[(i + 1) % m]));
-                out.corner_params.push(if lv.sub_face[f] == WHOLE_FACE {
-                    [f64::NAN; 2]
-                } else {
-                    param(poly[i])
-                });
+                out.corner_params.push(param(poly[i]));
             }
-            out.face_offsets.push(out.face_vertices.len() as u32);
-            out.face_levels.push(leaf.level as u8);
-            out.face_uniform.push(lv.face_key[f]);
-            out.holes.push(t.is_hole(f));
-            out.transition.push(transition);
-            out.face_domains.push((lv.base_face[f], lv.sub_face[f]));
+            self.close_face(out, leaf, true);
         }
+    }
+}
+
+impl AdaptiveRefinement {
+    /// Ends the face just written to `out`: its offset and the per-face arrays of `leaf`.
+    fn close_face(&self, out: &mut AdaptiveMesh, leaf: &Leaf, transition: bool) {
+        let lv = &self.levels[leaf.level];
+        let f = leaf.face;
+        out.face_offsets.push(out.face_vertices.len() as u32);
+        out.face_levels.push(leaf.level as u8);
+        out.face_uniform.push(lv.face_key[f]);
+        out.holes.push(lv.topology.is_hole(f));
+        out.transition.push(transition);
+        out.face_domains.push((lv.base_face[f], lv.sub_face[f]));
     }
 }

@@ -215,18 +215,9 @@ impl FaceSelection {
     /// # Errors
     /// [`AdaptiveError::SelectionIndex`] for an index out of range.
     pub fn from_faces(num_faces: usize, faces: &[u64]) -> Result<Self, AdaptiveError> {
-        let mut base_faces = vec![false; num_faces];
-        for &f in faces {
-            if f >= num_faces as u64 {
-                return Err(AdaptiveError::SelectionIndex {
-                    what: "face",
-                    index: f,
-                    count: num_faces,
-                });
-            }
-            base_faces[f as usize] = true;
-        }
-        Ok(FaceSelection { base_faces })
+        Ok(FaceSelection {
+            base_faces: marks(num_faces, faces, "face")?,
+        })
     }
 
     /// The base faces with two or more of the chosen `vertices` (seed 002 §2.1: "any
@@ -235,18 +226,7 @@ impl FaceSelection {
     /// # Errors
     /// [`AdaptiveError::SelectionIndex`] for an index out of range.
     pub fn from_vertices(base: &Topology, vertices: &[u64]) -> Result<Self, AdaptiveError> {
-        let nv = base.num_vertices();
-        let mut chosen = vec![false; nv];
-        for &v in vertices {
-            if v >= nv as u64 {
-                return Err(AdaptiveError::SelectionIndex {
-                    what: "vertex",
-                    index: v,
-                    count: nv,
-                });
-            }
-            chosen[v as usize] = true;
-        }
+        let chosen = marks(base.num_vertices(), vertices, "vertex")?;
         let base_faces = (0..base.num_faces())
             .map(|f| {
                 base.face_vertices(f)
@@ -263,6 +243,22 @@ impl FaceSelection {
     pub fn num_selected(&self) -> usize {
         self.base_faces.iter().filter(|&&b| b).count()
     }
+}
+
+/// A flag per element of `count`, set for each of `indices`.
+fn marks(count: usize, indices: &[u64], what: &'static str) -> Result<Vec<bool>, AdaptiveError> {
+    let mut m = vec![false; count];
+    for &i in indices {
+        if i >= count as u64 {
+            return Err(AdaptiveError::SelectionIndex {
+                what,
+                index: i,
+                count,
+            });
+        }
+        m[i as usize] = true;
+    }
+    Ok(m)
 }
 
 impl Criterion for FaceSelection {
@@ -551,21 +547,22 @@ impl LimitSurface {
     }
 }
 
-/// Sample weights over a face's corners: corners, edge midpoints and centre.
+/// Sample weights over a face's `n` (3 or 4) corners: corners, edge midpoints and centre,
+/// without allocating (it runs for every face of every level).
 fn sample_weights(n: usize) -> impl Iterator<Item = ([f64; 4], usize)> {
     let k = n.min(4);
-    let mut out = Vec::with_capacity(2 * k + 1);
-    for i in 0..k {
+    (0..2 * k + 1).map(move |s| {
         let mut w = [0.0; 4];
-        w[i] = 1.0;
-        out.push((w, k));
-        let mut m = [0.0; 4];
-        m[i] = 0.5;
-        m[(i + 1) % k] = 0.5;
-        out.push((m, k));
-    }
-    out.push(([1.0 / k as f64; 4], k));
-    out.into_iter()
+        match s {
+            s if s == 2 * k => w[..k].fill(1.0 / k as f64),
+            s if s % 2 == 0 => w[s / 2] = 1.0,
+            s => {
+                w[s / 2] = 0.5;
+                w[(s / 2 + 1) % k] = 0.5;
+            }
+        }
+        (w, k)
+    })
 }
 
 /// Distance to the exact limit surface: a face is refined while its largest sampled distance

@@ -252,15 +252,6 @@ pub(crate) fn run(
     };
     let options = args.rules.options(&mesh.hints);
     let input_err = |e: AdaptiveError| bad(format!("{}: {e}", args.input.display()));
-    if scheme == Scheme::Loop
-        && let Some(f) = (0..base.num_faces()).find(|&f| base.face_size(f) != 3)
-    {
-        return Err(bad(format!(
-            "{}: face {f} has {} vertices; the Loop scheme needs triangles",
-            args.input.display(),
-            base.face_size(f)
-        )));
-    }
     let diagonal = mesh
         .bounding_box()
         .map_or(0.0, |(lo, hi)| (hi - lo).length());
