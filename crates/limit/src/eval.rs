@@ -61,7 +61,7 @@ pub struct FaceParam {
 
 /// How one face (of the base level or of level 2) is evaluated.
 #[derive(Clone, Debug)]
-enum Piece {
+pub(crate) enum Piece {
     /// Bicubic B-spline over 16 control points (grid order).
     Regular([u32; 16]),
     /// Bicubic B-spline over 16 control points some of which are phantom points reflected
@@ -209,13 +209,13 @@ fn piece_kind(
 /// ```
 #[derive(Debug)]
 pub struct LimitEvaluator {
-    scheme: Scheme,
-    options: Options,
-    base: Topology,
-    base_pieces: Vec<Piece>,
+    pub(crate) scheme: Scheme,
+    pub(crate) options: Options,
+    pub(crate) base: Topology,
+    pub(crate) base_pieces: Vec<Piece>,
     /// Two levels of refinement, when some base face needs them.
-    refined: Option<Refinement>,
-    level2_pieces: Vec<Piece>,
+    pub(crate) refined: Option<Refinement>,
+    pub(crate) level2_pieces: Vec<Piece>,
 }
 
 /// Control points of every level the evaluator reads, for one set of base positions, with
@@ -229,7 +229,7 @@ pub struct PatchPoints {
 }
 
 /// Projected control points of every corner piece.
-fn project_all(pieces: &[Piece], pts: &[DVec3]) -> Vec<Option<Projected>> {
+pub(crate) fn project_all(pieces: &[Piece], pts: &[DVec3]) -> Vec<Option<Projected>> {
     pieces
         .iter()
         .map(|p| match p {
@@ -373,24 +373,7 @@ impl LimitEvaluator {
         match &self.base_pieces[at.face] {
             Piece::Refined => {
                 let r = self.refined.as_ref().expect("refined when a face needs it");
-                let off = self.base.face_offsets()[at.face] as usize;
-                let (f2, s2, t2, scale) = if self.scheme == Scheme::Loop {
-                    // Four children per triangle at each level.
-                    let (j, s, t, k1) = tri_child(at.u, at.v.min(1.0 - at.u));
-                    let (k, s2, t2, k2) = tri_child(s, t.min(1.0 - s));
-                    (4 * (4 * at.face + j) + k, s2, t2, k1 * k2)
-                } else {
-                    // Level 1: a quad's child by quadrant, or a non-quad's sub-face; level 2:
-                    // every level-1 face is a quad with 4 consecutive children.
-                    let (c1, s, t, scale1) = if self.base.face_size(at.face) == 4 {
-                        let (j, s, t) = quadrant(at.u, at.v);
-                        (off + j, s, t, 2.0)
-                    } else {
-                        (off + at.sub, at.u, at.v, 1.0)
-                    };
-                    let (k, s2, t2) = quadrant(s, t);
-                    (4 * c1 + k, s2, t2, 2.0 * scale1)
-                };
+                let (f2, s2, t2, scale) = self.level2_location(&at);
                 debug_assert!(f2 < r.topology(2).num_faces());
                 if let Piece::Local = self.level2_pieces[f2] {
                     let p = crate::local::evaluate(
@@ -431,6 +414,28 @@ impl LimitEvaluator {
                 at.u,
                 at.v,
             ),
+        }
+    }
+    /// The level-2 face holding `at` of a base face that is refined, its parameters there,
+    /// and the scale of the map from the base (sub-)face's parameters to the level-2 face's.
+    pub(crate) fn level2_location(&self, at: &FaceParam) -> (usize, f64, f64, f64) {
+        let off = self.base.face_offsets()[at.face] as usize;
+        if self.scheme == Scheme::Loop {
+            // Four children per triangle at each level.
+            let (j, s, t, k1) = tri_child(at.u, at.v.min(1.0 - at.u));
+            let (k, s2, t2, k2) = tri_child(s, t.min(1.0 - s));
+            (4 * (4 * at.face + j) + k, s2, t2, k1 * k2)
+        } else {
+            // Level 1: a quad's child by quadrant, or a non-quad's sub-face; level 2: every
+            // level-1 face is a quad with 4 consecutive children.
+            let (c1, s, t, scale1) = if self.base.face_size(at.face) == 4 {
+                let (j, s, t) = quadrant(at.u, at.v);
+                (off + j, s, t, 2.0)
+            } else {
+                (off + at.sub, at.u, at.v, 1.0)
+            };
+            let (k, s2, t2) = quadrant(s, t);
+            (4 * c1 + k, s2, t2, 2.0 * scale1)
         }
     }
 }
@@ -512,6 +517,20 @@ pub(crate) fn direct_evaluation(
     eval_piece(&piece, pts, projected.as_ref(), f, s, tp).map(Some)
 }
 
+/// Whether face `f` of `t` is a patch [`direct_evaluation`] evaluates (not one that needs
+/// refining).
+pub(crate) fn is_direct(
+    t: &Topology,
+    rules: &[subd_schemes::Rule],
+    f: usize,
+    scheme: Scheme,
+) -> Result<bool, LimitError> {
+    Ok(!matches!(
+        piece_of(t, rules, f, scheme)?,
+        Piece::Refined | Piece::Local
+    ))
+}
+
 /// A grid point's position: a vertex or a phantom combination.
 fn combine(g: &GridPoint, pts: &[DVec3]) -> DVec3 {
     g.iter()
@@ -519,7 +538,7 @@ fn combine(g: &GridPoint, pts: &[DVec3]) -> DVec3 {
 }
 
 /// Evaluates one piece at (s, t) in its face's parameters.
-fn eval_piece(
+pub(crate) fn eval_piece(
     piece: &Piece,
     pts: &[DVec3],
     projected: Option<&Projected>,

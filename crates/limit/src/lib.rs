@@ -47,6 +47,7 @@ pub mod local;
 pub mod loop_patch;
 pub mod masks;
 pub mod patch;
+pub mod point_stencil;
 mod smooth_closed;
 pub mod stam;
 mod table;
@@ -58,6 +59,7 @@ use subd_schemes::{Options, RefineError, Refinement, Scheme, StencilTable, TwoPh
 use thiserror::Error;
 
 pub use masks::{LimitMask, RingMask};
+pub use point_stencil::{FacePatch, PatchForm, PointStencil};
 pub use table::{LimitPoints, LimitStencilTable, eigen_limit_vertices};
 
 /// What can go wrong computing limits.

@@ -31,15 +31,75 @@ use crate::patch::SurfacePoint;
 /// that to an irregular vertex, but not exactly at it, get there.
 pub const MAX_LOCAL_LEVELS: usize = 60;
 
-/// A piece of a refined level around one face.
-pub(crate) struct Neighbourhood {
+/// A piece of a refined level around one face, with what is carried along for its
+/// vertices (positions, or the weights of the first piece's vertices).
+pub(crate) struct Neighbourhood<P = Vec<DVec3>> {
     topology: Topology,
     rules: Vec<Rule>,
-    points: Vec<DVec3>,
+    points: P,
     face: usize,
 }
 
-impl Neighbourhood {
+/// What the local descent carries for the vertices of each piece: positions, or weights
+/// over the vertices of the first piece ([`Weights`]).
+pub(crate) trait Carried: Sized {
+    /// The values of vertices `ids` (in that order).
+    fn pick(&self, ids: &[u32]) -> Self;
+    /// The values of the vertices of level 1 of `r` from those of its level 0.
+    fn refined(&self, r: &Refinement) -> Self;
+}
+
+impl Carried for Vec<DVec3> {
+    fn pick(&self, ids: &[u32]) -> Self {
+        ids.iter().map(|&v| self[v as usize]).collect()
+    }
+    fn refined(&self, r: &Refinement) -> Self {
+        r.refine_points(self).pop().expect("one level")
+    }
+}
+
+/// Per vertex, its weights over `width` source vertices (row-major).
+pub(crate) struct Weights {
+    width: usize,
+    rows: Vec<f64>,
+}
+
+impl Carried for Weights {
+    fn pick(&self, ids: &[u32]) -> Self {
+        let w = self.width;
+        let mut rows = Vec::with_capacity(ids.len() * w);
+        for &v in ids {
+            rows.extend_from_slice(&self.rows[v as usize * w..(v as usize + 1) * w]);
+        }
+        Weights { width: w, rows }
+    }
+    fn refined(&self, r: &Refinement) -> Self {
+        let table = r.stencils(1);
+        let mut rows = vec![0.0; table.num_rows() * self.width];
+        table.apply(&self.rows, self.width, &mut rows);
+        Weights {
+            width: self.width,
+            rows,
+        }
+    }
+}
+
+impl Weights {
+    /// Positions whose coordinates are the weights of sources `first..first + 3` (zero past
+    /// the last source): evaluating with them gives those sources' weights.
+    fn columns(&self, first: usize) -> Vec<DVec3> {
+        let w = self.width;
+        self.rows
+            .chunks_exact(w)
+            .map(|row| {
+                let at = |k: usize| if first + k < w { row[first + k] } else { 0.0 };
+                DVec3::new(at(0), at(1), at(2))
+            })
+            .collect()
+    }
+}
+
+impl<P> Neighbourhood<P> {
     /// One uniform step of the piece, continuing the refinement it was cut from.
     fn refine(
         &self,
@@ -59,12 +119,12 @@ impl Neighbourhood {
 
 /// Faces within two vertex-rings of face `f` of a prepared level `t` (f first) as a
 /// [`Neighbourhood`] with the positions `points`.
-fn cut_out(
+fn cut_out<P>(
     t: &Topology,
     rules: &[Rule],
-    points: &[DVec3],
+    pick: impl FnOnce(&[u32]) -> P,
     f: usize,
-) -> Result<Neighbourhood, LimitError> {
+) -> Result<Neighbourhood<P>, LimitError> {
     let mut faces = vec![f as u32];
     let mut frontier = 0..1;
     for _ in 0..2 {
@@ -85,7 +145,7 @@ fn cut_out(
         e => e,
     })?;
     Ok(Neighbourhood {
-        points: cut.vertices.iter().map(|&v| points[v as usize]).collect(),
+        points: pick(&cut.vertices),
         topology: cut.topology,
         rules: cut.rules,
         face: 0,
@@ -231,8 +291,9 @@ fn nearest_corner(scheme: Scheme, u: f64, v: f64) -> usize {
 /// The limit at corner `c` of the neighbourhood's face: position and the limit tangents
 /// (their directions exact, their scale the masks' convention; at an interior crease vertex
 /// those of the face's side of the crease), second derivatives zero.
-fn corner_limit(
-    nb: &Neighbourhood,
+fn corner_limit<P>(
+    nb: &Neighbourhood<P>,
+    base_points: &[DVec3],
     scheme: Scheme,
     options: &Options,
     c: usize,
@@ -242,7 +303,7 @@ fn corner_limit(
     let levels = crate::levels_for_exact_limit(&nb.topology, scheme).0;
     let r = nb.refine(scheme, options, levels)?;
     let table = crate::LimitStencilTable::at_level(&r, levels)?;
-    let points = r.refine_points(&nb.points).pop().expect("the last level");
+    let points = r.refine_points(base_points).pop().expect("the last level");
     let row = |t: &subd_schemes::StencilTable| {
         let (idx, w) = t.row(v);
         idx.iter()
@@ -304,55 +365,189 @@ pub(crate) fn evaluate(
     u: f64,
     v: f64,
 ) -> Result<SurfacePoint, LimitError> {
-    // The pieces are a few dozen faces: the refinement's parallel loops would spend far more
-    // waking the global pool's threads than computing. One single-thread pool per calling
-    // thread runs them inline.
+    inline(|| {
+        let pick = |ids: &[u32]| ids.iter().map(|&v| points[v as usize]).collect::<Vec<_>>();
+        let start = cut_out(t, rules, pick, f)?;
+        match descend(start, scheme, options, u, v)? {
+            Ending::Patch { nb, u, v, scale } => crate::eval::direct_evaluation(
+                &nb.topology,
+                &nb.rules,
+                &nb.points,
+                nb.face,
+                scheme,
+                u,
+                v,
+            )?
+            .map(|p| p.scaled(scale))
+            .ok_or(LimitError::Unsupported {
+                face: f,
+                reason: "local refinement ended off a patch",
+            }),
+            Ending::Corner {
+                nb,
+                corner,
+                options,
+            } => corner_limit(&nb, &nb.points, scheme, &options, corner),
+        }
+    })
+}
+
+/// [`evaluate`] as weights: the limit at (u, v) of face `f` of `t` as (vertex of `t`,
+/// weights of position, ∂u, ∂v, ∂uu, ∂uv, ∂vv) pairs, from one descent that carries each
+/// vertex's weights over the first piece's vertices.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn stencil(
+    t: &Topology,
+    rules: &[Rule],
+    f: usize,
+    scheme: Scheme,
+    options: &Options,
+    u: f64,
+    v: f64,
+) -> Result<Vec<(u32, [f64; 6])>, LimitError> {
+    inline(|| {
+        let mut sources = Vec::new();
+        let pick = |ids: &[u32]| {
+            sources = ids.to_vec();
+            let width = ids.len();
+            let mut rows = vec![0.0; width * width];
+            for i in 0..width {
+                rows[i * width + i] = 1.0;
+            }
+            Weights { width, rows }
+        };
+        let start = cut_out(t, rules, pick, f)?;
+        let ending = descend(start, scheme, options, u, v)?;
+        let mut out = Vec::with_capacity(sources.len());
+        for first in (0..sources.len()).step_by(3) {
+            let p = match &ending {
+                Ending::Patch { nb, u, v, scale } => {
+                    let cols = nb.points.columns(first);
+                    crate::eval::direct_evaluation(
+                        &nb.topology,
+                        &nb.rules,
+                        &cols,
+                        nb.face,
+                        scheme,
+                        *u,
+                        *v,
+                    )?
+                    .map(|p| p.scaled(*scale))
+                    .ok_or(LimitError::Unsupported {
+                        face: f,
+                        reason: "local refinement ended off a patch",
+                    })?
+                }
+                Ending::Corner {
+                    nb,
+                    corner,
+                    options,
+                } => corner_limit(nb, &nb.points.columns(first), scheme, options, *corner)?,
+            };
+            for (k, &src) in sources[first..].iter().take(3).enumerate() {
+                out.push((
+                    src,
+                    [
+                        p.position[k],
+                        p.du[k],
+                        p.dv[k],
+                        p.duu[k],
+                        p.duv[k],
+                        p.dvv[k],
+                    ],
+                ));
+            }
+        }
+        Ok(out)
+    })
+}
+
+/// Where the local descent stops: on a known patch (with the point's parameters there and
+/// the scale of the parameter map), or at a corner of the face whose limit is taken.
+enum Ending<P> {
+    Patch {
+        nb: Neighbourhood<P>,
+        u: f64,
+        v: f64,
+        scale: f64,
+    },
+    Corner {
+        nb: Neighbourhood<P>,
+        corner: usize,
+        options: Options,
+    },
+}
+
+/// Refines `nb` one level at a time, following (u, v) into the child face that holds it,
+/// until that child is a known patch or the point is at (or, after
+/// [`MAX_LOCAL_LEVELS`], indistinguishable from) a corner.
+fn descend<P: Carried>(
+    mut nb: Neighbourhood<P>,
+    scheme: Scheme,
+    options: &Options,
+    u: f64,
+    v: f64,
+) -> Result<Ending<P>, LimitError> {
+    // Boundary edges are already infinitely sharp and holes already tagged; the cut's
+    // artificial boundary must not turn faces into holes.
+    let options = Options {
+        boundary_interpolation: BoundaryInterpolation::EdgeOnly,
+        ..*options
+    };
+    let (mut u, mut v, mut scale) = (u, v, 1.0);
+    for depth in 0..MAX_LOCAL_LEVELS {
+        let r = nb.refine(scheme, &options, 1)?;
+        let (t0, rules0) = (r.topology(0), r.vertex_rules(0));
+        if crate::eval::is_direct(t0, rules0, nb.face, scheme)? {
+            return Ok(Ending::Patch { nb, u, v, scale });
+        }
+        // At a corner: once the other corners are refined away (two levels) and nothing
+        // semi-sharp is left, the corner vertex is what keeps the face irregular for ever.
+        if let Some(corner) = exact_corner(scheme, u, v)
+            && depth >= 2
+            && crate::levels_for_exact_limit(&nb.topology, scheme).0 == 0
+        {
+            return Ok(Ending::Corner {
+                nb,
+                corner,
+                options,
+            });
+        }
+        let child_points = nb.points.refined(&r);
+        let (child, s, tt, k) = child_at(t0, scheme, nb.face, u, v);
+        nb = cut_out(
+            r.topology(1),
+            r.vertex_rules(1),
+            |ids| child_points.pick(ids),
+            child,
+        )?;
+        (u, v, scale) = (s, tt, scale * k);
+    }
+    let corner = nearest_corner(scheme, u, v);
+    Ok(Ending::Corner {
+        nb,
+        corner,
+        options,
+    })
+}
+
+/// Runs `work` inline: the pieces are a few dozen faces, and the refinement's parallel loops
+/// would spend far more waking the global pool's threads than computing. One single-thread
+/// pool per calling thread runs them.
+fn inline<R: Send>(work: impl FnOnce() -> R + Send) -> R {
     thread_local! {
         static INLINE: Option<rayon::ThreadPool> =
             rayon::ThreadPoolBuilder::new().num_threads(1).build().ok();
     }
-    let descend = || -> Result<SurfacePoint, LimitError> {
-        // Boundary edges are already infinitely sharp and holes already tagged; the cut's
-        // artificial boundary must not turn faces into holes.
-        let options = Options {
-            boundary_interpolation: BoundaryInterpolation::EdgeOnly,
-            ..*options
-        };
-        let mut nb = cut_out(t, rules, points, f)?;
-        let (mut u, mut v, mut scale) = (u, v, 1.0);
-        for depth in 0..MAX_LOCAL_LEVELS {
-            let r = nb.refine(scheme, &options, 1)?;
-            let (t0, rules0) = (r.topology(0), r.vertex_rules(0));
-            if let Some(p) =
-                crate::eval::direct_evaluation(t0, rules0, &nb.points, nb.face, scheme, u, v)?
-            {
-                return Ok(p.scaled(scale));
-            }
-            // At a corner: once the other corners are refined away (two levels) and nothing
-            // semi-sharp is left, the corner vertex is what keeps the face irregular for ever.
-            if let Some(c) = exact_corner(scheme, u, v)
-                && depth >= 2
-                && crate::levels_for_exact_limit(&nb.topology, scheme).0 == 0
-            {
-                return corner_limit(&nb, scheme, &options, c);
-            }
-            let child_points = r.refine_points(&nb.points).pop().expect("one level");
-            let (child, s, tt, k) = child_at(t0, scheme, nb.face, u, v);
-            nb = cut_out(r.topology(1), r.vertex_rules(1), &child_points, child)?;
-            (u, v, scale) = (s, tt, scale * k);
-        }
-        let c = nearest_corner(scheme, u, v);
-        corner_limit(&nb, scheme, &options, c)
-    };
     // Inside a pool's worker (a caller evaluating in parallel) the work runs where it is:
     // installing into another pool would let the blocked worker steal its own pool's next
     // evaluation meanwhile, nesting evaluations on one stack until it overflows.
     if rayon::current_thread_index().is_some() {
-        return descend();
+        return work();
     }
     INLINE.with(|pool| match pool {
-        Some(pool) => pool.install(descend),
-        None => descend(),
+        Some(pool) => pool.install(work),
+        None => work(),
     })
 }
 
