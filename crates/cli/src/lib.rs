@@ -16,6 +16,7 @@
 mod adaptive;
 mod analyze;
 mod curve;
+mod edit;
 mod eval;
 mod failure;
 mod info;
@@ -70,6 +71,13 @@ enum Command {
     /// Progressive iterative interpolation: a control mesh with IN's topology whose limit
     /// surface passes through IN's vertices (all, or those chosen with --moving/--fixed).
     Pia(pia::PiaArgs),
+    /// Constraint-based editing of the limit surface (points, normals, iso-lines): the
+    /// control vertices that meet the constraints with the least change or the least
+    /// thin-plate energy.
+    Edit(edit::EditArgs),
+    /// Simple constrained deformation: points move by radial blends around constraint
+    /// points, each constraint point exactly by its displacement (any mesh level).
+    Deform(edit::DeformArgs),
     /// Subdivision curves (linear and circle-average schemes) from a text point list, to
     /// text or SVG.
     Curve(curve::CurveArgs),
@@ -130,6 +138,8 @@ where
         Command::Eval(a) => eval::run(&a, out, err),
         Command::Pia(a) => pia::run(&a, out, err),
         Command::Adaptive(a) => adaptive::run(&a, out, err),
+        Command::Edit(a) => edit::run(&a, out, err),
+        Command::Deform(a) => edit::run_deform(&a, out, err),
         Command::Curve(a) => curve::run(&a, out, err),
         Command::Analyze(a) => analyze::run(&a, out),
     };

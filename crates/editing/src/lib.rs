@@ -45,11 +45,13 @@
 //!
 //! [`LimitEvaluator::stencil`]: subd_limit::eval::LimitEvaluator::stencil
 
+pub mod check;
 pub mod constraint;
 pub mod deform;
 pub mod energy;
 pub mod isoline;
 pub mod solve;
+pub mod spec;
 
 pub use constraint::{Constraint, ConstraintRows, Coupling, Goal, Location, Row};
 pub use deform::{DeformConstraint, Deformation};

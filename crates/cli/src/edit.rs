@@ -1,0 +1,381 @@
+//! `subd edit`: move the limit surface to meet constraints (seed 003), and `subd deform`:
+//! simple constrained deformation of a mesh at any level (seed 002 §3).
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use clap::{Args, ValueEnum};
+use serde::Serialize;
+use subd_editing::energy::{EnergyMatrix, EnergyOptions};
+use subd_editing::{Constraint, Deformation, Editor, Method};
+use subd_mesh::{DVec3, Mesh};
+use subd_schemes::Scheme;
+
+use crate::failure::{bad, refuse_overwrite};
+use crate::limit::LimitSchemeArg;
+use crate::rule_args::RuleArgs;
+use crate::{Failure, print_warnings};
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub(crate) enum EditMethodArg {
+    /// The smallest change of the control vertices the constraints involve (A⁺ r).
+    LeastSquares,
+    /// The smallest thin-plate (+ membrane) energy of the change over a region.
+    Energy,
+}
+
+#[derive(Debug, Args)]
+pub(crate) struct EditArgs {
+    /// Constraint file (JSON; see the README for the schema).
+    #[arg(long, value_name = "FILE")]
+    constraints: PathBuf,
+    /// How the control vertices change.
+    #[arg(long, value_enum, default_value = "least-squares")]
+    method: EditMethodArg,
+    /// Scheme of the limit surface (the energy method needs catmull-clark).
+    #[arg(long, value_enum, default_value = "catmull-clark")]
+    scheme: LimitSchemeArg,
+    /// Energy method: the seed's penalty form with this weight (relative to
+    /// mean diag Q / mean diag AᵀA) instead of the exact solve.
+    #[arg(long, conflicts_with = "exact")]
+    penalty: Option<f64>,
+    /// Energy method: the exact equality-constrained solve (the default).
+    #[arg(long)]
+    exact: bool,
+    /// Energy method: weight of the membrane term ∬ S_u² + S_v².
+    #[arg(long, default_value_t = 0.0)]
+    membrane: f64,
+    /// Energy method: only vertices within K rings of the constraints move (default 3;
+    /// `all`: every vertex, so that one point constraint translates the whole surface).
+    #[arg(long, value_name = "K", default_value = "3")]
+    region_rings: String,
+    #[command(flatten)]
+    rules: RuleArgs,
+    /// Input mesh (.obj or .ply).
+    input: PathBuf,
+    /// Output mesh (.obj, .ply or .glb): IN's topology and tags, the edited control vertices.
+    output: PathBuf,
+    /// Print a JSON report on stdout.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Serialize)]
+struct ConstraintReport {
+    constraint: usize,
+    kind: &'static str,
+    /// Measured on OUT with a fresh limit evaluator: distance (points, iso-lines, model
+    /// units) or the sine of the angle to the target normal.
+    residual: f64,
+}
+
+#[derive(Serialize)]
+struct EditSeconds {
+    read: f64,
+    constraints: f64,
+    assemble: f64,
+    factor: f64,
+    solve: f64,
+    check: f64,
+    write: f64,
+    total: f64,
+}
+
+#[derive(Serialize)]
+struct EditReport {
+    input: String,
+    output: String,
+    scheme: Scheme,
+    method: &'static str,
+    vertices: usize,
+    constraints: usize,
+    rows: usize,
+    rank: usize,
+    /// Whether the constraints were dependent or conflicting (least-squares solution).
+    rank_deficient: bool,
+    /// Vertices allowed to move (the constraints' support, or the energy's region).
+    free_vertices: usize,
+    moved_vertices: Vec<u32>,
+    residuals: Vec<ConstraintReport>,
+    /// The largest point residual over the bounding-box diagonal.
+    max_residual_relative: f64,
+    /// Thin-plate energy of the limit surface over the faces the edit can change, before and
+    /// after (Catmull-Clark), and of the displacement.
+    energy_before: Option<f64>,
+    energy_after: Option<f64>,
+    displacement_energy: Option<f64>,
+    seconds: EditSeconds,
+}
+
+fn kind(c: &Constraint) -> &'static str {
+    match c {
+        Constraint::Point { .. } => "point",
+        Constraint::Normal { .. } => "normal",
+        Constraint::Isoline { .. } => "isoline",
+    }
+}
+
+fn read_text(path: &Path) -> Result<String, Failure> {
+    std::fs::read_to_string(path).map_err(|e| bad(format!("{}: cannot read: {e}", path.display())))
+}
+
+fn region_rings(text: &str) -> Result<Option<usize>, Failure> {
+    if text == "all" {
+        return Ok(None);
+    }
+    text.parse::<usize>().map(Some).map_err(|_| {
+        bad(format!(
+            "--region-rings {text:?}: expected a number of rings or `all`"
+        ))
+    })
+}
+
+fn check_output_format(output: &Path) -> Result<(), Failure> {
+    if subd_io::Format::from_path(output).is_none() {
+        return Err(bad(format!(
+            "{}: unsupported output extension (expected .obj, .ply or .glb)",
+            output.display()
+        )));
+    }
+    Ok(())
+}
+
+/// The method the arguments ask for.
+fn method(args: &EditArgs) -> Result<Method, Failure> {
+    let energy_only = args.penalty.is_some() || args.exact || args.membrane != 0.0;
+    match args.method {
+        EditMethodArg::LeastSquares => {
+            if energy_only {
+                return Err(bad(
+                    "--penalty, --exact and --membrane apply to --method energy only".into(),
+                ));
+            }
+            Ok(Method::LeastSquares)
+        }
+        EditMethodArg::Energy => {
+            if let Some(p) = args.penalty
+                && (p.is_nan() || p <= 0.0)
+            {
+                return Err(bad(format!("--penalty {p}: must be a positive number")));
+            }
+            if !(args.membrane >= 0.0 && args.membrane.is_finite()) {
+                return Err(bad(format!(
+                    "--membrane {}: must be a non-negative number",
+                    args.membrane
+                )));
+            }
+            Ok(Method::Energy {
+                penalty: args.penalty,
+                region_rings: region_rings(&args.region_rings)?,
+                energy: EnergyOptions {
+                    membrane: args.membrane,
+                    ..EnergyOptions::default()
+                },
+            })
+        }
+    }
+}
+
+pub(crate) fn run(
+    args: &EditArgs,
+    out: &mut dyn Write,
+    err: &mut dyn Write,
+) -> Result<(), Failure> {
+    let t_start = Instant::now();
+    refuse_overwrite(&args.input, &args.output)?;
+    check_output_format(&args.output)?;
+    let method = method(args)?;
+    let constraints = subd_editing::spec::parse_constraints(&read_text(&args.constraints)?)
+        .map_err(|e| bad(format!("{}: {e}", args.constraints.display())))?;
+    if constraints.is_empty() {
+        return Err(bad(format!(
+            "{}: no constraints",
+            args.constraints.display()
+        )));
+    }
+    let file = subd_io::read_mesh(&args.input, &args.rules.read_options())?;
+    print_warnings(err, &args.input, &file.warnings);
+    let t_read = t_start.elapsed().as_secs_f64();
+    let scheme = args.scheme.scheme();
+    let options = args.rules.options(&file.mesh.hints);
+    let topo = &file.mesh.topology;
+    let x0 = &file.mesh.positions;
+    let named = |e: subd_editing::EditError| match e {
+        subd_editing::EditError::Constraint { .. } => {
+            bad(format!("{}: {e}", args.constraints.display()))
+        }
+        e => bad(format!("{}: {e}", args.input.display())),
+    };
+    let mut editor =
+        Editor::new(topo, x0, scheme, &options, &constraints, method).map_err(named)?;
+    let edit = editor.solve_timed(&constraints).map_err(named)?;
+
+    // Residuals measured afresh: a new evaluator on the output positions.
+    let t_check = Instant::now();
+    let ev = subd_limit::eval::LimitEvaluator::new(topo, scheme, &options)
+        .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
+    let res = subd_editing::check::residuals(&ev, topo, scheme, &constraints, x0, &edit.positions)
+        .map_err(named)?;
+    let diag = subd_pia::bbox_diagonal(x0).max(f64::MIN_POSITIVE);
+    let max_rel = constraints
+        .iter()
+        .zip(&res)
+        .filter(|(c, _)| !matches!(c, Constraint::Normal { .. }))
+        .map(|(_, r)| r / diag)
+        .fold(0.0, f64::max);
+    let (before, after, disp) = if scheme == Scheme::CatmullClark {
+        let q = match editor.energy.take() {
+            Some(q) => q,
+            None => {
+                let free = subd_editing::solve::region(topo, editor.free_vertices(), Some(0));
+                let faces = faces_of(topo, &free);
+                EnergyMatrix::new(&ev, topo.num_vertices(), &faces, &EnergyOptions::default())
+                    .map_err(named)?
+            }
+        };
+        let d: Vec<DVec3> = edit
+            .positions
+            .iter()
+            .zip(x0)
+            .map(|(a, b)| *a - *b)
+            .collect();
+        (
+            Some(q.energy(x0)),
+            Some(q.energy(&edit.positions)),
+            Some(q.energy(&d)),
+        )
+    } else {
+        (None, None, None)
+    };
+    let t_check = t_check.elapsed().as_secs_f64();
+
+    let t_write = Instant::now();
+    let mut mesh = Mesh::new(topo.clone(), edit.positions.clone())
+        .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
+    mesh.hints = file.mesh.hints;
+    subd_io::write_mesh(&args.output, &mesh, &subd_io::WriteOptions::default())?;
+    let t_write = t_write.elapsed().as_secs_f64();
+
+    if args.json {
+        let t = editor.timings;
+        let report = EditReport {
+            input: args.input.display().to_string(),
+            output: args.output.display().to_string(),
+            scheme,
+            method: match args.method {
+                EditMethodArg::LeastSquares => "least-squares",
+                EditMethodArg::Energy if args.penalty.is_some() => "energy-penalty",
+                EditMethodArg::Energy => "energy-exact",
+            },
+            vertices: topo.num_vertices(),
+            constraints: constraints.len(),
+            rows: editor.rows().rows.len(),
+            rank: editor.rank,
+            rank_deficient: editor.rank_deficient,
+            free_vertices: editor.free_vertices().len(),
+            moved_vertices: edit.moved.clone(),
+            residuals: constraints
+                .iter()
+                .zip(&res)
+                .enumerate()
+                .map(|(i, (c, &r))| ConstraintReport {
+                    constraint: i,
+                    kind: kind(c),
+                    residual: r,
+                })
+                .collect(),
+            max_residual_relative: max_rel,
+            energy_before: before,
+            energy_after: after,
+            displacement_energy: disp,
+            seconds: EditSeconds {
+                read: t_read,
+                constraints: t.constraints,
+                assemble: t.assemble,
+                factor: t.factor,
+                solve: t.solve,
+                check: t_check,
+                write: t_write,
+                total: t_start.elapsed().as_secs_f64(),
+            },
+        };
+        crate::print_json(out, &report);
+    }
+    Ok(())
+}
+
+fn faces_of(topo: &subd_mesh::Topology, vertices: &[u32]) -> Vec<usize> {
+    let mut f: Vec<usize> = vertices
+        .iter()
+        .flat_map(|&v| topo.vertex_faces(v as usize).iter().map(|&f| f as usize))
+        .collect();
+    f.sort_unstable();
+    f.dedup();
+    f
+}
+
+#[derive(Debug, Args)]
+pub(crate) struct DeformArgs {
+    /// Deformation file (JSON: constraint points with radius and displacement).
+    #[arg(long, value_name = "FILE")]
+    constraints: PathBuf,
+    /// Input mesh (.obj or .ply), at any level (a base mesh, `subd refine` or
+    /// `subd adaptive` output).
+    input: PathBuf,
+    /// Output mesh (.obj, .ply or .glb): the same topology, the moved vertices.
+    output: PathBuf,
+    /// Print a JSON report on stdout.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Serialize)]
+struct DeformReport {
+    input: String,
+    output: String,
+    vertices: usize,
+    constraints: usize,
+    moved: usize,
+    /// max |d(C_i) − D_i| over the constraint points, from the solved deformation.
+    max_constraint_error: f64,
+    seconds: f64,
+}
+
+pub(crate) fn run_deform(
+    args: &DeformArgs,
+    out: &mut dyn Write,
+    err: &mut dyn Write,
+) -> Result<(), Failure> {
+    let t0 = Instant::now();
+    refuse_overwrite(&args.input, &args.output)?;
+    check_output_format(&args.output)?;
+    let cs = subd_editing::spec::parse_deformation(&read_text(&args.constraints)?)
+        .map_err(|e| bad(format!("{}: {e}", args.constraints.display())))?;
+    let d =
+        Deformation::new(&cs).map_err(|e| bad(format!("{}: {e}", args.constraints.display())))?;
+    let file = subd_io::read_mesh(&args.input, &subd_io::ReadOptions::default())?;
+    print_warnings(err, &args.input, &file.warnings);
+    let mut mesh = file.mesh;
+    let moved = d.apply(&mut mesh.positions);
+    let max_err = cs
+        .iter()
+        .map(|c| (d.displacement(c.center) - c.displacement).length())
+        .fold(0.0, f64::max);
+    subd_io::write_mesh(&args.output, &mesh, &subd_io::WriteOptions::default())?;
+    if args.json {
+        crate::print_json(
+            out,
+            &DeformReport {
+                input: args.input.display().to_string(),
+                output: args.output.display().to_string(),
+                vertices: mesh.positions.len(),
+                constraints: cs.len(),
+                moved,
+                max_constraint_error: max_err,
+                seconds: t0.elapsed().as_secs_f64(),
+            },
+        );
+    }
+    Ok(())
+}
