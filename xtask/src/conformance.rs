@@ -188,8 +188,204 @@ pub fn compare(
         rows.push(compare_pia(
             exe, name, topo, positions, scheme, options, diag,
         ));
+        for method in [EditCheck::LeastSquares, EditCheck::Energy] {
+            if method == EditCheck::Energy && scheme != Scheme::CatmullClark {
+                continue;
+            }
+            rows.push(compare_edit(
+                exe, name, topo, positions, scheme, options, diag, method,
+            ));
+        }
     }
     rows
+}
+
+/// Which method an `edit` row checks.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+enum EditCheck {
+    LeastSquares,
+    Energy,
+}
+
+/// Tolerance of the edit check (relative to the bounding-box diagonal; normals: |n · t| / |t|).
+const EDIT_TOLERANCE: f64 = 1e-9;
+
+/// A random edit (seeded by the mesh name): point constraints at the limits of up to four
+/// vertices, displaced by 5 % of the diagonal in varied directions, and (Catmull-Clark) a
+/// normal constraint at a smooth interior vertex; solved by subd-editing, then OpenSubdiv's
+/// `Limit` of the edited control mesh must meet them to 1e-9 of the diagonal (points) and
+/// with both limit tangents perpendicular to the target normal. Vertices where OpenSubdiv's
+/// limit is inexact (darts, interior valence 2, see OPENSUBDIV.md) are not used.
+#[allow(clippy::too_many_arguments)]
+fn compare_edit(
+    exe: &Path,
+    name: &str,
+    topo: &Topology,
+    positions: &[DVec3],
+    scheme: Scheme,
+    options: &Options,
+    diag: f64,
+    method: EditCheck,
+) -> Row {
+    use subd_editing::{Constraint, Editor, Goal, Location, Method};
+    let mut row = Row::pending(
+        name,
+        match method {
+            EditCheck::LeastSquares => "edit",
+            EditCheck::Energy => "edit-e",
+        },
+        0,
+    );
+    let level = subd_limit::levels_for_exact_limit(topo, scheme).0.max(1);
+    if topo.num_face_vertices() << (2 * level) > MAX_LIMIT_FACE_VERTICES {
+        row.error = 0.0;
+        row.note = Some("too deep for OpenSubdiv's limit, not checked".into());
+        return row;
+    }
+    row.level = level;
+    let prepared = match Refinement::new(topo, scheme, options, level) {
+        Ok(r) => r,
+        Err(e) => {
+            row.problem = Some(format!("subd: {e}"));
+            return row;
+        }
+    };
+    let inexact = subd_limit::eigen_limit_vertices(&prepared, level);
+    let (t0, rules0) = (prepared.topology(0), prepared.vertex_rules(0));
+    let nv = topo.num_vertices();
+    let seed = name
+        .bytes()
+        .fold(7u64, |h, b| h.wrapping_mul(31).wrapping_add(b as u64));
+    let usable = |v: usize| {
+        v < nv
+            && !inexact.contains(&v)
+            && topo
+                .vertex_faces(v)
+                .iter()
+                .any(|&f| !topo.is_hole(f as usize))
+    };
+    let mut chosen: Vec<usize> = Vec::new();
+    for k in 0..4u64 {
+        let v = ((seed.wrapping_mul(k + 1) >> 7) % nv as u64) as usize;
+        if usable(v) && !chosen.contains(&v) {
+            chosen.push(v);
+        }
+    }
+    let normal_vertex = (0..nv).map(|k| (k + seed as usize) % nv).find(|&v| {
+        usable(v)
+            && !chosen.contains(&v)
+            && scheme == Scheme::CatmullClark
+            && !t0.is_boundary_vertex(v)
+            && rules0[v] == subd_schemes::Rule::Smooth
+            && t0.vertex_faces(v).len() >= 3
+    });
+    let dirs = [
+        DVec3::new(0.0, 0.0, 1.0),
+        DVec3::new(0.6, 0.8, 0.0),
+        DVec3::new(-0.48, 0.6, 0.64),
+        DVec3::new(0.0, -1.0, 0.0),
+    ];
+    let mut cs: Vec<Constraint> = chosen
+        .iter()
+        .enumerate()
+        .map(|(k, &v)| Constraint::Point {
+            at: Location::Vertex(v),
+            goal: Goal::Displacement(0.05 * diag * dirs[k % 4]),
+        })
+        .collect();
+    let target_normal = DVec3::new(0.3, -0.2, 0.93).normalize();
+    if let Some(v) = normal_vertex {
+        cs.push(Constraint::Normal {
+            at: Location::Vertex(v),
+            normal: target_normal,
+        });
+    }
+    if cs.is_empty() {
+        row.error = 0.0;
+        row.note = Some("no vertex with an exact OpenSubdiv limit, not checked".into());
+        return row;
+    }
+    let m = match method {
+        EditCheck::LeastSquares => Method::LeastSquares,
+        EditCheck::Energy => Method::Energy {
+            penalty: None,
+            region_rings: Some(2),
+            energy: Default::default(),
+        },
+    };
+    let edited = Editor::new(topo, positions, scheme, options, &cs, m)
+        .and_then(|ed| ed.solve(&cs).map(|e| (ed.rank_deficient, e)));
+    let (rank_deficient, edit) = match edited {
+        Ok(e) => e,
+        Err(e) => {
+            row.error = 0.0;
+            row.note = Some(format!("subd-editing: {e}; not checked"));
+            return row;
+        }
+    };
+    let before = match osd::run(
+        exe,
+        &osd::encode(topo, positions, scheme, options, level as u32),
+        &["--limit-positions"],
+    )
+    .and_then(|b| osd::decode_limit(&b))
+    {
+        Ok(l) => l,
+        Err(e) => {
+            row.problem = Some(format!("OpenSubdiv: {e}"));
+            return row;
+        }
+    };
+    let after = match osd::run(
+        exe,
+        &osd::encode(topo, &edit.positions, scheme, options, level as u32),
+        &["--limit-positions"],
+    )
+    .and_then(|b| osd::decode_limit(&b))
+    {
+        Ok(l) => l,
+        Err(e) => {
+            row.problem = Some(format!("OpenSubdiv: {e}"));
+            return row;
+        }
+    };
+    let mut err = 0.0f64;
+    for (k, &v) in chosen.iter().enumerate() {
+        let moved = after.positions[v] - before.positions[v];
+        err = err.max((moved - 0.05 * diag * dirs[k % 4]).length() / diag);
+    }
+    let mut normal_err = None;
+    if let Some(v) = normal_vertex {
+        let (a, b) = (after.tangent1[v], after.tangent2[v]);
+        let e =
+            (target_normal.dot(a).abs() / a.length()).max(target_normal.dot(b).abs() / b.length());
+        normal_err = Some(e);
+    }
+    row.vertices = chosen.len() + usize::from(normal_vertex.is_some());
+    row.error = err;
+    row.normal_error = normal_err;
+    row.note = Some(format!(
+        "{} points{}, {} vertices moved{}",
+        chosen.len(),
+        if normal_vertex.is_some() {
+            " + 1 normal"
+        } else {
+            ""
+        },
+        edit.moved.len(),
+        if rank_deficient {
+            ", rank-deficient: least-squares solution"
+        } else {
+            ""
+        }
+    ));
+    let bad_normal = normal_err.is_some_and(|e| e.is_nan() || e > EDIT_TOLERANCE);
+    if !rank_deficient && (err.is_nan() || err > EDIT_TOLERANCE || bad_normal) {
+        row.problem = Some(format!(
+            "constraints not met by OpenSubdiv's limit (points {err:e}, normal {normal_err:?})"
+        ));
+    }
+    row
 }
 
 /// Adaptive refinement of random selections (two seeds, about 40 % of the faces of every

@@ -31,7 +31,8 @@
 //! * Faces refined by the evaluator (several extraordinary corners, non-quads, sharp
 //!   features) are summed over their level-2 pieces, each scaled by its parameter map.
 //!   Pieces refined further next to irregular sharp features have no closed form here:
-//!   4 × 4 Gauss points on each quarter of the piece, with [`LimitEvaluator::stencil`].
+//!   4 × 4 Gauss points on the piece, with [`LimitEvaluator::stencil`] (exact where the
+//!   piece is polynomial, an approximation where it is not).
 
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, OnceLock};
@@ -177,9 +178,15 @@ impl CornerEnergy {
     /// The matrices for valence `n`: the whole thin-plate series where it converges
     /// (`4λ₁² < 1`, valence 3), else its first `depth` rings; the whole membrane series.
     pub fn new(m: &CornerPatchMatrices, depth: usize) -> CornerEnergy {
+        Self::with_membrane(m, depth, true)
+    }
+
+    /// [`CornerEnergy::new`], the membrane matrix left zero unless `membrane` (its series
+    /// costs a few hundred products of (2n + 8)² matrices at high valence).
+    pub fn with_membrane(m: &CornerPatchMatrices, depth: usize, membrane: bool) -> CornerEnergy {
         let divergent = 4.0 * subdominant(m.n).powi(2) >= 1.0;
         let rings = divergent.then_some(depth.max(1));
-        let mut e = Self::partial(m, rings);
+        let mut e = Self::series(m, rings, membrane);
         e.truncated_at = rings;
         e
     }
@@ -187,6 +194,10 @@ impl CornerEnergy {
     /// The thin-plate series summed over rings 1..=`rings` exactly (`None`: to
     /// convergence, which only valence 3 reaches), with the whole membrane series.
     pub fn partial(m: &CornerPatchMatrices, rings: Option<usize>) -> CornerEnergy {
+        Self::series(m, rings, true)
+    }
+
+    fn series(m: &CornerPatchMatrices, rings: Option<usize>, membrane: bool) -> CornerEnergy {
         let sub = &m.sub;
         let q0 = mat16(&bicubic_thin_plate());
         let q1 = mat16(&bicubic_membrane());
@@ -202,22 +213,38 @@ impl CornerEnergy {
             n: m.n,
             // Thin plate: 4^m per ring; membrane: 1 per ring (λ² < 1 but for constants).
             thin_plate: ring_series(&a1, &mt, 4.0, rings),
-            membrane: ring_series(&a1, &mm, 1.0, None),
+            membrane: if membrane {
+                ring_series(&a1, &mm, 1.0, None)
+            } else {
+                Mat::zeros(k, k)
+            },
             truncated_at: rings,
         }
     }
 }
 
-/// Cached [`CornerEnergy`] per (valence, depth).
+/// Cached [`CornerEnergy`] per (valence, depth), with the membrane matrix.
 pub fn corner_energy(n: usize, depth: usize) -> Result<Arc<CornerEnergy>, EditError> {
-    static CACHE: OnceLock<Mutex<HashMap<(usize, usize), Arc<CornerEnergy>>>> = OnceLock::new();
+    cached_corner_energy(n, depth, true)
+}
+
+type CornerCache = Mutex<HashMap<(usize, usize, bool), Arc<CornerEnergy>>>;
+
+fn cached_corner_energy(
+    n: usize,
+    depth: usize,
+    membrane: bool,
+) -> Result<Arc<CornerEnergy>, EditError> {
+    static CACHE: OnceLock<CornerCache> = OnceLock::new();
     let cache = CACHE.get_or_init(|| Mutex::new(HashMap::new()));
-    if let Some(e) = cache.lock().expect("cache").get(&(n, depth)) {
+    // Held while computing: faces of one valence in parallel wait for one computation.
+    let mut guard = cache.lock().expect("cache");
+    if let Some(e) = guard.get(&(n, depth, membrane)) {
         return Ok(e.clone());
     }
     let m = subd_limit::stam::corner_patch_matrices(n)?;
-    let e = Arc::new(CornerEnergy::new(&m, depth));
-    cache.lock().expect("cache").insert((n, depth), e.clone());
+    let e = Arc::new(CornerEnergy::with_membrane(&m, depth, membrane));
+    guard.insert((n, depth, membrane), e.clone());
     Ok(e)
 }
 
@@ -278,7 +305,7 @@ fn patch_matrix(
     Ok(match &patch.form {
         PatchForm::Bicubic => Some(tp * q0 + options.membrane * q1),
         PatchForm::Corner(m) => {
-            let e = corner_energy(m.n, options.corner_depth)?;
+            let e = cached_corner_energy(m.n, options.corner_depth, options.membrane != 0.0)?;
             Some(tp * &e.thin_plate + options.membrane * &e.membrane)
         }
         PatchForm::Other => None,
@@ -336,7 +363,7 @@ fn face_triplets(
     Ok(())
 }
 
-/// A piece without a closed form: 4 × 4 Gauss points on each quarter of its domain.
+/// A piece without a closed form: 4 × 4 Gauss points on its domain.
 fn quadrature_triplets(
     ev: &LimitEvaluator,
     face: usize,
@@ -345,8 +372,9 @@ fn quadrature_triplets(
     out: &mut Vec<(u32, u32, f64)>,
 ) -> Result<(), EditError> {
     let g = gauss4();
-    let h = 0.5 * patch.size;
-    for (qi, qj) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+    let h = patch.size;
+    let mut stencils = Vec::with_capacity(16);
+    for (qi, qj) in [(0, 0)] {
         for &(x, wx) in &g {
             for &(y, wy) in &g {
                 let u = patch.origin[0] + h * (qi as f64 + x);
@@ -357,21 +385,102 @@ fn quadrature_triplets(
                     u,
                     v,
                 })?;
-                let w = wx * wy * h * h;
-                for (a, &va) in st.indices.iter().enumerate() {
-                    for (b, &vb) in st.indices.iter().enumerate() {
-                        let tp = st.weights[3][a] * st.weights[3][b]
-                            + 2.0 * st.weights[4][a] * st.weights[4][b]
-                            + st.weights[5][a] * st.weights[5][b];
-                        let mem = st.weights[1][a] * st.weights[1][b]
-                            + st.weights[2][a] * st.weights[2][b];
-                        out.push((va, vb, w * (tp + options.membrane * mem)));
-                    }
-                }
+                stencils.push((wx * wy * h * h, st));
+            }
+        }
+    }
+    // One dense matrix over the union of the points' vertices, then its entries.
+    let mut verts: Vec<u32> = stencils
+        .iter()
+        .flat_map(|(_, s)| s.indices.iter().copied())
+        .collect();
+    verts.sort_unstable();
+    verts.dedup();
+    let n = verts.len();
+    let mut m = vec![0.0; n * n];
+    for (w, st) in &stencils {
+        let local: Vec<usize> = st
+            .indices
+            .iter()
+            .map(|v| verts.binary_search(v).expect("listed"))
+            .collect();
+        for (a, &la) in local.iter().enumerate() {
+            for (b, &lb) in local.iter().enumerate() {
+                let tp = st.weights[3][a] * st.weights[3][b]
+                    + 2.0 * st.weights[4][a] * st.weights[4][b]
+                    + st.weights[5][a] * st.weights[5][b];
+                let mem = st.weights[1][a] * st.weights[1][b] + st.weights[2][a] * st.weights[2][b];
+                m[la * n + lb] += w * (tp + options.membrane * mem);
+            }
+        }
+    }
+    for (a, &va) in verts.iter().enumerate() {
+        for (b, &vb) in verts.iter().enumerate() {
+            if m[a * n + b] != 0.0 {
+                out.push((va, vb, m[a * n + b]));
             }
         }
     }
     Ok(())
+}
+
+/// Appends a chunk's entries to `merged`; where they repeat a few vertex pairs many times
+/// (the faces around a vertex of high valence share their (2n + 8)² pairs) they are summed
+/// in a dense block over the chunk's vertices first. `local` is an all-`MAX` scratch map
+/// from vertex to block index, left as it was found.
+fn accumulate(
+    chunk: Vec<Vec<(u32, u32, f64)>>,
+    local: &mut [u32],
+    merged: &mut Vec<(u32, u32, f64)>,
+) {
+    let mut verts: Vec<u32> = Vec::new();
+    let mut count = 0usize;
+    for &(i, _, _) in chunk.iter().flatten() {
+        count += 1;
+        if local[i as usize] == u32::MAX {
+            local[i as usize] = verts.len() as u32;
+            verts.push(i);
+        }
+    }
+    let n = verts.len();
+    if count > 4 * n * n {
+        // Faces in order, entries in order: the same sums for any thread count.
+        let mut block = vec![0.0; n * n];
+        for &(i, j, v) in chunk.iter().flatten() {
+            block[local[i as usize] as usize * n + local[j as usize] as usize] += v;
+        }
+        for (a, &va) in verts.iter().enumerate() {
+            for (b, &vb) in verts.iter().enumerate() {
+                if block[a * n + b] != 0.0 {
+                    merged.push((va, vb, block[a * n + b]));
+                }
+            }
+        }
+    } else {
+        merged.extend(chunk.into_iter().flatten());
+    }
+    for &v in &verts {
+        local[v as usize] = u32::MAX;
+    }
+}
+
+/// Sorts entries by (column, row) and sums repeated ones. The order is a function of the
+/// entries alone (not of the thread count that produced them, which `collect` keeps in face
+/// order), so the sums are reproducible.
+fn merge_entries(e: &mut Vec<(u32, u32, f64)>) {
+    let mut keyed: Vec<(u64, f64)> = e
+        .iter()
+        .map(|&(i, j, v)| ((u64::from(j) << 32) | u64::from(i), v))
+        .collect();
+    keyed.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    e.clear();
+    for (k, v) in keyed {
+        let (i, j) = ((k & 0xffff_ffff) as u32, (k >> 32) as u32);
+        match e.last_mut() {
+            Some(last) if last.0 == i && last.1 == j => last.2 += v,
+            _ => e.push((i, j, v)),
+        }
+    }
 }
 
 /// The energy's matrix `Q` (n × n, symmetric) over the faces `faces` of the evaluator's
@@ -383,8 +492,8 @@ pub struct EnergyMatrix {
 }
 
 impl EnergyMatrix {
-    /// Assembles `Q` over `faces` (in parallel; the sum is the same for any thread count, the
-    /// triplets being merged in face order).
+    /// Assembles `Q` over `faces` (in parallel; the sum is the same for any thread count,
+    /// the entries being merged in face order).
     ///
     /// # Errors
     /// A face the evaluator cannot evaluate (other than holes).
@@ -396,16 +505,26 @@ impl EnergyMatrix {
     ) -> Result<EnergyMatrix, EditError> {
         let q0 = mat16(&bicubic_thin_plate());
         let q1 = mat16(&bicubic_membrane());
-        let per_face: Vec<Vec<(u32, u32, f64)>> = faces
-            .par_iter()
-            .map(|&f| {
-                let mut t = Vec::new();
-                face_triplets(ev, f, options, &q0, &q1, &mut t).map(|_| t)
-            })
-            .collect::<Result<_, _>>()?;
-        let triplets: Vec<Triplet<usize, usize, f64>> = per_face
+        // Faces in chunks, each chunk's entries merged before the next (a face at a vertex
+        // of valence n has (2n + 8)² of them, the same pairs for every face around it).
+        let mut merged: Vec<(u32, u32, f64)> = Vec::new();
+        let mut local = vec![u32::MAX; num_vertices];
+        for chunk in faces.chunks(32) {
+            let per_face: Vec<Vec<(u32, u32, f64)>> = chunk
+                .par_iter()
+                .map(|&f| {
+                    let mut t = Vec::new();
+                    face_triplets(ev, f, options, &q0, &q1, &mut t).map(|_| t)
+                })
+                .collect::<Result<_, _>>()?;
+            accumulate(per_face, &mut local, &mut merged);
+            if merged.len() > 1 << 22 {
+                merge_entries(&mut merged);
+            }
+        }
+        merge_entries(&mut merged);
+        let triplets: Vec<Triplet<usize, usize, f64>> = merged
             .iter()
-            .flatten()
             .map(|&(i, j, v)| Triplet::new(i as usize, j as usize, v))
             .collect();
         let q = SparseColMat::try_new_from_triplets(num_vertices, num_vertices, &triplets)

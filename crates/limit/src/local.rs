@@ -45,57 +45,57 @@ pub(crate) struct Neighbourhood<P = Vec<DVec3>> {
 pub(crate) trait Carried: Sized {
     /// The values of vertices `ids` (in that order).
     fn pick(&self, ids: &[u32]) -> Self;
-    /// The values of the vertices of level 1 of `r` from those of its level 0.
-    fn refined(&self, r: &Refinement) -> Self;
+    /// The values of vertices `ids` of level 1 of `r` from those of its level 0.
+    fn refined_pick(&self, r: &Refinement, ids: &[u32]) -> Self;
 }
 
 impl Carried for Vec<DVec3> {
     fn pick(&self, ids: &[u32]) -> Self {
         ids.iter().map(|&v| self[v as usize]).collect()
     }
-    fn refined(&self, r: &Refinement) -> Self {
-        r.refine_points(self).pop().expect("one level")
+    fn refined_pick(&self, r: &Refinement, ids: &[u32]) -> Self {
+        r.refine_points(self).pop().expect("one level").pick(ids)
     }
 }
 
-/// Per vertex, its weights over `width` source vertices (row-major).
+/// Per vertex, its non-zero weights over the source vertices (indices into the first
+/// piece's vertices, ascending).
 pub(crate) struct Weights {
-    width: usize,
-    rows: Vec<f64>,
+    rows: Vec<Vec<(u32, f64)>>,
 }
 
 impl Carried for Weights {
     fn pick(&self, ids: &[u32]) -> Self {
-        let w = self.width;
-        let mut rows = Vec::with_capacity(ids.len() * w);
-        for &v in ids {
-            rows.extend_from_slice(&self.rows[v as usize * w..(v as usize + 1) * w]);
-        }
-        Weights { width: w, rows }
-    }
-    fn refined(&self, r: &Refinement) -> Self {
-        let table = r.stencils(1);
-        let mut rows = vec![0.0; table.num_rows() * self.width];
-        table.apply(&self.rows, self.width, &mut rows);
         Weights {
-            width: self.width,
-            rows,
+            rows: ids.iter().map(|&v| self.rows[v as usize].clone()).collect(),
         }
     }
-}
-
-impl Weights {
-    /// Positions whose coordinates are the weights of sources `first..first + 3` (zero past
-    /// the last source): evaluating with them gives those sources' weights.
-    fn columns(&self, first: usize) -> Vec<DVec3> {
-        let w = self.width;
-        self.rows
-            .chunks_exact(w)
-            .map(|row| {
-                let at = |k: usize| if first + k < w { row[first + k] } else { 0.0 };
-                DVec3::new(at(0), at(1), at(2))
+    fn refined_pick(&self, r: &Refinement, ids: &[u32]) -> Self {
+        // Only the rows the next piece keeps.
+        let table = r.stencils(1);
+        let rows = ids
+            .iter()
+            .map(|&i| {
+                let (idx, w) = table.row(i as usize);
+                let mut acc: Vec<(u32, f64)> = idx
+                    .iter()
+                    .zip(w)
+                    .flat_map(|(&p, &wp)| {
+                        self.rows[p as usize].iter().map(move |&(s, x)| (s, wp * x))
+                    })
+                    .collect();
+                acc.sort_unstable_by_key(|e| e.0);
+                let mut out: Vec<(u32, f64)> = Vec::with_capacity(acc.len());
+                for (s, x) in acc {
+                    match out.last_mut() {
+                        Some(l) if l.0 == s => l.1 += x,
+                        _ => out.push((s, x)),
+                    }
+                }
+                out
             })
-            .collect()
+            .collect();
+        Weights { rows }
     }
 }
 
@@ -409,55 +409,54 @@ pub(crate) fn stencil(
         let mut sources = Vec::new();
         let pick = |ids: &[u32]| {
             sources = ids.to_vec();
-            let width = ids.len();
-            let mut rows = vec![0.0; width * width];
-            for i in 0..width {
-                rows[i * width + i] = 1.0;
+            Weights {
+                rows: (0..ids.len() as u32).map(|i| vec![(i, 1.0)]).collect(),
             }
-            Weights { width, rows }
         };
         let start = cut_out(t, rules, pick, f)?;
         let ending = descend(start, scheme, options, u, v)?;
-        let mut out = Vec::with_capacity(sources.len());
-        for first in (0..sources.len()).step_by(3) {
-            let p = match &ending {
-                Ending::Patch { nb, u, v, scale } => {
-                    let cols = nb.points.columns(first);
-                    crate::eval::direct_evaluation(
-                        &nb.topology,
-                        &nb.rules,
-                        &cols,
-                        nb.face,
-                        scheme,
-                        *u,
-                        *v,
-                    )?
-                    .map(|p| p.scaled(*scale))
-                    .ok_or(LimitError::Unsupported {
-                        face: f,
-                        reason: "local refinement ended off a patch",
-                    })?
-                }
+        let nb = match &ending {
+            Ending::Patch { nb, .. } | Ending::Corner { nb, .. } => nb,
+        };
+        // The final piece's weights over its own support, one unit-vector evaluation per
+        // three vertices, then carried back to the sources through the weights.
+        let support = crate::point_stencil::face_support(&nb.topology, nb.face);
+        let mut buf = Vec::new();
+        let local = crate::point_stencil::linear_weights(
+            &mut buf,
+            nb.topology.num_vertices(),
+            &support,
+            |pts| match &ending {
+                Ending::Patch { nb, u, v, scale } => crate::eval::direct_evaluation(
+                    &nb.topology,
+                    &nb.rules,
+                    pts,
+                    nb.face,
+                    scheme,
+                    *u,
+                    *v,
+                )?
+                .map(|p| p.scaled(*scale))
+                .ok_or(LimitError::Unsupported {
+                    face: f,
+                    reason: "local refinement ended off a patch",
+                }),
                 Ending::Corner {
                     nb,
                     corner,
                     options,
-                } => corner_limit(nb, &nb.points.columns(first), scheme, options, *corner)?,
-            };
-            for (k, &src) in sources[first..].iter().take(3).enumerate() {
-                out.push((
-                    src,
-                    [
-                        p.position[k],
-                        p.du[k],
-                        p.dv[k],
-                        p.duu[k],
-                        p.duv[k],
-                        p.dvv[k],
-                    ],
-                ));
+                } => corner_limit(nb, pts, scheme, options, *corner),
+            },
+        )?;
+        let mut acc = vec![[0.0f64; 6]; sources.len()];
+        for (v, w) in local {
+            for &(src, x) in &nb.points.rows[v as usize] {
+                for k in 0..6 {
+                    acc[src as usize][k] += w[k] * x;
+                }
             }
         }
+        let out = sources.iter().copied().zip(acc).collect();
         Ok(out)
     })
 }
@@ -513,14 +512,14 @@ fn descend<P: Carried>(
                 options,
             });
         }
-        let child_points = nb.points.refined(&r);
         let (child, s, tt, k) = child_at(t0, scheme, nb.face, u, v);
-        nb = cut_out(
+        let next = cut_out(
             r.topology(1),
             r.vertex_rules(1),
-            |ids| child_points.pick(ids),
+            |ids| nb.points.refined_pick(&r, ids),
             child,
         )?;
+        nb = next;
         (u, v, scale) = (s, tt, scale * k);
     }
     let corner = nearest_corner(scheme, u, v);

@@ -155,7 +155,7 @@ thread_local! {
 }
 
 /// Vertices of the faces around the vertices of face `f`, ascending.
-fn face_support(t: &Topology, f: usize) -> Vec<u32> {
+pub(crate) fn face_support(t: &Topology, f: usize) -> Vec<u32> {
     let mut out = Vec::new();
     for &v in t.face_vertices(f) {
         for &g in t.vertex_faces(v as usize) {
@@ -169,7 +169,7 @@ fn face_support(t: &Topology, f: usize) -> Vec<u32> {
 
 /// The weights of `support` in `eval`, a linear function of `n` points that reads only
 /// `support`, by evaluating with unit vectors three vertices at a time.
-fn linear_weights(
+pub(crate) fn linear_weights(
     scratch: &mut Vec<DVec3>,
     n: usize,
     support: &[u32],
