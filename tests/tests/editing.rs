@@ -391,9 +391,10 @@ fn without_a_region_one_point_translates_the_surface() {
         goal: Goal::Displacement(d),
     }];
     let (_, x) = edit(&m, &cs, energy_method(None));
+    // A rigid translation, to the 1e-10 regularisation of Q.
     for (a, b) in x.iter().zip(&m.positions) {
         assert!(
-            (*a - *b - d).length() < 1e-8,
+            (*a - *b - d).length() < 1e-7,
             "{} not a translation",
             *a - *b
         );

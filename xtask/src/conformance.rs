@@ -252,6 +252,15 @@ fn compare_edit(
     };
     let inexact = subd_limit::eigen_limit_vertices(&prepared, level);
     let (t0, rules0) = (prepared.topology(0), prepared.vertex_rules(0));
+    // Holes as the evaluator sees them (boundary faces too under boundary "none").
+    let surface = match subd_limit::eval::LimitEvaluator::new(topo, scheme, options) {
+        Ok(ev) => ev.topology().clone(),
+        Err(e) => {
+            row.error = 0.0;
+            row.note = Some(format!("subd-limit: {e}; not checked"));
+            return row;
+        }
+    };
     let nv = topo.num_vertices();
     let seed = name
         .bytes()
@@ -259,10 +268,10 @@ fn compare_edit(
     let usable = |v: usize| {
         v < nv
             && !inexact.contains(&v)
-            && topo
+            && surface
                 .vertex_faces(v)
                 .iter()
-                .any(|&f| !topo.is_hole(f as usize))
+                .any(|&f| !surface.is_hole(f as usize))
     };
     let mut chosen: Vec<usize> = Vec::new();
     for k in 0..4u64 {
@@ -336,11 +345,23 @@ fn compare_edit(
             return row;
         }
     };
+    // Tangents for the normal check; where OpenSubdiv's tangent masks crash (see
+    // `compare_limit`), positions only.
+    let edited_input = osd::encode(topo, &edit.positions, scheme, options, level as u32);
+    let mut with_tangents = normal_vertex.is_some();
     let after = match osd::run(
         exe,
-        &osd::encode(topo, &edit.positions, scheme, options, level as u32),
-        &["--limit-positions"],
+        &edited_input,
+        &[if with_tangents {
+            "--limit"
+        } else {
+            "--limit-positions"
+        }],
     )
+    .or_else(|_| {
+        with_tangents = false;
+        osd::run(exe, &edited_input, &["--limit-positions"])
+    })
     .and_then(|b| osd::decode_limit(&b))
     {
         Ok(l) => l,
@@ -355,7 +376,7 @@ fn compare_edit(
         err = err.max((moved - 0.05 * diag * dirs[k % 4]).length() / diag);
     }
     let mut normal_err = None;
-    if let Some(v) = normal_vertex {
+    if let Some(v) = normal_vertex.filter(|_| with_tangents) {
         let (a, b) = (after.tangent1[v], after.tangent2[v]);
         let e =
             (target_normal.dot(a).abs() / a.length()).max(target_normal.dot(b).abs() / b.length());

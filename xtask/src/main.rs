@@ -10,6 +10,7 @@ use clap::{Parser, Subcommand};
 mod adaptive_bench;
 mod bench;
 mod conformance;
+mod editing_bench;
 mod osd;
 mod pia_bench;
 mod random_mesh;
@@ -74,6 +75,10 @@ enum Task {
         /// speed against uniform refinement).
         #[arg(long)]
         adaptive_only: bool,
+        /// Only the editing benchmark (least squares, energy, re-solve; seed 003's
+        /// examples).
+        #[arg(long)]
+        editing_only: bool,
     },
     /// (internal) The subd side of the evaluation benchmark, in its own process.
     #[command(hide = true)]
@@ -196,6 +201,7 @@ fn main() -> ExitCode {
             eval_only,
             pia_only,
             adaptive_only,
+            editing_only,
         } => {
             let refinement = || {
                 bench::run(
@@ -208,6 +214,8 @@ fn main() -> ExitCode {
             };
             if pia_only {
                 pia_bench::run(repeats)
+            } else if editing_only {
+                editing_bench::run(repeats)
             } else if adaptive_only {
                 ensure_system_packages(OPENSUBDIV_PACKAGES)
                     .and_then(|_| adaptive_bench::run(repeats))
@@ -221,7 +229,9 @@ fn main() -> ExitCode {
                         if eval_only {
                             Ok(())
                         } else {
-                            pia_bench::run(repeats).and_then(|_| adaptive_bench::run(repeats))
+                            pia_bench::run(repeats)
+                                .and_then(|_| adaptive_bench::run(repeats))
+                                .and_then(|_| editing_bench::run(repeats))
                         }
                     })
             }

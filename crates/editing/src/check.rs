@@ -45,7 +45,7 @@ fn residual(
     p1: &PatchPoints,
 ) -> Result<f64, String> {
     let param = |l: &Location| match l {
-        Location::Vertex(v) => vertex_param(topology, scheme, *v),
+        Location::Vertex(v) => vertex_param(ev.topology(), scheme, *v),
         Location::Face(p) => Ok(*p),
     };
     let eval = |p: &PatchPoints, q: FaceParam| ev.evaluate(p, q).map_err(|e| e.to_string());

@@ -144,7 +144,7 @@ impl ConstraintRows {
             let bad = |message: String| EditError::Constraint { index: i, message };
             match c {
                 Constraint::Point { at, goal } => {
-                    let st = stencil_at(ev, topology, scheme, at).map_err(bad)?;
+                    let st = stencil_at(ev, scheme, at).map_err(bad)?;
                     let target = check_goal(goal).map_err(bad)?;
                     out.push_point(&st.indices, &st.weights[POSITION], target, i);
                 }
@@ -156,7 +156,7 @@ impl ConstraintRows {
                         return Err(bad("the normal is zero".into()));
                     }
                     let n = normal.normalize();
-                    let st = stencil_at(ev, topology, scheme, at).map_err(bad)?;
+                    let st = stencil_at(ev, scheme, at).map_err(bad)?;
                     for k in [DU, DV] {
                         out.rows.push(Row {
                             entries: pairs(&st.indices, &st.weights[k]),
@@ -273,12 +273,11 @@ pub(crate) fn vertex_param(
 /// The stencil of a location, with a one-line reason when it is not on the surface.
 pub(crate) fn stencil_at(
     ev: &LimitEvaluator,
-    topology: &Topology,
     scheme: Scheme,
     at: &Location,
 ) -> Result<PointStencil, String> {
     let p = match at {
-        Location::Vertex(v) => vertex_param(topology, scheme, *v)?,
+        Location::Vertex(v) => vertex_param(ev.topology(), scheme, *v)?,
         Location::Face(p) => {
             if !p.u.is_finite() || !p.v.is_finite() {
                 return Err("the parameters are not finite".into());

@@ -15,6 +15,7 @@
 
 use glam::DVec3;
 use subd_limit::PatchForm;
+use subd_limit::point_stencil::ControlRow;
 use subd_limit::eval::{FaceParam, LimitEvaluator};
 use subd_limit::point_stencil::{DU, DV, POSITION};
 use subd_mesh::Topology;
@@ -253,7 +254,7 @@ pub(crate) fn strip_rows(
     topology: &Topology,
     line: &Isoline,
     goals: &[Goal],
-) -> Result<Vec<(Vec<(u32, f64)>, Goal)>, String> {
+) -> Result<Vec<(ControlRow, Goal)>, String> {
     let faces = strip(topology, line)?;
     let m = faces.len();
     if goals.len() != m + 3 {

@@ -9,13 +9,15 @@
 //!   `A⁺` from the SVD of A: the minimum-norm least-squares solution.
 //! * **Energy**: minimise the thin-plate (+ membrane) energy of the displacement,
 //!   `Σ_c ΔX_cᵀ Q ΔX_c`, over the vertices within `region_rings` rings of the constraints
-//!   (the rest fixed), subject to the rows. Exactly (the KKT system by its Schur
-//!   complement: `ΔX = Q⁻¹Aᵀ (A Q⁻¹ Aᵀ)⁻¹ r`, Q by faer's sparse Cholesky, the c × c Schur
-//!   matrix dense, with the pseudo-inverse when it is singular), or by the seed's penalty
+//!   (the rest fixed), subject to the rows. Exactly (the KKT system `[Q Aᵀ; A 0]` by faer's
+//!   sparse LU; when it is singular — dependent or conflicting rows — by its Schur
+//!   complement `ΔX = Q⁻¹Aᵀ (A Q⁻¹ Aᵀ)⁺ r`, Q by faer's sparse Cholesky, the c × c Schur
+//!   matrix's pseudo-inverse giving the least-squares solution), or by the seed's penalty
 //!   `(Q + λ AᵀA) ΔX = λ Aᵀ r`. `Q` gets `1e-12` of its largest diagonal added: that keeps it
 //!   definite when no vertex of a component is fixed (a translation costs no energy; with
 //!   the term the smallest such move is taken) and changes nothing else measurably.
 
+use std::sync::Arc;
 use std::time::Instant;
 
 use faer::linalg::solvers::{DenseSolveCore, Solve};
@@ -53,7 +55,9 @@ pub enum Method {
 /// Seconds spent in each phase.
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
 pub struct Timings {
-    /// Evaluator and constraint rows.
+    /// The limit evaluator (0 when one was given).
+    pub evaluator: f64,
+    /// The constraint rows.
     pub constraints: f64,
     /// Energy matrix assembly (0 for least squares).
     pub assemble: f64,
@@ -98,7 +102,7 @@ pub struct Edit {
 pub struct Editor {
     topology: Topology,
     scheme: Scheme,
-    ev: LimitEvaluator,
+    ev: Arc<LimitEvaluator>,
     base: Vec<DVec3>,
     constraints: Vec<Constraint>,
     rows: ConstraintRows,
@@ -135,7 +139,30 @@ impl Editor {
         constraints: &[Constraint],
         method: Method,
     ) -> Result<Editor, EditError> {
-        if positions.len() != topology.num_vertices() {
+        let t = Instant::now();
+        let ev = Arc::new(LimitEvaluator::new(topology, scheme, options)?);
+        let evaluator = t.elapsed().as_secs_f64();
+        let mut ed = Self::with_evaluator(ev, topology, positions, scheme, constraints, method)?;
+        ed.timings.evaluator = evaluator;
+        Ok(ed)
+    }
+
+    /// [`Editor::new`] with an evaluator already built for `topology` (a modeller keeps one
+    /// per mesh: building it is the one step that grows with the whole mesh).
+    ///
+    /// # Errors
+    /// As [`Editor::new`].
+    pub fn with_evaluator(
+        ev: Arc<LimitEvaluator>,
+        topology: &Topology,
+        positions: &[DVec3],
+        scheme: Scheme,
+        constraints: &[Constraint],
+        method: Method,
+    ) -> Result<Editor, EditError> {
+        if positions.len() != topology.num_vertices()
+            || ev.topology().num_vertices() != positions.len()
+        {
             return Err(EditError::Solve(format!(
                 "{} positions for {} vertices",
                 positions.len(),
@@ -146,7 +173,6 @@ impl Editor {
             return Err(EditError::Solve("no constraints".into()));
         }
         let t0 = Instant::now();
-        let ev = LimitEvaluator::new(topology, scheme, options)?;
         let rows = ConstraintRows::new(&ev, topology, scheme, constraints)?;
         let mut timings = Timings {
             constraints: t0.elapsed().as_secs_f64(),
@@ -174,8 +200,20 @@ impl Editor {
                 let q = EnergyMatrix::new(&ev, topology.num_vertices(), &faces, &energy)?;
                 timings.assemble = t1.elapsed().as_secs_f64();
                 let t2 = Instant::now();
+                // With vertices fixed around the region Q is definite and its Cholesky
+                // Schur complement is accurate and the faster; with every vertex free Q is
+                // singular up to the regularisation and the KKT system is solved instead.
+                let bounded = free.len() < topology.num_vertices();
                 let m = match penalty {
-                    None => schur_map(&rows.rows, &free, &q)?,
+                    None if bounded => schur_map(&rows.rows, &free, &q)?,
+                    None => match independent(&rows.rows, &support)
+                        .then(|| kkt_map(&rows.rows, &free, &q))
+                        .transpose()?
+                        .flatten()
+                    {
+                        Some(map) => (map, None, rows.rows.len()),
+                        None => schur_map(&rows.rows, &free, &q)?,
+                    },
                     Some(lambda) => (
                         penalty_map(&rows.rows, &free, &q, lambda)?,
                         None,
@@ -258,22 +296,34 @@ impl Editor {
     fn apply(&self, r: &[f64]) -> Edit {
         let mut dx = self.changes(r);
         if self.exact {
-            // One step of iterative refinement: the solution map of a nearly singular energy
-            // (every vertex free) loses digits to its null space; the residual's correction
-            // restores them.
-            let mut moved = self.base.clone();
-            for (i, &v) in self.free.iter().enumerate() {
-                moved[v as usize] += DVec3::new(dx[3 * i], dx[3 * i + 1], dx[3 * i + 2]);
-            }
-            let r2: Vec<f64> = self
-                .rows
-                .rows
+            // Iterative refinement: the solution map of a nearly singular energy (every
+            // vertex of a component free) loses digits to its null space; correcting with
+            // the residual restores them (a few steps at most).
+            let scale = r
                 .iter()
-                .zip(r)
-                .map(|(row, &ri)| ri - (row.value(&moved) - row.value(&self.base)))
-                .collect();
-            for (d, c) in dx.iter_mut().zip(self.changes(&r2)) {
-                *d += c;
+                .fold(0.0f64, |m, x| m.max(x.abs()))
+                .max(f64::MIN_POSITIVE);
+            let mut last = f64::INFINITY;
+            for _ in 0..5 {
+                let mut moved = self.base.clone();
+                for (i, &v) in self.free.iter().enumerate() {
+                    moved[v as usize] += DVec3::new(dx[3 * i], dx[3 * i + 1], dx[3 * i + 2]);
+                }
+                let r2: Vec<f64> = self
+                    .rows
+                    .rows
+                    .iter()
+                    .zip(r)
+                    .map(|(row, &ri)| ri - (row.value(&moved) - row.value(&self.base)))
+                    .collect();
+                let worst = r2.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+                if worst <= 1e-15 * scale || worst >= 0.5 * last {
+                    break;
+                }
+                last = worst;
+                for (d, c) in dx.iter_mut().zip(self.changes(&r2)) {
+                    *d += c;
+                }
             }
         }
         let mut positions = self.base.clone();
@@ -315,7 +365,7 @@ impl Editor {
     pub fn limit_of(&self, c: &Constraint, x: &[DVec3]) -> Option<DVec3> {
         match c {
             Constraint::Point { at, .. } => {
-                crate::constraint::stencil_at(&self.ev, &self.topology, self.scheme, at)
+                crate::constraint::stencil_at(&self.ev, self.scheme, at)
                     .ok()
                     .map(|s| s.apply(x).position)
             }
@@ -530,6 +580,79 @@ fn free_block(q: &EnergyMatrix, free: &[u32]) -> Result<SparseColMat<usize, f64>
     }
     SparseColMat::try_new_from_triplets(free.len(), free.len(), &t)
         .map_err(|e| EditError::Solve(format!("energy block: {e:?}")))
+}
+
+/// Whether the rows are linearly independent (the pivot test of [`definite_inverse`] on
+/// `A Aᵀ`; above [`DENSE_ROWS`] rows assumed, the KKT check deciding).
+fn independent(rows: &[Row], support: &[u32]) -> bool {
+    if rows.len() > DENSE_ROWS {
+        return true;
+    }
+    let a = dense_rows(rows, support);
+    definite_inverse(&(&a * a.transpose())).is_some()
+}
+
+/// Exact: the KKT system `[Q Aᵀ; A 0] [ΔX; μ] = [0; r]` by faer's sparse LU, its solution
+/// map being the first block of `[Q Aᵀ; A 0]⁻¹ [0; I]`. `None` when the system is singular
+/// (dependent or conflicting rows): the map must reproduce the rows (`A W = I` to 1e-9).
+fn kkt_map(rows: &[Row], free: &[u32], q: &EnergyMatrix) -> Result<Option<Mat<f64>>, EditError> {
+    let qf = free_block(q, free)?;
+    let nf = free.len();
+    let c = rows.len();
+    let n = 3 * nf + c;
+    let qr = qf.as_ref();
+    let mut t = Vec::new();
+    for j in 0..nf {
+        for (&i, &x) in qr.row_idx_of_col_raw(j).iter().zip(qr.val_of_col(j)) {
+            for coord in 0..3 {
+                t.push(Triplet::new(3 * i + coord, 3 * j + coord, x));
+            }
+        }
+    }
+    for (k, r) in rows.iter().enumerate() {
+        for &(v, w) in &r.entries {
+            let i = free
+                .binary_search(&v)
+                .expect("rows lie inside the free set");
+            for coord in 0..3 {
+                let a = r.coefficient(w, coord);
+                if a != 0.0 {
+                    t.push(Triplet::new(3 * nf + k, 3 * i + coord, a));
+                    t.push(Triplet::new(3 * i + coord, 3 * nf + k, a));
+                }
+            }
+        }
+    }
+    let m = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &t)
+        .map_err(|e| EditError::Solve(format!("KKT matrix: {e:?}")))?;
+    let Ok(lu) = m.sp_lu() else {
+        return Ok(None);
+    };
+    let mut rhs = Mat::<f64>::zeros(n, c);
+    for k in 0..c {
+        rhs[(3 * nf + k, k)] = 1.0;
+    }
+    lu.solve_in_place(rhs.as_mut());
+    let w = Mat::from_fn(3 * nf, c, |i, k| rhs[(i, k)]);
+    // A W must be the identity.
+    for (j, r) in rows.iter().enumerate() {
+        for k in 0..c {
+            let mut s = 0.0;
+            for &(v, wv) in &r.entries {
+                let i = free
+                    .binary_search(&v)
+                    .expect("rows lie inside the free set");
+                for coord in 0..3 {
+                    s += r.coefficient(wv, coord) * w[(3 * i + coord, k)];
+                }
+            }
+            let want = if j == k { 1.0 } else { 0.0 };
+            if !s.is_finite() || (s - want).abs() > 1e-9 {
+                return Ok(None);
+            }
+        }
+    }
+    Ok(Some(w))
 }
 
 /// Exact: `Q⁻¹ Aᵀ (A Q⁻¹ Aᵀ)⁻¹` (Q per coordinate), pseudo-inverse of the Schur complement

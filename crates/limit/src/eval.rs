@@ -305,6 +305,12 @@ impl LimitEvaluator {
         })
     }
 
+    /// The base topology as the evaluator sees it (boundary faces are holes under
+    /// `BoundaryInterpolation::None`).
+    pub fn topology(&self) -> &Topology {
+        &self.base
+    }
+
     /// The control points for base positions `points` (one per base vertex).
     ///
     /// # Panics

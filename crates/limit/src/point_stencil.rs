@@ -118,6 +118,9 @@ impl PointStencil {
     }
 }
 
+/// A control point as (vertex, weight) pairs.
+pub type ControlRow = Vec<(u32, f64)>;
+
 /// How a [`FacePatch`] is a function of its control points.
 #[derive(Clone, Debug)]
 pub enum PatchForm {
@@ -138,7 +141,7 @@ pub struct FacePatch {
     /// Its form.
     pub form: PatchForm,
     /// Control points as rows over base vertices (empty for [`PatchForm::Other`]).
-    pub controls: Vec<Vec<(u32, f64)>>,
+    pub controls: Vec<ControlRow>,
     /// The sub-face of the base face it lies in (0 for quads).
     pub sub: usize,
     /// Its domain in the base (sub-)face's parameters: the square with corner `origin` and
@@ -410,7 +413,7 @@ impl LimitEvaluator {
 fn piece_form(
     piece: &Piece,
     face: usize,
-) -> Result<Option<(PatchForm, Vec<Vec<(u32, f64)>>)>, LimitError> {
+) -> Result<Option<(PatchForm, Vec<ControlRow>)>, LimitError> {
     let unit = |ids: &[u32]| ids.iter().map(|&i| vec![(i, 1.0)]).collect();
     Ok(match piece {
         Piece::Regular(grid) => Some((PatchForm::Bicubic, unit(grid))),
