@@ -15,8 +15,8 @@
 
 use glam::DVec3;
 use subd_limit::PatchForm;
-use subd_limit::point_stencil::ControlRow;
 use subd_limit::eval::{FaceParam, LimitEvaluator};
+use subd_limit::point_stencil::ControlRow;
 use subd_limit::point_stencil::{DU, DV, POSITION};
 use subd_mesh::Topology;
 
