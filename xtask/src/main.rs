@@ -256,7 +256,11 @@ fn main() -> ExitCode {
         Task::Fuzz { seconds, target } => {
             let targets = match target {
                 Some(t) => vec![t],
-                None => vec!["obj_topology".to_string(), "ply".to_string()],
+                None => vec![
+                    "obj_topology".to_string(),
+                    "ply".to_string(),
+                    "edit_constraints".to_string(),
+                ],
             };
             targets.iter().try_for_each(|t| {
                 run(cargo().args([
