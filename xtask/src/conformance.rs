@@ -200,6 +200,20 @@ pub fn compare(
     rows
 }
 
+/// OpenSubdiv's `Limit` of an encoded mesh, with tangents when asked and OpenSubdiv computes
+/// them (its tangent masks overflow and crash on some meshes: then positions only), and
+/// whether the tangents came.
+fn osd_limit(exe: &Path, input: &[u8], tangents: bool) -> Result<(osd::OsdLimit, bool), String> {
+    if tangents
+        && let Ok(l) = osd::run(exe, input, &["--limit"]).and_then(|b| osd::decode_limit(&b))
+    {
+        return Ok((l, true));
+    }
+    osd::run(exe, input, &["--limit-positions"])
+        .and_then(|b| osd::decode_limit(&b))
+        .map(|l| (l, false))
+}
+
 /// Which method an `edit` row checks.
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
 enum EditCheck {
@@ -332,14 +346,12 @@ fn compare_edit(
             return row;
         }
     };
-    let before = match osd::run(
+    let before = match osd_limit(
         exe,
         &osd::encode(topo, positions, scheme, options, level as u32),
-        &["--limit-positions"],
-    )
-    .and_then(|b| osd::decode_limit(&b))
-    {
-        Ok(l) => l,
+        false,
+    ) {
+        Ok((l, _)) => l,
         Err(e) => {
             row.problem = Some(format!("OpenSubdiv: {e}"));
             return row;
@@ -348,22 +360,7 @@ fn compare_edit(
     // Tangents for the normal check; where OpenSubdiv's tangent masks crash (see
     // `compare_limit`), positions only.
     let edited_input = osd::encode(topo, &edit.positions, scheme, options, level as u32);
-    let mut with_tangents = normal_vertex.is_some();
-    let after = match osd::run(
-        exe,
-        &edited_input,
-        &[if with_tangents {
-            "--limit"
-        } else {
-            "--limit-positions"
-        }],
-    )
-    .or_else(|_| {
-        with_tangents = false;
-        osd::run(exe, &edited_input, &["--limit-positions"])
-    })
-    .and_then(|b| osd::decode_limit(&b))
-    {
+    let (after, with_tangents) = match osd_limit(exe, &edited_input, normal_vertex.is_some()) {
         Ok(l) => l,
         Err(e) => {
             row.problem = Some(format!("OpenSubdiv: {e}"));
@@ -927,14 +924,7 @@ fn compare_limit(
     let mut row = Row::pending(name, "limit", level);
     let input = osd::encode(topo, positions, scheme, options, level as u32);
     // Where OpenSubdiv crashes computing tangents (see `overflow` below), compare positions.
-    let mut with_tangents = true;
-    let theirs = match osd::run(exe, &input, &["--limit"])
-        .or_else(|_| {
-            with_tangents = false;
-            osd::run(exe, &input, &["--limit-positions"])
-        })
-        .and_then(|b| osd::decode_limit(&b))
-    {
+    let (theirs, with_tangents) = match osd_limit(exe, &input, true) {
         Ok(l) => l,
         Err(e) => {
             row.problem = Some(format!("OpenSubdiv: {e}"));

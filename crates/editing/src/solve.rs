@@ -436,17 +436,25 @@ fn faces_touching(topology: &Topology, vertices: &[u32]) -> Vec<usize> {
     f
 }
 
+/// The non-zero coefficients of row `r` as (unknown `3 i + coordinate`, coefficient),
+/// `i` the vertex's place in `free` (which holds every vertex of the rows).
+fn coefficients<'a>(r: &'a Row, free: &'a [u32]) -> impl Iterator<Item = (usize, f64)> + 'a {
+    r.entries.iter().flat_map(move |&(v, w)| {
+        let i = free
+            .binary_search(&v)
+            .expect("rows lie inside the free set");
+        (0..3)
+            .map(move |c| (3 * i + c, r.coefficient(w, c)))
+            .filter(|&(_, a)| a != 0.0)
+    })
+}
+
 /// A as a dense c × 3|free| matrix.
 fn dense_rows(rows: &[Row], free: &[u32]) -> Mat<f64> {
     let mut a = Mat::<f64>::zeros(rows.len(), 3 * free.len());
     for (k, r) in rows.iter().enumerate() {
-        for &(v, w) in &r.entries {
-            let i = free
-                .binary_search(&v)
-                .expect("rows lie inside the free set");
-            for c in 0..3 {
-                a[(k, 3 * i + c)] += r.coefficient(w, c);
-            }
+        for (u, x) in coefficients(r, free) {
+            a[(k, u)] += x;
         }
     }
     a
@@ -610,17 +618,9 @@ fn kkt_map(rows: &[Row], free: &[u32], q: &EnergyMatrix) -> Result<Option<Mat<f6
         }
     }
     for (k, r) in rows.iter().enumerate() {
-        for &(v, w) in &r.entries {
-            let i = free
-                .binary_search(&v)
-                .expect("rows lie inside the free set");
-            for coord in 0..3 {
-                let a = r.coefficient(w, coord);
-                if a != 0.0 {
-                    t.push(Triplet::new(3 * nf + k, 3 * i + coord, a));
-                    t.push(Triplet::new(3 * i + coord, 3 * nf + k, a));
-                }
-            }
+        for (u, a) in coefficients(r, free) {
+            t.push(Triplet::new(3 * nf + k, u, a));
+            t.push(Triplet::new(u, 3 * nf + k, a));
         }
     }
     let m = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &t)
@@ -637,15 +637,7 @@ fn kkt_map(rows: &[Row], free: &[u32], q: &EnergyMatrix) -> Result<Option<Mat<f6
     // A W must be the identity.
     for (j, r) in rows.iter().enumerate() {
         for k in 0..c {
-            let mut s = 0.0;
-            for &(v, wv) in &r.entries {
-                let i = free
-                    .binary_search(&v)
-                    .expect("rows lie inside the free set");
-                for coord in 0..3 {
-                    s += r.coefficient(wv, coord) * w[(3 * i + coord, k)];
-                }
-            }
+            let s: f64 = coefficients(r, free).map(|(u, a)| a * w[(u, k)]).sum();
             let want = if j == k { 1.0 } else { 0.0 };
             if !s.is_finite() || (s - want).abs() > 1e-9 {
                 return Ok(None);
@@ -667,13 +659,8 @@ fn schur_map(rows: &[Row], free: &[u32], q: &EnergyMatrix) -> Result<SolutionMap
     // Per coordinate, Aᵀ's slice as columns: |free| × 3c (column 3k + coord).
     let mut rhs = Mat::<f64>::zeros(nf, 3 * c);
     for (k, r) in rows.iter().enumerate() {
-        for &(v, w) in &r.entries {
-            let i = free
-                .binary_search(&v)
-                .expect("rows lie inside the free set");
-            for coord in 0..3 {
-                rhs[(i, 3 * k + coord)] += r.coefficient(w, coord);
-            }
+        for (u, a) in coefficients(r, free) {
+            rhs[(u / 3, 3 * k + u % 3)] += a;
         }
     }
     llt.solve_in_place(rhs.as_mut());
@@ -681,17 +668,9 @@ fn schur_map(rows: &[Row], free: &[u32], q: &EnergyMatrix) -> Result<SolutionMap
     let w = Mat::from_fn(3 * nf, c, |i, k| rhs[(i / 3, 3 * k + i % 3)]);
     let mut s = Mat::<f64>::zeros(c, c);
     for (j, r) in rows.iter().enumerate() {
-        for &(v, wv) in &r.entries {
-            let i = free
-                .binary_search(&v)
-                .expect("rows lie inside the free set");
-            for coord in 0..3 {
-                let a = r.coefficient(wv, coord);
-                if a != 0.0 {
-                    for k in 0..c {
-                        s[(j, k)] += a * w[(3 * i + coord, k)];
-                    }
-                }
+        for (u, a) in coefficients(r, free) {
+            for k in 0..c {
+                s[(j, k)] += a * w[(u, k)];
             }
         }
     }

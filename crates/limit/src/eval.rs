@@ -392,14 +392,8 @@ impl LimitEvaluator {
                         s2,
                         t2,
                     )
-                    .map_err(|e| match e {
-                        // Name the base face, not the level-2 one.
-                        LimitError::Unsupported { reason, .. } => LimitError::Unsupported {
-                            face: at.face,
-                            reason,
-                        },
-                        e => e,
-                    })?;
+                    // Name the base face, not the level-2 one.
+                    .map_err(|e| on_base_face(e, at.face))?;
                     return Ok(p.scaled(scale));
                 }
                 let p = eval_piece(
@@ -443,6 +437,15 @@ impl LimitEvaluator {
             let (k, s2, t2) = quadrant(s, t);
             (4 * c1 + k, s2, t2, 2.0 * scale1)
         }
+    }
+}
+
+/// `e` naming base face `face` when it names a face (errors of local evaluation name the
+/// refined face they met).
+pub(crate) fn on_base_face(e: LimitError, face: usize) -> LimitError {
+    match e {
+        LimitError::Unsupported { reason, .. } => LimitError::Unsupported { face, reason },
+        e => e,
     }
 }
 

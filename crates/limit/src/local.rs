@@ -368,27 +368,8 @@ pub(crate) fn evaluate(
     inline(|| {
         let pick = |ids: &[u32]| ids.iter().map(|&v| points[v as usize]).collect::<Vec<_>>();
         let start = cut_out(t, rules, pick, f)?;
-        match descend(start, scheme, options, u, v)? {
-            Ending::Patch { nb, u, v, scale } => crate::eval::direct_evaluation(
-                &nb.topology,
-                &nb.rules,
-                &nb.points,
-                nb.face,
-                scheme,
-                u,
-                v,
-            )?
-            .map(|p| p.scaled(scale))
-            .ok_or(LimitError::Unsupported {
-                face: f,
-                reason: "local refinement ended off a patch",
-            }),
-            Ending::Corner {
-                nb,
-                corner,
-                options,
-            } => corner_limit(&nb, &nb.points, scheme, &options, corner),
-        }
+        let ending = descend(start, scheme, options, u, v)?;
+        ending.value(&ending.piece().points, scheme, f)
     })
 }
 
@@ -415,9 +396,7 @@ pub(crate) fn stencil(
         };
         let start = cut_out(t, rules, pick, f)?;
         let ending = descend(start, scheme, options, u, v)?;
-        let nb = match &ending {
-            Ending::Patch { nb, .. } | Ending::Corner { nb, .. } => nb,
-        };
+        let nb = ending.piece();
         // The final piece's weights over its own support, one unit-vector evaluation per
         // three vertices, then carried back to the sources through the weights.
         let support = crate::point_stencil::face_support(&nb.topology, nb.face);
@@ -426,27 +405,7 @@ pub(crate) fn stencil(
             &mut buf,
             nb.topology.num_vertices(),
             &support,
-            |pts| match &ending {
-                Ending::Patch { nb, u, v, scale } => crate::eval::direct_evaluation(
-                    &nb.topology,
-                    &nb.rules,
-                    pts,
-                    nb.face,
-                    scheme,
-                    *u,
-                    *v,
-                )?
-                .map(|p| p.scaled(*scale))
-                .ok_or(LimitError::Unsupported {
-                    face: f,
-                    reason: "local refinement ended off a patch",
-                }),
-                Ending::Corner {
-                    nb,
-                    corner,
-                    options,
-                } => corner_limit(nb, pts, scheme, options, *corner),
-            },
+            |pts| ending.value(pts, scheme, f),
         )?;
         let mut acc = vec![[0.0f64; 6]; sources.len()];
         for (v, w) in local {
@@ -475,6 +434,41 @@ enum Ending<P> {
         corner: usize,
         options: Options,
     },
+}
+
+impl<P> Ending<P> {
+    /// The piece the descent stopped in.
+    fn piece(&self) -> &Neighbourhood<P> {
+        match self {
+            Ending::Patch { nb, .. } | Ending::Corner { nb, .. } => nb,
+        }
+    }
+
+    /// The surface point there for positions `pts` of the piece's vertices (`f` names the
+    /// face the descent started from in errors).
+    fn value(&self, pts: &[DVec3], scheme: Scheme, f: usize) -> Result<SurfacePoint, LimitError> {
+        match self {
+            Ending::Patch { nb, u, v, scale } => crate::eval::direct_evaluation(
+                &nb.topology,
+                &nb.rules,
+                pts,
+                nb.face,
+                scheme,
+                *u,
+                *v,
+            )?
+            .map(|p| p.scaled(*scale))
+            .ok_or(LimitError::Unsupported {
+                face: f,
+                reason: "local refinement ended off a patch",
+            }),
+            Ending::Corner {
+                nb,
+                corner,
+                options,
+            } => corner_limit(nb, pts, scheme, options, *corner),
+        }
+    }
 }
 
 /// Refines `nb` one level at a time, following (u, v) into the child face that holds it,

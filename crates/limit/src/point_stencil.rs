@@ -286,13 +286,7 @@ impl LimitEvaluator {
                     s2,
                     t2,
                 )
-                .map_err(|e| match e {
-                    LimitError::Unsupported { reason, .. } => LimitError::Unsupported {
-                        face: at.face,
-                        reason,
-                    },
-                    e => e,
-                })?,
+                .map_err(|e| crate::eval::on_base_face(e, at.face))?,
                 p2 => linear_weights(level2_buf, n2, &support, |p| {
                     single_piece(p2, p, at.face, s2, t2)
                 })?,
