@@ -225,7 +225,7 @@ enum EditCheck {
 const EDIT_TOLERANCE: f64 = 1e-9;
 
 /// A random edit (seeded by the mesh name): point constraints at the limits of up to four
-/// vertices, displaced by 5 % of the diagonal in varied directions, and (Catmull-Clark) a
+/// vertices (spread over the vertex list from a seeded start), displaced by 5 % of the diagonal in varied directions, and (Catmull-Clark) a
 /// normal constraint at a smooth interior vertex; solved by subd-editing, then OpenSubdiv's
 /// `Limit` of the edited control mesh must meet them to 1e-9 of the diagonal (points) and
 /// with both limit tangents perpendicular to the target normal. Vertices where OpenSubdiv's
@@ -287,9 +287,15 @@ fn compare_edit(
                 .iter()
                 .any(|&f| !surface.is_hole(f as usize))
     };
+    // Up to four usable vertices, spread from a seeded start.
+    let start = ((seed >> 7) % nv as u64) as usize;
+    let stride = (nv / 4).max(1);
     let mut chosen: Vec<usize> = Vec::new();
-    for k in 0..4u64 {
-        let v = ((seed.wrapping_mul(k + 1) >> 7) % nv as u64) as usize;
+    for k in 0..nv {
+        let v = (start + k * stride + k / 4) % nv;
+        if chosen.len() == 4 {
+            break;
+        }
         if usable(v) && !chosen.contains(&v) {
             chosen.push(v);
         }
@@ -325,7 +331,10 @@ fn compare_edit(
     }
     if cs.is_empty() {
         row.error = 0.0;
-        row.note = Some("no vertex with an exact OpenSubdiv limit, not checked".into());
+        row.note = Some(
+            "no vertex on the surface (off holes) with an exact OpenSubdiv limit, not checked"
+                .into(),
+        );
         return row;
     }
     let m = match method {
