@@ -228,8 +228,7 @@ pub(crate) fn run(
         let q = match editor.energy.take() {
             Some(q) => q,
             None => {
-                let free = subd_editing::solve::region(topo, editor.free_vertices(), Some(0));
-                let faces = faces_of(topo, &free);
+                let faces = subd_editing::solve::faces_touching(topo, editor.free_vertices());
                 EnergyMatrix::new(&ev, topo.num_vertices(), &faces, &EnergyOptions::default())
                     .map_err(named)?
             }
@@ -303,16 +302,6 @@ pub(crate) fn run(
         crate::print_json(out, &report);
     }
     Ok(())
-}
-
-fn faces_of(topo: &subd_mesh::Topology, vertices: &[u32]) -> Vec<usize> {
-    let mut f: Vec<usize> = vertices
-        .iter()
-        .flat_map(|&v| topo.vertex_faces(v as usize).iter().map(|&f| f as usize))
-        .collect();
-    f.sort_unstable();
-    f.dedup();
-    f
 }
 
 #[derive(Debug, Args)]

@@ -546,15 +546,3 @@ impl EnergyMatrix {
         e
     }
 }
-
-/// The thin-plate energy of the limit surface over all faces of `ev`'s mesh, for positions
-/// `x`: the quadratic form above, evaluated once (convenience for reports).
-pub fn surface_energy(
-    ev: &LimitEvaluator,
-    num_faces: usize,
-    x: &[DVec3],
-    options: &EnergyOptions,
-) -> Result<f64, EditError> {
-    let faces: Vec<usize> = (0..num_faces).collect();
-    Ok(EnergyMatrix::new(ev, x.len(), &faces, options)?.energy(x))
-}

@@ -420,8 +420,9 @@ pub fn region(topology: &Topology, seed: &[u32], rings: Option<usize>) -> Vec<u3
         .collect()
 }
 
-/// Faces with a vertex in `vertices` (ascending).
-fn faces_touching(topology: &Topology, vertices: &[u32]) -> Vec<usize> {
+/// Faces with a vertex in `vertices` (ascending): the faces an edit of those vertices
+/// can change.
+pub fn faces_touching(topology: &Topology, vertices: &[u32]) -> Vec<usize> {
     let mut f: Vec<usize> = vertices
         .iter()
         .flat_map(|&v| {
