@@ -1,4 +1,5 @@
-//! `subd refine`: uniform Catmull-Clark, Loop or Bilinear refinement of a mesh file.
+//! `subd refine`: uniform refinement of a mesh file with Catmull-Clark, Loop or Bilinear
+//! (OpenSubdiv's schemes), seed 000's two-phase scheme, or Doo-Sabin, √3 and the butterflies.
 
 use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
@@ -7,7 +8,8 @@ use std::time::Instant;
 use clap::{Args, ValueEnum};
 use serde::Serialize;
 use subd_mesh::{BoundaryInterpolation, CreaseMethod, SchemeHints, TriangleSubdivision};
-use subd_schemes::{Refinement, Scheme};
+use subd_schemes::split_schemes::{SplitRefinement, SplitScheme};
+use subd_schemes::{ExplicitTags, Refinement, Scheme};
 
 use crate::failure::{bad, refuse_overwrite};
 use crate::rule_args::RuleArgs;
@@ -21,16 +23,37 @@ pub(crate) enum SchemeArg {
     Bilinear,
     /// Seed 000's two-phase modified Catmull-Clark (needs --lambda or --lambda-file).
     TwoPhase,
+    /// Doo-Sabin's dual scheme, any polygons.
+    DooSabin,
+    /// Kobbelt's √3 scheme, triangles.
+    Sqrt3,
+    /// The interpolating butterfly scheme (Dyn, Levin, Gregory), triangles; see --tension.
+    Butterfly,
+    /// Zorin, Schröder and Sweldens' modified butterfly, triangles.
+    ModifiedButterfly,
+}
+
+/// Which family a scheme argument belongs to.
+enum Chosen {
+    /// OpenSubdiv's schemes and the two-phase scheme, which refines with Catmull-Clark's
+    /// topology and rules after its first step.
+    Osd(Scheme),
+    /// A scheme of `subd_schemes::split_schemes`.
+    Split(SplitScheme),
 }
 
 impl SchemeArg {
-    /// The refinement scheme (two-phase refines with Catmull-Clark's topology and rules
-    /// after its first step).
-    pub(crate) fn scheme(self) -> Scheme {
+    fn chosen(self, tension: Option<f64>) -> Chosen {
         match self {
-            SchemeArg::CatmullClark | SchemeArg::TwoPhase => Scheme::CatmullClark,
-            SchemeArg::Loop => Scheme::Loop,
-            SchemeArg::Bilinear => Scheme::Bilinear,
+            SchemeArg::CatmullClark | SchemeArg::TwoPhase => Chosen::Osd(Scheme::CatmullClark),
+            SchemeArg::Loop => Chosen::Osd(Scheme::Loop),
+            SchemeArg::Bilinear => Chosen::Osd(Scheme::Bilinear),
+            SchemeArg::DooSabin => Chosen::Split(SplitScheme::DooSabin),
+            SchemeArg::Sqrt3 => Chosen::Split(SplitScheme::Sqrt3),
+            SchemeArg::Butterfly => Chosen::Split(SplitScheme::Butterfly {
+                tension: tension.unwrap_or(1.0 / 16.0),
+            }),
+            SchemeArg::ModifiedButterfly => Chosen::Split(SplitScheme::ModifiedButterfly),
         }
     }
 
@@ -41,6 +64,10 @@ impl SchemeArg {
             SchemeArg::Loop => "loop",
             SchemeArg::Bilinear => "bilinear",
             SchemeArg::TwoPhase => "two-phase",
+            SchemeArg::DooSabin => "doo-sabin",
+            SchemeArg::Sqrt3 => "sqrt3",
+            SchemeArg::Butterfly => "butterfly",
+            SchemeArg::ModifiedButterfly => "modified-butterfly",
         }
     }
 }
@@ -53,6 +80,9 @@ pub(crate) struct RefineArgs {
     /// Number of uniform refinement levels (0 to 15; for two-phase, level 1 is phase 1).
     #[arg(long)]
     levels: usize,
+    /// Tension w of --scheme butterfly (default 1/16, the classic scheme).
+    #[arg(long, allow_hyphen_values = true)]
+    tension: Option<f64>,
     #[command(flatten)]
     lambda: LambdaArgs,
     #[command(flatten)]
@@ -88,13 +118,75 @@ struct RefineReport {
     output: String,
     scheme: &'static str,
     levels: usize,
-    boundary_interpolation: BoundaryInterpolation,
-    crease_method: CreaseMethod,
-    triangle_subdivision: TriangleSubdivision,
+    /// The butterfly's tension.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    tension: Option<f64>,
+    /// OpenSubdiv's rule options (its schemes only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    boundary_interpolation: Option<BoundaryInterpolation>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    crease_method: Option<CreaseMethod>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    triangle_subdivision: Option<TriangleSubdivision>,
     input_counts: Counts,
     output_counts: Counts,
     seconds: Timings,
     warnings: Vec<String>,
+}
+
+/// A refinement of either family, reduced to what writing its last level needs.
+enum Refined {
+    Osd(Refinement),
+    Split(SplitRefinement),
+}
+
+impl Refined {
+    fn faces(&self, level: usize) -> (&[u32], &[u32]) {
+        match self {
+            Refined::Osd(r) => r.faces(level),
+            Refined::Split(r) => {
+                let t = r.topology(level);
+                (t.face_offsets(), t.all_face_vertices())
+            }
+        }
+    }
+
+    fn explicit_tags(&self, level: usize) -> ExplicitTags {
+        match self {
+            Refined::Osd(r) => r.explicit_tags(level),
+            Refined::Split(r) => split_tags(r.topology(level)),
+        }
+    }
+
+    fn num_edges(&self, level: usize) -> usize {
+        match self {
+            Refined::Osd(r) => r.num_edges(level),
+            Refined::Split(r) => r.topology(level).num_edges(),
+        }
+    }
+
+    fn last_positions(&self, base: &[subd_mesh::DVec3]) -> Vec<subd_mesh::DVec3> {
+        let mut levels = match self {
+            Refined::Osd(r) => r.refine_points(base),
+            Refined::Split(r) => r.refine_points(base),
+        };
+        levels.pop().expect("last level")
+    }
+}
+
+/// The tags a split scheme carries that a reader cannot infer: infinitely sharp interior
+/// creases and corner tags.
+fn split_tags(t: &subd_mesh::Topology) -> ExplicitTags {
+    ExplicitTags {
+        creases: (0..t.num_edges())
+            .filter(|&e| t.edge_sharpness(e) > 0.0 && !t.is_boundary_edge(e))
+            .map(|e| (t.edge_vertices(e), t.edge_sharpness(e)))
+            .collect(),
+        corners: (0..t.num_vertices() as u32)
+            .filter(|&v| t.vertex_sharpness(v as usize) > 0.0)
+            .map(|v| (v, t.vertex_sharpness(v as usize)))
+            .collect(),
+    }
 }
 
 pub(crate) fn run(
@@ -110,10 +202,17 @@ pub(crate) fn run(
             args.output.display()
         )));
     }
+    if args.tension.is_some() && !matches!(args.scheme, SchemeArg::Butterfly) {
+        return Err(bad("--tension applies to --scheme butterfly only".into()));
+    }
+    if let Some(w) = args.tension
+        && !w.is_finite()
+    {
+        return Err(bad(format!("--tension {w}: must be a finite number")));
+    }
     let file = subd_io::read_mesh(&args.input, &args.rules.read_options())?;
     print_warnings(err, &args.input, &file.warnings);
     let t_read = t_start.elapsed().as_secs_f64();
-    let scheme = args.scheme.scheme();
     let options = args.rules.options(&file.mesh.hints);
     let base = &file.mesh.topology;
     let two_phase = match args.scheme {
@@ -125,42 +224,61 @@ pub(crate) fn run(
         }
         _ => None,
     };
+    let chosen = args.scheme.chosen(args.tension);
 
     let progress = Progress::new(args.levels, args.json);
     let t0 = Instant::now();
-    let refinement = match &two_phase {
-        Some(tp) => Refinement::two_phase(base, tp, &options, args.levels),
-        None => Refinement::new(base, scheme, &options, args.levels),
-    }
-    .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
+    let in_file = |e: &dyn std::fmt::Display| bad(format!("{}: {e}", args.input.display()));
+    let refinement = match (&chosen, &two_phase) {
+        (Chosen::Osd(_), Some(tp)) => Refined::Osd(
+            Refinement::two_phase(base, tp, &options, args.levels).map_err(|e| in_file(&e))?,
+        ),
+        (Chosen::Osd(scheme), None) => Refined::Osd(
+            Refinement::new(base, *scheme, &options, args.levels).map_err(|e| in_file(&e))?,
+        ),
+        (Chosen::Split(scheme), _) => Refined::Split(
+            SplitRefinement::new(base, *scheme, args.levels).map_err(|e| in_file(&e))?,
+        ),
+    };
     progress.step("topology");
     let t_topology = t0.elapsed().as_secs_f64();
     let t1 = Instant::now();
-    let mut levels = refinement.refine_points(&file.mesh.positions);
-    let positions = levels.pop().expect("last level");
-    drop(levels);
+    let positions = refinement.last_positions(&file.mesh.positions);
     progress.step("positions");
     let t_positions = t1.elapsed().as_secs_f64();
 
     let t2 = Instant::now();
-    let hints = SchemeHints {
-        boundary_interpolation: Some(options.boundary_interpolation),
-        crease_method: Some(options.crease_method),
-        triangle_subdivision: file
-            .mesh
-            .hints
-            .triangle_subdivision
-            .or(args.rules.triangles.map(|_| options.triangle_subdivision)),
+    // OpenSubdiv's rule options are recorded only for its schemes.
+    let osd = matches!(chosen, Chosen::Osd(_));
+    let hints = if osd {
+        SchemeHints {
+            boundary_interpolation: Some(options.boundary_interpolation),
+            crease_method: Some(options.crease_method),
+            triangle_subdivision: file
+                .mesh
+                .hints
+                .triangle_subdivision
+                .or(args.rules.triangles.map(|_| options.triangle_subdivision)),
+        }
+    } else {
+        SchemeHints::default()
     };
     // Polygons, holes and the tags a reader cannot infer are all the file holds: they are
     // written without building the output level's edges (most of the time and memory of a
     // deep refinement's output).
     let (offsets, vertices) = refinement.faces(args.levels);
     let tags = refinement.explicit_tags(args.levels);
-    let mut view =
-        subd_io::MeshView::new(&positions, offsets, vertices, refinement.holes(args.levels))
-            .and_then(|v| v.with_tags(tags.creases, tags.corners))
-            .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
+    let no_holes;
+    let holes = match &refinement {
+        Refined::Osd(r) => r.holes(args.levels),
+        Refined::Split(_) => {
+            no_holes = vec![false; offsets.len() - 1];
+            &no_holes[..]
+        }
+    };
+    let mut view = subd_io::MeshView::new(&positions, offsets, vertices, holes)
+        .and_then(|v| v.with_tags(tags.creases, tags.corners))
+        .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
     view.hints = hints;
     subd_io::write_view(&args.output, &view, &subd_io::WriteOptions::default())?;
     let out_counts = Counts {
@@ -177,9 +295,13 @@ pub(crate) fn run(
             output: args.output.display().to_string(),
             scheme: args.scheme.name(),
             levels: args.levels,
-            boundary_interpolation: options.boundary_interpolation,
-            crease_method: options.crease_method,
-            triangle_subdivision: options.triangle_subdivision,
+            tension: match chosen {
+                Chosen::Split(SplitScheme::Butterfly { tension }) => Some(tension),
+                _ => None,
+            },
+            boundary_interpolation: osd.then_some(options.boundary_interpolation),
+            crease_method: osd.then_some(options.crease_method),
+            triangle_subdivision: osd.then_some(options.triangle_subdivision),
             input_counts: Counts {
                 vertices: base.num_vertices(),
                 edges: Some(base.num_edges()),

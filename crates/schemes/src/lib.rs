@@ -48,6 +48,7 @@ pub mod curve;
 pub mod memory;
 mod refine;
 pub mod rules;
+pub mod split_schemes;
 pub mod stencil;
 pub mod two_phase;
 

@@ -1,0 +1,385 @@
+//! The schemes of seed 001 §4 that OpenSubdiv does not have: Doo-Sabin, √3 (Kobbelt),
+//! Butterfly (Dyn, Levin, Gregory) and Modified Butterfly (Zorin, Schröder, Sweldens).
+//!
+//! Each is a topology split plus masks, refined one level at a time into a [`SplitRefinement`]:
+//! the topology of every level and a [`StencilTable`] per level, which compose into one table
+//! from the base mesh to any level, as [`crate::Refinement`] does for OpenSubdiv's schemes.
+//!
+//! | scheme | input faces | split | interpolating | boundary | creases |
+//! |---|---|---|---|---|---|
+//! | Doo-Sabin | any polygons | dual (F, E and V faces) | no | Chaikin along the boundary polygon | no |
+//! | √3 | triangles | 1 → 3 with edge flips | no | Kobbelt's: trisected every second step | infinitely sharp |
+//! | Butterfly | triangles | 1 → 4 | yes | 4-point rule | infinitely sharp |
+//! | Modified Butterfly | triangles | 1 → 4 | yes | 4-point rule (see [`butterfly`]) | infinitely sharp |
+//!
+//! Every level is a new [`Topology`]; rows of the stencil tables are built in parallel and do
+//! not depend on the number of threads.
+//!
+//! ```
+//! use subd_mesh::{DVec3, TopologyBuilder};
+//! use subd_schemes::split_schemes::{SplitRefinement, SplitScheme};
+//!
+//! // A tetrahedron, three √3 steps: 4 → 12 → 36 → 108 faces.
+//! let faces = [0, 2, 1, 0, 1, 3, 1, 2, 3, 0, 3, 2];
+//! let topo = TopologyBuilder::new(4).build(&[3; 4], &faces).unwrap();
+//! let r = SplitRefinement::new(&topo, SplitScheme::Sqrt3, 3).unwrap();
+//! assert_eq!(r.topology(3).num_faces(), 108);
+//! let points = [DVec3::X, DVec3::Y, DVec3::Z, DVec3::ONE];
+//! let level3 = r.refine_points(&points).pop().unwrap();
+//! assert_eq!(level3.len(), r.topology(3).num_vertices());
+//! ```
+
+pub mod butterfly;
+pub mod doo_sabin;
+mod features;
+pub mod sqrt3;
+
+use glam::DVec3;
+use subd_mesh::{Topology, TopologyError, tags};
+use thiserror::Error;
+
+use crate::{MAX_LEVELS, StencilTable};
+
+pub use features::Features;
+
+/// A scheme of seed 001 §4 defined by a split and masks (see the [module docs](self)).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SplitScheme {
+    /// Doo-Sabin's dual scheme on any polygons.
+    DooSabin,
+    /// Kobbelt's √3 scheme on triangles.
+    Sqrt3,
+    /// The butterfly scheme of Dyn, Levin and Gregory with tension `w` (1/16 is the classic
+    /// one; 0 is linear interpolation).
+    Butterfly {
+        /// The tension `w`.
+        tension: f64,
+    },
+    /// The modified butterfly scheme of Zorin, Schröder and Sweldens.
+    ModifiedButterfly,
+}
+
+impl SplitScheme {
+    /// The classic butterfly, `w = 1/16`.
+    pub const BUTTERFLY: SplitScheme = SplitScheme::Butterfly {
+        tension: 1.0 / 16.0,
+    };
+
+    /// The scheme's name as the command line spells it.
+    pub fn name(self) -> &'static str {
+        match self {
+            SplitScheme::DooSabin => "doo-sabin",
+            SplitScheme::Sqrt3 => "sqrt3",
+            SplitScheme::Butterfly { .. } => "butterfly",
+            SplitScheme::ModifiedButterfly => "modified-butterfly",
+        }
+    }
+
+    /// Whether the scheme keeps the vertices of every level (the butterflies).
+    pub fn is_interpolating(self) -> bool {
+        matches!(
+            self,
+            SplitScheme::Butterfly { .. } | SplitScheme::ModifiedButterfly
+        )
+    }
+
+    /// Whether the scheme needs triangles (all but Doo-Sabin).
+    pub fn needs_triangles(self) -> bool {
+        self != SplitScheme::DooSabin
+    }
+
+    /// Regular interior valence: 4 for Doo-Sabin's quads, 6 for the triangle schemes.
+    pub fn regular_valence(self) -> usize {
+        if self == SplitScheme::DooSabin { 4 } else { 6 }
+    }
+}
+
+/// Why a mesh cannot be refined with a [`SplitScheme`].
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum SplitError {
+    /// The scheme needs triangles.
+    #[error("face {face} has {size} vertices; the {scheme} scheme needs triangles")]
+    NotTriangle {
+        /// The scheme's name.
+        scheme: &'static str,
+        /// Face index.
+        face: usize,
+        /// Its size.
+        size: usize,
+    },
+    /// A non-manifold edge.
+    #[error("edge {edge} ({a}-{b}) is non-manifold; the {scheme} scheme needs a manifold mesh")]
+    NonManifoldEdge {
+        /// The scheme's name.
+        scheme: &'static str,
+        /// Edge index.
+        edge: usize,
+        /// Its end vertices.
+        a: u32,
+        /// Its end vertices.
+        b: u32,
+    },
+    /// A non-manifold vertex (faces around it that are not one fan).
+    #[error("vertex {vertex} is non-manifold; the {scheme} scheme needs a manifold mesh")]
+    NonManifoldVertex {
+        /// The scheme's name.
+        scheme: &'static str,
+        /// Vertex index.
+        vertex: usize,
+    },
+    /// A tag the scheme has no rule for.
+    #[error("{what}: the {scheme} scheme {why}")]
+    UnsupportedTag {
+        /// The scheme's name.
+        scheme: &'static str,
+        /// The tagged element, e.g. `edge 4 (1-2)`.
+        what: String,
+        /// Why it cannot be used.
+        why: &'static str,
+    },
+    /// A butterfly tension that is not a finite number.
+    #[error("tension {0} is not a finite number")]
+    Tension(f64),
+    /// Too many levels.
+    #[error("{levels} levels requested; at most {max} are supported")]
+    TooManyLevels {
+        /// Requested levels.
+        levels: usize,
+        /// The maximum.
+        max: usize,
+    },
+    /// The refined mesh would not fit 32-bit indices.
+    #[error("level {level} would have more than 2^32 face-vertices")]
+    TooLarge {
+        /// The level that overflows.
+        level: usize,
+    },
+    /// Building a refined level's topology failed (a bug if it ever happens).
+    #[error("level {level}: {source}")]
+    Topology {
+        /// The level.
+        level: usize,
+        /// What the topology builder said.
+        source: TopologyError,
+    },
+}
+
+/// One refined level: its topology and the stencils giving its vertices from the level above.
+#[derive(Debug, Clone)]
+pub struct SplitLevel {
+    /// Topology of the level, with the tags the scheme carries (infinitely sharp creases and
+    /// corners of √3 and the butterflies).
+    pub topology: Topology,
+    /// Child vertices as weighted sums of the parent level's vertices.
+    pub stencils: StencilTable,
+}
+
+/// A uniform refinement with a [`SplitScheme`]: the topology of every level and the stencils
+/// between levels.
+#[derive(Debug, Clone)]
+pub struct SplitRefinement {
+    scheme: SplitScheme,
+    base: Topology,
+    levels: Vec<SplitLevel>,
+}
+
+impl SplitRefinement {
+    /// Refines `base` uniformly `levels` times with `scheme`.
+    ///
+    /// # Errors
+    /// [`SplitError`] for a face the scheme cannot take (triangles for all but Doo-Sabin),
+    /// non-manifold input, tags the scheme has no rule for (semi-sharp creases, holes; any
+    /// crease for Doo-Sabin), a tension that is not finite, or too many levels.
+    pub fn new(
+        base: &Topology,
+        scheme: SplitScheme,
+        levels: usize,
+    ) -> Result<SplitRefinement, SplitError> {
+        check_input(base, scheme, levels)?;
+        let mut out: Vec<SplitLevel> = Vec::with_capacity(levels);
+        for l in 1..=levels {
+            let parent = out.last().map_or(base, |s| &s.topology);
+            let child = match scheme {
+                SplitScheme::DooSabin => doo_sabin::refine(parent),
+                SplitScheme::Sqrt3 => sqrt3::refine(parent, l % 2 == 0),
+                SplitScheme::Butterfly { tension } => {
+                    butterfly::refine(parent, butterfly::EdgeRule::Classic { tension })
+                }
+                SplitScheme::ModifiedButterfly => {
+                    butterfly::refine(parent, butterfly::EdgeRule::Modified)
+                }
+            }
+            .map_err(|e| match e {
+                StepError::TooLarge => SplitError::TooLarge { level: l },
+                StepError::Topology(source) => SplitError::Topology { level: l, source },
+            })?;
+            out.push(child);
+        }
+        Ok(SplitRefinement {
+            scheme,
+            base: base.clone(),
+            levels: out,
+        })
+    }
+
+    /// The scheme.
+    pub fn scheme(&self) -> SplitScheme {
+        self.scheme
+    }
+
+    /// Number of refined levels.
+    pub fn num_levels(&self) -> usize {
+        self.levels.len()
+    }
+
+    /// Topology of `level` (0 is the base mesh).
+    pub fn topology(&self, level: usize) -> &Topology {
+        match level {
+            0 => &self.base,
+            l => &self.levels[l - 1].topology,
+        }
+    }
+
+    /// Stencils giving the vertices of `level` from those of `level - 1` (`level ≥ 1`).
+    pub fn stencils(&self, level: usize) -> &StencilTable {
+        &self.levels[level - 1].stencils
+    }
+
+    /// One table from the base vertices to the vertices of `level`.
+    pub fn composed(&self, level: usize) -> StencilTable {
+        let mut t = StencilTable::identity(self.base.num_vertices());
+        for l in 1..=level {
+            t = t.then(self.stencils(l));
+        }
+        t
+    }
+
+    /// Positions of every level from base positions (`result[0]` is `base`).
+    ///
+    /// # Panics
+    /// If `base.len()` differs from the number of base vertices.
+    pub fn refine_points(&self, base: &[DVec3]) -> Vec<Vec<DVec3>> {
+        assert_eq!(
+            base.len(),
+            self.base.num_vertices(),
+            "one position per base vertex"
+        );
+        let mut out = vec![base.to_vec()];
+        for level in &self.levels {
+            let next = level.stencils.apply_points(out.last().expect("level 0"));
+            out.push(next);
+        }
+        out
+    }
+
+    /// The last level's topology, the refinement consumed.
+    pub fn into_last_topology(mut self) -> Topology {
+        match self.levels.pop() {
+            Some(l) => l.topology,
+            None => self.base,
+        }
+    }
+}
+
+/// What a single step can fail with; [`SplitRefinement::new`] adds the level.
+#[derive(Debug)]
+pub(crate) enum StepError {
+    TooLarge,
+    Topology(TopologyError),
+}
+
+impl From<TopologyError> for StepError {
+    fn from(e: TopologyError) -> Self {
+        StepError::Topology(e)
+    }
+}
+
+/// The checks every split scheme makes on its input before the first step.
+fn check_input(base: &Topology, scheme: SplitScheme, levels: usize) -> Result<(), SplitError> {
+    let name = scheme.name();
+    if levels > MAX_LEVELS {
+        return Err(SplitError::TooManyLevels {
+            levels,
+            max: MAX_LEVELS,
+        });
+    }
+    if let SplitScheme::Butterfly { tension } = scheme
+        && !tension.is_finite()
+    {
+        return Err(SplitError::Tension(tension));
+    }
+    if scheme.needs_triangles()
+        && let Some(f) = (0..base.num_faces()).find(|&f| base.face_size(f) != 3)
+    {
+        return Err(SplitError::NotTriangle {
+            scheme: name,
+            face: f,
+            size: base.face_size(f),
+        });
+    }
+    if let Some(e) = (0..base.num_edges()).find(|&e| base.is_non_manifold_edge(e)) {
+        let [a, b] = base.edge_vertices(e);
+        return Err(SplitError::NonManifoldEdge {
+            scheme: name,
+            edge: e,
+            a,
+            b,
+        });
+    }
+    if let Some(v) = (0..base.num_vertices()).find(|&v| base.is_non_manifold_vertex(v)) {
+        return Err(SplitError::NonManifoldVertex {
+            scheme: name,
+            vertex: v,
+        });
+    }
+    if let Some(f) = (0..base.num_faces()).find(|&f| base.is_hole(f)) {
+        return Err(SplitError::UnsupportedTag {
+            scheme: name,
+            what: format!("face {f}"),
+            why: "has no rule for holes",
+        });
+    }
+    for e in 0..base.num_edges() {
+        let s = base.edge_sharpness(e);
+        if s <= 0.0 || base.is_boundary_edge(e) {
+            continue;
+        }
+        let [a, b] = base.edge_vertices(e);
+        let what = format!("edge {e} ({a}-{b}) crease {s}");
+        if scheme == SplitScheme::DooSabin {
+            return Err(SplitError::UnsupportedTag {
+                scheme: name,
+                what,
+                why: "has no crease rule",
+            });
+        }
+        if !tags::is_infinite(s) {
+            return Err(SplitError::UnsupportedTag {
+                scheme: name,
+                what,
+                why: "supports only infinitely sharp creases",
+            });
+        }
+    }
+    if scheme == SplitScheme::DooSabin
+        && let Some(v) = (0..base.num_vertices()).find(|&v| base.vertex_sharpness(v) > 0.0)
+    {
+        return Err(SplitError::UnsupportedTag {
+            scheme: name,
+            what: format!("vertex {v} corner {}", base.vertex_sharpness(v)),
+            why: "has no corner rule",
+        });
+    }
+    Ok(())
+}
+
+/// Guards the 32-bit indices of a child level with `face_vertices` face-vertices.
+fn check_size(face_vertices: u64) -> Result<(), StepError> {
+    if face_vertices >= u32::MAX as u64 {
+        Err(StepError::TooLarge)
+    } else {
+        Ok(())
+    }
+}
