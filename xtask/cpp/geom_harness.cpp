@@ -14,9 +14,10 @@
 // Build (header-only CGAL with Simple_cartesian<double> needs neither GMP nor MPFR; OpenMesh's
 // subdividers are header templates and only need libOpenMeshCore; -frounding-math is what CGAL
 // asks for and costs nothing here; asserts are left on on purpose so that misuse aborts loudly):
-//   mkdir -p target/xtask && g++ -O2 -std=c++17 -frounding-math -o target/xtask/geom_harness \
-//       xtask/cpp/geom_harness.cpp -lOpenMeshCore
-//   (takes ~35-40 s on one core, ~1.2 GB peak memory; -lOpenMeshTools is not needed)
+//   mkdir -p target/xtask
+//   g++ -O2 -std=c++17 -frounding-math -o target/xtask/geom_harness xtask/cpp/geom_harness.cpp -lOpenMeshCore
+//   (about 12-13 s wall on one core, ~800 MB peak memory, g++ 12.2; -lOpenMeshTools, -lgmp and
+//   -lmpfr are not needed; adding them is harmless)
 //
 // Input and output are ASCII OFF. The reader here parses coordinates with strtod (full double
 // precision; '#' comments, optional per-face colour columns after the indices are ignored); the
@@ -25,9 +26,10 @@
 //
 // Exit status: 0 success; 3 unsupported LIBRARY/SCHEME combination or an input that is rejected
 // (by the library, or by the harness's own checks below, which reject what the libraries would
-// silently mishandle: faces with < 3 or repeated vertices, non-triangles for sqrt3/loop/butterfly,
-// an edge used by more than two faces or twice in the same direction (non-manifold or
-// inconsistently oriented), a vertex whose faces do not form a single fan, unreferenced vertices);
+// silently mishandle or assert on: faces with < 3 or repeated vertices, non-triangles for
+// sqrt3/loop/butterfly, an edge used by more than two faces or twice in the same direction
+// (non-manifold or inconsistently oriented), a vertex whose faces do not form a single fan,
+// unreferenced vertices, and for the triangle schemes an interior vertex of valence < 3);
 // one line is printed to stderr. 2: usage, I/O or OFF syntax error.
 //
 // Debug knobs (environment variables, not part of the interface):
@@ -231,6 +233,11 @@ void validate(const Mesh& m, bool triangles_only) {
         }
         if (visited != corners[v].size())
             reject("non-manifold vertex " + std::to_string(v) + " (faces do not form one fan)");
+        // In a triangle mesh an interior vertex of valence < 3 means two triangles sharing two
+        // edges; OpenMesh's Sqrt3T (flip) and ModifiedButterflyT assert on it. (In polygon meshes
+        // an interior valence-2 vertex is legitimate and kept for catmull-clark / doo-sabin.)
+        if (triangles_only && starts == 0 && corners[v].size() < 3)
+            reject("degenerate triangle mesh: interior vertex " + std::to_string(v) + " has valence < 3");
     }
 }
 

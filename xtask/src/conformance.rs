@@ -42,7 +42,7 @@ pub struct Row {
 
 impl Row {
     /// A row not decided yet: infinite error, nothing found.
-    fn pending(mesh: &str, check: &'static str, level: usize) -> Row {
+    pub(crate) fn pending(mesh: &str, check: &'static str, level: usize) -> Row {
         Row {
             mesh: mesh.to_string(),
             check,
@@ -1109,7 +1109,7 @@ pub fn random(exe: &Path, count: u64) -> Vec<Row> {
 /// Prints the table and returns whether every row passed.
 pub fn report(rows: &[Row]) -> bool {
     println!(
-        "{:<36} {:<6} {:>5} {:>9} {:>12} {:>10}  status",
+        "{:<36} {:<18} {:>5} {:>9} {:>12} {:>10}  status",
         "mesh", "check", "level", "vertices", "max|Δ|/diag", "normal Δ"
     );
     let mut ok = true;
@@ -1131,7 +1131,7 @@ pub fn report(rows: &[Row]) -> bool {
             .as_deref()
             .map_or_else(String::new, |n| format!("; {n}"));
         println!(
-            "{:<36} {:<6} {:>5} {:>9} {:>12.3e} {:>10}  {}{}{}",
+            "{:<36} {:<18} {:>5} {:>9} {:>12.3e} {:>10}  {}{}{}",
             r.mesh,
             r.check,
             r.level,

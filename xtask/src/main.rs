@@ -11,6 +11,8 @@ mod adaptive_bench;
 mod bench;
 mod conformance;
 mod editing_bench;
+mod geom_conformance;
+mod geom_ref;
 mod osd;
 mod pia_bench;
 mod random_mesh;
@@ -117,14 +119,22 @@ enum Task {
     },
 }
 
-/// System packages the OpenSubdiv harness needs: (file that proves it is there, Debian
+/// System packages the reference harnesses (OpenSubdiv, CGAL, OpenMesh) need: (file that proves it is there, Debian
 /// package). The unit and integration tests need none.
-const OPENSUBDIV_PACKAGES: &[(&str, &str)] = &[
+const REFERENCE_PACKAGES: &[(&str, &str)] = &[
     (
         "/usr/include/opensubdiv/far/topologyRefinerFactory.h",
         "libosd-dev",
     ),
     ("/usr/bin/g++", "g++"),
+    (
+        "/usr/include/CGAL/Subdivision_method_3/subdivision_methods_3.h",
+        "libcgal-dev",
+    ),
+    (
+        "/usr/include/OpenMesh/Tools/Subdivider/Uniform/Sqrt3T.hh",
+        "libopenmesh-dev",
+    ),
 ];
 
 fn is_root() -> bool {
@@ -180,11 +190,14 @@ fn main() -> ExitCode {
             .args(["test", "--workspace", "--release"])
             .arg("--")
             .args(&extra)),
-        Task::Conformance { shapes, random } => ensure_system_packages(OPENSUBDIV_PACKAGES)
+        Task::Conformance { shapes, random } => ensure_system_packages(REFERENCE_PACKAGES)
             .and_then(|_| {
                 let exe = osd::build_harness()?;
+                let geom = geom_ref::build_harness()?;
                 let mut rows = conformance::shapes(&exe, &shapes)?;
                 rows.extend(conformance::random(&exe, random));
+                rows.extend(geom_conformance::shapes(&geom, &shapes)?);
+                rows.extend(geom_conformance::random(&geom, random));
                 if conformance::report(&rows) {
                     Ok(())
                 } else {
@@ -217,12 +230,12 @@ fn main() -> ExitCode {
             } else if editing_only {
                 editing_bench::run(repeats)
             } else if adaptive_only {
-                ensure_system_packages(OPENSUBDIV_PACKAGES)
+                ensure_system_packages(REFERENCE_PACKAGES)
                     .and_then(|_| adaptive_bench::run(repeats))
             } else if refine_only {
-                ensure_system_packages(OPENSUBDIV_PACKAGES).and_then(|_| refinement())
+                ensure_system_packages(REFERENCE_PACKAGES).and_then(|_| refinement())
             } else {
-                ensure_system_packages(OPENSUBDIV_PACKAGES)
+                ensure_system_packages(REFERENCE_PACKAGES)
                     .and_then(|_| if eval_only { Ok(()) } else { refinement() })
                     .and_then(|_| bench::run_eval(repeats))
                     .and_then(|_| {

@@ -5,8 +5,10 @@ use std::io::Write;
 
 use clap::{Args, ValueEnum};
 use serde::Serialize;
+use subd_limit::split_eigen::{FourierEigenvalue, SpectrumTest, split_spectrum};
 use subd_schemes::Scheme;
 use subd_schemes::analysis::{Lattice, analyze, analyze_bivariate};
+use subd_schemes::split_schemes::SplitScheme;
 
 use crate::Failure;
 use crate::failure::bad;
@@ -15,6 +17,13 @@ use crate::failure::bad;
 pub(crate) enum SurfaceArg {
     CatmullClark,
     Loop,
+    /// Around an n-sided face.
+    DooSabin,
+    /// Over two steps (one step turns the mesh).
+    Sqrt3,
+    /// With --tension (default 1/16).
+    Butterfly,
+    ModifiedButterfly,
 }
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
@@ -51,9 +60,12 @@ pub(crate) struct AnalyzeArgs {
     /// matrix at an interior vertex of valence --valence.
     #[arg(long, value_enum, requires = "valence")]
     surface: Option<SurfaceArg>,
-    /// Valence for --surface.
+    /// Valence for --surface (the number of sides of the centre face for doo-sabin).
     #[arg(long)]
     valence: Option<usize>,
+    /// Tension w of --surface butterfly (default 1/16).
+    #[arg(long, allow_hyphen_values = true, requires = "surface")]
+    tension: Option<f64>,
     /// Print a JSON report on stdout.
     #[arg(long)]
     json: bool,
@@ -70,8 +82,27 @@ struct SurfaceReport {
 }
 
 pub(crate) fn run(args: &AnalyzeArgs, out: &mut dyn Write) -> Result<(), Failure> {
+    if args.tension.is_some() && !matches!(args.surface, Some(SurfaceArg::Butterfly)) {
+        return Err(bad("--tension applies to --surface butterfly only".into()));
+    }
     if let (Some(surface), Some(n)) = (args.surface, args.valence) {
-        return run_surface(surface, n, args.json, out);
+        let split = match surface {
+            SurfaceArg::CatmullClark | SurfaceArg::Loop => None,
+            SurfaceArg::DooSabin => Some(SplitScheme::DooSabin),
+            SurfaceArg::Sqrt3 => Some(SplitScheme::Sqrt3),
+            SurfaceArg::Butterfly => {
+                let tension = args.tension.unwrap_or(1.0 / 16.0);
+                if !tension.is_finite() {
+                    return Err(bad(format!("--tension {tension}: must be a finite number")));
+                }
+                Some(SplitScheme::Butterfly { tension })
+            }
+            SurfaceArg::ModifiedButterfly => Some(SplitScheme::ModifiedButterfly),
+        };
+        return match split {
+            Some(scheme) => run_split_surface(scheme, n, args.json, out),
+            None => run_surface(surface, n, args.json, out),
+        };
     }
     if let Some(text) = &args.mask2 {
         return run_bivariate(text, args, out);
@@ -215,8 +246,8 @@ fn run_surface(
     out: &mut dyn Write,
 ) -> Result<(), Failure> {
     let (scheme, name, min) = match surface {
-        SurfaceArg::CatmullClark => (Scheme::CatmullClark, "catmull-clark", 3),
         SurfaceArg::Loop => (Scheme::Loop, "loop", 3),
+        _ => (Scheme::CatmullClark, "catmull-clark", 3),
     };
     if !(min..=64).contains(&n) {
         return Err(bad(format!("--valence {n}: must be {min} to 64")));
@@ -252,6 +283,82 @@ fn run_surface(
         list.join(", "),
         if mods.len() > 6 { ", …" } else { "" },
         if passes { "yes" } else { "no" }
+    );
+    Ok(())
+}
+
+#[derive(Serialize)]
+struct SplitSurfaceReport {
+    scheme: &'static str,
+    valence: usize,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    tension: Option<f64>,
+    /// Steps the matrix covers (2 for √3, whose single step turns the mesh).
+    steps: usize,
+    /// Size of the invariant neighbourhood.
+    ball_size: usize,
+    /// Every eigenvalue with its Fourier frequency, largest modulus first.
+    eigenvalues: Vec<FourierEigenvalue>,
+    test: SpectrumTest,
+}
+
+/// The eigenvalue test of a split scheme (Fourier blocks of its local subdivision matrix).
+fn run_split_surface(
+    scheme: SplitScheme,
+    n: usize,
+    json: bool,
+    out: &mut dyn Write,
+) -> Result<(), Failure> {
+    let name = scheme.name();
+    if !(3..=64).contains(&n) {
+        return Err(bad(format!("--valence {n}: must be 3 to 64")));
+    }
+    let spectrum = split_spectrum(scheme, n).map_err(|e| bad(format!("--surface {name}: {e}")))?;
+    let test = spectrum.test();
+    let steps = if scheme == SplitScheme::Sqrt3 { 2 } else { 1 };
+    if json {
+        crate::print_json(
+            out,
+            &SplitSurfaceReport {
+                scheme: name,
+                valence: n,
+                tension: match scheme {
+                    SplitScheme::Butterfly { tension } => Some(tension),
+                    _ => None,
+                },
+                steps,
+                ball_size: spectrum.ball_size,
+                eigenvalues: spectrum.eigenvalues,
+                test,
+            },
+        );
+        return Ok(());
+    }
+    let list: Vec<String> = spectrum
+        .eigenvalues
+        .iter()
+        .take(6)
+        .map(|e| format!("{:.6} (k={})", e.norm(), e.frequency))
+        .collect();
+    let centre = if scheme == SplitScheme::DooSabin {
+        format!("{n}-sided face")
+    } else {
+        format!("valence {n}")
+    };
+    let _ = writeln!(
+        out,
+        "{name}, {centre}{}: |λ| = [{}{}]; C¹ eigenvalue test: {}",
+        if steps == 2 { " (two steps)" } else { "" },
+        list.join(", "),
+        if spectrum.eigenvalues.len() > 6 {
+            ", …"
+        } else {
+            ""
+        },
+        match &test.reason {
+            None => format!("yes (λ = {:.6}, frequency 1)", test.subdominant),
+            Some(r) => format!("no: {r}"),
+        }
     );
     Ok(())
 }

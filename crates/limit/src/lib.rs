@@ -49,6 +49,7 @@ pub mod masks;
 pub mod patch;
 pub mod point_stencil;
 mod smooth_closed;
+pub mod split_eigen;
 pub mod stam;
 mod table;
 mod two_phase_closed;

@@ -1,0 +1,528 @@
+//! Eigen analysis of the split schemes (Doo-Sabin, √3, the butterflies) around an
+//! extraordinary vertex or face, read off the schemes' own stencils (seed 001 §5).
+//!
+//! The local subdivision matrix is not written down by hand. A disc of `K` rings of regular
+//! faces around a centre of valence `n` is refined once, and both levels are labelled the
+//! same way: a breadth-first walk from a root (the centre and one of its edges) that visits
+//! the neighbours of every vertex counter-clockwise from the one it was reached from. The
+//! children of the ball of radius `r` around the centre, in that labelling, are a linear
+//! function of the ball itself once `r` is large enough (the ball is *invariant*); that
+//! function is the local subdivision matrix `S`.
+//!
+//! Turning the root one sector gives the rotation `R` of the ball, which commutes with `S`.
+//! So `S` splits into one block per Fourier frequency `k = 0 … n−1`:
+//! `Ŝ_k[o′, o] = Σ_t ω^{kt} S[o′, R^t o]` over the rotation orbits `o` (`ω = e^{2πi/n}`), and
+//! every eigenvalue comes with the frequency of its eigenvector. The test of smoothness
+//! (Reif's conditions on the spectrum) is then: `1` simple, the subdominant eigenvalue `λ`
+//! real, positive and double, from frequencies 1 and `n − 1` (a characteristic map that
+//! winds once around the centre), and every other eigenvalue smaller than `λ` in modulus.
+//!
+//! Doo-Sabin is analysed around an `n`-sided face (its extraordinary elements): the disc is
+//! a quad disc around a valence-`n` vertex refined once, whose vertex face is that `n`-gon.
+
+use std::f64::consts::TAU;
+
+use faer::{Mat, c64};
+use subd_mesh::{Topology, TopologyBuilder};
+use subd_schemes::split_schemes::{SplitRefinement, SplitScheme};
+
+use crate::LimitError;
+
+/// One eigenvalue of a local subdivision matrix and the Fourier frequency of its eigenvector
+/// (`min(k, n − k)`).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct FourierEigenvalue {
+    /// Real part.
+    pub re: f64,
+    /// Imaginary part.
+    pub im: f64,
+    /// Frequency `min(k, n − k)`.
+    pub frequency: usize,
+}
+
+impl FourierEigenvalue {
+    /// Modulus.
+    pub fn norm(&self) -> f64 {
+        self.re.hypot(self.im)
+    }
+}
+
+/// The spectrum of a split scheme's local subdivision matrix at one valence.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct SplitSpectrum {
+    /// Valence of the centre (sides of the centre face for Doo-Sabin).
+    pub valence: usize,
+    /// Size of the invariant ball the matrix acts on.
+    pub ball_size: usize,
+    /// Every eigenvalue, largest modulus first (ties: lower frequency first).
+    pub eigenvalues: Vec<FourierEigenvalue>,
+}
+
+/// The verdict of the eigenvalue test.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct SpectrumTest {
+    /// Whether the spectrum meets the conditions (see the module docs).
+    pub passes: bool,
+    /// The subdominant eigenvalue's modulus.
+    pub subdominant: f64,
+    /// Frequency of the subdominant eigenvalue.
+    pub subdominant_frequency: usize,
+    /// What fails, when something does.
+    pub reason: Option<String>,
+}
+
+impl SplitSpectrum {
+    /// Reif's necessary conditions for a C¹ limit at the centre, on the spectrum.
+    ///
+    /// Eigenvalues within 1e-5 of each other in modulus count as one (a defective eigenvalue
+    /// comes out of a floating-point solver split by about the cube root of the rounding).
+    pub fn test(&self) -> SpectrumTest {
+        const CLUSTER: f64 = 1e-5;
+        let ev = &self.eigenvalues;
+        let sub = ev.get(1).copied().unwrap_or(FourierEigenvalue {
+            re: 0.0,
+            im: 0.0,
+            frequency: 0,
+        });
+        let mu = sub.norm();
+        let fail = |reason: String| SpectrumTest {
+            passes: false,
+            subdominant: mu,
+            subdominant_frequency: sub.frequency,
+            reason: Some(reason),
+        };
+        let one = ev[0];
+        if (one.re - 1.0).abs() > 1e-9 || one.im.abs() > 1e-9 || mu > 1.0 - CLUSTER {
+            return fail("the eigenvalue 1 is not simple and dominant".into());
+        }
+        let cluster: Vec<&FourierEigenvalue> = ev[1..]
+            .iter()
+            .filter(|e| (e.norm() - mu).abs() <= CLUSTER)
+            .collect();
+        let mut frequencies: Vec<usize> = cluster.iter().map(|e| e.frequency).collect();
+        frequencies.sort_unstable();
+        frequencies.dedup();
+        let list = frequencies
+            .iter()
+            .map(|k| k.to_string())
+            .collect::<Vec<_>>()
+            .join(", ");
+        if cluster.len() != 2 {
+            return fail(format!(
+                "the subdominant modulus {mu:.6} has multiplicity {} (frequencies {list}), not 2",
+                cluster.len()
+            ));
+        }
+        if frequencies != [1] {
+            return fail(format!(
+                "the subdominant eigenvalues {mu:.6} have frequency {list}: the characteristic map winds {list} times around the centre"
+            ));
+        }
+        if cluster.iter().any(|e| e.im.abs() > CLUSTER || e.re <= 0.0) {
+            return fail(format!(
+                "the subdominant eigenvalue {:.6}{:+.6}i is not real and positive",
+                sub.re, sub.im
+            ));
+        }
+        SpectrumTest {
+            passes: true,
+            subdominant: mu,
+            subdominant_frequency: 1,
+            reason: None,
+        }
+    }
+}
+
+/// A disc of `rings` rings of regular faces (triangles, or quads) around vertex 0 of valence
+/// `n`: sector `s` holds the lattice points `i·e_s + j·e_{s+1}`.
+fn disc(n: usize, rings: usize, quads: bool) -> Result<Topology, LimitError> {
+    let k = rings;
+    // Vertices of sector s with i ≥ 1 (the points with i = 0 belong to sector s − 1 … or the
+    // centre); quads take the full square, triangles the lattice triangle i + j ≤ K.
+    let in_sector = |i: usize, j: usize| if quads { i <= k && j <= k } else { i + j <= k };
+    let per_sector: Vec<(usize, usize)> = (1..=k)
+        .flat_map(|i| (0..=k).map(move |j| (i, j)))
+        .filter(|&(i, j)| in_sector(i, j))
+        .collect();
+    let index_of = |i: usize, j: usize| per_sector.iter().position(|&p| p == (i, j));
+    let m = per_sector.len();
+    let id = |s: usize, i: usize, j: usize| -> u32 {
+        if i == 0 && j == 0 {
+            0
+        } else if i == 0 {
+            (1 + ((s + 1) % n) * m + index_of(j, 0).expect("spoke point")) as u32
+        } else {
+            (1 + s * m + index_of(i, j).expect("sector point")) as u32
+        }
+    };
+    let mut sizes = Vec::new();
+    let mut verts = Vec::new();
+    for s in 0..n {
+        for i in 0..k {
+            for j in 0..k {
+                if quads {
+                    sizes.push(4);
+                    verts.extend([
+                        id(s, i, j),
+                        id(s, i + 1, j),
+                        id(s, i + 1, j + 1),
+                        id(s, i, j + 1),
+                    ]);
+                    continue;
+                }
+                if i + j < k {
+                    sizes.push(3);
+                    verts.extend([id(s, i, j), id(s, i + 1, j), id(s, i, j + 1)]);
+                }
+                if i + j + 2 <= k {
+                    sizes.push(3);
+                    verts.extend([id(s, i + 1, j), id(s, i + 1, j + 1), id(s, i, j + 1)]);
+                }
+            }
+        }
+    }
+    TopologyBuilder::new(1 + n * m)
+        .build(&sizes, &verts)
+        .map_err(|e| LimitError::Analysis(format!("disc of valence {n}: {e}")))
+}
+
+/// The neighbours of `v` counter-clockwise from `from` (which must be one of them).
+fn ring_from(t: &Topology, v: u32, from: u32) -> Vec<u32> {
+    let ring: Vec<u32> = t.vertex_ring(v as usize).collect();
+    let start = ring.iter().position(|&u| u == from).unwrap_or(0);
+    (0..ring.len())
+        .map(|i| ring[(start + i) % ring.len()])
+        .collect()
+}
+
+/// Breadth-first labels of the ball of radius `radius` around `seeds` (vertex, the
+/// neighbour its walk starts from), seeds first: `labels[i]` is the vertex labelled `i`.
+fn ball(t: &Topology, seeds: &[(u32, u32)], radius: usize) -> Vec<u32> {
+    let mut label = vec![u32::MAX; t.num_vertices()];
+    let mut order: Vec<u32> = Vec::new();
+    let mut queue: std::collections::VecDeque<(u32, u32, usize)> = Default::default();
+    for &(v, from) in seeds {
+        label[v as usize] = order.len() as u32;
+        order.push(v);
+        queue.push_back((v, from, 0));
+    }
+    while let Some((v, from, d)) = queue.pop_front() {
+        if d == radius {
+            continue;
+        }
+        for u in ring_from(t, v, from) {
+            if label[u as usize] == u32::MAX {
+                label[u as usize] = order.len() as u32;
+                order.push(u);
+                queue.push_back((u, v, d + 1));
+            }
+        }
+    }
+    order
+}
+
+/// A centre to analyse in a topology: its seeds for each of the `n` rotations.
+struct Centre {
+    /// `seeds[t]`: the walk's seeds with the root turned `t` sectors.
+    seeds: Vec<Vec<(u32, u32)>>,
+}
+
+/// The triangle in which `a → b` is an edge (the one left of `a → b`).
+fn face_with_edge(t: &Topology, a: u32, b: u32) -> usize {
+    (0..t.num_faces())
+        .find(|&f| {
+            let fv = t.face_vertices(f);
+            (0..fv.len()).any(|i| fv[i] == a && fv[(i + 1) % fv.len()] == b)
+        })
+        .expect("an interior edge has a face on each side")
+}
+
+/// A vertex centre: the vertex and its ring, turned.
+fn vertex_centre(t: &Topology, v: u32, first: u32) -> Centre {
+    let ring = ring_from(t, v, first);
+    Centre {
+        seeds: (0..ring.len()).map(|s| vec![(v, ring[s])]).collect(),
+    }
+}
+
+/// A face centre: the face's corners in order, each walked from the next, turned.
+fn face_centre(t: &Topology, f: usize) -> Centre {
+    let fv = t.face_vertices(f);
+    let n = fv.len();
+    Centre {
+        seeds: (0..n)
+            .map(|s| {
+                (0..n)
+                    .map(|i| (fv[(s + i) % n], fv[(s + i + 1) % n]))
+                    .collect()
+            })
+            .collect(),
+    }
+}
+
+/// The local subdivision matrix of the ball of `radius`, or `None` when the ball is not
+/// invariant (a child reaches outside it), with the rotation as a permutation of labels.
+fn local_matrix(
+    parent: &Topology,
+    child: &Topology,
+    stencils: &subd_schemes::StencilTable,
+    old: &Centre,
+    new: &Centre,
+    radius: usize,
+) -> Option<(Mat<f64>, Vec<usize>)> {
+    let old_ball = ball(parent, &old.seeds[0], radius);
+    let new_ball = ball(child, &new.seeds[0], radius);
+    if old_ball.len() != new_ball.len() {
+        return None;
+    }
+    let m = old_ball.len();
+    let mut label = vec![usize::MAX; parent.num_vertices()];
+    for (i, &v) in old_ball.iter().enumerate() {
+        label[v as usize] = i;
+    }
+    let mut s = Mat::<f64>::zeros(m, m);
+    for (row, &c) in new_ball.iter().enumerate() {
+        let (idx, w) = stencils.row(c as usize);
+        for (&j, &wj) in idx.iter().zip(w) {
+            let col = label[j as usize];
+            if col == usize::MAX {
+                return None;
+            }
+            s[(row, col)] += wj;
+        }
+    }
+    // The rotation: label i under the turned root is label rot[i] under the first root.
+    let turned = ball(parent, &old.seeds[1], radius);
+    let rot: Vec<usize> = turned.iter().map(|&v| label[v as usize]).collect();
+    if rot.contains(&usize::MAX) {
+        return None;
+    }
+    Some((s, rot))
+}
+
+/// Whether `s` commutes with the rotation `rot` (the labelling of both levels turned the same
+/// way), which the Fourier split needs.
+fn commutes(s: &Mat<f64>, rot: &[usize]) -> bool {
+    let m = rot.len();
+    (0..m).all(|i| (0..m).all(|j| (s[(rot[i], rot[j])] - s[(i, j)]).abs() <= 1e-12))
+}
+
+/// Eigenvalues per Fourier frequency of `s`, which commutes with the rotation `rot`.
+fn fourier_spectrum(
+    s: &Mat<f64>,
+    rot: &[usize],
+    n: usize,
+) -> Result<Vec<FourierEigenvalue>, LimitError> {
+    let m = rot.len();
+    // Orbits: representatives and their images R^t(o).
+    let mut seen = vec![false; m];
+    let mut orbits: Vec<Vec<usize>> = Vec::new();
+    for o in 0..m {
+        if seen[o] {
+            continue;
+        }
+        let mut orbit = vec![o];
+        seen[o] = true;
+        let mut x = rot[o];
+        while x != o {
+            seen[x] = true;
+            orbit.push(x);
+            x = rot[x];
+        }
+        orbits.push(orbit);
+    }
+    let mut out = Vec::new();
+    for k in 0..n {
+        // Orbits of size 1 (the centre vertex) only carry frequency 0.
+        let members: Vec<&Vec<usize>> = orbits.iter().filter(|o| o.len() == n || k == 0).collect();
+        let size = members.len();
+        if size == 0 {
+            continue;
+        }
+        let block = Mat::<c64>::from_fn(size, size, |a, b| {
+            let (row, col) = (members[a][0], members[b]);
+            let len = col.len();
+            (0..len)
+                .map(|t| {
+                    let w = TAU * (k * t) as f64 / n as f64;
+                    c64::new(w.cos(), w.sin()) * s[(row, col[t])]
+                })
+                .fold(c64::new(0.0, 0.0), |acc, x| acc + x)
+        });
+        let ev = block
+            .eigenvalues()
+            .map_err(|e| LimitError::Analysis(format!("eigenvalues: {e:?}")))?;
+        out.extend(ev.into_iter().map(|z| FourierEigenvalue {
+            re: z.re,
+            im: z.im,
+            frequency: k.min(n - k),
+        }));
+    }
+    out.sort_by(|a, b| {
+        b.norm()
+            .total_cmp(&a.norm())
+            .then(a.frequency.cmp(&b.frequency))
+    });
+    Ok(out)
+}
+
+/// The spectrum of `scheme`'s local subdivision matrix at an interior vertex of valence `n`
+/// (√3, the butterflies) or an `n`-sided face (Doo-Sabin), `3 ≤ n ≤ 64`.
+///
+/// ```
+/// use subd_limit::split_eigen::split_spectrum;
+/// use subd_schemes::split_schemes::SplitScheme;
+///
+/// // The modified butterfly is C¹ at every valence; its subdominant eigenvalue is ½.
+/// let s = split_spectrum(SplitScheme::ModifiedButterfly, 9).unwrap();
+/// let test = s.test();
+/// assert!(test.passes);
+/// assert!((test.subdominant - 0.5).abs() < 1e-12);
+/// ```
+///
+/// # Errors
+/// [`LimitError::Analysis`] for a valence out of range, or when no invariant ball is found.
+pub fn split_spectrum(scheme: SplitScheme, n: usize) -> Result<SplitSpectrum, LimitError> {
+    if !(3..=64).contains(&n) {
+        return Err(LimitError::Analysis(format!(
+            "valence {n}: must be 3 to 64"
+        )));
+    }
+    let analysis = |e: subd_schemes::split_schemes::SplitError| LimitError::Analysis(e.to_string());
+    for radius in 1..=6 {
+        let rings = 2 * radius + 4;
+        let (parent, child, stencils, old, new) = if scheme == SplitScheme::DooSabin {
+            // The n-gon: the vertex face of a valence-n vertex after one step.
+            let d = disc(n, rings + 1, true)?;
+            let r = SplitRefinement::new(&d, scheme, 2).map_err(analysis)?;
+            let level1 = r.topology(1);
+            // F-faces, then E-faces, then V-faces in vertex order: vertex 0's comes first.
+            let v_face = d.num_faces() + d.num_edges();
+            let old = face_centre(level1, v_face);
+            // Its F-face child keeps the face index and corner order.
+            let new = face_centre(r.topology(2), v_face);
+            (
+                level1.clone(),
+                r.topology(2).clone(),
+                r.stencils(2).clone(),
+                old,
+                new,
+            )
+        } else {
+            let d = disc(n, rings, false)?;
+            let first = d.vertex_ring(0).next().expect("centre has a ring");
+            let old = vertex_centre(&d, 0, first);
+            if scheme == SplitScheme::Sqrt3 {
+                // One step turns the mesh by π/n; two steps bring it back into line. The
+                // root spoke of level 2 is the one along the root spoke of level 0: through
+                // the centroid of the level-1 face right of the level-1 root spoke, itself
+                // through the centroid of the level-0 face left of the root spoke.
+                let r = SplitRefinement::new(&d, scheme, 2).map_err(analysis)?;
+                let level1 = r.topology(1);
+                let f0 = face_with_edge(&d, 0, first);
+                let first1 = (d.num_vertices() + f0) as u32;
+                let f1 = face_with_edge(level1, first1, 0);
+                let first2 = (level1.num_vertices() + f1) as u32;
+                let new = vertex_centre(r.topology(2), 0, first2);
+                (d.clone(), r.topology(2).clone(), r.composed(2), old, new)
+            } else {
+                let r = SplitRefinement::new(&d, scheme, 1).map_err(analysis)?;
+                // The root spoke's point.
+                let e = d.find_edge(0, first).expect("root spoke");
+                let new = vertex_centre(r.topology(1), 0, (d.num_vertices() + e as usize) as u32);
+                (
+                    d.clone(),
+                    r.topology(1).clone(),
+                    r.stencils(1).clone(),
+                    old,
+                    new,
+                )
+            }
+        };
+        if let Some((s, rot)) = local_matrix(&parent, &child, &stencils, &old, &new, radius) {
+            if !commutes(&s, &rot) {
+                return Err(LimitError::Analysis(format!(
+                    "{} at valence {n}: the local matrix does not commute with the rotation",
+                    scheme.name()
+                )));
+            }
+            let eigenvalues = fourier_spectrum(&s, &rot, n)?;
+            return Ok(SplitSpectrum {
+                valence: n,
+                ball_size: s.nrows(),
+                eigenvalues,
+            });
+        }
+    }
+    Err(LimitError::Analysis(format!(
+        "no invariant ball of radius ≤ 6 for {} at valence {n}",
+        scheme.name()
+    )))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn test_at(scheme: SplitScheme, n: usize) -> SpectrumTest {
+        split_spectrum(scheme, n).unwrap().test()
+    }
+
+    /// Dyn, Levin and Gregory's butterfly is C¹ only for valences 4 to 7: at valence 3 the
+    /// subdominant eigenvalue ¼ is not double, above 7 a pair of higher frequency dominates.
+    #[test]
+    fn classic_butterfly_fails_at_three_and_above_seven() {
+        for n in 3..=16 {
+            let t = test_at(SplitScheme::BUTTERFLY, n);
+            assert_eq!(t.passes, (4..=7).contains(&n), "valence {n}: {t:?}");
+            if n >= 8 {
+                // Frequency 2 from valence 8, frequency 3 from valence 14.
+                assert!(t.subdominant_frequency >= 2, "valence {n}: {t:?}");
+            }
+        }
+        // The regular case is the three-direction box spline's neighbour: λ = ½.
+        assert!((test_at(SplitScheme::BUTTERFLY, 6).subdominant - 0.5).abs() < 1e-12);
+    }
+
+    /// Zorin's rules put the subdominant eigenvalue at exactly ½ at every valence.
+    #[test]
+    fn modified_butterfly_is_c1_at_every_valence() {
+        for n in 3..=20 {
+            let t = test_at(SplitScheme::ModifiedButterfly, n);
+            assert!(t.passes, "valence {n}: {t:?}");
+            assert!((t.subdominant - 0.5).abs() < 1e-12, "valence {n}: {t:?}");
+        }
+    }
+
+    /// Doo-Sabin's weights give the face circulant the eigenvalues 1, ½, ½, ¼, ¼, 0, …; the
+    /// whole neighbourhood keeps ½ subdominant.
+    #[test]
+    fn doo_sabin_is_c1_with_one_half() {
+        for n in 3..=16 {
+            let t = test_at(SplitScheme::DooSabin, n);
+            assert!(t.passes, "valence {n}: {t:?}");
+            assert!((t.subdominant - 0.5).abs() < 1e-12, "valence {n}: {t:?}");
+        }
+    }
+
+    /// √3 over two steps: the ring of centroids scales frequency k by (1 + ω^k)/3, so the
+    /// subdominant eigenvalue of two steps is 4cos²(π/n)/9 (Kobbelt 2000, §3).
+    #[test]
+    fn sqrt3_is_c1_with_kobbelts_eigenvalue() {
+        for n in 3..=20 {
+            let t = test_at(SplitScheme::Sqrt3, n);
+            let expected = 4.0 * (std::f64::consts::PI / n as f64).cos().powi(2) / 9.0;
+            assert!(t.passes, "valence {n}: {t:?}");
+            assert!(
+                (t.subdominant - expected).abs() < 1e-12,
+                "valence {n}: {t:?} vs {expected}"
+            );
+        }
+    }
+
+    #[test]
+    fn valence_out_of_range_is_an_error() {
+        assert!(split_spectrum(SplitScheme::Sqrt3, 2).is_err());
+        assert!(split_spectrum(SplitScheme::Sqrt3, 65).is_err());
+    }
+}

@@ -1,0 +1,284 @@
+//! The second and third opinions in `cargo xtask conformance`: subd's Doo-Sabin, √3 and
+//! modified butterfly against CGAL and OpenMesh, and its Loop and Catmull-Clark against both
+//! as well, on every fitting OpenSubdiv shape and on random meshes, levels 1–3.
+//!
+//! The libraries number vertices their own way, so a level is compared by its vertex and face
+//! counts and by matching positions (nearest vertex, both ways) to 1e-12 × the bounding-box
+//! diagonal. Neither library reads crease tags: shapes are compared with their tags taken
+//! off.
+
+use std::path::{Path, PathBuf};
+
+use subd_mesh::{DVec3, Topology, TopologyBuilder};
+use subd_schemes::split_schemes::{SplitRefinement, SplitScheme};
+use subd_schemes::{Options, Refinement, Scheme};
+
+use crate::conformance::Row;
+use crate::geom_ref::{self, Library, RefOutcome};
+
+/// Tolerance on the matched distance / bounding-box diagonal.
+const TOLERANCE: f64 = 1e-12;
+/// Levels stop before a mesh passes this many vertices.
+const MAX_VERTICES: usize = 400_000;
+/// OpenMesh's Loop and √3 weight tables stop at this valence.
+const OPENMESH_MAX_VALENCE: usize = 50;
+
+/// A scheme as subd runs it.
+#[derive(Clone, Copy)]
+enum Ours {
+    Split(SplitScheme),
+    Osd(Scheme),
+}
+
+/// One comparison: which library, its name for the scheme, ours, and on which meshes.
+struct Pairing {
+    check: &'static str,
+    library: Library,
+    harness_scheme: &'static str,
+    ours: Ours,
+    triangles: bool,
+    /// Open meshes too (the library implements the boundary rule subd does).
+    open: bool,
+    /// Skip meshes above OpenMesh's valence tables.
+    valence_limit: bool,
+}
+
+const PAIRINGS: &[Pairing] = &[
+    Pairing {
+        check: "cgal-sqrt3",
+        library: Library::Cgal,
+        harness_scheme: "sqrt3",
+        ours: Ours::Split(SplitScheme::Sqrt3),
+        triangles: true,
+        open: true,
+        valence_limit: false,
+    },
+    Pairing {
+        check: "om-sqrt3",
+        library: Library::OpenMesh,
+        harness_scheme: "sqrt3",
+        ours: Ours::Split(SplitScheme::Sqrt3),
+        triangles: true,
+        open: false,
+        valence_limit: true,
+    },
+    Pairing {
+        check: "cgal-doo-sabin",
+        library: Library::Cgal,
+        harness_scheme: "doo-sabin",
+        ours: Ours::Split(SplitScheme::DooSabin),
+        triangles: false,
+        open: false,
+        valence_limit: false,
+    },
+    Pairing {
+        check: "om-mod-butterfly",
+        library: Library::OpenMesh,
+        harness_scheme: "modified-butterfly",
+        ours: Ours::Split(SplitScheme::ModifiedButterfly),
+        triangles: true,
+        open: true,
+        valence_limit: false,
+    },
+    Pairing {
+        check: "cgal-loop",
+        library: Library::Cgal,
+        harness_scheme: "loop",
+        ours: Ours::Osd(Scheme::Loop),
+        triangles: true,
+        open: false,
+        valence_limit: false,
+    },
+    Pairing {
+        check: "om-loop",
+        library: Library::OpenMesh,
+        harness_scheme: "loop",
+        ours: Ours::Osd(Scheme::Loop),
+        triangles: true,
+        open: false,
+        valence_limit: true,
+    },
+    Pairing {
+        check: "cgal-catmull-clark",
+        library: Library::Cgal,
+        harness_scheme: "catmull-clark",
+        ours: Ours::Osd(Scheme::CatmullClark),
+        triangles: false,
+        open: false,
+        valence_limit: false,
+    },
+    Pairing {
+        check: "om-catmull-clark",
+        library: Library::OpenMesh,
+        harness_scheme: "catmull-clark",
+        ours: Ours::Osd(Scheme::CatmullClark),
+        triangles: false,
+        open: false,
+        valence_limit: false,
+    },
+];
+
+/// The topology without its tags (creases, corners, holes), or `None` when it is not a
+/// manifold mesh (neither library takes one).
+fn untagged(topo: &Topology) -> Option<Topology> {
+    let manifold = (0..topo.num_edges()).all(|e| !topo.is_non_manifold_edge(e))
+        && (0..topo.num_vertices()).all(|v| !topo.is_non_manifold_vertex(v));
+    if !manifold {
+        return None;
+    }
+    let sizes: Vec<u32> = topo.face_sizes().collect();
+    TopologyBuilder::new(topo.num_vertices())
+        .build(&sizes, topo.all_face_vertices())
+        .ok()
+}
+
+/// Positions of every level of ours, level 0 included.
+fn our_levels(
+    ours: Ours,
+    topo: &Topology,
+    positions: &[DVec3],
+    levels: usize,
+) -> Result<Vec<(Vec<DVec3>, usize)>, String> {
+    match ours {
+        Ours::Split(s) => {
+            let r = SplitRefinement::new(topo, s, levels).map_err(|e| e.to_string())?;
+            Ok(r.refine_points(positions)
+                .into_iter()
+                .enumerate()
+                .map(|(l, p)| (p, r.topology(l).num_faces()))
+                .collect())
+        }
+        Ours::Osd(s) => {
+            let r =
+                Refinement::new(topo, s, &Options::default(), levels).map_err(|e| e.to_string())?;
+            Ok(r.refine_points(positions)
+                .into_iter()
+                .enumerate()
+                .map(|(l, p)| (p, r.faces(l).0.len() - 1))
+                .collect())
+        }
+    }
+}
+
+/// Levels to compare: up to 3, fewer where a level would pass [`MAX_VERTICES`].
+fn levels_for(topo: &Topology) -> usize {
+    let mut n = topo.num_face_vertices().max(topo.num_vertices());
+    let mut levels = 0;
+    while levels < 3 && 4 * n <= MAX_VERTICES {
+        n *= 4;
+        levels += 1;
+    }
+    levels
+}
+
+/// Every pairing that fits `topo`, levels 1–3.
+fn compare(exe: &Path, name: &str, topo: &Topology, positions: &[DVec3]) -> Vec<Row> {
+    let mut rows = Vec::new();
+    let Some(t) = untagged(topo) else {
+        return rows;
+    };
+    if t.num_faces() == 0 {
+        return rows;
+    }
+    let triangles = (0..t.num_faces()).all(|f| t.face_size(f) == 3);
+    let closed = (0..t.num_edges()).all(|e| !t.is_boundary_edge(e));
+    let max_valence = (0..t.num_vertices())
+        .map(|v| t.valence(v))
+        .max()
+        .unwrap_or(0);
+    let diag = subd_mesh::bounding_box(positions.iter().copied())
+        .map_or(1.0, |(lo, hi)| (hi - lo).length())
+        .max(f64::MIN_POSITIVE);
+    let levels = levels_for(&t);
+    for p in PAIRINGS {
+        if (p.triangles && !triangles) || (!p.open && !closed) {
+            continue;
+        }
+        if p.valence_limit && max_valence > OPENMESH_MAX_VALENCE {
+            let mut row = Row::pending(name, p.check, 0);
+            row.error = 0.0;
+            row.note = Some(format!(
+                "skipped: valence {max_valence} is above OpenMesh's tables (≤ {OPENMESH_MAX_VALENCE})"
+            ));
+            rows.push(row);
+            continue;
+        }
+        let ours = match our_levels(p.ours, &t, positions, levels) {
+            Ok(o) => o,
+            Err(e) => {
+                let mut row = Row::pending(name, p.check, 1);
+                row.problem = Some(format!("subd refused: {e}"));
+                rows.push(row);
+                continue;
+            }
+        };
+        for (level, (pos, faces)) in ours.iter().enumerate().skip(1) {
+            let mut row = Row::pending(name, p.check, level);
+            row.vertices = pos.len();
+            match geom_ref::refine(exe, p.library, p.harness_scheme, level, &t, positions) {
+                Err(e) => row.problem = Some(e),
+                Ok(RefOutcome::Refused(why)) => {
+                    row.problem = Some(format!(
+                        "{} refused a mesh subd took: {why}",
+                        p.library.name()
+                    ))
+                }
+                Ok(RefOutcome::Mesh(m)) => {
+                    if m.positions.len() != pos.len() || m.num_faces != *faces {
+                        row.problem = Some(format!(
+                            "counts differ: subd {} vertices {} faces, {} {} and {}",
+                            pos.len(),
+                            faces,
+                            p.library.name(),
+                            m.positions.len(),
+                            m.num_faces
+                        ));
+                    } else {
+                        row.error = geom_ref::matched_error(pos, &m.positions, diag);
+                        if !(row.error <= TOLERANCE) {
+                            row.problem = Some(format!("matched |Δ|/diag {:.3e}", row.error));
+                        }
+                    }
+                }
+            }
+            rows.push(row);
+        }
+    }
+    rows
+}
+
+/// Every fitting shape of the OpenSubdiv directory.
+pub fn shapes(exe: &Path, dir: &Path) -> Result<Vec<Row>, String> {
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map_err(|e| format!("{}: {e}", dir.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "obj"))
+        .collect();
+    paths.sort();
+    let opts = subd_io::ReadOptions {
+        accept_inconsistent_orientation: true,
+    };
+    let mut rows = Vec::new();
+    for p in paths {
+        let name = p.file_stem().unwrap().to_string_lossy().to_string();
+        let file = subd_io::read_mesh(&p, &opts).map_err(|e| e.to_string())?;
+        rows.extend(compare(
+            exe,
+            &name,
+            &file.mesh.topology,
+            &file.mesh.positions,
+        ));
+    }
+    Ok(rows)
+}
+
+/// `count` random meshes (those of `random_mesh`, tags taken off, non-manifold ones left
+/// out).
+pub fn random(exe: &Path, count: u64) -> Vec<Row> {
+    let mut rows = Vec::new();
+    for seed in 0..count {
+        let c = crate::random_mesh::case(seed);
+        rows.extend(compare(exe, &c.name, &c.topology, &c.positions));
+    }
+    rows
+}
