@@ -41,6 +41,9 @@ enum Task {
         /// Number of random meshes.
         #[arg(long, default_value_t = 360)]
         random: u64,
+        /// Which references: OpenSubdiv, CGAL and OpenMesh, or all.
+        #[arg(long, value_enum, default_value = "all")]
+        against: Against,
     },
     /// Time subd against OpenSubdiv on ~100k-face meshes (levels 1..L, 1 and all threads).
     Bench {
@@ -119,6 +122,14 @@ enum Task {
     },
 }
 
+/// The references `cargo xtask conformance` compares with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum Against {
+    Opensubdiv,
+    CgalOpenmesh,
+    All,
+}
+
 /// System packages the reference harnesses (OpenSubdiv, CGAL, OpenMesh) need: (file that proves it is there, Debian
 /// package). The unit and integration tests need none.
 const REFERENCE_PACKAGES: &[(&str, &str)] = &[
@@ -190,20 +201,28 @@ fn main() -> ExitCode {
             .args(["test", "--workspace", "--release"])
             .arg("--")
             .args(&extra)),
-        Task::Conformance { shapes, random } => ensure_system_packages(REFERENCE_PACKAGES)
-            .and_then(|_| {
+        Task::Conformance {
+            shapes,
+            random,
+            against,
+        } => ensure_system_packages(REFERENCE_PACKAGES).and_then(|_| {
+            let mut rows = Vec::new();
+            if against != Against::CgalOpenmesh {
                 let exe = osd::build_harness()?;
-                let geom = geom_ref::build_harness()?;
-                let mut rows = conformance::shapes(&exe, &shapes)?;
+                rows.extend(conformance::shapes(&exe, &shapes)?);
                 rows.extend(conformance::random(&exe, random));
+            }
+            if against != Against::Opensubdiv {
+                let geom = geom_ref::build_harness()?;
                 rows.extend(geom_conformance::shapes(&geom, &shapes)?);
                 rows.extend(geom_conformance::random(&geom, random));
-                if conformance::report(&rows) {
-                    Ok(())
-                } else {
-                    Err("conformance failed".into())
-                }
-            }),
+            }
+            if conformance::report(&rows) {
+                Ok(())
+            } else {
+                Err("conformance failed".into())
+            }
+        }),
         Task::Bench {
             levels,
             repeats,

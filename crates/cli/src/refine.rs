@@ -137,7 +137,7 @@ struct RefineReport {
 /// A refinement of either family, reduced to what writing its last level needs.
 enum Refined {
     Osd(Refinement),
-    Split(SplitRefinement),
+    Split(Box<SplitRefinement>),
 }
 
 impl Refined {
@@ -236,9 +236,9 @@ pub(crate) fn run(
         (Chosen::Osd(scheme), None) => Refined::Osd(
             Refinement::new(base, *scheme, &options, args.levels).map_err(|e| in_file(&e))?,
         ),
-        (Chosen::Split(scheme), _) => Refined::Split(
+        (Chosen::Split(scheme), _) => Refined::Split(Box::new(
             SplitRefinement::new(base, *scheme, args.levels).map_err(|e| in_file(&e))?,
-        ),
+        )),
     };
     progress.step("topology");
     let t_topology = t0.elapsed().as_secs_f64();

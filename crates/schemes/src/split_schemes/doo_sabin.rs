@@ -18,6 +18,9 @@
 //! leaves the boundary open without these faces, which loses a strip of the surface at every
 //! level.)
 //!
+//! An interior vertex with two faces gets no V-face (it would be a 2-gon): the E-faces of its
+//! two edges share the edge between its two face children instead.
+//!
 //! Vertex order of a level: the face children in face-vertex order (child `offset(f) + k` of
 //! corner `k` of face `f`), then two Chaikin points per boundary edge, in edge order, the one
 //! next to the edge's first vertex first. Face order: F-faces in face order, E-faces in edge
@@ -132,6 +135,11 @@ pub(crate) fn refine(p: &Topology) -> Result<SplitLevel, StepError> {
         }
         let local = p.vertex_face_local_indices(v);
         let boundary = p.is_boundary_vertex(v);
+        if !boundary && faces.len() < 3 {
+            // An interior vertex of valence 2: its vertex face would be a 2-gon, which
+            // collapses into the edge its two E-faces share.
+            continue;
+        }
         sizes.push((faces.len() + if boundary { 2 } else { 0 }) as u32);
         if boundary {
             let (f0, c0) = (faces[0] as usize, local[0] as usize);
