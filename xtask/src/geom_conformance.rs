@@ -254,7 +254,7 @@ fn compare(exe: &Path, name: &str, topo: &Topology, positions: &[DVec3]) -> Vec<
                         ));
                     } else {
                         row.error = geom_ref::matched_error(pos, &m.positions, diag);
-                        if !(row.error <= TOLERANCE) {
+                        if row.error.is_nan() || row.error > TOLERANCE {
                             row.problem = Some(format!("matched |Δ|/diag {:.3e}", row.error));
                         }
                     }
