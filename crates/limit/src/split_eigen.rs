@@ -307,16 +307,11 @@ fn commutes(s: &Mat<f64>, rot: &[usize]) -> bool {
     (0..m).all(|i| (0..m).all(|j| (s[(rot[i], rot[j])] - s[(i, j)]).abs() <= 1e-12))
 }
 
-/// Eigenvalues per Fourier frequency of `s`, which commutes with the rotation `rot`.
-fn fourier_spectrum(
-    s: &Mat<f64>,
-    rot: &[usize],
-    n: usize,
-) -> Result<Vec<FourierEigenvalue>, LimitError> {
+/// The rotation orbits of the ball's labels (each listed as `o, R(o), R²(o), …`).
+fn orbits(rot: &[usize]) -> Vec<Vec<usize>> {
     let m = rot.len();
-    // Orbits: representatives and their images R^t(o).
     let mut seen = vec![false; m];
-    let mut orbits: Vec<Vec<usize>> = Vec::new();
+    let mut out: Vec<Vec<usize>> = Vec::new();
     for o in 0..m {
         if seen[o] {
             continue;
@@ -329,26 +324,46 @@ fn fourier_spectrum(
             orbit.push(x);
             x = rot[x];
         }
-        orbits.push(orbit);
+        out.push(orbit);
     }
+    out
+}
+
+/// The Fourier block of frequency `k`: `Ŝ_k[o′, o] = Σ_t ω^{kt} S[o′, R^t o]` over the orbits
+/// that carry frequency `k` (all full orbits; the centre only for `k = 0`), and those orbits.
+fn fourier_block<'a>(
+    s: &Mat<f64>,
+    orbits: &'a [Vec<usize>],
+    n: usize,
+    k: usize,
+) -> (Mat<c64>, Vec<&'a Vec<usize>>) {
+    let members: Vec<&Vec<usize>> = orbits.iter().filter(|o| o.len() == n || k == 0).collect();
+    let size = members.len();
+    let block = Mat::<c64>::from_fn(size, size, |a, b| {
+        let (row, col) = (members[a][0], members[b]);
+        (0..col.len())
+            .map(|t| {
+                let w = TAU * (k * t) as f64 / n as f64;
+                c64::new(w.cos(), w.sin()) * s[(row, col[t])]
+            })
+            .fold(c64::new(0.0, 0.0), |acc, x| acc + x)
+    });
+    (block, members)
+}
+
+/// Eigenvalues per Fourier frequency of `s`, which commutes with the rotation `rot`.
+fn fourier_spectrum(
+    s: &Mat<f64>,
+    rot: &[usize],
+    n: usize,
+) -> Result<Vec<FourierEigenvalue>, LimitError> {
+    let orbits = orbits(rot);
     let mut out = Vec::new();
     for k in 0..n {
-        // Orbits of size 1 (the centre vertex) only carry frequency 0.
-        let members: Vec<&Vec<usize>> = orbits.iter().filter(|o| o.len() == n || k == 0).collect();
-        let size = members.len();
-        if size == 0 {
+        let (block, members) = fourier_block(s, &orbits, n, k);
+        if members.is_empty() {
             continue;
         }
-        let block = Mat::<c64>::from_fn(size, size, |a, b| {
-            let (row, col) = (members[a][0], members[b]);
-            let len = col.len();
-            (0..len)
-                .map(|t| {
-                    let w = TAU * (k * t) as f64 / n as f64;
-                    c64::new(w.cos(), w.sin()) * s[(row, col[t])]
-                })
-                .fold(c64::new(0.0, 0.0), |acc, x| acc + x)
-        });
         let ev = block
             .eigenvalues()
             .map_err(|e| LimitError::Analysis(format!("eigenvalues: {e:?}")))?;
@@ -364,6 +379,24 @@ fn fourier_spectrum(
             .then(a.frequency.cmp(&b.frequency))
     });
     Ok(out)
+}
+
+/// The left eigenvector of `block` for its eigenvalue of largest real part (the dominant one
+/// of the block), from the right eigenvectors of the transpose.
+fn dominant_left(block: &Mat<c64>) -> Result<(c64, Vec<c64>), LimitError> {
+    let t = block.transpose().to_owned();
+    let evd = t
+        .eigen()
+        .map_err(|e| LimitError::Analysis(format!("eigenvectors: {e:?}")))?;
+    let values = evd.S();
+    let vectors = evd.U();
+    let best = (0..t.nrows())
+        .max_by(|&a, &b| values[a].norm().total_cmp(&values[b].norm()))
+        .ok_or_else(|| LimitError::Analysis("empty Fourier block".into()))?;
+    Ok((
+        values[best],
+        (0..t.nrows()).map(|i| vectors[(i, best)]).collect(),
+    ))
 }
 
 /// The spectrum of `scheme`'s local subdivision matrix at an interior vertex of valence `n`
@@ -383,6 +416,22 @@ fn fourier_spectrum(
 /// # Errors
 /// [`LimitError::Analysis`] for a valence out of range, or when no invariant ball is found.
 pub fn split_spectrum(scheme: SplitScheme, n: usize) -> Result<SplitSpectrum, LimitError> {
+    let local = local_system(scheme, n)?;
+    Ok(SplitSpectrum {
+        valence: n,
+        ball_size: local.s.nrows(),
+        eigenvalues: fourier_spectrum(&local.s, &local.rot, n)?,
+    })
+}
+
+/// The local subdivision matrix on the smallest invariant ball, with the ball's rotation.
+struct LocalSystem {
+    radius: usize,
+    s: Mat<f64>,
+    rot: Vec<usize>,
+}
+
+fn local_system(scheme: SplitScheme, n: usize) -> Result<LocalSystem, LimitError> {
     if !(3..=64).contains(&n) {
         return Err(LimitError::Analysis(format!(
             "valence {n}: must be 3 to 64"
@@ -446,18 +495,104 @@ pub fn split_spectrum(scheme: SplitScheme, n: usize) -> Result<SplitSpectrum, Li
                     scheme.name()
                 )));
             }
-            let eigenvalues = fourier_spectrum(&s, &rot, n)?;
-            return Ok(SplitSpectrum {
-                valence: n,
-                ball_size: s.nrows(),
-                eigenvalues,
-            });
+            return Ok(LocalSystem { radius, s, rot });
         }
     }
     Err(LimitError::Analysis(format!(
         "no invariant ball of radius ≤ 6 for {} at valence {n}",
         scheme.name()
     )))
+}
+
+/// Limit and tangent masks of a split scheme at an interior vertex of valence `n` whose
+/// ball of radius [`Self::radius`] is otherwise regular: weights over the ball's labels (see
+/// [`Self::ball`]), from the left eigenvectors of the local subdivision matrix.
+#[derive(Debug, Clone)]
+pub struct LocalMasks {
+    /// Radius of the invariant ball.
+    pub radius: usize,
+    /// Limit-position weights (eigenvalue 1, frequency 0), summing to 1.
+    pub limit: Vec<f64>,
+    /// Two tangent masks (real and imaginary part of the frequency-1 left eigenvector of the
+    /// subdominant eigenvalue); `None` where the spectrum fails the C¹ test.
+    pub tangents: Option<[Vec<f64>; 2]>,
+}
+
+impl LocalMasks {
+    /// The labels of the ball of `radius` around vertex `v` of `t`, walked as the masks'
+    /// labels are (any first spoke: turning it turns the tangent masks within their plane).
+    pub fn ball(t: &Topology, v: u32, radius: usize) -> Vec<u32> {
+        match t.vertex_ring(v as usize).next() {
+            Some(first) => ball(t, &[(v, first)], radius),
+            None => vec![v],
+        }
+    }
+}
+
+/// The masks of `scheme` (√3 or a butterfly) at an interior vertex of valence `n`.
+///
+/// # Errors
+/// [`LimitError::Analysis`] for Doo-Sabin (its centres are faces), a valence out of range or
+/// a failed eigen solve.
+pub fn local_masks(scheme: SplitScheme, n: usize) -> Result<LocalMasks, LimitError> {
+    if scheme == SplitScheme::DooSabin {
+        return Err(LimitError::Analysis(
+            "Doo-Sabin's limit points are face centroids, not vertex masks".into(),
+        ));
+    }
+    let local = local_system(scheme, n)?;
+    let m = local.rot.len();
+    let orbits = orbits(&local.rot);
+    let (block0, members0) = fourier_block(&local.s, &orbits, n, 0);
+    let (one, l0) = dominant_left(&block0)?;
+    if (one.re - 1.0).abs() > 1e-9 {
+        return Err(LimitError::Analysis(format!(
+            "{} at valence {n}: dominant eigenvalue {one} is not 1",
+            scheme.name()
+        )));
+    }
+    // A block coefficient of a full orbit is 1/n of the sum over the orbit; the centre's is
+    // its value.
+    let mut limit = vec![0.0; m];
+    for (o, w) in members0.iter().zip(&l0) {
+        for &label in o.iter() {
+            limit[label] = w.re / o.len() as f64;
+        }
+    }
+    let total: f64 = limit.iter().sum();
+    limit.iter_mut().for_each(|w| *w /= total);
+    let passes = fourier_spectrum(&local.s, &local.rot, n)
+        .map(|ev| {
+            SplitSpectrum {
+                valence: n,
+                ball_size: m,
+                eigenvalues: ev,
+            }
+            .test()
+            .passes
+        })
+        .unwrap_or(false);
+    let tangents = if passes {
+        let (block1, members1) = fourier_block(&local.s, &orbits, n, 1);
+        let (_, l1) = dominant_left(&block1)?;
+        let (mut re, mut im) = (vec![0.0; m], vec![0.0; m]);
+        for (o, w) in members1.iter().zip(&l1) {
+            for (t, &label) in o.iter().enumerate() {
+                let a = -TAU * t as f64 / n as f64;
+                let z = *w * c64::new(a.cos(), a.sin());
+                re[label] = z.re;
+                im[label] = z.im;
+            }
+        }
+        Some([re, im])
+    } else {
+        None
+    };
+    Ok(LocalMasks {
+        radius: local.radius,
+        limit,
+        tangents,
+    })
 }
 
 #[cfg(test)]
@@ -518,6 +653,62 @@ mod tests {
                 "valence {n}: {t:?} vs {expected}"
             );
         }
+    }
+
+    /// The limit mask read off the eigenvectors is Kobbelt's closed form for √3:
+    /// `(1 − β) p + β/n Σ p_i` with `β = 3α/(1 + 3α)`; for the butterflies it is the vertex.
+    #[test]
+    fn limit_masks_match_closed_forms() {
+        for n in 3..=12 {
+            let m = local_masks(SplitScheme::Sqrt3, n).unwrap();
+            let a = subd_schemes::split_schemes::sqrt3::alpha(n);
+            let beta = 3.0 * a / (1.0 + 3.0 * a);
+            assert!((m.limit[0] - (1.0 - beta)).abs() < 1e-12, "valence {n}");
+            for j in 1..=n {
+                assert!((m.limit[j] - beta / n as f64).abs() < 1e-12, "valence {n}");
+            }
+            assert!(m.limit[n + 1..].iter().all(|w| w.abs() < 1e-12));
+            for scheme in [SplitScheme::BUTTERFLY, SplitScheme::ModifiedButterfly] {
+                let m = local_masks(scheme, n).unwrap();
+                assert!((m.limit[0] - 1.0).abs() < 1e-12, "{scheme:?} {n}");
+                assert!(m.limit[1..].iter().all(|w| w.abs() < 1e-12));
+            }
+        }
+    }
+
+    /// Modified butterfly at an extraordinary vertex: Zorin's rule only reads the 1-ring, so
+    /// its tangents are the ring's first Fourier coefficient (cos and sin weights, turned).
+    #[test]
+    fn modified_butterfly_tangents_are_ring_fourier_modes() {
+        for n in [3, 4, 5, 7, 9] {
+            let m = local_masks(SplitScheme::ModifiedButterfly, n).unwrap();
+            let [t1, t2] = m.tangents.unwrap();
+            assert!(t1[0].abs() < 1e-12 && t2[0].abs() < 1e-12);
+            assert!(
+                t1[n + 1..]
+                    .iter()
+                    .chain(&t2[n + 1..])
+                    .all(|w| w.abs() < 1e-12)
+            );
+            // A combination a·cos + b·sin of the ring angle, the same for both masks up to a
+            // turn: check that each is orthogonal to the constant and to frequency 2.
+            for t in [&t1, &t2] {
+                let sum: f64 = t[1..=n].iter().sum();
+                assert!(sum.abs() < 1e-12);
+                let c2: f64 = (0..n)
+                    .map(|j| t[1 + j] * (2.0 * TAU * j as f64 / n as f64).cos())
+                    .sum();
+                // (At valences 3 and 4 frequency 2 aliases frequency 1 or 0.)
+                assert!(c2.abs() < 1e-12 || n < 5, "valence {n}");
+            }
+        }
+        // The classic butterfly at valence 8 is not C¹: no tangents.
+        assert!(
+            local_masks(SplitScheme::BUTTERFLY, 8)
+                .unwrap()
+                .tangents
+                .is_none()
+        );
     }
 
     #[test]
