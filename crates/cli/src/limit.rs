@@ -7,9 +7,11 @@ use std::time::Instant;
 
 use clap::{Args, ValueEnum};
 use serde::Serialize;
+use subd_limit::split_limit::split_limit_stencils;
 use subd_limit::{LimitPoints, base_limit, levels_for_exact_limit, two_phase_base_limit};
 use subd_mesh::Mesh;
 use subd_schemes::Scheme;
+use subd_schemes::split_schemes::SplitScheme;
 
 use crate::failure::{bad, refuse_overwrite};
 use crate::rule_args::RuleArgs;
@@ -40,6 +42,14 @@ pub(crate) enum LimitCommandScheme {
     /// Seed 000's two-phase scheme: formula (2) on closed quad meshes (needs --lambda or
     /// --lambda-file).
     TwoPhase,
+    /// Doo-Sabin: each vertex at the centroid of its vertex face one level down.
+    DooSabin,
+    /// √3: Kobbelt's limit masks (cubic B-spline along boundaries and creases).
+    Sqrt3,
+    /// Butterfly (interpolating: the vertices themselves; normals from the eigenvectors).
+    Butterfly,
+    /// Modified butterfly (interpolating, as butterfly).
+    ModifiedButterfly,
 }
 
 #[derive(Debug, Args)]
@@ -51,9 +61,14 @@ pub(crate) struct LimitArgs {
     lambda: LambdaArgs,
     #[command(flatten)]
     rules: RuleArgs,
-    /// Also write unit normals (`.txt` output: `x y z nx ny nz` per line).
+    /// Also write unit normals (`.txt` output: `x y z nx ny nz` per line; `nan nan nan` where
+    /// a split scheme defines none: the butterflies on boundaries and creases and where they
+    /// are not C¹, √3 on boundaries and creases).
     #[arg(long)]
     normals: bool,
+    /// Tension w of --scheme butterfly (default 1/16).
+    #[arg(long, allow_hyphen_values = true)]
+    tension: Option<f64>,
     /// Input mesh (.obj or .ply).
     input: PathBuf,
     /// Output: `.txt` (one line per vertex) or a mesh (.obj, .ply, .glb) whose vertices are
@@ -119,7 +134,51 @@ pub(crate) fn run(
         LimitCommandScheme::CatmullClark => (Scheme::CatmullClark, "catmull-clark"),
         LimitCommandScheme::Loop => (Scheme::Loop, "loop"),
         LimitCommandScheme::TwoPhase => (Scheme::CatmullClark, "two-phase"),
+        _ => (Scheme::CatmullClark, "split"),
     };
+    if args.tension.is_some() && !matches!(args.scheme, LimitCommandScheme::Butterfly) {
+        return Err(bad("--tension applies to --scheme butterfly only".into()));
+    }
+    let split = match args.scheme {
+        LimitCommandScheme::DooSabin => Some(SplitScheme::DooSabin),
+        LimitCommandScheme::Sqrt3 => Some(SplitScheme::Sqrt3),
+        LimitCommandScheme::Butterfly => {
+            let tension = args.tension.unwrap_or(1.0 / 16.0);
+            if !tension.is_finite() {
+                return Err(bad(format!("--tension {tension}: must be a finite number")));
+            }
+            Some(SplitScheme::Butterfly { tension })
+        }
+        LimitCommandScheme::ModifiedButterfly => Some(SplitScheme::ModifiedButterfly),
+        _ => None,
+    };
+    if let Some(scheme) = split {
+        if args.lambda.given() {
+            return Err(bad(
+                "--lambda and --lambda-file apply to --scheme two-phase only".into(),
+            ));
+        }
+        if args.acc.is_some() {
+            return Err(bad(
+                "--acc: ACC patches approximate catmull-clark surfaces only".into(),
+            ));
+        }
+        let limit = split_limit(&args.input, topo, scheme, &file.mesh.positions)?;
+        write_limit(args, &limit, &file.mesh, is_text)?;
+        if args.json {
+            let report = LimitReport {
+                input: args.input.display().to_string(),
+                output: args.output.display().to_string(),
+                scheme: scheme.name(),
+                vertices: topo.num_vertices(),
+                levels_refined: 0,
+                seconds: t0.elapsed().as_secs_f64(),
+                warnings: file.warnings.clone(),
+            };
+            crate::print_json(out, &report);
+        }
+        return Ok(());
+    }
     let table = match args.scheme {
         LimitCommandScheme::TwoPhase => {
             let tp = args.lambda.two_phase(&args.input, topo.num_vertices())?;
@@ -151,15 +210,7 @@ pub(crate) fn run(
         }
         None => None,
     };
-    if is_text {
-        let body = text(&limit, args.normals);
-        subd_io::atomic_write(&args.output, |w| w.write_all(body.as_bytes()))?;
-    } else {
-        let mut mesh = Mesh::new(topo.clone(), limit.positions.clone())
-            .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
-        mesh.hints = file.mesh.hints;
-        subd_io::write_mesh(&args.output, &mesh, &subd_io::WriteOptions::default())?;
-    }
+    write_limit(args, &limit, &file.mesh, is_text)?;
     if let Some((path, json)) = acc {
         subd_io::atomic_write(path, |w| w.write_all(&json))?;
     }
@@ -178,4 +229,59 @@ pub(crate) fn run(
         crate::print_json(out, &report);
     }
     Ok(())
+}
+
+/// Writes the limit as text or as the input mesh with its vertices moved.
+fn write_limit(
+    args: &LimitArgs,
+    limit: &LimitPoints,
+    input: &Mesh,
+    is_text: bool,
+) -> Result<(), Failure> {
+    if is_text {
+        let body = text(limit, args.normals);
+        subd_io::atomic_write(&args.output, |w| w.write_all(body.as_bytes()))?;
+    } else {
+        let mut mesh = Mesh::new(input.topology.clone(), limit.positions.clone())
+            .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
+        mesh.hints = input.hints;
+        subd_io::write_mesh(&args.output, &mesh, &subd_io::WriteOptions::default())?;
+    }
+    Ok(())
+}
+
+/// The limit of a split scheme at every vertex; a vertex without one is an error naming it.
+fn split_limit(
+    input: &std::path::Path,
+    topo: &subd_mesh::Topology,
+    scheme: SplitScheme,
+    positions: &[subd_mesh::DVec3],
+) -> Result<LimitPoints, Failure> {
+    let in_file = |e: &dyn std::fmt::Display| bad(format!("{}: {e}", input.display()));
+    // The refinement's own checks first, so bad input reads as it does for `subd refine`.
+    subd_schemes::split_schemes::SplitRefinement::new(topo, scheme, 0).map_err(|e| in_file(&e))?;
+    let stencils = split_limit_stencils(topo, scheme).map_err(|e| in_file(&e))?;
+    let points = stencils.evaluate(positions);
+    if let Some(v) = points.positions.iter().position(Option::is_none) {
+        let why = if scheme == SplitScheme::DooSabin {
+            "an interior vertex of valence 2 has no vertex face"
+        } else {
+            "the end of a crease inside the surface (a dart) has no limit mask here"
+        };
+        return Err(in_file(&format!(
+            "vertex {v}: no {} limit: {why}",
+            scheme.name()
+        )));
+    }
+    let nan = subd_mesh::DVec3::splat(f64::NAN);
+    Ok(LimitPoints {
+        positions: points.positions.into_iter().flatten().collect(),
+        tangent1: vec![nan; positions.len()],
+        tangent2: vec![nan; positions.len()],
+        normals: points
+            .normals
+            .into_iter()
+            .map(|n| n.unwrap_or(nan))
+            .collect(),
+    })
 }

@@ -354,8 +354,38 @@ fn refine_bad_input_exits_2_without_output() {
         (
             "ok.obj",
             quad.into(),
+            &["--scheme", "kobbelt"],
+            "invalid value 'kobbelt'",
+        ),
+        (
+            "quads3.obj",
+            quad.into(),
+            &["--scheme", "sqrt3"],
+            "face 0 has 4 vertices; the sqrt3 scheme needs triangles",
+        ),
+        (
+            "semi.obj",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\nt crease 2/1/0 1 2 2.5\n".into(),
+            &["--scheme", "butterfly"],
+            "supports only infinitely sharp creases",
+        ),
+        (
+            "crease_ds.obj",
+            "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nv 1 1 0\nv 2 1 0\nf 1 2 5 4\nf 2 3 6 5\nt crease 2/1/0 1 4 10\n".into(),
             &["--scheme", "doo-sabin"],
-            "invalid value 'doo-sabin'",
+            "the doo-sabin scheme has no crease rule",
+        ),
+        (
+            "fin.obj",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\n".into(),
+            &["--scheme", "modified-butterfly"],
+            "needs a manifold mesh",
+        ),
+        (
+            "tension.obj",
+            quad.into(),
+            &["--scheme", "catmull-clark", "--tension", "0.1"],
+            "--tension applies to --scheme butterfly only",
         ),
         (
             "ok2.obj",
@@ -1778,4 +1808,109 @@ fn deform_moves_constraint_points_and_keeps_the_rest() {
             assert_eq!(p, q);
         }
     }
+}
+
+/// Doo-Sabin, √3 and the butterflies through `refine`, `limit` and `analyze`.
+#[test]
+fn split_schemes_refine_limit_and_analyze() {
+    let s = Scratch::new("split");
+    let cube = meshes().join("loop_cube.obj");
+    let quads = meshes().join("catmark_cube.obj");
+    for (scheme, input, vertices, faces) in [
+        // loop_cube: 14 vertices, 36 edges, 24 triangles; √3 adds F per step and triples F,
+        // the butterflies add E and quadruple F.
+        ("sqrt3", &cube, 14 + 24 + 72, 216),
+        ("butterfly", &cube, 194, 384),
+        ("modified-butterfly", &cube, 194, 384),
+        // catmark_cube: Doo-Sabin gives Σ face sizes vertices and F + E + V faces per step.
+        ("doo-sabin", &quads, 96, 98),
+    ] {
+        let out = s.0.join(format!("{scheme}.obj"));
+        let (code, stdout, err) = subd(&[
+            "refine",
+            "--scheme",
+            scheme,
+            "--levels",
+            "2",
+            "--json",
+            input.to_str().unwrap(),
+            out.to_str().unwrap(),
+        ]);
+        assert_eq!(code, 0, "{scheme}: {err}");
+        let report: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+        assert_eq!(report["scheme"], scheme);
+        assert_eq!(report["output_counts"]["faces"], faces, "{scheme}");
+        assert_eq!(report["output_counts"]["vertices"], vertices, "{scheme}");
+        assert!(report.get("boundary_interpolation").is_none());
+        let back = std::fs::read_to_string(&out).unwrap();
+        assert!(back.lines().filter(|l| l.starts_with("f ")).count() > 0);
+        let lim = s.0.join(format!("{scheme}.txt"));
+        let (code, _, err) = subd(&[
+            "limit",
+            "--scheme",
+            scheme,
+            "--normals",
+            input.to_str().unwrap(),
+            lim.to_str().unwrap(),
+        ]);
+        assert_eq!(code, 0, "{scheme}: {err}");
+        let text = std::fs::read_to_string(&lim).unwrap();
+        let base_vertices = if scheme == "doo-sabin" { 8 } else { 14 };
+        assert_eq!(text.lines().count(), base_vertices, "{scheme}");
+        assert!(
+            text.lines()
+                .all(|l| l.split(' ').count() == 6 && !l.contains("NaN"))
+        );
+    }
+    // Tension 0: linear interpolation, and the JSON says which tension.
+    let out = s.0.join("linear.obj");
+    let (code, stdout, err) = subd(&[
+        "refine",
+        "--scheme",
+        "butterfly",
+        "--tension",
+        "0",
+        "--levels",
+        "1",
+        "--json",
+        cube.to_str().unwrap(),
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(stdout.contains("\"tension\":0.0"), "{stdout}");
+    // A dart has no √3 limit mask: exit 2, one line, no output.
+    let lim = s.0.join("dart.txt");
+    let (code, _, err) = subd(&[
+        "limit",
+        "--scheme",
+        "sqrt3",
+        meshes().join("loop_icos_infsharp.obj").to_str().unwrap(),
+        lim.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("dart"), "{err}");
+    assert!(!lim.exists());
+    // The eigenvalue test: the classic butterfly fails at valence 3, passes at 6.
+    let (code, out, _) = subd(&[
+        "analyze",
+        "--surface",
+        "butterfly",
+        "--valence",
+        "3",
+        "--json",
+    ]);
+    assert_eq!(code, 0);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["test"]["passes"], false);
+    let (code, out, _) = subd(&[
+        "analyze",
+        "--surface",
+        "modified-butterfly",
+        "--valence",
+        "3",
+    ]);
+    assert_eq!(code, 0);
+    assert!(out.contains("C¹ eigenvalue test: yes"), "{out}");
+    let (code, _, err) = subd(&["analyze", "--surface", "sqrt3", "--valence", "2"]);
+    assert_eq!(code, 2, "{err}");
 }

@@ -50,6 +50,7 @@ pub mod patch;
 pub mod point_stencil;
 mod smooth_closed;
 pub mod split_eigen;
+pub mod split_limit;
 pub mod stam;
 mod table;
 mod two_phase_closed;

@@ -513,8 +513,10 @@ pub struct LocalMasks {
     pub radius: usize,
     /// Limit-position weights (eigenvalue 1, frequency 0), summing to 1.
     pub limit: Vec<f64>,
-    /// Two tangent masks (real and imaginary part of the frequency-1 left eigenvector of the
-    /// subdominant eigenvalue); `None` where the spectrum fails the C¹ test.
+    /// Two tangent masks (real part and minus the imaginary part of the frequency-1 left
+    /// eigenvector of the subdominant eigenvalue), whose cross product points to the side the
+    /// faces' counter-clockwise order makes the outside; `None` where the spectrum fails the
+    /// C¹ test.
     pub tangents: Option<[Vec<f64>; 2]>,
 }
 
@@ -581,7 +583,10 @@ pub fn local_masks(scheme: SplitScheme, n: usize) -> Result<LocalMasks, LimitErr
                 let a = -TAU * t as f64 / n as f64;
                 let z = *w * c64::new(a.cos(), a.sin());
                 re[label] = z.re;
-                im[label] = z.im;
+                // The conjugate's sign: with the labels counter-clockwise, (Re, −Im) is
+                // (Σ cos·p, Σ sin·p) turned, so their cross product follows the faces'
+                // orientation.
+                im[label] = -z.im;
             }
         }
         Some([re, im])
@@ -629,7 +634,8 @@ mod tests {
         }
     }
 
-    /// Doo-Sabin's weights give the face circulant the eigenvalues 1, ½, ½, ¼, ¼, 0, …; the
+    /// Doo-Sabin's weights give the face circulant the eigenvalues 1, ½, ½ and ¼ at every
+    /// other frequency; the
     /// whole neighbourhood keeps ½ subdominant.
     #[test]
     fn doo_sabin_is_c1_with_one_half() {

@@ -4,7 +4,8 @@
 //! `α_0 = (n + 5)/(4n)` and `α_d = (3 + 2cos(2πd/n))/(4n)`. The children are joined into an
 //! F-face per face (same size), an E-face per edge (a quad) and a V-face per vertex (one
 //! corner per face around it). A face's children have the face's centroid as their centroid,
-//! and the face's circulant mask has eigenvalues 1, ½, ½, ¼, ¼, 0, …, so under repeated
+//! and the face's circulant mask has the eigenvalue 1 once, ½ twice (frequencies ±1) and ¼ at
+//! every other frequency, so under repeated
 //! refinement each face shrinks to its centroid: the limit surface passes through the
 //! centroid of every face of every level.
 //!
@@ -87,6 +88,28 @@ fn boundary_points(p: &Topology, first: u32) -> (Vec<u32>, usize) {
     (at, (next - first) as usize)
 }
 
+/// Whether vertex `v` of `p` gets a vertex face: it has faces, and two or more when it is
+/// interior (the vertex face of an interior valence-2 vertex would be a 2-gon).
+fn has_vertex_face(p: &Topology, v: usize) -> bool {
+    let faces = p.vertex_faces(v).len();
+    faces > 0 && (p.is_boundary_vertex(v) || faces >= 3)
+}
+
+/// For each vertex of `p`, the index of its vertex face in the child level (`None` for an
+/// isolated vertex and an interior vertex of valence 2). Its corners, in order, are the face
+/// children around the vertex (with the two Chaikin points first and last at a boundary).
+pub fn vertex_face_indices(p: &Topology) -> Vec<Option<u32>> {
+    let mut next = (p.num_faces() + p.num_edges()) as u32;
+    (0..p.num_vertices())
+        .map(|v| {
+            has_vertex_face(p, v).then(|| {
+                next += 1;
+                next - 1
+            })
+        })
+        .collect()
+}
+
 /// One Doo-Sabin step.
 pub(crate) fn refine(p: &Topology) -> Result<SplitLevel, StepError> {
     let nfv = p.num_face_vertices();
@@ -129,17 +152,12 @@ pub(crate) fn refine(p: &Topology) -> Result<SplitLevel, StepError> {
     }
     // V-faces.
     for v in 0..p.num_vertices() {
-        let faces = p.vertex_faces(v);
-        if faces.is_empty() {
+        if !has_vertex_face(p, v) {
             continue;
         }
+        let faces = p.vertex_faces(v);
         let local = p.vertex_face_local_indices(v);
         let boundary = p.is_boundary_vertex(v);
-        if !boundary && faces.len() < 3 {
-            // An interior vertex of valence 2: its vertex face would be a 2-gon, which
-            // collapses into the edge its two E-faces share.
-            continue;
-        }
         sizes.push((faces.len() + if boundary { 2 } else { 0 }) as u32);
         if boundary {
             let (f0, c0) = (faces[0] as usize, local[0] as usize);

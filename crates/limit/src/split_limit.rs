@@ -1,0 +1,281 @@
+//! Limit positions and normals of the split schemes (Doo-Sabin, √3, the butterflies) at the
+//! base vertices, as stencil tables over the base vertices.
+//!
+//! * **√3**: an interior vertex's limit and tangents come from the left eigenvectors of its
+//!   local subdivision matrix ([`crate::split_eigen::local_masks`]; the limit mask is
+//!   Kobbelt's `(1 − β) p + β/n Σ p_i`, `β = 3α_n/(1 + 3α_n)`). They are applied at the first
+//!   level (0 to [`MAX_LEVELS`]) where the vertex's invariant ball is regular but for the
+//!   vertex itself: away from features that is the base level; next to a boundary, a crease or
+//!   another extraordinary vertex, one or two levels down. A vertex inside a boundary or crease
+//!   curve has the cubic B-spline limit `(p₋₁ + 4p + p₁)/6` of its curve (the curve is refined
+//!   by the ternary cubic B-spline mask every second step and left alone in between); a corner
+//!   stays put. Normals are given at interior vertices.
+//! * **Butterflies**: interpolating, so the limit of a vertex is the vertex. Normals come from
+//!   the tangent masks (left eigenvectors) at the first level where the ball is regular; none
+//!   where the scheme is not C¹ (the classic butterfly at valence 3 and above 7) and none on
+//!   boundaries and creases.
+//! * **Doo-Sabin**: every face of every level shrinks to its centroid, so the limit of a base
+//!   vertex is the centroid of its vertex face one level down, with the normal of that face's
+//!   first Fourier mode (the face circulant's eigenvalue-½ pair). An interior vertex of
+//!   valence 2 has no vertex face and no limit here.
+//!
+//! Where a value is not given, [`SplitLimitStencils::position_known`] or
+//! [`SplitLimitStencils::tangents_known`] says so and the row is empty.
+
+use std::collections::HashMap;
+use std::f64::consts::TAU;
+
+use glam::DVec3;
+use subd_mesh::Topology;
+use subd_schemes::StencilTable;
+use subd_schemes::split_schemes::{Features, SplitRefinement, SplitScheme, doo_sabin};
+
+use crate::LimitError;
+use crate::split_eigen::{LocalMasks, local_masks};
+
+/// The deepest level searched for a regular ball around an interior vertex.
+pub const MAX_LEVELS: usize = 4;
+
+/// Limit position and tangent stencils of every base vertex.
+#[derive(Debug, Clone)]
+pub struct SplitLimitStencils {
+    /// Limit position of each base vertex (an empty row where unknown).
+    pub position: StencilTable,
+    /// Two tangents of each base vertex (empty rows where unknown).
+    pub tangents: [StencilTable; 2],
+    /// Whether the position row of a vertex is given.
+    pub position_known: Vec<bool>,
+    /// Whether the tangent rows of a vertex are given.
+    pub tangents_known: Vec<bool>,
+}
+
+/// Limit positions and unit normals, `None` where not given.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SplitLimitPoints {
+    /// Limit position per base vertex.
+    pub positions: Vec<Option<DVec3>>,
+    /// Unit normal per base vertex (from the tangents' cross product).
+    pub normals: Vec<Option<DVec3>>,
+}
+
+impl SplitLimitStencils {
+    /// Applies the stencils to base positions.
+    pub fn evaluate(&self, points: &[DVec3]) -> SplitLimitPoints {
+        let p = self.position.apply_points(points);
+        let t1 = self.tangents[0].apply_points(points);
+        let t2 = self.tangents[1].apply_points(points);
+        SplitLimitPoints {
+            positions: (0..p.len())
+                .map(|v| self.position_known[v].then_some(p[v]))
+                .collect(),
+            normals: (0..p.len())
+                .map(|v| {
+                    let n = t1[v].cross(t2[v]);
+                    (self.tangents_known[v] && n.length() > 0.0).then(|| n.normalize())
+                })
+                .collect(),
+        }
+    }
+}
+
+/// A row under construction: weights over some level's vertices.
+type Row = Vec<(u32, f64)>;
+
+/// Rows over level-`l` vertices carried back to the base through `composed` (`l ≥ 1`).
+fn to_base(row: &Row, composed: &StencilTable) -> Row {
+    let mut acc: HashMap<u32, f64> = HashMap::new();
+    let mut order = Vec::new();
+    for &(v, w) in row {
+        let (idx, wts) = composed.row(v as usize);
+        for (&s, &b) in idx.iter().zip(wts) {
+            let e = acc.entry(s).or_insert_with(|| {
+                order.push(s);
+                0.0
+            });
+            *e += w * b;
+        }
+    }
+    order.into_iter().map(|s| (s, acc[&s])).collect()
+}
+
+/// The stencils of `scheme`'s limit at every vertex of `base`.
+///
+/// # Errors
+/// [`LimitError::Analysis`] when `base` is not a mesh `scheme` refines (see
+/// [`SplitRefinement::new`]) or an eigen solve fails.
+pub fn split_limit_stencils(
+    base: &Topology,
+    scheme: SplitScheme,
+) -> Result<SplitLimitStencils, LimitError> {
+    let nv = base.num_vertices();
+    let refinement = |levels| {
+        SplitRefinement::new(base, scheme, levels).map_err(|e| LimitError::Analysis(e.to_string()))
+    };
+    let mut position: Vec<Option<Row>> = vec![None; nv];
+    let mut tangents: Vec<Option<[Row; 2]>> = vec![None; nv];
+    if scheme == SplitScheme::DooSabin {
+        let r = refinement(1)?;
+        doo_sabin_rows(base, &r, &mut position, &mut tangents);
+    } else {
+        vertex_rows(base, scheme, &refinement, &mut position, &mut tangents)?;
+    }
+    let table = |rows: Vec<Row>| {
+        StencilTable::build(nv, nv, |v, sink| {
+            for &(s, w) in &rows[v] {
+                sink.add(s, w);
+            }
+        })
+    };
+    let position_known: Vec<bool> = position.iter().map(Option::is_some).collect();
+    let tangents_known: Vec<bool> = tangents.iter().map(Option::is_some).collect();
+    let (mut t1, mut t2) = (Vec::with_capacity(nv), Vec::with_capacity(nv));
+    for t in tangents {
+        let [a, b] = t.unwrap_or_default();
+        t1.push(a);
+        t2.push(b);
+    }
+    Ok(SplitLimitStencils {
+        position: table(
+            position
+                .into_iter()
+                .map(Option::unwrap_or_default)
+                .collect(),
+        ),
+        tangents: [table(t1), table(t2)],
+        position_known,
+        tangents_known,
+    })
+}
+
+/// Doo-Sabin: centroid and first Fourier mode of each vertex's vertex face.
+fn doo_sabin_rows(
+    base: &Topology,
+    r: &SplitRefinement,
+    position: &mut [Option<Row>],
+    tangents: &mut [Option<[Row; 2]>],
+) {
+    let level1 = r.topology(1);
+    let stencils = r.stencils(1);
+    for (v, face) in doo_sabin::vertex_face_indices(base).into_iter().enumerate() {
+        let Some(face) = face else { continue };
+        let corners = level1.face_vertices(face as usize);
+        let m = corners.len();
+        let mode = |f: fn(f64) -> f64| -> Row {
+            corners
+                .iter()
+                .enumerate()
+                .map(|(i, &c)| (c, f(TAU * i as f64 / m as f64)))
+                .collect()
+        };
+        let centroid: Row = corners.iter().map(|&c| (c, 1.0 / m as f64)).collect();
+        position[v] = Some(to_base(&centroid, stencils));
+        tangents[v] = Some([
+            to_base(&mode(f64::cos), stencils),
+            to_base(&mode(f64::sin), stencils),
+        ]);
+    }
+}
+
+/// Whether the ball of `radius` around interior vertex `v` of `t` is regular but for `v`:
+/// no vertex of it on a feature, every other one of valence 6, and as many vertices as the
+/// regular ball has.
+fn regular_ball(t: &Topology, features: &Features, v: u32, ball: &[u32], expected: usize) -> bool {
+    ball.len() == expected
+        && ball.iter().all(|&u| {
+            !features.is_on_feature(u as usize)
+                && !t.is_boundary_vertex(u as usize)
+                && (u == v || t.valence(u as usize) == 6)
+        })
+}
+
+/// √3 and the butterflies: features by their curve rules, interior vertices by their masks
+/// at the first level with a regular ball.
+fn vertex_rows(
+    base: &Topology,
+    scheme: SplitScheme,
+    refinement: &dyn Fn(usize) -> Result<SplitRefinement, LimitError>,
+    position: &mut [Option<Row>],
+    tangents: &mut [Option<[Row; 2]>],
+) -> Result<(), LimitError> {
+    let nv = base.num_vertices();
+    let features = Features::new(base);
+    let mut pending: Vec<u32> = Vec::new();
+    for v in 0..nv as u32 {
+        let vi = v as usize;
+        if base.vertex_faces(vi).is_empty() || scheme.is_interpolating() {
+            position[vi] = Some(vec![(v, 1.0)]);
+        }
+        if base.vertex_faces(vi).is_empty() {
+            continue;
+        }
+        if features.is_on_feature(vi) {
+            if scheme == SplitScheme::Sqrt3 {
+                if features.is_corner(vi) {
+                    position[vi] = Some(vec![(v, 1.0)]);
+                } else if features.is_curve_vertex(vi) {
+                    let [e0, e1] = features.curve_edges(vi);
+                    position[vi] = Some(vec![
+                        (base.edge_other_vertex(e0 as usize, v), 1.0 / 6.0),
+                        (v, 4.0 / 6.0),
+                        (base.edge_other_vertex(e1 as usize, v), 1.0 / 6.0),
+                    ]);
+                }
+                // A dart (one crease edge ending inside the surface): no mask here.
+            }
+            continue;
+        }
+        pending.push(v);
+    }
+    let mut masks: HashMap<usize, (LocalMasks, usize)> = HashMap::new();
+    let mut level = 0;
+    let mut refined: Option<SplitRefinement> = None;
+    while !pending.is_empty() && level <= MAX_LEVELS {
+        let (t, composed) = match &refined {
+            None => (base, None),
+            Some(r) => (r.topology(level), Some(r.composed(level))),
+        };
+        let features = Features::new(t);
+        let mut still = Vec::new();
+        for &v in &pending {
+            let n = base.valence(v as usize);
+            if !(3..=64).contains(&n) {
+                continue;
+            }
+            if let std::collections::hash_map::Entry::Vacant(e) = masks.entry(n) {
+                let m = local_masks(scheme, n)?;
+                let size = m.limit.len();
+                e.insert((m, size));
+            }
+            let (m, size) = &masks[&n];
+            let ball = LocalMasks::ball(t, v, m.radius);
+            if !regular_ball(t, &features, v, &ball, *size) {
+                still.push(v);
+                continue;
+            }
+            let row = |w: &[f64]| -> Row {
+                let r: Row = ball
+                    .iter()
+                    .zip(w)
+                    .filter(|(_, w)| **w != 0.0)
+                    .map(|(&u, &w)| (u, w))
+                    .collect();
+                match &composed {
+                    None => r,
+                    Some(c) => to_base(&r, c),
+                }
+            };
+            if !scheme.is_interpolating() {
+                position[v as usize] = Some(row(&m.limit));
+            }
+            if let Some([a, b]) = &m.tangents {
+                tangents[v as usize] = Some([row(a), row(b)]);
+            }
+        }
+        pending = still;
+        level += 1;
+        if !pending.is_empty() && level <= MAX_LEVELS {
+            refined = Some(refinement(level)?);
+        }
+    }
+    Ok(())
+}
