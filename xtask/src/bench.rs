@@ -40,7 +40,7 @@ pub fn tri_bench_mesh() -> Mesh {
     Mesh::new(topo, q.positions).expect("finite")
 }
 
-fn peak_rss_bytes() -> u64 {
+pub(crate) fn peak_rss_bytes() -> u64 {
     std::fs::read_to_string("/proc/self/status")
         .ok()
         .and_then(|s| {

@@ -75,7 +75,7 @@ pub fn build_harness() -> Result<PathBuf, String> {
     Ok(exe)
 }
 
-fn write_off(path: &Path, topo: &Topology, positions: &[DVec3]) -> Result<(), String> {
+pub fn write_off(path: &Path, topo: &Topology, positions: &[DVec3]) -> Result<(), String> {
     use std::fmt::Write as _;
     let mut s = String::new();
     let _ = writeln!(s, "OFF\n{} {} 0", topo.num_vertices(), topo.num_faces());

@@ -16,6 +16,7 @@ mod geom_ref;
 mod osd;
 mod pia_bench;
 mod random_mesh;
+mod split_bench;
 
 #[derive(Parser)]
 #[command(name = "xtask", about = "subd project automation")]
@@ -84,6 +85,24 @@ enum Task {
         /// examples).
         #[arg(long)]
         editing_only: bool,
+        /// Only the split-scheme benchmark (Doo-Sabin, √3, butterflies against CGAL and
+        /// OpenMesh).
+        #[arg(long)]
+        split_only: bool,
+    },
+    /// (internal) One subd split-scheme measurement for `bench`, in its own process.
+    #[command(hide = true)]
+    BenchSplitRun {
+        #[arg(long)]
+        mesh: std::path::PathBuf,
+        #[arg(long)]
+        scheme: String,
+        #[arg(long)]
+        levels: usize,
+        #[arg(long)]
+        threads: usize,
+        #[arg(long)]
+        repeats: usize,
     },
     /// (internal) The subd side of the evaluation benchmark, in its own process.
     #[command(hide = true)]
@@ -234,6 +253,7 @@ fn main() -> ExitCode {
             pia_only,
             adaptive_only,
             editing_only,
+            split_only,
         } => {
             let refinement = || {
                 bench::run(
@@ -244,7 +264,10 @@ fn main() -> ExitCode {
                     !no_huge_page_advice,
                 )
             };
-            if pia_only {
+            let split = || split_bench::run(levels, repeats, rounds.max(1));
+            if split_only {
+                ensure_system_packages(REFERENCE_PACKAGES).and_then(|_| split())
+            } else if pia_only {
                 pia_bench::run(repeats)
             } else if editing_only {
                 editing_bench::run(repeats)
@@ -264,11 +287,19 @@ fn main() -> ExitCode {
                             pia_bench::run(repeats)
                                 .and_then(|_| adaptive_bench::run(repeats))
                                 .and_then(|_| editing_bench::run(repeats))
+                                .and_then(|_| split())
                         }
                     })
             }
         }
         Task::BenchEval { mesh, repeats } => bench::run_subd_eval(&mesh, repeats),
+        Task::BenchSplitRun {
+            mesh,
+            scheme,
+            levels,
+            threads,
+            repeats,
+        } => split_bench::run_subd(&mesh, &scheme, levels, threads, repeats),
         Task::BenchRun {
             mesh,
             scheme,

@@ -144,24 +144,23 @@ impl Refined {
     fn faces(&self, level: usize) -> (&[u32], &[u32]) {
         match self {
             Refined::Osd(r) => r.faces(level),
-            Refined::Split(r) => {
-                let t = r.topology(level);
-                (t.face_offsets(), t.all_face_vertices())
-            }
+            Refined::Split(r) => r.faces(level),
         }
     }
 
     fn explicit_tags(&self, level: usize) -> ExplicitTags {
         match self {
             Refined::Osd(r) => r.explicit_tags(level),
-            Refined::Split(r) => split_tags(r.topology(level)),
+            Refined::Split(r) => r.explicit_tags(level),
         }
     }
 
-    fn num_edges(&self, level: usize) -> usize {
+    /// Edges of the level; not counted for a split scheme's last level, whose edges are
+    /// never built.
+    fn num_edges(&self, level: usize) -> Option<usize> {
         match self {
-            Refined::Osd(r) => r.num_edges(level),
-            Refined::Split(r) => r.topology(level).num_edges(),
+            Refined::Osd(r) => Some(r.num_edges(level)),
+            Refined::Split(_) => None,
         }
     }
 
@@ -171,21 +170,6 @@ impl Refined {
             Refined::Split(r) => r.refine_points(base),
         };
         levels.pop().expect("last level")
-    }
-}
-
-/// The tags a split scheme carries that a reader cannot infer: infinitely sharp interior
-/// creases and corner tags.
-fn split_tags(t: &subd_mesh::Topology) -> ExplicitTags {
-    ExplicitTags {
-        creases: (0..t.num_edges())
-            .filter(|&e| t.edge_sharpness(e) > 0.0 && !t.is_boundary_edge(e))
-            .map(|e| (t.edge_vertices(e), t.edge_sharpness(e)))
-            .collect(),
-        corners: (0..t.num_vertices() as u32)
-            .filter(|&v| t.vertex_sharpness(v as usize) > 0.0)
-            .map(|v| (v, t.vertex_sharpness(v as usize)))
-            .collect(),
     }
 }
 
@@ -283,7 +267,7 @@ pub(crate) fn run(
     subd_io::write_view(&args.output, &view, &subd_io::WriteOptions::default())?;
     let out_counts = Counts {
         vertices: positions.len(),
-        edges: Some(refinement.num_edges(args.levels)),
+        edges: refinement.num_edges(args.levels),
         faces: view.num_faces(),
     };
     progress.finish();

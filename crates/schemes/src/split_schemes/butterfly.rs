@@ -24,10 +24,9 @@
 
 use std::f64::consts::TAU;
 
-use subd_mesh::Topology;
+use subd_mesh::{Topology, tags};
 
-use super::{Features, SplitLevel, StepError};
-use crate::{Options, RefineError, Refinement, RowSink, Scheme, StencilTable};
+use super::{ChildFaces, Features, StepError, Weights, check_size};
 
 /// The rule for the point of an interior edge.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -36,18 +35,16 @@ pub(crate) enum EdgeRule {
     Modified,
 }
 
-/// Zorin's weights `s_j` of the ring of an extraordinary vertex of valence `n` (`j = 0` is
-/// the other end of the edge); the vertex itself weighs ¾.
-pub fn zorin_weights(n: usize) -> Vec<f64> {
+/// Zorin's weight `s_j` of ring vertex `j` of an extraordinary vertex of valence `n`
+/// (`j = 0` is the other end of the edge); the vertex itself weighs ¾.
+pub fn zorin_weight(n: usize, j: usize) -> f64 {
     match n {
-        3 => vec![5.0 / 12.0, -1.0 / 12.0, -1.0 / 12.0],
-        4 => vec![3.0 / 8.0, 0.0, -1.0 / 8.0, 0.0],
-        _ => (0..n)
-            .map(|j| {
-                let t = TAU * j as f64 / n as f64;
-                (0.25 + t.cos() + 0.5 * (2.0 * t).cos()) / n as f64
-            })
-            .collect(),
+        3 => [5.0 / 12.0, -1.0 / 12.0, -1.0 / 12.0][j],
+        4 => [3.0 / 8.0, 0.0, -1.0 / 8.0, 0.0][j],
+        _ => {
+            let t = TAU * j as f64 / n as f64;
+            (0.25 + t.cos() + 0.5 * (2.0 * t).cos()) / n as f64
+        }
     }
 }
 
@@ -60,7 +57,7 @@ enum Point {
 }
 
 impl Point {
-    fn add_to(self, sink: &mut RowSink, w: f64) {
+    fn add_to<W: Weights>(self, sink: &mut W, w: f64) {
         match self {
             Point::Vertex(v) => sink.add(v, w),
             Point::Reflected(x, y, z) => {
@@ -72,13 +69,69 @@ impl Point {
     }
 }
 
-/// Topology and features of the level being refined, with the stencil walks over it.
-struct Level<'a> {
+/// One butterfly step over a parent level: its features and edge rule.
+pub(crate) struct Step<'a> {
     t: &'a Topology,
     features: Features,
+    rule: EdgeRule,
 }
 
-impl Level<'_> {
+impl<'a> Step<'a> {
+    pub(crate) fn new(t: &'a Topology, rule: EdgeRule) -> Step<'a> {
+        Step {
+            t,
+            features: Features::new(t),
+            rule,
+        }
+    }
+
+    pub(crate) fn num_rows(&self) -> usize {
+        self.t.num_vertices() + self.t.num_edges()
+    }
+
+    #[inline]
+    pub(crate) fn fill<W: Weights>(&self, r: usize, w: &mut W) {
+        let nv = self.t.num_vertices();
+        if r < nv {
+            w.add(r as u32, 1.0);
+        } else {
+            self.edge_point(r - nv, w);
+        }
+    }
+
+    /// Loop's split: triangle `(v0, v1, v2)` with edge points `E_i` of its edges
+    /// `(v_i, v_i+1)` becomes `(v0, E0, E2)`, `(E0, v1, E1)`, `(E2, E1, v2)`, `(E1, E2, E0)`;
+    /// an interior crease's two halves stay creases, corner tags stay.
+    pub(crate) fn child_faces(&self) -> Result<ChildFaces, StepError> {
+        let t = self.t;
+        let nv = t.num_vertices() as u32;
+        check_size(12 * t.num_faces() as u64)?;
+        let mut verts = Vec::with_capacity(12 * t.num_faces());
+        for f in 0..t.num_faces() {
+            let v = t.face_vertices(f);
+            let e: Vec<u32> = t.face_edges(f).iter().map(|&e| nv + e).collect();
+            verts.extend([
+                v[0], e[0], e[2], e[0], v[1], e[1], e[2], e[1], v[2], e[1], e[2], e[0],
+            ]);
+        }
+        let mut faces = ChildFaces::triangles(self.num_rows(), verts);
+        for e in 0..t.num_edges() {
+            if !t.is_boundary_edge(e) && tags::is_infinite(t.edge_sharpness(e)) {
+                let [a, b] = t.edge_vertices(e);
+                faces
+                    .creases
+                    .extend([[a, nv + e as u32], [nv + e as u32, b]]);
+            }
+        }
+        for v in 0..t.num_vertices() {
+            let s = t.vertex_sharpness(v);
+            if s > 0.0 {
+                faces.corners.push((v as u32, s));
+            }
+        }
+        Ok(faces)
+    }
+
     /// The vertex across edge `pos` of triangle `f` (the edge from corner `pos` to
     /// `pos + 1`), or that edge's reflection of `f`'s own third vertex when the edge is a
     /// feature.
@@ -98,7 +151,7 @@ impl Level<'_> {
     }
 
     /// Point of feature edge `e` by the 4-point rule along its curve.
-    fn curve_point(&self, e: usize, w: f64, sink: &mut RowSink) {
+    fn curve_point<W: Weights>(&self, e: usize, w: f64, sink: &mut W) {
         let t = self.t;
         let [a, b] = t.edge_vertices(e);
         for (near, far) in [(a, b), (b, a)] {
@@ -111,7 +164,7 @@ impl Level<'_> {
     }
 
     /// The butterfly stencil of interior edge `e` with tension `w`.
-    fn butterfly_point(&self, e: usize, w: f64, sink: &mut RowSink) {
+    fn butterfly_point<W: Weights>(&self, e: usize, w: f64, sink: &mut W) {
         let t = self.t;
         let faces = t.edge_faces(e);
         let local = t.edge_face_local_indices(e);
@@ -128,7 +181,7 @@ impl Level<'_> {
     }
 
     /// Zorin's rule at extraordinary end `a` of edge `e` (weight `scale` for averaging).
-    fn zorin_point(&self, e: usize, a: u32, scale: f64, sink: &mut RowSink) {
+    fn zorin_point<W: Weights>(&self, e: usize, a: u32, scale: f64, sink: &mut W) {
         let t = self.t;
         let edges = t.vertex_edges(a as usize);
         let n = edges.len();
@@ -137,9 +190,9 @@ impl Level<'_> {
             .position(|&x| x as usize == e)
             .expect("edge at its end");
         sink.add(a, 0.75 * scale);
-        for (j, s) in zorin_weights(n).into_iter().enumerate() {
+        for j in 0..n {
             let v = t.edge_other_vertex(edges[(start + j) % n] as usize, a);
-            sink.add(v, s * scale);
+            sink.add(v, zorin_weight(n, j) * scale);
         }
     }
 
@@ -147,7 +200,8 @@ impl Level<'_> {
         self.features.is_on_feature(v as usize) || self.t.valence(v as usize) == 6
     }
 
-    fn edge_point(&self, e: usize, rule: EdgeRule, sink: &mut RowSink) {
+    fn edge_point<W: Weights>(&self, e: usize, sink: &mut W) {
+        let rule = self.rule;
         let w = match rule {
             EdgeRule::Classic { tension } => tension,
             EdgeRule::Modified => 1.0 / 16.0,
@@ -172,28 +226,4 @@ impl Level<'_> {
         }
         self.butterfly_point(e, w, sink)
     }
-}
-
-/// One butterfly step: Loop's split (and its tag propagation), butterfly masks.
-pub(crate) fn refine(p: &Topology, rule: EdgeRule) -> Result<SplitLevel, StepError> {
-    let split = Refinement::new(p, Scheme::Loop, &Options::default(), 1).map_err(|e| match e {
-        RefineError::TooLarge { .. } => StepError::TooLarge,
-        other => unreachable!("checked before the first step: {other}"),
-    })?;
-    let level = Level {
-        t: p,
-        features: Features::new(p),
-    };
-    let nv = p.num_vertices();
-    let stencils = StencilTable::build(nv + p.num_edges(), nv, |r, sink| {
-        if r < nv {
-            sink.add(r as u32, 1.0);
-        } else {
-            level.edge_point(r - nv, rule, sink);
-        }
-    });
-    Ok(SplitLevel {
-        topology: split.into_topology(1),
-        stencils,
-    })
 }

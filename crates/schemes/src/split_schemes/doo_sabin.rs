@@ -29,10 +29,9 @@
 
 use std::f64::consts::TAU;
 
-use subd_mesh::{Topology, TopologyBuilder};
+use subd_mesh::Topology;
 
-use super::{SplitLevel, StepError, check_size};
-use crate::StencilTable;
+use super::{ChildFaces, StepError, Weights, check_size};
 
 /// Doo-Sabin weight `α_d` of corner distance `d` in an `n`-sided face.
 pub fn weight(n: usize, d: usize) -> f64 {
@@ -110,95 +109,132 @@ pub fn vertex_face_indices(p: &Topology) -> Vec<Option<u32>> {
         .collect()
 }
 
-/// One Doo-Sabin step.
-pub(crate) fn refine(p: &Topology) -> Result<SplitLevel, StepError> {
-    let nfv = p.num_face_vertices();
-    let (chaikin_at, num_chaikin) = boundary_points(p, nfv as u32);
-    let num_boundary_vertices = (0..p.num_vertices())
-        .filter(|&v| p.is_boundary_vertex(v))
-        .count();
-    check_size(2 * nfv as u64 + 4 * p.num_edges() as u64 + 2 * num_boundary_vertices as u64)?;
-    let offsets = p.face_offsets();
-    let child = |f: u32, k: usize| offsets[f as usize] + k as u32;
-    // The Chaikin point of boundary edge `e` next to its end `v`.
-    let chaikin =
-        |e: u32, v: u32| chaikin_at[e as usize] + u32::from(p.edge_vertices(e as usize)[1] == v);
+/// One Doo-Sabin step over a parent level.
+pub(crate) struct Step<'a> {
+    p: &'a Topology,
+    /// First Chaikin point of each boundary edge (`u32::MAX` inside).
+    chaikin_at: Vec<u32>,
+    num_chaikin: usize,
+    /// The face of each face-vertex.
+    face_of: Vec<u32>,
+    boundary_edges: Vec<u32>,
+    table: WeightTable,
+}
 
-    let mut sizes: Vec<u32> = Vec::with_capacity(p.num_faces() + p.num_edges() + p.num_vertices());
-    let mut verts: Vec<u32> = Vec::with_capacity(2 * nfv + 4 * p.num_edges());
-    // F-faces.
-    sizes.extend(p.face_sizes());
-    verts.extend(0..nfv as u32);
-    // E-faces.
-    for e in 0..p.num_edges() {
-        let faces = p.edge_faces(e);
-        let local = p.edge_face_local_indices(e);
-        let n0 = p.face_size(faces[0] as usize);
-        // In face 0 the edge runs from corner k to corner k+1, which may be either end.
-        let (f, k) = (faces[0], local[0] as usize);
-        let (a_child, b_child) = (child(f, k), child(f, (k + 1) % n0));
-        sizes.push(4);
-        if faces.len() == 1 {
-            let fv = p.face_vertices(f as usize);
-            let (a, b) = (fv[k], fv[(k + 1) % n0]);
-            verts.extend([chaikin(e as u32, a), chaikin(e as u32, b), b_child, a_child]);
-        } else {
-            let (g, j) = (faces[1], local[1] as usize);
-            let n1 = p.face_size(g as usize);
-            // Face 1 runs the edge the other way: from corner j (= b) to j+1 (= a).
-            let (gb, ga) = (child(g, j), child(g, (j + 1) % n1));
-            verts.extend([b_child, a_child, ga, gb]);
+impl<'a> Step<'a> {
+    pub(crate) fn new(p: &'a Topology) -> Step<'a> {
+        let (chaikin_at, num_chaikin) = boundary_points(p, p.num_face_vertices() as u32);
+        let mut face_of = Vec::with_capacity(p.num_face_vertices());
+        for f in 0..p.num_faces() {
+            face_of.extend(std::iter::repeat_n(f as u32, p.face_size(f)));
+        }
+        let boundary_edges = (0..p.num_edges() as u32)
+            .filter(|&e| chaikin_at[e as usize] != u32::MAX)
+            .collect();
+        Step {
+            p,
+            chaikin_at,
+            num_chaikin,
+            face_of,
+            boundary_edges,
+            table: WeightTable::new(17),
         }
     }
-    // V-faces.
-    for v in 0..p.num_vertices() {
-        if !has_vertex_face(p, v) {
-            continue;
-        }
-        let faces = p.vertex_faces(v);
-        let local = p.vertex_face_local_indices(v);
-        let boundary = p.is_boundary_vertex(v);
-        sizes.push((faces.len() + if boundary { 2 } else { 0 }) as u32);
-        if boundary {
-            let (f0, c0) = (faces[0] as usize, local[0] as usize);
-            verts.push(chaikin(p.face_edges(f0)[c0], v as u32));
-        }
-        verts.extend(faces.iter().zip(local).map(|(&f, &c)| child(f, c as usize)));
-        if boundary {
-            let (fl, cl) = (
-                faces[faces.len() - 1] as usize,
-                local[local.len() - 1] as usize,
-            );
-            let n = p.face_size(fl);
-            verts.push(chaikin(p.face_edges(fl)[(cl + n - 1) % n], v as u32));
-        }
-    }
-    let num_child = nfv + num_chaikin;
-    let topology = TopologyBuilder::new(num_child).build(&sizes, &verts)?;
 
-    let face_of: Vec<u32> = (0..p.num_faces())
-        .flat_map(|f| std::iter::repeat_n(f as u32, p.face_size(f)))
-        .collect();
-    let boundary_edges: Vec<u32> = (0..p.num_edges() as u32)
-        .filter(|&e| chaikin_at[e as usize] != u32::MAX)
-        .collect();
-    let table = WeightTable::new(17);
-    let stencils = StencilTable::build(num_child, p.num_vertices(), |r, sink| {
+    pub(crate) fn num_rows(&self) -> usize {
+        self.p.num_face_vertices() + self.num_chaikin
+    }
+
+    /// The Chaikin point of boundary edge `e` next to its end `v`.
+    fn chaikin(&self, e: u32, v: u32) -> u32 {
+        self.chaikin_at[e as usize] + u32::from(self.p.edge_vertices(e as usize)[1] == v)
+    }
+
+    #[inline]
+    pub(crate) fn fill<W: Weights>(&self, r: usize, w: &mut W) {
+        let p = self.p;
+        let nfv = p.num_face_vertices();
         if r < nfv {
-            let f = face_of[r] as usize;
-            let k = r - offsets[f] as usize;
+            let f = self.face_of[r] as usize;
+            let k = r - p.face_offsets()[f] as usize;
             let fv = p.face_vertices(f);
             let n = fv.len();
             for (j, &x) in fv.iter().enumerate() {
-                sink.add(x, table.get(n, (j + n - k) % n));
+                w.add(x, self.table.get(n, (j + n - k) % n));
             }
         } else {
             let i = r - nfv;
-            let [a, b] = p.edge_vertices(boundary_edges[i / 2] as usize);
+            let [a, b] = p.edge_vertices(self.boundary_edges[i / 2] as usize);
             let (near, far) = if i % 2 == 0 { (a, b) } else { (b, a) };
-            sink.add(near, 0.75);
-            sink.add(far, 0.25);
+            w.add(near, 0.75);
+            w.add(far, 0.25);
         }
-    });
-    Ok(SplitLevel { topology, stencils })
+    }
+
+    pub(crate) fn child_faces(&self) -> Result<ChildFaces, StepError> {
+        let p = self.p;
+        let nfv = p.num_face_vertices();
+        let num_boundary_vertices = (0..p.num_vertices())
+            .filter(|&v| p.is_boundary_vertex(v))
+            .count();
+        check_size(2 * nfv as u64 + 4 * p.num_edges() as u64 + 2 * num_boundary_vertices as u64)?;
+        let offsets = p.face_offsets();
+        let child = |f: u32, k: usize| offsets[f as usize] + k as u32;
+        let mut sizes: Vec<u32> =
+            Vec::with_capacity(p.num_faces() + p.num_edges() + p.num_vertices());
+        let mut verts: Vec<u32> = Vec::with_capacity(2 * nfv + 4 * p.num_edges());
+        // F-faces.
+        sizes.extend(p.face_sizes());
+        verts.extend(0..nfv as u32);
+        // E-faces.
+        for e in 0..p.num_edges() {
+            let faces = p.edge_faces(e);
+            let local = p.edge_face_local_indices(e);
+            let n0 = p.face_size(faces[0] as usize);
+            // In face 0 the edge runs from corner k to corner k+1, which may be either end.
+            let (f, k) = (faces[0], local[0] as usize);
+            let (a_child, b_child) = (child(f, k), child(f, (k + 1) % n0));
+            sizes.push(4);
+            if faces.len() == 1 {
+                let fv = p.face_vertices(f as usize);
+                let (a, b) = (fv[k], fv[(k + 1) % n0]);
+                verts.extend([
+                    self.chaikin(e as u32, a),
+                    self.chaikin(e as u32, b),
+                    b_child,
+                    a_child,
+                ]);
+            } else {
+                let (g, j) = (faces[1], local[1] as usize);
+                let n1 = p.face_size(g as usize);
+                // Face 1 runs the edge the other way: from corner j (= b) to j+1 (= a).
+                let (gb, ga) = (child(g, j), child(g, (j + 1) % n1));
+                verts.extend([b_child, a_child, ga, gb]);
+            }
+        }
+        // V-faces.
+        for v in 0..p.num_vertices() {
+            if !has_vertex_face(p, v) {
+                continue;
+            }
+            let faces = p.vertex_faces(v);
+            let local = p.vertex_face_local_indices(v);
+            let boundary = p.is_boundary_vertex(v);
+            sizes.push((faces.len() + if boundary { 2 } else { 0 }) as u32);
+            if boundary {
+                let (f0, c0) = (faces[0] as usize, local[0] as usize);
+                verts.push(self.chaikin(p.face_edges(f0)[c0], v as u32));
+            }
+            verts.extend(faces.iter().zip(local).map(|(&f, &c)| child(f, c as usize)));
+            if boundary {
+                let (fl, cl) = (
+                    faces[faces.len() - 1] as usize,
+                    local[local.len() - 1] as usize,
+                );
+                let n = p.face_size(fl);
+                verts.push(self.chaikin(p.face_edges(fl)[(cl + n - 1) % n], v as u32));
+            }
+        }
+        Ok(ChildFaces::from_sizes(self.num_rows(), &sizes, verts))
+    }
 }

@@ -34,11 +34,14 @@ pub mod doo_sabin;
 mod features;
 pub mod sqrt3;
 
+use std::sync::OnceLock;
+
 use glam::DVec3;
-use subd_mesh::{Topology, TopologyError, tags};
+use rayon::prelude::*;
+use subd_mesh::{Topology, TopologyBuilder, TopologyError, tags};
 use thiserror::Error;
 
-use crate::{MAX_LEVELS, StencilTable};
+use crate::{MAX_LEVELS, RowSink, StencilTable};
 
 pub use features::Features;
 
@@ -166,19 +169,178 @@ pub enum SplitError {
     },
 }
 
-/// One refined level: its topology and the stencils giving its vertices from the level above.
+/// The faces and tags of a refined level, before its topology is built.
 #[derive(Debug, Clone)]
-pub struct SplitLevel {
-    /// Topology of the level, with the tags the scheme carries (infinitely sharp creases and
-    /// corners of √3 and the butterflies).
-    pub topology: Topology,
-    /// Child vertices as weighted sums of the parent level's vertices.
-    pub stencils: StencilTable,
+pub(crate) struct ChildFaces {
+    pub(crate) num_vertices: usize,
+    /// Face offsets (one more than faces) and vertices.
+    pub(crate) offsets: Vec<u32>,
+    pub(crate) vertices: Vec<u32>,
+    /// Infinitely sharp interior creases, as end vertices.
+    pub(crate) creases: Vec<[u32; 2]>,
+    /// Corner tags.
+    pub(crate) corners: Vec<(u32, f32)>,
+}
+
+impl ChildFaces {
+    /// Faces from per-face sizes.
+    pub(crate) fn from_sizes(num_vertices: usize, sizes: &[u32], vertices: Vec<u32>) -> ChildFaces {
+        let mut offsets = Vec::with_capacity(sizes.len() + 1);
+        offsets.push(0u32);
+        let mut end = 0u32;
+        for &n in sizes {
+            end += n;
+            offsets.push(end);
+        }
+        ChildFaces {
+            num_vertices,
+            offsets,
+            vertices,
+            creases: Vec::new(),
+            corners: Vec::new(),
+        }
+    }
+
+    /// All faces triangles.
+    pub(crate) fn triangles(num_vertices: usize, vertices: Vec<u32>) -> ChildFaces {
+        let offsets = (0..=vertices.len() as u32 / 3).map(|f| 3 * f).collect();
+        ChildFaces {
+            num_vertices,
+            offsets,
+            vertices,
+            creases: Vec::new(),
+            corners: Vec::new(),
+        }
+    }
+
+    fn build(&self) -> Result<Topology, TopologyError> {
+        let sizes: Vec<u32> = self.offsets.windows(2).map(|w| w[1] - w[0]).collect();
+        let mut t = TopologyBuilder::new(self.num_vertices).build(&sizes, &self.vertices)?;
+        for &[a, b] in &self.creases {
+            if let Some(e) = t.find_edge(a, b) {
+                t.set_edge_sharpness(e as usize, tags::SHARPNESS_INFINITE);
+            }
+        }
+        for &(v, s) in &self.corners {
+            t.set_vertex_sharpness(v as usize, s);
+        }
+        Ok(t)
+    }
+}
+
+/// Where a row's weights go: a stencil row, or a point being summed.
+pub(crate) trait Weights {
+    /// Adds `w` times parent vertex `i`.
+    fn add(&mut self, i: u32, w: f64);
+}
+
+impl Weights for RowSink<'_> {
+    #[inline]
+    fn add(&mut self, i: u32, w: f64) {
+        RowSink::add(self, i, w);
+    }
+}
+
+/// A child point summed from parent points.
+struct PointSum<'a> {
+    src: &'a [DVec3],
+    acc: DVec3,
+}
+
+impl Weights for PointSum<'_> {
+    #[inline]
+    fn add(&mut self, i: u32, w: f64) {
+        self.acc += self.src[i as usize] * w;
+    }
+}
+
+/// One step of a scheme over its parent level: the child faces, and each child vertex's row.
+enum Step<'a> {
+    DooSabin(doo_sabin::Step<'a>),
+    Sqrt3(sqrt3::Step<'a>),
+    Butterfly(butterfly::Step<'a>),
+}
+
+impl Step<'_> {
+    fn new(p: &Topology, scheme: SplitScheme, level: usize) -> Step<'_> {
+        match scheme {
+            SplitScheme::DooSabin => Step::DooSabin(doo_sabin::Step::new(p)),
+            SplitScheme::Sqrt3 => Step::Sqrt3(sqrt3::Step::new(p, level % 2 == 0)),
+            SplitScheme::Butterfly { tension } => Step::Butterfly(butterfly::Step::new(
+                p,
+                butterfly::EdgeRule::Classic { tension },
+            )),
+            SplitScheme::ModifiedButterfly => {
+                Step::Butterfly(butterfly::Step::new(p, butterfly::EdgeRule::Modified))
+            }
+        }
+    }
+
+    fn num_rows(&self) -> usize {
+        match self {
+            Step::DooSabin(s) => s.num_rows(),
+            Step::Sqrt3(s) => s.num_rows(),
+            Step::Butterfly(s) => s.num_rows(),
+        }
+    }
+
+    #[inline]
+    fn fill<W: Weights>(&self, r: usize, w: &mut W) {
+        match self {
+            Step::DooSabin(s) => s.fill(r, w),
+            Step::Sqrt3(s) => s.fill(r, w),
+            Step::Butterfly(s) => s.fill(r, w),
+        }
+    }
+
+    fn child_faces(&self) -> Result<ChildFaces, StepError> {
+        match self {
+            Step::DooSabin(s) => s.child_faces(),
+            Step::Sqrt3(s) => s.child_faces(),
+            Step::Butterfly(s) => s.child_faces(),
+        }
+    }
+
+    fn stencils(&self, num_sources: usize) -> StencilTable {
+        StencilTable::build(self.num_rows(), num_sources, |r, sink| self.fill(r, sink))
+    }
+
+    fn points(&self, src: &[DVec3]) -> Vec<DVec3> {
+        let mut out = Vec::new();
+        (0..self.num_rows())
+            .into_par_iter()
+            .with_min_len(1024)
+            .map(|r| {
+                let mut sum = PointSum {
+                    src,
+                    acc: DVec3::ZERO,
+                };
+                self.fill(r, &mut sum);
+                sum.acc
+            })
+            .collect_into_vec(&mut out);
+        out
+    }
+}
+
+/// One refined level: its faces and tags, its topology (built eagerly below the last level,
+/// which the next step needs, and on first request for the last), and the stencils from the
+/// level above (built on first request).
+#[derive(Debug)]
+struct SplitLevel {
+    faces: ChildFaces,
+    topology: OnceLock<Topology>,
+    stencils: OnceLock<StencilTable>,
 }
 
 /// A uniform refinement with a [`SplitScheme`]: the topology of every level and the stencils
 /// between levels.
-#[derive(Debug, Clone)]
+///
+/// Like [`crate::Refinement`], it computes what a refinement always needs up front (the
+/// faces of every level, the topology of every level but the last) and the rest on request:
+/// the last level's full topology, and the stencil tables. [`Self::refine_points`] evaluates
+/// the masks directly, level by level, in parallel, with the same rows the tables hold.
+#[derive(Debug)]
 pub struct SplitRefinement {
     scheme: SplitScheme,
     base: Topology,
@@ -200,22 +362,25 @@ impl SplitRefinement {
         check_input(base, scheme, levels)?;
         let mut out: Vec<SplitLevel> = Vec::with_capacity(levels);
         for l in 1..=levels {
-            let parent = out.last().map_or(base, |s| &s.topology);
-            let child = match scheme {
-                SplitScheme::DooSabin => doo_sabin::refine(parent),
-                SplitScheme::Sqrt3 => sqrt3::refine(parent, l % 2 == 0),
-                SplitScheme::Butterfly { tension } => {
-                    butterfly::refine(parent, butterfly::EdgeRule::Classic { tension })
-                }
-                SplitScheme::ModifiedButterfly => {
-                    butterfly::refine(parent, butterfly::EdgeRule::Modified)
-                }
+            let parent = match out.last() {
+                None => base,
+                Some(s) => s.topology.get().expect("levels above the last are built"),
+            };
+            let faces = Step::new(parent, scheme, l)
+                .child_faces()
+                .map_err(|e| e.at_level(l))?;
+            let topology = OnceLock::new();
+            if l < levels {
+                let t = faces
+                    .build()
+                    .map_err(|e| StepError::Topology(e).at_level(l))?;
+                let _ = topology.set(t);
             }
-            .map_err(|e| match e {
-                StepError::TooLarge => SplitError::TooLarge { level: l },
-                StepError::Topology(source) => SplitError::Topology { level: l, source },
-            })?;
-            out.push(child);
+            out.push(SplitLevel {
+                faces,
+                topology,
+                stencils: OnceLock::new(),
+            });
         }
         Ok(SplitRefinement {
             scheme,
@@ -234,17 +399,78 @@ impl SplitRefinement {
         self.levels.len()
     }
 
-    /// Topology of `level` (0 is the base mesh).
-    pub fn topology(&self, level: usize) -> &Topology {
+    /// Number of vertices of `level`.
+    pub fn num_vertices(&self, level: usize) -> usize {
         match level {
-            0 => &self.base,
-            l => &self.levels[l - 1].topology,
+            0 => self.base.num_vertices(),
+            l => self.levels[l - 1].faces.num_vertices,
         }
     }
 
-    /// Stencils giving the vertices of `level` from those of `level - 1` (`level ≥ 1`).
+    /// Face offsets and face vertices of `level`, without building its topology.
+    pub fn faces(&self, level: usize) -> (&[u32], &[u32]) {
+        match level {
+            0 => (self.base.face_offsets(), self.base.all_face_vertices()),
+            l => {
+                let f = &self.levels[l - 1].faces;
+                (&f.offsets, &f.vertices)
+            }
+        }
+    }
+
+    /// The interior infinitely sharp creases (end vertices) and corner tags of `level`: the
+    /// tags a mesh file records beyond what its faces imply.
+    pub fn explicit_tags(&self, level: usize) -> crate::ExplicitTags {
+        let (creases, corners): (Vec<[u32; 2]>, Vec<(u32, f32)>) = match level {
+            0 => {
+                let t = &self.base;
+                (
+                    (0..t.num_edges())
+                        .filter(|&e| t.edge_sharpness(e) > 0.0 && !t.is_boundary_edge(e))
+                        .map(|e| t.edge_vertices(e))
+                        .collect(),
+                    (0..t.num_vertices() as u32)
+                        .filter(|&v| t.vertex_sharpness(v as usize) > 0.0)
+                        .map(|v| (v, t.vertex_sharpness(v as usize)))
+                        .collect(),
+                )
+            }
+            l => {
+                let f = &self.levels[l - 1].faces;
+                (f.creases.clone(), f.corners.clone())
+            }
+        };
+        crate::ExplicitTags {
+            creases: creases
+                .into_iter()
+                .map(|c| (c, tags::SHARPNESS_INFINITE))
+                .collect(),
+            corners,
+        }
+    }
+
+    /// Topology of `level` (0 is the base mesh); the last level's is built on first request.
+    pub fn topology(&self, level: usize) -> &Topology {
+        match level {
+            0 => &self.base,
+            l => {
+                let lv = &self.levels[l - 1];
+                lv.topology.get_or_init(|| {
+                    // The faces were derived from a valid manifold parent; building them is
+                    // what the levels above the last already did without fail.
+                    lv.faces.build().expect("a refined level is a valid mesh")
+                })
+            }
+        }
+    }
+
+    /// Stencils giving the vertices of `level` from those of `level - 1` (`level ≥ 1`), built
+    /// on first request.
     pub fn stencils(&self, level: usize) -> &StencilTable {
-        &self.levels[level - 1].stencils
+        self.levels[level - 1].stencils.get_or_init(|| {
+            let parent = self.topology(level - 1);
+            Step::new(parent, self.scheme, level).stencils(parent.num_vertices())
+        })
     }
 
     /// One table from the base vertices to the vertices of `level`.
@@ -256,7 +482,8 @@ impl SplitRefinement {
         t
     }
 
-    /// Positions of every level from base positions (`result[0]` is `base`).
+    /// Positions of every level from base positions (`result[0]` is `base`), the masks
+    /// evaluated directly, level by level, in parallel.
     ///
     /// # Panics
     /// If `base.len()` differs from the number of base vertices.
@@ -267,8 +494,9 @@ impl SplitRefinement {
             "one position per base vertex"
         );
         let mut out = vec![base.to_vec()];
-        for level in &self.levels {
-            let next = level.stencils.apply_points(out.last().expect("level 0"));
+        for l in 1..=self.levels.len() {
+            let parent = self.topology(l - 1);
+            let next = Step::new(parent, self.scheme, l).points(out.last().expect("level 0"));
             out.push(next);
         }
         out
@@ -276,10 +504,15 @@ impl SplitRefinement {
 
     /// The last level's topology, the refinement consumed.
     pub fn into_last_topology(mut self) -> Topology {
-        match self.levels.pop() {
-            Some(l) => l.topology,
-            None => self.base,
+        let last = self.levels.len();
+        if last == 0 {
+            return self.base;
         }
+        self.topology(last);
+        self.levels
+            .pop()
+            .and_then(|l| l.topology.into_inner())
+            .expect("built above")
     }
 }
 
@@ -288,6 +521,15 @@ impl SplitRefinement {
 pub(crate) enum StepError {
     TooLarge,
     Topology(TopologyError),
+}
+
+impl StepError {
+    fn at_level(self, level: usize) -> SplitError {
+        match self {
+            StepError::TooLarge => SplitError::TooLarge { level },
+            StepError::Topology(source) => SplitError::Topology { level, source },
+        }
+    }
 }
 
 impl From<TopologyError> for StepError {

@@ -28,203 +28,223 @@
 
 use std::f64::consts::TAU;
 
-use subd_mesh::{Topology, TopologyBuilder, tags};
+use subd_mesh::Topology;
 
-use super::{Features, SplitLevel, StepError, check_size};
-use crate::StencilTable;
+use super::{ChildFaces, Features, StepError, Weights, check_size};
 
 /// Kobbelt's `α_n`.
 pub fn alpha(n: usize) -> f64 {
     (4.0 - 2.0 * (TAU / n as f64).cos()) / 9.0
 }
 
-/// What stands in for a face's centroid in the flip of one of its edges.
-enum Apex {
-    /// The face's centroid (child vertex index).
-    Centroid(u32),
-    /// A face with a feature edge on a trisecting step: no centroid; the face is fanned from
-    /// its opposite vertex, and an edge flip uses the trisection point next to the vertex the
-    /// flipped edge shares with the feature edge. Holds the feature edge's position in the
-    /// face.
-    Fan(usize),
+/// One √3 step over a parent level.
+pub(crate) struct Step<'a> {
+    p: &'a Topology,
+    trisect: bool,
+    features: Features,
+    /// The feature edge of each face on a trisecting step (after an odd step a face has at
+    /// most one): such a face gets no centroid and is fanned from its opposite vertex.
+    fan_edge: Vec<Option<u8>>,
+    /// Child index of each face's centroid (`u32::MAX` for fanned faces).
+    centroid_of: Vec<u32>,
+    centroid_faces: Vec<u32>,
+    /// First of the two trisection points of each feature edge (`u32::MAX` elsewhere).
+    trisection: Vec<u32>,
+    feature_edges: Vec<u32>,
+    num_child: usize,
 }
 
-/// One √3 step; `trisect` on even steps.
-pub(crate) fn refine(p: &Topology, trisect: bool) -> Result<SplitLevel, StepError> {
-    let nv = p.num_vertices();
-    let nf = p.num_faces();
-    let features = Features::new(p);
-    // The feature edge of each face on a trisecting step (after an odd step a face has at
-    // most one).
-    let fan_edge: Vec<Option<usize>> = (0..nf)
-        .map(|f| {
-            if !trisect {
-                return None;
-            }
-            p.face_edges(f)
-                .iter()
-                .position(|&e| features.is_feature_edge(e as usize))
-        })
-        .collect();
-    let mut next = nv as u32;
-    let centroid_of: Vec<u32> = fan_edge
-        .iter()
-        .map(|fan| {
-            if fan.is_some() {
-                u32::MAX
-            } else {
-                next += 1;
-                next - 1
-            }
-        })
-        .collect();
-    let num_centroids = next as usize - nv;
-    // Trisection points of feature edges: index of the first of each edge's two.
-    let trisection: Vec<u32> = (0..p.num_edges())
-        .map(|e| {
-            if trisect && features.is_feature_edge(e) {
-                next += 2;
-                next - 2
-            } else {
-                u32::MAX
-            }
-        })
-        .collect();
-    let num_child = next as usize;
-    check_size(9 * nf as u64 + 9 * p.num_edges() as u64)?;
-    // The trisection point of feature edge `e` next to its end `v`.
-    let third =
-        |e: u32, v: u32| trisection[e as usize] + u32::from(p.edge_vertices(e as usize)[1] == v);
-    let apex = |f: usize| match fan_edge[f] {
-        None => Apex::Centroid(centroid_of[f]),
-        Some(pos) => Apex::Fan(pos),
-    };
-    // The apex of face `f` for the flip of the edge at `pos` (from corner `pos` to `pos + 1`).
-    let apex_for = |f: usize, pos: usize| match apex(f) {
-        Apex::Centroid(c) => c,
-        Apex::Fan(fe) => {
-            let fv = p.face_vertices(f);
-            // The flipped edge shares corner `pos` with the feature edge when the feature
-            // edge ends there, else corner `pos + 1`.
-            let shared = if (fe + 1) % 3 == pos {
-                fv[pos]
-            } else {
-                fv[(pos + 1) % 3]
-            };
-            third(p.face_edges(f)[fe], shared)
+impl<'a> Step<'a> {
+    pub(crate) fn new(p: &'a Topology, trisect: bool) -> Step<'a> {
+        let nv = p.num_vertices();
+        let features = Features::new(p);
+        let fan_edge: Vec<Option<u8>> = (0..p.num_faces())
+            .map(|f| {
+                if !trisect {
+                    return None;
+                }
+                p.face_edges(f)
+                    .iter()
+                    .position(|&e| features.is_feature_edge(e as usize))
+                    .map(|i| i as u8)
+            })
+            .collect();
+        let mut next = nv as u32;
+        let mut centroid_faces = Vec::with_capacity(p.num_faces());
+        let centroid_of: Vec<u32> = fan_edge
+            .iter()
+            .enumerate()
+            .map(|(f, fan)| {
+                if fan.is_some() {
+                    u32::MAX
+                } else {
+                    centroid_faces.push(f as u32);
+                    next += 1;
+                    next - 1
+                }
+            })
+            .collect();
+        let mut feature_edges = Vec::new();
+        let trisection: Vec<u32> = (0..p.num_edges())
+            .map(|e| {
+                if trisect && features.is_feature_edge(e) {
+                    feature_edges.push(e as u32);
+                    next += 2;
+                    next - 2
+                } else {
+                    u32::MAX
+                }
+            })
+            .collect();
+        Step {
+            p,
+            trisect,
+            features,
+            fan_edge,
+            centroid_of,
+            centroid_faces,
+            trisection,
+            feature_edges,
+            num_child: next as usize,
         }
-    };
+    }
 
-    let mut verts: Vec<u32> = Vec::with_capacity(6 * p.num_edges());
-    for e in 0..p.num_edges() {
-        let faces = p.edge_faces(e);
-        let local = p.edge_face_local_indices(e);
-        if !features.is_feature_edge(e) {
-            let (f0, k0) = (faces[0] as usize, local[0] as usize);
-            let fv = p.face_vertices(f0);
-            let (a, b) = (fv[k0], fv[(k0 + 1) % 3]);
-            let c0 = apex_for(f0, k0);
-            let c1 = apex_for(faces[1] as usize, local[1] as usize);
-            verts.extend([a, c1, c0, c1, b, c0]);
-            continue;
-        }
-        for (&f, &k) in faces.iter().zip(local) {
-            let fv = p.face_vertices(f as usize);
-            let k = k as usize;
-            let (a, b, x) = (fv[k], fv[(k + 1) % 3], fv[(k + 2) % 3]);
-            if trisect {
-                // The middle of the fan; its two outer triangles come from the flips of the
-                // face's other edges.
-                verts.extend([third(e as u32, a), third(e as u32, b), x]);
-            } else {
-                verts.extend([a, b, centroid_of[f as usize]]);
+    pub(crate) fn num_rows(&self) -> usize {
+        self.num_child
+    }
+
+    /// The trisection point of feature edge `e` next to its end `v`.
+    fn third(&self, e: u32, v: u32) -> u32 {
+        self.trisection[e as usize] + u32::from(self.p.edge_vertices(e as usize)[1] == v)
+    }
+
+    /// What stands in for face `f`'s centroid in the flip of its edge at `pos` (from corner
+    /// `pos` to `pos + 1`): the centroid, or for a fanned face the trisection point next to
+    /// the corner the flipped edge shares with the feature edge.
+    fn apex(&self, f: usize, pos: usize) -> u32 {
+        match self.fan_edge[f] {
+            None => self.centroid_of[f],
+            Some(fe) => {
+                let fe = fe as usize;
+                let fv = self.p.face_vertices(f);
+                let shared = if (fe + 1) % 3 == pos {
+                    fv[pos]
+                } else {
+                    fv[(pos + 1) % 3]
+                };
+                self.third(self.p.face_edges(f)[fe], shared)
             }
         }
     }
-    let sizes = vec![3u32; verts.len() / 3];
-    let mut topology = TopologyBuilder::new(num_child).build(&sizes, &verts)?;
-    carry_tags(p, &features, &trisection, &mut topology);
 
-    let centroid_faces: Vec<u32> = (0..nf as u32)
-        .filter(|&f| fan_edge[f as usize].is_none())
-        .collect();
-    let feature_edges: Vec<u32> = (0..p.num_edges() as u32)
-        .filter(|&e| trisection[e as usize] != u32::MAX)
-        .collect();
-    let curve_point = |near: u32, far: u32, e: u32, sink: &mut crate::RowSink| {
-        // (p₋₁ + 16 near + 10 far)/27, p₋₁ reflected at a curve end.
-        sink.add(near, 16.0 / 27.0);
-        sink.add(far, 10.0 / 27.0);
-        match features.curve_neighbour(p, near, e) {
-            Some(n) => sink.add(n, 1.0 / 27.0),
-            None => {
-                sink.add(near, 2.0 / 27.0);
-                sink.add(far, -1.0 / 27.0);
+    pub(crate) fn child_faces(&self) -> Result<ChildFaces, StepError> {
+        let p = self.p;
+        check_size(9 * p.num_faces() as u64 + 9 * p.num_edges() as u64)?;
+        let mut verts: Vec<u32> = Vec::with_capacity(9 * p.num_faces());
+        for e in 0..p.num_edges() {
+            let faces = p.edge_faces(e);
+            let local = p.edge_face_local_indices(e);
+            if !self.features.is_feature_edge(e) {
+                let (f0, k0) = (faces[0] as usize, local[0] as usize);
+                let fv = p.face_vertices(f0);
+                let (a, b) = (fv[k0], fv[(k0 + 1) % 3]);
+                let c0 = self.apex(f0, k0);
+                let c1 = self.apex(faces[1] as usize, local[1] as usize);
+                verts.extend([a, c1, c0, c1, b, c0]);
+                continue;
+            }
+            for (&f, &k) in faces.iter().zip(local) {
+                let fv = p.face_vertices(f as usize);
+                let k = k as usize;
+                let (a, b, x) = (fv[k], fv[(k + 1) % 3], fv[(k + 2) % 3]);
+                if self.trisect {
+                    // The middle of the fan; its two outer triangles come from the flips
+                    // of the face's other edges.
+                    verts.extend([self.third(e as u32, a), self.third(e as u32, b), x]);
+                } else {
+                    verts.extend([a, b, self.centroid_of[f as usize]]);
+                }
             }
         }
-    };
-    let stencils = StencilTable::build(num_child, nv, |r, sink| {
+        let mut faces = ChildFaces::triangles(self.num_child, verts);
+        carry_tags(p, &self.features, &self.trisection, &mut faces);
+        Ok(faces)
+    }
+
+    /// `(p₋₁ + 16 near + 10 far)/27`, `p₋₁` reflected at a curve end.
+    fn curve_point<W: Weights>(&self, near: u32, far: u32, e: u32, w: &mut W) {
+        w.add(near, 16.0 / 27.0);
+        w.add(far, 10.0 / 27.0);
+        match self.features.curve_neighbour(self.p, near, e) {
+            Some(n) => w.add(n, 1.0 / 27.0),
+            None => {
+                w.add(near, 2.0 / 27.0);
+                w.add(far, -1.0 / 27.0);
+            }
+        }
+    }
+
+    #[inline]
+    pub(crate) fn fill<W: Weights>(&self, r: usize, w: &mut W) {
+        let p = self.p;
+        let nv = p.num_vertices();
+        let num_centroids = self.centroid_faces.len();
         if r < nv {
             let v = r as u32;
-            if features.is_corner(r) || (features.is_curve_vertex(r) && !trisect) {
-                sink.add(v, 1.0);
-            } else if features.is_curve_vertex(r) {
-                let [e0, e1] = features.curve_edges(r);
-                sink.add(p.edge_other_vertex(e0 as usize, v), 4.0 / 27.0);
-                sink.add(v, 19.0 / 27.0);
-                sink.add(p.edge_other_vertex(e1 as usize, v), 4.0 / 27.0);
+            let f = &self.features;
+            if f.is_corner(r) || (f.is_curve_vertex(r) && !self.trisect) {
+                w.add(v, 1.0);
+            } else if f.is_curve_vertex(r) {
+                let [e0, e1] = f.curve_edges(r);
+                w.add(p.edge_other_vertex(e0 as usize, v), 4.0 / 27.0);
+                w.add(v, 19.0 / 27.0);
+                w.add(p.edge_other_vertex(e1 as usize, v), 4.0 / 27.0);
             } else if p.vertex_faces(r).is_empty() {
-                sink.add(v, 1.0);
+                w.add(v, 1.0);
             } else {
                 let n = p.valence(r);
                 let a = alpha(n);
-                sink.add(v, 1.0 - a);
+                w.add(v, 1.0 - a);
                 for u in p.vertex_ring(r) {
-                    sink.add(u, a / n as f64);
+                    w.add(u, a / n as f64);
                 }
             }
         } else if r < nv + num_centroids {
-            for &x in p.face_vertices(centroid_faces[r - nv] as usize) {
-                sink.add(x, 1.0 / 3.0);
+            for &x in p.face_vertices(self.centroid_faces[r - nv] as usize) {
+                w.add(x, 1.0 / 3.0);
             }
         } else {
             let i = r - nv - num_centroids;
-            let e = feature_edges[i / 2];
+            let e = self.feature_edges[i / 2];
             let [a, b] = p.edge_vertices(e as usize);
             if i % 2 == 0 {
-                curve_point(a, b, e, sink);
+                self.curve_point(a, b, e, w);
             } else {
-                curve_point(b, a, e, sink);
+                self.curve_point(b, a, e, w);
             }
         }
-    });
-    Ok(SplitLevel { topology, stencils })
+    }
 }
 
 /// Infinitely sharp creases and corner tags of the child level: a crease edge's children (the
 /// edge itself on odd steps, its three thirds on even steps) stay creases; corner tags stay
 /// on their vertices.
-fn carry_tags(p: &Topology, features: &Features, trisection: &[u32], child: &mut Topology) {
+fn carry_tags(p: &Topology, features: &Features, trisection: &[u32], child: &mut ChildFaces) {
     for (e, &t) in trisection.iter().enumerate() {
         if !features.is_feature_edge(e) || p.is_boundary_edge(e) {
             continue;
         }
         let [a, b] = p.edge_vertices(e);
-        let pieces: Vec<[u32; 2]> = if t == u32::MAX {
-            vec![[a, b]]
+        if t == u32::MAX {
+            child.creases.push([a, b]);
         } else {
-            vec![[a, t], [t, t + 1], [t + 1, b]]
-        };
-        for [x, y] in pieces {
-            if let Some(ce) = child.find_edge(x, y) {
-                child.set_edge_sharpness(ce as usize, tags::SHARPNESS_INFINITE);
-            }
+            child.creases.extend([[a, t], [t, t + 1], [t + 1, b]]);
         }
     }
     for v in 0..p.num_vertices() {
         let s = p.vertex_sharpness(v);
         if s > 0.0 {
-            child.set_vertex_sharpness(v, s);
+            child.corners.push((v as u32, s));
         }
     }
 }
