@@ -234,9 +234,8 @@ pub fn run(levels: usize, repeats: usize, rounds: usize) -> Result<(), String> {
                         .fold(f64::INFINITY, f64::min);
                 faster.is_finite().then(|| r.1.seconds / faster)
             });
-            let peak = |f: &dyn Fn(&Round) -> Option<f64>| {
-                runs.iter().filter_map(f).reduce(f64::max)
-            };
+            let peak =
+                |f: &dyn Fn(&Round) -> Option<f64>| runs.iter().filter_map(f).reduce(f64::max);
             println!(
                 "{:<19} {:>7} {:>5} {:>9} {:>10} {:>10} {:>10.4} {:>10.4} {:>7} {:>8} {:>8} {:>8.0}",
                 case.scheme,

@@ -5,7 +5,10 @@
 
 mod fused;
 mod par;
+mod refinement;
 mod split;
+
+pub use refinement::Refinement;
 
 pub(crate) use fused::{
     applies as fusion_applies, child_too_large as fused_child_too_large, grandchild_faces,

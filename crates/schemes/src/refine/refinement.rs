@@ -1,0 +1,435 @@
+//! [`Refinement`]: the topology of every level of a uniform refinement and the stencils
+//! between levels, for OpenSubdiv's schemes and the two-phase scheme.
+
+use std::sync::OnceLock;
+
+use subd_mesh::{DVec3, Topology};
+
+use crate::memory;
+use crate::rules::Rule;
+use crate::stencil::StencilTable;
+use crate::{ExplicitTags, MAX_LEVELS, Options, RefineError, Scheme, TwoPhase};
+
+/// One level of a refinement.
+#[derive(Debug)]
+struct Level {
+    /// Full topology with tags; built eagerly below the last level (the next level needs it),
+    /// on first request for the last, and for the level before it when the last comes from
+    /// its grandparent.
+    topology: OnceLock<Topology>,
+    /// Face lists of the last level, available without building its full topology.
+    faces: Option<super::ChildFaces>,
+    /// Rule of every vertex.
+    rules: Vec<Rule>,
+    /// Number of vertices.
+    num_vertices: usize,
+    /// Faces, rules and points of this level come from the level two above
+    /// ([`super::grandchild_points`]): the level above is not built unless asked for.
+    from_grandparent: bool,
+}
+
+/// A uniform refinement: the topology of every level and the stencils between levels.
+///
+/// The work OpenSubdiv's `TopologyRefiner` and `PrimvarRefiner` do is split the same way: the
+/// constructor derives every level's topology and vertex rules; [`Self::refine_points`]
+/// evaluates the masks level by level (any other primvar goes through the stencil tables,
+/// [`StencilTable::apply`]). Stencil tables and the last
+/// level's full topology (edges, rings, tags) are built on first request, so a refinement that
+/// only needs the final faces and positions does not pay for them. On a closed, smooth
+/// mesh refined by Catmull-Clark (all quads, as every level after the first is) or Loop (no
+/// boundary, crease, corner, hole or non-manifold part) the level before the last is not
+/// built either: the last level's faces, rules and points are derived from the level two
+/// above, with the same results bit for bit ([`Self::has_topology`]).
+#[derive(Debug)]
+pub struct Refinement {
+    scheme: Scheme,
+    options: Options,
+    levels: Vec<Level>,
+    stencils: Vec<OnceLock<StencilTable>>,
+    /// `λ` per base vertex when the first step is the two-phase scheme's phase 1.
+    phase_one: Option<Vec<f64>>,
+}
+
+/// What every refinement checks first: the level count, and triangles for Loop.
+fn check_request(t: &Topology, scheme: Scheme, levels: usize) -> Result<(), RefineError> {
+    if levels > MAX_LEVELS {
+        return Err(RefineError::TooManyLevels {
+            levels,
+            max: MAX_LEVELS,
+        });
+    }
+    if scheme == Scheme::Loop
+        && let Some(f) = (0..t.num_faces()).find(|&f| t.face_size(f) != 3)
+    {
+        return Err(RefineError::NotTriangle {
+            face: f,
+            size: t.face_size(f),
+        });
+    }
+    Ok(())
+}
+
+impl Refinement {
+    /// Refines `base` uniformly `levels` times.
+    pub fn new(
+        base: &Topology,
+        scheme: Scheme,
+        options: &Options,
+        levels: usize,
+    ) -> Result<Self, RefineError> {
+        check_request(base, scheme, levels)?;
+        let (t0, rules0) = super::prepare_base(base, scheme, options);
+        Self::refine_prepared(t0, rules0, scheme, options, levels)
+    }
+
+    /// Refines a level that is already prepared — its boundary and non-manifold tags
+    /// applied and the rule of every vertex known, as in the levels of another refinement —
+    /// `levels` more times. Unlike [`Self::new`] it does not re-derive base-level tags (a
+    /// non-manifold vertex of a refined level, for instance, is not a corner unless its tags
+    /// say so). Used to continue refining a piece cut out of a refined level.
+    ///
+    /// # Errors
+    /// As [`Self::new`]; also [`RefineError::RuleCount`] when `rules` does not have one rule
+    /// per vertex.
+    pub fn from_prepared(
+        level: Topology,
+        rules: Vec<Rule>,
+        scheme: Scheme,
+        options: &Options,
+        levels: usize,
+    ) -> Result<Self, RefineError> {
+        if rules.len() != level.num_vertices() {
+            return Err(RefineError::RuleCount {
+                rules: rules.len(),
+                vertices: level.num_vertices(),
+            });
+        }
+        check_request(&level, scheme, levels)?;
+        Self::refine_prepared(level, rules, scheme, options, levels)
+    }
+
+    fn refine_prepared(
+        t0: Topology,
+        rules0: Vec<Rule>,
+        scheme: Scheme,
+        options: &Options,
+        levels: usize,
+    ) -> Result<Self, RefineError> {
+        let mut r = Refinement {
+            scheme,
+            options: *options,
+            levels: vec![Level {
+                num_vertices: t0.num_vertices(),
+                topology: OnceLock::from(t0),
+                faces: None,
+                rules: rules0,
+                from_grandparent: false,
+            }],
+            stencils: (0..levels).map(|_| OnceLock::new()).collect(),
+            phase_one: None,
+        };
+        for l in 1..=levels {
+            let p = r.levels[l - 1]
+                .topology
+                .get()
+                .expect("parent level is built");
+            // Each level multiplies face-vertices by 4 (quad split) or 4 (triangles, 3 → 12).
+            if 4 * p.num_face_vertices() as u64 + 4 * p.num_edges() as u64 >= u32::MAX as u64 {
+                return Err(RefineError::TooLarge { level: l });
+            }
+            let layout = super::Layout::new(p, scheme);
+            let rules = super::child_rules(p, &r.levels[l - 1].rules, options, layout);
+            if l + 1 == levels && super::fusion_applies(p, &r.levels[l - 1].rules, scheme) {
+                // The last two levels of a closed smooth mesh: the last one straight from
+                // this parent, its own parent left unbuilt.
+                if super::fused_child_too_large(p, scheme) {
+                    return Err(RefineError::TooLarge { level: levels });
+                }
+                let (offsets, vertices) = super::grandchild_faces(p, scheme);
+                let num_vertices = super::grandchild_num_vertices(p, scheme);
+                let num_faces = offsets.len() - 1;
+                let last = Level {
+                    num_vertices,
+                    topology: OnceLock::new(),
+                    faces: Some(super::ChildFaces {
+                        offsets,
+                        vertices,
+                        holes: memory::zeroed(num_faces),
+                    }),
+                    // Closed and smooth stays closed and smooth: no creases, no corners.
+                    rules: vec![Rule::Smooth; num_vertices],
+                    from_grandparent: true,
+                };
+                r.levels.push(Level {
+                    num_vertices: layout.num_child_vertices,
+                    topology: OnceLock::new(),
+                    faces: None,
+                    rules,
+                    from_grandparent: false,
+                });
+                r.levels.push(last);
+                break;
+            }
+            let level = if l < levels {
+                Level {
+                    num_vertices: layout.num_child_vertices,
+                    topology: OnceLock::from(super::child_topology(p, scheme, options, layout)),
+                    faces: None,
+                    rules,
+                    from_grandparent: false,
+                }
+            } else {
+                Level {
+                    num_vertices: layout.num_child_vertices,
+                    topology: OnceLock::new(),
+                    faces: Some(super::child_faces(p, scheme)),
+                    rules,
+                    from_grandparent: false,
+                }
+            };
+            r.levels.push(level);
+        }
+        Ok(r)
+    }
+
+    /// Refines `base` with the two-phase modified Catmull-Clark scheme of seed 000: level 1
+    /// is phase 1 (the modified vertex rule with `two_phase`'s `λ`, see [`two_phase`](crate::two_phase)),
+    /// levels 2 and on are ordinary Catmull-Clark. Topology and vertex order are
+    /// Catmull-Clark's; [`Self::scheme`] reports [`Scheme::CatmullClark`] and
+    /// [`Self::phase_one_lambda`] the `λ`.
+    ///
+    /// ```
+    /// use subd_mesh::{DVec3, TopologyBuilder};
+    /// use subd_schemes::{Options, Refinement, TwoPhase};
+    ///
+    /// let faces = [0, 1, 3, 2, 2, 3, 5, 4, 4, 5, 7, 6, 6, 7, 1, 0, 1, 7, 5, 3, 6, 0, 2, 4];
+    /// let cube = TopologyBuilder::new(8).build(&[4; 6], &faces).unwrap();
+    /// let points: Vec<DVec3> = (0..8)
+    ///     .map(|i| DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64))
+    ///     .collect();
+    /// // λ = 1 freezes the vertices in phase 1.
+    /// let tp = TwoPhase::uniform(8, 1.0).unwrap();
+    /// let r = Refinement::two_phase(&cube, &tp, &Options::default(), 1).unwrap();
+    /// let level1 = r.refine_points(&points).pop().unwrap();
+    /// assert_eq!(level1[..8], points[..]);
+    /// ```
+    ///
+    /// # Errors
+    /// [`RefineError::NotQuad`] for a face that is not a quad, [`RefineError::LambdaCount`]
+    /// when there is not one `λ` per vertex, and as [`Self::new`].
+    pub fn two_phase(
+        base: &Topology,
+        two_phase: &TwoPhase,
+        options: &Options,
+        levels: usize,
+    ) -> Result<Self, RefineError> {
+        if let Some(f) = (0..base.num_faces()).find(|&f| base.face_size(f) != 4) {
+            return Err(RefineError::NotQuad {
+                face: f,
+                size: base.face_size(f),
+            });
+        }
+        let lambda = two_phase.lambda();
+        if lambda.len() != base.num_vertices() {
+            return Err(RefineError::LambdaCount {
+                given: lambda.len(),
+                vertices: base.num_vertices(),
+            });
+        }
+        let mut r = Self::new(base, Scheme::CatmullClark, options, levels)?;
+        r.phase_one = Some(lambda.to_vec());
+        Ok(r)
+    }
+
+    /// `λ` of every base vertex when this is a two-phase refinement.
+    pub fn phase_one_lambda(&self) -> Option<&[f64]> {
+        self.phase_one.as_deref()
+    }
+
+    /// The scheme.
+    pub fn scheme(&self) -> Scheme {
+        self.scheme
+    }
+
+    /// The options.
+    pub fn options(&self) -> &Options {
+        &self.options
+    }
+
+    /// Number of refined levels (level 0 is the base).
+    pub fn num_levels(&self) -> usize {
+        self.levels.len() - 1
+    }
+
+    /// Number of vertices of `level`.
+    pub fn num_vertices(&self, level: usize) -> usize {
+        self.levels[level].num_vertices
+    }
+
+    /// Number of edges of `level`, without building its topology: each parent edge has two
+    /// halves, and each parent face adds one interior edge per corner (Catmull-Clark,
+    /// bilinear) or three (Loop).
+    pub fn num_edges(&self, level: usize) -> usize {
+        if let Some(t) = self.levels[level].topology.get() {
+            return t.num_edges();
+        }
+        if self.levels[level].from_grandparent && !self.has_topology(level - 1) {
+            return super::grandchild_num_edges(self.topology(level - 2), self.scheme);
+        }
+        // Only the last level can be unbuilt, and it is not the base level.
+        let p = self.topology(level - 1);
+        super::Layout::new(p, self.scheme).half_edge_base as usize + 2 * p.num_edges()
+    }
+
+    /// Whether any edge or vertex of `level` has a crease or corner sharpness above zero
+    /// (boundary and non-manifold edges count: the refinement makes them infinitely
+    /// sharp), without building the level's topology. When it is `false`, the level's
+    /// only tags are its holes ([`Self::holes`]), so [`Self::faces`] describes it whole.
+    pub fn has_sharpness(&self, level: usize) -> bool {
+        if let Some(t) = self.levels[level].topology.get() {
+            let tags = t.tags();
+            return tags.edge_sharpness().iter().any(|&s| s > 0.0)
+                || tags.vertex_sharpness().iter().any(|&s| s > 0.0);
+        }
+        if self.levels[level].from_grandparent {
+            return false;
+        }
+        super::child_has_sharpness(self.topology(level - 1), &self.options)
+    }
+
+    /// The crease and corner tags of `level` that a file must carry (see [`ExplicitTags`]),
+    /// without building the level's topology.
+    pub fn explicit_tags(&self, level: usize) -> ExplicitTags {
+        if let Some(t) = self.levels[level].topology.get() {
+            return super::explicit_tags(t, &self.options);
+        }
+        if self.levels[level].from_grandparent {
+            return ExplicitTags::default();
+        }
+        super::child_explicit_tags(self.topology(level - 1), self.scheme, &self.options)
+    }
+
+    /// Face offsets and face-vertex indices of `level`, without building its full topology.
+    pub fn faces(&self, level: usize) -> (&[u32], &[u32]) {
+        match &self.levels[level].faces {
+            Some(f) => (&f.offsets, &f.vertices),
+            None => {
+                let t = self.topology(level);
+                (t.face_offsets(), t.all_face_vertices())
+            }
+        }
+    }
+
+    /// Hole flags of the faces of `level`.
+    pub fn holes(&self, level: usize) -> &[bool] {
+        match &self.levels[level].faces {
+            Some(f) => &f.holes,
+            None => self.topology(level).tags().holes(),
+        }
+    }
+
+    /// Topology of `level` (0 = base, with the boundary rules applied to its tags), built on
+    /// first request where it is not built yet ([`Self::has_topology`]).
+    pub fn topology(&self, level: usize) -> &Topology {
+        self.levels[level].topology.get_or_init(|| {
+            let p = self.topology(level - 1);
+            let layout = super::Layout::new(p, self.scheme);
+            super::child_topology(p, self.scheme, &self.options, layout)
+        })
+    }
+
+    /// Whether the full topology of `level` is built. The last level is built only on
+    /// request; so is the level before it on a closed, smooth Catmull-Clark (all-quad) or Loop
+    /// mesh, whose last level is then derived from the level two above (every result is the
+    /// same as with the level built, bit for bit).
+    ///
+    /// ```
+    /// use subd_mesh::TopologyBuilder;
+    /// use subd_schemes::{Options, Refinement, Scheme};
+    ///
+    /// // A cube: closed, smooth, all quads.
+    /// let faces = [0, 1, 3, 2, 2, 3, 5, 4, 4, 5, 7, 6, 6, 7, 1, 0, 1, 7, 5, 3, 6, 0, 2, 4];
+    /// let cube = TopologyBuilder::new(8).build(&[4; 6], &faces).unwrap();
+    /// let r = Refinement::new(&cube, Scheme::CatmullClark, &Options::default(), 3).unwrap();
+    /// assert!(r.has_topology(1));
+    /// assert!(!r.has_topology(2) && !r.has_topology(3));
+    /// assert_eq!(r.faces(3).1.len(), 4 * 6 * 64);
+    /// assert_eq!(r.topology(3).num_faces(), 6 * 64); // builds levels 2 and 3
+    /// assert!(r.has_topology(2));
+    /// ```
+    pub fn has_topology(&self, level: usize) -> bool {
+        self.levels[level].topology.get().is_some()
+    }
+
+    /// Takes the topology of `level` out of the refinement (building it if needed), without
+    /// copying it.
+    pub fn into_topology(mut self, level: usize) -> Topology {
+        self.topology(level);
+        self.levels
+            .swap_remove(level)
+            .topology
+            .into_inner()
+            .expect("built just above")
+    }
+
+    /// The rule of every vertex of `level`.
+    pub fn vertex_rules(&self, level: usize) -> &[Rule] {
+        &self.levels[level].rules
+    }
+
+    fn step(&self, level: usize) -> super::Step<'_> {
+        let p = self.topology(level - 1);
+        super::Step {
+            parent: p,
+            parent_rules: &self.levels[level - 1].rules,
+            child_rules: &self.levels[level].rules,
+            scheme: self.scheme,
+            options: &self.options,
+            layout: super::Layout::new(p, self.scheme),
+            phase_one: if level == 1 {
+                self.phase_one.as_deref()
+            } else {
+                None
+            },
+        }
+    }
+
+    /// Stencils giving the vertices of `level` from those of `level - 1` (`level ≥ 1`), built
+    /// on first request.
+    pub fn stencils(&self, level: usize) -> &StencilTable {
+        self.stencils[level - 1].get_or_init(|| self.step(level).stencils())
+    }
+
+    /// One table from the base vertices to the vertices of `level`.
+    pub fn composed(&self, level: usize) -> StencilTable {
+        let mut t = StencilTable::identity(self.levels[0].num_vertices);
+        for l in 1..=level {
+            t = t.then(self.stencils(l));
+        }
+        t
+    }
+
+    /// Positions of every level from base positions (`result[0]` is `base`), evaluating the
+    /// masks directly, level by level, in parallel.
+    ///
+    /// # Panics
+    /// If `base.len()` differs from the number of base vertices.
+    pub fn refine_points(&self, base: &[DVec3]) -> Vec<Vec<DVec3>> {
+        assert_eq!(
+            base.len(),
+            self.levels[0].num_vertices,
+            "one position per base vertex"
+        );
+        let mut out = vec![base.to_vec()];
+        for l in 1..self.levels.len() {
+            let src = out.last().expect("level 0");
+            let next = if self.levels[l].from_grandparent && !self.has_topology(l - 1) {
+                super::grandchild_points(self.topology(l - 2), self.scheme, src)
+            } else {
+                self.step(l).points(src)
+            };
+            out.push(next);
+        }
+        out
+    }
+}
