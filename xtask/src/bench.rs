@@ -27,7 +27,11 @@ pub fn quad_bench_mesh() -> Mesh {
 
 /// The quad bench mesh with every quad split along its 0-2 diagonal, for Loop.
 pub fn tri_bench_mesh() -> Mesh {
-    let q = quad_bench_mesh();
+    split_quads(&quad_bench_mesh())
+}
+
+/// An all-quad mesh with every quad split along its 0-2 diagonal.
+pub fn split_quads(q: &Mesh) -> Mesh {
     let t = &q.topology;
     let mut idx = Vec::with_capacity(t.num_faces() * 6);
     for f in 0..t.num_faces() {
@@ -37,7 +41,7 @@ pub fn tri_bench_mesh() -> Mesh {
     let topo = TopologyBuilder::new(t.num_vertices())
         .build(&vec![3; 2 * t.num_faces()], &idx)
         .expect("valid");
-    Mesh::new(topo, q.positions).expect("finite")
+    Mesh::new(topo, q.positions.clone()).expect("finite")
 }
 
 pub(crate) fn peak_rss_bytes() -> u64 {

@@ -1058,14 +1058,20 @@ fn scheme_of(name: &str) -> Option<Scheme> {
     }
 }
 
-/// Every shape of the OpenSubdiv directory.
-pub fn shapes(exe: &Path, dir: &Path) -> Result<Vec<Row>, String> {
+/// The OBJ shapes of a directory, sorted.
+pub(crate) fn shape_paths(dir: &Path) -> Result<Vec<PathBuf>, String> {
     let mut paths: Vec<PathBuf> = std::fs::read_dir(dir)
         .map_err(|e| format!("{}: {e}", dir.display()))?
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| p.extension().is_some_and(|x| x == "obj"))
         .collect();
     paths.sort();
+    Ok(paths)
+}
+
+/// Every shape of the OpenSubdiv directory.
+pub fn shapes(exe: &Path, dir: &Path) -> Result<Vec<Row>, String> {
+    let paths = shape_paths(dir)?;
     let mut rows = Vec::new();
     let opts = subd_io::ReadOptions {
         accept_inconsistent_orientation: true,

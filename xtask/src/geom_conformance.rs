@@ -7,7 +7,7 @@
 //! diagonal. Neither library reads crease tags: shapes are compared with their tags taken
 //! off.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use subd_mesh::{DVec3, Topology, TopologyBuilder};
 use subd_schemes::split_schemes::{SplitRefinement, SplitScheme};
@@ -268,12 +268,7 @@ fn compare(exe: &Path, name: &str, topo: &Topology, positions: &[DVec3]) -> Vec<
 
 /// Every fitting shape of the OpenSubdiv directory.
 pub fn shapes(exe: &Path, dir: &Path) -> Result<Vec<Row>, String> {
-    let mut paths: Vec<PathBuf> = std::fs::read_dir(dir)
-        .map_err(|e| format!("{}: {e}", dir.display()))?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "obj"))
-        .collect();
-    paths.sort();
+    let paths = crate::conformance::shape_paths(dir)?;
     let opts = subd_io::ReadOptions {
         accept_inconsistent_orientation: true,
     };

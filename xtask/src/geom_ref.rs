@@ -37,42 +37,17 @@ pub enum RefOutcome {
     Refused(String),
 }
 
-fn workspace_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .expect("workspace root")
-        .to_path_buf()
-}
-
 /// Compiles the harness (when missing or older than its source) and returns its path.
 pub fn build_harness() -> Result<PathBuf, String> {
-    let root = workspace_root();
-    let src = root.join("xtask/cpp/geom_harness.cpp");
-    let out_dir = root.join("target/xtask");
-    std::fs::create_dir_all(&out_dir).map_err(|e| e.to_string())?;
-    let exe = out_dir.join("geom_harness");
-    let stale = match (std::fs::metadata(&exe), std::fs::metadata(&src)) {
-        (Ok(a), Ok(b)) => a.modified().ok() < b.modified().ok(),
-        _ => true,
-    };
-    if stale {
-        eprintln!("xtask: compiling the CGAL/OpenMesh harness");
-        // CGAL asks for -frounding-math; its kernel here is plain `double`, header-only.
-        let status = Command::new("g++")
-            .args(["-O2", "-std=c++17", "-frounding-math", "-o"])
-            .arg(&exe)
-            .arg(&src)
-            .arg("-lOpenMeshCore")
-            .status()
-            .map_err(|e| format!("cannot run g++: {e}"))?;
-        if !status.success() {
-            return Err(
-                "compiling the CGAL/OpenMesh harness failed (are libcgal-dev and libopenmesh-dev installed?)"
-                    .into(),
-            );
-        }
+    // CGAL asks for -frounding-math; its kernel here is plain `double`, header-only.
+    crate::osd::CppHarness {
+        source: "geom_harness.cpp",
+        exe: "geom_harness",
+        flags: &["-O2", "-std=c++17", "-frounding-math"],
+        libs: &["-lOpenMeshCore"],
+        hint: "are libcgal-dev and libopenmesh-dev installed?",
     }
-    Ok(exe)
+    .build()
 }
 
 pub fn write_off(path: &Path, topo: &Topology, positions: &[DVec3]) -> Result<(), String> {

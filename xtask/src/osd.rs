@@ -22,32 +22,58 @@ fn workspace_root() -> PathBuf {
         .to_path_buf()
 }
 
-/// Compiles the harness (when missing or older than its source) and returns its path.
-pub fn build_harness() -> Result<PathBuf, String> {
-    let root = workspace_root();
-    let src = root.join("xtask/cpp/osd_harness.cpp");
-    let out_dir = root.join("target/xtask");
-    std::fs::create_dir_all(&out_dir).map_err(|e| e.to_string())?;
-    let exe = out_dir.join("osd_harness");
-    let stale = match (std::fs::metadata(&exe), std::fs::metadata(&src)) {
-        (Ok(a), Ok(b)) => a.modified().ok() < b.modified().ok(),
-        _ => true,
-    };
-    if stale {
-        let status = Command::new("g++")
-            .args(["-O2", "-std=c++14", "-o"])
-            .arg(&exe)
-            .arg(&src)
-            .arg("-losdCPU")
-            .status()
-            .map_err(|e| format!("cannot run g++: {e}"))?;
-        if !status.success() {
-            return Err(
-                "compiling the OpenSubdiv harness failed (is libosd-dev installed?)".into(),
-            );
+/// A C++ reference harness: its source under `xtask/cpp`, the executable it becomes under
+/// `target/xtask`, the compiler flags before the source and the libraries after it, and the
+/// hint to give when the compile fails.
+pub struct CppHarness<'a> {
+    pub source: &'a str,
+    pub exe: &'a str,
+    pub flags: &'a [&'a str],
+    pub libs: &'a [&'a str],
+    pub hint: &'a str,
+}
+
+impl CppHarness<'_> {
+    /// Compiles the harness when it is missing or older than its source; returns its path.
+    pub fn build(&self) -> Result<PathBuf, String> {
+        let root = workspace_root();
+        let src = root.join("xtask/cpp").join(self.source);
+        let out_dir = root.join("target/xtask");
+        std::fs::create_dir_all(&out_dir).map_err(|e| e.to_string())?;
+        let exe = out_dir.join(self.exe);
+        let stale = match (std::fs::metadata(&exe), std::fs::metadata(&src)) {
+            (Ok(a), Ok(b)) => a.modified().ok() < b.modified().ok(),
+            _ => true,
+        };
+        if stale {
+            eprintln!("xtask: compiling {}", self.source);
+            let status = Command::new("g++")
+                .args(self.flags)
+                .arg("-o")
+                .arg(&exe)
+                .arg(&src)
+                .args(self.libs)
+                .status()
+                .map_err(|e| format!("cannot run g++: {e}"))?;
+            if !status.success() {
+                return Err(format!("compiling {} failed ({})", self.source, self.hint));
+            }
         }
+        Ok(exe)
     }
-    Ok(exe)
+}
+
+/// Compiles the OpenSubdiv harness (when missing or older than its source) and returns its
+/// path.
+pub fn build_harness() -> Result<PathBuf, String> {
+    CppHarness {
+        source: "osd_harness.cpp",
+        exe: "osd_harness",
+        flags: &["-O2", "-std=c++14"],
+        libs: &["-losdCPU"],
+        hint: "is libosd-dev installed?",
+    }
+    .build()
 }
 
 fn scheme_code(s: Scheme) -> u32 {

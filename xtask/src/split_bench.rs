@@ -12,10 +12,11 @@ use std::process::Command;
 use std::time::Instant;
 
 use subd_mesh::{Mesh, TopologyBuilder};
+
 use subd_schemes::split_schemes::{SplitRefinement, SplitScheme};
 use subd_schemes::{Options, Refinement, Scheme};
 
-use crate::bench::{json_number, median, peak_rss_bytes, quad_bench_mesh};
+use crate::bench::{json_number, median, peak_rss_bytes, quad_bench_mesh, split_quads};
 use crate::geom_ref::{self, Library};
 
 /// The triangle bench mesh: a 112 × 112 torus with hexagons, refined once by Catmull-Clark
@@ -26,16 +27,7 @@ pub fn tri_100k_mesh() -> Mesh {
     let r = Refinement::new(&base.topology, Scheme::CatmullClark, &Options::default(), 1)
         .expect("refine");
     let pts = r.refine_points(&base.positions).pop().expect("level 1");
-    let q = r.into_topology(1);
-    let mut idx = Vec::with_capacity(q.num_faces() * 6);
-    for f in 0..q.num_faces() {
-        let v = q.face_vertices(f);
-        idx.extend_from_slice(&[v[0], v[1], v[2], v[0], v[2], v[3]]);
-    }
-    let topo = TopologyBuilder::new(q.num_vertices())
-        .build(&vec![3; 2 * q.num_faces()], &idx)
-        .expect("valid");
-    Mesh::new(topo, pts).expect("finite")
+    split_quads(&Mesh::new(r.into_topology(1), pts).expect("finite"))
 }
 
 fn scheme_named(name: &str) -> Option<SplitScheme> {

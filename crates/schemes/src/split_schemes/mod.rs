@@ -183,15 +183,8 @@ pub(crate) struct ChildFaces {
 }
 
 impl ChildFaces {
-    /// Faces from per-face sizes.
-    pub(crate) fn from_sizes(num_vertices: usize, sizes: &[u32], vertices: Vec<u32>) -> ChildFaces {
-        let mut offsets = Vec::with_capacity(sizes.len() + 1);
-        offsets.push(0u32);
-        let mut end = 0u32;
-        for &n in sizes {
-            end += n;
-            offsets.push(end);
-        }
+    /// Faces from offsets and vertices, no tags yet.
+    fn untagged(num_vertices: usize, offsets: Vec<u32>, vertices: Vec<u32>) -> ChildFaces {
         ChildFaces {
             num_vertices,
             offsets,
@@ -201,16 +194,21 @@ impl ChildFaces {
         }
     }
 
+    /// Faces from per-face sizes.
+    pub(crate) fn from_sizes(num_vertices: usize, sizes: &[u32], vertices: Vec<u32>) -> ChildFaces {
+        let offsets = std::iter::once(0)
+            .chain(sizes.iter().scan(0u32, |end, &n| {
+                *end += n;
+                Some(*end)
+            }))
+            .collect();
+        ChildFaces::untagged(num_vertices, offsets, vertices)
+    }
+
     /// All faces triangles.
     pub(crate) fn triangles(num_vertices: usize, vertices: Vec<u32>) -> ChildFaces {
         let offsets = (0..=vertices.len() as u32 / 3).map(|f| 3 * f).collect();
-        ChildFaces {
-            num_vertices,
-            offsets,
-            vertices,
-            creases: Vec::new(),
-            corners: Vec::new(),
-        }
+        ChildFaces::untagged(num_vertices, offsets, vertices)
     }
 
     fn build(&self) -> Result<Topology, TopologyError> {
