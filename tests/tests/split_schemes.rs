@@ -394,7 +394,14 @@ fn limits_are_invariant_under_refinement() {
     for (i, q) in po.iter_mut().enumerate() {
         q.z = 0.4 * (i as f64 * 0.9).sin();
     }
-    for (t, p) in [(tc, pc), (to, po)] {
+    // A crease from the boundary into the middle of the grid: it ends in a dart.
+    let mut td = to.clone();
+    for j in 0..4u32 {
+        let e = td.find_edge(4 * 9 + j, 4 * 9 + j + 1).unwrap() as usize;
+        td.set_edge_sharpness(e, tags::SHARPNESS_INFINITE);
+    }
+    let pd = po.clone();
+    for (t, p) in [(tc, pc), (to, po), (td, pd)] {
         for scheme in [
             SplitScheme::Sqrt3,
             SplitScheme::BUTTERFLY,
@@ -529,5 +536,37 @@ fn normals_point_outwards() {
         .evaluate(p);
     for (v, (n, q)) in l.normals.iter().zip(p).enumerate() {
         assert!(n.unwrap().dot(*q - centre) > 0.0, "doo-sabin vertex {v}");
+    }
+}
+
+/// On a flat grid every limit normal is the plane's, at interior and boundary vertices alike
+/// (turned by the faces' orientation: +z here), for √3 and both butterflies.
+#[test]
+fn normals_of_a_flat_grid_are_the_plane_normal() {
+    let (t, p) = regular_grid(7);
+    for scheme in [
+        SplitScheme::Sqrt3,
+        SplitScheme::BUTTERFLY,
+        SplitScheme::ModifiedButterfly,
+    ] {
+        let l = split_limit_stencils(&t, scheme).unwrap().evaluate(&p);
+        let mut boundary = 0;
+        for v in 0..p.len() {
+            let corner = t.vertex_faces(v).len() < 2 && t.is_boundary_vertex(v);
+            match l.normals[v] {
+                Some(n) => {
+                    assert!(
+                        (n - DVec3::Z).length() < 1e-12,
+                        "{scheme:?} vertex {v}: {n}"
+                    );
+                    boundary += usize::from(t.is_boundary_vertex(v));
+                }
+                None => assert!(
+                    corner || t.vertex_faces(v).len() == 2,
+                    "{scheme:?} vertex {v}"
+                ),
+            }
+        }
+        assert!(boundary > 10, "{scheme:?}: {boundary} boundary normals");
     }
 }

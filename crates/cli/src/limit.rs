@@ -62,8 +62,8 @@ pub(crate) struct LimitArgs {
     #[command(flatten)]
     rules: RuleArgs,
     /// Also write unit normals (`.txt` output: `x y z nx ny nz` per line; `nan nan nan` where
-    /// a split scheme defines none: the butterflies on boundaries and creases and where they
-    /// are not C¹, √3 on boundaries and creases).
+    /// a split scheme defines none: inside creases, at corners, where the classic butterfly
+    /// is not C¹).
     #[arg(long)]
     normals: bool,
     /// Tension w of --scheme butterfly (default 1/16).
@@ -266,7 +266,7 @@ fn split_limit(
         let why = if scheme == SplitScheme::DooSabin {
             "an interior vertex of valence 2 has no vertex face"
         } else {
-            "the end of a crease inside the surface (a dart) has no limit mask here"
+            "its neighbourhood never became one with a known limit mask (a dart or boundary vertex whose refined neighbourhood stays irregular)"
         };
         return Err(in_file(&format!(
             "vertex {v}: no {} limit: {why}",

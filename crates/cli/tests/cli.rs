@@ -1878,18 +1878,35 @@ fn split_schemes_refine_limit_and_analyze() {
     ]);
     assert_eq!(code, 0, "{err}");
     assert!(stdout.contains("\"tension\":0.0"), "{stdout}");
-    // A dart has no √3 limit mask: exit 2, one line, no output.
+    // Darts (infinitely sharp creases ending inside the surface) have √3 limits too.
     let lim = s.0.join("dart.txt");
     let (code, _, err) = subd(&[
         "limit",
         "--scheme",
         "sqrt3",
+        "--normals",
         meshes().join("loop_icos_infsharp.obj").to_str().unwrap(),
         lim.to_str().unwrap(),
     ]);
+    assert_eq!(code, 0, "{err}");
+    let text = std::fs::read_to_string(&lim).unwrap();
+    assert!(text.lines().all(|l| {
+        l.split(' ')
+            .take(3)
+            .all(|x| x.parse::<f64>().unwrap().is_finite())
+    }));
+    // A bad mesh is refused as by refine: exit 2, no output.
+    let quads_out = s.0.join("quads.txt");
+    let (code, _, err) = subd(&[
+        "limit",
+        "--scheme",
+        "butterfly",
+        quads.to_str().unwrap(),
+        quads_out.to_str().unwrap(),
+    ]);
     assert_eq!(code, 2, "{err}");
-    assert!(err.contains("dart"), "{err}");
-    assert!(!lim.exists());
+    assert!(err.contains("needs triangles"), "{err}");
+    assert!(!quads_out.exists());
     // The eigenvalue test: the classic butterfly fails at valence 3, passes at 6.
     let (code, out, _) = subd(&[
         "analyze",

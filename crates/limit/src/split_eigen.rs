@@ -23,6 +23,7 @@
 use std::f64::consts::TAU;
 
 use faer::{Mat, c64};
+use glam::DVec3;
 use subd_mesh::{Topology, TopologyBuilder};
 use subd_schemes::split_schemes::{SplitRefinement, SplitScheme};
 
@@ -600,6 +601,286 @@ pub fn local_masks(scheme: SplitScheme, n: usize) -> Result<LocalMasks, LimitErr
     })
 }
 
+/// A centre on a feature curve: a boundary vertex with `faces` triangles around it, or a
+/// dart of valence `valence` (one infinitely sharp edge, whose crease runs on away from it).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum FeatureCentre {
+    /// A boundary vertex.
+    Boundary {
+        /// Triangles around it.
+        faces: usize,
+    },
+    /// A crease ending inside the surface.
+    Dart {
+        /// Its valence.
+        valence: usize,
+    },
+}
+
+/// Masks at a feature centre, over the ball labelled from the centre's canonical feature
+/// spoke ([`feature_spoke`]); the local subdivision matrix has no rotation symmetry there, so
+/// its eigenvectors come from the dense matrix.
+#[derive(Debug, Clone)]
+pub struct FeatureMasks {
+    /// Radius of the invariant ball.
+    pub radius: usize,
+    /// Steps the matrix covers (2 for √3).
+    pub steps: usize,
+    /// The local subdivision matrix over the ball (a level's ball to the ball `steps`
+    /// levels down).
+    pub matrix: Mat<f64>,
+    /// Limit-position weights (the left eigenvector of eigenvalue 1, summing to 1).
+    pub limit: Vec<f64>,
+    /// Tangent masks: the left eigenvectors of the two subdominant eigenvalues when they
+    /// are real, positive and larger than the rest, turned so that their cross product
+    /// follows the faces' orientation; `None` otherwise.
+    pub tangents: Option<[Vec<f64>; 2]>,
+}
+
+/// The spoke a feature centre's ball is labelled from: a boundary vertex's outgoing boundary
+/// edge, or a dart's one sharp edge; `None` for other vertices.
+pub fn feature_spoke(t: &Topology, v: u32) -> Option<u32> {
+    let vi = v as usize;
+    let edges = t.vertex_edges(vi);
+    if t.is_boundary_vertex(vi) {
+        let e = *edges.first()?;
+        return t
+            .is_boundary_edge(e as usize)
+            .then(|| t.edge_other_vertex(e as usize, v));
+    }
+    let mut sharp = edges
+        .iter()
+        .filter(|&&e| subd_mesh::tags::is_infinite(t.edge_sharpness(e as usize)));
+    match (sharp.next(), sharp.next()) {
+        (Some(&e), None) => Some(t.edge_other_vertex(e as usize, v)),
+        _ => None,
+    }
+}
+
+/// The ball of `radius` around feature vertex `v`, labelled from its feature spoke.
+pub fn feature_ball(t: &Topology, v: u32, radius: usize) -> Option<Vec<u32>> {
+    feature_spoke(t, v).map(|s| ball(t, &[(v, s)], radius))
+}
+
+/// The local subdivision matrix of `v` over the ball of `radius`: the rows of the child
+/// ball's vertices (`rows(c)`: weights over the parent level) on the parent ball, or `None`
+/// when the balls differ in size or a row reaches outside.
+pub fn feature_matrix(
+    parent: &Topology,
+    child: &Topology,
+    rows: &dyn Fn(u32) -> Vec<(u32, f64)>,
+    v: u32,
+    radius: usize,
+) -> Option<Mat<f64>> {
+    let old = feature_ball(parent, v, radius)?;
+    let new = feature_ball(child, v, radius)?;
+    if old.len() != new.len() {
+        return None;
+    }
+    let mut label = std::collections::HashMap::with_capacity(old.len());
+    for (i, &u) in old.iter().enumerate() {
+        label.insert(u, i);
+    }
+    let mut s = Mat::<f64>::zeros(old.len(), old.len());
+    for (row, &c) in new.iter().enumerate() {
+        for (j, w) in rows(c) {
+            s[(row, *label.get(&j)?)] += w;
+        }
+    }
+    Some(s)
+}
+
+/// A fan of triangles around vertex 0 (`rings` rings): `sectors` sectors of the lattice,
+/// closed around the centre or open (a boundary vertex with that many triangles), with
+/// planar positions whose triangles run counter-clockwise.
+fn triangle_fan(sectors: usize, rings: usize, closed: bool) -> (Topology, Vec<DVec3>) {
+    let k = rings;
+    let per_sector: Vec<(usize, usize)> = (1..=k)
+        .flat_map(|i| (0..=k - i).map(move |j| (i, j)))
+        .collect();
+    let m = per_sector.len();
+    let index_of = |i: usize, j: usize| per_sector.iter().position(|&p| p == (i, j));
+    let last_spoke = 1 + sectors * m;
+    let id = |s: usize, i: usize, j: usize| -> u32 {
+        if i == 0 && j == 0 {
+            0
+        } else if i == 0 && (closed || s + 1 < sectors) {
+            (1 + ((s + 1) % sectors) * m + index_of(j, 0).expect("spoke point")) as u32
+        } else if i == 0 {
+            (last_spoke + j - 1) as u32
+        } else {
+            (1 + s * m + index_of(i, j).expect("sector point")) as u32
+        }
+    };
+    let nv = last_spoke + if closed { 0 } else { k };
+    let span = if closed { TAU } else { TAU / 2.0 };
+    let at = |s: usize, i: usize, j: usize| {
+        let r = (i + j) as f64;
+        let a = (s as f64 + j as f64 / r.max(1.0)) * span / sectors as f64;
+        DVec3::new(r * a.cos(), r * a.sin(), 0.0)
+    };
+    let mut positions = vec![DVec3::ZERO; nv];
+    let mut verts = Vec::new();
+    for s in 0..sectors {
+        for i in 0..=k {
+            for j in 0..=k - i {
+                positions[id(s, i, j) as usize] = at(s, i, j);
+            }
+        }
+        for i in 0..k {
+            for j in 0..k - i {
+                verts.extend([id(s, i, j), id(s, i + 1, j), id(s, i, j + 1)]);
+                if i + j + 2 <= k {
+                    verts.extend([id(s, i + 1, j), id(s, i + 1, j + 1), id(s, i, j + 1)]);
+                }
+            }
+        }
+    }
+    let t = TopologyBuilder::new(nv)
+        .build(&vec![3; verts.len() / 3], &verts)
+        .expect("a lattice fan is a valid mesh");
+    (t, positions)
+}
+
+/// A row of `r` from level `from` to level `to`, for vertex `c` of level `to`.
+pub fn row_between(r: &SplitRefinement, from: usize, to: usize, c: u32) -> Vec<(u32, f64)> {
+    let mut row = vec![(c, 1.0)];
+    for level in (from + 1..=to).rev() {
+        let st = r.stencils(level);
+        let mut acc: std::collections::HashMap<u32, f64> = Default::default();
+        let mut order = Vec::new();
+        for (v, w) in row {
+            let (idx, wts) = st.row(v as usize);
+            for (&s, &b) in idx.iter().zip(wts) {
+                *acc.entry(s).or_insert_with(|| {
+                    order.push(s);
+                    0.0
+                }) += w * b;
+            }
+        }
+        row = order.into_iter().map(|s| (s, acc[&s])).collect();
+    }
+    row
+}
+
+/// The masks of `scheme` (√3 or a butterfly) at a feature centre.
+///
+/// # Errors
+/// [`LimitError::Analysis`] for Doo-Sabin, a centre out of range (3 to 64 edges; 1 to 32
+/// boundary triangles), no invariant ball of radius ≤ 6, or a failed eigen solve.
+pub fn feature_masks(
+    scheme: SplitScheme,
+    centre: FeatureCentre,
+) -> Result<FeatureMasks, LimitError> {
+    if scheme == SplitScheme::DooSabin {
+        return Err(LimitError::Analysis(
+            "Doo-Sabin's limit points are face centroids, not vertex masks".into(),
+        ));
+    }
+    let (sectors, closed) = match centre {
+        FeatureCentre::Boundary { faces } if (1..=32).contains(&faces) => (faces, false),
+        FeatureCentre::Dart { valence } if (3..=64).contains(&valence) => (valence, true),
+        _ => {
+            return Err(LimitError::Analysis(format!(
+                "no feature masks for {centre:?}"
+            )));
+        }
+    };
+    let steps = if scheme == SplitScheme::Sqrt3 { 2 } else { 1 };
+    let analysis = |e: subd_schemes::split_schemes::SplitError| LimitError::Analysis(e.to_string());
+    for radius in 1..=6 {
+        let (mut fan, positions) = triangle_fan(sectors, 2 * radius + 4, closed);
+        if closed {
+            // The dart's crease: spoke 0 from the centre to the edge of the fan.
+            let mut prev = 0u32;
+            let first = feature_spoke_of_lattice(&fan);
+            let mut next = first;
+            while let Some(e) = fan.find_edge(prev, next) {
+                fan.set_edge_sharpness(e as usize, subd_mesh::tags::SHARPNESS_INFINITE);
+                // Straight on: the neighbour of `next` opposite `prev` in its ring of six.
+                let ring: Vec<u32> = ring_from(&fan, next, prev);
+                if ring.len() != 6 || fan.is_boundary_vertex(next as usize) {
+                    break;
+                }
+                (prev, next) = (next, ring[3]);
+            }
+        }
+        let r = SplitRefinement::new(&fan, scheme, steps).map_err(analysis)?;
+        let rows = |c: u32| row_between(&r, 0, steps, c);
+        let Some(s) = feature_matrix(&fan, r.topology(steps), &rows, 0, radius) else {
+            continue;
+        };
+        let labels = feature_ball(&fan, 0, radius).expect("a feature centre");
+        let (limit, tangents) = left_masks(&s, &labels, &positions)?;
+        return Ok(FeatureMasks {
+            radius,
+            steps,
+            matrix: s,
+            limit,
+            tangents,
+        });
+    }
+    Err(LimitError::Analysis(format!(
+        "no invariant ball of radius ≤ 6 for {} at {centre:?}",
+        scheme.name()
+    )))
+}
+
+/// The first spoke of a closed lattice fan (the one along sector 0's first edge).
+fn feature_spoke_of_lattice(fan: &Topology) -> u32 {
+    // Vertex 1 is sector 0's (1, 0): the end of spoke 0.
+    debug_assert!(fan.find_edge(0, 1).is_some());
+    1
+}
+
+/// Limit and tangent masks from the dense local matrix `s` (left eigenvectors), the tangents
+/// turned to follow the orientation of the planar fan whose ball `labels` has `positions`.
+#[allow(clippy::type_complexity)]
+fn left_masks(
+    s: &Mat<f64>,
+    labels: &[u32],
+    positions: &[DVec3],
+) -> Result<(Vec<f64>, Option<[Vec<f64>; 2]>), LimitError> {
+    let m = s.nrows();
+    let t = s.transpose().to_owned();
+    let evd = t
+        .eigen()
+        .map_err(|e| LimitError::Analysis(format!("eigenvectors: {e:?}")))?;
+    let values = evd.S();
+    let vectors = evd.U();
+    let mut order: Vec<usize> = (0..m).collect();
+    order.sort_by(|&a, &b| values[b].norm().total_cmp(&values[a].norm()));
+    let vec_of = |k: usize| -> Vec<f64> { (0..m).map(|i| vectors[(i, k)].re).collect() };
+    let one = values[order[0]];
+    if (one.re - 1.0).abs() > 1e-9 || one.im.abs() > 1e-9 {
+        return Err(LimitError::Analysis(format!(
+            "dominant eigenvalue {one} is not 1"
+        )));
+    }
+    let mut limit = vec_of(order[0]);
+    let total: f64 = limit.iter().sum();
+    limit.iter_mut().for_each(|w| *w /= total);
+    let tangents = (m >= 4).then(|| {
+        let (l1, l2, l3) = (values[order[1]], values[order[2]], values[order[3]]);
+        let real = |z: c64| z.im.abs() < 1e-9 && z.re > 1e-9;
+        (real(l1) && real(l2) && l2.norm() > l3.norm() + 1e-9).then(|| {
+            let (a, mut b) = (vec_of(order[1]), vec_of(order[2]));
+            let apply = |w: &[f64]| -> DVec3 {
+                labels
+                    .iter()
+                    .zip(w)
+                    .map(|(&u, &x)| positions[u as usize] * x)
+                    .sum()
+            };
+            if apply(&a).cross(apply(&b)).z < 0.0 {
+                b.iter_mut().for_each(|x| *x = -*x);
+            }
+            [a, b]
+        })
+    });
+    Ok((limit, tangents.flatten()))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -715,6 +996,62 @@ mod tests {
                 .tangents
                 .is_none()
         );
+    }
+
+    /// At a boundary vertex the eigenvectors of the dense local matrix give √3's cubic
+    /// B-spline limit `(p₋₁ + 4p + p₁)/6` and the butterflies' vertex itself, with tangents
+    /// (the boundary is smooth).
+    #[test]
+    fn boundary_masks_match_the_curve_rules() {
+        for faces in 1..=6 {
+            let centre = FeatureCentre::Boundary { faces };
+            let m = feature_masks(SplitScheme::Sqrt3, centre).unwrap();
+            // Labels: 0 the vertex, 1 its outgoing boundary neighbour, faces + 1 the other.
+            assert!(
+                (m.limit[0] - 4.0 / 6.0).abs() < 1e-12,
+                "{faces}: {:?}",
+                m.limit
+            );
+            assert!((m.limit[1] - 1.0 / 6.0).abs() < 1e-12, "{faces}");
+            assert!((m.limit[faces + 1] - 1.0 / 6.0).abs() < 1e-12, "{faces}");
+            let rest: f64 = m.limit.iter().map(|w| w.abs()).sum::<f64>() - 1.0;
+            assert!(rest.abs() < 1e-12, "{faces}: only three weights");
+            // A lone triangle at a corner of the mesh has no subdominant pair; from six
+            // triangles on, √3's along-the-boundary eigenvalue ⅓ is double and defective
+            // below the cross one, and no tangent pair is given.
+            assert_eq!(
+                m.tangents.is_some(),
+                (2..=5).contains(&faces),
+                "√3 boundary {faces}"
+            );
+            for scheme in [SplitScheme::BUTTERFLY, SplitScheme::ModifiedButterfly] {
+                let m = feature_masks(scheme, centre).unwrap();
+                assert!((m.limit[0] - 1.0).abs() < 1e-12, "{scheme:?} {faces}");
+                assert!(
+                    faces == 1 || m.tangents.is_some(),
+                    "{scheme:?} boundary {faces}"
+                );
+            }
+        }
+    }
+
+    /// A dart's limit mask sums to 1 and is the eigenvalue-1 left eigenvector of its
+    /// local matrix.
+    #[test]
+    fn dart_masks_are_left_eigenvectors() {
+        for valence in [4, 5, 6, 7] {
+            for scheme in [SplitScheme::Sqrt3, SplitScheme::ModifiedButterfly] {
+                let m = feature_masks(scheme, FeatureCentre::Dart { valence }).unwrap();
+                let sum: f64 = m.limit.iter().sum();
+                assert!((sum - 1.0).abs() < 1e-12);
+                for j in 0..m.limit.len() {
+                    let lj: f64 = (0..m.limit.len())
+                        .map(|i| m.limit[i] * m.matrix[(i, j)])
+                        .sum();
+                    assert!((lj - m.limit[j]).abs() < 1e-12, "{scheme:?} {valence}");
+                }
+            }
+        }
     }
 
     #[test]

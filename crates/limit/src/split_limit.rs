@@ -9,11 +9,15 @@
 //!   another extraordinary vertex, one or two levels down. A vertex inside a boundary or crease
 //!   curve has the cubic B-spline limit `(p₋₁ + 4p + p₁)/6` of its curve (the curve is refined
 //!   by the ternary cubic B-spline mask every second step and left alone in between); a corner
-//!   stays put. Normals are given at interior vertices.
+//!   stays put.
 //! * **Butterflies**: interpolating, so the limit of a vertex is the vertex. Normals come from
 //!   the tangent masks (left eigenvectors) at the first level where the ball is regular; none
-//!   where the scheme is not C¹ (the classic butterfly at valence 3 and above 7) and none on
-//!   boundaries and creases.
+//!   where the scheme is not C¹ (the classic butterfly at valence 3 and above 7).
+//! * **Boundary vertices and darts** (√3 and the butterflies): the dense local subdivision
+//!   matrix of a synthetic boundary fan or dart disc of the same size
+//!   ([`crate::split_eigen::feature_masks`]) gives the limit (a dart's, for √3) and the
+//!   tangents, applied where the vertex's own local matrix, read off the refinement, equals
+//!   it. Vertices inside a crease have two one-sided normals and get none; corners none.
 //! * **Doo-Sabin**: every face of every level shrinks to its centroid, so the limit of a base
 //!   vertex is the centroid of its vertex face one level down, with the normal of that face's
 //!   first Fourier mode (the face circulant's eigenvalue-½ pair). An interior vertex of
@@ -31,7 +35,10 @@ use subd_schemes::StencilTable;
 use subd_schemes::split_schemes::{Features, SplitRefinement, SplitScheme, doo_sabin};
 
 use crate::LimitError;
-use crate::split_eigen::{LocalMasks, local_masks};
+use crate::split_eigen::{
+    FeatureCentre, FeatureMasks, LocalMasks, feature_ball, feature_masks, feature_matrix,
+    local_masks, row_between,
+};
 
 /// The deepest level searched for a regular ball around an interior vertex.
 pub const MAX_LEVELS: usize = 4;
@@ -200,6 +207,7 @@ fn vertex_rows(
     let nv = base.num_vertices();
     let features = Features::new(base);
     let mut pending: Vec<u32> = Vec::new();
+    let mut feature_pending: Vec<u32> = Vec::new();
     for v in 0..nv as u32 {
         let vi = v as usize;
         if base.vertex_faces(vi).is_empty() || scheme.is_interpolating() {
@@ -209,16 +217,16 @@ fn vertex_rows(
             continue;
         }
         if features.is_on_feature(vi) {
+            let dart = features.degree(vi) == 1 && !base.is_boundary_vertex(vi);
+            let boundary_curve = base.is_boundary_vertex(vi) && features.is_curve_vertex(vi);
+            if (dart || boundary_curve) && !features.is_corner(vi) {
+                feature_pending.push(v);
+            }
             if scheme == SplitScheme::Sqrt3 {
                 if features.is_corner(vi) {
                     position[vi] = Some(vec![(v, 1.0)]);
                 } else if features.is_curve_vertex(vi) {
-                    let [e0, e1] = features.curve_edges(vi);
-                    position[vi] = Some(vec![
-                        (base.edge_other_vertex(e0 as usize, v), 1.0 / 6.0),
-                        (v, 4.0 / 6.0),
-                        (base.edge_other_vertex(e1 as usize, v), 1.0 / 6.0),
-                    ]);
+                    position[vi] = Some(sqrt3_curve_limit(base, &features, v, refinement)?);
                 }
                 // A dart (one crease edge ending inside the surface): no mask here.
             }
@@ -275,6 +283,114 @@ fn vertex_rows(
         level += 1;
         if !pending.is_empty() && level <= MAX_LEVELS {
             refined = Some(refinement(level)?);
+        }
+    }
+    feature_rows(scheme, refinement, &feature_pending, position, tangents)
+}
+
+/// √3's limit of a vertex inside a boundary or crease curve: `(p₋₁ + 4p + p₁)/6` of its
+/// curve neighbours. The mask is invariant under every step as long as those neighbours do
+/// not move on odd steps, which holds unless one is a dart (the end of a crease inside the
+/// surface, moved by the smooth rule); then it is applied two levels down, where the
+/// neighbours are trisection points.
+fn sqrt3_curve_limit(
+    base: &Topology,
+    features: &Features,
+    v: u32,
+    refinement: &dyn Fn(usize) -> Result<SplitRefinement, LimitError>,
+) -> Result<Row, LimitError> {
+    let curve = |t: &Topology, f: &Features| -> Row {
+        let [e0, e1] = f.curve_edges(v as usize);
+        vec![
+            (t.edge_other_vertex(e0 as usize, v), 1.0 / 6.0),
+            (v, 4.0 / 6.0),
+            (t.edge_other_vertex(e1 as usize, v), 1.0 / 6.0),
+        ]
+    };
+    let row = curve(base, features);
+    let is_dart = |u: u32| features.degree(u as usize) == 1 && !base.is_boundary_vertex(u as usize);
+    if !row.iter().any(|&(u, _)| u != v && is_dart(u)) {
+        return Ok(row);
+    }
+    let r = refinement(2)?;
+    let t2 = r.topology(2);
+    Ok(to_base(&curve(t2, &Features::new(t2)), &r.composed(2)))
+}
+
+/// Darts and boundary vertices: the masks of the synthetic feature centre of the same kind
+/// ([`feature_masks`]) wherever the vertex's own local subdivision matrix, read off the
+/// refinement, is that centre's (so its neighbourhood has become regular but for it). √3's
+/// matrix covers an odd and an even step, so only even levels are tried there.
+fn feature_rows(
+    scheme: SplitScheme,
+    refinement: &dyn Fn(usize) -> Result<SplitRefinement, LimitError>,
+    vertices: &[u32],
+    position: &mut [Option<Row>],
+    tangents: &mut [Option<[Row; 2]>],
+) -> Result<(), LimitError> {
+    if vertices.is_empty() {
+        return Ok(());
+    }
+    let steps = if scheme == SplitScheme::Sqrt3 { 2 } else { 1 };
+    let mut masks: HashMap<FeatureCentre, Option<FeatureMasks>> = HashMap::new();
+    let mut pending = vertices.to_vec();
+    for level in (0..=MAX_LEVELS - steps).step_by(steps) {
+        // Refined only as deep as this level needs (most vertices are settled at level 0).
+        let r = refinement(level + steps)?;
+        let (parent, child) = (r.topology(level), r.topology(level + steps));
+        let composed = (level > 0).then(|| r.composed(level));
+        let rows = |c: u32| row_between(&r, level, level + steps, c);
+        let mut still = Vec::new();
+        for &v in &pending {
+            let vi = v as usize;
+            let centre = if parent.is_boundary_vertex(vi) {
+                FeatureCentre::Boundary {
+                    faces: parent.vertex_faces(vi).len(),
+                }
+            } else {
+                FeatureCentre::Dart {
+                    valence: parent.valence(vi),
+                }
+            };
+            let m = masks
+                .entry(centre)
+                .or_insert_with(|| feature_masks(scheme, centre).ok());
+            let Some(m) = m else { continue };
+            let Some(local) = feature_matrix(parent, child, &rows, v, m.radius) else {
+                still.push(v);
+                continue;
+            };
+            let same = local.nrows() == m.matrix.nrows()
+                && (0..local.nrows()).all(|i| {
+                    (0..local.ncols()).all(|j| (local[(i, j)] - m.matrix[(i, j)]).abs() <= 1e-12)
+                });
+            if !same {
+                still.push(v);
+                continue;
+            }
+            let ball = feature_ball(parent, v, m.radius).expect("a feature vertex");
+            let row = |w: &[f64]| -> Row {
+                let r: Row = ball
+                    .iter()
+                    .zip(w)
+                    .filter(|(_, w)| w.abs() > 1e-15)
+                    .map(|(&u, &w)| (u, w))
+                    .collect();
+                match &composed {
+                    None => r,
+                    Some(c) => to_base(&r, c),
+                }
+            };
+            if position[vi].is_none() {
+                position[vi] = Some(row(&m.limit));
+            }
+            if let Some([a, b]) = &m.tangents {
+                tangents[vi] = Some([row(a), row(b)]);
+            }
+        }
+        pending = still;
+        if pending.is_empty() {
+            break;
         }
     }
     Ok(())
