@@ -90,13 +90,9 @@ pub(crate) fn run(args: &AnalyzeArgs, out: &mut dyn Write) -> Result<(), Failure
             SurfaceArg::CatmullClark | SurfaceArg::Loop => None,
             SurfaceArg::DooSabin => Some(SplitScheme::DooSabin),
             SurfaceArg::Sqrt3 => Some(SplitScheme::Sqrt3),
-            SurfaceArg::Butterfly => {
-                let tension = args.tension.unwrap_or(1.0 / 16.0);
-                if !tension.is_finite() {
-                    return Err(bad(format!("--tension {tension}: must be a finite number")));
-                }
-                Some(SplitScheme::Butterfly { tension })
-            }
+            SurfaceArg::Butterfly => Some(SplitScheme::Butterfly {
+                tension: crate::rule_args::butterfly_tension(args.tension)?,
+            }),
             SurfaceArg::ModifiedButterfly => Some(SplitScheme::ModifiedButterfly),
         };
         return match split {

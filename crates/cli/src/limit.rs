@@ -142,13 +142,9 @@ pub(crate) fn run(
     let split = match args.scheme {
         LimitCommandScheme::DooSabin => Some(SplitScheme::DooSabin),
         LimitCommandScheme::Sqrt3 => Some(SplitScheme::Sqrt3),
-        LimitCommandScheme::Butterfly => {
-            let tension = args.tension.unwrap_or(1.0 / 16.0);
-            if !tension.is_finite() {
-                return Err(bad(format!("--tension {tension}: must be a finite number")));
-            }
-            Some(SplitScheme::Butterfly { tension })
-        }
+        LimitCommandScheme::Butterfly => Some(SplitScheme::Butterfly {
+            tension: crate::rule_args::butterfly_tension(args.tension)?,
+        }),
         LimitCommandScheme::ModifiedButterfly => Some(SplitScheme::ModifiedButterfly),
         _ => None,
     };

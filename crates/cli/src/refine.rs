@@ -43,16 +43,14 @@ enum Chosen {
 }
 
 impl SchemeArg {
-    fn chosen(self, tension: Option<f64>) -> Chosen {
+    fn chosen(self, tension: f64) -> Chosen {
         match self {
             SchemeArg::CatmullClark | SchemeArg::TwoPhase => Chosen::Osd(Scheme::CatmullClark),
             SchemeArg::Loop => Chosen::Osd(Scheme::Loop),
             SchemeArg::Bilinear => Chosen::Osd(Scheme::Bilinear),
             SchemeArg::DooSabin => Chosen::Split(SplitScheme::DooSabin),
             SchemeArg::Sqrt3 => Chosen::Split(SplitScheme::Sqrt3),
-            SchemeArg::Butterfly => Chosen::Split(SplitScheme::Butterfly {
-                tension: tension.unwrap_or(1.0 / 16.0),
-            }),
+            SchemeArg::Butterfly => Chosen::Split(SplitScheme::Butterfly { tension }),
             SchemeArg::ModifiedButterfly => Chosen::Split(SplitScheme::ModifiedButterfly),
         }
     }
@@ -189,11 +187,7 @@ pub(crate) fn run(
     if args.tension.is_some() && !matches!(args.scheme, SchemeArg::Butterfly) {
         return Err(bad("--tension applies to --scheme butterfly only".into()));
     }
-    if let Some(w) = args.tension
-        && !w.is_finite()
-    {
-        return Err(bad(format!("--tension {w}: must be a finite number")));
-    }
+    let tension = crate::rule_args::butterfly_tension(args.tension)?;
     let file = subd_io::read_mesh(&args.input, &args.rules.read_options())?;
     print_warnings(err, &args.input, &file.warnings);
     let t_read = t_start.elapsed().as_secs_f64();
@@ -208,7 +202,7 @@ pub(crate) fn run(
         }
         _ => None,
     };
-    let chosen = args.scheme.chosen(args.tension);
+    let chosen = args.scheme.chosen(tension);
 
     let progress = Progress::new(args.levels, args.json);
     let t0 = Instant::now();

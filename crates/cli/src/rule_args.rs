@@ -78,3 +78,15 @@ impl RuleArgs {
         }
     }
 }
+
+/// The butterfly's tension `w` from `--tension` (1/16, the classic scheme, when absent).
+pub(crate) fn butterfly_tension(tension: Option<f64>) -> Result<f64, crate::Failure> {
+    let w = tension.unwrap_or(1.0 / 16.0);
+    if w.is_finite() {
+        Ok(w)
+    } else {
+        Err(crate::failure::bad(format!(
+            "--tension {w}: must be a finite number"
+        )))
+    }
+}

@@ -742,23 +742,28 @@ fn triangle_fan(sectors: usize, rings: usize, closed: bool) -> (Topology, Vec<DV
     (t, positions)
 }
 
+/// A sparse row over a table's rows, re-expressed over the table's sources (entries in
+/// order of first appearance).
+pub fn expand_row(row: &[(u32, f64)], table: &subd_schemes::StencilTable) -> Vec<(u32, f64)> {
+    let mut acc: std::collections::HashMap<u32, f64> = Default::default();
+    let mut order = Vec::new();
+    for &(v, w) in row {
+        let (idx, wts) = table.row(v as usize);
+        for (&s, &b) in idx.iter().zip(wts) {
+            *acc.entry(s).or_insert_with(|| {
+                order.push(s);
+                0.0
+            }) += w * b;
+        }
+    }
+    order.into_iter().map(|s| (s, acc[&s])).collect()
+}
+
 /// A row of `r` from level `from` to level `to`, for vertex `c` of level `to`.
 pub fn row_between(r: &SplitRefinement, from: usize, to: usize, c: u32) -> Vec<(u32, f64)> {
     let mut row = vec![(c, 1.0)];
     for level in (from + 1..=to).rev() {
-        let st = r.stencils(level);
-        let mut acc: std::collections::HashMap<u32, f64> = Default::default();
-        let mut order = Vec::new();
-        for (v, w) in row {
-            let (idx, wts) = st.row(v as usize);
-            for (&s, &b) in idx.iter().zip(wts) {
-                *acc.entry(s).or_insert_with(|| {
-                    order.push(s);
-                    0.0
-                }) += w * b;
-            }
-        }
-        row = order.into_iter().map(|s| (s, acc[&s])).collect();
+        row = expand_row(&row, r.stencils(level));
     }
     row
 }

@@ -36,8 +36,8 @@ use subd_schemes::split_schemes::{Features, SplitRefinement, SplitScheme, doo_sa
 
 use crate::LimitError;
 use crate::split_eigen::{
-    FeatureCentre, FeatureMasks, LocalMasks, feature_ball, feature_masks, feature_matrix,
-    local_masks, row_between,
+    FeatureCentre, FeatureMasks, LocalMasks, expand_row, feature_ball, feature_masks,
+    feature_matrix, local_masks, row_between,
 };
 
 /// The deepest level searched for a regular ball around an interior vertex.
@@ -90,19 +90,7 @@ type Row = Vec<(u32, f64)>;
 
 /// Rows over level-`l` vertices carried back to the base through `composed` (`l ≥ 1`).
 fn to_base(row: &Row, composed: &StencilTable) -> Row {
-    let mut acc: HashMap<u32, f64> = HashMap::new();
-    let mut order = Vec::new();
-    for &(v, w) in row {
-        let (idx, wts) = composed.row(v as usize);
-        for (&s, &b) in idx.iter().zip(wts) {
-            let e = acc.entry(s).or_insert_with(|| {
-                order.push(s);
-                0.0
-            });
-            *e += w * b;
-        }
-    }
-    order.into_iter().map(|s| (s, acc[&s])).collect()
+    expand_row(row, composed)
 }
 
 /// The stencils of `scheme`'s limit at every vertex of `base`.
