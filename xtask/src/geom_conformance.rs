@@ -61,7 +61,7 @@ const PAIRINGS: &[Pairing] = &[
         harness_scheme: "sqrt3",
         ours: Ours::Split(SplitScheme::Sqrt3),
         triangles: true,
-        open: false,
+        open: true,
         valence_limit: true,
     },
     Pairing {
