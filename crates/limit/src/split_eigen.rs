@@ -798,8 +798,8 @@ pub fn feature_masks(
         if closed {
             // The dart's crease: spoke 0 from the centre to the edge of the fan.
             let mut prev = 0u32;
-            let first = feature_spoke_of_lattice(&fan);
-            let mut next = first;
+            // Vertex 1 is sector 0's lattice point (1, 0), the end of spoke 0.
+            let mut next = 1u32;
             while let Some(e) = fan.find_edge(prev, next) {
                 fan.set_edge_sharpness(e as usize, subd_mesh::tags::SHARPNESS_INFINITE);
                 // Straight on: the neighbour of `next` opposite `prev` in its ring of six.
@@ -829,13 +829,6 @@ pub fn feature_masks(
         "no invariant ball of radius ≤ 6 for {} at {centre:?}",
         scheme.name()
     )))
-}
-
-/// The first spoke of a closed lattice fan (the one along sector 0's first edge).
-fn feature_spoke_of_lattice(fan: &Topology) -> u32 {
-    // Vertex 1 is sector 0's (1, 0): the end of spoke 0.
-    debug_assert!(fan.find_edge(0, 1).is_some());
-    1
 }
 
 /// Limit and tangent masks from the dense local matrix `s` (left eigenvectors), the tangents

@@ -499,19 +499,6 @@ impl SplitRefinement {
         }
         out
     }
-
-    /// The last level's topology, the refinement consumed.
-    pub fn into_last_topology(mut self) -> Topology {
-        let last = self.levels.len();
-        if last == 0 {
-            return self.base;
-        }
-        self.topology(last);
-        self.levels
-            .pop()
-            .and_then(|l| l.topology.into_inner())
-            .expect("built above")
-    }
 }
 
 /// What a single step can fail with; [`SplitRefinement::new`] adds the level.
