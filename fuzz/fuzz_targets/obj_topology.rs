@@ -10,6 +10,7 @@ fuzz_target!(|data: &[u8]| {
     for accept in [false, true] {
         let opts = ReadOptions {
             accept_inconsistent_orientation: accept,
+            ..Default::default()
         };
         if let Ok(file) = parse_mesh(data, Format::Obj, &opts) {
             let topo = &file.mesh.topology;

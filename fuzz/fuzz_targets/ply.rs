@@ -8,6 +8,7 @@ use subd_io::{Format, PlyEncoding, ReadOptions, WriteOptions, encode_mesh, parse
 fuzz_target!(|data: &[u8]| {
     let opts = ReadOptions {
         accept_inconsistent_orientation: true,
+        ..Default::default()
     };
     if let Ok(file) = parse_mesh(data, Format::Ply, &opts) {
         for encoding in [PlyEncoding::Ascii, PlyEncoding::BinaryLittleEndian] {

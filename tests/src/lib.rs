@@ -383,6 +383,7 @@ pub struct SurfaceShape {
 pub fn surface_shapes() -> Vec<SurfaceShape> {
     let opts = subd_io::ReadOptions {
         accept_inconsistent_orientation: true,
+        ..Default::default()
     };
     osd_meshes()
         .into_iter()

@@ -27,6 +27,7 @@ fn shapes(scheme: Scheme, whole: bool) -> Vec<Shape> {
     let centre = if scheme == Scheme::Loop { 0.25 } else { 0.5 };
     let opts = ReadOptions {
         accept_inconsistent_orientation: true,
+        ..Default::default()
     };
     let mut out = Vec::new();
     for path in osd_meshes() {

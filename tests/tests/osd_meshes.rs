@@ -11,6 +11,7 @@ use subd_tests::{index_rows, osd_mesh_dir, osd_meshes};
 fn accept() -> ReadOptions {
     ReadOptions {
         accept_inconsistent_orientation: true,
+        ..Default::default()
     }
 }
 

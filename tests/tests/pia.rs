@@ -26,6 +26,7 @@ fn load(path: &std::path::Path) -> Shape {
         path,
         &subd_io::ReadOptions {
             accept_inconsistent_orientation: true,
+            ..Default::default()
         },
     )
     .expect("readable shape");

@@ -10,6 +10,7 @@ use subd_tests::osd_meshes;
 fn derived_child_topology_matches_the_builder() {
     let opts = ReadOptions {
         accept_inconsistent_orientation: true,
+        ..Default::default()
     };
     for path in osd_meshes() {
         let name = path.file_stem().unwrap().to_string_lossy().to_string();
@@ -105,6 +106,7 @@ fn derived_child_topology_matches_the_builder() {
 fn last_level_counts_and_sharpness_without_its_topology() {
     let opts = ReadOptions {
         accept_inconsistent_orientation: true,
+        ..Default::default()
     };
     let (mut sharp, mut smooth, mut explicit) = (0, 0, 0);
     for path in osd_meshes() {
@@ -184,6 +186,7 @@ fn last_level_counts_and_sharpness_without_its_topology() {
 fn last_level_from_its_grandparent_equals_the_built_path() {
     let opts = ReadOptions {
         accept_inconsistent_orientation: true,
+        ..Default::default()
     };
     let mut fused = Vec::new();
     for path in osd_meshes() {

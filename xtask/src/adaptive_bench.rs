@@ -89,6 +89,7 @@ fn decimated_scan(faces: usize) -> Result<Mesh, String> {
 fn read(path: &Path) -> Result<Mesh, String> {
     let opts = subd_io::ReadOptions {
         accept_inconsistent_orientation: true,
+        ..Default::default()
     };
     Ok(subd_io::read_mesh(path, &opts)
         .map_err(|e| e.to_string())?

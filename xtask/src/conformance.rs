@@ -1075,6 +1075,7 @@ pub fn shapes(exe: &Path, dir: &Path) -> Result<Vec<Row>, String> {
     let mut rows = Vec::new();
     let opts = subd_io::ReadOptions {
         accept_inconsistent_orientation: true,
+        ..Default::default()
     };
     for p in paths {
         let name = p.file_stem().unwrap().to_string_lossy().to_string();

@@ -271,6 +271,7 @@ pub fn shapes(exe: &Path, dir: &Path) -> Result<Vec<Row>, String> {
     let paths = crate::conformance::shape_paths(dir)?;
     let opts = subd_io::ReadOptions {
         accept_inconsistent_orientation: true,
+        ..Default::default()
     };
     let mut rows = Vec::new();
     for p in paths {

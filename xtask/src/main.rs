@@ -323,6 +323,7 @@ fn main() -> ExitCode {
                     "obj_topology".to_string(),
                     "ply".to_string(),
                     "edit_constraints".to_string(),
+                    "gltf".to_string(),
                 ],
             };
             targets.iter().try_for_each(|t| {

@@ -161,6 +161,7 @@ pub(crate) fn scan_mesh() -> Result<subd_mesh::Mesh, String> {
     let path = bunny()?;
     let opts = subd_io::ReadOptions {
         accept_inconsistent_orientation: true,
+        ..Default::default()
     };
     Ok(subd_io::read_mesh(&path, &opts)
         .map_err(|e| e.to_string())?
@@ -250,6 +251,7 @@ fn scan() -> Result<(), String> {
         &path,
         &subd_io::ReadOptions {
             accept_inconsistent_orientation: true,
+            ..Default::default()
         },
     )
     .map_err(|e| e.to_string())?;

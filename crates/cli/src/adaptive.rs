@@ -14,6 +14,7 @@ use subd_adaptive::{
 use subd_mesh::{BoundaryInterpolation, CreaseMethod, SchemeHints, TriangleSubdivision};
 use subd_schemes::Scheme;
 
+use crate::batch::{self, Files, Job};
 use crate::failure::{bad, refuse_overwrite};
 use crate::progress::Spinner;
 use crate::rule_args::RuleArgs;
@@ -63,10 +64,8 @@ pub(crate) struct AdaptiveArgs {
     limit: bool,
     #[command(flatten)]
     rules: RuleArgs,
-    /// Input mesh (.obj or .ply).
-    input: PathBuf,
-    /// Output mesh (.obj, .ply with a per-face `level`, or .glb).
-    output: PathBuf,
+    #[command(flatten)]
+    files: Files,
     /// Print a JSON report on stdout.
     #[arg(long)]
     json: bool,
@@ -134,12 +133,12 @@ fn in_range(name: &str, value: f64, ok: bool, what: &str) -> Result<(), Failure>
 
 /// Checks what can be checked before reading the input: the output's extension, the
 /// thresholds and the level cap (returned).
-fn check_arguments(args: &AdaptiveArgs) -> Result<usize, Failure> {
-    refuse_overwrite(&args.input, &args.output)?;
-    if subd_io::Format::from_path(&args.output).is_none() {
+fn check_arguments(args: &AdaptiveArgs, job: &Job) -> Result<usize, Failure> {
+    refuse_overwrite(&job.input, &job.output)?;
+    if subd_io::Format::for_output(&job.output).is_none() {
         return Err(bad(format!(
             "{}: unsupported output extension (expected .obj, .ply or .glb)",
-            args.output.display()
+            job.output.display()
         )));
     }
     let degrees = |d: f64| (0.0..=180.0).contains(&d);
@@ -177,13 +176,14 @@ struct Selection {
 impl Selection {
     fn new(
         args: &AdaptiveArgs,
+        job: &Job,
         mesh: &subd_mesh::Mesh,
         scheme: Scheme,
         options: &subd_schemes::Options,
         diagonal: f64,
     ) -> Result<Selection, Failure> {
         let base = &mesh.topology;
-        let input_err = |e: AdaptiveError| bad(format!("{}: {e}", args.input.display()));
+        let input_err = |e: AdaptiveError| bad(format!("{}: {e}", job.input.display()));
         let mut others: Vec<Box<dyn Criterion>> = Vec::new();
         if let Some(d) = args.flatness {
             others.push(Box::new(Flatness::new(d).map_err(input_err)?));
@@ -239,10 +239,30 @@ pub(crate) fn run(
     out: &mut dyn Write,
     err: &mut dyn Write,
 ) -> Result<(), Failure> {
+    let command = batch::Command {
+        name: "adaptive",
+        formats: batch::MESH_OUTPUTS,
+    };
+    batch::run(
+        &args.files,
+        &command,
+        args.json,
+        out,
+        err,
+        |job, out, err| run_one(args, job, out, err),
+    )
+}
+
+fn run_one(
+    args: &AdaptiveArgs,
+    job: &Job,
+    out: &mut dyn Write,
+    err: &mut dyn Write,
+) -> Result<(), Failure> {
     let t_start = Instant::now();
-    let levels = check_arguments(args)?;
-    let file = subd_io::read_mesh(&args.input, &args.rules.read_options())?;
-    print_warnings(err, &args.input, &file.warnings);
+    let levels = check_arguments(args, job)?;
+    let file = subd_io::read_mesh(&job.input, &args.rules.read_options())?;
+    print_warnings(err, &job.input, &file.warnings);
     let t_read = t_start.elapsed().as_secs_f64();
     let mesh = &file.mesh;
     let base = &mesh.topology;
@@ -251,13 +271,13 @@ pub(crate) fn run(
         AdaptiveScheme::CatmullClark => Scheme::CatmullClark,
     };
     let options = args.rules.options(&mesh.hints);
-    let input_err = |e: AdaptiveError| bad(format!("{}: {e}", args.input.display()));
+    let input_err = |e: AdaptiveError| bad(format!("{}: {e}", job.input.display()));
     let diagonal = mesh
         .bounding_box()
         .map_or(0.0, |(lo, hi)| (hi - lo).length());
-    let selection = Selection::new(args, mesh, scheme, &options, diagonal)?;
+    let selection = Selection::new(args, job, mesh, scheme, &options, diagonal)?;
 
-    let spinner = Spinner::new(args.json, "refining");
+    let spinner = Spinner::new(args.json || job.quiet, "refining");
     let t0 = Instant::now();
     let hierarchy = AdaptiveRefinement::with_progress(
         base,
@@ -299,7 +319,7 @@ pub(crate) fn run(
 
     spinner.message("writing");
     let t3 = Instant::now();
-    write(args, &result, &options)?;
+    write(job, &result, &options)?;
     spinner.finish();
     let t_write = t3.elapsed().as_secs_f64();
 
@@ -314,6 +334,7 @@ pub(crate) fn run(
         };
         let context = ReportContext {
             args,
+            job,
             base,
             options: &options,
             levels,
@@ -329,6 +350,7 @@ pub(crate) fn run(
 /// What the JSON report says besides the hierarchy and the mesh.
 struct ReportContext<'a> {
     args: &'a AdaptiveArgs,
+    job: &'a Job,
     base: &'a subd_mesh::Topology,
     options: &'a subd_schemes::Options,
     levels: usize,
@@ -344,13 +366,13 @@ impl ReportContext<'_> {
         (conformity, min_angle, distance): (Conformity, f64, Option<f64>),
         seconds: Timings,
     ) -> AdaptiveReport {
-        let (args, base, options) = (self.args, self.base, self.options);
+        let (args, job, base, options) = (self.args, self.job, self.base, self.options);
         let depth = hierarchy.depth();
         let uniform_faces = hierarchy.uniform_counts(depth).faces;
         let path = |p: &Option<PathBuf>| p.as_ref().map(|p| p.display().to_string());
         AdaptiveReport {
-            input: args.input.display().to_string(),
-            output: args.output.display().to_string(),
+            input: job.input.display().to_string(),
+            output: job.output.display().to_string(),
             scheme: match hierarchy.scheme() {
                 Scheme::Loop => "loop",
                 _ => "catmull-clark",
@@ -400,12 +422,8 @@ fn measure(mesh: &AdaptiveMesh, surface: Option<&LimitSurface>) -> (Conformity, 
     (conformity, min_angle, distance)
 }
 
-fn write(
-    args: &AdaptiveArgs,
-    mesh: &AdaptiveMesh,
-    options: &subd_schemes::Options,
-) -> Result<(), Failure> {
-    let fail = |e: subd_io::ViewError| bad(format!("{}: {e}", args.input.display()));
+fn write(job: &Job, mesh: &AdaptiveMesh, options: &subd_schemes::Options) -> Result<(), Failure> {
+    let fail = |e: subd_io::ViewError| bad(format!("{}: {e}", job.input.display()));
     let mut view = subd_io::MeshView::new(
         &mesh.positions,
         &mesh.face_offsets,
@@ -422,6 +440,6 @@ fn write(
         crease_method: Some(options.crease_method),
         triangle_subdivision: Some(options.triangle_subdivision),
     };
-    subd_io::write_view(&args.output, &view, &subd_io::WriteOptions::default())?;
+    subd_io::write_view(&job.output, &view, &subd_io::WriteOptions::default())?;
     Ok(())
 }

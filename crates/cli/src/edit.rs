@@ -12,6 +12,7 @@ use subd_editing::{Constraint, Deformation, Editor, Method};
 use subd_mesh::{DVec3, Mesh};
 use subd_schemes::Scheme;
 
+use crate::batch::{self, Files, Job};
 use crate::failure::{bad, refuse_overwrite};
 use crate::limit::LimitSchemeArg;
 use crate::rule_args::RuleArgs;
@@ -52,10 +53,8 @@ pub(crate) struct EditArgs {
     region_rings: String,
     #[command(flatten)]
     rules: RuleArgs,
-    /// Input mesh (.obj or .ply).
-    input: PathBuf,
-    /// Output mesh (.obj, .ply or .glb): IN's topology and tags, the edited control vertices.
-    output: PathBuf,
+    #[command(flatten)]
+    files: Files,
     /// Print a JSON report on stdout.
     #[arg(long)]
     json: bool,
@@ -132,7 +131,7 @@ fn region_rings(text: &str) -> Result<Option<usize>, Failure> {
 }
 
 fn check_output_format(output: &Path) -> Result<(), Failure> {
-    if subd_io::Format::from_path(output).is_none() {
+    if subd_io::Format::for_output(output).is_none() {
         return Err(bad(format!(
             "{}: unsupported output extension (expected .obj, .ply or .glb)",
             output.display()
@@ -182,9 +181,29 @@ pub(crate) fn run(
     out: &mut dyn Write,
     err: &mut dyn Write,
 ) -> Result<(), Failure> {
+    let command = batch::Command {
+        name: "edit",
+        formats: batch::MESH_OUTPUTS,
+    };
+    batch::run(
+        &args.files,
+        &command,
+        args.json,
+        out,
+        err,
+        |job, out, err| run_one(args, job, out, err),
+    )
+}
+
+fn run_one(
+    args: &EditArgs,
+    job: &Job,
+    out: &mut dyn Write,
+    err: &mut dyn Write,
+) -> Result<(), Failure> {
     let t_start = Instant::now();
-    refuse_overwrite(&args.input, &args.output)?;
-    check_output_format(&args.output)?;
+    refuse_overwrite(&job.input, &job.output)?;
+    check_output_format(&job.output)?;
     let method = method(args)?;
     let constraints = subd_editing::spec::parse_constraints(&read_text(&args.constraints)?)
         .map_err(|e| bad(format!("{}: {e}", args.constraints.display())))?;
@@ -194,8 +213,8 @@ pub(crate) fn run(
             args.constraints.display()
         )));
     }
-    let file = subd_io::read_mesh(&args.input, &args.rules.read_options())?;
-    print_warnings(err, &args.input, &file.warnings);
+    let file = subd_io::read_mesh(&job.input, &args.rules.read_options())?;
+    print_warnings(err, &job.input, &file.warnings);
     let t_read = t_start.elapsed().as_secs_f64();
     let scheme = args.scheme.scheme();
     let options = args.rules.options(&file.mesh.hints);
@@ -205,7 +224,7 @@ pub(crate) fn run(
         subd_editing::EditError::Constraint { .. } => {
             bad(format!("{}: {e}", args.constraints.display()))
         }
-        e => bad(format!("{}: {e}", args.input.display())),
+        e => bad(format!("{}: {e}", job.input.display())),
     };
     let mut editor =
         Editor::new(topo, x0, scheme, &options, &constraints, method).map_err(named)?;
@@ -214,7 +233,7 @@ pub(crate) fn run(
     // Residuals measured afresh: a new evaluator on the output positions.
     let t_check = Instant::now();
     let ev = subd_limit::eval::LimitEvaluator::new(topo, scheme, &options)
-        .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
+        .map_err(|e| bad(format!("{}: {e}", job.input.display())))?;
     let res = subd_editing::check::residuals(&ev, topo, scheme, &constraints, x0, &edit.positions)
         .map_err(named)?;
     let diag = subd_pia::bbox_diagonal(x0).max(f64::MIN_POSITIVE);
@@ -251,16 +270,16 @@ pub(crate) fn run(
 
     let t_write = Instant::now();
     let mut mesh = Mesh::new(topo.clone(), edit.positions.clone())
-        .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
+        .map_err(|e| bad(format!("{}: {e}", job.input.display())))?;
     mesh.hints = file.mesh.hints;
-    subd_io::write_mesh(&args.output, &mesh, &subd_io::WriteOptions::default())?;
+    subd_io::write_mesh(&job.output, &mesh, &subd_io::WriteOptions::default())?;
     let t_write = t_write.elapsed().as_secs_f64();
 
     if args.json {
         let t = editor.timings;
         let report = EditReport {
-            input: args.input.display().to_string(),
-            output: args.output.display().to_string(),
+            input: job.input.display().to_string(),
+            output: job.output.display().to_string(),
             scheme,
             method: match args.method {
                 EditMethodArg::LeastSquares => "least-squares",
@@ -309,11 +328,8 @@ pub(crate) struct DeformArgs {
     /// Deformation file (JSON: constraint points with radius and displacement).
     #[arg(long, value_name = "FILE")]
     constraints: PathBuf,
-    /// Input mesh (.obj or .ply), at any level (a base mesh, `subd refine` or
-    /// `subd adaptive` output).
-    input: PathBuf,
-    /// Output mesh (.obj, .ply or .glb): the same topology, the moved vertices.
-    output: PathBuf,
+    #[command(flatten)]
+    files: Files,
     /// Print a JSON report on stdout.
     #[arg(long)]
     json: bool,
@@ -336,28 +352,48 @@ pub(crate) fn run_deform(
     out: &mut dyn Write,
     err: &mut dyn Write,
 ) -> Result<(), Failure> {
+    let command = batch::Command {
+        name: "deform",
+        formats: batch::MESH_OUTPUTS,
+    };
+    batch::run(
+        &args.files,
+        &command,
+        args.json,
+        out,
+        err,
+        |job, out, err| run_deform_one(args, job, out, err),
+    )
+}
+
+fn run_deform_one(
+    args: &DeformArgs,
+    job: &Job,
+    out: &mut dyn Write,
+    err: &mut dyn Write,
+) -> Result<(), Failure> {
     let t0 = Instant::now();
-    refuse_overwrite(&args.input, &args.output)?;
-    check_output_format(&args.output)?;
+    refuse_overwrite(&job.input, &job.output)?;
+    check_output_format(&job.output)?;
     let cs = subd_editing::spec::parse_deformation(&read_text(&args.constraints)?)
         .map_err(|e| bad(format!("{}: {e}", args.constraints.display())))?;
     let d =
         Deformation::new(&cs).map_err(|e| bad(format!("{}: {e}", args.constraints.display())))?;
-    let file = subd_io::read_mesh(&args.input, &subd_io::ReadOptions::default())?;
-    print_warnings(err, &args.input, &file.warnings);
+    let file = subd_io::read_mesh(&job.input, &subd_io::ReadOptions::default())?;
+    print_warnings(err, &job.input, &file.warnings);
     let mut mesh = file.mesh;
     let moved = d.apply(&mut mesh.positions);
     let max_err = cs
         .iter()
         .map(|c| (d.displacement(c.center) - c.displacement).length())
         .fold(0.0, f64::max);
-    subd_io::write_mesh(&args.output, &mesh, &subd_io::WriteOptions::default())?;
+    subd_io::write_mesh(&job.output, &mesh, &subd_io::WriteOptions::default())?;
     if args.json {
         crate::print_json(
             out,
             &DeformReport {
-                input: args.input.display().to_string(),
-                output: args.output.display().to_string(),
+                input: job.input.display().to_string(),
+                output: job.output.display().to_string(),
                 vertices: mesh.positions.len(),
                 constraints: cs.len(),
                 moved,

@@ -48,6 +48,7 @@ pub(crate) fn run(
     // first one.
     let options = subd_io::ReadOptions {
         accept_inconsistent_orientation: true,
+        ..subd_io::ReadOptions::default()
     };
     let file = subd_io::read_mesh(&args.input, &options)?;
     print_warnings(err, &args.input, &file.warnings);

@@ -15,6 +15,7 @@
 
 mod adaptive;
 mod analyze;
+mod batch;
 mod curve;
 mod edit;
 mod eval;

@@ -13,6 +13,7 @@ use subd_mesh::Mesh;
 use subd_schemes::Scheme;
 use subd_schemes::split_schemes::SplitScheme;
 
+use crate::batch::{self, Files, Job, OutputFormat};
 use crate::failure::{bad, refuse_overwrite};
 use crate::rule_args::RuleArgs;
 use crate::vertex_data::LambdaArgs;
@@ -69,11 +70,8 @@ pub(crate) struct LimitArgs {
     /// Tension w of --scheme butterfly (default 1/16).
     #[arg(long, allow_hyphen_values = true)]
     tension: Option<f64>,
-    /// Input mesh (.obj or .ply).
-    input: PathBuf,
-    /// Output: `.txt` (one line per vertex) or a mesh (.obj, .ply, .glb) whose vertices are
-    /// moved to their limit positions.
-    output: PathBuf,
+    #[command(flatten)]
+    files: Files,
     /// Also write the ACC approximation (Loop & Schaefer 2008: a bicubic Bézier geometry
     /// patch and two tangent patches per face) to this JSON file (Catmull-Clark, closed
     /// all-quad meshes).
@@ -114,20 +112,45 @@ pub(crate) fn run(
     out: &mut dyn Write,
     err: &mut dyn Write,
 ) -> Result<(), Failure> {
+    let command = batch::Command {
+        name: "limit",
+        formats: &[
+            OutputFormat::Txt,
+            OutputFormat::Obj,
+            OutputFormat::Ply,
+            OutputFormat::Glb,
+        ],
+    };
+    batch::run(
+        &args.files,
+        &command,
+        args.json,
+        out,
+        err,
+        |job, out, err| run_one(args, job, out, err),
+    )
+}
+
+fn run_one(
+    args: &LimitArgs,
+    job: &Job,
+    out: &mut dyn Write,
+    err: &mut dyn Write,
+) -> Result<(), Failure> {
     let t0 = Instant::now();
-    refuse_overwrite(&args.input, &args.output)?;
-    let is_text = args
+    refuse_overwrite(&job.input, &job.output)?;
+    let is_text = job
         .output
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("txt"));
-    if !is_text && subd_io::Format::from_path(&args.output).is_none() {
+    if !is_text && subd_io::Format::for_output(&job.output).is_none() {
         return Err(bad(format!(
             "{}: unsupported output extension (expected .txt, .obj, .ply or .glb)",
-            args.output.display()
+            job.output.display()
         )));
     }
-    let file = subd_io::read_mesh(&args.input, &args.rules.read_options())?;
-    print_warnings(err, &args.input, &file.warnings);
+    let file = subd_io::read_mesh(&job.input, &args.rules.read_options())?;
+    print_warnings(err, &job.input, &file.warnings);
     let options = args.rules.options(&file.mesh.hints);
     let topo = &file.mesh.topology;
     let (scheme, name) = match args.scheme {
@@ -159,12 +182,12 @@ pub(crate) fn run(
                 "--acc: ACC patches approximate catmull-clark surfaces only".into(),
             ));
         }
-        let limit = split_limit(&args.input, topo, scheme, &file.mesh.positions)?;
-        write_limit(args, &limit, &file.mesh, is_text)?;
+        let limit = split_limit(&job.input, topo, scheme, &file.mesh.positions)?;
+        write_limit(args, job, &limit, &file.mesh, is_text)?;
         if args.json {
             let report = LimitReport {
-                input: args.input.display().to_string(),
-                output: args.output.display().to_string(),
+                input: job.input.display().to_string(),
+                output: job.output.display().to_string(),
                 scheme: scheme.name(),
                 vertices: topo.num_vertices(),
                 levels_refined: 0,
@@ -177,7 +200,7 @@ pub(crate) fn run(
     }
     let table = match args.scheme {
         LimitCommandScheme::TwoPhase => {
-            let tp = args.lambda.two_phase(&args.input, topo.num_vertices())?;
+            let tp = args.lambda.two_phase(&job.input, topo.num_vertices())?;
             two_phase_base_limit(topo, &tp, &options)
         }
         _ if args.lambda.given() => {
@@ -187,7 +210,7 @@ pub(crate) fn run(
         }
         _ => base_limit(topo, scheme, &options),
     }
-    .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
+    .map_err(|e| bad(format!("{}: {e}", job.input.display())))?;
     let limit = table.apply(&file.mesh.positions);
     // ACC first, so that a mesh it does not cover fails before any file is written.
     let acc = match &args.acc {
@@ -199,21 +222,21 @@ pub(crate) fn run(
                 )));
             }
             let patches = subd_limit::acc::acc_patches(topo, &file.mesh.positions)
-                .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
+                .map_err(|e| bad(format!("{}: {e}", job.input.display())))?;
             let json = serde_json::to_vec(&patches)
                 .map_err(|e| bad(format!("{}: {e}", path.display())))?;
             Some((path, json))
         }
         None => None,
     };
-    write_limit(args, &limit, &file.mesh, is_text)?;
+    write_limit(args, job, &limit, &file.mesh, is_text)?;
     if let Some((path, json)) = acc {
         subd_io::atomic_write(path, |w| w.write_all(&json))?;
     }
     if args.json {
         let report = LimitReport {
-            input: args.input.display().to_string(),
-            output: args.output.display().to_string(),
+            input: job.input.display().to_string(),
+            output: job.output.display().to_string(),
             scheme: name,
             vertices: topo.num_vertices(),
             levels_refined: levels_for_exact_limit(topo, scheme)
@@ -230,18 +253,19 @@ pub(crate) fn run(
 /// Writes the limit as text or as the input mesh with its vertices moved.
 fn write_limit(
     args: &LimitArgs,
+    job: &Job,
     limit: &LimitPoints,
     input: &Mesh,
     is_text: bool,
 ) -> Result<(), Failure> {
     if is_text {
         let body = text(limit, args.normals);
-        subd_io::atomic_write(&args.output, |w| w.write_all(body.as_bytes()))?;
+        subd_io::atomic_write(&job.output, |w| w.write_all(body.as_bytes()))?;
     } else {
         let mut mesh = Mesh::new(input.topology.clone(), limit.positions.clone())
-            .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
+            .map_err(|e| bad(format!("{}: {e}", job.input.display())))?;
         mesh.hints = input.hints;
-        subd_io::write_mesh(&args.output, &mesh, &subd_io::WriteOptions::default())?;
+        subd_io::write_mesh(&job.output, &mesh, &subd_io::WriteOptions::default())?;
     }
     Ok(())
 }

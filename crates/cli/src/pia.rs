@@ -11,6 +11,7 @@ use subd_mesh::Mesh;
 use subd_pia::{Method, Moving, Pia, PiaOptions, PiaScheme, Solver, bbox_diagonal};
 use subd_schemes::Scheme;
 
+use crate::batch::{self, Files, Job};
 use crate::failure::{bad, refuse_overwrite};
 use crate::progress::Spinner;
 use crate::rule_args::RuleArgs;
@@ -72,10 +73,8 @@ pub(crate) struct PiaArgs {
     max_iter: usize,
     #[command(flatten)]
     rules: RuleArgs,
-    /// Input mesh (.obj or .ply): its vertices are the targets.
-    input: PathBuf,
-    /// Output mesh (.obj, .ply or .glb): IN's topology and tags, the solved positions.
-    output: PathBuf,
+    #[command(flatten)]
+    files: Files,
     /// Print a JSON report on stdout.
     #[arg(long)]
     json: bool,
@@ -115,12 +114,32 @@ struct PiaReport {
 }
 
 pub(crate) fn run(args: &PiaArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<(), Failure> {
+    let command = batch::Command {
+        name: "pia",
+        formats: batch::MESH_OUTPUTS,
+    };
+    batch::run(
+        &args.files,
+        &command,
+        args.json,
+        out,
+        err,
+        |job, out, err| run_one(args, job, out, err),
+    )
+}
+
+fn run_one(
+    args: &PiaArgs,
+    job: &Job,
+    out: &mut dyn Write,
+    err: &mut dyn Write,
+) -> Result<(), Failure> {
     let t_start = Instant::now();
-    refuse_overwrite(&args.input, &args.output)?;
-    if subd_io::Format::from_path(&args.output).is_none() {
+    refuse_overwrite(&job.input, &job.output)?;
+    if subd_io::Format::for_output(&job.output).is_none() {
         return Err(bad(format!(
             "{}: unsupported output extension (expected .obj, .ply or .glb)",
-            args.output.display()
+            job.output.display()
         )));
     }
     if args.tol.is_nan() || args.tol <= 0.0 {
@@ -129,8 +148,8 @@ pub(crate) fn run(args: &PiaArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
             args.tol
         )));
     }
-    let file = subd_io::read_mesh(&args.input, &args.rules.read_options())?;
-    print_warnings(err, &args.input, &file.warnings);
+    let file = subd_io::read_mesh(&job.input, &args.rules.read_options())?;
+    print_warnings(err, &job.input, &file.warnings);
     let t_read = t_start.elapsed().as_secs_f64();
     let topo = &file.mesh.topology;
     let nv = topo.num_vertices();
@@ -139,7 +158,7 @@ pub(crate) fn run(args: &PiaArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
         PiaSchemeArg::CatmullClark => (PiaScheme::CatmullClark, "catmull-clark"),
         PiaSchemeArg::Loop => (PiaScheme::Loop, "loop"),
         PiaSchemeArg::TwoPhase => (
-            PiaScheme::TwoPhase(args.lambda.two_phase(&args.input, nv)?),
+            PiaScheme::TwoPhase(args.lambda.two_phase(&job.input, nv)?),
             "two-phase",
         ),
     };
@@ -161,9 +180,9 @@ pub(crate) fn run(args: &PiaArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
         SolverArg::Chebyshev => Solver::Chebyshev,
         SolverArg::Direct => Solver::Direct,
     };
-    let at_input = |e: subd_pia::PiaError| bad(format!("{}: {e}", args.input.display()));
+    let at_input = |e: subd_pia::PiaError| bad(format!("{}: {e}", job.input.display()));
 
-    let spinner = Spinner::new(args.json, "limit stencils");
+    let spinner = Spinner::new(args.json || job.quiet, "limit stencils");
     let t0 = Instant::now();
     let pia = Pia::new(topo, &scheme, &options).map_err(at_input)?;
     let t_setup = t0.elapsed().as_secs_f64();
@@ -210,7 +229,7 @@ pub(crate) fn run(args: &PiaArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
             code: EXIT_FAILURE,
             message: format!(
                 "{}: {name} interpolation did not reach --tol {} in {} iterations ({:?}): max error {:e} of the diagonal; no output written (raise --max-iter or try another --solver)",
-                args.input.display(),
+                job.input.display(),
                 args.tol,
                 result.iterations,
                 result.method,
@@ -221,15 +240,15 @@ pub(crate) fn run(args: &PiaArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
 
     let t3 = Instant::now();
     let mut mesh = Mesh::new(topo.clone(), result.points.clone())
-        .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
+        .map_err(|e| bad(format!("{}: {e}", job.input.display())))?;
     mesh.hints = file.mesh.hints;
-    subd_io::write_mesh(&args.output, &mesh, &subd_io::WriteOptions::default())?;
+    subd_io::write_mesh(&job.output, &mesh, &subd_io::WriteOptions::default())?;
     let t_write = t3.elapsed().as_secs_f64();
 
     if args.json {
         let report = PiaReport {
-            input: args.input.display().to_string(),
-            output: args.output.display().to_string(),
+            input: job.input.display().to_string(),
+            output: job.output.display().to_string(),
             scheme: name,
             solver,
             method: result.method,

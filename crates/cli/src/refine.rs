@@ -2,7 +2,6 @@
 //! (OpenSubdiv's schemes), seed 000's two-phase scheme, or Doo-Sabin, √3 and the butterflies.
 
 use std::io::{IsTerminal, Write};
-use std::path::PathBuf;
 use std::time::Instant;
 
 use clap::{Args, ValueEnum};
@@ -11,6 +10,7 @@ use subd_mesh::{BoundaryInterpolation, CreaseMethod, SchemeHints, TriangleSubdiv
 use subd_schemes::split_schemes::{SplitRefinement, SplitScheme};
 use subd_schemes::{ExplicitTags, Refinement, Scheme};
 
+use crate::batch::{self, Files, Job};
 use crate::failure::{bad, refuse_overwrite};
 use crate::rule_args::RuleArgs;
 use crate::vertex_data::LambdaArgs;
@@ -85,10 +85,8 @@ pub(crate) struct RefineArgs {
     lambda: LambdaArgs,
     #[command(flatten)]
     rules: RuleArgs,
-    /// Input mesh (.obj or .ply).
-    input: PathBuf,
-    /// Output mesh (.obj with tags, .ply or .glb).
-    output: PathBuf,
+    #[command(flatten)]
+    files: Files,
     /// Print a JSON report (counts, timings) on stdout.
     #[arg(long)]
     json: bool,
@@ -176,25 +174,45 @@ pub(crate) fn run(
     out: &mut dyn Write,
     err: &mut dyn Write,
 ) -> Result<(), Failure> {
+    let command = batch::Command {
+        name: "refine",
+        formats: batch::MESH_OUTPUTS,
+    };
+    batch::run(
+        &args.files,
+        &command,
+        args.json,
+        out,
+        err,
+        |job, out, err| run_one(args, job, out, err),
+    )
+}
+
+fn run_one(
+    args: &RefineArgs,
+    job: &Job,
+    out: &mut dyn Write,
+    err: &mut dyn Write,
+) -> Result<(), Failure> {
     let t_start = Instant::now();
-    refuse_overwrite(&args.input, &args.output)?;
-    if subd_io::Format::from_path(&args.output).is_none() {
+    refuse_overwrite(&job.input, &job.output)?;
+    if subd_io::Format::for_output(&job.output).is_none() {
         return Err(bad(format!(
             "{}: unsupported output extension (expected .obj, .ply or .glb)",
-            args.output.display()
+            job.output.display()
         )));
     }
     if args.tension.is_some() && !matches!(args.scheme, SchemeArg::Butterfly) {
         return Err(bad("--tension applies to --scheme butterfly only".into()));
     }
     let tension = crate::rule_args::butterfly_tension(args.tension)?;
-    let file = subd_io::read_mesh(&args.input, &args.rules.read_options())?;
-    print_warnings(err, &args.input, &file.warnings);
+    let file = subd_io::read_mesh(&job.input, &args.rules.read_options())?;
+    print_warnings(err, &job.input, &file.warnings);
     let t_read = t_start.elapsed().as_secs_f64();
     let options = args.rules.options(&file.mesh.hints);
     let base = &file.mesh.topology;
     let two_phase = match args.scheme {
-        SchemeArg::TwoPhase => Some(args.lambda.two_phase(&args.input, base.num_vertices())?),
+        SchemeArg::TwoPhase => Some(args.lambda.two_phase(&job.input, base.num_vertices())?),
         _ if args.lambda.given() => {
             return Err(bad(
                 "--lambda and --lambda-file apply to --scheme two-phase only".into(),
@@ -204,9 +222,9 @@ pub(crate) fn run(
     };
     let chosen = args.scheme.chosen(tension);
 
-    let progress = Progress::new(args.levels, args.json);
+    let progress = Progress::new(args.levels, args.json || job.quiet);
     let t0 = Instant::now();
-    let in_file = |e: &dyn std::fmt::Display| bad(format!("{}: {e}", args.input.display()));
+    let in_file = |e: &dyn std::fmt::Display| bad(format!("{}: {e}", job.input.display()));
     let refinement = match (&chosen, &two_phase) {
         (Chosen::Osd(_), Some(tp)) => Refined::Osd(
             Refinement::two_phase(base, tp, &options, args.levels).map_err(|e| in_file(&e))?,
@@ -256,9 +274,9 @@ pub(crate) fn run(
     };
     let mut view = subd_io::MeshView::new(&positions, offsets, vertices, holes)
         .and_then(|v| v.with_tags(tags.creases, tags.corners))
-        .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
+        .map_err(|e| bad(format!("{}: {e}", job.input.display())))?;
     view.hints = hints;
-    subd_io::write_view(&args.output, &view, &subd_io::WriteOptions::default())?;
+    subd_io::write_view(&job.output, &view, &subd_io::WriteOptions::default())?;
     let out_counts = Counts {
         vertices: positions.len(),
         edges: refinement.num_edges(args.levels),
@@ -269,8 +287,8 @@ pub(crate) fn run(
 
     if args.json {
         let report = RefineReport {
-            input: args.input.display().to_string(),
-            output: args.output.display().to_string(),
+            input: job.input.display().to_string(),
+            output: job.output.display().to_string(),
             scheme: args.scheme.name(),
             levels: args.levels,
             tension: match chosen {

@@ -1,5 +1,6 @@
 //! The rule options every surface command shares (`--boundary`, `--crease-method`,
-//! `--triangles`, `--accept-inconsistent-orientation`): defaults from the file's tags,
+//! `--triangles`, `--accept-inconsistent-orientation`, and glTF's `--no-transform` and
+//! `--weld-tolerance`): defaults from the file's tags,
 //! overridden on the command line.
 
 use clap::{Args, ValueEnum};
@@ -43,6 +44,19 @@ pub(crate) struct RuleArgs {
     /// Accept faces whose windings disagree across a shared edge (treated as non-manifold).
     #[arg(long)]
     pub(crate) accept_inconsistent_orientation: bool,
+    /// glTF input: read each mesh as stored, without its nodes' transforms.
+    #[arg(long)]
+    no_transform: bool,
+    /// glTF input: weld vertices closer than this (default: only identical positions).
+    #[arg(long, value_name = "D", value_parser = non_negative_distance)]
+    weld_tolerance: Option<f64>,
+}
+
+fn non_negative_distance(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(d) if d.is_finite() && d >= 0.0 => Ok(d),
+        _ => Err("expected a finite distance ≥ 0".into()),
+    }
 }
 
 impl RuleArgs {
@@ -75,6 +89,8 @@ impl RuleArgs {
     pub(crate) fn read_options(&self) -> subd_io::ReadOptions {
         subd_io::ReadOptions {
             accept_inconsistent_orientation: self.accept_inconsistent_orientation,
+            ignore_transforms: self.no_transform,
+            weld_tolerance: self.weld_tolerance,
         }
     }
 }

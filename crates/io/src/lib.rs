@@ -6,6 +6,8 @@
 //! * **PLY** in (ASCII, binary little- and big-endian) and out (ASCII, binary little-endian)
 //!   ([`ply`]).
 //! * **glTF 2.0 binary** (`.glb`) out: positions, normals, triangle indices ([`glb`]).
+//! * **glTF 2.0** in (`.glb`, `.gltf`): every triangle primitive, node transforms applied,
+//!   vertices welded by position ([`gltf_input`]).
 //!
 //! The format is chosen by the file extension. Every output goes through
 //! [`atomic_write`]: the data is written to a temporary file beside the target and renamed
@@ -21,6 +23,7 @@
 
 pub mod error;
 pub mod glb;
+pub mod gltf_input;
 pub mod obj;
 pub mod ply;
 mod records;
@@ -41,8 +44,10 @@ pub enum Format {
     Obj,
     /// Stanford PLY.
     Ply,
-    /// glTF 2.0 binary (write only).
+    /// glTF 2.0 binary.
     Glb,
+    /// glTF 2.0 JSON (read only).
+    Gltf,
 }
 
 impl Format {
@@ -53,8 +58,20 @@ impl Format {
             "obj" => Some(Format::Obj),
             "ply" => Some(Format::Ply),
             "glb" => Some(Format::Glb),
+            "gltf" => Some(Format::Gltf),
             _ => None,
         }
+    }
+
+    /// Whether subd writes this format (all but `.gltf`, whose external buffers make it a
+    /// set of files; `.glb` is the one-file form).
+    pub fn can_write(self) -> bool {
+        !matches!(self, Format::Gltf)
+    }
+
+    /// The format named by an output path's extension, if subd writes it.
+    pub fn for_output(path: &Path) -> Option<Format> {
+        Format::from_path(path).filter(|f| f.can_write())
     }
 }
 
@@ -64,6 +81,11 @@ pub struct ReadOptions {
     /// Accept faces whose windings disagree across a shared edge (the edge becomes
     /// non-manifold) instead of failing.
     pub accept_inconsistent_orientation: bool,
+    /// glTF: read each mesh as stored instead of placing it by its nodes' transforms.
+    pub ignore_transforms: bool,
+    /// glTF: weld vertices within this distance of each other (default: only vertices at
+    /// exactly the same position).
+    pub weld_tolerance: Option<f64>,
 }
 
 /// Options for writing.
@@ -91,7 +113,8 @@ pub struct MeshFile {
     pub orientation_conflicts: usize,
 }
 
-/// Parses a mesh from bytes in the given format (not [`Format::Glb`], which is write-only).
+/// Parses a mesh from bytes in the given format. A `.gltf` document whose buffers are
+/// external files needs [`read_mesh`], which knows the document's directory.
 pub fn parse_mesh(
     bytes: &[u8],
     format: Format,
@@ -100,29 +123,30 @@ pub fn parse_mesh(
     match format {
         Format::Obj => obj::parse_obj(bytes, options),
         Format::Ply => ply::parse_ply(bytes, options),
-        Format::Glb => Err(ReadError::Syntax {
-            line: None,
-            message: "reading .glb is not supported; use .obj or .ply".into(),
-        }),
+        Format::Glb | Format::Gltf => gltf_input::parse_gltf(bytes, None, options),
     }
 }
 
-/// Reads a mesh file, choosing the format by extension (`.obj`, `.ply`).
+/// Reads a mesh file, choosing the format by extension (`.obj`, `.ply`, `.glb`, `.gltf`).
 pub fn read_mesh(path: &Path, options: &ReadOptions) -> Result<MeshFile, IoError> {
-    let format = match Format::from_path(path) {
-        Some(f @ (Format::Obj | Format::Ply)) => f,
-        _ => {
-            return Err(IoError::UnknownFormat {
-                path: path.to_path_buf(),
-                expected: ".obj or .ply",
-            });
-        }
+    let Some(format) = Format::from_path(path) else {
+        return Err(IoError::UnknownFormat {
+            path: path.to_path_buf(),
+            expected: ".obj, .ply, .glb or .gltf",
+        });
     };
     let bytes = std::fs::read(path).map_err(|source| IoError::Read {
         path: path.to_path_buf(),
         source,
     })?;
-    parse_mesh(&bytes, format, options).map_err(|e| e.at(path))
+    let parsed = match format {
+        Format::Glb | Format::Gltf => {
+            let dir = path.parent().unwrap_or(Path::new("."));
+            gltf_input::parse_gltf(&bytes, Some(dir), options)
+        }
+        _ => parse_mesh(&bytes, format, options),
+    };
+    parsed.map_err(|e| e.at(path))
 }
 
 /// Encodes `mesh` in `format` into `w`.
@@ -146,6 +170,10 @@ pub fn encode_view(
         Format::Obj => obj::write_obj(w, view, &options.extra_obj_tags),
         Format::Ply => ply::write_ply(w, view, options.ply_encoding),
         Format::Glb => glb::write_glb(w, view),
+        Format::Gltf => Err(std::io::Error::new(
+            std::io::ErrorKind::Unsupported,
+            "writing .gltf is not supported; use .glb",
+        )),
     }
 }
 
@@ -158,7 +186,7 @@ pub fn write_mesh(path: &Path, mesh: &Mesh, options: &WriteOptions) -> Result<()
 /// extension (`.obj`, `.ply`, `.glb`): for callers that have face lists but no edge
 /// topology.
 pub fn write_view(path: &Path, view: &MeshView<'_>, options: &WriteOptions) -> Result<(), IoError> {
-    let format = Format::from_path(path).ok_or_else(|| IoError::UnknownFormat {
+    let format = Format::for_output(path).ok_or_else(|| IoError::UnknownFormat {
         path: path.to_path_buf(),
         expected: ".obj, .ply or .glb",
     })?;

@@ -13,6 +13,7 @@ fn check(name: &str, format: Format) {
     let bytes = std::fs::read(&path).unwrap();
     let opts = ReadOptions {
         accept_inconsistent_orientation: true,
+        ..Default::default()
     };
     let start = Instant::now();
     let parsed = parse_mesh(&bytes, format, &opts);

@@ -1,0 +1,394 @@
+//! Batch mode: the mesh commands take `IN OUT`, or any number of inputs (files, or
+//! directories searched recursively) with `--out-dir DIR`.
+//!
+//! Files run on `--jobs` worker threads (default: one per CPU). Each file's own parallel
+//! work (stencil evaluation, PIA sweeps) goes to rayon's shared pool, so a few large meshes
+//! still use every core once the small ones are done. A failed file prints its usual
+//! one-line error and the others go on; the exit code is 2 if any failed.
+
+use std::io::{IsTerminal, Write};
+use std::num::NonZeroUsize;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::mpsc;
+use std::time::Instant;
+
+use clap::{Args, ValueEnum};
+use serde::Serialize;
+
+use crate::failure::bad;
+use crate::{EXIT_BAD_INPUT, Failure};
+
+/// Extensions of the mesh files a directory input contributes.
+const MESH_EXTENSIONS: [&str; 4] = ["obj", "ply", "glb", "gltf"];
+
+/// The input and output paths of a mesh command, single or batch.
+#[derive(Debug, Clone, Args)]
+pub(crate) struct Files {
+    /// `IN OUT`; or, with --out-dir, any number of inputs: mesh files, or directories
+    /// searched recursively for .obj, .ply, .glb and .gltf files.
+    #[arg(required = true, value_name = "IN... [OUT]")]
+    paths: Vec<PathBuf>,
+    /// Batch mode: write one output per input into DIR (created if missing), named after
+    /// the input's file stem.
+    #[arg(long, value_name = "DIR")]
+    out_dir: Option<PathBuf>,
+    /// Batch mode: the outputs' format (default: the input's; .gltf inputs give .glb).
+    #[arg(long, value_enum, requires = "out_dir")]
+    format: Option<OutputFormat>,
+    /// Batch mode: files processed at once (default: the number of CPUs).
+    #[arg(long, requires = "out_dir")]
+    jobs: Option<NonZeroUsize>,
+}
+
+/// An output format of batch mode.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub(crate) enum OutputFormat {
+    Obj,
+    Ply,
+    Glb,
+    /// Text, one line per vertex (`subd limit` only).
+    Txt,
+}
+
+impl OutputFormat {
+    fn extension(self) -> &'static str {
+        match self {
+            OutputFormat::Obj => "obj",
+            OutputFormat::Ply => "ply",
+            OutputFormat::Glb => "glb",
+            OutputFormat::Txt => "txt",
+        }
+    }
+}
+
+/// One file's work: where to read, where to write, and whether the command may draw its
+/// own progress display (not in batch mode, which draws one bar for all files).
+pub(crate) struct Job {
+    pub(crate) input: PathBuf,
+    pub(crate) output: PathBuf,
+    pub(crate) quiet: bool,
+}
+
+/// What batch mode needs to know about the command it drives.
+pub(crate) struct Command {
+    /// The subcommand's name, for messages.
+    pub(crate) name: &'static str,
+    /// The output formats the command writes.
+    pub(crate) formats: &'static [OutputFormat],
+}
+
+/// Output formats of the commands that write meshes.
+pub(crate) const MESH_OUTPUTS: &[OutputFormat] =
+    &[OutputFormat::Obj, OutputFormat::Ply, OutputFormat::Glb];
+
+#[derive(Serialize)]
+struct FileError<'a> {
+    input: String,
+    output: String,
+    error: &'a str,
+    code: i32,
+}
+
+#[derive(Serialize)]
+struct Summary {
+    command: &'static str,
+    files: usize,
+    succeeded: usize,
+    failed: usize,
+    seconds: f64,
+}
+
+#[derive(Serialize)]
+struct SummaryLine {
+    summary: Summary,
+}
+
+/// What one file's run left behind, sent from a worker to the thread that owns the
+/// output streams.
+struct Outcome {
+    index: usize,
+    stdout: Vec<u8>,
+    stderr: Vec<u8>,
+    failure: Option<Failure>,
+}
+
+/// Runs `one` on the command's file(s): once with `IN OUT`, or on every input with
+/// `--out-dir`. `json` is the command's `--json`: batch mode then prints one line per file
+/// (the command's report, or the error) and a summary line.
+pub(crate) fn run<F>(
+    files: &Files,
+    command: &Command,
+    json: bool,
+    out: &mut dyn Write,
+    err: &mut dyn Write,
+    one: F,
+) -> Result<(), Failure>
+where
+    F: Fn(&Job, &mut dyn Write, &mut dyn Write) -> Result<(), Failure> + Sync,
+{
+    let Some(dir) = &files.out_dir else {
+        let [input, output] = &files.paths[..] else {
+            return Err(bad(format!(
+                "{}: expected IN OUT, or inputs with --out-dir DIR ({} paths given)",
+                command.name,
+                files.paths.len()
+            )));
+        };
+        let job = Job {
+            input: input.clone(),
+            output: output.clone(),
+            quiet: false,
+        };
+        return one(&job, out, err);
+    };
+    if let Some(f) = files.format
+        && !command.formats.contains(&f)
+    {
+        return Err(bad(format!(
+            "--format {}: {} does not write it",
+            f.extension(),
+            command.name
+        )));
+    }
+    let jobs = plan(files, dir, command)?;
+    std::fs::create_dir_all(dir).map_err(|e| {
+        bad(format!(
+            "{}: cannot create the directory: {e}",
+            dir.display()
+        ))
+    })?;
+    let workers = files
+        .jobs
+        .map(NonZeroUsize::get)
+        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, NonZeroUsize::get))
+        .min(jobs.len());
+
+    let t0 = Instant::now();
+    let bar = FilesBar::new(&jobs, json);
+    let next = AtomicUsize::new(0);
+    let (tx, rx) = mpsc::channel::<Outcome>();
+    let mut failed = 0;
+    std::thread::scope(|scope| {
+        for _ in 0..workers {
+            let tx = tx.clone();
+            let (jobs, next, one, bar) = (&jobs, &next, &one, &bar);
+            scope.spawn(move || {
+                loop {
+                    let index = next.fetch_add(1, Ordering::Relaxed);
+                    let Some(job) = jobs.get(index) else { break };
+                    bar.started(job);
+                    let (mut stdout, mut stderr) = (Vec::new(), Vec::new());
+                    let failure = one(job, &mut stdout, &mut stderr).err();
+                    let sent = tx.send(Outcome {
+                        index,
+                        stdout,
+                        stderr,
+                        failure,
+                    });
+                    if sent.is_err() {
+                        break;
+                    }
+                }
+            });
+        }
+        drop(tx);
+        // Streams are written here only, whole file at a time, so lines never interleave.
+        for outcome in rx {
+            let job = &jobs[outcome.index];
+            bar.finished(job);
+            bar.suspend(|| {
+                let _ = err.write_all(&outcome.stderr);
+                if let Some(f) = &outcome.failure {
+                    let _ = writeln!(err, "subd: {}", f.message);
+                }
+            });
+            let _ = out.write_all(&outcome.stdout);
+            if let Some(f) = outcome.failure {
+                failed += 1;
+                if json {
+                    crate::print_json(
+                        out,
+                        &FileError {
+                            input: job.input.display().to_string(),
+                            output: job.output.display().to_string(),
+                            error: &f.message,
+                            code: f.code,
+                        },
+                    );
+                }
+            }
+        }
+    });
+    bar.finish();
+
+    let summary = Summary {
+        command: command.name,
+        files: jobs.len(),
+        succeeded: jobs.len() - failed,
+        failed,
+        seconds: t0.elapsed().as_secs_f64(),
+    };
+    let line = format!(
+        "{}: {} of {} files done, {} failed ({:.2} s)",
+        command.name, summary.succeeded, summary.files, summary.failed, summary.seconds
+    );
+    if json {
+        crate::print_json(out, &SummaryLine { summary });
+    }
+    if failed > 0 {
+        return Err(Failure {
+            code: EXIT_BAD_INPUT,
+            message: line,
+        });
+    }
+    let _ = writeln!(err, "subd: {line}");
+    Ok(())
+}
+
+/// The inputs in order (directories expanded, sorted by path) with their outputs; refuses
+/// two inputs that would write the same output before any work starts.
+fn plan(files: &Files, dir: &Path, command: &Command) -> Result<Vec<Job>, Failure> {
+    let mut inputs = Vec::new();
+    for path in &files.paths {
+        if path.is_dir() {
+            let mut found = Vec::new();
+            collect_meshes(path, &mut found).map_err(|e| {
+                bad(format!(
+                    "{}: cannot list the directory: {e}",
+                    path.display()
+                ))
+            })?;
+            found.sort();
+            inputs.extend(found);
+        } else {
+            inputs.push(path.clone());
+        }
+    }
+    if inputs.is_empty() {
+        return Err(bad(format!("{}: no input meshes found", command.name)));
+    }
+    let mut jobs = Vec::with_capacity(inputs.len());
+    let mut seen = std::collections::HashMap::new();
+    for input in inputs {
+        let extension = match files.format {
+            Some(f) => f.extension(),
+            None => default_extension(&input),
+        };
+        let stem = input.file_stem().unwrap_or(input.as_os_str());
+        let output = dir.join(stem).with_extension(extension);
+        if let Some(first) = seen.insert(output.clone(), input.clone()) {
+            return Err(bad(format!(
+                "{}: {} and {} would both write it (outputs are named after the input stem)",
+                output.display(),
+                first.display(),
+                input.display()
+            )));
+        }
+        jobs.push(Job {
+            input,
+            output,
+            quiet: true,
+        });
+    }
+    Ok(jobs)
+}
+
+/// The output extension of an input when `--format` is not given: its own, with .gltf
+/// (not written) becoming .glb. An unknown extension is kept, and the file fails with the
+/// command's usual message.
+fn default_extension(input: &Path) -> &'static str {
+    let ext = input
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("ply") => "ply",
+        Some("glb" | "gltf") => "glb",
+        _ => "obj",
+    }
+}
+
+fn collect_meshes(dir: &Path, found: &mut Vec<PathBuf>) -> std::io::Result<()> {
+    for entry in std::fs::read_dir(dir)? {
+        let path = entry?.path();
+        if path.is_dir() {
+            collect_meshes(&path, found)?;
+        } else if path
+            .extension()
+            .and_then(|e| e.to_str())
+            .is_some_and(|e| MESH_EXTENSIONS.iter().any(|m| e.eq_ignore_ascii_case(m)))
+        {
+            found.push(path);
+        }
+    }
+    Ok(())
+}
+
+/// One progress bar over the batch's bytes, counting files and naming the file started
+/// last; drawn only on a terminal and never with `--json`.
+struct FilesBar {
+    bar: Option<indicatif::ProgressBar>,
+    done: AtomicUsize,
+    total: usize,
+}
+
+impl FilesBar {
+    fn new(jobs: &[Job], json: bool) -> FilesBar {
+        let total = jobs.len();
+        if json || !std::io::stderr().is_terminal() {
+            return FilesBar {
+                bar: None,
+                done: AtomicUsize::new(0),
+                total,
+            };
+        }
+        let bytes: u64 = jobs.iter().map(|j| file_size(&j.input)).sum();
+        let bar = indicatif::ProgressBar::new(bytes);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template(
+                "[{bar:30}] {binary_bytes}/{binary_total_bytes} {prefix} {wide_msg}",
+            )
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        bar.set_prefix(format!("0/{total} files"));
+        bar.enable_steady_tick(std::time::Duration::from_millis(100));
+        FilesBar {
+            bar: Some(bar),
+            done: AtomicUsize::new(0),
+            total,
+        }
+    }
+
+    fn started(&self, job: &Job) {
+        if let Some(b) = &self.bar {
+            b.set_message(job.input.display().to_string());
+        }
+    }
+
+    fn finished(&self, job: &Job) {
+        let done = self.done.fetch_add(1, Ordering::Relaxed) + 1;
+        if let Some(b) = &self.bar {
+            b.inc(file_size(&job.input));
+            b.set_prefix(format!("{done}/{} files", self.total));
+        }
+    }
+
+    /// Runs `f` with the bar hidden, so a line printed meanwhile is not drawn over.
+    fn suspend<R>(&self, f: impl FnOnce() -> R) -> R {
+        match &self.bar {
+            Some(b) => b.suspend(f),
+            None => f(),
+        }
+    }
+
+    fn finish(&self) {
+        if let Some(b) = &self.bar {
+            b.finish_and_clear();
+        }
+    }
+}
+
+fn file_size(path: &Path) -> u64 {
+    std::fs::metadata(path).map_or(0, |m| m.len())
+}
