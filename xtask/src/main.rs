@@ -8,6 +8,7 @@ use std::process::{Command, ExitCode};
 use clap::{Parser, Subcommand};
 
 mod adaptive_bench;
+mod batch_bench;
 mod bench;
 mod conformance;
 mod editing_bench;
@@ -89,6 +90,10 @@ enum Task {
         /// OpenMesh).
         #[arg(long)]
         split_only: bool,
+        /// Only the batch-mode benchmark (`subd refine` on 1,000 small and 10 large meshes
+        /// against a shell loop of single runs).
+        #[arg(long)]
+        batch_only: bool,
     },
     /// (internal) One subd split-scheme measurement for `bench`, in its own process.
     #[command(hide = true)]
@@ -254,6 +259,7 @@ fn main() -> ExitCode {
             adaptive_only,
             editing_only,
             split_only,
+            batch_only,
         } => {
             let refinement = || {
                 bench::run(
@@ -265,7 +271,12 @@ fn main() -> ExitCode {
                 )
             };
             let split = || split_bench::run(levels, repeats, rounds.max(1));
-            if split_only {
+            let shapes = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+                .join("../../shared/meshes/osd");
+            let batch = || batch_bench::run_batch(rounds.max(1), &shapes);
+            if batch_only {
+                batch()
+            } else if split_only {
                 ensure_system_packages(REFERENCE_PACKAGES).and_then(|_| split())
             } else if pia_only {
                 pia_bench::run(repeats)
@@ -288,6 +299,7 @@ fn main() -> ExitCode {
                                 .and_then(|_| adaptive_bench::run(repeats))
                                 .and_then(|_| editing_bench::run(repeats))
                                 .and_then(|_| split())
+                                .and_then(|_| batch())
                         }
                     })
             }
