@@ -182,7 +182,8 @@ fn run_one(
                 "--acc: ACC patches approximate catmull-clark surfaces only".into(),
             ));
         }
-        let limit = split_limit(&job.input, topo, scheme, &file.mesh.positions)?;
+        let limit = split_limit_points(topo, scheme, &file.mesh.positions)
+            .map_err(|e| bad(format!("{}: {e}", job.input.display())))?;
         write_limit(args, job, &limit, &file.mesh, is_text)?;
         if args.json {
             let report = LimitReport {
@@ -270,17 +271,17 @@ fn write_limit(
     Ok(())
 }
 
-/// The limit of a split scheme at every vertex; a vertex without one is an error naming it.
-fn split_limit(
-    input: &std::path::Path,
+/// The limit of a split scheme at every vertex (`nan` normals where none is defined); a
+/// vertex without a limit is an error naming it.
+pub(crate) fn split_limit_points(
     topo: &subd_mesh::Topology,
     scheme: SplitScheme,
     positions: &[subd_mesh::DVec3],
-) -> Result<LimitPoints, Failure> {
-    let in_file = |e: &dyn std::fmt::Display| bad(format!("{}: {e}", input.display()));
+) -> Result<LimitPoints, String> {
     // The refinement's own checks first, so bad input reads as it does for `subd refine`.
-    subd_schemes::split_schemes::SplitRefinement::new(topo, scheme, 0).map_err(|e| in_file(&e))?;
-    let stencils = split_limit_stencils(topo, scheme).map_err(|e| in_file(&e))?;
+    subd_schemes::split_schemes::SplitRefinement::new(topo, scheme, 0)
+        .map_err(|e| e.to_string())?;
+    let stencils = split_limit_stencils(topo, scheme).map_err(|e| e.to_string())?;
     let points = stencils.evaluate(positions);
     if let Some(v) = points.positions.iter().position(Option::is_none) {
         let why = if scheme == SplitScheme::DooSabin {
@@ -288,10 +289,7 @@ fn split_limit(
         } else {
             "its neighbourhood never became one with a known limit mask (a dart or boundary vertex whose refined neighbourhood stays irregular)"
         };
-        return Err(in_file(&format!(
-            "vertex {v}: no {} limit: {why}",
-            scheme.name()
-        )));
+        return Err(format!("vertex {v}: no {} limit: {why}", scheme.name()));
     }
     let nan = subd_mesh::DVec3::splat(f64::NAN);
     Ok(LimitPoints {

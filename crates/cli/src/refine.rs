@@ -87,6 +87,10 @@ pub(crate) struct RefineArgs {
     rules: RuleArgs,
     #[command(flatten)]
     files: Files,
+    /// Move every output vertex to its exact limit position and write its limit normal
+    /// (OBJ `vn`, PLY `nx ny nz`, glTF `NORMAL`): the limit masks of the output level.
+    #[arg(long)]
+    limit: bool,
     /// Print a JSON report (counts, timings) on stdout.
     #[arg(long)]
     json: bool,
@@ -124,6 +128,8 @@ struct RefineReport {
     crease_method: Option<CreaseMethod>,
     #[serde(skip_serializing_if = "Option::is_none")]
     triangle_subdivision: Option<TriangleSubdivision>,
+    /// Whether the vertices were moved to the limit surface.
+    limit: bool,
     input_counts: Counts,
     output_counts: Counts,
     seconds: Timings,
@@ -239,7 +245,21 @@ fn run_one(
     progress.step("topology");
     let t_topology = t0.elapsed().as_secs_f64();
     let t1 = Instant::now();
-    let positions = refinement.last_positions(&file.mesh.positions);
+    let mut positions = refinement.last_positions(&file.mesh.positions);
+    let normals = if args.limit {
+        let limit = output_limit(
+            &refinement,
+            args.levels,
+            two_phase.as_ref(),
+            &options,
+            &positions,
+        )
+        .map_err(|e| in_file(&e))?;
+        positions = limit.positions;
+        Some(limit.normals)
+    } else {
+        None
+    };
     progress.step("positions");
     let t_positions = t1.elapsed().as_secs_f64();
 
@@ -275,6 +295,13 @@ fn run_one(
     let mut view = subd_io::MeshView::new(&positions, offsets, vertices, holes)
         .and_then(|v| v.with_tags(tags.creases, tags.corners))
         .map_err(|e| bad(format!("{}: {e}", job.input.display())))?;
+    let filled;
+    if let Some(n) = &normals {
+        filled = normals_or_faces(n, &view);
+        view = view
+            .with_normals(&filled)
+            .map_err(|e| bad(format!("{}: {e}", job.input.display())))?;
+    }
     view.hints = hints;
     subd_io::write_view(&job.output, &view, &subd_io::WriteOptions::default())?;
     let out_counts = Counts {
@@ -298,6 +325,7 @@ fn run_one(
             boundary_interpolation: osd.then_some(options.boundary_interpolation),
             crease_method: osd.then_some(options.crease_method),
             triangle_subdivision: osd.then_some(options.triangle_subdivision),
+            limit: args.limit,
             input_counts: Counts {
                 vertices: base.num_vertices(),
                 edges: Some(base.num_edges()),
@@ -316,6 +344,53 @@ fn run_one(
         crate::print_json(out, &report);
     }
     Ok(())
+}
+
+/// The exact limit (positions and normals) of the vertices of the output level, from the
+/// limit masks of that level's own topology: what Blender calls "use limit surface".
+fn output_limit(
+    refinement: &Refined,
+    level: usize,
+    two_phase: Option<&subd_schemes::TwoPhase>,
+    options: &subd_schemes::Options,
+    positions: &[subd_mesh::DVec3],
+) -> Result<subd_limit::LimitPoints, String> {
+    match refinement {
+        Refined::Osd(r) => {
+            let topology = r.topology(level);
+            let table = match two_phase {
+                // Level 0 of the two-phase scheme is its phase-1 input; from level 1 on it
+                // is Catmull-Clark.
+                Some(tp) if level == 0 => subd_limit::two_phase_base_limit(topology, tp, options),
+                _ => subd_limit::base_limit(topology, r.scheme(), options),
+            }
+            .map_err(|e| e.to_string())?;
+            Ok(table.apply(positions))
+        }
+        Refined::Split(r) => {
+            crate::limit::split_limit_points(r.topology(level), r.scheme(), positions)
+        }
+    }
+}
+
+/// `normals` where they are unit vectors; elsewhere (a split scheme's creases and corners,
+/// parallel tangents) the area-weighted normal of the output faces, as `.glb` shading uses.
+fn normals_or_faces(
+    normals: &[subd_mesh::DVec3],
+    view: &subd_io::MeshView<'_>,
+) -> Vec<subd_mesh::DVec3> {
+    let from_faces = subd_io::glb::vertex_normals(view);
+    normals
+        .iter()
+        .zip(from_faces)
+        .map(|(n, f)| {
+            if n.is_finite() && n.length_squared() > 0.5 {
+                *n
+            } else {
+                f.try_normalize().unwrap_or(subd_mesh::DVec3::Z)
+            }
+        })
+        .collect()
 }
 
 /// A progress bar on a terminal for refinements deep enough to take a while; nothing when

@@ -2236,3 +2236,124 @@ fn a_gltf_exported_with_split_seams_refines_to_a_closed_mesh() {
         "a sphere"
     );
 }
+
+/// `x y z nx ny nz` lines of `subd limit --normals` output.
+fn limit_lines(path: &Path) -> Vec<[f64; 6]> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .map(|l| {
+            let v: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
+            [v[0], v[1], v[2], v[3], v[4], v[5]]
+        })
+        .collect()
+}
+
+#[test]
+fn refine_limit_puts_every_output_vertex_on_the_limit_surface() {
+    let s = Scratch::new("refine-limit");
+    let torus =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/meshes/torus_creased.obj");
+    for (scheme, input) in [
+        ("catmull-clark", torus),
+        ("loop", meshes().join("loop_cube_creases0.obj")),
+        ("sqrt3", meshes().join("loop_cube.obj")),
+    ] {
+        let input = input.to_str().unwrap();
+        let on_limit = s.0.join(format!("{scheme}-limit.obj"));
+        let (code, _, err) = subd(&[
+            "refine",
+            "--scheme",
+            scheme,
+            "--levels",
+            "2",
+            "--limit",
+            input,
+            on_limit.to_str().unwrap(),
+        ]);
+        assert_eq!(code, 0, "{scheme}: {err}");
+        let refined = subd_io::read_mesh(&on_limit, &subd_io::ReadOptions::default()).unwrap();
+        let text = std::fs::read_to_string(&on_limit).unwrap();
+        let normals: Vec<[f64; 3]> = text
+            .lines()
+            .filter_map(|l| l.strip_prefix("vn "))
+            .map(|l| {
+                let v: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
+                [v[0], v[1], v[2]]
+            })
+            .collect();
+        assert_eq!(
+            normals.len(),
+            refined.mesh.positions.len(),
+            "{scheme}: one vn per vertex"
+        );
+        // The same points another way: plain refinement, then `subd limit` on that file.
+        let plain = s.0.join(format!("{scheme}-plain.obj"));
+        let plain_limit = s.0.join(format!("{scheme}-plain-limit.txt"));
+        let (code, _, err) = subd(&[
+            "refine",
+            "--scheme",
+            scheme,
+            "--levels",
+            "2",
+            input,
+            plain.to_str().unwrap(),
+        ]);
+        assert_eq!(code, 0, "{err}");
+        let (code, _, err) = subd(&[
+            "limit",
+            "--scheme",
+            scheme,
+            "--normals",
+            plain.to_str().unwrap(),
+            plain_limit.to_str().unwrap(),
+        ]);
+        assert_eq!(code, 0, "{err}");
+        let expected = limit_lines(&plain_limit);
+        assert_eq!(expected.len(), normals.len());
+        for (v, (p, e)) in refined.mesh.positions.iter().zip(&expected).enumerate() {
+            let d = (*p - subd_mesh::DVec3::new(e[0], e[1], e[2])).length();
+            assert!(d < 1e-12, "{scheme}: vertex {v} off by {d}");
+            let n = subd_mesh::DVec3::from_array(normals[v]);
+            assert!(
+                (n.length() - 1.0).abs() < 1e-12,
+                "{scheme}: vertex {v} normal {n}"
+            );
+            let en = subd_mesh::DVec3::new(e[3], e[4], e[5]);
+            if en.is_finite() {
+                assert!(
+                    n.dot(en) > 1.0 - 1e-12,
+                    "{scheme}: vertex {v} normal {n} vs {en}"
+                );
+            }
+        }
+        // Two levels apart, the base vertices' own limits are among the output's.
+        let base_limit = s.0.join(format!("{scheme}-base-limit.txt"));
+        let (code, _, err) = subd(&[
+            "limit",
+            "--scheme",
+            scheme,
+            input,
+            base_limit.to_str().unwrap(),
+        ]);
+        assert_eq!(code, 0, "{err}");
+        for (v, b) in std::fs::read_to_string(&base_limit)
+            .unwrap()
+            .lines()
+            .enumerate()
+        {
+            let b: Vec<f64> = b.split_whitespace().map(|x| x.parse().unwrap()).collect();
+            let b = subd_mesh::DVec3::new(b[0], b[1], b[2]);
+            let nearest = refined
+                .mesh
+                .positions
+                .iter()
+                .map(|p| (*p - b).length())
+                .fold(f64::INFINITY, f64::min);
+            assert!(
+                nearest < 1e-12,
+                "{scheme}: base vertex {v}'s limit is {nearest} from the output"
+            );
+        }
+    }
+}
