@@ -24,7 +24,9 @@ mod info;
 mod limit;
 mod pia;
 mod progress;
+mod raster;
 mod refine;
+mod render;
 mod rule_args;
 mod vertex_data;
 
@@ -79,6 +81,9 @@ enum Command {
     /// Simple constrained deformation: points move by radial blends around constraint
     /// points, each constraint point exactly by its displacement (any mesh level).
     Deform(edit::DeformArgs),
+    /// A shaded picture (PNG) of a mesh, its refinement or its limit surface, with the
+    /// control cage, the wireframe and marked points drawn over it; headless, CPU only.
+    Render(render::RenderArgs),
     /// Subdivision curves (linear and circle-average schemes) from a text point list, to
     /// text or SVG.
     Curve(curve::CurveArgs),
@@ -141,6 +146,7 @@ where
         Command::Adaptive(a) => adaptive::run(&a, out, err),
         Command::Edit(a) => edit::run(&a, out, err),
         Command::Deform(a) => edit::run_deform(&a, out, err),
+        Command::Render(a) => render::run(&a, out, err),
         Command::Curve(a) => curve::run(&a, out, err),
         Command::Analyze(a) => analyze::run(&a, out),
     };

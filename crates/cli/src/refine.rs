@@ -34,7 +34,7 @@ pub(crate) enum SchemeArg {
 }
 
 /// Which family a scheme argument belongs to.
-enum Chosen {
+pub(crate) enum Chosen {
     /// OpenSubdiv's schemes and the two-phase scheme, which refines with Catmull-Clark's
     /// topology and rules after its first step.
     Osd(Scheme),
@@ -43,7 +43,7 @@ enum Chosen {
 }
 
 impl SchemeArg {
-    fn chosen(self, tension: f64) -> Chosen {
+    pub(crate) fn chosen(self, tension: f64) -> Chosen {
         match self {
             SchemeArg::CatmullClark | SchemeArg::TwoPhase => Chosen::Osd(Scheme::CatmullClark),
             SchemeArg::Loop => Chosen::Osd(Scheme::Loop),
@@ -137,13 +137,44 @@ struct RefineReport {
 }
 
 /// A refinement of either family, reduced to what writing its last level needs.
-enum Refined {
+pub(crate) enum Refined {
     Osd(Refinement),
     Split(Box<SplitRefinement>),
 }
 
 impl Refined {
-    fn faces(&self, level: usize) -> (&[u32], &[u32]) {
+    /// Refines `base` with the chosen scheme (the two-phase scheme when `two_phase` is
+    /// given); the error names the element.
+    pub(crate) fn new(
+        base: &subd_mesh::Topology,
+        chosen: &Chosen,
+        two_phase: Option<&subd_schemes::TwoPhase>,
+        options: &subd_schemes::Options,
+        levels: usize,
+    ) -> Result<Refined, String> {
+        let e = |e: &dyn std::fmt::Display| e.to_string();
+        Ok(match (chosen, two_phase) {
+            (Chosen::Osd(_), Some(tp)) => {
+                Refined::Osd(Refinement::two_phase(base, tp, options, levels).map_err(|x| e(&x))?)
+            }
+            (Chosen::Osd(scheme), None) => {
+                Refined::Osd(Refinement::new(base, *scheme, options, levels).map_err(|x| e(&x))?)
+            }
+            (Chosen::Split(scheme), _) => Refined::Split(Box::new(
+                SplitRefinement::new(base, *scheme, levels).map_err(|x| e(&x))?,
+            )),
+        })
+    }
+
+    /// Hole flags of the faces of `level` (the split schemes have no holes).
+    pub(crate) fn holes(&self, level: usize) -> std::borrow::Cow<'_, [bool]> {
+        match self {
+            Refined::Osd(r) => std::borrow::Cow::Borrowed(r.holes(level)),
+            Refined::Split(r) => std::borrow::Cow::Owned(vec![false; r.faces(level).0.len() - 1]),
+        }
+    }
+
+    pub(crate) fn faces(&self, level: usize) -> (&[u32], &[u32]) {
         match self {
             Refined::Osd(r) => r.faces(level),
             Refined::Split(r) => r.faces(level),
@@ -166,7 +197,7 @@ impl Refined {
         }
     }
 
-    fn last_positions(&self, base: &[subd_mesh::DVec3]) -> Vec<subd_mesh::DVec3> {
+    pub(crate) fn last_positions(&self, base: &[subd_mesh::DVec3]) -> Vec<subd_mesh::DVec3> {
         let mut levels = match self {
             Refined::Osd(r) => r.refine_points(base),
             Refined::Split(r) => r.refine_points(base),
@@ -231,17 +262,8 @@ fn run_one(
     let progress = Progress::new(args.levels, args.json || job.quiet);
     let t0 = Instant::now();
     let in_file = |e: &dyn std::fmt::Display| bad(format!("{}: {e}", job.input.display()));
-    let refinement = match (&chosen, &two_phase) {
-        (Chosen::Osd(_), Some(tp)) => Refined::Osd(
-            Refinement::two_phase(base, tp, &options, args.levels).map_err(|e| in_file(&e))?,
-        ),
-        (Chosen::Osd(scheme), None) => Refined::Osd(
-            Refinement::new(base, *scheme, &options, args.levels).map_err(|e| in_file(&e))?,
-        ),
-        (Chosen::Split(scheme), _) => Refined::Split(Box::new(
-            SplitRefinement::new(base, *scheme, args.levels).map_err(|e| in_file(&e))?,
-        )),
-    };
+    let refinement = Refined::new(base, &chosen, two_phase.as_ref(), &options, args.levels)
+        .map_err(|e| in_file(&e))?;
     progress.step("topology");
     let t_topology = t0.elapsed().as_secs_f64();
     let t1 = Instant::now();
@@ -284,15 +306,8 @@ fn run_one(
     // deep refinement's output).
     let (offsets, vertices) = refinement.faces(args.levels);
     let tags = refinement.explicit_tags(args.levels);
-    let no_holes;
-    let holes = match &refinement {
-        Refined::Osd(r) => r.holes(args.levels),
-        Refined::Split(_) => {
-            no_holes = vec![false; offsets.len() - 1];
-            &no_holes[..]
-        }
-    };
-    let mut view = subd_io::MeshView::new(&positions, offsets, vertices, holes)
+    let holes = refinement.holes(args.levels);
+    let mut view = subd_io::MeshView::new(&positions, offsets, vertices, &holes)
         .and_then(|v| v.with_tags(tags.creases, tags.corners))
         .map_err(|e| bad(format!("{}: {e}", job.input.display())))?;
     let filled;
@@ -348,7 +363,7 @@ fn run_one(
 
 /// The exact limit (positions and normals) of the vertices of the output level, from the
 /// limit masks of that level's own topology: what Blender calls "use limit surface".
-fn output_limit(
+pub(crate) fn output_limit(
     refinement: &Refined,
     level: usize,
     two_phase: Option<&subd_schemes::TwoPhase>,
@@ -375,7 +390,7 @@ fn output_limit(
 
 /// `normals` where they are unit vectors; elsewhere (a split scheme's creases and corners,
 /// parallel tangents) the area-weighted normal of the output faces, as `.glb` shading uses.
-fn normals_or_faces(
+pub(crate) fn normals_or_faces(
     normals: &[subd_mesh::DVec3],
     view: &subd_io::MeshView<'_>,
 ) -> Vec<subd_mesh::DVec3> {

@@ -292,6 +292,7 @@ impl TriangleSoup {
             warnings: self.warnings,
             extra_tags: Vec::new(),
             orientation_conflicts,
+            face_levels: None,
         })
     }
 }

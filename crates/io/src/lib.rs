@@ -111,6 +111,9 @@ pub struct MeshFile {
     /// Number of edges that two faces traverse in the same direction (only non-zero when
     /// [`ReadOptions::accept_inconsistent_orientation`] is set).
     pub orientation_conflicts: usize,
+    /// Per-face refinement levels: the PLY face property `level`, as `subd adaptive` writes
+    /// it (`None` where the file has none).
+    pub face_levels: Option<Vec<u8>>,
 }
 
 /// Parses a mesh from bytes in the given format. A `.gltf` document whose buffers are

@@ -267,6 +267,7 @@ pub fn parse_obj(bytes: &[u8], options: &ReadOptions) -> Result<MeshFile, ReadEr
         warnings,
         extra_tags,
         orientation_conflicts,
+        face_levels: None,
     })
 }
 

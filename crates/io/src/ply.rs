@@ -347,6 +347,7 @@ pub fn parse_ply(bytes: &[u8], options: &ReadOptions) -> Result<MeshFile, ReadEr
     let mut positions: Vec<DVec3> = Vec::new();
     let mut face_sizes: Vec<u32> = Vec::new();
     let mut face_vertices: Vec<u32> = Vec::new();
+    let mut face_levels: Vec<u8> = Vec::new();
     let mut creases: Vec<(f64, f64, f64, Option<usize>)> = Vec::new();
     let mut corners: Vec<(f64, f64, Option<usize>)> = Vec::new();
     let mut holes: Vec<(f64, Option<usize>)> = Vec::new();
@@ -378,7 +379,8 @@ pub fn parse_ply(bytes: &[u8], options: &ReadOptions) -> Result<MeshFile, ReadEr
                         "face vertex_indices is not a list property",
                     ));
                 }
-                Some(("face", [i, 0, 0]))
+                // `level`, as `subd adaptive` writes it; usize::MAX: absent.
+                Some(("face", [i, find("level").unwrap_or(usize::MAX), 0]))
             }
             "crease" => match (find("v0"), find("v1"), find("sharpness")) {
                 (Some(a), Some(b), Some(s)) => Some(("crease", [a, b, s])),
@@ -458,7 +460,14 @@ pub fn parse_ply(bytes: &[u8], options: &ReadOptions) -> Result<MeshFile, ReadEr
                     }
                     positions.push(p);
                 }
-                Some(("face", _)) => {
+                Some(("face", [_, level, _])) => {
+                    if level != usize::MAX {
+                        let l = values[level];
+                        if !(0.0..=255.0).contains(&l) || l.fract() != 0.0 {
+                            return Err(err_at(&body, format!("face {k} has invalid level {l}")));
+                        }
+                        face_levels.push(l as u8);
+                    }
                     if list.len() < 3 {
                         return Err(err_at(
                             &body,
@@ -564,6 +573,7 @@ pub fn parse_ply(bytes: &[u8], options: &ReadOptions) -> Result<MeshFile, ReadEr
         warnings,
         extra_tags: Vec::new(),
         orientation_conflicts,
+        face_levels: (!face_levels.is_empty()).then_some(face_levels),
     })
 }
 

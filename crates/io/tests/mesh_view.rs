@@ -70,3 +70,35 @@ proptest! {
         prop_assert_eq!(u32::from_le_bytes(glb[8..12].try_into().unwrap()) as usize, glb.len());
     }
 }
+
+#[test]
+fn ply_face_levels_read_back_in_both_encodings() {
+    let positions = [
+        DVec3::new(0.0, 0.0, 0.0),
+        DVec3::new(1.0, 0.0, 0.0),
+        DVec3::new(1.0, 1.0, 0.0),
+        DVec3::new(0.0, 1.0, 0.0),
+    ];
+    let (offsets, vertices, holes) = ([0u32, 3, 6], [0u32, 1, 2, 0, 2, 3], [false, false]);
+    let levels = [2u8, 7];
+    let view = MeshView::new(&positions, &offsets, &vertices, &holes)
+        .unwrap()
+        .with_face_levels(&levels)
+        .unwrap();
+    for encoding in [PlyEncoding::Ascii, PlyEncoding::BinaryLittleEndian] {
+        let mut ply = Vec::new();
+        let w = WriteOptions {
+            ply_encoding: encoding,
+            ..Default::default()
+        };
+        encode_view(&mut ply, &view, Format::Ply, &w).unwrap();
+        let file = subd_io::parse_mesh(&ply, Format::Ply, &Default::default()).unwrap();
+        assert_eq!(file.face_levels.as_deref(), Some(&levels[..]), "{encoding:?}");
+    }
+    // A file without the property has none.
+    let plain = MeshView::new(&positions, &offsets, &vertices, &holes).unwrap();
+    let mut ply = Vec::new();
+    encode_view(&mut ply, &plain, Format::Ply, &WriteOptions::default()).unwrap();
+    let file = subd_io::parse_mesh(&ply, Format::Ply, &Default::default()).unwrap();
+    assert_eq!(file.face_levels, None);
+}
