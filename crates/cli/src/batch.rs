@@ -68,6 +68,8 @@ pub(crate) struct Job {
     pub(crate) input: PathBuf,
     pub(crate) output: PathBuf,
     pub(crate) quiet: bool,
+    /// Files processed at the same time as this one (they share the memory budget).
+    pub(crate) concurrent: usize,
 }
 
 /// What batch mode needs to know about the command it drives.
@@ -139,6 +141,7 @@ where
             input: input.clone(),
             output: output.clone(),
             quiet: false,
+            concurrent: 1,
         };
         return one(&job, out, err);
     };
@@ -151,7 +154,7 @@ where
             command.name
         )));
     }
-    let jobs = plan(files, dir, command)?;
+    let mut jobs = plan(files, dir, command)?;
     std::fs::create_dir_all(dir).map_err(|e| {
         bad(format!(
             "{}: cannot create the directory: {e}",
@@ -163,6 +166,9 @@ where
         .map(NonZeroUsize::get)
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, NonZeroUsize::get))
         .min(jobs.len());
+    for job in &mut jobs {
+        job.concurrent = workers;
+    }
 
     let t0 = Instant::now();
     let bar = FilesBar::new(&jobs, json);
@@ -289,6 +295,7 @@ fn plan(files: &Files, dir: &Path, command: &Command) -> Result<Vec<Job>, Failur
             input,
             output,
             quiet: true,
+            concurrent: 1,
         });
     }
     Ok(jobs)

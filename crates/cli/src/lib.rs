@@ -16,6 +16,7 @@
 mod adaptive;
 mod analyze;
 mod batch;
+mod budget;
 mod curve;
 mod edit;
 mod eval;

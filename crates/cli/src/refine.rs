@@ -11,6 +11,7 @@ use subd_schemes::split_schemes::{SplitRefinement, SplitScheme};
 use subd_schemes::{ExplicitTags, Refinement, Scheme};
 
 use crate::batch::{self, Files, Job};
+use crate::budget::{Budget, PeakModel};
 use crate::failure::{bad, refuse_overwrite};
 use crate::rule_args::RuleArgs;
 use crate::vertex_data::LambdaArgs;
@@ -87,6 +88,11 @@ pub(crate) struct RefineArgs {
     rules: RuleArgs,
     #[command(flatten)]
     files: Files,
+    /// The memory the refinement may use (e.g. 800M, 4G); default: the available memory
+    /// and the address-space limit (`ulimit -v`). A request estimated to need more is
+    /// refused before any work, naming the deepest level that fits.
+    #[arg(long, value_name = "SIZE", value_parser = crate::budget::parse_size)]
+    max_memory: Option<u64>,
     /// Move every output vertex to its exact limit position and write its limit normal
     /// (OBJ `vn`, PLY `nx ny nz`, glTF `NORMAL`): the limit masks of the output level.
     #[arg(long)]
@@ -258,6 +264,7 @@ fn run_one(
         _ => None,
     };
     let chosen = args.scheme.chosen(tension);
+    check_memory(args, job, &file, &chosen)?;
 
     let progress = Progress::new(args.levels, args.json || job.quiet);
     let t0 = Instant::now();
@@ -359,6 +366,36 @@ fn run_one(
         crate::print_json(out, &report);
     }
     Ok(())
+}
+
+/// Refuses the request if its estimated peak memory is over the budget (see
+/// [`crate::budget`]).
+fn check_memory(
+    args: &RefineArgs,
+    job: &Job,
+    file: &subd_io::MeshFile,
+    chosen: &Chosen,
+) -> Result<(), Failure> {
+    let base = &file.mesh.topology;
+    let (counts, model) = match chosen {
+        Chosen::Osd(scheme) => (
+            subd_schemes::refined_counts(base, *scheme, args.levels),
+            PeakModel::osd(*scheme),
+        ),
+        Chosen::Split(scheme) => (
+            subd_schemes::refined_split_counts(base, *scheme, args.levels),
+            PeakModel::split(*scheme),
+        ),
+    };
+    let file_bytes = std::fs::metadata(&job.input).map_or(0, |m| m.len());
+    let glb = subd_io::Format::for_output(&job.output) == Some(subd_io::Format::Glb);
+    let budget = Budget::detect(args.max_memory).map(|b| b.share(job.concurrent));
+    crate::budget::check_refinement(
+        &job.input,
+        &counts,
+        |last| model.peak(file_bytes, last, glb, args.limit),
+        budget,
+    )
 }
 
 /// The exact limit (positions and normals) of the vertices of the output level, from the

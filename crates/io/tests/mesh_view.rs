@@ -93,7 +93,11 @@ fn ply_face_levels_read_back_in_both_encodings() {
         };
         encode_view(&mut ply, &view, Format::Ply, &w).unwrap();
         let file = subd_io::parse_mesh(&ply, Format::Ply, &Default::default()).unwrap();
-        assert_eq!(file.face_levels.as_deref(), Some(&levels[..]), "{encoding:?}");
+        assert_eq!(
+            file.face_levels.as_deref(),
+            Some(&levels[..]),
+            "{encoding:?}"
+        );
     }
     // A file without the property has none.
     let plain = MeshView::new(&positions, &offsets, &vertices, &holes).unwrap();

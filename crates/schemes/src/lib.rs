@@ -55,7 +55,7 @@ pub mod two_phase;
 use subd_mesh::{BoundaryInterpolation, CreaseMethod, SchemeHints, TriangleSubdivision};
 use thiserror::Error;
 
-pub use refine::Refinement;
+pub use refine::{LevelCounts, Refinement, refined_counts, refined_split_counts};
 pub use rules::Rule;
 pub use stencil::{RowSink, StencilTable};
 pub use two_phase::TwoPhase;
@@ -179,6 +179,16 @@ pub enum RefineError {
     TooLarge {
         /// The level that overflows.
         level: usize,
+    },
+    /// The memory for a level could not be allocated (an address-space limit, or the
+    /// system's memory): the request is refused before anything is written, instead of the
+    /// process aborting part-way.
+    #[error("level {level} needs about {} more memory, which cannot be allocated", memory::human_bytes(*bytes))]
+    OutOfMemory {
+        /// The level that does not fit.
+        level: usize,
+        /// About how many bytes it needs.
+        bytes: u64,
     },
 }
 

@@ -39,6 +39,42 @@ pub fn huge_pages() -> bool {
     HUGE_PAGES.load(Ordering::Relaxed)
 }
 
+/// Whether `bytes` can be allocated now: reserves them (address space only, no page is
+/// touched) and gives them back. Under an address-space limit (`ulimit -v`) or a strict
+/// overcommit policy this is where a too-large request shows, as a value instead of an
+/// abort in the middle of filling an array.
+///
+/// ```
+/// assert!(subd_schemes::memory::can_allocate(1 << 20));
+/// assert!(!subd_schemes::memory::can_allocate(u64::MAX));
+/// ```
+pub fn can_allocate(bytes: u64) -> bool {
+    let Ok(n) = usize::try_from(bytes) else {
+        return false;
+    };
+    Vec::<u8>::new().try_reserve_exact(n).is_ok()
+}
+
+/// `bytes` for people: `512 B`, `3.2 MiB`, `1.5 GiB`.
+///
+/// ```
+/// assert_eq!(subd_schemes::memory::human_bytes(3 << 29), "1.5 GiB");
+/// ```
+pub fn human_bytes(bytes: u64) -> String {
+    const UNITS: [&str; 5] = ["B", "KiB", "MiB", "GiB", "TiB"];
+    let mut v = bytes as f64;
+    let mut unit = 0;
+    while v >= 1024.0 && unit + 1 < UNITS.len() {
+        v /= 1024.0;
+        unit += 1;
+    }
+    if unit == 0 {
+        format!("{bytes} B")
+    } else {
+        format!("{v:.1} {}", UNITS[unit])
+    }
+}
+
 /// A zeroed vector of `len` elements; large ones are advised to use huge pages before anything
 /// touches them.
 ///

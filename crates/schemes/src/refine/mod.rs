@@ -3,11 +3,14 @@
 //! vertices from parent vertices — evaluated directly into positions, or recorded as a
 //! [`StencilTable`].
 
+mod counts;
 mod fused;
 mod par;
 mod refinement;
 mod split;
 
+pub use counts::{LevelCounts, refined_counts, refined_split_counts};
+pub(crate) use counts::{last_level_bytes, topology_bytes};
 pub use refinement::Refinement;
 
 pub(crate) use fused::{

@@ -137,6 +137,18 @@ impl Refinement {
             if 4 * p.num_face_vertices() as u64 + 4 * p.num_edges() as u64 >= u32::MAX as u64 {
                 return Err(RefineError::TooLarge { level: l });
             }
+            // Refuse a level whose arrays cannot be allocated before filling any of them.
+            let child = super::LevelCounts::of(p).refined(scheme);
+            let fused = l + 1 == levels;
+            let need = match (l < levels, fused) {
+                (true, true) => super::last_level_bytes(child.refined(scheme)),
+                (true, false) => super::topology_bytes(child),
+                (false, _) => super::last_level_bytes(child),
+            };
+            if !memory::can_allocate(need) {
+                let level = if fused { levels } else { l };
+                return Err(RefineError::OutOfMemory { level, bytes: need });
+            }
             let layout = super::Layout::new(p, scheme);
             let rules = super::child_rules(p, &r.levels[l - 1].rules, options, layout);
             if l + 1 == levels && super::fusion_applies(p, &r.levels[l - 1].rules, scheme) {

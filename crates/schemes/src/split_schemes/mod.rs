@@ -159,6 +159,15 @@ pub enum SplitError {
         /// The level that overflows.
         level: usize,
     },
+    /// The memory for a level could not be allocated (see
+    /// [`crate::RefineError::OutOfMemory`]).
+    #[error("level {level} needs about {} more memory, which cannot be allocated", crate::memory::human_bytes(*bytes))]
+    OutOfMemory {
+        /// The level that does not fit.
+        level: usize,
+        /// About how many bytes it needs.
+        bytes: u64,
+    },
     /// Building a refined level's topology failed (a bug if it ever happens).
     #[error("level {level}: {source}")]
     Topology {
@@ -364,6 +373,19 @@ impl SplitRefinement {
                 None => base,
                 Some(s) => s.topology.get().expect("levels above the last are built"),
             };
+            // Refuse a level whose arrays cannot be allocated before filling any of them.
+            let child = crate::LevelCounts::of(parent).refined_split(scheme);
+            let need = if l < levels {
+                crate::refine::topology_bytes(child)
+            } else {
+                crate::refine::last_level_bytes(child)
+            };
+            if !crate::memory::can_allocate(need) {
+                return Err(SplitError::OutOfMemory {
+                    level: l,
+                    bytes: need,
+                });
+            }
             let faces = Step::new(parent, scheme, l)
                 .child_faces()
                 .map_err(|e| e.at_level(l))?;
