@@ -18,7 +18,17 @@
 // refined adaptively to isolation level L (infinitely sharp patches on, legacy sharp corners
 // off, Gregory end caps) and the patch table evaluated in double precision at each point:
 // output per point f64 P[3], Du[3], Dv[3], Duu[3], Duv[3], Dvv[3].
+// With --bfr RATE: Bfr::RefinerSurfaceFactory (approximation levels 10, as the patch table's
+// isolation) and a uniform Bfr::Tessellation at RATE for every face with a surface; output
+// u32 count, then per point u32 face, u32 sub-face (0 unless the face is parameterised by
+// quad sub-faces), f64 u, f64 v (the sub-face's normalised coordinates), f64 P[3].
+// With --bfr-bench RATE REPEATS: the median time of building the factory and, for every
+// face, its surface, tessellation coordinates, patch points and positions with first
+// derivatives; one line of JSON.
 
+#include <opensubdiv/bfr/refinerSurfaceFactory.h>
+#include <opensubdiv/bfr/surface.h>
+#include <opensubdiv/bfr/tessellation.h>
 #include <opensubdiv/far/patchMap.h>
 #include <opensubdiv/far/patchTable.h>
 #include <opensubdiv/far/patchTableFactory.h>
@@ -172,6 +182,52 @@ long peakRssBytes() {
     return kb * 1024;
 }
 
+// Bfr's uniform tessellation of every face at `rate`: writes the points (see the header)
+// into `out` when given; returns a checksum (so the timed run does the same work).
+double bfrTessellate(Far::TopologyRefiner const &refiner, Mesh const &m, int rate,
+                     std::vector<unsigned char> *out) {
+    typedef Bfr::RefinerSurfaceFactory<> Factory;
+    Factory::Options fo;
+    fo.SetApproxLevelSmooth(10);
+    fo.SetApproxLevelSharp(10);
+    Factory factory(refiner, fo);
+    Bfr::Surface<double> surface;
+    Bfr::Surface<double>::PointDescriptor desc(3);
+    std::vector<double> coords, patchPoints;
+    std::vector<unsigned char> body;
+    uint32_t count = 0;
+    double check = 0.0;
+    for (int f = 0; f < (int)m.sizes.size(); ++f) {
+        if (!factory.InitVertexSurface(f, &surface)) continue;
+        Bfr::Parameterization param = surface.GetParameterization();
+        Bfr::Tessellation tess(param, rate, Bfr::Tessellation::Options());
+        coords.resize(2 * tess.GetNumCoords());
+        tess.GetCoords(coords.data());
+        patchPoints.resize(3 * surface.GetNumPatchPoints());
+        surface.PreparePatchPoints(&m.pos[0].p[0], desc, patchPoints.data(), desc);
+        for (int k = 0; k < tess.GetNumCoords(); ++k) {
+            double P[3], Du[3], Dv[3];
+            surface.Evaluate(&coords[2 * k], patchPoints.data(), desc, P, Du, Dv);
+            check += P[0] + Du[1] + Dv[2];
+            if (!out) continue;
+            double uv[2] = {coords[2 * k], coords[2 * k + 1]};
+            int sub = 0;
+            if (param.HasSubFaces()) sub = param.ConvertCoordToNormalizedSubFace(&coords[2 * k], uv);
+            put<uint32_t>(body, (uint32_t)f);
+            put<uint32_t>(body, (uint32_t)sub);
+            put<double>(body, uv[0]);
+            put<double>(body, uv[1]);
+            for (double x : P) put<double>(body, x);
+            ++count;
+        }
+    }
+    if (out) {
+        put<uint32_t>(*out, count);
+        out->insert(out->end(), body.begin(), body.end());
+    }
+    return check;
+}
+
 } // namespace
 
 int main(int argc, char **argv) {
@@ -213,6 +269,30 @@ int main(int argc, char **argv) {
             std::printf("{\"seconds\": %.9f, \"topology_seconds\": %.9f, \"primvar_seconds\": %.9f, "
                         "\"peak_rss_bytes\": %ld}\n",
                         median(total), median(topo), median(prim), peakRssBytes());
+            return 0;
+        }
+        bool bfrBench = argc > 1 && std::string(argv[1]) == "--bfr-bench";
+        if (bfrBench || (argc > 1 && std::string(argv[1]) == "--bfr")) {
+            int rate = argc > 2 ? std::atoi(argv[2]) : 4;
+            Far::TopologyRefiner *refiner = createRefiner(m);
+            if (!bfrBench) {
+                std::vector<unsigned char> out;
+                bfrTessellate(*refiner, m, rate, &out);
+                std::fwrite(out.data(), 1, out.size(), stdout);
+                delete refiner;
+                return 0;
+            }
+            int reps = argc > 3 ? std::atoi(argv[3]) : 5;
+            std::vector<double> times;
+            double check = 0.0;
+            for (int i = 0; i < reps; ++i) {
+                auto a = std::chrono::steady_clock::now();
+                check += bfrTessellate(*refiner, m, rate, nullptr);
+                times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - a).count());
+            }
+            std::sort(times.begin(), times.end());
+            std::printf("{\"seconds\": %.9f, \"check\": %.6f}\n", times[times.size() / 2], check);
+            delete refiner;
             return 0;
         }
         bool evalBench = argc > 1 && std::string(argv[1]) == "--eval-bench";

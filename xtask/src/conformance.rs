@@ -185,6 +185,9 @@ pub fn compare(
         rows.push(compare_eval(
             exe, name, topo, positions, scheme, options, diag,
         ));
+        rows.push(crate::tess_conformance::compare(
+            exe, name, topo, positions, scheme, options, diag,
+        ));
         rows.push(compare_pia(
             exe, name, topo, positions, scheme, options, diag,
         ));
@@ -1127,7 +1130,9 @@ pub fn report(rows: &[Row]) -> bool {
             .normal_error
             .map_or_else(|| "-".to_string(), |e| format!("{e:.3e}"));
         let excluded = r.excluded.map_or_else(String::new, |(n, e)| {
-            if r.check == "eval" {
+            if r.check == "tessellate" {
+                format!(" ({n} points left out: Bfr's Gregory-cap corners off the exact limit, or faces subd does not evaluate; there |Δ|/diag ≤ {e:.1e})")
+            } else if r.check == "eval" {
                 format!(" ({n} points not on the surface (holes) or not covered left out; in the 2^-10 end-cap squares |Δ|/diag ≤ {e:.1e})")
             } else {
                 format!(" ({n} vertices where OpenSubdiv is inexact left out; there |Δ|/diag ≤ {e:.1e})")

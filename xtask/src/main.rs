@@ -18,6 +18,8 @@ mod osd;
 mod pia_bench;
 mod random_mesh;
 mod split_bench;
+mod tess_bench;
+mod tess_conformance;
 
 #[derive(Parser)]
 #[command(name = "xtask", about = "subd project automation")]
@@ -94,6 +96,9 @@ enum Task {
         /// against a shell loop of single runs).
         #[arg(long)]
         batch_only: bool,
+        /// Only the tessellation benchmark (`subd tessellate` against OpenSubdiv's Bfr).
+        #[arg(long)]
+        tess_only: bool,
     },
     /// (internal) One subd split-scheme measurement for `bench`, in its own process.
     #[command(hide = true)]
@@ -260,6 +265,7 @@ fn main() -> ExitCode {
             editing_only,
             split_only,
             batch_only,
+            tess_only,
         } => {
             let refinement = || {
                 bench::run(
@@ -274,7 +280,10 @@ fn main() -> ExitCode {
             let shapes = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
                 .join("../../shared/meshes/osd");
             let batch = || batch_bench::run_batch(rounds.max(1), &shapes);
-            if batch_only {
+            let tess = || tess_bench::run(repeats);
+            if tess_only {
+                ensure_system_packages(REFERENCE_PACKAGES).and_then(|_| tess())
+            } else if batch_only {
                 batch()
             } else if split_only {
                 ensure_system_packages(REFERENCE_PACKAGES).and_then(|_| split())
@@ -300,6 +309,7 @@ fn main() -> ExitCode {
                                 .and_then(|_| editing_bench::run(repeats))
                                 .and_then(|_| split())
                                 .and_then(|_| batch())
+                                .and_then(|_| tess())
                         }
                     })
             }

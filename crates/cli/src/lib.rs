@@ -29,6 +29,7 @@ mod raster;
 mod refine;
 mod render;
 mod rule_args;
+mod tessellate;
 mod vertex_data;
 
 use std::ffi::OsString;
@@ -68,6 +69,9 @@ enum Command {
     /// The exact limit surface (position and unit normal) at given (face, u, v) parameters,
     /// in OpenSubdiv's parameterisation.
     Eval(eval::EvalArgs),
+    /// The limit surface on a uniform grid of N segments per base edge, positions and
+    /// normals, watertight (OpenSubdiv Bfr's uniform tessellation).
+    Tessellate(tessellate::TessellateArgs),
     /// Adaptive Loop or Catmull-Clark refinement: only where criteria select (flatness,
     /// distance to the limit, curvature, dihedral angle, chosen faces or vertices), closed
     /// into a crack-free mesh whose every vertex is uniform refinement's (or the limit's).
@@ -143,6 +147,7 @@ where
         Command::Refine(a) => refine::run(&a, out, err),
         Command::Limit(a) => limit::run(&a, out, err),
         Command::Eval(a) => eval::run(&a, out, err),
+        Command::Tessellate(a) => tessellate::run(&a, out, err),
         Command::Pia(a) => pia::run(&a, out, err),
         Command::Adaptive(a) => adaptive::run(&a, out, err),
         Command::Edit(a) => edit::run(&a, out, err),

@@ -53,6 +53,7 @@ pub mod split_eigen;
 pub mod split_limit;
 pub mod stam;
 mod table;
+pub mod tessellation;
 mod two_phase_closed;
 
 use subd_mesh::Topology;

@@ -1,0 +1,354 @@
+//! Uniform tessellation of the limit surface: every face sampled on a regular grid of `rate`
+//! segments per base edge, in OpenSubdiv's parameterisation (as `Bfr::Tessellation` with a
+//! uniform rate), into one watertight mesh.
+//!
+//! * A Catmull-Clark quad: an (N + 1)² grid of quads over (u, v) = (i/N, j/N).
+//! * A Catmull-Clark face of n ≠ 4 sides: its n quad sub-faces (`FaceParam::sub`, the quad at
+//!   each corner after one step, as `Bfr`'s quad sub-faces), each an (N/2 + 1)² grid, so its
+//!   edges get N segments like a quad's. N must be even then.
+//! * A Loop triangle: the barycentric grid (i/N, j/N), i + j ≤ N, of N² triangles.
+//! * Hole faces are left out.
+//!
+//! Watertight by construction: a sample on a base vertex, on a base edge or on a sub-face
+//! boundary is evaluated once, from the first face that reaches it, and shared by index, so
+//! the two sides of an edge hold the same bits and a closed input gives a closed, manifold
+//! output.
+
+use std::collections::HashMap;
+
+use glam::DVec3;
+use subd_schemes::Scheme;
+
+use crate::LimitError;
+use crate::eval::{FaceParam, LimitEvaluator, PatchPoints};
+
+/// The largest rate accepted.
+pub const MAX_RATE: usize = 1024;
+
+/// A tessellated limit surface.
+#[derive(Debug, Clone)]
+pub struct Tessellation {
+    /// Positions on the limit surface.
+    pub positions: Vec<DVec3>,
+    /// Unit normals there (zero where the surface has no tangent plane).
+    pub normals: Vec<DVec3>,
+    /// Where each sample was evaluated.
+    pub params: Vec<FaceParam>,
+    /// Face offsets into [`Self::face_vertices`]: quads (Catmull-Clark) or triangles (Loop).
+    pub face_offsets: Vec<u32>,
+    /// Vertices of each output face, counter-clockwise as the base face.
+    pub face_vertices: Vec<u32>,
+    /// Each tessellated (face, sub-face) with its grid of samples, in face order.
+    pub grids: Vec<SampleGrid>,
+    /// The samples of every grid, row by row (`v` rows of `u`), as vertex indices.
+    pub grid_vertices: Vec<u32>,
+}
+
+/// The samples of one face (or sub-face): the vertex at (u, v) = (i, j) / `segments` is
+/// `grid_vertices[start + index]`, where `index` is `j (segments + 1) + i` on a quad and
+/// `j (2 segments + 3 − j) / 2 + i` (i + j ≤ segments) on a triangle.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SampleGrid {
+    /// Base face.
+    pub face: usize,
+    /// Sub-face (0 for quads and triangles).
+    pub sub: usize,
+    /// Segments per side.
+    pub segments: u32,
+    /// Offset of its first sample in [`Tessellation::grid_vertices`].
+    pub start: u32,
+}
+
+impl Tessellation {
+    /// The output vertex at grid point (i, j) of `grid` (see [`SampleGrid`]).
+    pub fn grid_vertex(&self, grid: &SampleGrid, triangle: bool, i: u32, j: u32) -> u32 {
+        let n = grid.segments;
+        let index = if triangle {
+            j * (2 * n + 3 - j) / 2 + i
+        } else {
+            j * (n + 1) + i
+        };
+        self.grid_vertices[(grid.start + index) as usize]
+    }
+}
+
+/// What identifies a sample independently of the face that reaches it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+enum Sample {
+    /// A base vertex.
+    Vertex(u32),
+    /// Step `k` of `rate` along base edge `e`, counted from the edge's first vertex.
+    Edge(u32, u32),
+    /// The centre of a non-quad face.
+    Centre(u32),
+    /// Step `k` from the midpoint of side `side` of non-quad face `face` towards its centre.
+    Spoke { face: u32, side: u32, k: u32 },
+    /// Inside face `face` (sub-face `sub`) at grid point (i, j).
+    Inner { face: u32, sub: u32, i: u32, j: u32 },
+}
+
+/// Tessellates the limit surface of `points` (from [`LimitEvaluator::prepare`]) at `rate`.
+///
+/// # Errors
+/// A rate of 0 or above [`MAX_RATE`], an odd rate on a Catmull-Clark mesh with non-quad
+/// faces, and the evaluator's errors (a face it does not cover) naming the face.
+///
+/// ```
+/// use subd_limit::eval::LimitEvaluator;
+/// use subd_limit::tessellation::tessellate;
+/// use subd_mesh::{DVec3, TopologyBuilder};
+/// use subd_schemes::{Options, Scheme};
+///
+/// let faces = [0, 1, 3, 2, 2, 3, 5, 4, 4, 5, 7, 6, 6, 7, 1, 0, 1, 7, 5, 3, 6, 0, 2, 4];
+/// let cube = TopologyBuilder::new(8).build(&[4; 6], &faces).unwrap();
+/// let s = [(-1., -1., 1.), (1., -1., 1.), (-1., 1., 1.), (1., 1., 1.),
+///          (-1., 1., -1.), (1., 1., -1.), (-1., -1., -1.), (1., -1., -1.)];
+/// let p: Vec<DVec3> = s.iter().map(|&(x, y, z)| DVec3::new(x, y, z)).collect();
+/// let eval = LimitEvaluator::new(&cube, Scheme::CatmullClark, &Options::default()).unwrap();
+/// let t = tessellate(&eval, &eval.prepare(&p), 4).unwrap();
+/// assert_eq!(t.face_offsets.len() - 1, 6 * 16);
+/// // Shared samples: V - E + F = 2 for the closed grid, 6·16 quads.
+/// assert_eq!(t.positions.len(), 6 * 16 + 2);
+/// ```
+pub fn tessellate(
+    evaluator: &LimitEvaluator,
+    points: &PatchPoints,
+    rate: usize,
+) -> Result<Tessellation, LimitError> {
+    let topo = evaluator.topology();
+    let catmark = evaluator.scheme == Scheme::CatmullClark;
+    if rate == 0 || rate > MAX_RATE {
+        return Err(LimitError::Param(format!(
+            "rate {rate}: expected 1 to {MAX_RATE}"
+        )));
+    }
+    if catmark && rate % 2 == 1 {
+        if let Some(f) = (0..topo.num_faces()).find(|&f| topo.face_size(f) != 4 && !topo.is_hole(f))
+        {
+            return Err(LimitError::Param(format!(
+                "rate {rate}: face {f} is not a quad, and its quad sub-faces take half the rate each; use an even rate"
+            )));
+        }
+    }
+    let mut t = Builder {
+        evaluator,
+        points,
+        rate: rate as u32,
+        index: HashMap::new(),
+        out: Tessellation {
+            positions: Vec::new(),
+            normals: Vec::new(),
+            params: Vec::new(),
+            face_offsets: vec![0],
+            face_vertices: Vec::new(),
+            grids: Vec::new(),
+            grid_vertices: Vec::new(),
+        },
+    };
+    for f in 0..topo.num_faces() {
+        if topo.is_hole(f) {
+            continue;
+        }
+        let n = topo.face_size(f);
+        if !catmark {
+            t.triangle(f)?;
+        } else if n == 4 {
+            t.quad(f)?;
+        } else {
+            for sub in 0..n {
+                t.sub_face(f, sub)?;
+            }
+        }
+    }
+    Ok(t.out)
+}
+
+struct Builder<'a> {
+    evaluator: &'a LimitEvaluator,
+    points: &'a PatchPoints,
+    rate: u32,
+    index: HashMap<Sample, u32>,
+    out: Tessellation,
+}
+
+impl Builder<'_> {
+    /// The output vertex of `sample`, evaluated at `at` the first time it is met.
+    fn vertex(&mut self, sample: Sample, at: FaceParam) -> Result<u32, LimitError> {
+        if let Some(&i) = self.index.get(&sample) {
+            return Ok(i);
+        }
+        let p = self.evaluator.evaluate(self.points, at)?;
+        let i = self.out.positions.len() as u32;
+        self.out.positions.push(p.position);
+        self.out.normals.push(p.normal());
+        self.out.params.push(at);
+        self.index.insert(sample, i);
+        Ok(i)
+    }
+
+    /// Step `t` of `rate` along the face's side `side` (from corner `side` to `side + 1`).
+    fn on_side(&self, face: usize, side: usize, t: u32) -> Sample {
+        let topo = self.evaluator.topology();
+        let fv = topo.face_vertices(face);
+        let n = fv.len();
+        let (a, b) = (fv[side], fv[(side + 1) % n]);
+        if t == 0 {
+            return Sample::Vertex(a);
+        }
+        if t == self.rate {
+            return Sample::Vertex(b);
+        }
+        let e = topo.face_edges(face)[side];
+        let first = topo.edge_vertices(e as usize)[0];
+        // Counted from the edge's first vertex, so both faces of the edge name it alike.
+        let k = if first == a && a != b {
+            t
+        } else {
+            self.rate - t
+        };
+        Sample::Edge(e, k)
+    }
+
+    fn push_face(&mut self, vertices: &[u32]) {
+        self.out.face_vertices.extend_from_slice(vertices);
+        self.out
+            .face_offsets
+            .push(self.out.face_vertices.len() as u32);
+    }
+
+    /// A quad: corners 0, 1, 2, 3 at (0,0), (1,0), (1,1), (0,1).
+    fn quad(&mut self, face: usize) -> Result<(), LimitError> {
+        let n = self.rate;
+        let mut grid = vec![0u32; ((n + 1) * (n + 1)) as usize];
+        for j in 0..=n {
+            for i in 0..=n {
+                let sample = match (i, j) {
+                    (_, 0) => self.on_side(face, 0, i),
+                    (i, _) if i == n => self.on_side(face, 1, j),
+                    (_, j) if j == n => self.on_side(face, 2, n - i),
+                    (0, _) => self.on_side(face, 3, n - j),
+                    _ => Sample::Inner {
+                        face: face as u32,
+                        sub: 0,
+                        i,
+                        j,
+                    },
+                };
+                let at = FaceParam {
+                    face,
+                    sub: 0,
+                    u: f64::from(i) / f64::from(n),
+                    v: f64::from(j) / f64::from(n),
+                };
+                grid[(j * (n + 1) + i) as usize] = self.vertex(sample, at)?;
+            }
+        }
+        self.record(face, 0, n, &grid);
+        self.grid_quads(&grid, n);
+        Ok(())
+    }
+
+    fn record(&mut self, face: usize, sub: usize, segments: u32, grid: &[u32]) {
+        self.out.grids.push(SampleGrid {
+            face,
+            sub,
+            segments,
+            start: self.out.grid_vertices.len() as u32,
+        });
+        self.out.grid_vertices.extend_from_slice(grid);
+    }
+
+    /// Sub-face `sub` of a non-quad: corner `sub` at (0,0), u towards the midpoint of side
+    /// `sub`, v towards the midpoint of side `sub − 1`, the face centre at (1,1).
+    fn sub_face(&mut self, face: usize, sub: usize) -> Result<(), LimitError> {
+        let m = self.rate / 2;
+        let sides = self.evaluator.topology().face_size(face);
+        let prev = (sub + sides - 1) % sides;
+        let f = face as u32;
+        let mut grid = vec![0u32; ((m + 1) * (m + 1)) as usize];
+        for j in 0..=m {
+            for i in 0..=m {
+                let sample = match (i, j) {
+                    (i, j) if i == m && j == m => Sample::Centre(f),
+                    (_, 0) => self.on_side(face, sub, i),
+                    (0, _) => self.on_side(face, prev, self.rate - j),
+                    (i, _) if i == m => Sample::Spoke {
+                        face: f,
+                        side: sub as u32,
+                        k: j,
+                    },
+                    (_, j) if j == m => Sample::Spoke {
+                        face: f,
+                        side: prev as u32,
+                        k: i,
+                    },
+                    _ => Sample::Inner {
+                        face: f,
+                        sub: sub as u32,
+                        i,
+                        j,
+                    },
+                };
+                let at = FaceParam {
+                    face,
+                    sub,
+                    u: f64::from(i) / f64::from(m),
+                    v: f64::from(j) / f64::from(m),
+                };
+                grid[(j * (m + 1) + i) as usize] = self.vertex(sample, at)?;
+            }
+        }
+        self.record(face, sub, m, &grid);
+        self.grid_quads(&grid, m);
+        Ok(())
+    }
+
+    fn grid_quads(&mut self, grid: &[u32], n: u32) {
+        let at = |i: u32, j: u32| grid[(j * (n + 1) + i) as usize];
+        for j in 0..n {
+            for i in 0..n {
+                self.push_face(&[at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)]);
+            }
+        }
+    }
+
+    /// A Loop triangle: corners 0, 1, 2 at (0,0), (1,0), (0,1).
+    fn triangle(&mut self, face: usize) -> Result<(), LimitError> {
+        let n = self.rate;
+        let row = |j: u32| (j * (2 * n + 3 - j) / 2) as usize;
+        let mut grid = vec![0u32; row(n + 1)];
+        for j in 0..=n {
+            for i in 0..=(n - j) {
+                let sample = match (i, j) {
+                    (_, 0) => self.on_side(face, 0, i),
+                    (i, j) if i + j == n => self.on_side(face, 1, j),
+                    (0, _) => self.on_side(face, 2, n - j),
+                    _ => Sample::Inner {
+                        face: face as u32,
+                        sub: 0,
+                        i,
+                        j,
+                    },
+                };
+                let at = FaceParam {
+                    face,
+                    sub: 0,
+                    u: f64::from(i) / f64::from(n),
+                    v: f64::from(j) / f64::from(n),
+                };
+                grid[row(j) + i as usize] = self.vertex(sample, at)?;
+            }
+        }
+        self.record(face, 0, n, &grid);
+        let at = |i: u32, j: u32| grid[row(j) + i as usize];
+        for j in 0..n {
+            for i in 0..(n - j) {
+                self.push_face(&[at(i, j), at(i + 1, j), at(i, j + 1)]);
+                if i + j + 1 < n {
+                    self.push_face(&[at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)]);
+                }
+            }
+        }
+        Ok(())
+    }
+}
