@@ -29,6 +29,7 @@
 #include <opensubdiv/bfr/refinerSurfaceFactory.h>
 #include <opensubdiv/bfr/surface.h>
 #include <opensubdiv/bfr/tessellation.h>
+#include <opensubdiv/far/error.h>
 #include <opensubdiv/far/patchMap.h>
 #include <opensubdiv/far/patchTable.h>
 #include <opensubdiv/far/patchTableFactory.h>
@@ -231,6 +232,9 @@ double bfrTessellate(Far::TopologyRefiner const &refiner, Mesh const &m, int rat
 } // namespace
 
 int main(int argc, char **argv) {
+    // OpenSubdiv prints its warnings on stdout, which carries the binary results: send them
+    // to stderr.
+    Far::SetWarningCallback([](char const *msg) { std::fprintf(stderr, "OpenSubdiv: %s\n", msg); });
     try {
         bool bench = argc > 1 && std::string(argv[1]) == "--bench";
         int repeats = argc > 2 ? std::atoi(argv[2]) : 5;

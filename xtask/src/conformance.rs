@@ -859,7 +859,7 @@ fn compare_eval(
 
 /// Uniform refinement past semi-sharp decay (at least 4 levels) and the exact limits of its
 /// vertices: the independent reference used where OpenSubdiv's patch evaluation is not exact.
-struct RefinedLimits {
+pub(crate) struct RefinedLimits {
     refinement: Refinement,
     level: usize,
     limits: subd_limit::LimitPoints,
@@ -867,7 +867,7 @@ struct RefinedLimits {
 
 impl RefinedLimits {
     /// `None` where the mesh would be too large to refine that far here.
-    fn new(
+    pub(crate) fn new(
         topo: &Topology,
         positions: &[DVec3],
         scheme: Scheme,
@@ -885,6 +885,13 @@ impl RefinedLimits {
             level,
             limits,
         })
+    }
+
+    /// The limit of the refined vertex at dyadic parameter (u, v) of base face `f` (a quad
+    /// for Catmull-Clark, a triangle for Loop); `None` off the refined vertices.
+    pub(crate) fn at(&self, f: usize, u: f64, v: f64) -> Option<DVec3> {
+        subd_limit::eval::dyadic_vertex(&self.refinement, self.level, f, u, v)
+            .map(|vtx| self.limits.positions[vtx])
     }
 
     /// Whether subd's evaluation of ptex face `(f, sub)` equals the limit of the refined
