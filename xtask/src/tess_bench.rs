@@ -23,8 +23,8 @@ pub fn run(repeats: usize) -> Result<(), String> {
         "uniform limit tessellation: subd tessellate (1 thread) vs OpenSubdiv 3.5 Bfr (approximation level 10); medians of {repeats} runs"
     );
     println!(
-        "{:<14} {:>7} {:>5} {:>10} {:>10} {:>10} {:>7}",
-        "scheme", "faces", "rate", "samples", "bfr s", "subd s", "ratio"
+        "{:<14} {:>7} {:>5} {:>10} {:>10} {:>10} {:>12} {:>7}",
+        "scheme", "faces", "rate", "samples", "bfr s", "subd s", "(setup s)", "ratio"
     );
     for (scheme, mesh) in [
         (Scheme::CatmullClark, quad_bench_mesh()),
@@ -41,25 +41,28 @@ pub fn run(repeats: usize) -> Result<(), String> {
             let line = String::from_utf8_lossy(&out);
             let bfr = json_number(&line, "seconds").ok_or("Bfr bench: no seconds")?;
             let mut times = Vec::new();
+            let mut setups = Vec::new();
             let mut samples = 0;
             for _ in 0..repeats {
                 let t = Instant::now();
                 let ev = LimitEvaluator::new(&mesh.topology, scheme, &options)
                     .map_err(|e| e.to_string())?;
                 let pts = ev.prepare(&mesh.positions);
+                setups.push(t.elapsed().as_secs_f64());
                 let tess = tessellate(&ev, &pts, rate).map_err(|e| e.to_string())?;
                 times.push(t.elapsed().as_secs_f64());
                 samples = tess.positions.len();
             }
             let ours = median(times);
             println!(
-                "{:<14} {:>7} {:>5} {:>10} {:>10.3} {:>10.3} {:>7.2}",
+                "{:<14} {:>7} {:>5} {:>10} {:>10.3} {:>10.3} {:>12.3} {:>7.2}",
                 format!("{scheme:?}"),
                 mesh.topology.num_faces(),
                 rate,
                 samples,
                 bfr,
                 ours,
+                median(setups),
                 ours / bfr
             );
         }

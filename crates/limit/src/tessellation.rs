@@ -13,10 +13,14 @@
 //! boundary is evaluated once, from the first face that reaches it, and shared by index, so
 //! the two sides of an edge hold the same bits and a closed input gives a closed, manifold
 //! output.
-
-use std::collections::HashMap;
+//!
+//! Two passes: the samples are numbered first (serially, by arithmetic on the base vertex,
+//! edge and face indices, each with the parameter of the first face that reaches it), then
+//! evaluated in parallel; each sample's value depends only on its own parameter, so any
+//! number of threads gives the same bits.
 
 use glam::DVec3;
+use rayon::prelude::*;
 use subd_schemes::Scheme;
 
 use crate::LimitError;
@@ -72,21 +76,6 @@ impl Tessellation {
     }
 }
 
-/// What identifies a sample independently of the face that reaches it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-enum Sample {
-    /// A base vertex.
-    Vertex(u32),
-    /// Step `k` of `rate` along base edge `e`, counted from the edge's first vertex.
-    Edge(u32, u32),
-    /// The centre of a non-quad face.
-    Centre(u32),
-    /// Step `k` from the midpoint of side `side` of non-quad face `face` towards its centre.
-    Spoke { face: u32, side: u32, k: u32 },
-    /// Inside face `face` (sub-face `sub`) at grid point (i, j).
-    Inner { face: u32, sub: u32, i: u32, j: u32 },
-}
-
 /// Tessellates the limit surface of `points` (from [`LimitEvaluator::prepare`]) at `rate`.
 ///
 /// # Errors
@@ -132,9 +121,10 @@ pub fn tessellate(
     }
     let mut t = Builder {
         evaluator,
-        points,
         rate: rate as u32,
-        index: HashMap::new(),
+        vertex_index: vec![UNSET; topo.num_vertices()],
+        edge_first: vec![UNSET; topo.num_edges()],
+        params: Vec::new(),
         out: Tessellation {
             positions: Vec::new(),
             normals: Vec::new(),
@@ -151,62 +141,152 @@ pub fn tessellate(
         }
         let n = topo.face_size(f);
         if !catmark {
-            t.triangle(f)?;
+            t.triangle(f);
         } else if n == 4 {
-            t.quad(f)?;
+            t.quad(f);
         } else {
+            // The centre and the n spokes (midpoint of a side to the centre) belong to
+            // this face alone.
+            let m = t.rate / 2;
+            let centre = t.new_sample(FaceParam {
+                face: f,
+                sub: 0,
+                u: 1.0,
+                v: 1.0,
+            });
+            let spokes = t.params.len() as u32;
+            for side in 0..n {
+                for k in 1..m {
+                    // On sub-face `side`, the spoke of side `side` is its line u = 1.
+                    let v = f64::from(k) / f64::from(m);
+                    t.new_sample(FaceParam {
+                        face: f,
+                        sub: side,
+                        u: 1.0,
+                        v,
+                    });
+                }
+            }
             for sub in 0..n {
-                t.sub_face(f, sub)?;
+                t.sub_face(f, sub, centre, spokes);
             }
         }
     }
-    Ok(t.out)
+    let Builder {
+        params, mut out, ..
+    } = t;
+    let evaluated: Result<Vec<(DVec3, DVec3)>, LimitError> = params
+        .par_iter()
+        .map(|&at| {
+            evaluator
+                .evaluate(points, at)
+                .map(|p| (p.position, p.normal()))
+        })
+        .collect();
+    (out.positions, out.normals) = evaluated?.into_iter().unzip();
+    out.params = params;
+    Ok(out)
 }
+
+/// Not numbered yet.
+const UNSET: u32 = u32::MAX;
 
 struct Builder<'a> {
     evaluator: &'a LimitEvaluator,
-    points: &'a PatchPoints,
     rate: u32,
-    index: HashMap<Sample, u32>,
+    /// Each base vertex's sample, once numbered.
+    vertex_index: Vec<u32>,
+    /// The first of each base edge's `rate − 1` inner samples, once numbered.
+    edge_first: Vec<u32>,
+    /// The parameter each sample is evaluated at, by sample index.
+    params: Vec<FaceParam>,
     out: Tessellation,
 }
 
 impl Builder<'_> {
-    /// The output vertex of `sample`, evaluated at `at` the first time it is met.
-    fn vertex(&mut self, sample: Sample, at: FaceParam) -> Result<u32, LimitError> {
-        if let Some(&i) = self.index.get(&sample) {
-            return Ok(i);
-        }
-        let p = self.evaluator.evaluate(self.points, at)?;
-        let i = self.out.positions.len() as u32;
-        self.out.positions.push(p.position);
-        self.out.normals.push(p.normal());
-        self.out.params.push(at);
-        self.index.insert(sample, i);
-        Ok(i)
+    fn new_sample(&mut self, at: FaceParam) -> u32 {
+        self.params.push(at);
+        self.params.len() as u32 - 1
     }
 
-    /// Step `t` of `rate` along the face's side `side` (from corner `side` to `side + 1`).
-    fn on_side(&self, face: usize, side: usize, t: u32) -> Sample {
+    /// The sample at step `t` of `rate` along the face's side `side` (from corner `side` to
+    /// `side + 1`), numbered with this face's parameter if no face reached it before.
+    fn on_side(&mut self, face: usize, side: usize, t: u32) -> u32 {
         let topo = self.evaluator.topology();
         let fv = topo.face_vertices(face);
         let n = fv.len();
         let (a, b) = (fv[side], fv[(side + 1) % n]);
-        if t == 0 {
-            return Sample::Vertex(a);
+        let corner = match t {
+            0 => Some(a),
+            t if t == self.rate => Some(b),
+            _ => None,
+        };
+        if let Some(v) = corner {
+            if self.vertex_index[v as usize] == UNSET {
+                let at = self.side_param(face, side, t);
+                self.vertex_index[v as usize] = self.new_sample(at);
+            }
+            return self.vertex_index[v as usize];
         }
-        if t == self.rate {
-            return Sample::Vertex(b);
-        }
-        let e = topo.face_edges(face)[side];
-        let first = topo.edge_vertices(e as usize)[0];
+        let e = topo.face_edges(face)[side] as usize;
+        let first_vertex = topo.edge_vertices(e)[0];
         // Counted from the edge's first vertex, so both faces of the edge name it alike.
-        let k = if first == a && a != b {
+        let k = if first_vertex == a && a != b {
             t
         } else {
             self.rate - t
         };
-        Sample::Edge(e, k)
+        if self.edge_first[e] == UNSET {
+            // All of the edge's inner samples at once, each with this face's parameter.
+            let first = self.params.len() as u32;
+            self.edge_first[e] = first;
+            for kk in 1..self.rate {
+                let tt = if first_vertex == a && a != b {
+                    kk
+                } else {
+                    self.rate - kk
+                };
+                let p = self.side_param(face, side, tt);
+                self.params.push(p);
+            }
+        }
+        self.edge_first[e] + k - 1
+    }
+
+    /// The parameter of step `t` along side `side` of `face`, in the grid's own integer
+    /// coordinates (so a sample has the same bits whichever way it is reached).
+    fn side_param(&self, face: usize, side: usize, t: u32) -> FaceParam {
+        let n = self.rate;
+        let size = self.evaluator.topology().face_size(face);
+        let param = |sub: usize, i: u32, j: u32, m: u32| FaceParam {
+            face,
+            sub,
+            u: f64::from(i) / f64::from(m),
+            v: f64::from(j) / f64::from(m),
+        };
+        if self.evaluator.scheme == Scheme::Loop {
+            return match side {
+                0 => param(0, t, 0, n),
+                1 => param(0, n - t, t, n),
+                _ => param(0, 0, n - t, n),
+            };
+        }
+        if size == 4 {
+            return match side {
+                0 => param(0, t, 0, n),
+                1 => param(0, n, t, n),
+                2 => param(0, n - t, n, n),
+                _ => param(0, 0, n - t, n),
+            };
+        }
+        // The first half of a side is on sub-face `side` (its u axis), the second half on
+        // sub-face `side + 1` (its v axis, from the far corner).
+        let m = n / 2;
+        if t <= m {
+            param(side, t, 0, m)
+        } else {
+            param((side + 1) % size, 0, n - t, m)
+        }
     }
 
     fn push_face(&mut self, vertices: &[u32]) {
@@ -217,35 +297,27 @@ impl Builder<'_> {
     }
 
     /// A quad: corners 0, 1, 2, 3 at (0,0), (1,0), (1,1), (0,1).
-    fn quad(&mut self, face: usize) -> Result<(), LimitError> {
+    fn quad(&mut self, face: usize) {
         let n = self.rate;
         let mut grid = vec![0u32; ((n + 1) * (n + 1)) as usize];
         for j in 0..=n {
             for i in 0..=n {
-                let sample = match (i, j) {
+                grid[(j * (n + 1) + i) as usize] = match (i, j) {
                     (_, 0) => self.on_side(face, 0, i),
                     (i, _) if i == n => self.on_side(face, 1, j),
                     (_, j) if j == n => self.on_side(face, 2, n - i),
                     (0, _) => self.on_side(face, 3, n - j),
-                    _ => Sample::Inner {
-                        face: face as u32,
+                    _ => self.new_sample(FaceParam {
+                        face,
                         sub: 0,
-                        i,
-                        j,
-                    },
+                        u: f64::from(i) / f64::from(n),
+                        v: f64::from(j) / f64::from(n),
+                    }),
                 };
-                let at = FaceParam {
-                    face,
-                    sub: 0,
-                    u: f64::from(i) / f64::from(n),
-                    v: f64::from(j) / f64::from(n),
-                };
-                grid[(j * (n + 1) + i) as usize] = self.vertex(sample, at)?;
             }
         }
         self.record(face, 0, n, &grid);
         self.grid_quads(&grid, n);
-        Ok(())
     }
 
     fn record(&mut self, face: usize, sub: usize, segments: u32, grid: &[u32]) {
@@ -259,48 +331,34 @@ impl Builder<'_> {
     }
 
     /// Sub-face `sub` of a non-quad: corner `sub` at (0,0), u towards the midpoint of side
-    /// `sub`, v towards the midpoint of side `sub − 1`, the face centre at (1,1).
-    fn sub_face(&mut self, face: usize, sub: usize) -> Result<(), LimitError> {
+    /// `sub`, v towards the midpoint of side `sub − 1`, the face centre at (1,1). `centre`
+    /// and `spokes` are the face's own samples (`spokes`: side by side, `m − 1` each, from
+    /// the side's midpoint inwards).
+    fn sub_face(&mut self, face: usize, sub: usize, centre: u32, spokes: u32) {
         let m = self.rate / 2;
         let sides = self.evaluator.topology().face_size(face);
         let prev = (sub + sides - 1) % sides;
-        let f = face as u32;
+        let spoke = |side: usize, k: u32| spokes + side as u32 * (m - 1) + k - 1;
         let mut grid = vec![0u32; ((m + 1) * (m + 1)) as usize];
         for j in 0..=m {
             for i in 0..=m {
-                let sample = match (i, j) {
-                    (i, j) if i == m && j == m => Sample::Centre(f),
+                grid[(j * (m + 1) + i) as usize] = match (i, j) {
+                    (i, j) if i == m && j == m => centre,
                     (_, 0) => self.on_side(face, sub, i),
                     (0, _) => self.on_side(face, prev, self.rate - j),
-                    (i, _) if i == m => Sample::Spoke {
-                        face: f,
-                        side: sub as u32,
-                        k: j,
-                    },
-                    (_, j) if j == m => Sample::Spoke {
-                        face: f,
-                        side: prev as u32,
-                        k: i,
-                    },
-                    _ => Sample::Inner {
-                        face: f,
-                        sub: sub as u32,
-                        i,
-                        j,
-                    },
+                    (i, _) if i == m => spoke(sub, j),
+                    (_, j) if j == m => spoke(prev, i),
+                    _ => self.new_sample(FaceParam {
+                        face,
+                        sub,
+                        u: f64::from(i) / f64::from(m),
+                        v: f64::from(j) / f64::from(m),
+                    }),
                 };
-                let at = FaceParam {
-                    face,
-                    sub,
-                    u: f64::from(i) / f64::from(m),
-                    v: f64::from(j) / f64::from(m),
-                };
-                grid[(j * (m + 1) + i) as usize] = self.vertex(sample, at)?;
             }
         }
         self.record(face, sub, m, &grid);
         self.grid_quads(&grid, m);
-        Ok(())
     }
 
     fn grid_quads(&mut self, grid: &[u32], n: u32) {
@@ -313,30 +371,23 @@ impl Builder<'_> {
     }
 
     /// A Loop triangle: corners 0, 1, 2 at (0,0), (1,0), (0,1).
-    fn triangle(&mut self, face: usize) -> Result<(), LimitError> {
+    fn triangle(&mut self, face: usize) {
         let n = self.rate;
         let row = |j: u32| (j * (2 * n + 3 - j) / 2) as usize;
         let mut grid = vec![0u32; row(n + 1)];
         for j in 0..=n {
             for i in 0..=(n - j) {
-                let sample = match (i, j) {
+                grid[row(j) + i as usize] = match (i, j) {
                     (_, 0) => self.on_side(face, 0, i),
                     (i, j) if i + j == n => self.on_side(face, 1, j),
                     (0, _) => self.on_side(face, 2, n - j),
-                    _ => Sample::Inner {
-                        face: face as u32,
+                    _ => self.new_sample(FaceParam {
+                        face,
                         sub: 0,
-                        i,
-                        j,
-                    },
+                        u: f64::from(i) / f64::from(n),
+                        v: f64::from(j) / f64::from(n),
+                    }),
                 };
-                let at = FaceParam {
-                    face,
-                    sub: 0,
-                    u: f64::from(i) / f64::from(n),
-                    v: f64::from(j) / f64::from(n),
-                };
-                grid[row(j) + i as usize] = self.vertex(sample, at)?;
             }
         }
         self.record(face, 0, n, &grid);
@@ -349,6 +400,5 @@ impl Builder<'_> {
                 }
             }
         }
-        Ok(())
     }
 }
