@@ -2690,3 +2690,44 @@ fn tessellate_is_watertight_and_checks_its_rate() {
         assert!(!out.exists());
     }
 }
+
+#[test]
+fn batch_progress_bar_on_a_terminal_draws_and_finishes() {
+    let s = Scratch::new("batch-tty");
+    let input = s.0.join("in");
+    std::fs::create_dir_all(&input).unwrap();
+    for name in ["catmark_cube.obj", "catmark_torus.obj"] {
+        std::fs::copy(meshes().join(name), input.join(name)).unwrap();
+    }
+    std::fs::write(input.join("broken.obj"), "v 0 0\n").unwrap();
+    let out_dir = s.0.join("out");
+    let cmd = format!(
+        "{} refine --scheme catmull-clark --levels 5 {} --out-dir {}",
+        env!("CARGO_BIN_EXE_subd"),
+        input.display(),
+        out_dir.display()
+    );
+    let transcript = s.0.join("transcript.txt");
+    let status = Command::new("script")
+        .args(["-qec", &cmd, transcript.to_str().unwrap()])
+        .stdin(std::process::Stdio::null())
+        .stdout(std::process::Stdio::null())
+        .status()
+        .expect("`script` (util-linux) runs the command on a pseudo-terminal");
+    // `script -e` passes on the command's exit code: 2, one file failed.
+    assert_eq!(status.code(), Some(2));
+    let seen = String::from_utf8_lossy(&std::fs::read(&transcript).unwrap()).into_owned();
+    assert!(seen.contains("files"), "the bar counts files: {seen}");
+    assert!(
+        seen.contains("broken.obj"),
+        "the failed file's line: {seen}"
+    );
+    assert!(
+        seen.contains("refine: 2 of 3 files done, 1 failed"),
+        "{seen}"
+    );
+    assert_eq!(
+        file_names(&out_dir),
+        ["catmark_cube.obj", "catmark_torus.obj"]
+    );
+}

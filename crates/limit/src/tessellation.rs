@@ -402,3 +402,33 @@ impl Builder<'_> {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use subd_schemes::Options;
+
+    #[test]
+    fn one_thread_gives_the_same_bits_as_many() {
+        let mesh = subd_mesh::primitives::torus_with_hexagons(12, 8, 4, 3.0, 1.0);
+        let ev =
+            LimitEvaluator::new(&mesh.topology, Scheme::CatmullClark, &Options::default()).unwrap();
+        let pts = ev.prepare(&mesh.positions);
+        let many = tessellate(&ev, &pts, 6).unwrap();
+        let one = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap()
+            .install(|| tessellate(&ev, &pts, 6).unwrap());
+        assert_eq!(many.positions, one.positions);
+        assert_eq!(many.normals, one.normals);
+        assert_eq!(many.face_vertices, one.face_vertices);
+        // Every sample of every grid is an output vertex at its own parameter.
+        for g in &many.grids {
+            let v = many.grid_vertex(g, false, 0, 0) as usize;
+            let at = many.params[v];
+            let p = ev.evaluate(&pts, at).unwrap().position;
+            assert_eq!(p, many.positions[v]);
+        }
+    }
+}
