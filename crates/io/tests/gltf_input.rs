@@ -275,3 +275,34 @@ fn number_spans(text: &str) -> Vec<(usize, usize)> {
     }
     spans
 }
+
+#[test]
+fn a_gltf_with_an_external_buffer_reads_it_beside_the_document() {
+    let doc = split_cube_gltf(r#"{"mesh": 0}"#);
+    // Move the data-URI buffer into a file named with a space (percent-encoded in the URI).
+    let start = doc.find("data:application/octet-stream;base64,").unwrap();
+    let end = start + doc[start..].find('"').unwrap();
+    let payload = &doc[start + "data:application/octet-stream;base64,".len()..end];
+    let bytes = base64::engine::general_purpose::STANDARD
+        .decode(payload)
+        .unwrap();
+    let dir = std::env::temp_dir().join(format!("subd-gltf-ext-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("cube data.bin"), &bytes).unwrap();
+    let external = format!("{}cube%20data.bin{}", &doc[..start], &doc[end..]);
+    let path = dir.join("cube.gltf");
+    std::fs::write(&path, &external).unwrap();
+    let file = subd_io::read_mesh(&path, &ReadOptions::default()).unwrap();
+    assert_eq!(file.mesh.topology.num_vertices(), 8);
+    // Without the directory (bytes only) the external file cannot be found: a typed error.
+    let e = parse_mesh(external.as_bytes(), Format::Gltf, &ReadOptions::default()).unwrap_err();
+    assert!(
+        e.to_string().contains("needs the document's directory"),
+        "{e}"
+    );
+    // A missing file names it.
+    std::fs::remove_file(dir.join("cube data.bin")).unwrap();
+    let e = subd_io::read_mesh(&path, &ReadOptions::default()).unwrap_err();
+    assert!(e.to_string().contains("cube data.bin"), "{e}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
