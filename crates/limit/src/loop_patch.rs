@@ -193,6 +193,20 @@ impl BoxSpline {
         w
     }
 
+    /// Position and first derivatives of the regular patch over `cp` at (u, v): half of
+    /// [`Self::evaluate`]'s work, for callers that need no second derivatives.
+    pub fn evaluate_first(&self, cp: &[DVec3; 12], u: f64, v: f64) -> (DVec3, DVec3, DVec3) {
+        let m = monomials(u, v);
+        let mut out = [DVec3::ZERO; 3];
+        for (k, p) in cp.iter().enumerate() {
+            for (d, o) in out.iter_mut().enumerate() {
+                let w: f64 = self.coeffs[k].iter().zip(&m[d]).map(|(c, x)| c * x).sum();
+                *o += w * *p;
+            }
+        }
+        (out[0], out[1], out[2])
+    }
+
     /// The regular patch over control points `cp` (corner-patch order, n = 6) at (u, v).
     pub fn evaluate(&self, cp: &[DVec3], u: f64, v: f64) -> SurfacePoint {
         let w = self.weights(u, v);
@@ -599,6 +613,27 @@ mod tests {
             let e = b.evaluate(&cp, u, v);
             assert!((a.position - e.position).length() < 1e-12, "({u},{v})");
             assert!((a.du - e.du).length() < 1e-9, "({u},{v})");
+        }
+    }
+}
+
+#[cfg(test)]
+mod first_derivative_tests {
+    use super::*;
+
+    #[test]
+    fn first_derivatives_equal_the_full_evaluation() {
+        let basis = box_spline().unwrap();
+        let cp: [DVec3; 12] = std::array::from_fn(|k| {
+            let x = k as f64;
+            DVec3::new((0.9 * x).sin(), (1.7 * x).cos(), 0.05 * x * x)
+        });
+        for &(u, v) in &[(0.0, 0.0), (0.2, 0.3), (1.0, 0.0), (0.4, 0.6)] {
+            let full = basis.evaluate(&cp, u, v);
+            let (p, du, dv) = basis.evaluate_first(&cp, u, v);
+            assert!((p - full.position).length() < 1e-14);
+            assert!((du - full.du).length() < 1e-13);
+            assert!((dv - full.dv).length() < 1e-13);
         }
     }
 }

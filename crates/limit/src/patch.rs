@@ -117,6 +117,24 @@ pub fn eval_bicubic(grid: &[DVec3; 16], u: f64, v: f64) -> SurfacePoint {
     }
 }
 
+/// Position and first derivatives of the bicubic B-spline patch over `grid[4 j + i]` at
+/// (u, v), summed row by row (the tensor product split in two): a third of
+/// [`eval_bicubic`]'s work, for callers that need no second derivatives.
+pub fn eval_bicubic_first(grid: &[DVec3; 16], u: f64, v: f64) -> (DVec3, DVec3, DVec3) {
+    let (bu, du, _) = bspline_basis(u);
+    let (bv, dv, _) = bspline_basis(v);
+    let (mut p, mut pu, mut pv) = (DVec3::ZERO, DVec3::ZERO, DVec3::ZERO);
+    for j in 0..4 {
+        let row = &grid[4 * j..4 * j + 4];
+        let r = bu[0] * row[0] + bu[1] * row[1] + bu[2] * row[2] + bu[3] * row[3];
+        let ru = du[0] * row[0] + du[1] * row[1] + du[2] * row[2] + du[3] * row[3];
+        p += bv[j] * r;
+        pu += bv[j] * ru;
+        pv += dv[j] * r;
+    }
+    (p, pu, pv)
+}
+
 /// The ring of interior manifold vertex `v` starting at face `f`: for each incident face in
 /// counter-clockwise order, the face's vertices after `v` (so `[next, …, previous]`). `None`
 /// unless every face around `v` has `K + 1` vertices, `v` is interior and manifold, and `f`
@@ -392,5 +410,25 @@ mod tests {
             ],
             [0, 1, 2, 3]
         );
+    }
+}
+
+#[cfg(test)]
+mod first_derivative_tests {
+    use super::*;
+
+    #[test]
+    fn row_by_row_equals_the_full_tensor_product() {
+        let grid: [DVec3; 16] = std::array::from_fn(|k| {
+            let x = k as f64;
+            DVec3::new((1.3 * x).sin(), (0.7 * x).cos() * 2.0, x * x * 0.01)
+        });
+        for &(u, v) in &[(0.0, 0.0), (0.3, 0.8), (1.0, 0.25), (0.5, 1.0)] {
+            let full = eval_bicubic(&grid, u, v);
+            let (p, du, dv) = eval_bicubic_first(&grid, u, v);
+            assert!((p - full.position).length() < 1e-14);
+            assert!((du - full.du).length() < 1e-13);
+            assert!((dv - full.dv).length() < 1e-13);
+        }
     }
 }
