@@ -202,7 +202,7 @@ where
         // Streams are written here only, whole file at a time, so lines never interleave.
         for outcome in rx {
             let job = &jobs[outcome.index];
-            bar.finished(job);
+            bar.finished(outcome.index);
             bar.suspend(|| {
                 let _ = err.write_all(&outcome.stderr);
                 if let Some(f) = &outcome.failure {
@@ -336,6 +336,8 @@ fn collect_meshes(dir: &Path, found: &mut Vec<PathBuf>) -> std::io::Result<()> {
 /// last; drawn only on a terminal and never with `--json`.
 struct FilesBar {
     bar: Option<indicatif::ProgressBar>,
+    /// Each file's size, read once (for the bar only).
+    sizes: Vec<u64>,
     done: AtomicUsize,
     total: usize,
 }
@@ -346,12 +348,16 @@ impl FilesBar {
         if json || !std::io::stderr().is_terminal() {
             return FilesBar {
                 bar: None,
+                sizes: Vec::new(),
                 done: AtomicUsize::new(0),
                 total,
             };
         }
-        let bytes: u64 = jobs.iter().map(|j| file_size(&j.input)).sum();
-        let bar = indicatif::ProgressBar::new(bytes);
+        let sizes: Vec<u64> = jobs
+            .iter()
+            .map(|j| std::fs::metadata(&j.input).map_or(0, |m| m.len()))
+            .collect();
+        let bar = indicatif::ProgressBar::new(sizes.iter().sum());
         bar.set_style(
             indicatif::ProgressStyle::with_template(
                 "[{bar:30}] {binary_bytes}/{binary_total_bytes} {prefix} {wide_msg}",
@@ -362,6 +368,7 @@ impl FilesBar {
         bar.enable_steady_tick(std::time::Duration::from_millis(100));
         FilesBar {
             bar: Some(bar),
+            sizes,
             done: AtomicUsize::new(0),
             total,
         }
@@ -373,10 +380,11 @@ impl FilesBar {
         }
     }
 
-    fn finished(&self, job: &Job) {
+    /// Job `index` is done.
+    fn finished(&self, index: usize) {
         let done = self.done.fetch_add(1, Ordering::Relaxed) + 1;
         if let Some(b) = &self.bar {
-            b.inc(file_size(&job.input));
+            b.inc(self.sizes[index]);
             b.set_prefix(format!("{done}/{} files", self.total));
         }
     }
@@ -394,8 +402,4 @@ impl FilesBar {
             b.finish_and_clear();
         }
     }
-}
-
-fn file_size(path: &Path) -> u64 {
-    std::fs::metadata(path).map_or(0, |m| m.len())
 }

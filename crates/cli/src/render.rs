@@ -205,19 +205,11 @@ pub(crate) fn run(
             None,
         )
     } else {
-        let topo = base;
-        let mut offsets = Vec::with_capacity(topo.num_faces() + 1);
-        offsets.push(0u32);
-        let mut vertices = Vec::new();
-        for f in 0..topo.num_faces() {
-            vertices.extend_from_slice(topo.face_vertices(f));
-            offsets.push(vertices.len() as u32);
-        }
-        let holes = topo.tags().holes().to_vec();
+        let holes = base.tags().holes().to_vec();
         let levels = file.face_levels.as_deref();
         surface(
-            offsets,
-            vertices,
+            base.face_offsets().to_vec(),
+            base.all_face_vertices().to_vec(),
             holes,
             file.mesh.positions.clone(),
             None,
