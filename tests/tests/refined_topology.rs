@@ -265,3 +265,91 @@ fn last_level_from_its_grandparent_equals_the_built_path() {
         "no Loop case: {fused:?}"
     );
 }
+
+/// The last level streamed a range at a time (faces from the level above or its
+/// grandparent, points from the level above) is, bit for bit, the level held whole, on
+/// every shape with every scheme that applies and the two-phase scheme, in windows that
+/// split parent faces.
+#[test]
+fn last_level_streams_equal_the_held_level() {
+    use subd_mesh::DVec3;
+    let opts = ReadOptions {
+        accept_inconsistent_orientation: true,
+        ..Default::default()
+    };
+    let (mut cases, mut from_grandparent, mut with_holes) = (0, 0, 0);
+    for path in osd_meshes() {
+        let name = path.file_stem().unwrap().to_string_lossy().to_string();
+        let file = read_mesh(&path, &opts).unwrap();
+        let base = &file.mesh.topology;
+        if base.num_face_vertices() > 8000 {
+            continue;
+        }
+        let triangles = (0..base.num_faces()).all(|f| base.face_size(f) == 3);
+        let quads = (0..base.num_faces()).all(|f| base.face_size(f) == 4);
+        let schemes: &[Scheme] = if triangles {
+            &[Scheme::Loop, Scheme::CatmullClark, Scheme::Bilinear]
+        } else {
+            &[Scheme::CatmullClark, Scheme::Bilinear]
+        };
+        let options = Options::from_hints(&file.mesh.hints);
+        let mut runs: Vec<(Scheme, bool)> = schemes.iter().map(|&s| (s, false)).collect();
+        if quads {
+            runs.push((Scheme::CatmullClark, true));
+        }
+        for (scheme, two_phase) in runs {
+            for levels in 1..=3 {
+                let refine = || match two_phase {
+                    true => {
+                        let tp = subd_schemes::TwoPhase::uniform(base.num_vertices(), 0.6).unwrap();
+                        Refinement::two_phase(base, &tp, &options, levels).unwrap()
+                    }
+                    false => Refinement::new(base, scheme, &options, levels).unwrap(),
+                };
+                let (streamed, held) = (refine(), refine());
+                let what = format!("{name} {scheme:?} two-phase {two_phase} L{levels}");
+                from_grandparent += usize::from(!streamed.has_topology(levels - 1));
+                let faces = streamed.face_stream().unwrap();
+                let above = streamed.points_at(&file.mesh.positions, levels - 1);
+                let points = streamed.point_stream(&above).unwrap();
+                // Windows of 7 faces and 5 points cut through the children of parent faces.
+                let mut got_faces = Vec::new();
+                let n = faces.num_faces();
+                for start in (0..n).step_by(7) {
+                    faces.fill(start..(start + 7).min(n), &mut got_faces);
+                }
+                let mut got_points = vec![DVec3::ZERO; points.len()];
+                for (i, chunk) in got_points.chunks_mut(5).enumerate() {
+                    points.fill(5 * i, chunk);
+                }
+                let (offsets, vertices) = held.faces(levels);
+                assert_eq!(n, offsets.len() - 1, "{what} face count");
+                assert!(
+                    offsets
+                        .windows(2)
+                        .all(|w| (w[1] - w[0]) as usize == faces.face_size()),
+                    "{what} face size"
+                );
+                assert_eq!(got_faces, vertices, "{what} faces");
+                let holes: Vec<usize> = (0..n).filter(|&f| held.holes(levels)[f]).collect();
+                with_holes += usize::from(!holes.is_empty());
+                assert_eq!(faces.hole_faces(), holes, "{what} holes");
+                let all = held.refine_points(&file.mesh.positions);
+                assert_eq!(above, all[levels - 1], "{what} level above");
+                assert_eq!(got_points, all[levels], "{what} points");
+                // Streaming built no level the held path did not.
+                assert!(
+                    !streamed.has_topology(levels),
+                    "{what}: the streamed level stays unbuilt"
+                );
+                cases += 1;
+            }
+        }
+    }
+    assert!(cases > 300, "{cases} cases");
+    assert!(
+        from_grandparent > 10,
+        "{from_grandparent} from the grandparent"
+    );
+    assert!(with_holes > 3, "{with_holes} with holes");
+}

@@ -118,6 +118,10 @@ pub(crate) fn parse_size(s: &str) -> Result<u64, String> {
 pub(crate) struct PeakModel {
     /// Bytes per output vertex.
     per_vertex: u64,
+    /// Bytes per output vertex when the output level is streamed to the file from the level
+    /// above (OpenSubdiv's schemes without `--limit`): the level above's topology, its
+    /// points and the output level's face points.
+    streamed_per_vertex: Option<u64>,
     /// Bytes per output vertex that `--limit` adds (the output level's limit stencils).
     limit_per_vertex: u64,
 }
@@ -128,17 +132,22 @@ const FIXED_BYTES: u64 = 24 << 20;
 const PER_INPUT_BYTE: u64 = 4;
 /// A `.glb` writer's f32 position, normal and index arrays, per output vertex.
 const GLB_PER_VERTEX: u64 = 24;
+/// A streamed `.glb`'s positions and vertex normals, held whole (the normals sum every
+/// face around a vertex), per output vertex.
+const STREAMED_GLB_PER_VERTEX: u64 = 50;
 
 impl PeakModel {
     /// OpenSubdiv's schemes (and the two-phase scheme, Catmull-Clark's after level 1).
     pub(crate) fn osd(scheme: subd_schemes::Scheme) -> PeakModel {
         use subd_schemes::Scheme;
-        let per_vertex = match scheme {
-            Scheme::CatmullClark => 90,
-            Scheme::Loop | Scheme::Bilinear => 120,
+        let (per_vertex, streamed) = match scheme {
+            Scheme::CatmullClark => (105, 70),
+            Scheme::Bilinear => (120, 70),
+            Scheme::Loop => (120, 90),
         };
         PeakModel {
             per_vertex,
+            streamed_per_vertex: Some(streamed),
             limit_per_vertex: 1150,
         }
     }
@@ -153,6 +162,7 @@ impl PeakModel {
         };
         PeakModel {
             per_vertex,
+            streamed_per_vertex: None,
             limit_per_vertex: 2800,
         }
     }
@@ -160,9 +170,14 @@ impl PeakModel {
     /// The estimated peak of refining to the level of `last` from a file of `file_bytes`,
     /// writing `.glb` or not, with `--limit` or not.
     pub(crate) fn peak(self, file_bytes: u64, last: LevelCounts, glb: bool, limit: bool) -> u64 {
-        let per_vertex = self.per_vertex
-            + if glb { GLB_PER_VERTEX } else { 0 }
-            + if limit { self.limit_per_vertex } else { 0 };
+        let per_vertex = match self.streamed_per_vertex {
+            Some(s) if !limit => s + if glb { STREAMED_GLB_PER_VERTEX } else { 0 },
+            _ => {
+                self.per_vertex
+                    + if glb { GLB_PER_VERTEX } else { 0 }
+                    + if limit { self.limit_per_vertex } else { 0 }
+            }
+        };
         FIXED_BYTES
             .saturating_add(PER_INPUT_BYTE.saturating_mul(file_bytes))
             .saturating_add(per_vertex.saturating_mul(last.vertices))

@@ -22,6 +22,7 @@ mod edit;
 mod eval;
 mod failure;
 mod info;
+mod level_stream;
 mod limit;
 mod pia;
 mod progress;

@@ -249,7 +249,7 @@ fn run_one(
         return Err(bad("--tension applies to --scheme butterfly only".into()));
     }
     let tension = crate::rule_args::butterfly_tension(args.tension)?;
-    let file = subd_io::read_mesh(&job.input, &args.rules.read_options())?;
+    let mut file = subd_io::read_mesh(&job.input, &args.rules.read_options())?;
     print_warnings(err, &job.input, &file.warnings);
     let t_read = t_start.elapsed().as_secs_f64();
     let options = args.rules.options(&file.mesh.hints);
@@ -271,65 +271,93 @@ fn run_one(
     let in_file = |e: &dyn std::fmt::Display| bad(format!("{}: {e}", job.input.display()));
     let refinement = Refined::new(base, &chosen, two_phase.as_ref(), &options, args.levels)
         .map_err(|e| in_file(&e))?;
+    let input_counts = Counts {
+        vertices: base.num_vertices(),
+        edges: Some(base.num_edges()),
+        faces: base.num_faces(),
+    };
+    // The refinement holds its own copy of the base level: the file's is not needed again.
+    if let Ok(empty) = subd_mesh::TopologyBuilder::new(0).build(&[], &[]) {
+        file.mesh.topology = empty;
+    }
     progress.step("topology");
     let t_topology = t0.elapsed().as_secs_f64();
     let t1 = Instant::now();
-    let mut positions = refinement.last_positions(&file.mesh.positions);
-    let normals = if args.limit {
-        let limit = output_limit(
-            &refinement,
-            args.levels,
-            two_phase.as_ref(),
-            &options,
-            &positions,
-        )
-        .map_err(|e| in_file(&e))?;
-        positions = limit.positions;
-        Some(limit.normals)
-    } else {
-        None
-    };
-    progress.step("positions");
-    let t_positions = t1.elapsed().as_secs_f64();
-
-    let t2 = Instant::now();
-    // OpenSubdiv's rule options are recorded only for its schemes.
     let osd = matches!(chosen, Chosen::Osd(_));
-    let hints = if osd {
-        SchemeHints {
-            boundary_interpolation: Some(options.boundary_interpolation),
-            crease_method: Some(options.crease_method),
-            triangle_subdivision: file
-                .mesh
-                .hints
-                .triangle_subdivision
-                .or(args.rules.triangles.map(|_| options.triangle_subdivision)),
-        }
-    } else {
-        SchemeHints::default()
+    let hints = output_hints(osd, &options, &file.mesh.hints, &args.rules);
+    let in_view = |e: subd_io::ViewError| bad(format!("{}: {e}", job.input.display()));
+    let streams = match &refinement {
+        Refined::Osd(r) if !args.limit && args.levels > 0 => Some(r),
+        _ => None,
     };
-    // Polygons, holes and the tags a reader cannot infer are all the file holds: they are
-    // written without building the output level's edges (most of the time and memory of a
-    // deep refinement's output).
-    let (offsets, vertices) = refinement.faces(args.levels);
-    let tags = refinement.explicit_tags(args.levels);
-    let holes = refinement.holes(args.levels);
-    let mut view = subd_io::MeshView::new(&positions, offsets, vertices, &holes)
-        .and_then(|v| v.with_tags(tags.creases, tags.corners))
-        .map_err(|e| bad(format!("{}: {e}", job.input.display())))?;
-    let filled;
-    if let Some(n) = &normals {
-        filled = normals_or_faces(n, &view);
-        view = view
-            .with_normals(&filled)
-            .map_err(|e| bad(format!("{}: {e}", job.input.display())))?;
-    }
-    view.hints = hints;
-    subd_io::write_view(&job.output, &view, &subd_io::WriteOptions::default())?;
-    let out_counts = Counts {
-        vertices: positions.len(),
-        edges: refinement.num_edges(args.levels),
-        faces: view.num_faces(),
+    let (out_counts, t_positions, t2) = if let Some(r) = streams {
+        // The last level straight to the file, a window at a time, from the level above.
+        let above = r.points_at(&file.mesh.positions, args.levels - 1);
+        let points = crate::level_stream::Points(r.point_stream(&above).expect("levels > 0"));
+        let faces = crate::level_stream::Faces(r.face_stream().expect("levels > 0"));
+        // `.glb` normals need every position at hand.
+        let held = (subd_io::Format::for_output(&job.output) == Some(subd_io::Format::Glb))
+            .then(|| points.all());
+        progress.step("positions");
+        let t_positions = t1.elapsed().as_secs_f64();
+        let t2 = Instant::now();
+        let source = match &held {
+            Some(p) => subd_io::Points::Held(p),
+            None => subd_io::Points::Streamed(&points),
+        };
+        let tags = refinement.explicit_tags(args.levels);
+        let mut view = subd_io::MeshView::streamed(source, &faces, faces.0.hole_faces())
+            .and_then(|v| v.with_tags(tags.creases, tags.corners))
+            .map_err(in_view)?;
+        view.hints = hints;
+        subd_io::write_view(&job.output, &view, &subd_io::WriteOptions::default())?;
+        let counts = Counts {
+            vertices: view.num_vertices(),
+            edges: refinement.num_edges(args.levels),
+            faces: view.num_faces(),
+        };
+        (counts, t_positions, t2)
+    } else {
+        let mut positions = refinement.last_positions(&file.mesh.positions);
+        let normals = if args.limit {
+            let limit = output_limit(
+                &refinement,
+                args.levels,
+                two_phase.as_ref(),
+                &options,
+                &positions,
+            )
+            .map_err(|e| in_file(&e))?;
+            positions = limit.positions;
+            Some(limit.normals)
+        } else {
+            None
+        };
+        progress.step("positions");
+        let t_positions = t1.elapsed().as_secs_f64();
+        let t2 = Instant::now();
+        // Polygons, holes and the tags a reader cannot infer are all the file holds: they
+        // are written without building the output level's edges (most of the time and
+        // memory of a deep refinement's output).
+        let (offsets, vertices) = refinement.faces(args.levels);
+        let tags = refinement.explicit_tags(args.levels);
+        let holes = refinement.holes(args.levels);
+        let mut view = subd_io::MeshView::new(&positions, offsets, vertices, &holes)
+            .and_then(|v| v.with_tags(tags.creases, tags.corners))
+            .map_err(in_view)?;
+        let filled;
+        if let Some(n) = &normals {
+            filled = normals_or_faces(n, &view);
+            view = view.with_normals(&filled).map_err(in_view)?;
+        }
+        view.hints = hints;
+        subd_io::write_view(&job.output, &view, &subd_io::WriteOptions::default())?;
+        let counts = Counts {
+            vertices: positions.len(),
+            edges: refinement.num_edges(args.levels),
+            faces: view.num_faces(),
+        };
+        (counts, t_positions, t2)
     };
     progress.finish();
     let t_write = t2.elapsed().as_secs_f64();
@@ -348,11 +376,7 @@ fn run_one(
             crease_method: osd.then_some(options.crease_method),
             triangle_subdivision: osd.then_some(options.triangle_subdivision),
             limit: args.limit,
-            input_counts: Counts {
-                vertices: base.num_vertices(),
-                edges: Some(base.num_edges()),
-                faces: base.num_faces(),
-            },
+            input_counts,
             output_counts: out_counts,
             seconds: Timings {
                 read: t_read,
@@ -366,6 +390,26 @@ fn run_one(
         crate::print_json(out, &report);
     }
     Ok(())
+}
+
+/// The scheme hints a refined file records: OpenSubdiv's rule options, for its schemes
+/// only.
+fn output_hints(
+    osd: bool,
+    options: &subd_schemes::Options,
+    read: &SchemeHints,
+    rules: &RuleArgs,
+) -> SchemeHints {
+    if !osd {
+        return SchemeHints::default();
+    }
+    SchemeHints {
+        boundary_interpolation: Some(options.boundary_interpolation),
+        crease_method: Some(options.crease_method),
+        triangle_subdivision: read
+            .triangle_subdivision
+            .or(rules.triangles.map(|_| options.triangle_subdivision)),
+    }
 }
 
 /// Refuses the request if its estimated peak memory is over the budget (see

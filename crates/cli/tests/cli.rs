@@ -2540,7 +2540,7 @@ fn requests_over_the_memory_budget_are_refused_not_aborted() {
     assert_eq!(code, 2, "{err}");
     assert!(
         err.starts_with(&format!("subd: {torus}: refining 6 levels needs about "))
-            && err.contains("over the budget of 30.0 MiB (--max-memory); --levels 4 fits"),
+            && err.contains("over the budget of 30.0 MiB (--max-memory); --levels 5 fits"),
         "{err}"
     );
     assert_eq!(err.lines().count(), 1, "{err}");
@@ -2551,7 +2551,7 @@ fn requests_over_the_memory_budget_are_refused_not_aborted() {
         "--scheme",
         "catmull-clark",
         "--levels",
-        "4",
+        "5",
         "--max-memory",
         "30M",
         torus,

@@ -14,29 +14,48 @@ use json::validation::USize64;
 use rayon::prelude::*;
 use subd_mesh::DVec3;
 
-use crate::records::write_records;
+use crate::records::{for_each_windowed, write_records, write_windows};
 use crate::view::MeshView;
 
-/// Area-weighted vertex normals (Newell's method per polygon, hole faces skipped).
+/// Area-weighted vertex normals (Newell's method per polygon, hole faces skipped). Needs
+/// every position at hand: streamed positions ([`crate::Points::Streamed`]) are made
+/// whole first.
 pub fn vertex_normals(mesh: &MeshView<'_>) -> Vec<DVec3> {
-    let positions = mesh.positions();
+    let made;
+    let positions = match mesh.positions() {
+        Some(p) => p,
+        None => {
+            made = mesh
+                .point_window(0..mesh.num_vertices())
+                .map(|w| w.points().to_vec())
+                .unwrap_or_else(|_| vec![DVec3::ZERO; mesh.num_vertices()]);
+            &made[..]
+        }
+    };
     let mut normals = vec![DVec3::ZERO; positions.len()];
-    for f in 0..mesh.num_faces() {
-        if mesh.is_hole(f) {
-            continue;
-        }
-        let fv = mesh.face_vertices(f);
-        let mut n = DVec3::ZERO;
-        for i in 0..fv.len() {
-            let a = positions[fv[i] as usize];
-            let b = positions[fv[(i + 1) % fv.len()] as usize];
-            n += a.cross(b);
-        }
-        // `n` is twice the vector area: weighting by it gives area weighting.
-        for &v in fv {
-            normals[v as usize] += n;
-        }
-    }
+    // Faces in order, serially: the sums (and so the bits) do not depend on threads. A
+    // streamed face naming a vertex beyond the positions ends the walk early (nothing is
+    // indexed out of range); the writer reports it when it reaches the same window.
+    let _ = for_each_windowed(
+        mesh.num_faces(),
+        |r| mesh.face_window(r),
+        |faces, f| {
+            if mesh.is_hole(f) {
+                return;
+            }
+            let fv = faces.face(f);
+            let mut n = DVec3::ZERO;
+            for i in 0..fv.len() {
+                let a = positions[fv[i] as usize];
+                let b = positions[fv[(i + 1) % fv.len()] as usize];
+                n += a.cross(b);
+            }
+            // `n` is twice the vector area: weighting by it gives area weighting.
+            for &v in fv {
+                normals[v as usize] += n;
+            }
+        },
+    );
     normals
         .par_iter_mut()
         .with_min_len(4096)
@@ -44,23 +63,28 @@ pub fn vertex_normals(mesh: &MeshView<'_>) -> Vec<DVec3> {
     normals
 }
 
-fn bounds(values: &[DVec3]) -> (json::Value, json::Value) {
+/// Per-axis bounds of the `f32` positions, as glTF's accessor `min` and `max`.
+fn bounds(mesh: &MeshView<'_>) -> std::io::Result<(json::Value, json::Value)> {
     let mut lo = [f32::INFINITY; 3];
     let mut hi = [f32::NEG_INFINITY; 3];
-    for p in values {
-        for (k, c) in to_f32(p).into_iter().enumerate() {
-            lo[k] = lo[k].min(c);
-            hi[k] = hi[k].max(c);
-        }
-    }
-    if values.is_empty() {
+    for_each_windowed(
+        mesh.num_vertices(),
+        |r| mesh.point_window(r),
+        |points, i| {
+            for (k, c) in to_f32(&points.get(i)).into_iter().enumerate() {
+                lo[k] = lo[k].min(c);
+                hi[k] = hi[k].max(c);
+            }
+        },
+    )?;
+    if mesh.num_vertices() == 0 {
         lo = [0.0; 3];
         hi = [0.0; 3];
     }
-    (
+    Ok((
         json::Value::from(lo.to_vec()),
         json::Value::from(hi.to_vec()),
-    )
+    ))
 }
 
 fn to_f32(p: &DVec3) -> [f32; 3] {
@@ -70,18 +94,19 @@ fn to_f32(p: &DVec3) -> [f32; 3] {
 /// Writes `mesh` as a binary glTF 2.0 file. The arrays are encoded by all threads straight
 /// into the output, so besides the normals nothing the size of the mesh is held.
 pub fn write_glb(w: &mut dyn Write, mesh: &MeshView<'_>) -> std::io::Result<()> {
-    let positions = mesh.positions();
+    let nv = mesh.num_vertices();
+    let computed;
     let normals = match mesh.normals() {
-        Some(n) => n.to_vec(),
-        None => vertex_normals(mesh),
+        Some(n) => n,
+        None => {
+            computed = vertex_normals(mesh);
+            &computed[..]
+        }
     };
-    let num_indices: usize = (0..mesh.num_faces())
-        .filter(|&f| !mesh.is_hole(f))
-        .map(|f| 3 * (mesh.face_vertices(f).len() - 2))
-        .sum();
+    let num_indices = 3 * mesh.num_fan_triangles();
 
     // Every element is 4 bytes, so the BIN chunk needs no padding.
-    let vec3_len = positions.len() * 12;
+    let vec3_len = nv * 12;
     let bin_len = 2 * vec3_len + num_indices * 4;
 
     let mut root = json::Root {
@@ -149,10 +174,10 @@ pub fn write_glb(w: &mut dyn Write, mesh: &MeshView<'_>) -> std::io::Result<()> 
     let pos_acc = accessor(
         &mut root,
         pos_view,
-        positions.len(),
+        nv,
         C::F32,
         T::Vec3,
-        Some(bounds(positions)),
+        Some(bounds(mesh)?),
     );
     let nrm_acc = accessor(&mut root, nrm_view, normals.len(), C::F32, T::Vec3, None);
     let idx_acc = accessor(&mut root, idx_view, num_indices, C::U32, T::Scalar, None);
@@ -208,23 +233,36 @@ pub fn write_glb(w: &mut dyn Write, mesh: &MeshView<'_>) -> std::io::Result<()> 
     w.write_all(&json_padded)?;
     w.write_all(&(bin_len as u32).to_le_bytes())?;
     w.write_all(b"BIN\0")?;
-    for vectors in [positions, &normals[..]] {
-        write_records(w, vectors.len(), |i, b| {
-            for c in to_f32(&vectors[i]) {
+    write_windows(
+        w,
+        nv,
+        |r| mesh.point_window(r),
+        |points, i, b| {
+            for c in to_f32(&points.get(i)) {
                 b.extend_from_slice(&c.to_le_bytes());
             }
-        })?;
-    }
+        },
+    )?;
+    write_records(w, normals.len(), |i, b| {
+        for c in to_f32(&normals[i]) {
+            b.extend_from_slice(&c.to_le_bytes());
+        }
+    })?;
     // Polygons as fans from their first corner.
-    write_records(w, mesh.num_faces(), |f, b| {
-        if mesh.is_hole(f) {
-            return;
-        }
-        let fv = mesh.face_vertices(f);
-        for i in 1..fv.len() - 1 {
-            for v in [fv[0], fv[i], fv[i + 1]] {
-                b.extend_from_slice(&v.to_le_bytes());
+    write_windows(
+        w,
+        mesh.num_faces(),
+        |r| mesh.face_window(r),
+        |faces, f, b| {
+            if mesh.is_hole(f) {
+                return;
             }
-        }
-    })
+            let fv = faces.face(f);
+            for i in 1..fv.len() - 1 {
+                for v in [fv[0], fv[i], fv[i + 1]] {
+                    b.extend_from_slice(&v.to_le_bytes());
+                }
+            }
+        },
+    )
 }

@@ -35,7 +35,7 @@ use std::path::Path;
 pub use error::{IoError, ReadError};
 pub use ply::PlyEncoding;
 use subd_mesh::Mesh;
-pub use view::{MeshView, ViewError};
+pub use view::{FaceSource, MeshView, PointSource, Points, ViewError};
 
 /// A mesh file format.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -24,7 +24,7 @@ use subd_mesh::{
 };
 
 use crate::error::ReadError;
-use crate::records::write_records;
+use crate::records::{write_records, write_windows};
 use crate::view::MeshView;
 use crate::{MeshFile, ReadOptions};
 
@@ -445,18 +445,22 @@ pub fn write_obj(
     mesh: &MeshView<'_>,
     extra_tags: &[String],
 ) -> std::io::Result<()> {
-    let positions = mesh.positions();
     writeln!(w, "# written by subd {}", env!("CARGO_PKG_VERSION"))?;
     writeln!(
         w,
         "# {} vertices, {} faces; tag indices are 0-based (OpenSubdiv shape convention)",
-        positions.len(),
+        mesh.num_vertices(),
         mesh.num_faces()
     )?;
-    write_records(w, positions.len(), |i, b| {
-        let p = positions[i];
-        let _ = writeln!(b, "v {} {} {}", p.x, p.y, p.z);
-    })?;
+    write_windows(
+        w,
+        mesh.num_vertices(),
+        |r| mesh.point_window(r),
+        |points, i, b| {
+            let p = points.get(i);
+            let _ = writeln!(b, "v {} {} {}", p.x, p.y, p.z);
+        },
+    )?;
     if let Some(normals) = mesh.normals() {
         write_records(w, normals.len(), |i, b| {
             let n = normals[i];
@@ -464,17 +468,22 @@ pub fn write_obj(
         })?;
     }
     let with_normals = mesh.normals().is_some();
-    write_records(w, mesh.num_faces(), |f, b| {
-        b.push(b'f');
-        for &v in mesh.face_vertices(f) {
-            if with_normals {
-                let _ = write!(b, " {0}//{0}", v as u64 + 1);
-            } else {
-                let _ = write!(b, " {}", v as u64 + 1);
+    write_windows(
+        w,
+        mesh.num_faces(),
+        |r| mesh.face_window(r),
+        |faces, f, b| {
+            b.push(b'f');
+            for &v in faces.face(f) {
+                if with_normals {
+                    let _ = write!(b, " {0}//{0}", v as u64 + 1);
+                } else {
+                    let _ = write!(b, " {}", v as u64 + 1);
+                }
             }
-        }
-        b.push(b'\n');
-    })?;
+            b.push(b'\n');
+        },
+    )?;
     write_tags(w, mesh)?;
     for t in extra_tags {
         writeln!(w, "{t}")?;

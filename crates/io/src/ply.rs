@@ -19,7 +19,7 @@ use subd_mesh::{
 };
 
 use crate::error::ReadError;
-use crate::records::write_records;
+use crate::records::write_windows;
 use crate::view::MeshView;
 use crate::{MeshFile, ReadOptions};
 
@@ -585,12 +585,12 @@ pub fn write_ply(
     mesh: &MeshView<'_>,
     encoding: PlyEncoding,
 ) -> std::io::Result<()> {
-    let positions = mesh.positions();
+    let nv = mesh.num_vertices();
     let (creases, corners) = (mesh.creases(), mesh.corners());
     let holes = mesh.hole_faces();
     let nf = mesh.num_faces();
-    let wide_lists = (0..nf).any(|f| mesh.face_vertices(f).len() > 255);
-    let index_ty = if positions.len() > i32::MAX as usize {
+    let wide_lists = mesh.max_face_size() > 255;
+    let index_ty = if nv > i32::MAX as usize {
         "uint"
     } else {
         "int"
@@ -624,7 +624,7 @@ pub fn write_ply(
         };
         writeln!(w, "comment subd smoothtriangles {s}")?;
     }
-    writeln!(w, "element vertex {}", positions.len())?;
+    writeln!(w, "element vertex {nv}")?;
     for c in ["x", "y", "z"] {
         writeln!(w, "property double {c}")?;
     }
@@ -660,10 +660,12 @@ pub fn write_ply(
         writeln!(w, "property int face")?;
     }
     writeln!(w, "end_header")?;
+    let points = |r| mesh.point_window(r);
+    let faces = |r| mesh.face_window(r);
     match encoding {
         PlyEncoding::Ascii => {
-            write_records(w, positions.len(), |i, b| {
-                let p = positions[i];
+            write_windows(w, nv, points, |points, i, b| {
+                let p = points.get(i);
                 let _ = write!(b, "{} {} {}", p.x, p.y, p.z);
                 if let Some(n) = normals {
                     let n = n[i];
@@ -671,8 +673,8 @@ pub fn write_ply(
                 }
                 b.push(b'\n');
             })?;
-            write_records(w, nf, |f, b| {
-                let fv = mesh.face_vertices(f);
+            write_windows(w, nf, faces, |faces, f, b| {
+                let fv = faces.face(f);
                 let _ = write!(b, "{}", fv.len());
                 for &v in fv {
                     let _ = write!(b, " {v}");
@@ -693,8 +695,8 @@ pub fn write_ply(
             }
         }
         PlyEncoding::BinaryLittleEndian => {
-            write_records(w, positions.len(), |i, b| {
-                for c in positions[i].to_array() {
+            write_windows(w, nv, points, |points, i, b| {
+                for c in points.get(i).to_array() {
                     b.extend_from_slice(&c.to_le_bytes());
                 }
                 if let Some(n) = normals {
@@ -703,8 +705,8 @@ pub fn write_ply(
                     }
                 }
             })?;
-            write_records(w, nf, |f, b| {
-                let fv = mesh.face_vertices(f);
+            write_windows(w, nf, faces, |faces, f, b| {
+                let fv = faces.face(f);
                 if wide_lists {
                     b.extend_from_slice(&(fv.len() as u32).to_le_bytes());
                 } else {

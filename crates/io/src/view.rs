@@ -6,8 +6,12 @@
 //! borrowed. [`MeshView::from_mesh`] takes it from a mesh; [`MeshView::new`] assembles it
 //! from face lists, so a caller that has polygons but no edges (the last level of a
 //! refinement, which `subd refine` writes without building its edges) can write them.
+//! [`MeshView::streamed`] takes the points, the polygons or both from sources that make
+//! them a range at a time ([`PointSource`], [`FaceSource`]), so a level too large to hold
+//! whole (the last level of a deep refinement) is written window by window.
 
 use std::borrow::Cow;
+use std::ops::Range;
 
 use subd_mesh::{DVec3, Mesh, SchemeHints};
 use thiserror::Error;
@@ -74,13 +78,122 @@ pub enum ViewError {
     },
 }
 
+/// Vertex positions made a range at a time, for a [`MeshView::streamed`] view.
+pub trait PointSource: Sync {
+    /// Number of points.
+    fn len(&self) -> usize;
+    /// Whether there are no points.
+    fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+    /// Writes points `first..first + out.len()` into `out`.
+    fn fill(&self, first: usize, out: &mut [DVec3]);
+}
+
+/// Polygons of one size made a range at a time, for a [`MeshView::streamed`] view.
+pub trait FaceSource: Sync {
+    /// Number of faces.
+    fn num_faces(&self) -> usize;
+    /// Corners of every face.
+    fn face_size(&self) -> usize;
+    /// Appends the vertices of faces `faces` to `out`, [`Self::face_size`] per face.
+    fn fill(&self, faces: Range<usize>, out: &mut Vec<u32>);
+}
+
+/// The positions of a [`MeshView::streamed`] view: held whole, or made a range at a time.
+#[derive(Clone, Copy)]
+pub enum Points<'a> {
+    /// Every position, in memory (what vertex normals need).
+    Held(&'a [DVec3]),
+    /// Positions made window by window while writing.
+    Streamed(&'a dyn PointSource),
+}
+
+impl std::fmt::Debug for Points<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Points::Held(p) => write!(f, "Held({} points)", p.len()),
+            Points::Streamed(s) => write!(f, "Streamed({} points)", s.len()),
+        }
+    }
+}
+
+impl Points<'_> {
+    fn len(&self) -> usize {
+        match self {
+            Points::Held(p) => p.len(),
+            Points::Streamed(s) => s.len(),
+        }
+    }
+}
+
+#[derive(Clone, Copy)]
+enum Faces<'a> {
+    Held {
+        offsets: &'a [u32],
+        vertices: &'a [u32],
+    },
+    Streamed(&'a dyn FaceSource),
+}
+
+impl std::fmt::Debug for Faces<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Faces::Held { offsets, .. } => write!(f, "Held({} faces)", offsets.len() - 1),
+            Faces::Streamed(s) => write!(f, "Streamed({} faces)", s.num_faces()),
+        }
+    }
+}
+
+#[derive(Clone, Debug)]
+enum Holes<'a> {
+    /// One flag per face, or none at all.
+    Flags(&'a [bool]),
+    /// The hole faces, ascending.
+    List(Vec<usize>),
+}
+
+/// Points of a window of vertices, borrowed from a held view or made for the window.
+pub(crate) struct PointWindow<'a> {
+    first: usize,
+    points: Cow<'a, [DVec3]>,
+}
+
+impl PointWindow<'_> {
+    /// Point `i` (an index of the whole view, inside the window).
+    #[inline]
+    pub(crate) fn get(&self, i: usize) -> DVec3 {
+        self.points[i - self.first]
+    }
+
+    pub(crate) fn points(&self) -> &[DVec3] {
+        &self.points
+    }
+}
+
+/// Polygons of a window of faces, borrowed from a held view or made for the window.
+pub(crate) struct FaceWindow<'a> {
+    first: usize,
+    /// Offsets of the window's faces into `vertices` (for a held view, the view's own).
+    offsets: Cow<'a, [u32]>,
+    vertices: Cow<'a, [u32]>,
+}
+
+impl FaceWindow<'_> {
+    /// The vertices of face `f` (an index of the whole view, inside the window).
+    #[inline]
+    pub(crate) fn face(&self, f: usize) -> &[u32] {
+        let k = f - self.first;
+        &self.vertices[self.offsets[k] as usize..self.offsets[k + 1] as usize]
+    }
+}
+
 /// Positions, polygons and tags, as a writer needs them (see the [module docs](self)).
 #[derive(Debug, Clone)]
 pub struct MeshView<'a> {
-    positions: &'a [DVec3],
-    face_offsets: &'a [u32],
-    face_vertices: &'a [u32],
-    holes: &'a [bool],
+    positions: Points<'a>,
+    faces: Faces<'a>,
+    holes: Holes<'a>,
     creases: Cow<'a, [([u32; 2], f32)]>,
     corners: Cow<'a, [(u32, f32)]>,
     normals: Option<&'a [DVec3]>,
@@ -148,10 +261,80 @@ impl<'a> MeshView<'a> {
             return Err(ViewError::NonFinite { vertex });
         }
         Ok(MeshView {
+            positions: Points::Held(positions),
+            faces: Faces::Held {
+                offsets: face_offsets,
+                vertices: face_vertices,
+            },
+            holes: Holes::Flags(holes),
+            creases: Cow::Borrowed(&[]),
+            corners: Cow::Borrowed(&[]),
+            normals: None,
+            face_levels: None,
+            hints: SchemeHints::default(),
+        })
+    }
+
+    /// A view whose positions, polygons or both are made a range at a time while writing
+    /// (see the [module docs](self)), with the given hole faces, no crease or corner tags
+    /// and no hints. Streamed positions are checked finite, and streamed polygons against
+    /// the number of positions, as each window is made: a bad one fails the write (an
+    /// `InvalidData` error naming the element) rather than the view.
+    ///
+    /// ```
+    /// use std::ops::Range;
+    /// use subd_io::{FaceSource, Format, MeshView, Points, WriteOptions, encode_view};
+    /// use subd_mesh::DVec3;
+    ///
+    /// /// A strip of `n` quads, made on demand.
+    /// struct Strip(usize);
+    /// impl FaceSource for Strip {
+    ///     fn num_faces(&self) -> usize { self.0 }
+    ///     fn face_size(&self) -> usize { 4 }
+    ///     fn fill(&self, faces: Range<usize>, out: &mut Vec<u32>) {
+    ///         for f in faces {
+    ///             let f = f as u32;
+    ///             out.extend_from_slice(&[2 * f, 2 * f + 2, 2 * f + 3, 2 * f + 1]);
+    ///         }
+    ///     }
+    /// }
+    /// let points: Vec<DVec3> = (0..8).map(|i| DVec3::new((i / 2) as f64, (i % 2) as f64, 0.0)).collect();
+    /// let view = MeshView::streamed(Points::Held(&points), &Strip(3), vec![]).unwrap();
+    /// let mut obj = Vec::new();
+    /// encode_view(&mut obj, &view, Format::Obj, &WriteOptions::default()).unwrap();
+    /// assert!(String::from_utf8(obj).unwrap().contains("\nf 3 5 6 4\n"));
+    /// ```
+    ///
+    /// # Errors
+    /// [`ViewError::FaceTooSmall`] for faces of fewer than three corners, and
+    /// [`ViewError::HoleCount`] for hole faces that are not ascending face indices.
+    pub fn streamed(
+        positions: Points<'a>,
+        faces: &'a dyn FaceSource,
+        hole_faces: Vec<usize>,
+    ) -> Result<MeshView<'a>, ViewError> {
+        if faces.face_size() < 3 && faces.num_faces() > 0 {
+            return Err(ViewError::FaceTooSmall {
+                face: 0,
+                size: faces.face_size(),
+            });
+        }
+        let ascending = hole_faces.windows(2).all(|w| w[0] < w[1]);
+        if !ascending || hole_faces.last().is_some_and(|&f| f >= faces.num_faces()) {
+            return Err(ViewError::HoleCount {
+                flags: hole_faces.len(),
+                faces: faces.num_faces(),
+            });
+        }
+        if let Points::Held(p) = positions
+            && let Some(vertex) = p.iter().position(|p| !p.is_finite())
+        {
+            return Err(ViewError::NonFinite { vertex });
+        }
+        Ok(MeshView {
             positions,
-            face_offsets,
-            face_vertices,
-            holes,
+            faces: Faces::Streamed(faces),
+            holes: Holes::List(hole_faces),
             creases: Cow::Borrowed(&[]),
             corners: Cow::Borrowed(&[]),
             normals: None,
@@ -167,11 +350,11 @@ impl<'a> MeshView<'a> {
     /// [`ViewError::Count`] unless there is one normal per position, [`ViewError::NonFinite`]
     /// for a normal with a NaN or infinite coordinate.
     pub fn with_normals(mut self, normals: &'a [DVec3]) -> Result<MeshView<'a>, ViewError> {
-        if normals.len() != self.positions.len() {
+        if normals.len() != self.num_vertices() {
             return Err(ViewError::Count {
                 what: "normals",
                 given: normals.len(),
-                expected: self.positions.len(),
+                expected: self.num_vertices(),
             });
         }
         if let Some(vertex) = normals.iter().position(|n| !n.is_finite()) {
@@ -219,7 +402,7 @@ impl<'a> MeshView<'a> {
         creases: Vec<([u32; 2], f32)>,
         corners: Vec<(u32, f32)>,
     ) -> Result<MeshView<'a>, ViewError> {
-        let n = self.positions.len();
+        let n = self.num_vertices();
         let ok = |v: u32, s: f32| (v as usize) < n && s > 0.0;
         if let Some(index) = creases
             .iter()
@@ -254,10 +437,12 @@ impl<'a> MeshView<'a> {
             .map(|v| (v as u32, topo.vertex_sharpness(v)))
             .collect();
         MeshView {
-            positions: &mesh.positions,
-            face_offsets: topo.face_offsets(),
-            face_vertices: topo.all_face_vertices(),
-            holes: topo.tags().holes(),
+            positions: Points::Held(&mesh.positions),
+            faces: Faces::Held {
+                offsets: topo.face_offsets(),
+                vertices: topo.all_face_vertices(),
+            },
+            holes: Holes::Flags(topo.tags().holes()),
             creases: Cow::Owned(creases),
             corners: Cow::Owned(corners),
             normals: None,
@@ -266,36 +451,129 @@ impl<'a> MeshView<'a> {
         }
     }
 
-    /// Vertex positions.
-    pub fn positions(&self) -> &[DVec3] {
-        self.positions
+    /// Vertex positions, when the view holds them (not for [`Points::Streamed`]).
+    pub fn positions(&self) -> Option<&[DVec3]> {
+        match self.positions {
+            Points::Held(p) => Some(p),
+            Points::Streamed(_) => None,
+        }
+    }
+
+    /// Number of vertices.
+    pub fn num_vertices(&self) -> usize {
+        self.positions.len()
     }
 
     /// Number of faces.
     pub fn num_faces(&self) -> usize {
-        self.face_offsets.len() - 1
+        match self.faces {
+            Faces::Held { offsets, .. } => offsets.len() - 1,
+            Faces::Streamed(s) => s.num_faces(),
+        }
     }
 
-    /// All face-vertex indices, face after face.
-    pub fn all_face_vertices(&self) -> &[u32] {
-        self.face_vertices
+    /// The largest face size.
+    pub fn max_face_size(&self) -> usize {
+        match self.faces {
+            Faces::Held { offsets, .. } => offsets
+                .windows(2)
+                .map(|w| (w[1] - w[0]) as usize)
+                .max()
+                .unwrap_or(0),
+            Faces::Streamed(s) => s.face_size(),
+        }
     }
 
-    /// The vertices of face `f`.
-    #[inline]
-    pub fn face_vertices(&self, f: usize) -> &[u32] {
-        &self.face_vertices[self.face_offsets[f] as usize..self.face_offsets[f + 1] as usize]
+    /// Number of triangles in the fan triangulation of the faces that are not holes.
+    pub fn num_fan_triangles(&self) -> usize {
+        match self.faces {
+            Faces::Held { offsets, .. } => (0..offsets.len() - 1)
+                .filter(|&f| !self.is_hole(f))
+                .map(|f| (offsets[f + 1] - offsets[f]) as usize - 2)
+                .sum(),
+            Faces::Streamed(s) => (s.num_faces() - self.hole_faces().len()) * (s.face_size() - 2),
+        }
+    }
+
+    /// All face-vertex indices, face after face, when the view holds them (not for a
+    /// streamed [`FaceSource`]).
+    pub fn all_face_vertices(&self) -> Option<&[u32]> {
+        match self.faces {
+            Faces::Held { vertices, .. } => Some(vertices),
+            Faces::Streamed(_) => None,
+        }
     }
 
     /// Whether face `f` is a hole.
     #[inline]
     pub fn is_hole(&self, f: usize) -> bool {
-        self.holes.get(f).copied().unwrap_or(false)
+        match &self.holes {
+            Holes::Flags(h) => h.get(f).copied().unwrap_or(false),
+            Holes::List(l) => l.binary_search(&f).is_ok(),
+        }
     }
 
     /// Indices of the hole faces.
     pub fn hole_faces(&self) -> Vec<usize> {
-        (0..self.holes.len()).filter(|&f| self.holes[f]).collect()
+        match &self.holes {
+            Holes::Flags(h) => (0..h.len()).filter(|&f| h[f]).collect(),
+            Holes::List(l) => l.clone(),
+        }
+    }
+
+    /// The points of vertices `range`, checked finite where they are made here.
+    pub(crate) fn point_window(&self, range: Range<usize>) -> std::io::Result<PointWindow<'_>> {
+        let points = match self.positions {
+            Points::Held(p) => Cow::Borrowed(&p[range.clone()]),
+            Points::Streamed(s) => {
+                let mut out = vec![DVec3::ZERO; range.len()];
+                s.fill(range.start, &mut out);
+                if let Some(i) = out.iter().position(|p| !p.is_finite()) {
+                    return Err(invalid(ViewError::NonFinite {
+                        vertex: range.start + i,
+                    }));
+                }
+                Cow::Owned(out)
+            }
+        };
+        Ok(PointWindow {
+            first: range.start,
+            points,
+        })
+    }
+
+    /// The polygons of faces `range`, their vertices checked against the positions where
+    /// they are made here.
+    pub(crate) fn face_window(&self, range: Range<usize>) -> std::io::Result<FaceWindow<'_>> {
+        let (offsets, vertices) = match self.faces {
+            Faces::Held { offsets, vertices } => (
+                Cow::Borrowed(&offsets[range.start..=range.end]),
+                Cow::Borrowed(vertices),
+            ),
+            Faces::Streamed(s) => {
+                let k = s.face_size();
+                let mut out = Vec::with_capacity(k * range.len());
+                s.fill(range.clone(), &mut out);
+                let n = self.num_vertices();
+                if out.len() != k * range.len() {
+                    return Err(invalid(ViewError::Offsets { indices: out.len() }));
+                }
+                if let Some(i) = out.iter().position(|&v| v as usize >= n) {
+                    return Err(invalid(ViewError::VertexOutOfRange {
+                        face: range.start + i / k,
+                        vertex: out[i],
+                        vertices: n,
+                    }));
+                }
+                let offsets = (0..=range.len()).map(|f| (k * f) as u32).collect();
+                (Cow::Owned(offsets), Cow::Owned(out))
+            }
+        };
+        Ok(FaceWindow {
+            first: range.start,
+            offsets,
+            vertices,
+        })
     }
 
     /// Crease tags: edge end points and sharpness.
@@ -307,6 +585,11 @@ impl<'a> MeshView<'a> {
     pub fn corners(&self) -> &[(u32, f32)] {
         &self.corners
     }
+}
+
+/// A view error met while writing, as an I/O error.
+fn invalid(e: ViewError) -> std::io::Error {
+    std::io::Error::new(std::io::ErrorKind::InvalidData, e)
 }
 
 #[cfg(test)]

@@ -55,7 +55,9 @@ pub mod two_phase;
 use subd_mesh::{BoundaryInterpolation, CreaseMethod, SchemeHints, TriangleSubdivision};
 use thiserror::Error;
 
-pub use refine::{LevelCounts, Refinement, refined_counts, refined_split_counts};
+pub use refine::{
+    FaceStream, LevelCounts, PointStream, Refinement, refined_counts, refined_split_counts,
+};
 pub use rules::Rule;
 pub use stencil::{RowSink, StencilTable};
 pub use two_phase::TwoPhase;

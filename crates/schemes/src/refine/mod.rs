@@ -7,11 +7,14 @@ mod counts;
 mod fused;
 mod par;
 mod refinement;
+mod rows;
 mod split;
+mod stream;
 
 pub use counts::{LevelCounts, refined_counts, refined_split_counts};
 pub(crate) use counts::{last_level_bytes, topology_bytes};
 pub use refinement::Refinement;
+pub use stream::{FaceStream, PointStream};
 
 pub(crate) use fused::{
     applies as fusion_applies, child_too_large as fused_child_too_large, grandchild_faces,
@@ -652,28 +655,46 @@ impl Step<'_> {
     /// which use them (the order of OpenSubdiv's `PrimvarRefiner`). Parallel over rows; each
     /// row is computed alone, so the result does not depend on the number of threads.
     pub(crate) fn points(&self, src: &[DVec3]) -> Vec<DVec3> {
-        let l = self.layout;
-        let (fb, eb) = (l.face_vertex_base as usize, l.edge_vertex_base as usize);
-        let one = |r: usize, face_points: &[DVec3]| {
-            let mut s = PointSink {
-                src,
-                face_points,
-                acc: DVec3::ZERO,
-            };
-            self.row(r, &mut s);
-            s.acc
+        rows::build(&StepRows { step: self, src })
+    }
+
+    /// The child point of row `r` through the general mask machinery.
+    fn general_point(&self, r: usize, src: &[DVec3], face_points: &[DVec3]) -> DVec3 {
+        let mut s = PointSink {
+            src,
+            face_points,
+            acc: DVec3::ZERO,
         };
-        // The output is written once, in place: face points first, then the rest from them.
-        memory::build_around(
-            l.num_child_vertices,
-            fb..eb,
-            CHUNK,
-            |r| one(r, &[]),
-            |r, face_points| {
-                self.smooth_catmark_point(r, src, face_points)
-                    .unwrap_or_else(|| one(r, face_points))
-            },
-        )
+        self.row(r, &mut s);
+        s.acc
+    }
+}
+
+/// The rows of one step's child points ([`Step::points`]): the face points are the middle
+/// rows, and the vertex and edge points read them.
+pub(crate) struct StepRows<'a> {
+    pub step: &'a Step<'a>,
+    pub src: &'a [DVec3],
+}
+
+impl rows::PointRows for StepRows<'_> {
+    fn len(&self) -> usize {
+        self.step.layout.num_child_vertices
+    }
+
+    fn middle(&self) -> std::ops::Range<usize> {
+        let l = self.step.layout;
+        l.face_vertex_base as usize..l.edge_vertex_base as usize
+    }
+
+    fn middle_row(&self, r: usize) -> DVec3 {
+        self.step.general_point(r, self.src, &[])
+    }
+
+    fn row(&self, r: usize, face_points: &[DVec3]) -> DVec3 {
+        self.step
+            .smooth_catmark_point(r, self.src, face_points)
+            .unwrap_or_else(|| self.step.general_point(r, self.src, face_points))
     }
 }
 

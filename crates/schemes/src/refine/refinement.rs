@@ -17,8 +17,8 @@ struct Level {
     /// on first request for the last, and for the level before it when the last comes from
     /// its grandparent.
     topology: OnceLock<Topology>,
-    /// Face lists of the last level, available without building its full topology.
-    faces: Option<super::ChildFaces>,
+    /// Face lists of the last level without its full topology, built on first request.
+    faces: OnceLock<super::ChildFaces>,
     /// Rule of every vertex.
     rules: Vec<Rule>,
     /// Number of vertices.
@@ -121,7 +121,7 @@ impl Refinement {
             levels: vec![Level {
                 num_vertices: t0.num_vertices(),
                 topology: OnceLock::from(t0),
-                faces: None,
+                faces: OnceLock::new(),
                 rules: rules0,
                 from_grandparent: false,
             }],
@@ -157,17 +157,11 @@ impl Refinement {
                 if super::fused_child_too_large(p, scheme) {
                     return Err(RefineError::TooLarge { level: levels });
                 }
-                let (offsets, vertices) = super::grandchild_faces(p, scheme);
                 let num_vertices = super::grandchild_num_vertices(p, scheme);
-                let num_faces = offsets.len() - 1;
                 let last = Level {
                     num_vertices,
                     topology: OnceLock::new(),
-                    faces: Some(super::ChildFaces {
-                        offsets,
-                        vertices,
-                        holes: memory::zeroed(num_faces),
-                    }),
+                    faces: OnceLock::new(),
                     // Closed and smooth stays closed and smooth: no creases, no corners.
                     rules: vec![Rule::Smooth; num_vertices],
                     from_grandparent: true,
@@ -175,7 +169,7 @@ impl Refinement {
                 r.levels.push(Level {
                     num_vertices: layout.num_child_vertices,
                     topology: OnceLock::new(),
-                    faces: None,
+                    faces: OnceLock::new(),
                     rules,
                     from_grandparent: false,
                 });
@@ -186,7 +180,7 @@ impl Refinement {
                 Level {
                     num_vertices: layout.num_child_vertices,
                     topology: OnceLock::from(super::child_topology(p, scheme, options, layout)),
-                    faces: None,
+                    faces: OnceLock::new(),
                     rules,
                     from_grandparent: false,
                 }
@@ -194,7 +188,7 @@ impl Refinement {
                 Level {
                     num_vertices: layout.num_child_vertices,
                     topology: OnceLock::new(),
-                    faces: Some(super::child_faces(p, scheme)),
+                    faces: OnceLock::new(),
                     rules,
                     from_grandparent: false,
                 }
@@ -323,7 +317,7 @@ impl Refinement {
 
     /// Face offsets and face-vertex indices of `level`, without building its full topology.
     pub fn faces(&self, level: usize) -> (&[u32], &[u32]) {
-        match &self.levels[level].faces {
+        match self.face_lists(level) {
             Some(f) => (&f.offsets, &f.vertices),
             None => {
                 let t = self.topology(level);
@@ -334,10 +328,118 @@ impl Refinement {
 
     /// Hole flags of the faces of `level`.
     pub fn holes(&self, level: usize) -> &[bool] {
-        match &self.levels[level].faces {
+        match self.face_lists(level) {
             Some(f) => &f.holes,
             None => self.topology(level).tags().holes(),
         }
+    }
+
+    /// The face lists of an unbuilt level, built on first request; `None` where the
+    /// level's topology is built (or is to be, below the last level).
+    fn face_lists(&self, level: usize) -> Option<&super::ChildFaces> {
+        let lists = &self.levels[level].faces;
+        if lists.get().is_none()
+            && (level == 0 || level < self.num_levels() || self.has_topology(level))
+        {
+            return None;
+        }
+        Some(lists.get_or_init(|| {
+            if self.levels[level].from_grandparent && !self.has_topology(level - 1) {
+                let g = self.topology(level - 2);
+                let (offsets, vertices) = super::grandchild_faces(g, self.scheme);
+                // A level refined from its grandparent has no holes.
+                let holes = memory::zeroed(offsets.len() - 1);
+                super::ChildFaces {
+                    offsets,
+                    vertices,
+                    holes,
+                }
+            } else {
+                super::child_faces(self.topology(level - 1), self.scheme)
+            }
+        }))
+    }
+
+    /// The faces of the last level, a range at a time, computed from the level above (or
+    /// the one above that, see [`Self::has_topology`]) without building them all: for
+    /// writing a deep level to a file. `None` when nothing is refined (level 0 is the
+    /// last).
+    ///
+    /// ```
+    /// use subd_mesh::TopologyBuilder;
+    /// use subd_schemes::{Options, Refinement, Scheme};
+    ///
+    /// let faces = [0, 1, 3, 2, 2, 3, 5, 4, 4, 5, 7, 6, 6, 7, 1, 0, 1, 7, 5, 3, 6, 0, 2, 4];
+    /// let cube = TopologyBuilder::new(8).build(&[4; 6], &faces).unwrap();
+    /// let r = Refinement::new(&cube, Scheme::CatmullClark, &Options::default(), 3).unwrap();
+    /// let stream = r.face_stream().unwrap();
+    /// assert_eq!(stream.num_faces(), 6 * 64);
+    /// let mut part = Vec::new();
+    /// stream.fill(100..110, &mut part);
+    /// assert_eq!(part[..], r.faces(3).1[4 * 100..4 * 110]);
+    /// ```
+    pub fn face_stream(&self) -> Option<super::FaceStream<'_>> {
+        let last = self.num_levels();
+        if last == 0 {
+            return None;
+        }
+        let quads = self.scheme != Scheme::Loop;
+        Some(
+            if self.levels[last].from_grandparent && !self.has_topology(last - 1) {
+                super::FaceStream::grandchild(self.topology(last - 2), quads)
+            } else if quads {
+                super::FaceStream::quad_split(self.topology(last - 1))
+            } else {
+                super::FaceStream::tri_split(self.topology(last - 1))
+            },
+        )
+    }
+
+    /// The points of the last level, a range at a time, from `above`, the points of the
+    /// level before it ([`Self::points_at`]): bit for bit those of [`Self::refine_points`],
+    /// without holding them all. `None` when nothing is refined.
+    ///
+    /// ```
+    /// use subd_mesh::{DVec3, TopologyBuilder};
+    /// use subd_schemes::{Options, Refinement, Scheme};
+    ///
+    /// let faces = [0, 1, 3, 2, 2, 3, 5, 4, 4, 5, 7, 6, 6, 7, 1, 0, 1, 7, 5, 3, 6, 0, 2, 4];
+    /// let cube = TopologyBuilder::new(8).build(&[4; 6], &faces).unwrap();
+    /// let points: Vec<DVec3> = (0..8)
+    ///     .map(|i| DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64))
+    ///     .collect();
+    /// let r = Refinement::new(&cube, Scheme::CatmullClark, &Options::default(), 2).unwrap();
+    /// let above = r.points_at(&points, 1);
+    /// let stream = r.point_stream(&above).unwrap();
+    /// let mut part = vec![DVec3::ZERO; 20];
+    /// stream.fill(50, &mut part);
+    /// assert_eq!(part[..], r.refine_points(&points)[2][50..70]);
+    /// ```
+    ///
+    /// # Panics
+    /// If `above` does not have one point per vertex of the level before the last.
+    pub fn point_stream<'a>(&'a self, above: &'a [DVec3]) -> Option<super::PointStream<'a>> {
+        let last = self.num_levels();
+        if last == 0 {
+            return None;
+        }
+        assert_eq!(
+            above.len(),
+            self.num_vertices(last - 1),
+            "one point per vertex of level {}",
+            last - 1
+        );
+        Some(
+            if self.levels[last].from_grandparent && !self.has_topology(last - 1) {
+                let g = self.topology(last - 2);
+                match self.scheme {
+                    Scheme::Loop => super::PointStream::loop_grandchild(g, above),
+                    _ => super::PointStream::catmark_grandchild(g, above),
+                }
+            } else {
+                super::PointStream::step(self.step(last), above)
+            },
+        )
     }
 
     /// Topology of `level` (0 = base, with the boundary rules applied to its tags), built on
@@ -427,21 +529,45 @@ impl Refinement {
     /// # Panics
     /// If `base.len()` differs from the number of base vertices.
     pub fn refine_points(&self, base: &[DVec3]) -> Vec<Vec<DVec3>> {
+        self.check_base(base);
+        let mut out = vec![base.to_vec()];
+        for l in 1..self.levels.len() {
+            let next = self.next_points(l, out.last().expect("level 0"));
+            out.push(next);
+        }
+        out
+    }
+
+    /// Positions of `level` alone from base positions, each level dropped once the next is
+    /// computed: [`Self::refine_points`]`(base)[level]` in less memory.
+    ///
+    /// # Panics
+    /// If `base.len()` differs from the number of base vertices, or `level` is beyond
+    /// [`Self::num_levels`].
+    pub fn points_at(&self, base: &[DVec3], level: usize) -> Vec<DVec3> {
+        self.check_base(base);
+        assert!(level <= self.num_levels(), "level {level} is not refined");
+        let mut points = base.to_vec();
+        for l in 1..=level {
+            points = self.next_points(l, &points);
+        }
+        points
+    }
+
+    fn check_base(&self, base: &[DVec3]) {
         assert_eq!(
             base.len(),
             self.levels[0].num_vertices,
             "one position per base vertex"
         );
-        let mut out = vec![base.to_vec()];
-        for l in 1..self.levels.len() {
-            let src = out.last().expect("level 0");
-            let next = if self.levels[l].from_grandparent && !self.has_topology(l - 1) {
-                super::grandchild_points(self.topology(l - 2), self.scheme, src)
-            } else {
-                self.step(l).points(src)
-            };
-            out.push(next);
+    }
+
+    /// Points of `level` from those of the level above.
+    fn next_points(&self, level: usize, src: &[DVec3]) -> Vec<DVec3> {
+        if self.levels[level].from_grandparent && !self.has_topology(level - 1) {
+            super::grandchild_points(self.topology(level - 2), self.scheme, src)
+        } else {
+            self.step(level).points(src)
         }
-        out
     }
 }

@@ -106,7 +106,7 @@ pub(super) fn per_face<B: bytemuck::Pod + Send>(
 /// edges (hNext, I_k, I_{k-1}, hPrev); a quad's child k is rotated so that the parent corner
 /// sits at position k. Writes the vertices into `verts` and, when given, the edges into
 /// `edges`; both start at the first child face-vertex of `faces`.
-fn quad_face_block(
+pub(super) fn quad_face_block(
     p: &Topology,
     faces: Range<usize>,
     verts: &mut [u32],
