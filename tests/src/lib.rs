@@ -17,6 +17,26 @@ pub fn osd_mesh_dir() -> PathBuf {
     base.join("osd")
 }
 
+/// Every OpenSubdiv shape with at most `max_face_vertices` face-vertices, by name, read
+/// as OpenSubdiv reads them (inconsistent orientation accepted).
+pub fn small_shapes(max_face_vertices: usize) -> impl Iterator<Item = (String, subd_io::MeshFile)> {
+    let opts = subd_io::ReadOptions {
+        accept_inconsistent_orientation: true,
+        ..Default::default()
+    };
+    osd_meshes().into_iter().filter_map(move |path| {
+        let name = path.file_stem()?.to_string_lossy().to_string();
+        let file =
+            subd_io::read_mesh(&path, &opts).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        (file.mesh.topology.num_face_vertices() <= max_face_vertices).then_some((name, file))
+    })
+}
+
+/// Whether every face of `t` has `n` corners.
+pub fn all_faces_of_size(t: &Topology, n: usize) -> bool {
+    (0..t.num_faces()).all(|f| t.face_size(f) == n)
+}
+
 /// Every `.obj` file of the OpenSubdiv shape directory, sorted by name.
 pub fn osd_meshes() -> Vec<PathBuf> {
     let dir = osd_mesh_dir();

@@ -4,7 +4,7 @@
 use subd_io::{ReadOptions, read_mesh};
 use subd_mesh::{TopologyBuilder, TopologySummary};
 use subd_schemes::{Options, Refinement, Scheme};
-use subd_tests::osd_meshes;
+use subd_tests::{all_faces_of_size, osd_meshes, small_shapes};
 
 #[test]
 fn derived_child_topology_matches_the_builder() {
@@ -104,16 +104,10 @@ fn derived_child_topology_matches_the_builder() {
 /// topology shows, on every shape with every scheme that applies, and with Chaikin creases.
 #[test]
 fn last_level_counts_and_sharpness_without_its_topology() {
-    let opts = ReadOptions {
-        accept_inconsistent_orientation: true,
-        ..Default::default()
-    };
     let (mut sharp, mut smooth, mut explicit) = (0, 0, 0);
-    for path in osd_meshes() {
-        let name = path.file_stem().unwrap().to_string_lossy().to_string();
-        let file = read_mesh(&path, &opts).unwrap();
+    for (name, file) in small_shapes(usize::MAX) {
         let base = &file.mesh.topology;
-        let schemes: &[Scheme] = if (0..base.num_faces()).all(|f| base.face_size(f) == 3) {
+        let schemes: &[Scheme] = if all_faces_of_size(base, 3) {
             &[Scheme::Loop, Scheme::CatmullClark, Scheme::Bilinear]
         } else {
             &[Scheme::CatmullClark, Scheme::Bilinear]
@@ -184,19 +178,10 @@ fn last_level_counts_and_sharpness_without_its_topology() {
 /// refinement), and the deeper refinement that builds it.
 #[test]
 fn last_level_from_its_grandparent_equals_the_built_path() {
-    let opts = ReadOptions {
-        accept_inconsistent_orientation: true,
-        ..Default::default()
-    };
     let mut fused = Vec::new();
-    for path in osd_meshes() {
-        let name = path.file_stem().unwrap().to_string_lossy().to_string();
-        let file = read_mesh(&path, &opts).unwrap();
+    for (name, file) in small_shapes(8000) {
         let base = &file.mesh.topology;
-        if base.num_face_vertices() > 8000 {
-            continue;
-        }
-        let schemes: &[Scheme] = if (0..base.num_faces()).all(|f| base.face_size(f) == 3) {
+        let schemes: &[Scheme] = if all_faces_of_size(base, 3) {
             &[Scheme::CatmullClark, Scheme::Loop]
         } else {
             &[Scheme::CatmullClark]
@@ -273,20 +258,11 @@ fn last_level_from_its_grandparent_equals_the_built_path() {
 #[test]
 fn last_level_streams_equal_the_held_level() {
     use subd_mesh::DVec3;
-    let opts = ReadOptions {
-        accept_inconsistent_orientation: true,
-        ..Default::default()
-    };
     let (mut cases, mut from_grandparent, mut with_holes) = (0, 0, 0);
-    for path in osd_meshes() {
-        let name = path.file_stem().unwrap().to_string_lossy().to_string();
-        let file = read_mesh(&path, &opts).unwrap();
+    for (name, file) in small_shapes(8000) {
         let base = &file.mesh.topology;
-        if base.num_face_vertices() > 8000 {
-            continue;
-        }
-        let triangles = (0..base.num_faces()).all(|f| base.face_size(f) == 3);
-        let quads = (0..base.num_faces()).all(|f| base.face_size(f) == 4);
+        let triangles = all_faces_of_size(base, 3);
+        let quads = all_faces_of_size(base, 4);
         let schemes: &[Scheme] = if triangles {
             &[Scheme::Loop, Scheme::CatmullClark, Scheme::Bilinear]
         } else {

@@ -5,12 +5,11 @@
 use std::ops::Range;
 
 use subd_io::{
-    FaceSource, Format, MeshView, PlyEncoding, PointSource, Points, ReadOptions, WriteOptions,
-    encode_view, read_mesh,
+    FaceSource, Format, MeshView, PlyEncoding, PointSource, Points, WriteOptions, encode_view,
 };
 use subd_mesh::{DVec3, SchemeHints};
 use subd_schemes::{FaceStream, Options, PointStream, Refinement, Scheme};
-use subd_tests::osd_meshes;
+use subd_tests::{all_faces_of_size, small_shapes};
 
 struct StreamedPoints<'a>(PointStream<'a>);
 
@@ -68,19 +67,10 @@ fn streamed_view<'a>(
 
 #[test]
 fn streamed_last_level_files_equal_the_held_ones() {
-    let opts = ReadOptions {
-        accept_inconsistent_orientation: true,
-        ..Default::default()
-    };
     let (mut files, mut with_holes, mut with_tags) = (0, 0, 0);
-    for path in osd_meshes() {
-        let name = path.file_stem().unwrap().to_string_lossy().to_string();
-        let file = read_mesh(&path, &opts).unwrap();
+    for (name, file) in small_shapes(4000) {
         let base = &file.mesh.topology;
-        if base.num_face_vertices() > 4000 {
-            continue;
-        }
-        let schemes: &[Scheme] = if (0..base.num_faces()).all(|f| base.face_size(f) == 3) {
+        let schemes: &[Scheme] = if all_faces_of_size(base, 3) {
             &[Scheme::Loop, Scheme::CatmullClark]
         } else {
             &[Scheme::CatmullClark, Scheme::Bilinear]

@@ -306,16 +306,10 @@ fn run_one(
             None => subd_io::Points::Streamed(&points),
         };
         let tags = refinement.explicit_tags(args.levels);
-        let mut view = subd_io::MeshView::streamed(source, &faces, faces.0.hole_faces())
+        let view = subd_io::MeshView::streamed(source, &faces, faces.0.hole_faces())
             .and_then(|v| v.with_tags(tags.creases, tags.corners))
             .map_err(in_view)?;
-        view.hints = hints;
-        subd_io::write_view(&job.output, &view, &subd_io::WriteOptions::default())?;
-        let counts = Counts {
-            vertices: view.num_vertices(),
-            edges: refinement.num_edges(args.levels),
-            faces: view.num_faces(),
-        };
+        let counts = write_level(job, view, hints, refinement.num_edges(args.levels))?;
         (counts, t_positions, t2)
     } else {
         let mut positions = refinement.last_positions(&file.mesh.positions);
@@ -350,13 +344,7 @@ fn run_one(
             filled = normals_or_faces(n, &view);
             view = view.with_normals(&filled).map_err(in_view)?;
         }
-        view.hints = hints;
-        subd_io::write_view(&job.output, &view, &subd_io::WriteOptions::default())?;
-        let counts = Counts {
-            vertices: positions.len(),
-            edges: refinement.num_edges(args.levels),
-            faces: view.num_faces(),
-        };
+        let counts = write_level(job, view, hints, refinement.num_edges(args.levels))?;
         (counts, t_positions, t2)
     };
     progress.finish();
@@ -390,6 +378,22 @@ fn run_one(
         crate::print_json(out, &report);
     }
     Ok(())
+}
+
+/// Writes the output level with its hints; its counts for the report.
+fn write_level(
+    job: &Job,
+    mut view: subd_io::MeshView<'_>,
+    hints: SchemeHints,
+    edges: Option<usize>,
+) -> Result<Counts, Failure> {
+    view.hints = hints;
+    subd_io::write_view(&job.output, &view, &subd_io::WriteOptions::default())?;
+    Ok(Counts {
+        vertices: view.num_vertices(),
+        edges,
+        faces: view.num_faces(),
+    })
 }
 
 /// The scheme hints a refined file records: OpenSubdiv's rule options, for its schemes
