@@ -48,6 +48,18 @@ fn parse_document(bytes: &[u8]) -> Result<gltf::Gltf, ReadError> {
     use gltf::json::mesh::Semantic;
     use gltf::json::validation::Checked;
     let bad = |e: gltf::Error| ReadError::general(e.to_string());
+    // `gltf` 1.4 subtracts the 12-byte header from the declared file length unchecked (an
+    // overflow panic under overflow checks), so a shorter declared length is refused here.
+    if let Some(len) = bytes
+        .strip_prefix(b"glTF")
+        .and_then(|rest| rest.get(4..8))
+        .map(|l| u32::from_le_bytes([l[0], l[1], l[2], l[3]]))
+        && len < 12
+    {
+        return Err(ReadError::general(format!(
+            "the GLB header declares {len} bytes, less than the 12 of the header itself"
+        )));
+    }
     let gltf::Gltf { document, blob } =
         gltf::Gltf::from_slice_without_validation(bytes).map_err(bad)?;
     let root = document.into_json();

@@ -231,6 +231,35 @@ fn malformed_documents_are_errors_not_panics() {
     }
 }
 
+/// GLB containers with forged header and chunk lengths (found by the `gltf` fuzz target:
+/// a declared length under the header's own 12 bytes overflowed inside `gltf`) are errors.
+#[test]
+fn forged_glb_lengths_are_errors_not_panics() {
+    let json = br#"{"asset":{"version":"2.0"}}"#;
+    let glb = |declared: u32, chunk: u32| {
+        let mut b = b"glTF".to_vec();
+        b.extend_from_slice(&2u32.to_le_bytes());
+        b.extend_from_slice(&declared.to_le_bytes());
+        b.extend_from_slice(&chunk.to_le_bytes());
+        b.extend_from_slice(b"JSON");
+        b.extend_from_slice(json);
+        b
+    };
+    let honest = (12 + 8 + json.len()) as u32;
+    for (declared, chunk) in [
+        (0, json.len() as u32),
+        (11, json.len() as u32),
+        (honest + 100, json.len() as u32),
+        (honest, u32::MAX),
+        (honest, 3),
+    ] {
+        let r = parse_mesh(&glb(declared, chunk), Format::Glb, &ReadOptions::default());
+        assert!(r.is_err(), "declared {declared}, chunk {chunk}");
+    }
+    let e = parse_mesh(&glb(5, 27), Format::Glb, &ReadOptions::default()).unwrap_err();
+    assert!(e.to_string().contains("declares 5 bytes"), "{e}");
+}
+
 proptest::proptest! {
     #![proptest_config(proptest::prelude::ProptestConfig::with_cases(400))]
 
