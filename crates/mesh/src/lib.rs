@@ -29,6 +29,7 @@
 pub mod analysis;
 mod build;
 pub mod error;
+pub mod fvar;
 pub mod geometry;
 pub mod primitives;
 pub mod tags;
