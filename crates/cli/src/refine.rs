@@ -204,11 +204,11 @@ impl Refined {
     }
 
     pub(crate) fn last_positions(&self, base: &[subd_mesh::DVec3]) -> Vec<subd_mesh::DVec3> {
-        let mut levels = match self {
-            Refined::Osd(r) => r.refine_points(base),
-            Refined::Split(r) => r.refine_points(base),
-        };
-        levels.pop().expect("last level")
+        match self {
+            // Each level dropped once the next is computed.
+            Refined::Osd(r) => r.points_at(base, r.num_levels()),
+            Refined::Split(r) => r.refine_points(base).pop().expect("last level"),
+        }
     }
 }
 

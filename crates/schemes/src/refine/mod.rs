@@ -234,17 +234,15 @@ pub(crate) struct ChildFaces {
     pub holes: Vec<bool>,
 }
 
-/// Hole flags of the child faces: children of holes are holes.
+/// Hole flags of the child faces: children of holes are holes ([`FaceStream::hole_faces`]).
 fn child_holes(p: &Topology, scheme: Scheme, num_child_faces: usize) -> Vec<bool> {
+    let faces = match scheme {
+        Scheme::Loop => FaceStream::tri_split(p),
+        _ => FaceStream::quad_split(p),
+    };
     let mut holes: Vec<bool> = memory::zeroed(num_child_faces);
-    for f in 0..p.num_faces() {
-        if p.is_hole(f) {
-            let children = match scheme {
-                Scheme::Loop => 4 * f..4 * f + 4,
-                _ => p.face_offsets()[f] as usize..p.face_offsets()[f + 1] as usize,
-            };
-            holes[children].fill(true);
-        }
+    for f in faces.hole_faces() {
+        holes[f] = true;
     }
     holes
 }

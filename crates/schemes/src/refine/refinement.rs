@@ -279,7 +279,7 @@ impl Refinement {
         if let Some(t) = self.levels[level].topology.get() {
             return t.num_edges();
         }
-        if self.levels[level].from_grandparent && !self.has_topology(level - 1) {
+        if self.skips_parent(level) {
             return super::grandchild_num_edges(self.topology(level - 2), self.scheme);
         }
         // Only the last level can be unbuilt, and it is not the base level.
@@ -344,7 +344,7 @@ impl Refinement {
             return None;
         }
         Some(lists.get_or_init(|| {
-            if self.levels[level].from_grandparent && !self.has_topology(level - 1) {
+            if self.skips_parent(level) {
                 let g = self.topology(level - 2);
                 let (offsets, vertices) = super::grandchild_faces(g, self.scheme);
                 // A level refined from its grandparent has no holes.
@@ -384,15 +384,13 @@ impl Refinement {
             return None;
         }
         let quads = self.scheme != Scheme::Loop;
-        Some(
-            if self.levels[last].from_grandparent && !self.has_topology(last - 1) {
-                super::FaceStream::grandchild(self.topology(last - 2), quads)
-            } else if quads {
-                super::FaceStream::quad_split(self.topology(last - 1))
-            } else {
-                super::FaceStream::tri_split(self.topology(last - 1))
-            },
-        )
+        Some(if self.skips_parent(last) {
+            super::FaceStream::grandchild(self.topology(last - 2), quads)
+        } else if quads {
+            super::FaceStream::quad_split(self.topology(last - 1))
+        } else {
+            super::FaceStream::tri_split(self.topology(last - 1))
+        })
     }
 
     /// The points of the last level, a range at a time, from `above`, the points of the
@@ -429,17 +427,15 @@ impl Refinement {
             "one point per vertex of level {}",
             last - 1
         );
-        Some(
-            if self.levels[last].from_grandparent && !self.has_topology(last - 1) {
-                let g = self.topology(last - 2);
-                match self.scheme {
-                    Scheme::Loop => super::PointStream::loop_grandchild(g, above),
-                    _ => super::PointStream::catmark_grandchild(g, above),
-                }
-            } else {
-                super::PointStream::step(self.step(last), above)
-            },
-        )
+        Some(if self.skips_parent(last) {
+            let g = self.topology(last - 2);
+            match self.scheme {
+                Scheme::Loop => super::PointStream::loop_grandchild(g, above),
+                _ => super::PointStream::catmark_grandchild(g, above),
+            }
+        } else {
+            super::PointStream::step(self.step(last), above)
+        })
     }
 
     /// Topology of `level` (0 = base, with the boundary rules applied to its tags), built on
@@ -554,6 +550,12 @@ impl Refinement {
         points
     }
 
+    /// Whether `level` comes from its grandparent with the level between still unbuilt
+    /// (so its faces and points are derived from `level - 2`).
+    fn skips_parent(&self, level: usize) -> bool {
+        self.levels[level].from_grandparent && !self.has_topology(level - 1)
+    }
+
     fn check_base(&self, base: &[DVec3]) {
         assert_eq!(
             base.len(),
@@ -564,7 +566,7 @@ impl Refinement {
 
     /// Points of `level` from those of the level above.
     fn next_points(&self, level: usize, src: &[DVec3]) -> Vec<DVec3> {
-        if self.levels[level].from_grandparent && !self.has_topology(level - 1) {
+        if self.skips_parent(level) {
             super::grandchild_points(self.topology(level - 2), self.scheme, src)
         } else {
             self.step(level).points(src)
