@@ -86,6 +86,10 @@ pub enum FVarError {
     /// A channel needs at least one component per value.
     #[error("a face-varying channel needs at least one component per value")]
     NoComponents,
+    /// A channel without values (OpenSubdiv refuses it: "face-varying channel has no
+    /// values").
+    #[error("a face-varying channel has no values")]
+    NoValues,
     /// The value array is not a whole number of values.
     #[error("{len} face-varying numbers are not a whole number of {components}-component values")]
     ValueLength {

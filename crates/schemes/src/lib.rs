@@ -56,7 +56,8 @@ use subd_mesh::{BoundaryInterpolation, CreaseMethod, SchemeHints, TriangleSubdiv
 use thiserror::Error;
 
 pub use refine::{
-    FaceStream, LevelCounts, PointStream, Refinement, refined_counts, refined_split_counts,
+    FaceStream, FaceVaryingRefinement, LevelCounts, PointStream, Refinement, refined_counts,
+    refined_split_counts,
 };
 pub use rules::Rule;
 pub use stencil::{RowSink, StencilTable};

@@ -5,6 +5,7 @@
 
 mod counts;
 mod fused;
+mod fvar;
 mod par;
 mod refinement;
 mod rows;
@@ -13,6 +14,7 @@ mod stream;
 
 pub use counts::{LevelCounts, refined_counts, refined_split_counts};
 pub(crate) use counts::{last_level_bytes, topology_bytes};
+pub use fvar::FaceVaryingRefinement;
 pub use refinement::Refinement;
 pub use stream::{FaceStream, PointStream};
 
@@ -367,6 +369,18 @@ pub(crate) trait MaskSink {
     fn vertex(&mut self, i: u32, w: f64);
     /// Adds `w` times the face point of parent face `f`.
     fn face(&mut self, p: &Topology, f: usize, w: f64);
+    /// Adds `w` times the vertex at the far end of edge `e` from `v`: a face-varying sink
+    /// reads the value on that edge rather than the vertex's own.
+    #[inline]
+    fn edge_end(&mut self, p: &Topology, e: usize, v: u32, w: f64) {
+        self.vertex(p.edge_other_vertex(e, v), w);
+    }
+    /// Adds `w` times the vertex at corner `k` of face `f` (a face-varying sink reads that
+    /// corner's value).
+    #[inline]
+    fn corner(&mut self, p: &Topology, f: usize, k: usize, w: f64) {
+        self.vertex(p.face_vertices(f)[k], w);
+    }
 }
 
 impl MaskSink for RowSink<'_> {
@@ -451,8 +465,8 @@ impl Step<'_> {
         let [a, b] = p.edge_vertices(e);
         let s = p.edge_sharpness(e);
         if s > 0.0 && child_rule == Rule::Crease {
-            sink.vertex(a, 0.5);
-            sink.vertex(b, 0.5);
+            sink.edge_end(p, e, b, 0.5);
+            sink.edge_end(p, e, a, 0.5);
             return;
         }
         let faces = p.edge_faces(e);
@@ -488,8 +502,8 @@ impl Step<'_> {
             vw = pw * 0.5 + cw * vw;
             fw *= cw;
         }
-        sink.vertex(a, vw);
-        sink.vertex(b, vw);
+        sink.edge_end(p, e, b, vw);
+        sink.edge_end(p, e, a, vw);
         for (&f, &l) in faces.iter().zip(p.edge_face_local_indices(e)) {
             match self.scheme {
                 Scheme::Loop => {
@@ -502,7 +516,7 @@ impl Step<'_> {
                     } else {
                         l as usize
                     };
-                    sink.vertex(p.face_vertices(f as usize)[(k + 2) % 3], fw);
+                    sink.corner(p, f as usize, (k + 2) % 3, fw);
                 }
                 _ => sink.face(p, f as usize, fw),
             }
@@ -546,7 +560,7 @@ impl Step<'_> {
         }
         if m.has_edges() {
             for (i, &e) in p.vertex_edges(v).iter().enumerate() {
-                sink.vertex(p.edge_other_vertex(e as usize, v as u32), m.edge(i));
+                sink.edge_end(p, e as usize, v as u32, m.edge(i));
             }
         }
         sink.vertex(v as u32, m.vertex());
@@ -572,7 +586,7 @@ impl Step<'_> {
         if pm.has_edges() || cm.has_edges() {
             for (i, &e) in p.vertex_edges(v).iter().enumerate() {
                 let w = mix(pm.has_edges(), pm.edge(i), cm.has_edges(), cm.edge(i));
-                sink.vertex(p.edge_other_vertex(e as usize, v as u32), w);
+                sink.edge_end(p, e as usize, v as u32, w);
             }
         }
         sink.vertex(v as u32, pw * pm.vertex() + cw * cm.vertex());
@@ -597,13 +611,13 @@ impl Step<'_> {
                     let ve = p.vertex_edges(v);
                     let we = w * (1.0 - lambda) * two_phase::ALPHA / ve.len() as f64;
                     for &e in ve {
-                        sink.vertex(p.edge_other_vertex(e as usize, v as u32), we);
+                        sink.edge_end(p, e as usize, v as u32, we);
                     }
                     let vf = p.vertex_faces(v);
                     let wf = w * (1.0 - lambda) * (1.0 - two_phase::ALPHA) / vf.len() as f64;
                     for (&f, &c) in vf.iter().zip(p.vertex_face_local_indices(v)) {
                         let fv = p.face_vertices(f as usize);
-                        sink.vertex(fv[(c as usize + fv.len() / 2) % fv.len()], wf);
+                        sink.corner(p, f as usize, (c as usize + fv.len() / 2) % fv.len(), wf);
                     }
                     sink.vertex(v as u32, w * lambda);
                 }
@@ -612,10 +626,7 @@ impl Step<'_> {
                     let (a, b) = rules::crease_pair(ve.len(), |i| sharpness(ve[i] as usize) > 0.0);
                     let mu = two_phase::crease_vertex_weight(lambda);
                     for i in [a, b] {
-                        sink.vertex(
-                            p.edge_other_vertex(ve[i] as usize, v as u32),
-                            w * 0.5 * (1.0 - mu),
-                        );
+                        sink.edge_end(p, ve[i] as usize, v as u32, w * 0.5 * (1.0 - mu));
                     }
                     sink.vertex(v as u32, w * mu);
                 }

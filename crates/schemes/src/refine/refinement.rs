@@ -487,7 +487,7 @@ impl Refinement {
         &self.levels[level].rules
     }
 
-    fn step(&self, level: usize) -> super::Step<'_> {
+    pub(super) fn step(&self, level: usize) -> super::Step<'_> {
         let p = self.topology(level - 1);
         super::Step {
             parent: p,

@@ -1,0 +1,1082 @@
+//! Face-varying refinement: a channel's values (UVs) refined beside the vertices, with
+//! their own seams, as OpenSubdiv's `Vtr::FVarLevel`/`FVarRefinement` and
+//! `Far::PrimvarRefiner::InterpolateFaceVarying` do. The rules are digested in
+//! `docs/opensubdiv-face-varying.md` (section numbers below refer to it).
+//!
+//! Each level numbers its values by vertex: the values ("siblings") of vertex 0, then of
+//! vertex 1, ... . A value that matches its neighbours follows the geometric rule of its
+//! vertex; values on a seam (or, in the boundary modes, the mesh boundary) follow
+//! OpenSubdiv's face-varying crease and corner rules, chosen by [`FVarLinearInterpolation`].
+
+use subd_mesh::Topology;
+use subd_mesh::fvar::{FVarChannel, FVarError, FVarLinearInterpolation};
+use subd_mesh::tags::{is_infinite, is_semi_sharp};
+
+use super::{Layout, MaskSink, Refinement, half_sharpness, nm_vertex};
+use crate::Scheme;
+use crate::rules;
+use crate::stencil::{RowSink, StencilTable};
+use subd_mesh::BoundaryInterpolation;
+
+/// The tags of one face-varying value (`Vtr::FVarLevel::ValueTag`, the bits that change
+/// interpolation).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+struct ValueTag {
+    /// Not the one value of a smooth, seamless vertex.
+    mismatch: bool,
+    /// Refined with the crease rule (otherwise a mismatched value is a corner).
+    crease: bool,
+    /// A corner until its semi-sharp features decay.
+    semi_sharp: bool,
+    /// Semi-sharp because the other value at its vertex is (the two-value plus modes).
+    dep_sharp: bool,
+}
+
+impl ValueTag {
+    fn is_corner(self) -> bool {
+        !self.crease
+    }
+}
+
+/// The mode's consequences (§2.1).
+#[derive(Debug, Clone, Copy)]
+struct ModeFlags {
+    linear_all: bool,
+    linear_boundaries: bool,
+    dependent_sharpness: bool,
+    corners_sharp: bool,
+    smooth_corners_sharp: bool,
+    sharpen_both_if_one_corner: bool,
+    sharpen_darts: bool,
+}
+
+impl ModeFlags {
+    fn new(mode: FVarLinearInterpolation, boundary: BoundaryInterpolation) -> ModeFlags {
+        use FVarLinearInterpolation as M;
+        let linear_boundaries = matches!(mode, M::All | M::Boundaries);
+        let corners_sharp = mode != M::None;
+        ModeFlags {
+            linear_all: mode == M::All,
+            linear_boundaries,
+            dependent_sharpness: matches!(mode, M::CornersPlus1 | M::CornersPlus2),
+            corners_sharp,
+            smooth_corners_sharp: boundary != BoundaryInterpolation::EdgeAndCorner && corners_sharp,
+            sharpen_both_if_one_corner: mode == M::CornersPlus2,
+            sharpen_darts: mode == M::CornersPlus2 || linear_boundaries,
+        }
+    }
+
+    fn smooth_boundaries(self) -> bool {
+        !self.linear_boundaries
+    }
+}
+
+/// One level of a refined channel.
+#[derive(Debug, Clone)]
+struct ChannelLevel {
+    /// Where each vertex's values start (one more entry than vertices).
+    value_offsets: Vec<u32>,
+    /// The value of every face-vertex.
+    face_values: Vec<u32>,
+    /// Level 0 only: the caller's value index of each per-vertex value.
+    user: Option<Vec<u32>>,
+    tags: Vec<ValueTag>,
+    /// First and last local face (in the vertex's face order) of each crease value's span.
+    ends: Vec<[u16; 2]>,
+    /// Per edge: discontinuous at one end or both.
+    edge_mismatch: Vec<bool>,
+    /// Per edge: kept linear by the mode.
+    edge_linear: Vec<bool>,
+}
+
+impl ChannelLevel {
+    fn num_values(&self) -> usize {
+        *self.value_offsets.last().unwrap_or(&0) as usize
+    }
+
+    fn offset(&self, v: usize) -> usize {
+        self.value_offsets[v] as usize
+    }
+
+    fn count(&self, v: usize) -> usize {
+        (self.value_offsets[v + 1] - self.value_offsets[v]) as usize
+    }
+
+    /// The source index (into the values a stencil reads) of per-vertex value `slot`.
+    fn source(&self, slot: usize) -> u32 {
+        match &self.user {
+            Some(u) => u[slot],
+            None => slot as u32,
+        }
+    }
+
+    fn corner_slot(&self, t: &Topology, f: usize, k: usize) -> usize {
+        self.face_values[t.face_offsets()[f] as usize + k] as usize
+    }
+
+    /// The source of corner `k` of face `f`.
+    fn corner_source(&self, t: &Topology, f: usize, k: usize) -> u32 {
+        self.source(self.corner_slot(t, f, k))
+    }
+
+    /// The sources of edge `e`'s two ends (in edge order) inside its `j`-th face.
+    fn edge_face_sources(&self, t: &Topology, e: usize, j: usize) -> [u32; 2] {
+        let f = t.edge_faces(e)[j] as usize;
+        let l = t.edge_face_local_indices(e)[j] as usize;
+        let n = t.face_size(f);
+        let (here, next) = (
+            self.corner_source(t, f, l),
+            self.corner_source(t, f, (l + 1) % n),
+        );
+        if t.face_vertices(f)[l] == t.edge_vertices(e)[0] {
+            [here, next]
+        } else {
+            [next, here]
+        }
+    }
+
+    /// The crease end values of value `slot` of vertex `v` (§2.3 "crease end values"): the
+    /// far end of the span's leading edge and of its trailing edge.
+    fn crease_end_sources(&self, t: &Topology, v: usize, slot: usize) -> [u32; 2] {
+        let [s, e] = self.ends[slot];
+        let faces = t.vertex_faces(v);
+        let local = t.vertex_face_local_indices(v);
+        let after = |i: usize| {
+            let f = faces[i] as usize;
+            let n = t.face_size(f);
+            self.corner_source(t, f, (local[i] as usize + 1) % n)
+        };
+        let before = |i: usize| {
+            let f = faces[i] as usize;
+            let n = t.face_size(f);
+            self.corner_source(t, f, (local[i] as usize + n - 1) % n)
+        };
+        [after(s as usize), before(e as usize)]
+    }
+}
+
+/// Where a mask of a matching value reads: face-varying values in place of vertices.
+struct ValueSink<'a, 'b> {
+    level: &'a ChannelLevel,
+    row: &'a mut RowSink<'b>,
+}
+
+impl MaskSink for ValueSink<'_, '_> {
+    #[inline]
+    fn vertex(&mut self, i: u32, w: f64) {
+        // Only the centre vertex of a vertex mask comes here; it matches, so has one value.
+        self.row
+            .add(self.level.source(self.level.offset(i as usize)), w);
+    }
+
+    #[inline]
+    fn face(&mut self, p: &Topology, f: usize, w: f64) {
+        let n = p.face_size(f);
+        let inv = 1.0 / n as f64;
+        for k in 0..n {
+            self.row.add(self.level.corner_source(p, f, k), w * inv);
+        }
+    }
+
+    #[inline]
+    fn edge_end(&mut self, p: &Topology, e: usize, v: u32, w: f64) {
+        // Every edge at a matching value is continuous: any of its faces gives the value.
+        let [a, b] = self.level.edge_face_sources(p, e, 0);
+        let far_is_a = p.edge_vertices(e)[0] != v;
+        self.row.add(if far_is_a { a } else { b }, w);
+    }
+
+    #[inline]
+    fn corner(&mut self, p: &Topology, f: usize, k: usize, w: f64) {
+        self.row.add(self.level.corner_source(p, f, k), w);
+    }
+}
+
+/// A face-varying channel refined with a [`Refinement`]: per level, the values of every
+/// face corner and the [`StencilTable`] giving a level's values from the level above.
+///
+/// ```
+/// use subd_mesh::TopologyBuilder;
+/// use subd_mesh::fvar::{FVarChannel, FVarLinearInterpolation};
+/// use subd_schemes::{FaceVaryingRefinement, Options, Refinement, Scheme};
+///
+/// // Two quads whose UVs are cut apart along their shared edge 1-4.
+/// let t = TopologyBuilder::new(6).build(&[4, 4], &[0, 1, 4, 3, 1, 2, 5, 4]).unwrap();
+/// let uv = vec![0., 0., 1., 0., 1., 1., 0., 1., 2., 0., 3., 0., 3., 1., 2., 1.];
+/// let channel = FVarChannel::new(&t, 2, uv, (0..8).collect()).unwrap();
+/// let r = Refinement::new(&t, Scheme::CatmullClark, &Options::default(), 1).unwrap();
+/// let fr = FaceVaryingRefinement::new(&r, &channel, FVarLinearInterpolation::All).unwrap();
+/// let level1 = fr.refine_values(channel.values(), 2).pop().unwrap();
+/// // The seam's midpoint has one value per side.
+/// assert_eq!(fr.num_values(1), 18);
+/// assert_eq!(level1.len(), 2 * 18);
+/// ```
+#[derive(Debug, Clone)]
+pub struct FaceVaryingRefinement {
+    mode: FVarLinearInterpolation,
+    num_user_values: usize,
+    levels: Vec<ChannelLevel>,
+    stencils: Vec<StencilTable>,
+}
+
+impl FaceVaryingRefinement {
+    /// Refines `channel` (made for `refinement`'s base topology) to every level of
+    /// `refinement`, interpolated by `mode`.
+    ///
+    /// # Errors
+    /// [`FVarError::NoValues`] for a channel without values (OpenSubdiv refuses it too), and
+    /// [`FVarError::IndexCount`] when the channel does not have one index per face-vertex
+    /// of the base topology.
+    pub fn new(
+        refinement: &Refinement,
+        channel: &FVarChannel,
+        mode: FVarLinearInterpolation,
+    ) -> Result<FaceVaryingRefinement, FVarError> {
+        let base = refinement.topology(0);
+        if channel.num_values() == 0 {
+            return Err(FVarError::NoValues);
+        }
+        if channel.indices().len() != base.num_face_vertices() {
+            return Err(FVarError::IndexCount {
+                given: channel.indices().len(),
+                expected: base.num_face_vertices(),
+            });
+        }
+        let options = refinement.options();
+        let flags = ModeFlags::new(mode, options.boundary_interpolation);
+        let mut levels = vec![base_level(base, channel.indices(), flags)];
+        let mut stencils = Vec::with_capacity(refinement.num_levels());
+        for l in 1..=refinement.num_levels() {
+            let step = refinement.step(l);
+            let parent = &levels[l - 1];
+            let child = child_level(&step, parent, flags);
+            let num_sources = if l == 1 {
+                channel.num_values()
+            } else {
+                parent.num_values()
+            };
+            let table = StencilTable::build(child.num_values(), num_sources, |r, sink| {
+                value_row(&step, parent, &child, flags, r, sink)
+            });
+            stencils.push(table);
+            levels.push(child);
+        }
+        Ok(FaceVaryingRefinement {
+            mode,
+            num_user_values: channel.num_values(),
+            levels,
+            stencils,
+        })
+    }
+
+    /// The interpolation mode.
+    pub fn mode(&self) -> FVarLinearInterpolation {
+        self.mode
+    }
+
+    /// Number of refined levels.
+    pub fn num_levels(&self) -> usize {
+        self.levels.len() - 1
+    }
+
+    /// Number of values at `level`: the channel's own count at level 0, and at refined
+    /// levels the distinct values of every vertex (OpenSubdiv's `GetNumFVarValues`).
+    pub fn num_values(&self, level: usize) -> usize {
+        if level == 0 {
+            self.num_user_values
+        } else {
+            self.levels[level].num_values()
+        }
+    }
+
+    /// The value index of every face-vertex of `level` (the channel's own indices at level
+    /// 0; OpenSubdiv's `GetFaceFVarValues`, face after face).
+    pub fn face_values(&self, level: usize) -> Vec<u32> {
+        let l = &self.levels[level];
+        l.face_values
+            .iter()
+            .map(|&s| l.source(s as usize))
+            .collect()
+    }
+
+    /// Stencils giving the values of `level` from those of `level - 1` (`level ≥ 1`).
+    pub fn stencils(&self, level: usize) -> &StencilTable {
+        &self.stencils[level - 1]
+    }
+
+    /// One table from the channel's values to the values of `level`.
+    pub fn composed(&self, level: usize) -> StencilTable {
+        let mut t = StencilTable::identity(self.num_user_values);
+        for s in &self.stencils[..level] {
+            t = t.then(s);
+        }
+        t
+    }
+
+    /// The values of every level (`result[0]` is `values`), `components` numbers each.
+    ///
+    /// # Panics
+    /// If `values` is not `components` numbers per value of the channel.
+    pub fn refine_values(&self, values: &[f64], components: usize) -> Vec<Vec<f64>> {
+        assert_eq!(
+            values.len(),
+            components * self.num_user_values,
+            "components numbers per value"
+        );
+        let mut out = vec![values.to_vec()];
+        for s in &self.stencils {
+            let mut next = vec![0.0; s.num_rows() * components];
+            s.apply(out.last().expect("level 0"), components, &mut next);
+            out.push(next);
+        }
+        out
+    }
+}
+
+/// Per-vertex classification of the base level (`FVarLevel::completeTopologyFromFaceValues`,
+/// §2.2–2.3).
+fn base_level(t: &Topology, indices: &[u32], flags: ModeFlags) -> ChannelLevel {
+    let (nv, ne) = (t.num_vertices(), t.num_edges());
+    let fo = t.face_offsets();
+    let value_at = |f: u32, k: u16| indices[fo[f as usize] as usize + k as usize];
+    let mut edge_mismatch = vec![false; ne];
+    let mut edge_linear = vec![false; ne];
+    let mut mismatched = vec![false; nv];
+    // Per vertex-face, the sibling of the corner; per vertex, its distinct values.
+    let vfo = t.vertex_face_offsets();
+    let mut siblings = vec![0u16; vfo[nv] as usize];
+    let mut distinct_offsets = Vec::with_capacity(nv + 1);
+    let mut distinct: Vec<u32> = Vec::new();
+    let mut vals: Vec<u32> = Vec::new();
+    // First pass (§2.2), in vertex order: "not yet mismatched" depends on it.
+    for v in 0..nv {
+        let (faces, local, edges) = (
+            t.vertex_faces(v),
+            t.vertex_face_local_indices(v),
+            t.vertex_edges(v),
+        );
+        vals.clear();
+        vals.extend(faces.iter().zip(local).map(|(&f, &k)| value_at(f, k)));
+        let nf = faces.len();
+        let manifold = !nm_vertex(t, v);
+        let boundary = t.is_boundary_vertex(v);
+        let mut mark = |e: usize, mismatched: &mut [bool]| {
+            edge_mismatch[e] = true;
+            edge_linear[e] = flags.linear_boundaries;
+            let [a, b] = t.edge_vertices(e);
+            mismatched[a as usize] = true;
+            mismatched[b as usize] = true;
+        };
+        if manifold {
+            for i in usize::from(boundary)..nf {
+                let prev = if i == 0 { nf - 1 } else { i - 1 };
+                if vals[i] != vals[prev] {
+                    mark(edges[i] as usize, &mut mismatched);
+                }
+            }
+        } else if nf > 0 {
+            for &e in edges {
+                let e = e as usize;
+                let ef = t.edge_faces(e);
+                if ef.len() < 2 {
+                    continue;
+                }
+                let at_v = |j: usize| {
+                    let f = ef[j];
+                    let l = t.edge_face_local_indices(e)[j];
+                    let fv = t.face_vertices(f as usize);
+                    let k = if fv[l as usize] as usize == v {
+                        l
+                    } else {
+                        ((l as usize + 1) % fv.len()) as u16
+                    };
+                    value_at(f, k)
+                };
+                if (1..ef.len()).any(|j| at_v(j) != at_v(0)) {
+                    mark(e, &mut mismatched);
+                }
+            }
+        }
+        if boundary && !mismatched[v] {
+            if flags.linear_boundaries && nf > 0 {
+                mismatched[v] = true;
+                if manifold {
+                    edge_linear[edges[0] as usize] = true;
+                    edge_linear[edges[edges.len() - 1] as usize] = true;
+                } else {
+                    for &e in edges {
+                        if t.is_boundary_edge(e as usize) {
+                            edge_linear[e as usize] = true;
+                        }
+                    }
+                }
+            } else if nf == 1 && flags.smooth_corners_sharp {
+                mismatched[v] = true;
+            }
+        }
+        // Siblings: the k-th distinct value met walking the faces.
+        let first = distinct.len();
+        distinct_offsets.push(first as u32);
+        let sib = &mut siblings[vfo[v] as usize..vfo[v + 1] as usize];
+        for (i, &x) in vals.iter().enumerate() {
+            let k = match distinct[first..].iter().position(|&d| d == x) {
+                Some(k) => k,
+                None => {
+                    distinct.push(x);
+                    distinct.len() - first - 1
+                }
+            };
+            sib[i] = k as u16;
+        }
+        if nf == 0 {
+            // A vertex without faces still has one value, value 0.
+            distinct.push(0);
+        }
+        if !manifold && distinct.len() - first > 1 {
+            mismatched[v] = true;
+        }
+    }
+    distinct_offsets.push(distinct.len() as u32);
+    // Second pass (§2.3): the tags of each value of a mismatched vertex.
+    let num = distinct.len();
+    let mut tags = vec![ValueTag::default(); num];
+    let mut ends = vec![[0u16; 2]; num];
+    for v in 0..nv {
+        if !mismatched[v] {
+            continue;
+        }
+        let o = distinct_offsets[v] as usize;
+        let n = distinct_offsets[v + 1] as usize - o;
+        let sib = &siblings[vfo[v] as usize..vfo[v + 1] as usize];
+        classify_vertex(
+            t,
+            v,
+            n,
+            sib,
+            &edge_mismatch,
+            flags,
+            &mut tags[o..o + n],
+            &mut ends[o..o + n],
+        );
+    }
+    let face_values = (0..t.num_faces())
+        .flat_map(|f| {
+            let (faces_v, fo_f) = (t.face_vertices(f), fo[f] as usize);
+            let distinct = &distinct;
+            let distinct_offsets = &distinct_offsets;
+            (0..faces_v.len()).map(move |k| {
+                let v = faces_v[k] as usize;
+                let o = distinct_offsets[v] as usize;
+                let n = distinct_offsets[v + 1] as usize - o;
+                let x = indices[fo_f + k];
+                (o + distinct[o..o + n].iter().position(|&d| d == x).unwrap_or(0)) as u32
+            })
+        })
+        .collect();
+    ChannelLevel {
+        value_offsets: distinct_offsets,
+        face_values,
+        user: Some(distinct),
+        tags,
+        ends,
+        edge_mismatch,
+        edge_linear,
+    }
+}
+
+/// The span of one value around its vertex (`FVarLevel::ValueSpan`).
+#[derive(Debug, Clone, Copy, Default)]
+struct Span {
+    size: u16,
+    start: u16,
+    discts: u16,
+    semi: u16,
+    inf: u16,
+}
+
+/// Tags and crease ends of the `n` values of mismatched vertex `v` (`sib`: the sibling of
+/// each of its faces): `gatherValueSpans` and the per-value decisions of §2.3.
+#[allow(clippy::too_many_arguments)]
+fn classify_vertex(
+    t: &Topology,
+    v: usize,
+    n: usize,
+    sib: &[u16],
+    edge_mismatch: &[bool],
+    flags: ModeFlags,
+    tags: &mut [ValueTag],
+    ends: &mut [[u16; 2]],
+) {
+    let edges = t.vertex_edges(v);
+    let nf = sib.len();
+    let vs = t.vertex_sharpness(v);
+    let nonmanifold = nm_vertex(t, v);
+    let boundary = t.is_boundary_vertex(v);
+    let mut all_corners = flags.linear_boundaries
+        || is_infinite(vs)
+        || nonmanifold
+        || (flags.dependent_sharpness && n > 2)
+        || (flags.sharpen_darts && n == 1 && !boundary);
+    let mut spans = vec![Span::default(); n];
+    let classify_edge = |span: &mut Span, e: u32| {
+        let e = e as usize;
+        if edge_mismatch[e] {
+            span.discts += 1;
+        } else if is_infinite(t.edge_sharpness(e)) {
+            span.inf += 1;
+        } else if is_semi_sharp(t.edge_sharpness(e)) {
+            span.semi += 1;
+        }
+    };
+    if nonmanifold {
+        for s in &mut spans {
+            s.discts = 1;
+        }
+    } else if n == 1 && !boundary {
+        let s = &mut spans[0];
+        s.size = nf as u16;
+        let mut seen = false;
+        for (i, &e) in edges.iter().enumerate() {
+            let e = e as usize;
+            if edge_mismatch[e] {
+                if seen {
+                    s.discts = 1;
+                    break;
+                }
+                seen = true;
+                s.start = i as u16;
+            } else if is_infinite(t.edge_sharpness(e)) {
+                s.inf += 1;
+            } else if is_semi_sharp(t.edge_sharpness(e)) {
+                s.semi += 1;
+            }
+        }
+    } else if nf > 0 {
+        spans[0].size = 1;
+        let wraps = !boundary && sib[nf - 1] == 0;
+        if wraps {
+            classify_edge(&mut spans[0], edges[0]);
+        }
+        for i in 1..nf {
+            let k = sib[i] as usize;
+            if sib[i] == sib[i - 1] {
+                classify_edge(&mut spans[k], edges[i]);
+            } else {
+                if spans[k].size > 0 {
+                    spans[k].discts += 1;
+                }
+                spans[k].start = i as u16;
+            }
+            spans[k].size += 1;
+        }
+        if wraps {
+            spans[0].discts -= 1;
+        }
+    }
+    let mut dependent = false;
+    if flags.dependent_sharpness && n == 2 && !all_corners {
+        let (a, b) = (spans[0], spans[1]);
+        all_corners |= a.inf > 0 || b.inf > 0 || a.discts > 0 || b.discts > 0;
+        if flags.sharpen_both_if_one_corner {
+            all_corners |= a.size == 1 || b.size == 1;
+        }
+        dependent = (a.semi > 0) != (b.semi > 0);
+    }
+    for (k, s) in spans.iter().enumerate() {
+        let mut tag = ValueTag {
+            mismatch: true,
+            ..ValueTag::default()
+        };
+        let inf_sharp =
+            all_corners || s.inf > 0 || (s.size == 1 && flags.corners_sharp) || s.discts > 0;
+        if !inf_sharp {
+            if s.semi > 0 || is_semi_sharp(vs) {
+                tag.semi_sharp = true;
+            } else if dependent {
+                tag.semi_sharp = true;
+                tag.dep_sharp = true;
+            } else {
+                tag.crease = true;
+            }
+            if flags.smooth_boundaries() {
+                let (start, size) = (s.start as i64, s.size as i64);
+                let end = if k == 0 && start != 0 {
+                    start + size - 1 - nf as i64
+                } else {
+                    start + size - 1
+                };
+                ends[k] = [s.start, end as u16];
+            }
+        }
+        tags[k] = tag;
+    }
+}
+
+/// The channel at the child level of `step` (§3): value counts, face values, edge and value
+/// tags, crease ends, semi-sharp decay.
+fn child_level(step: &super::Step<'_>, parent: &ChannelLevel, flags: ModeFlags) -> ChannelLevel {
+    let p = step.parent;
+    let l: Layout = step.layout;
+    let (nv, nf, ne) = (p.num_vertices(), p.num_faces(), p.num_edges());
+    let ncv = l.num_child_vertices;
+    let quads = step.scheme != Scheme::Loop;
+    // Counts by child vertex, in child vertex order.
+    let mut offsets = Vec::with_capacity(ncv + 1);
+    let mut total = 0u32;
+    let vertex_mismatched = |v: usize| parent.tags[parent.offset(v)].mismatch;
+    for v in 0..nv {
+        offsets.push(total);
+        total += if vertex_mismatched(v) {
+            parent.count(v) as u32
+        } else {
+            1
+        };
+    }
+    if quads {
+        for _ in 0..nf {
+            offsets.push(total);
+            total += 1;
+        }
+    }
+    for e in 0..ne {
+        offsets.push(total);
+        total += if parent.edge_mismatch[e] {
+            p.edge_faces(e).len() as u32
+        } else {
+            1
+        };
+    }
+    offsets.push(total);
+    let num = total as usize;
+    // Face values from the parent faces' corners.
+    let vertex_value = |f: usize, k: usize| {
+        let v = p.face_vertices(f)[k] as usize;
+        let c = offsets[v];
+        if vertex_mismatched(v) {
+            c + (parent.corner_slot(p, f, k) - parent.offset(v)) as u32
+        } else {
+            c
+        }
+    };
+    let edge_value = |f: usize, k: usize| {
+        let e = p.face_edges(f)[k] as usize;
+        let c = offsets[l.edge_vertex_base as usize + e];
+        if parent.edge_mismatch[e] {
+            let j = p
+                .edge_faces(e)
+                .iter()
+                .zip(p.edge_face_local_indices(e))
+                .position(|(&ef, &el)| ef as usize == f && el as usize == k)
+                .unwrap_or(0);
+            c + j as u32
+        } else {
+            c
+        }
+    };
+    let mut face_values = Vec::with_capacity(4 * p.num_face_vertices());
+    for f in 0..nf {
+        let n = p.face_size(f);
+        if quads {
+            let fc = offsets[l.face_vertex_base as usize + f];
+            for k in 0..n {
+                let mut child = [
+                    vertex_value(f, k),
+                    edge_value(f, k),
+                    fc,
+                    edge_value(f, (k + n - 1) % n),
+                ];
+                // A quad's child k has the parent corner at position k.
+                if n == 4 {
+                    child.rotate_right(k);
+                }
+                face_values.extend(child);
+            }
+        } else {
+            let (v0, v1, v2) = (vertex_value(f, 0), vertex_value(f, 1), vertex_value(f, 2));
+            let (e0, e1, e2) = (edge_value(f, 0), edge_value(f, 1), edge_value(f, 2));
+            face_values.extend([v0, e0, e2, e0, v1, e1, e2, e1, v2, e1, e2, e0]);
+        }
+    }
+    // Edge tags: face-interior edges continuous, halves copy their parent.
+    let nce = l.half_edge_base as usize + 2 * ne;
+    let mut edge_mismatch = vec![false; nce];
+    let mut edge_linear = vec![false; nce];
+    for e in 0..ne {
+        for h in [0, 1] {
+            let c = l.half_edge_base as usize + 2 * e + h;
+            edge_mismatch[c] = parent.edge_mismatch[e];
+            edge_linear[c] = parent.edge_linear[e];
+        }
+    }
+    // Value tags and crease ends.
+    let mut tags = vec![ValueTag::default(); num];
+    let mut ends = vec![[0u16; 2]; num];
+    for (v, &co) in offsets[..nv].iter().enumerate() {
+        if vertex_mismatched(v) {
+            let (po, co, n) = (parent.offset(v), co as usize, parent.count(v));
+            tags[co..co + n].copy_from_slice(&parent.tags[po..po + n]);
+            ends[co..co + n].copy_from_slice(&parent.ends[po..po + n]);
+        }
+    }
+    let per_face = if quads { 2 } else { 3 };
+    for e in 0..ne {
+        if parent.edge_mismatch[e] || parent.edge_linear[e] {
+            let c = offsets[l.edge_vertex_base as usize + e] as usize;
+            let n = offsets[l.edge_vertex_base as usize + e + 1] as usize - c;
+            for j in 0..n {
+                tags[c + j] = ValueTag {
+                    mismatch: true,
+                    crease: flags.smooth_boundaries(),
+                    ..ValueTag::default()
+                };
+                if flags.smooth_boundaries() && parent.edge_mismatch[e] {
+                    ends[c + j] = [(per_face * j) as u16, (per_face * j + per_face - 1) as u16];
+                }
+            }
+        }
+    }
+    if flags.smooth_boundaries() {
+        reclassify_semi_sharp(step, parent, &offsets, flags, &mut tags);
+    }
+    ChannelLevel {
+        value_offsets: offsets,
+        face_values,
+        user: None,
+        tags,
+        ends,
+        edge_mismatch,
+        edge_linear,
+    }
+}
+
+/// Semi-sharp values whose features decayed become creases (`reclassifySemisharpValues`,
+/// §3.5). Child edges and faces keep the parent's order around a vertex child, so the
+/// child edge at a position is the half of the parent edge there.
+fn reclassify_semi_sharp(
+    step: &super::Step<'_>,
+    parent: &ChannelLevel,
+    offsets: &[u32],
+    flags: ModeFlags,
+    tags: &mut [ValueTag],
+) {
+    let p = step.parent;
+    let method = step.options.crease_method;
+    for (v, &co) in offsets[..p.num_vertices()].iter().enumerate() {
+        if !parent.tags[parent.offset(v)].mismatch {
+            continue;
+        }
+        let edges = p.vertex_edges(v);
+        let ps = p.vertex_sharpness(v);
+        let parent_semi_edges = edges
+            .iter()
+            .any(|&e| is_semi_sharp(p.edge_sharpness(e as usize)));
+        if !is_semi_sharp(ps) && !parent_semi_edges {
+            continue;
+        }
+        let cs = rules::child_vertex_sharpness(ps);
+        if is_semi_sharp(cs) || is_infinite(cs) {
+            continue;
+        }
+        let child_edge_semi =
+            |i: usize| is_semi_sharp(half_sharpness(p, edges[i] as usize, v, method));
+        let child_semi_edges = (0..edges.len()).any(child_edge_semi);
+        let (co, n) = (co as usize, parent.count(v));
+        let values = &mut tags[co..co + n];
+        let to_crease = |t: &mut ValueTag| {
+            t.crease = true;
+            t.semi_sharp = false;
+            t.dep_sharp = false;
+        };
+        if !child_semi_edges {
+            for t in values.iter_mut().filter(|t| t.semi_sharp) {
+                to_crease(t);
+            }
+            continue;
+        }
+        for (k, t) in values.iter_mut().enumerate() {
+            if t.semi_sharp && !t.dep_sharp {
+                let [s, e] = parent.ends[parent.offset(v) + k];
+                let still = span_interior_edges(s, e, edges.len()).any(child_edge_semi);
+                if !still {
+                    to_crease(t);
+                }
+            }
+        }
+        if flags.dependent_sharpness && n == 2 {
+            if values[0].dep_sharp && !values[1].semi_sharp {
+                values[0].dep_sharp = false;
+            }
+            if values[1].dep_sharp && !values[0].semi_sharp {
+                values[1].dep_sharp = false;
+            }
+        }
+    }
+}
+
+/// Positions of the edges inside a span of faces `s..=e` (with wrap-around): edges
+/// `s+1 ..= e`, edge `i` lying between faces `i-1` and `i`.
+fn span_interior_edges(s: u16, e: u16, num_edges: usize) -> impl Iterator<Item = usize> {
+    let (s, e) = (s as usize, e as usize);
+    let count = if e >= s { e - s } else { e + num_edges - s };
+    (1..=count).map(move |i| (s + i) % num_edges.max(1))
+}
+
+/// The mask of child value `r` (§4).
+fn value_row(
+    step: &super::Step<'_>,
+    parent: &ChannelLevel,
+    child: &ChannelLevel,
+    flags: ModeFlags,
+    r: usize,
+    sink: &mut RowSink,
+) {
+    let p = step.parent;
+    let l = step.layout;
+    let linear = flags.linear_all || step.scheme == Scheme::Bilinear;
+    let cv = child.value_offsets.partition_point(|&o| o as usize <= r) - 1;
+    let k = r - child.offset(cv);
+    let cv32 = cv as u32;
+    if cv32 >= l.face_vertex_base && cv32 < l.edge_vertex_base {
+        let f = (cv32 - l.face_vertex_base) as usize;
+        let n = p.face_size(f);
+        let inv = 1.0 / n as f64;
+        for c in 0..n {
+            sink.add(parent.corner_source(p, f, c), inv);
+        }
+    } else if cv32 >= l.edge_vertex_base {
+        let e = (cv32 - l.edge_vertex_base) as usize;
+        if child.tags[r].mismatch {
+            let [a, b] = parent.edge_face_sources(p, e, k);
+            sink.add(a, 0.5);
+            sink.add(b, 0.5);
+        } else if linear {
+            let [a, b] = parent.edge_face_sources(p, e, 0);
+            sink.add(a, 0.5);
+            sink.add(b, 0.5);
+        } else {
+            let mut s = ValueSink {
+                level: parent,
+                row: sink,
+            };
+            step.edge_row(e, step.child_rules[cv], &mut s);
+        }
+    } else {
+        let v = cv;
+        let pslot = parent.offset(v) + k;
+        if !parent.tags[parent.offset(v)].mismatch {
+            if linear {
+                sink.add(parent.source(pslot), 1.0);
+            } else {
+                let mut s = ValueSink {
+                    level: parent,
+                    row: sink,
+                };
+                step.vertex_row(v, &mut s);
+            }
+            return;
+        }
+        let tag = child.tags[r];
+        if linear || tag.is_corner() {
+            sink.add(parent.source(pslot), 1.0);
+            return;
+        }
+        let [end0, end1] = parent.crease_end_sources(p, v, pslot);
+        let (mut vw, mut ew) = (0.75, 0.125);
+        let ptag = parent.tags[pslot];
+        if ptag.semi_sharp {
+            let other = if ptag.dep_sharp { 1 - k.min(1) } else { k };
+            let w = fractional_weight(step, parent, v, parent.offset(v) + other) as f64;
+            vw = (1.0 - w) * 0.75 + w;
+            ew = (1.0 - w) * 0.125;
+        }
+        sink.add(end0, ew);
+        sink.add(end1, ew);
+        sink.add(parent.source(pslot), vw);
+    }
+}
+
+/// `FVarRefinement::getFractionalWeight` (§3.6): the fractional weight of the edges inside
+/// the span of value `slot` of vertex `v`, in `f32`.
+fn fractional_weight(step: &super::Step<'_>, parent: &ChannelLevel, v: usize, slot: usize) -> f32 {
+    let p = step.parent;
+    let method = step.options.crease_method;
+    let edges = p.vertex_edges(v);
+    let [s, e] = parent.ends[slot];
+    let ps = p.vertex_sharpness(v);
+    let interior = span_interior_edges(s, e, edges.len()).map(|i| {
+        let e = edges[i] as usize;
+        (p.edge_sharpness(e), half_sharpness(p, e, v, method))
+    });
+    rules::fractional_weight(ps, rules::child_vertex_sharpness(ps), interior, method)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Options;
+    use subd_mesh::{DVec3, TopologyBuilder};
+
+    /// A 3 × 3 grid of quads (16 vertices), z bumped so no two rules agree by accident.
+    fn grid() -> (Topology, Vec<DVec3>) {
+        let mut faces = Vec::new();
+        for y in 0..3u32 {
+            for x in 0..3u32 {
+                let v = 4 * y + x;
+                faces.extend([v, v + 1, v + 5, v + 4]);
+            }
+        }
+        let t = TopologyBuilder::new(16).build(&[4; 9], &faces).unwrap();
+        let p = (0..16)
+            .map(|i| {
+                let (x, y) = ((i % 4) as f64, (i / 4) as f64);
+                DVec3::new(x, y, (x * 1.3 + y * y * 0.7).sin())
+            })
+            .collect();
+        (t, p)
+    }
+
+    /// Per face-vertex values of a refined channel.
+    fn corners(fr: &FaceVaryingRefinement, values: &[f64], c: usize, level: usize) -> Vec<f64> {
+        let v = fr.refine_values(values, c).swap_remove(level);
+        fr.face_values(level)
+            .iter()
+            .flat_map(|&i| v[c * i as usize..c * (i as usize + 1)].to_vec())
+            .collect()
+    }
+
+    #[test]
+    fn a_seamless_channel_in_mode_none_is_refined_as_the_positions() {
+        let (mut t, p) = grid();
+        let e = t.find_edge(5, 6).unwrap() as usize;
+        t.set_edge_sharpness(e, 1.5);
+        t.set_vertex_sharpness(10, 2.25);
+        let xyz: Vec<f64> = p.iter().flat_map(|q| q.to_array()).collect();
+        let tri_faces: Vec<u32> = (0..9)
+            .flat_map(|f| {
+                let q = t.face_vertices(f);
+                [q[0], q[1], q[2], q[0], q[2], q[3]]
+            })
+            .collect();
+        let mut tris = TopologyBuilder::new(16)
+            .build(&[3; 18], &tri_faces)
+            .unwrap();
+        let e = tris.find_edge(5, 6).unwrap() as usize;
+        tris.set_edge_sharpness(e, 1.5);
+        tris.set_vertex_sharpness(10, 2.25);
+        for (scheme, t) in [
+            (Scheme::CatmullClark, &t),
+            (Scheme::Bilinear, &t),
+            (Scheme::Loop, &tris),
+        ] {
+            let r = Refinement::new(t, scheme, &Options::default(), 3).unwrap();
+            let channel =
+                FVarChannel::new(t, 3, xyz.clone(), t.all_face_vertices().to_vec()).unwrap();
+            let fr =
+                FaceVaryingRefinement::new(&r, &channel, FVarLinearInterpolation::None).unwrap();
+            let pts = r.refine_points(&p);
+            for (level, level_points) in pts.iter().enumerate().skip(1) {
+                assert_eq!(fr.num_values(level), r.num_vertices(level));
+                let got = corners(&fr, &xyz, 3, level);
+                let (_, fv) = r.faces(level);
+                for (k, &v) in fv.iter().enumerate() {
+                    let want = level_points[v as usize].to_array();
+                    for d in 0..3 {
+                        assert!(
+                            (got[3 * k + d] - want[d]).abs() < 1e-13,
+                            "{scheme:?} L{level} corner {k} vertex {v}: {got:?} {want:?}",
+                            got = &got[3 * k..3 * k + 3]
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn mode_all_is_the_bilinear_refinement_of_the_uv_layout() {
+        let (t, _) = grid();
+        // Every face its own UV island except the middle column, which shares its values.
+        let mut indices = Vec::new();
+        let mut uv = Vec::new();
+        for f in 0..9 {
+            for (k, &v) in t.face_vertices(f).iter().enumerate() {
+                if f % 3 == 1 {
+                    indices.push(100 + v);
+                } else {
+                    indices.push((4 * f + k) as u32);
+                }
+            }
+        }
+        for i in 0..116u32 {
+            uv.extend([(i as f64 * 0.37).sin(), (i as f64 * 0.11).cos()]);
+        }
+        let channel = FVarChannel::new(&t, 2, uv.clone(), indices.clone()).unwrap();
+        let layout = TopologyBuilder::new(116).build(&[4; 9], &indices).unwrap();
+        let layout_points: Vec<DVec3> = (0..116)
+            .map(|i| DVec3::new(uv[2 * i], uv[2 * i + 1], 0.0))
+            .collect();
+        let bilinear = Refinement::new(&layout, Scheme::Bilinear, &Options::default(), 3)
+            .unwrap()
+            .refine_points(&layout_points);
+        let r = Refinement::new(&t, Scheme::CatmullClark, &Options::default(), 3).unwrap();
+        let fr = FaceVaryingRefinement::new(&r, &channel, FVarLinearInterpolation::All).unwrap();
+        let lr = Refinement::new(&layout, Scheme::Bilinear, &Options::default(), 3).unwrap();
+        for (level, level_points) in bilinear.iter().enumerate().skip(1) {
+            let got = corners(&fr, &uv, 2, level);
+            let (_, fv) = lr.faces(level);
+            for (k, &v) in fv.iter().enumerate() {
+                let want = level_points[v as usize];
+                assert!((got[2 * k] - want.x).abs() < 1e-14);
+                assert!((got[2 * k + 1] - want.y).abs() < 1e-14);
+            }
+        }
+    }
+
+    #[test]
+    fn corners_only_pins_the_corners_of_the_layout_and_none_does_not() {
+        let (t, p) = grid();
+        let uv: Vec<f64> = p.iter().flat_map(|q| [q.x + 0.1 * q.z, q.y]).collect();
+        let channel = FVarChannel::new(&t, 2, uv.clone(), t.all_face_vertices().to_vec()).unwrap();
+        let r = Refinement::new(&t, Scheme::CatmullClark, &Options::default(), 2).unwrap();
+        let at_vertex0 = |mode| {
+            let fr = FaceVaryingRefinement::new(&r, &channel, mode).unwrap();
+            let v = fr.refine_values(&uv, 2).swap_remove(2);
+            // Vertex 0 keeps its index at every level and has one value.
+            [v[0], v[1]]
+        };
+        assert_eq!(
+            at_vertex0(FVarLinearInterpolation::CornersOnly),
+            [uv[0], uv[1]]
+        );
+        assert_ne!(at_vertex0(FVarLinearInterpolation::None), [uv[0], uv[1]]);
+        // Every stencil row of every mode sums to one.
+        for mode in FVarLinearInterpolation::ALL_MODES {
+            let fr = FaceVaryingRefinement::new(&r, &channel, mode).unwrap();
+            let table = fr.composed(2);
+            for i in 0..table.num_rows() {
+                let s: f64 = table.row(i).1.iter().sum();
+                assert!((s - 1.0).abs() < 1e-14, "{mode:?} row {i}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_seam_doubles_the_values_of_its_vertices_and_edge_children() {
+        let t = TopologyBuilder::new(6)
+            .build(&[4, 4], &[0, 1, 4, 3, 1, 2, 5, 4])
+            .unwrap();
+        let channel =
+            FVarChannel::new(&t, 1, (0..8).map(f64::from).collect(), (0..8).collect()).unwrap();
+        let r = Refinement::new(&t, Scheme::CatmullClark, &Options::default(), 2).unwrap();
+        let fr = FaceVaryingRefinement::new(&r, &channel, FVarLinearInterpolation::CornersPlus1)
+            .unwrap();
+        // Level 1: 6 vertices (1 and 4 doubled: 8), 2 face points, 7 edges (1-4 doubled: 8).
+        assert_eq!(fr.num_values(1), 18);
+        let v = fr.refine_values(channel.values(), 1).swap_remove(1);
+        // The seam's edge child on each side is the midpoint of that side's values.
+        let fv = fr.face_values(1);
+        // Face 0's child 1 is (E0, V1, E1, F); E1 of face 0 is edge 1-4, the seam.
+        let seam_side0 = v[fv[4 + 2] as usize];
+        assert_eq!(seam_side0, 0.5 * (1.0 + 2.0));
+    }
+}
