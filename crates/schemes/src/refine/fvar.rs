@@ -537,18 +537,15 @@ fn classify_vertex(
         s.size = nf as u16;
         let mut seen = false;
         for (i, &e) in edges.iter().enumerate() {
-            let e = e as usize;
-            if edge_mismatch[e] {
-                if seen {
-                    s.discts = 1;
-                    break;
-                }
+            if !edge_mismatch[e as usize] {
+                classify_edge(s, e);
+            } else if seen {
+                // A second discontinuous edge: the one value is split in two (disjoint).
+                s.discts = 1;
+                break;
+            } else {
                 seen = true;
                 s.start = i as u16;
-            } else if is_infinite(t.edge_sharpness(e)) {
-                s.inf += 1;
-            } else if is_semi_sharp(t.edge_sharpness(e)) {
-                s.semi += 1;
             }
         }
     } else if nf > 0 {
