@@ -235,6 +235,7 @@ fn isoline_through_an_extraordinary_region_is_sampled() {
         topology: t1,
         positions: p1,
         hints: Default::default(),
+        fvar: Vec::new(),
     };
     let line = Isoline {
         face: 0,
@@ -295,6 +296,7 @@ fn edits_are_reversible_commutative_and_additive() {
             topology: m.topology.clone(),
             positions: x1,
             hints: Default::default(),
+            fvar: Vec::new(),
         };
         let (_, x2) = edit(&m1, &back, method);
         for (a, b) in x2.iter().zip(&m.positions) {
@@ -310,6 +312,7 @@ fn edits_are_reversible_commutative_and_additive() {
             topology: m.topology.clone(),
             positions: h1,
             hints: Default::default(),
+            fvar: Vec::new(),
         };
         let (_, h2) = edit(&m_h, &half, method);
         for (a, b) in h2.iter().zip(&x) {
@@ -822,6 +825,7 @@ fn valence_disk(n: usize) -> subd_mesh::Mesh {
         topology: r.topology(3).clone(),
         positions: pts,
         hints: Default::default(),
+        fvar: Vec::new(),
     }
 }
 
@@ -1052,5 +1056,6 @@ fn triangulate(m: &subd_mesh::Mesh) -> subd_mesh::Mesh {
         topology,
         positions: m.positions.clone(),
         hints: Default::default(),
+        fvar: Vec::new(),
     }
 }

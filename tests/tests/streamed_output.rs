@@ -80,6 +80,7 @@ fn streamed_last_level_files_equal_the_held_ones() {
             boundary_interpolation: Some(options.boundary_interpolation),
             crease_method: Some(options.crease_method),
             triangle_subdivision: file.mesh.hints.triangle_subdivision,
+            fvar_interpolation: None,
         };
         for &scheme in schemes {
             for levels in 1..=2 {

@@ -22,6 +22,13 @@
 // isolation) and a uniform Bfr::Tessellation at RATE for every face with a surface; output
 // u32 count, then per point u32 face, u32 sub-face (0 unless the face is parameterised by
 // quad sub-faces), f64 u, f64 v (the sub-face's normalised coordinates), f64 P[3].
+// With --fvar MODE (Sdc's FVarLinearInterpolation, 0 none .. 5 all), the input continues with
+// one face-varying channel of 2-component values: u32 nvalues, f64 values[2 nvalues],
+// u32 index[nidx] (one per face-vertex). The channel is refined with
+// PrimvarRefinerReal<double>::InterpolateFaceVarying; output per level 1..L: u32 nvalues,
+// u32 nfv, u32 faceValues[nfv] (GetFaceFVarValues, face after face), f64 values[2 nvalues].
+// --fvar-limit MODE then applies LimitFaceVarying at level L instead: u32 nvalues,
+// f64 values[2 nvalues].
 // With --bfr-bench RATE REPEATS: the median time of building the factory and, for every
 // face, its surface, tessellation coordinates, patch points and positions with first
 // derivatives; one line of JSON.
@@ -72,6 +79,15 @@ struct Point {
     }
 };
 
+struct Uv {
+    double p[2];
+    void Clear() { p[0] = p[1] = 0.0; }
+    void AddWithWeight(Uv const &src, double w) {
+        p[0] += w * src.p[0];
+        p[1] += w * src.p[1];
+    }
+};
+
 template <typename T> void put(std::vector<unsigned char> &out, T v) {
     size_t n = out.size();
     out.resize(n + sizeof(T));
@@ -91,7 +107,19 @@ struct Mesh {
     std::vector<Far::Index> corners;
     std::vector<float> cornerWeights;
     std::vector<Far::Index> holes;
+    std::vector<Uv> fvarValues;
+    std::vector<Far::Index> fvarIndices;
 };
+
+// The face-varying channel that follows the mesh for --fvar.
+void readFVar(Reader &r, Mesh &m) {
+    uint32_t nvalues = r.get<uint32_t>();
+    m.fvarValues.resize(nvalues);
+    for (auto &v : m.fvarValues)
+        for (double &c : v.p) c = r.get<double>();
+    m.fvarIndices.resize(m.idx.size());
+    for (auto &i : m.fvarIndices) i = (Far::Index)r.get<uint32_t>();
+}
 
 Mesh readMesh(Reader &r) {
     if (r.data.size() < 8 || std::memcmp(r.data.data(), "SUBDOSD1", 8) != 0)
@@ -149,6 +177,13 @@ Far::TopologyRefiner *createRefiner(Mesh const &m) {
     desc.cornerWeights = m.cornerWeights.data();
     desc.numHoles = (int)m.holes.size();
     desc.holeIndices = m.holes.data();
+    Far::TopologyDescriptor::FVarChannel channel;
+    if (!m.fvarIndices.empty()) {
+        channel.numValues = (int)m.fvarValues.size();
+        channel.valueIndices = m.fvarIndices.data();
+        desc.numFVarChannels = 1;
+        desc.fvarChannels = &channel;
+    }
     typedef Far::TopologyRefinerFactory<Far::TopologyDescriptor> Factory;
     Far::TopologyRefiner *refiner =
         Factory::Create(desc, Factory::Options(m.scheme, m.options));
@@ -374,6 +409,43 @@ int main(int argc, char **argv) {
             }
             std::fwrite(out.data(), 1, out.size(), stdout);
             delete table;
+            delete refiner;
+            return 0;
+        }
+        bool fvarLimit = argc > 2 && std::string(argv[1]) == "--fvar-limit";
+        if (fvarLimit || (argc > 2 && std::string(argv[1]) == "--fvar")) {
+            m.options.SetFVarLinearInterpolation((Sdc::Options::FVarLinearInterpolation)std::atoi(argv[2]));
+            readFVar(r, m);
+            Far::TopologyRefiner *refiner = createRefiner(m);
+            Far::TopologyRefiner::UniformOptions uo(m.levels);
+            uo.fullTopologyInLastLevel = true;
+            refiner->RefineUniform(uo);
+            Far::PrimvarRefinerReal<double> primvar(*refiner);
+            std::vector<std::vector<Uv>> values(m.levels + 1);
+            values[0] = m.fvarValues;
+            std::vector<unsigned char> out;
+            for (int l = 1; l <= m.levels; ++l) {
+                Far::TopologyLevel const &lev = refiner->GetLevel(l);
+                values[l].resize(lev.GetNumFVarValues(0));
+                primvar.InterpolateFaceVarying(l, values[l - 1], values[l], 0);
+                if (fvarLimit) continue;
+                put<uint32_t>(out, (uint32_t)values[l].size());
+                put<uint32_t>(out, (uint32_t)lev.GetNumFaceVertices());
+                for (int f = 0; f < lev.GetNumFaces(); ++f) {
+                    Far::ConstIndexArray fv = lev.GetFaceFVarValues(f, 0);
+                    for (int k = 0; k < fv.size(); ++k) put<uint32_t>(out, (uint32_t)fv[k]);
+                }
+                for (auto const &v : values[l])
+                    for (double c : v.p) put<double>(out, c);
+            }
+            if (fvarLimit) {
+                std::vector<Uv> limit(values[m.levels].size());
+                primvar.LimitFaceVarying(values[m.levels], limit, 0);
+                put<uint32_t>(out, (uint32_t)limit.size());
+                for (auto const &v : limit)
+                    for (double c : v.p) put<double>(out, c);
+            }
+            std::fwrite(out.data(), 1, out.size(), stdout);
             delete refiner;
             return 0;
         }

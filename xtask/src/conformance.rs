@@ -58,7 +58,7 @@ impl Row {
 }
 
 /// Levels to check: up to 3, fewer where the mesh would grow past [`MAX_VERTICES`].
-fn levels_for(topo: &Topology, scheme: Scheme) -> usize {
+pub(crate) fn levels_for(topo: &Topology, scheme: Scheme) -> usize {
     let mut faces = topo.num_face_vertices() as f64;
     let mut levels = 0;
     while levels < 3 {
@@ -1056,7 +1056,7 @@ fn compare_limit(
     row
 }
 
-fn scheme_of(name: &str) -> Option<Scheme> {
+pub(crate) fn scheme_of(name: &str) -> Option<Scheme> {
     if name.starts_with("catmark_") {
         Some(Scheme::CatmullClark)
     } else if name.starts_with("loop_") {

@@ -12,6 +12,7 @@ mod batch_bench;
 mod bench;
 mod conformance;
 mod editing_bench;
+mod fvar_conformance;
 mod geom_conformance;
 mod geom_ref;
 mod osd;
@@ -48,6 +49,10 @@ enum Task {
         /// Which references: OpenSubdiv, CGAL and OpenMesh, or all.
         #[arg(long, value_enum, default_value = "all")]
         against: Against,
+        /// Only the face-varying checks (OpenSubdiv's InterpolateFaceVarying and
+        /// LimitFaceVarying).
+        #[arg(long)]
+        fvar_only: bool,
     },
     /// Time subd against OpenSubdiv on ~100k-face meshes (levels 1..L, 1 and all threads).
     Bench {
@@ -234,14 +239,19 @@ fn main() -> ExitCode {
             shapes,
             random,
             against,
+            fvar_only,
         } => ensure_system_packages(REFERENCE_PACKAGES).and_then(|_| {
             let mut rows = Vec::new();
             if against != Against::CgalOpenmesh {
                 let exe = osd::build_harness()?;
-                rows.extend(conformance::shapes(&exe, &shapes)?);
-                rows.extend(conformance::random(&exe, random));
+                if !fvar_only {
+                    rows.extend(conformance::shapes(&exe, &shapes)?);
+                    rows.extend(conformance::random(&exe, random));
+                }
+                rows.extend(fvar_conformance::shapes(&exe, &shapes)?);
+                rows.extend(fvar_conformance::random(&exe, random));
             }
-            if against != Against::Opensubdiv {
+            if against != Against::Opensubdiv && !fvar_only {
                 let geom = geom_ref::build_harness()?;
                 rows.extend(geom_conformance::shapes(&geom, &shapes)?);
                 rows.extend(geom_conformance::random(&geom, random));

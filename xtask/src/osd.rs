@@ -286,3 +286,75 @@ pub fn decode_eval(bytes: &[u8], count: usize) -> Result<Vec<[DVec3; 6]>, String
         })
         .collect())
 }
+
+/// Appends a two-component face-varying channel (values, one index per face-vertex) to an
+/// encoded mesh for `--fvar` / `--fvar-limit`.
+pub fn encode_fvar(mut input: Vec<u8>, values: &[f64], indices: &[u32]) -> Vec<u8> {
+    input.extend_from_slice(&((values.len() / 2) as u32).to_le_bytes());
+    for x in values {
+        input.extend_from_slice(&x.to_le_bytes());
+    }
+    for i in indices {
+        input.extend_from_slice(&i.to_le_bytes());
+    }
+    input
+}
+
+/// One refined level of a face-varying channel as OpenSubdiv produced it.
+pub struct OsdFVarLevel {
+    /// `GetFaceFVarValues`, face after face.
+    pub face_values: Vec<u32>,
+    /// Two numbers per value.
+    pub values: Vec<f64>,
+}
+
+/// Little-endian reader of the harness output.
+struct Cursor<'a> {
+    bytes: &'a [u8],
+    pos: usize,
+}
+
+impl Cursor<'_> {
+    fn take(&mut self, n: usize) -> Result<&[u8], String> {
+        let s = self
+            .bytes
+            .get(self.pos..self.pos + n)
+            .ok_or("harness output truncated")?;
+        self.pos += n;
+        Ok(s)
+    }
+    fn u32(&mut self) -> Result<u32, String> {
+        Ok(u32::from_le_bytes(self.take(4)?.try_into().unwrap()))
+    }
+    fn f64s(&mut self, n: usize) -> Result<Vec<f64>, String> {
+        Ok(self
+            .take(8 * n)?
+            .chunks_exact(8)
+            .map(|c| f64::from_le_bytes(c.try_into().unwrap()))
+            .collect())
+    }
+}
+
+/// Decodes `--fvar` output: `levels` refined levels of the channel.
+pub fn decode_fvar(bytes: &[u8], levels: usize) -> Result<Vec<OsdFVarLevel>, String> {
+    let mut c = Cursor { bytes, pos: 0 };
+    (0..levels)
+        .map(|_| {
+            let nvalues = c.u32()? as usize;
+            let nfv = c.u32()? as usize;
+            let face_values = (0..nfv).map(|_| c.u32()).collect::<Result<Vec<_>, _>>()?;
+            let values = c.f64s(2 * nvalues)?;
+            Ok(OsdFVarLevel {
+                face_values,
+                values,
+            })
+        })
+        .collect()
+}
+
+/// Decodes `--fvar-limit` output: two numbers per value of the last level.
+pub fn decode_fvar_limit(bytes: &[u8]) -> Result<Vec<f64>, String> {
+    let mut c = Cursor { bytes, pos: 0 };
+    let n = c.u32()? as usize;
+    c.f64s(2 * n)
+}

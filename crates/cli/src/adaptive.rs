@@ -439,6 +439,7 @@ fn write(job: &Job, mesh: &AdaptiveMesh, options: &subd_schemes::Options) -> Res
         boundary_interpolation: Some(options.boundary_interpolation),
         crease_method: Some(options.crease_method),
         triangle_subdivision: Some(options.triangle_subdivision),
+        fvar_interpolation: None,
     };
     subd_io::write_view(&job.output, &view, &subd_io::WriteOptions::default())?;
     Ok(())

@@ -413,6 +413,7 @@ fn output_hints(
         triangle_subdivision: read
             .triangle_subdivision
             .or(rules.triangles.map(|_| options.triangle_subdivision)),
+        fvar_interpolation: read.fvar_interpolation,
     }
 }
 

@@ -1395,6 +1395,7 @@ fn refine_output_equals_the_fully_built_level() {
             boundary_interpolation: Some(options.boundary_interpolation),
             crease_method: Some(options.crease_method),
             triangle_subdivision: file.mesh.hints.triangle_subdivision,
+            fvar_interpolation: None,
         };
         let tags = mesh.topology.tags();
         tagged += (tags.num_creased_edges() > 0 || tags.vertex_sharpness().iter().any(|&s| s > 0.0))

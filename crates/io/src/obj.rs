@@ -18,6 +18,7 @@
 
 use std::io::Write;
 
+use subd_mesh::fvar::{FVarChannel, FVarLinearInterpolation};
 use subd_mesh::{
     BoundaryInterpolation, CreaseMethod, DVec3, Mesh, SchemeHints, TopologyBuilder,
     TriangleSubdivision,
@@ -44,17 +45,62 @@ fn is_statement_name(s: &str) -> bool {
             .all(|b| b.is_ascii_alphanumeric() || b == b'_' || b == b'#')
 }
 
+/// The statements of an OBJ file that make a mesh, before any checking across lines.
+#[derive(Default)]
+struct ObjStatements {
+    positions: Vec<DVec3>,
+    /// `vt` lines: (u, v); a third coordinate is dropped.
+    texcoords: Vec<[f64; 2]>,
+    face_sizes: Vec<u32>,
+    face_vertices: Vec<u32>,
+    /// Per face-vertex, its `vt` index, for the faces that give one.
+    face_texcoords: Vec<u32>,
+    /// Faces that give `vt` indices, and the line of the first that gives none.
+    faces_with_texcoords: usize,
+    first_face_without_texcoords: Option<usize>,
+    face_lines: Vec<u32>,
+    tags: Vec<TagLine>,
+    warnings: Vec<String>,
+}
+
 /// Parses OBJ text. Errors carry the 1-based line number.
 pub fn parse_obj(bytes: &[u8], options: &ReadOptions) -> Result<MeshFile, ReadError> {
-    let mut positions: Vec<DVec3> = Vec::new();
-    let mut face_sizes: Vec<u32> = Vec::new();
-    let mut face_vertices: Vec<u32> = Vec::new();
-    let mut face_lines: Vec<u32> = Vec::new();
-    let mut tags: Vec<TagLine> = Vec::new();
-    let mut warnings: Vec<String> = Vec::new();
-    let mut unknown_reported = false;
-    let mut raw_indices: Vec<i64> = Vec::new();
+    let mut st = read_statements(bytes)?;
+    check_face_indices(&st)?;
+    let (mut topology, orientation_conflicts) = build_topology(&mut st, options)?;
+    let mut hints = SchemeHints::default();
+    let mut extra_tags = Vec::new();
+    for tag in &st.tags {
+        apply_tag(
+            tag,
+            &mut topology,
+            &mut hints,
+            &mut st.warnings,
+            &mut extra_tags,
+        )?;
+    }
+    let uv = texcoord_channel(&mut st, &topology)?;
+    let mut mesh =
+        Mesh::new(topology, std::mem::take(&mut st.positions)).map_err(ReadError::Topology)?;
+    mesh.hints = hints;
+    if let Some(uv) = uv {
+        mesh = mesh
+            .with_fvar(uv)
+            .map_err(|e| ReadError::general(e.to_string()))?;
+    }
+    Ok(MeshFile {
+        mesh,
+        warnings: st.warnings,
+        extra_tags,
+        orientation_conflicts,
+        face_levels: None,
+    })
+}
 
+/// Reads the file line by line into its statements (joining `\`-continued lines).
+fn read_statements(bytes: &[u8]) -> Result<ObjStatements, ReadError> {
+    let mut st = ObjStatements::default();
+    let mut unknown_reported = false;
     let mut line_no = 0usize;
     let mut rest = bytes;
     let mut joined = String::new();
@@ -95,92 +141,31 @@ pub fn parse_obj(bytes: &[u8], options: &ReadOptions) -> Result<MeshFile, ReadEr
         }
         match keyword {
             "v" => {
-                let mut p = [0.0f64; 3];
-                for (k, slot) in p.iter_mut().enumerate() {
-                    let tok = tokens.next().ok_or_else(|| {
-                        ReadError::line(
-                            this_line,
-                            format!("vertex has {k} coordinates; 3 are needed"),
-                        )
-                    })?;
-                    *slot = tok.parse::<f64>().map_err(|_| {
-                        ReadError::line(
-                            this_line,
-                            format!("vertex coordinate {tok:?} is not a number"),
-                        )
-                    })?;
-                    if !slot.is_finite() {
-                        return Err(ReadError::line(
-                            this_line,
-                            format!(
-                                "vertex {} has a non-finite coordinate {tok:?}",
-                                positions.len() + 1
-                            ),
-                        ));
-                    }
-                }
-                positions.push(DVec3::from_array(p));
+                let p = read_coordinates::<3>(this_line, tokens, "vertex", st.positions.len())?;
+                st.positions.push(DVec3::from_array(p));
             }
-            "f" | "fo" => {
-                raw_indices.clear();
-                for tok in tokens {
-                    let head = tok.split('/').next().unwrap_or("");
-                    let idx = head.parse::<i64>().map_err(|_| {
-                        ReadError::line(this_line, format!("face vertex {tok:?} is not an index"))
-                    })?;
-                    let resolved = if idx > 0 {
-                        idx - 1
-                    } else if idx < 0 {
-                        let r = positions.len() as i64 + idx;
-                        if r < 0 {
-                            return Err(ReadError::line(
-                                this_line,
-                                format!(
-                                    "relative face index {idx} points before the first vertex ({} vertices read so far)",
-                                    positions.len()
-                                ),
-                            ));
-                        }
-                        r
-                    } else {
-                        return Err(ReadError::line(
-                            this_line,
-                            "face index 0 is invalid (OBJ indices start at 1)",
-                        ));
-                    };
-                    raw_indices.push(resolved);
-                }
-                if raw_indices.len() < 3 {
-                    return Err(ReadError::line(
-                        this_line,
-                        format!(
-                            "face has {} vertices; a face needs at least 3",
-                            raw_indices.len()
-                        ),
-                    ));
-                }
-                if raw_indices.len() >= u32::MAX as usize {
-                    return Err(ReadError::line(this_line, "face has too many vertices"));
-                }
-                for &i in &raw_indices {
-                    // Range against the final vertex count is checked once all lines are read.
-                    face_vertices.push(u32::try_from(i).unwrap_or(u32::MAX));
-                }
-                face_sizes.push(raw_indices.len() as u32);
-                face_lines.push(this_line as u32);
+            "vt" => {
+                let uv = read_coordinates::<2>(
+                    this_line,
+                    tokens,
+                    "texture coordinate",
+                    st.texcoords.len(),
+                )?;
+                st.texcoords.push(uv);
             }
+            "f" | "fo" => read_face(this_line, tokens, &mut st)?,
             "t" => {
                 let tag = parse_tag(this_line, text, tokens)?;
-                tags.push(tag);
+                st.tags.push(tag);
             }
-            "vt" | "vn" | "vp" | "o" | "g" | "s" | "mg" | "usemtl" | "mtllib" | "l" | "p"
-            | "lod" | "bevel" | "c_interp" | "d_interp" | "shadow_obj" | "trace_obj" | "maplib"
+            "vn" | "vp" | "o" | "g" | "s" | "mg" | "usemtl" | "mtllib" | "l" | "p" | "lod"
+            | "bevel" | "c_interp" | "d_interp" | "shadow_obj" | "trace_obj" | "maplib"
             | "usemap" | "cstype" | "deg" | "bmat" | "step" | "curv" | "curv2" | "surf"
             | "parm" | "trim" | "hole" | "scrv" | "sp" | "end" | "con" | "ctech" | "stech"
             | "call" | "csh" => {}
             other if is_statement_name(other) => {
                 if !unknown_reported {
-                    warnings.push(format!(
+                    st.warnings.push(format!(
                         "line {this_line}: unknown OBJ statement {other:?} ignored"
                     ));
                     unknown_reported = true;
@@ -197,36 +182,201 @@ pub fn parse_obj(bytes: &[u8], options: &ReadOptions) -> Result<MeshFile, ReadEr
     if !joined.is_empty() {
         return Err(ReadError::line(line_no, "line continuation at end of file"));
     }
-    if face_sizes.is_empty() {
-        return Err(ReadError::general(if positions.is_empty() {
+    if st.face_sizes.is_empty() {
+        return Err(ReadError::general(if st.positions.is_empty() {
             "no vertices and no faces (empty or not an OBJ file)"
         } else {
             "no faces"
         }));
     }
-    // Index range check with the line of the offending face.
-    let nv = positions.len();
-    let mut offset = 0usize;
-    for (f, &n) in face_sizes.iter().enumerate() {
-        for &v in &face_vertices[offset..offset + n as usize] {
-            if v as usize >= nv {
-                let shown = if v == u32::MAX {
-                    "beyond 2^32".to_string()
-                } else {
-                    (v as u64 + 1).to_string()
-                };
+    Ok(st)
+}
+
+/// The first `N` numbers of a `v` or `vt` line (a `vt` line may give only u; v is then 0).
+fn read_coordinates<'a, const N: usize>(
+    line: usize,
+    mut tokens: impl Iterator<Item = &'a str>,
+    what: &str,
+    read_so_far: usize,
+) -> Result<[f64; N], ReadError> {
+    let mut p = [0.0f64; N];
+    for (k, slot) in p.iter_mut().enumerate() {
+        let Some(tok) = tokens.next() else {
+            if what == "vertex" || k == 0 {
                 return Err(ReadError::line(
-                    face_lines[f] as usize,
-                    format!("face refers to vertex {shown}, but the file has {nv} vertices"),
+                    line,
+                    format!("{what} has {k} coordinates; {N} are needed"),
+                ));
+            }
+            break;
+        };
+        *slot = tok.parse::<f64>().map_err(|_| {
+            ReadError::line(line, format!("{what} coordinate {tok:?} is not a number"))
+        })?;
+        if !slot.is_finite() {
+            return Err(ReadError::line(
+                line,
+                format!(
+                    "{what} {} has a non-finite coordinate {tok:?}",
+                    read_so_far + 1
+                ),
+            ));
+        }
+    }
+    Ok(p)
+}
+
+/// Resolves one OBJ index (1-based, or negative: relative to the `count` elements read so
+/// far) to a 0-based index.
+fn resolve_index(line: usize, idx: i64, count: usize, what: &str) -> Result<i64, ReadError> {
+    if idx > 0 {
+        Ok(idx - 1)
+    } else if idx < 0 {
+        let r = count as i64 + idx;
+        if r < 0 {
+            return Err(ReadError::line(
+                line,
+                format!(
+                    "relative face index {idx} points before the first {what} ({count} read so far)"
+                ),
+            ));
+        }
+        Ok(r)
+    } else {
+        Err(ReadError::line(
+            line,
+            format!("face index 0 is invalid (OBJ {what} indices start at 1)"),
+        ))
+    }
+}
+
+/// One `f` line: `v`, `v/vt`, `v/vt/vn` or `v//vn` per corner.
+fn read_face<'a>(
+    line: usize,
+    tokens: impl Iterator<Item = &'a str>,
+    st: &mut ObjStatements,
+) -> Result<(), ReadError> {
+    let first = st.face_vertices.len();
+    let first_uv = st.face_texcoords.len();
+    let mut corners = 0usize;
+    let mut with_uv = 0usize;
+    for tok in tokens {
+        let mut parts = tok.split('/');
+        let head = parts.next().unwrap_or("");
+        let idx = head
+            .parse::<i64>()
+            .map_err(|_| ReadError::line(line, format!("face vertex {tok:?} is not an index")))?;
+        let v = resolve_index(line, idx, st.positions.len(), "vertex")?;
+        // Range against the final vertex count is checked once all lines are read.
+        st.face_vertices.push(u32::try_from(v).unwrap_or(u32::MAX));
+        corners += 1;
+        match parts.next() {
+            Some(t) if !t.is_empty() => {
+                let idx = t.parse::<i64>().map_err(|_| {
+                    ReadError::line(
+                        line,
+                        format!("texture coordinate index {t:?} of {tok:?} is not an index"),
+                    )
+                })?;
+                let uv = resolve_index(line, idx, st.texcoords.len(), "texture coordinate")?;
+                st.face_texcoords
+                    .push(u32::try_from(uv).unwrap_or(u32::MAX));
+                with_uv += 1;
+            }
+            _ => {}
+        }
+    }
+    if corners < 3 {
+        return Err(ReadError::line(
+            line,
+            format!("face has {corners} vertices; a face needs at least 3"),
+        ));
+    }
+    if corners >= u32::MAX as usize {
+        return Err(ReadError::line(line, "face has too many vertices"));
+    }
+    if with_uv != 0 && with_uv != corners {
+        return Err(ReadError::line(
+            line,
+            format!("face gives texture coordinates at {with_uv} of its {corners} corners"),
+        ));
+    }
+    debug_assert_eq!(st.face_vertices.len() - first, corners);
+    if with_uv == 0 {
+        st.face_texcoords.truncate(first_uv);
+        st.first_face_without_texcoords.get_or_insert(line);
+    } else {
+        st.faces_with_texcoords += 1;
+    }
+    st.face_sizes.push(corners as u32);
+    st.face_lines.push(line as u32);
+    Ok(())
+}
+
+/// Checks every face's vertex and `vt` indices against the final counts, naming the line.
+fn check_face_indices(st: &ObjStatements) -> Result<(), ReadError> {
+    let nv = st.positions.len();
+    let mut offset = 0usize;
+    for (f, &n) in st.face_sizes.iter().enumerate() {
+        for &v in &st.face_vertices[offset..offset + n as usize] {
+            if v as usize >= nv {
+                return Err(ReadError::line(
+                    st.face_lines[f] as usize,
+                    format!(
+                        "face refers to vertex {}, but the file has {nv} vertices",
+                        shown_index(v)
+                    ),
                 ));
             }
         }
         offset += n as usize;
     }
+    // Texture indices parallel the face-vertices when every face gives them; otherwise
+    // they are dropped (see `texcoord_channel`) and not checked.
+    let nt = st.texcoords.len();
+    let out_of_range = match st.first_face_without_texcoords {
+        None => st.face_texcoords.iter().position(|&t| t as usize >= nt),
+        Some(_) => None,
+    };
+    if let Some(k) = out_of_range {
+        let mut end = 0usize;
+        let face = st
+            .face_sizes
+            .iter()
+            .position(|&n| {
+                end += n as usize;
+                end > k
+            })
+            .unwrap_or(0);
+        return Err(ReadError::line(
+            st.face_lines[face] as usize,
+            format!(
+                "face refers to texture coordinate {}, but the file has {nt}",
+                shown_index(st.face_texcoords[k])
+            ),
+        ));
+    }
+    Ok(())
+}
 
-    let (mut topology, build_warnings) = TopologyBuilder::new(nv)
+fn shown_index(i: u32) -> String {
+    if i == u32::MAX {
+        "beyond 2^32".to_string()
+    } else {
+        (i as u64 + 1).to_string()
+    }
+}
+
+/// Builds the topology of the faces; returns it with the number of accepted orientation
+/// conflicts, and turns the builder's warnings into lines of `st.warnings`.
+fn build_topology(
+    st: &mut ObjStatements,
+    options: &ReadOptions,
+) -> Result<(subd_mesh::Topology, usize), ReadError> {
+    let face_lines = &st.face_lines;
+    let (topology, build_warnings) = TopologyBuilder::new(st.positions.len())
         .accept_inconsistent_orientation(options.accept_inconsistent_orientation)
-        .build_with_warnings(&face_sizes, &face_vertices)
+        .build_with_warnings(&st.face_sizes, &st.face_vertices)
         .map_err(|e| match e {
             subd_mesh::TopologyError::InconsistentOrientation { second_face, .. } => {
                 ReadError::line(
@@ -246,29 +396,33 @@ pub fn parse_obj(bytes: &[u8], options: &ReadOptions) -> Result<MeshFile, ReadEr
             subd_mesh::BuildWarning::InconsistentOrientation { second_face, .. } => *second_face,
             _ => 0,
         };
-        warnings.push(format!("line {}: {w}", face_lines[face]));
+        st.warnings.push(format!("line {}: {w}", face_lines[face]));
     }
+    Ok((topology, orientation_conflicts))
+}
 
-    let mut hints = SchemeHints::default();
-    let mut extra_tags = Vec::new();
-    for tag in &tags {
-        apply_tag(
-            tag,
-            &mut topology,
-            &mut hints,
-            &mut warnings,
-            &mut extra_tags,
-        )?;
+/// The texture coordinates as a face-varying channel, when every face gives `vt` indices.
+/// A file where only some faces do keeps its geometry and loses its texture coordinates,
+/// with a warning naming the first face without them.
+fn texcoord_channel(
+    st: &mut ObjStatements,
+    topology: &subd_mesh::Topology,
+) -> Result<Option<FVarChannel>, ReadError> {
+    if st.faces_with_texcoords == 0 {
+        return Ok(None);
     }
-    let mut mesh = Mesh::new(topology, positions).map_err(ReadError::Topology)?;
-    mesh.hints = hints;
-    Ok(MeshFile {
-        mesh,
-        warnings,
-        extra_tags,
-        orientation_conflicts,
-        face_levels: None,
-    })
+    if let Some(line) = st.first_face_without_texcoords {
+        st.warnings.push(format!(
+            "line {line}: face has no texture coordinate indices while {} other faces have them; texture coordinates dropped",
+            st.faces_with_texcoords
+        ));
+        return Ok(None);
+    }
+    let values: Vec<f64> = st.texcoords.iter().flatten().copied().collect();
+    let indices = std::mem::take(&mut st.face_texcoords);
+    FVarChannel::new(topology, 2, values, indices)
+        .map(Some)
+        .map_err(|e| ReadError::general(format!("texture coordinates: {e}")))
 }
 
 fn parse_tag<'a>(
@@ -417,6 +571,18 @@ fn apply_tag(
                 Some("smooth") => TriangleSubdivision::Smooth,
                 _ => return Err(bad("expected one string: catmark or smooth")),
             });
+        }
+        "facevaryinginterpolateboundary" => {
+            let k = match tag.ints.as_slice() {
+                [k] => *k,
+                _ => return Err(bad("expected one integer (0 none ... 5 all)")),
+            };
+            hints.fvar_interpolation =
+                Some(FVarLinearInterpolation::from_shape_tag(k).ok_or_else(|| {
+                    bad(&format!(
+                        "unknown value {k} (0 none, 1 corners-only, 2 corners-plus1, 3 corners-plus2, 4 boundaries, 5 all)"
+                    ))
+                })?);
         }
         "vertexedit" | "edgeedit" | "faceedit" => {
             warnings.push(format!(

@@ -15,7 +15,9 @@ use crate::Topology;
 /// How face-varying values are interpolated along their seams and boundaries: OpenSubdiv's
 /// `Sdc::Options::FVarLinearInterpolation`, in its order (which is also the value of the
 /// OpenSubdiv shape tag `facevaryinginterpolateboundary`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, serde::Serialize)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, Default, serde::Serialize, serde::Deserialize,
+)]
 #[serde(rename_all = "kebab-case")]
 pub enum FVarLinearInterpolation {
     /// Smooth along seams and boundaries too; only values the geometry makes sharp

@@ -3,6 +3,7 @@
 use glam::DVec3;
 
 use crate::error::TopologyError;
+use crate::fvar::{FVarChannel, FVarError};
 use crate::tags::SchemeHints;
 use crate::topology::Topology;
 
@@ -18,6 +19,9 @@ pub struct Mesh {
     pub positions: Vec<DVec3>,
     /// Scheme options requested by the source file, if any.
     pub hints: SchemeHints,
+    /// Face-varying channels made for `topology`; the first is the texture coordinates
+    /// (OBJ `vt`, glTF `TEXCOORD_0`, PLY `u v`) when the file has them.
+    pub fvar: Vec<FVarChannel>,
 }
 
 impl Mesh {
@@ -35,7 +39,29 @@ impl Mesh {
             topology,
             positions,
             hints: SchemeHints::default(),
+            fvar: Vec::new(),
         })
+    }
+
+    /// Adds a face-varying channel, checking that it has one index per face-vertex of the
+    /// topology (the channel checked its values and index range when it was made).
+    ///
+    /// # Errors
+    /// [`FVarError::IndexCount`] when the channel was made for another topology.
+    pub fn with_fvar(mut self, channel: FVarChannel) -> Result<Self, FVarError> {
+        if channel.indices().len() != self.topology.num_face_vertices() {
+            return Err(FVarError::IndexCount {
+                given: channel.indices().len(),
+                expected: self.topology.num_face_vertices(),
+            });
+        }
+        self.fvar.push(channel);
+        Ok(self)
+    }
+
+    /// The texture coordinates: the first face-varying channel, if any.
+    pub fn uv(&self) -> Option<&FVarChannel> {
+        self.fvar.first()
     }
 
     /// Axis-aligned bounding box of the positions of the vertices that faces use, or `None`

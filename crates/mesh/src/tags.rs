@@ -197,8 +197,9 @@ pub enum TriangleSubdivision {
     Smooth,
 }
 
-/// Scheme options a mesh file asks for (the `t interpolateboundary`, `t creasemethod` and
-/// `t smoothtriangles` tags of OpenSubdiv's shape files). `None` means the file is silent and
+/// Scheme options a mesh file asks for (the `t interpolateboundary`, `t creasemethod`,
+/// `t smoothtriangles` and `t facevaryinginterpolateboundary` tags of OpenSubdiv's shape
+/// files). `None` means the file is silent and
 /// the scheme's default applies.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub struct SchemeHints {
@@ -208,4 +209,6 @@ pub struct SchemeHints {
     pub crease_method: Option<CreaseMethod>,
     /// Requested triangle rule for Catmull-Clark.
     pub triangle_subdivision: Option<TriangleSubdivision>,
+    /// Requested face-varying interpolation (`t facevaryinginterpolateboundary 1/0/0 k`).
+    pub fvar_interpolation: Option<crate::fvar::FVarLinearInterpolation>,
 }

@@ -187,6 +187,12 @@ impl MaskSink for ValueSink<'_, '_> {
     }
 
     #[inline]
+    fn edge_vertex(&mut self, p: &Topology, e: usize, end: usize, w: f64) {
+        // OpenSubdiv's `getEdgeFaceValues(edge, 0)`: the ends as they are in edge-face 0.
+        self.row.add(self.level.edge_face_sources(p, e, 0)[end], w);
+    }
+
+    #[inline]
     fn corner(&mut self, p: &Topology, f: usize, k: usize, w: f64) {
         self.row.add(self.level.corner_source(p, f, k), w);
     }
@@ -414,17 +420,27 @@ fn base_level(t: &Topology, indices: &[u32], flags: ModeFlags) -> ChannelLevel {
                 mismatched[v] = true;
             }
         }
-        // Siblings: the k-th distinct value met walking the faces.
+        // Siblings: the k-th distinct value met walking the faces, with OpenSubdiv's
+        // shortcut (`completeTopologyFromFaceValues`): while exactly two values are known, a
+        // change of value is looked up against the first only, so A B A B gives siblings
+        // 0 1 0 2 (three values, the last two both B).
         let first = distinct.len();
         distinct_offsets.push(first as u32);
         let sib = &mut siblings[vfo[v] as usize..vfo[v + 1] as usize];
         for (i, &x) in vals.iter().enumerate() {
-            let k = match distinct[first..].iter().position(|&d| d == x) {
-                Some(k) => k,
-                None => {
+            let known = &distinct[first..];
+            let k = if i > 0 && x == vals[i - 1] {
+                sib[i - 1] as usize
+            } else {
+                let found = match known.len() {
+                    0 | 1 => None,
+                    2 => (known[0] == x).then_some(0),
+                    _ => known.iter().position(|&d| d == x),
+                };
+                found.unwrap_or_else(|| {
                     distinct.push(x);
                     distinct.len() - first - 1
-                }
+                })
             };
             sib[i] = k as u16;
         }
@@ -459,20 +475,21 @@ fn base_level(t: &Topology, indices: &[u32], flags: ModeFlags) -> ChannelLevel {
             &mut ends[o..o + n],
         );
     }
-    let face_values = (0..t.num_faces())
-        .flat_map(|f| {
-            let (faces_v, fo_f) = (t.face_vertices(f), fo[f] as usize);
-            let distinct = &distinct;
-            let distinct_offsets = &distinct_offsets;
-            (0..faces_v.len()).map(move |k| {
-                let v = faces_v[k] as usize;
-                let o = distinct_offsets[v] as usize;
-                let n = distinct_offsets[v + 1] as usize - o;
-                let x = indices[fo_f + k];
-                (o + distinct[o..o + n].iter().position(|&d| d == x).unwrap_or(0)) as u32
-            })
-        })
-        .collect();
+    // Each corner names its vertex's sibling (not a search by value: two siblings can
+    // share a value, see above).
+    let mut face_values = vec![0u32; t.num_face_vertices()];
+    for v in 0..nv {
+        let o = distinct_offsets[v];
+        let range = vfo[v] as usize..vfo[v + 1] as usize;
+        for ((&f, &k), &s) in t
+            .vertex_faces(v)
+            .iter()
+            .zip(t.vertex_face_local_indices(v))
+            .zip(&siblings[range])
+        {
+            face_values[fo[f as usize] as usize + k as usize] = o + s as u32;
+        }
+    }
     ChannelLevel {
         value_offsets: distinct_offsets,
         face_values,

@@ -375,6 +375,13 @@ pub(crate) trait MaskSink {
     fn edge_end(&mut self, p: &Topology, e: usize, v: u32, w: f64) {
         self.vertex(p.edge_other_vertex(e, v), w);
     }
+    /// Adds `w` times end `end` (0 or 1) of edge `e`: an edge mask names its ends this way,
+    /// not as "far from the other", which a degenerate edge (both ends one vertex) would
+    /// not tell apart.
+    #[inline]
+    fn edge_vertex(&mut self, p: &Topology, e: usize, end: usize, w: f64) {
+        self.vertex(p.edge_vertices(e)[end], w);
+    }
     /// Adds `w` times the vertex at corner `k` of face `f` (a face-varying sink reads that
     /// corner's value).
     #[inline]
@@ -462,11 +469,10 @@ impl Step<'_> {
     /// Stencil of the child of parent edge `e` (`Sdc::Scheme::ComputeEdgeVertexMask`).
     fn edge_row<S: MaskSink>(&self, e: usize, child_rule: Rule, sink: &mut S) {
         let p = self.parent;
-        let [a, b] = p.edge_vertices(e);
         let s = p.edge_sharpness(e);
         if s > 0.0 && child_rule == Rule::Crease {
-            sink.edge_end(p, e, b, 0.5);
-            sink.edge_end(p, e, a, 0.5);
+            sink.edge_vertex(p, e, 0, 0.5);
+            sink.edge_vertex(p, e, 1, 0.5);
             return;
         }
         let faces = p.edge_faces(e);
@@ -502,8 +508,8 @@ impl Step<'_> {
             vw = pw * 0.5 + cw * vw;
             fw *= cw;
         }
-        sink.edge_end(p, e, b, vw);
-        sink.edge_end(p, e, a, vw);
+        sink.edge_vertex(p, e, 0, vw);
+        sink.edge_vertex(p, e, 1, vw);
         for (&f, &l) in faces.iter().zip(p.edge_face_local_indices(e)) {
             match self.scheme {
                 Scheme::Loop => {
