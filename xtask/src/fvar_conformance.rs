@@ -28,6 +28,128 @@ fn check_name(mode: FVarLinearInterpolation) -> &'static str {
     }
 }
 
+fn limit_check_name(mode: FVarLinearInterpolation) -> &'static str {
+    match mode {
+        FVarLinearInterpolation::None => "fvar-limit none",
+        FVarLinearInterpolation::CornersOnly => "fvar-limit c-only",
+        FVarLinearInterpolation::CornersPlus1 => "fvar-limit c-plus1",
+        FVarLinearInterpolation::CornersPlus2 => "fvar-limit c-plus2",
+        FVarLinearInterpolation::Boundaries => "fvar-limit bounds",
+        FVarLinearInterpolation::All => "fvar-limit all",
+    }
+}
+
+/// Where OpenSubdiv's `LimitFaceVarying` is off by more than round-off: its seam crease
+/// weights are `float` (1/6 and 2/3 to about 3e-8).
+const F32_SEAM_TOLERANCE: f64 = 1e-7;
+
+/// subd's face-varying limits at the last level against OpenSubdiv's `LimitFaceVarying`.
+/// Values where OpenSubdiv is not exact are left out of the 1e-12 comparison and reported:
+/// seam creases (float weights: compared to 1e-7 instead), seam creases under Bilinear
+/// (OpenSubdiv applies the crease mask although Bilinear refines every value linearly: subd
+/// keeps the value, its refinement's limit), and values of vertices whose position limit
+/// OpenSubdiv does not get exactly either (valence-2 interior vertices, darts on infinitely
+/// sharp edges: subd takes the eigen limit).
+#[allow(clippy::too_many_arguments)]
+fn compare_limit(
+    exe: &Path,
+    input: &[u8],
+    name: &str,
+    refinement: &Refinement,
+    fr: &FaceVaryingRefinement,
+    last: &[f64],
+    mode: FVarLinearInterpolation,
+    diag: f64,
+) -> Row {
+    let levels = refinement.num_levels();
+    let mut row = Row::pending(name, limit_check_name(mode), levels);
+    let mode_arg = mode.to_shape_tag().to_string();
+    let theirs = match osd::run(exe, input, &["--fvar-limit", &mode_arg])
+        .and_then(|b| osd::decode_fvar_limit(&b))
+    {
+        Ok(v) => v,
+        Err(e) => {
+            row.problem = Some(format!("OpenSubdiv: {e}"));
+            return row;
+        }
+    };
+    let ours = match subd_limit::fvar::limit_values(refinement, fr, last, 2) {
+        Ok(v) => v,
+        Err(e) => {
+            row.problem = Some(format!("subd: {e}"));
+            return row;
+        }
+    };
+    if ours.len() != theirs.len() {
+        row.problem = Some(format!(
+            "{} values, OpenSubdiv {}",
+            ours.len() / 2,
+            theirs.len() / 2
+        ));
+        return row;
+    }
+    let t = refinement.topology(levels);
+    let values = fr.level_values(refinement, levels);
+    let mut eigen = vec![false; t.num_vertices()];
+    if refinement.scheme() != Scheme::Bilinear {
+        for v in subd_limit::eigen_limit_vertices(refinement, levels) {
+            eigen[v] = true;
+        }
+    }
+    let linear = values.is_linear();
+    let (mut worst, mut at) = (0.0f64, 0usize);
+    let (mut left_out, mut left_worst) = (0usize, 0.0f64);
+    let mut f32_worst = 0.0f64;
+    let mut r = 0usize;
+    for v in 0..t.num_vertices() {
+        for k in 0..values.num_vertex_values(v) {
+            let d = (ours[2 * r] - theirs[2 * r])
+                .abs()
+                .max((ours[2 * r + 1] - theirs[2 * r + 1]).abs())
+                / diag;
+            let seam_crease = !linear && values.crease_ends(v, k).is_some();
+            if seam_crease && refinement.scheme() == Scheme::Bilinear {
+                left_out += 1;
+                left_worst = left_worst.max(d);
+                // subd keeps the value: Bilinear's refinement never moves it.
+                let i = values.vertex_value(v, k) as usize;
+                let kept = (ours[2 * r] - last[2 * i])
+                    .abs()
+                    .max((ours[2 * r + 1] - last[2 * i + 1]).abs());
+                if kept != 0.0 {
+                    row.problem = Some(format!("Bilinear seam value {r} moved"));
+                }
+            } else if seam_crease {
+                left_out += 1;
+                left_worst = left_worst.max(d);
+                f32_worst = f32_worst.max(d);
+            } else if eigen[v] && values.is_matching(v) {
+                left_out += 1;
+                left_worst = left_worst.max(d);
+            } else if !(d <= worst) {
+                worst = d;
+                at = r;
+            }
+            r += 1;
+        }
+    }
+    row.vertices = r;
+    row.error = worst;
+    if left_out > 0 {
+        row.excluded = Some((left_out, left_worst));
+    }
+    if row.problem.is_none() {
+        if worst.is_nan() || worst > TOLERANCE {
+            row.problem = Some(format!("worst value {at}"));
+        } else if f32_worst > F32_SEAM_TOLERANCE {
+            row.problem = Some(format!(
+                "seam crease values {f32_worst:.1e} from OpenSubdiv (float weights allow {F32_SEAM_TOLERANCE:.0e})"
+            ));
+        }
+    }
+    row
+}
+
 /// Diagonal of the bounding box of two-component values.
 fn uv_diagonal(values: &[f64]) -> f64 {
     let mut lo = [f64::INFINITY; 2];
@@ -121,6 +243,18 @@ pub fn compare(
             }
         }
         rows.push(row);
+    }
+    if levels >= 1 {
+        rows.push(compare_limit(
+            exe,
+            &input,
+            name,
+            &refinement,
+            &fr,
+            &ours[levels],
+            mode,
+            diag,
+        ));
     }
     rows
 }

@@ -251,6 +251,7 @@ fn run_one(
     let tension = crate::rule_args::butterfly_tension(args.tension)?;
     let mut file = subd_io::read_mesh(&job.input, &args.rules.read_options())?;
     print_warnings(err, &job.input, &file.warnings);
+    let warned = file.warnings.len();
     let t_read = t_start.elapsed().as_secs_f64();
     let options = args.rules.options(&file.mesh.hints);
     let base = &file.mesh.topology;
@@ -276,6 +277,21 @@ fn run_one(
         edges: Some(base.num_edges()),
         faces: base.num_faces(),
     };
+    let fvar_mode = args.rules.fvar_mode(&file.mesh.hints);
+    let uv = refined_uv(
+        &refinement,
+        &file.mesh,
+        fvar_mode,
+        args.limit,
+        args.scheme,
+        &mut file.warnings,
+    )
+    .map_err(|e| in_file(&e))?;
+    print_warnings(
+        err,
+        &job.input,
+        &file.warnings[file.warnings.len().min(warned)..],
+    );
     // The refinement holds its own copy of the base level: the file's is not needed again.
     if let Ok(empty) = subd_mesh::TopologyBuilder::new(0).build(&[], &[]) {
         file.mesh.topology = empty;
@@ -284,7 +300,14 @@ fn run_one(
     let t_topology = t0.elapsed().as_secs_f64();
     let t1 = Instant::now();
     let osd = matches!(chosen, Chosen::Osd(_));
-    let hints = output_hints(osd, &options, &file.mesh.hints, &args.rules);
+    let mut hints = output_hints(osd, &options, &file.mesh.hints, &args.rules);
+    hints.fvar_interpolation = uv.as_ref().map(|_| fvar_mode);
+    let with_uv = |v: subd_io::MeshView<'a>| -> Result<subd_io::MeshView<'a>, subd_io::ViewError> {
+        match &uv {
+            Some(uv) => v.with_uv(&uv.values, 2, &uv.indices),
+            None => Ok(v),
+        }
+    };
     let in_view = |e: subd_io::ViewError| bad(format!("{}: {e}", job.input.display()));
     let streams = match &refinement {
         Refined::Osd(r) if !args.limit && args.levels > 0 => Some(r),
@@ -308,6 +331,7 @@ fn run_one(
         let tags = refinement.explicit_tags(args.levels);
         let view = subd_io::MeshView::streamed(source, &faces, faces.0.hole_faces())
             .and_then(|v| v.with_tags(tags.creases, tags.corners))
+            .and_then(with_uv)
             .map_err(in_view)?;
         let counts = write_level(job, view, hints, refinement.num_edges(args.levels))?;
         (counts, t_positions, t2)
@@ -338,6 +362,7 @@ fn run_one(
         let holes = refinement.holes(args.levels);
         let mut view = subd_io::MeshView::new(&positions, offsets, vertices, &holes)
             .and_then(|v| v.with_tags(tags.creases, tags.corners))
+            .and_then(with_uv)
             .map_err(in_view)?;
         let filled;
         if let Some(n) = &normals {
@@ -378,6 +403,52 @@ fn run_one(
         crate::print_json(out, &report);
     }
     Ok(())
+}
+
+/// A refined face-varying channel: two numbers per value, one value index per face-vertex.
+pub(crate) struct RefinedUv {
+    pub(crate) values: Vec<f64>,
+    pub(crate) indices: Vec<u32>,
+}
+
+/// The mesh's texture coordinates at the last level of `refinement` (at their limit with
+/// `limit`), interpolated by `mode`; `None` when the mesh has none, or, with a warning, when
+/// the scheme does not carry them yet.
+pub(crate) fn refined_uv(
+    refinement: &Refined,
+    mesh: &subd_mesh::Mesh,
+    mode: subd_mesh::fvar::FVarLinearInterpolation,
+    limit: bool,
+    scheme: SchemeArg,
+    warnings: &mut Vec<String>,
+) -> Result<Option<RefinedUv>, String> {
+    let Some(channel) = mesh.uv() else {
+        return Ok(None);
+    };
+    let r = match refinement {
+        Refined::Osd(r) => r,
+        Refined::Split(_) => {
+            warnings.push(format!(
+                "texture coordinates are not refined by --scheme {} (only by catmull-clark, loop, bilinear and two-phase); the output has none",
+                scheme.name()
+            ));
+            return Ok(None);
+        }
+    };
+    let fr =
+        subd_schemes::FaceVaryingRefinement::new(r, channel, mode).map_err(|e| e.to_string())?;
+    let level = r.num_levels();
+    let mut values = fr
+        .refine_values(channel.values(), 2)
+        .pop()
+        .expect("level 0 at least");
+    if limit {
+        values = subd_limit::fvar::limit_values(r, &fr, &values, 2).map_err(|e| e.to_string())?;
+    }
+    Ok(Some(RefinedUv {
+        values,
+        indices: fr.face_values(level),
+    }))
 }
 
 /// Writes the output level with its hints; its counts for the report.

@@ -1,9 +1,10 @@
 //! The rule options every surface command shares (`--boundary`, `--crease-method`,
-//! `--triangles`, `--accept-inconsistent-orientation`, and glTF's `--no-transform` and
+//! `--triangles`, `--fvar-interpolation`, `--accept-inconsistent-orientation`, and glTF's `--no-transform` and
 //! `--weld-tolerance`): defaults from the file's tags,
 //! overridden on the command line.
 
 use clap::{Args, ValueEnum};
+use subd_mesh::fvar::FVarLinearInterpolation;
 use subd_mesh::{BoundaryInterpolation, CreaseMethod, SchemeHints, TriangleSubdivision};
 use subd_schemes::Options;
 
@@ -18,6 +19,25 @@ pub(crate) enum BoundaryArg {
 pub(crate) enum CreaseArg {
     Uniform,
     Chaikin,
+}
+
+/// OpenSubdiv's face-varying interpolation modes, by their command-line names.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub(crate) enum FVarArg {
+    /// Smooth everywhere; only what the geometry makes sharp is pinned.
+    None,
+    /// Smooth, with UV corners (a value used by one face at its vertex) pinned.
+    CornersOnly,
+    /// As corners-only, plus junctions of three or more UV regions (USD's, Blender's default).
+    #[value(name = "corners-plus1")]
+    CornersPlus1,
+    /// As corners-plus1, plus concave corners and seam ends inside the mesh.
+    #[value(name = "corners-plus2")]
+    CornersPlus2,
+    /// Seams and the mesh boundary kept piecewise linear, interiors smooth.
+    Boundaries,
+    /// Linear everywhere (bilinear UVs).
+    All,
 }
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
@@ -41,6 +61,11 @@ pub(crate) struct RuleArgs {
     /// catmark).
     #[arg(long, value_enum)]
     pub(crate) triangles: Option<TriangleArg>,
+    /// How texture coordinates are interpolated along seams and the boundary (default: the
+    /// file's `t facevaryinginterpolateboundary` tag, else corners-plus1, as USD and
+    /// Blender).
+    #[arg(long, value_enum, value_name = "MODE")]
+    fvar_interpolation: Option<FVarArg>,
     /// Accept faces whose windings disagree across a shared edge (treated as non-manifold).
     #[arg(long)]
     pub(crate) accept_inconsistent_orientation: bool,
@@ -83,6 +108,21 @@ impl RuleArgs {
             };
         }
         options
+    }
+
+    /// The face-varying interpolation: this command line's, else the file's tag, else
+    /// corners-plus1.
+    pub(crate) fn fvar_mode(&self, hints: &SchemeHints) -> FVarLinearInterpolation {
+        use FVarLinearInterpolation as M;
+        match self.fvar_interpolation {
+            Some(FVarArg::None) => M::None,
+            Some(FVarArg::CornersOnly) => M::CornersOnly,
+            Some(FVarArg::CornersPlus1) => M::CornersPlus1,
+            Some(FVarArg::CornersPlus2) => M::CornersPlus2,
+            Some(FVarArg::Boundaries) => M::Boundaries,
+            Some(FVarArg::All) => M::All,
+            None => hints.fvar_interpolation.unwrap_or(M::CornersPlus1),
+        }
     }
 
     /// Reader options.

@@ -1,4 +1,5 @@
-//! glTF 2.0 binary (`.glb`) output: positions, smooth vertex normals and triangle indices.
+//! glTF 2.0 binary (`.glb`) output: positions, smooth vertex normals, texture coordinates
+//! (`TEXCOORD_0`, vertices split at UV seams) and triangle indices.
 //!
 //! The JSON document is built with `gltf-json` and packed with `gltf`'s GLB writer. Polygons
 //! are fan-triangulated from their first vertex; hole faces are left out. Normals are the
@@ -92,9 +93,12 @@ fn to_f32(p: &DVec3) -> [f32; 3] {
 }
 
 /// Writes `mesh` as a binary glTF 2.0 file. The arrays are encoded by all threads straight
-/// into the output, so besides the normals nothing the size of the mesh is held.
+/// into the output, so besides the normals nothing the size of the mesh is held. Texture
+/// coordinates become `TEXCOORD_0`, with each vertex split into one glTF vertex per value
+/// its corners name (glTF has one attribute set per vertex; the normal stays the vertex's
+/// own, so seams do not show in the shading) and v flipped to glTF's top-left origin
+/// (`1 - v`).
 pub fn write_glb(w: &mut dyn Write, mesh: &MeshView<'_>) -> std::io::Result<()> {
-    let nv = mesh.num_vertices();
     let computed;
     let normals = match mesh.normals() {
         Some(n) => n,
@@ -103,11 +107,91 @@ pub fn write_glb(w: &mut dyn Write, mesh: &MeshView<'_>) -> std::io::Result<()> 
             &computed[..]
         }
     };
+    let Some(uv) = mesh.uv() else {
+        return write_arrays(w, mesh, normals, None);
+    };
+    let split = SplitAtSeams::new(mesh, normals, uv)?;
+    let holes: Vec<bool> = (0..mesh.num_faces()).map(|f| mesh.is_hole(f)).collect();
+    let view = MeshView::new(
+        &split.positions,
+        &split.face_offsets,
+        &split.face_vertices,
+        &holes,
+    )
+    .map_err(std::io::Error::other)?;
+    write_arrays(w, &view, &split.normals, Some(&split.texcoords))
+}
+
+/// A mesh with texture coordinates as glTF needs it: one vertex per (vertex, value) pair
+/// its corners use.
+struct SplitAtSeams {
+    positions: Vec<DVec3>,
+    normals: Vec<DVec3>,
+    /// (u, 1 - v) per split vertex.
+    texcoords: Vec<[f32; 2]>,
+    face_offsets: Vec<u32>,
+    face_vertices: Vec<u32>,
+}
+
+impl SplitAtSeams {
+    fn new(
+        mesh: &MeshView<'_>,
+        normals: &[DVec3],
+        uv: crate::TexCoords<'_>,
+    ) -> std::io::Result<SplitAtSeams> {
+        let mut face_offsets = Vec::with_capacity(mesh.num_faces() + 1);
+        let mut original = Vec::with_capacity(mesh.num_face_vertices());
+        face_offsets.push(0u32);
+        for_each_windowed(
+            mesh.num_faces(),
+            |r| mesh.face_window(r),
+            |faces, f| {
+                original.extend_from_slice(faces.face(f));
+                face_offsets.push(original.len() as u32);
+            },
+        )?;
+        // A sorted list of the (vertex, value) pairs in use numbers the split vertices.
+        let pair = |k: usize| (original[k] as u64) << 32 | uv.indices()[k] as u64;
+        let mut pairs: Vec<u64> = (0..original.len()).map(pair).collect();
+        pairs.par_sort_unstable();
+        pairs.dedup();
+        let face_vertices = (0..original.len())
+            .into_par_iter()
+            .map(|k| pairs.binary_search(&pair(k)).expect("every pair is listed") as u32)
+            .collect();
+        let points = mesh.point_window(0..mesh.num_vertices())?;
+        let vertex = |p: u64| (p >> 32) as usize;
+        Ok(SplitAtSeams {
+            positions: pairs.iter().map(|&p| points.get(vertex(p))).collect(),
+            normals: pairs.iter().map(|&p| normals[vertex(p)]).collect(),
+            texcoords: pairs
+                .iter()
+                .map(|&p| {
+                    let [u, v] = uv.uv(p as u32 as usize);
+                    [u as f32, (1.0 - v) as f32]
+                })
+                .collect(),
+            face_offsets,
+            face_vertices,
+        })
+    }
+}
+
+/// Writes the arrays of one glTF primitive: positions, normals, texture coordinates when
+/// given (one per vertex), and fan-triangulated indices.
+fn write_arrays(
+    w: &mut dyn Write,
+    mesh: &MeshView<'_>,
+    normals: &[DVec3],
+    texcoords: Option<&[[f32; 2]]>,
+) -> std::io::Result<()> {
+    let nv = mesh.num_vertices();
     let num_indices = 3 * mesh.num_fan_triangles();
 
     // Every element is 4 bytes, so the BIN chunk needs no padding.
     let vec3_len = nv * 12;
-    let bin_len = 2 * vec3_len + num_indices * 4;
+    let uv_len = if texcoords.is_some() { nv * 8 } else { 0 };
+    let bin_len = 2 * vec3_len + uv_len + num_indices * 4;
 
     let mut root = json::Root {
         asset: json::Asset {
@@ -140,9 +224,17 @@ pub fn write_glb(w: &mut dyn Write, mesh: &MeshView<'_>) -> std::io::Result<()> 
         vec3_len,
         json::buffer::Target::ArrayBuffer,
     );
+    let uv_view = texcoords.is_some().then(|| {
+        view(
+            &mut root,
+            2 * vec3_len,
+            uv_len,
+            json::buffer::Target::ArrayBuffer,
+        )
+    });
     let idx_view = view(
         &mut root,
-        2 * vec3_len,
+        2 * vec3_len + uv_len,
         num_indices * 4,
         json::buffer::Target::ElementArrayBuffer,
     );
@@ -180,14 +272,19 @@ pub fn write_glb(w: &mut dyn Write, mesh: &MeshView<'_>) -> std::io::Result<()> 
         Some(bounds(mesh)?),
     );
     let nrm_acc = accessor(&mut root, nrm_view, normals.len(), C::F32, T::Vec3, None);
+    let uv_acc = uv_view.map(|v| accessor(&mut root, v, nv, C::F32, T::Vec2, None));
     let idx_acc = accessor(&mut root, idx_view, num_indices, C::U32, T::Scalar, None);
+    let mut attributes: std::collections::BTreeMap<_, _> = [
+        (Valid(json::mesh::Semantic::Positions), pos_acc),
+        (Valid(json::mesh::Semantic::Normals), nrm_acc),
+    ]
+    .into_iter()
+    .collect();
+    if let Some(a) = uv_acc {
+        attributes.insert(Valid(json::mesh::Semantic::TexCoords(0)), a);
+    }
     let primitive = json::mesh::Primitive {
-        attributes: [
-            (Valid(json::mesh::Semantic::Positions), pos_acc),
-            (Valid(json::mesh::Semantic::Normals), nrm_acc),
-        ]
-        .into_iter()
-        .collect(),
+        attributes,
         extensions: Default::default(),
         extras: Default::default(),
         indices: Some(idx_acc),
@@ -248,6 +345,13 @@ pub fn write_glb(w: &mut dyn Write, mesh: &MeshView<'_>) -> std::io::Result<()> 
             b.extend_from_slice(&c.to_le_bytes());
         }
     })?;
+    if let Some(t) = texcoords {
+        write_records(w, t.len(), |i, b| {
+            for c in t[i] {
+                b.extend_from_slice(&c.to_le_bytes());
+            }
+        })?;
+    }
     // Polygons as fans from their first corner.
     write_windows(
         w,

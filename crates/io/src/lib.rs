@@ -35,7 +35,7 @@ use std::path::Path;
 pub use error::{IoError, ReadError};
 pub use ply::PlyEncoding;
 use subd_mesh::Mesh;
-pub use view::{FaceSource, MeshView, PointSource, Points, ViewError};
+pub use view::{FaceSource, MeshView, PointSource, Points, TexCoords, ViewError};
 
 /// A mesh file format.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -5,10 +5,14 @@
 //! defines them), and OpenSubdiv's `t` tag lines with **0-based** indices:
 //! `t crease 2/1/0 a b s` (a chain `n/1/0` or `n/(n-1)/0` also works), `t corner 1/1/0 v s`,
 //! `t hole 1/0/0 f`, `t interpolateboundary 1/0/0 k` (0 none, 1 edge-and-corner, 2 edge-only),
-//! `t creasemethod 0/0/1 normal|chaikin`, `t smoothtriangles 0/0/1 catmark|smooth`. Other
-//! tags (face-varying options, the hierarchical edits `vertexedit`/`edgeedit`/`faceedit`)
-//! are kept verbatim and reported in a warning. Texture coordinates, normals, groups and
-//! materials are skipped.
+//! `t creasemethod 0/0/1 normal|chaikin`, `t smoothtriangles 0/0/1 catmark|smooth`,
+//! `t facevaryinginterpolateboundary 1/0/0 k` (OpenSubdiv's `FVarLinearInterpolation`, 0 none
+//! to 5 all). Other tags (the hierarchical edits `vertexedit`/`edgeedit`/`faceedit`, ...)
+//! are kept verbatim and reported in a warning. Texture coordinates (`vt u v`, a third
+//! coordinate dropped, and the `vt` index of `f v/vt` or `f v/vt/vn`) become the mesh's
+//! first face-varying channel when every face gives them; normals, groups and materials are
+//! skipped. Written: `v`, `vt` and `f v/vt` when the view has texture coordinates, `vn`
+//! when it has normals, and the tags.
 //!
 //! Why not `tobj` for the geometry: `tobj` renumbers vertices by first use and drops vertices
 //! no face uses, which would break the vertex-index contract with OpenSubdiv (vertex `v` of the
@@ -633,6 +637,13 @@ pub fn write_obj(
             let _ = writeln!(b, "vn {} {} {}", n.x, n.y, n.z);
         })?;
     }
+    let uv = mesh.uv();
+    if let Some(uv) = uv {
+        write_records(w, uv.len(), |i, b| {
+            let [u, v] = uv.uv(i);
+            let _ = writeln!(b, "vt {u} {v}");
+        })?;
+    }
     let with_normals = mesh.normals().is_some();
     write_windows(
         w,
@@ -640,12 +651,17 @@ pub fn write_obj(
         |r| mesh.face_window(r),
         |faces, f, b| {
             b.push(b'f');
-            for &v in faces.face(f) {
-                if with_normals {
-                    let _ = write!(b, " {0}//{0}", v as u64 + 1);
-                } else {
-                    let _ = write!(b, " {}", v as u64 + 1);
-                }
+            let first = faces.first_corner(f);
+            for (k, &v) in faces.face(f).iter().enumerate() {
+                let v = v as u64 + 1;
+                let _ = match (uv, with_normals) {
+                    (Some(uv), true) => {
+                        write!(b, " {v}/{}/{v}", uv.indices()[first + k] as u64 + 1)
+                    }
+                    (Some(uv), false) => write!(b, " {v}/{}", uv.indices()[first + k] as u64 + 1),
+                    (None, true) => write!(b, " {v}//{v}"),
+                    (None, false) => write!(b, " {v}"),
+                };
             }
             b.push(b'\n');
         },
@@ -667,6 +683,13 @@ fn write_tags(w: &mut dyn Write, mesh: &MeshView<'_>) -> std::io::Result<()> {
             CreaseMethod::Chaikin => "chaikin",
         };
         writeln!(w, "t creasemethod 0/0/1 {s}")?;
+    }
+    if let (Some(m), Some(_)) = (mesh.hints.fvar_interpolation, mesh.uv()) {
+        writeln!(
+            w,
+            "t facevaryinginterpolateboundary 1/0/0 {}",
+            m.to_shape_tag()
+        )?;
     }
     if let Some(t) = mesh.hints.triangle_subdivision {
         let s = match t {

@@ -6,6 +6,8 @@
 //! are skipped. subd also writes (and reads back) its tags as extra elements that other
 //! readers ignore: `crease` (`v0`, `v1`, `sharpness`), `corner` (`vertex`, `sharpness`),
 //! `hole` (`face`), and scheme options as `comment subd <tag> <value>` header lines.
+//! Texture coordinates are the vertex properties `u v` (or `s t`, `texture_u texture_v`):
+//! one per vertex, so a channel with seams cannot be written (the error says so).
 //!
 //! Written by hand rather than with a PLY crate: the available crates are unmaintained or
 //! allocate per element, and a reader here must name the header line or the element of
@@ -13,13 +15,14 @@
 
 use std::io::Write;
 
+use subd_mesh::fvar::{FVarChannel, FVarLinearInterpolation};
 use subd_mesh::{
     BoundaryInterpolation, CreaseMethod, DVec3, Mesh, SchemeHints, TopologyBuilder,
     TriangleSubdivision,
 };
 
 use crate::error::ReadError;
-use crate::records::write_windows;
+use crate::records::{for_each_windowed, write_windows};
 use crate::view::MeshView;
 use crate::{MeshFile, ReadOptions};
 
@@ -314,6 +317,11 @@ fn parse_hint(line: usize, words: &[&str], hints: &mut SchemeHints) -> Result<()
             hints.boundary_interpolation =
                 Some(BoundaryInterpolation::from_shape_tag(k).ok_or_else(bad)?);
         }
+        ["facevaryinginterpolateboundary", k] => {
+            let k: i64 = k.parse().map_err(|_| bad())?;
+            hints.fvar_interpolation =
+                Some(FVarLinearInterpolation::from_shape_tag(k).ok_or_else(bad)?);
+        }
         ["creasemethod", "normal"] => hints.crease_method = Some(CreaseMethod::Uniform),
         ["creasemethod", "chaikin"] => hints.crease_method = Some(CreaseMethod::Chaikin),
         ["smoothtriangles", "catmark"] => {
@@ -355,6 +363,9 @@ pub fn parse_ply(bytes: &[u8], options: &ReadOptions) -> Result<MeshFile, ReadEr
     let mut have_face = false;
     let mut values: Vec<f64> = Vec::new();
     let mut list: Vec<f64> = Vec::new();
+    // Per-vertex texture coordinates, when the vertex element has them.
+    let mut texcoords: Vec<f64> = Vec::new();
+    let mut uv_props: Option<[usize; 2]> = None;
     for el in &header.elements {
         let find = |n: &str| el.props.iter().position(|p| p.name() == n);
         let role = match el.name.as_str() {
@@ -365,6 +376,7 @@ pub fn parse_ply(bytes: &[u8], options: &ReadOptions) -> Result<MeshFile, ReadEr
                         "vertex element lacks an x, y or z property",
                     ));
                 };
+                uv_props = texcoord_properties(&el.props);
                 Some(("vertex", [x, y, z]))
             }
             "face" => {
@@ -459,6 +471,15 @@ pub fn parse_ply(bytes: &[u8], options: &ReadOptions) -> Result<MeshFile, ReadEr
                         ));
                     }
                     positions.push(p);
+                    if let Some([u, v]) = uv_props {
+                        if !(values[u].is_finite() && values[v].is_finite()) {
+                            return Err(err_at(
+                                &body,
+                                format!("vertex {k} has a non-finite texture coordinate"),
+                            ));
+                        }
+                        texcoords.extend([values[u], values[v]]);
+                    }
                 }
                 Some(("face", [_, level, _])) => {
                     if level != usize::MAX {
@@ -566,8 +587,21 @@ pub fn parse_ply(bytes: &[u8], options: &ReadOptions) -> Result<MeshFile, ReadEr
         let f = index(f, "hole", "face", nf, line)?;
         topology.set_hole_checked(f).map_err(|e| at(line, e))?;
     }
+    let uv = match uv_props {
+        // One value per vertex: the corners name their vertex's value.
+        Some(_) => Some(
+            FVarChannel::new(&topology, 2, texcoords, face_vertices)
+                .map_err(|e| ReadError::general(format!("texture coordinates: {e}")))?,
+        ),
+        None => None,
+    };
     let mut mesh = Mesh::new(topology, positions)?;
     mesh.hints = header.hints;
+    if let Some(uv) = uv {
+        mesh = mesh
+            .with_fvar(uv)
+            .map_err(|e| ReadError::general(e.to_string()))?;
+    }
     Ok(MeshFile {
         mesh,
         warnings,
@@ -575,6 +609,56 @@ pub fn parse_ply(bytes: &[u8], options: &ReadOptions) -> Result<MeshFile, ReadEr
         orientation_conflicts,
         face_levels: (!face_levels.is_empty()).then_some(face_levels),
     })
+}
+
+/// The vertex properties holding texture coordinates: `u v`, `s t` or `texture_u
+/// texture_v` (the names exporters use), scalars both.
+fn texcoord_properties(props: &[Property]) -> Option<[usize; 2]> {
+    let find = |n: &str| {
+        props
+            .iter()
+            .position(|p| p.name() == n && matches!(p, Property::Scalar(..)))
+    };
+    [("u", "v"), ("s", "t"), ("texture_u", "texture_v")]
+        .iter()
+        .find_map(|&(a, b)| Some([find(a)?, find(b)?]))
+}
+
+/// One texture coordinate per vertex, for a format that has no per-corner values: an
+/// error naming the first vertex whose corners disagree (a UV seam). Vertices no face uses
+/// get (0, 0).
+fn per_vertex_uv(mesh: &MeshView<'_>) -> std::io::Result<Option<Vec<[f64; 2]>>> {
+    let Some(uv) = mesh.uv() else {
+        return Ok(None);
+    };
+    let mut out: Vec<Option<[f64; 2]>> = vec![None; mesh.num_vertices()];
+    let mut seam = None;
+    for_each_windowed(
+        mesh.num_faces(),
+        |r| mesh.face_window(r),
+        |faces, f| {
+            let first = faces.first_corner(f);
+            for (k, &v) in faces.face(f).iter().enumerate() {
+                let value = uv.uv(uv.indices()[first + k] as usize);
+                match out[v as usize] {
+                    None => out[v as usize] = Some(value),
+                    Some(old) if old != value && seam.is_none() => seam = Some(v),
+                    Some(_) => {}
+                }
+            }
+        },
+    )?;
+    if let Some(v) = seam {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!(
+                "PLY stores one texture coordinate per vertex, but vertex {v} has several (a UV seam); write .obj or .glb to keep them"
+            ),
+        ));
+    }
+    Ok(Some(
+        out.into_iter().map(|x| x.unwrap_or([0.0; 2])).collect(),
+    ))
 }
 
 /// Writes `mesh` as PLY: positions as `double`, faces as a `uchar`/`uint` count list of
@@ -588,6 +672,7 @@ pub fn write_ply(
     let nv = mesh.num_vertices();
     let (creases, corners) = (mesh.creases(), mesh.corners());
     let holes = mesh.hole_faces();
+    let uv = per_vertex_uv(mesh)?;
     let nf = mesh.num_faces();
     let wide_lists = mesh.max_face_size() > 255;
     let index_ty = if nv > i32::MAX as usize {
@@ -616,6 +701,13 @@ pub fn write_ply(
         };
         writeln!(w, "comment subd creasemethod {s}")?;
     }
+    if let (Some(m), Some(_)) = (mesh.hints.fvar_interpolation, &uv) {
+        writeln!(
+            w,
+            "comment subd facevaryinginterpolateboundary {}",
+            m.to_shape_tag()
+        )?;
+    }
     if let Some(t) = mesh.hints.triangle_subdivision {
         let s = if t == TriangleSubdivision::Smooth {
             "smooth"
@@ -633,6 +725,9 @@ pub fn write_ply(
         for c in ["nx", "ny", "nz"] {
             writeln!(w, "property double {c}")?;
         }
+    }
+    if uv.is_some() {
+        writeln!(w, "property double u\nproperty double v")?;
     }
     writeln!(w, "element face {nf}")?;
     writeln!(
@@ -671,6 +766,9 @@ pub fn write_ply(
                     let n = n[i];
                     let _ = write!(b, " {} {} {}", n.x, n.y, n.z);
                 }
+                if let Some(uv) = &uv {
+                    let _ = write!(b, " {} {}", uv[i][0], uv[i][1]);
+                }
                 b.push(b'\n');
             })?;
             write_windows(w, nf, faces, |faces, f, b| {
@@ -701,6 +799,11 @@ pub fn write_ply(
                 }
                 if let Some(n) = normals {
                     for c in n[i].to_array() {
+                        b.extend_from_slice(&c.to_le_bytes());
+                    }
+                }
+                if let Some(uv) = &uv {
+                    for c in uv[i] {
                         b.extend_from_slice(&c.to_le_bytes());
                     }
                 }

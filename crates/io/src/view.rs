@@ -57,6 +57,16 @@ pub enum ViewError {
         /// Faces.
         faces: usize,
     },
+    /// A texture-coordinate index names a value that does not exist.
+    #[error("face {face} uses texture coordinate {index}, but there are only {values}")]
+    TexCoordOutOfRange {
+        /// The face.
+        face: usize,
+        /// The index it names.
+        index: u32,
+        /// Number of texture coordinates.
+        values: usize,
+    },
     /// Normals or face levels, when given, must be one per vertex or per face.
     #[error("{given} {what} given for {expected}")]
     Count {
@@ -153,6 +163,40 @@ enum Holes<'a> {
     List(Vec<usize>),
 }
 
+/// Texture coordinates of a view: values and, per face-vertex, the index of its value.
+#[derive(Debug, Clone, Copy)]
+pub struct TexCoords<'a> {
+    values: &'a [f64],
+    components: usize,
+    indices: &'a [u32],
+}
+
+impl TexCoords<'_> {
+    /// Number of values.
+    pub fn len(&self) -> usize {
+        self.values.len() / self.components
+    }
+
+    /// Whether there are no values.
+    pub fn is_empty(&self) -> bool {
+        self.values.is_empty()
+    }
+
+    /// Value `i`'s u and v.
+    #[inline]
+    pub fn uv(&self, i: usize) -> [f64; 2] {
+        [
+            self.values[i * self.components],
+            self.values[i * self.components + 1],
+        ]
+    }
+
+    /// The value index of every face-vertex, face after face.
+    pub fn indices(&self) -> &[u32] {
+        self.indices
+    }
+}
+
 /// Points of a window of vertices, borrowed from a held view or made for the window.
 pub(crate) struct PointWindow<'a> {
     first: usize,
@@ -174,6 +218,8 @@ impl PointWindow<'_> {
 /// Polygons of a window of faces, borrowed from a held view or made for the window.
 pub(crate) struct FaceWindow<'a> {
     first: usize,
+    /// Face-vertex index of the first corner of `offsets[0]`'s face, less `offsets[0]`.
+    corner_base: usize,
     /// Offsets of the window's faces into `vertices` (for a held view, the view's own).
     offsets: Cow<'a, [u32]>,
     vertices: Cow<'a, [u32]>,
@@ -185,6 +231,12 @@ impl FaceWindow<'_> {
     pub(crate) fn face(&self, f: usize) -> &[u32] {
         let k = f - self.first;
         &self.vertices[self.offsets[k] as usize..self.offsets[k + 1] as usize]
+    }
+
+    /// The face-vertex index (in the whole view) of face `f`'s first corner.
+    #[inline]
+    pub(crate) fn first_corner(&self, f: usize) -> usize {
+        self.corner_base + self.offsets[f - self.first] as usize
     }
 }
 
@@ -198,6 +250,7 @@ pub struct MeshView<'a> {
     corners: Cow<'a, [(u32, f32)]>,
     normals: Option<&'a [DVec3]>,
     face_levels: Option<&'a [u8]>,
+    uv: Option<TexCoords<'a>>,
     /// Scheme hints written as tags (OBJ) or comments (PLY).
     pub hints: SchemeHints,
 }
@@ -271,6 +324,7 @@ impl<'a> MeshView<'a> {
             corners: Cow::Borrowed(&[]),
             normals: None,
             face_levels: None,
+            uv: None,
             hints: SchemeHints::default(),
         })
     }
@@ -339,6 +393,7 @@ impl<'a> MeshView<'a> {
             corners: Cow::Borrowed(&[]),
             normals: None,
             face_levels: None,
+            uv: None,
             hints: SchemeHints::default(),
         })
     }
@@ -379,6 +434,79 @@ impl<'a> MeshView<'a> {
         }
         self.face_levels = Some(levels);
         Ok(self)
+    }
+
+    /// Adds texture coordinates: `components` numbers per value (the first two are u and
+    /// v) and, per face-vertex (face after face), the index of its value. Corners of one
+    /// vertex may name different values (seams): OBJ keeps them (`f v/vt`), `.glb` splits
+    /// the vertex, PLY refuses them.
+    ///
+    /// # Errors
+    /// [`ViewError::Count`] unless there is one index per face-vertex and a whole number
+    /// of values of at least two components, [`ViewError::TexCoordOutOfRange`] for an
+    /// index without a value, [`ViewError::NonFinite`] for a non-finite value.
+    pub fn with_uv(
+        mut self,
+        values: &'a [f64],
+        components: usize,
+        indices: &'a [u32],
+    ) -> Result<MeshView<'a>, ViewError> {
+        let corners = self.num_face_vertices();
+        if indices.len() != corners {
+            return Err(ViewError::Count {
+                what: "texture coordinate indices",
+                given: indices.len(),
+                expected: corners,
+            });
+        }
+        if components < 2 || values.len() % components != 0 {
+            return Err(ViewError::Count {
+                what: "texture coordinate numbers",
+                given: values.len(),
+                expected: values.len().div_ceil(components.max(2)) * components.max(2),
+            });
+        }
+        let n = values.len() / components;
+        if let Some(k) = indices.iter().position(|&i| i as usize >= n) {
+            return Err(ViewError::TexCoordOutOfRange {
+                face: self.face_of_corner(k),
+                index: indices[k],
+                values: n,
+            });
+        }
+        if let Some(i) = values.iter().position(|x| !x.is_finite()) {
+            return Err(ViewError::NonFinite {
+                vertex: i / components,
+            });
+        }
+        self.uv = Some(TexCoords {
+            values,
+            components,
+            indices,
+        });
+        Ok(self)
+    }
+
+    /// The texture coordinates given with [`Self::with_uv`] (or the mesh's first
+    /// face-varying channel for [`Self::from_mesh`]).
+    pub fn uv(&self) -> Option<TexCoords<'a>> {
+        self.uv
+    }
+
+    /// Number of face-vertices (corners of all faces).
+    pub fn num_face_vertices(&self) -> usize {
+        match self.faces {
+            Faces::Held { vertices, .. } => vertices.len(),
+            Faces::Streamed(s) => s.num_faces() * s.face_size(),
+        }
+    }
+
+    /// The face of face-vertex `k`.
+    fn face_of_corner(&self, k: usize) -> usize {
+        match self.faces {
+            Faces::Held { offsets, .. } => offsets.partition_point(|&o| o as usize <= k) - 1,
+            Faces::Streamed(s) => k / s.face_size().max(1),
+        }
     }
 
     /// The per-vertex normals given with [`Self::with_normals`].
@@ -447,6 +575,11 @@ impl<'a> MeshView<'a> {
             corners: Cow::Owned(corners),
             normals: None,
             face_levels: None,
+            uv: mesh.uv().map(|c| TexCoords {
+                values: c.values(),
+                components: c.components(),
+                indices: c.indices(),
+            }),
             hints: mesh.hints,
         }
     }
@@ -545,6 +678,7 @@ impl<'a> MeshView<'a> {
     /// The polygons of faces `range`, their vertices checked against the positions where
     /// they are made here.
     pub(crate) fn face_window(&self, range: Range<usize>) -> std::io::Result<FaceWindow<'_>> {
+        let mut corner_base = 0;
         let (offsets, vertices) = match self.faces {
             Faces::Held { offsets, vertices } => (
                 Cow::Borrowed(&offsets[range.start..=range.end]),
@@ -566,11 +700,13 @@ impl<'a> MeshView<'a> {
                     }));
                 }
                 let offsets = (0..=range.len()).map(|f| (k * f) as u32).collect();
+                corner_base = k * range.start;
                 (Cow::Owned(offsets), Cow::Owned(out))
             }
         };
         Ok(FaceWindow {
             first: range.start,
+            corner_base,
             offsets,
             vertices,
         })

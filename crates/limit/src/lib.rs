@@ -43,6 +43,7 @@
 pub mod acc;
 pub mod eigen;
 pub mod eval;
+pub mod fvar;
 pub mod local;
 pub mod loop_patch;
 pub mod masks;

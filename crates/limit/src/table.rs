@@ -68,8 +68,19 @@ enum VertexCase {
     /// Closed form (Catmull-Clark valence ≥ 3, Loop), or a semi-sharp dart.
     Smooth,
     /// By eigen analysis: an infinitely sharp dart (sharp edge at the given position), or a
-    /// Catmull-Clark interior vertex of valence 2.
+    /// Catmull-Clark interior vertex of valence 2 (smooth, or a semi-sharp dart).
     Numeric(RingFeature, usize),
+}
+
+/// The smooth case of a vertex with `nf` faces and `ne` edges: the closed form, except at
+/// an interior Catmull-Clark vertex of valence 2, where it is not the limit (OpenSubdiv
+/// copies the vertex there) and the eigen analysis gives it.
+fn smooth_case(nf: usize, ne: usize, scheme: Scheme) -> VertexCase {
+    if scheme == Scheme::CatmullClark && nf == 2 && ne == 2 {
+        VertexCase::Numeric(RingFeature::Smooth, 0)
+    } else {
+        VertexCase::Smooth
+    }
 }
 
 fn classify(t: &Topology, v: usize, rule: Rule, scheme: Scheme) -> VertexCase {
@@ -92,16 +103,11 @@ fn classify(t: &Topology, v: usize, rule: Rule, scheme: Scheme) -> VertexCase {
             if is_infinite(t.edge_sharpness(ve[k] as usize)) && n == ve.len() {
                 VertexCase::Numeric(RingFeature::Dart, k)
             } else {
-                VertexCase::Smooth
+                // A semi-sharp dart takes the smooth mask at this level.
+                smooth_case(n, ve.len(), scheme)
             }
         }
-        Rule::Smooth => {
-            if scheme == Scheme::CatmullClark && n == 2 && ve.len() == 2 {
-                VertexCase::Numeric(RingFeature::Smooth, 0)
-            } else {
-                VertexCase::Smooth
-            }
-        }
+        Rule::Smooth => smooth_case(n, ve.len(), scheme),
     }
 }
 
@@ -141,7 +147,7 @@ fn rotated(m: &RingMask, k: usize) -> RingMask {
 /// The limit mask of every vertex of one level: masks depend only on the vertex's case and
 /// its edge and face counts, so each distinct one is built once and vertices point at it
 /// (filling the rows then allocates and hashes nothing per vertex).
-struct LevelMasks<'a> {
+pub(crate) struct LevelMasks<'a> {
     topology: &'a Topology,
     library: Vec<LimitMask>,
     /// Index into `library` per vertex.
@@ -149,7 +155,10 @@ struct LevelMasks<'a> {
 }
 
 impl<'a> LevelMasks<'a> {
-    fn new(refinement: &'a Refinement, level: usize) -> Result<LevelMasks<'a>, LimitError> {
+    pub(crate) fn new(
+        refinement: &'a Refinement,
+        level: usize,
+    ) -> Result<LevelMasks<'a>, LimitError> {
         let scheme = refinement.scheme();
         if scheme == Scheme::Bilinear {
             return Err(LimitError::Scheme);
@@ -205,6 +214,11 @@ impl<'a> LevelMasks<'a> {
             library,
             mask,
         })
+    }
+
+    /// The limit mask of vertex `v`.
+    pub(crate) fn of(&self, v: usize) -> &LimitMask {
+        &self.library[self.mask[v] as usize]
     }
 
     /// The table of one of the masks (`which` picks position or a tangent).
@@ -324,23 +338,46 @@ pub(crate) fn emit(t: &Topology, v: usize, m: &RingMask, sink: &mut RowSink) {
 
 /// The nonzero terms (vertex, weight) of ring mask `m` of vertex `v`, in [`emit`]'s order: a
 /// face weight goes to the face's vertex opposite `v`, an edge weight to the edge's other end.
-fn ring_terms(t: &Topology, v: usize, m: &RingMask, mut term: impl FnMut(u32, f64)) {
+pub(crate) fn ring_terms(t: &Topology, v: usize, m: &RingMask, term: impl FnMut(u32, f64)) {
+    ring_terms_by(
+        t,
+        v,
+        m,
+        |f, k| t.face_vertices(f)[k],
+        |e| t.edge_other_vertex(e, v as u32),
+        v as u32,
+        term,
+    );
+}
+
+/// [`ring_terms`] with the points named by the caller: `corner(f, k)` for the point at
+/// corner `k` of face `f`, `far(e)` for the far end of edge `e`, `centre` for the vertex
+/// (a face-varying channel names its values there).
+pub(crate) fn ring_terms_by(
+    t: &Topology,
+    v: usize,
+    m: &RingMask,
+    corner: impl Fn(usize, usize) -> u32,
+    far: impl Fn(usize) -> u32,
+    centre: u32,
+    mut term: impl FnMut(u32, f64),
+) {
     if !m.faces.is_empty() {
         let local = t.vertex_face_local_indices(v);
         for (i, &f) in t.vertex_faces(v).iter().enumerate() {
             if m.faces[i] != 0.0 {
-                let fv = t.face_vertices(f as usize);
-                term(fv[(local[i] as usize + 2) % fv.len()], m.faces[i]);
+                let n = t.face_size(f as usize);
+                term(corner(f as usize, (local[i] as usize + 2) % n), m.faces[i]);
             }
         }
     }
     for (i, &e) in t.vertex_edges(v).iter().enumerate() {
         if i < m.edges.len() && m.edges[i] != 0.0 {
-            term(t.edge_other_vertex(e as usize, v as u32), m.edges[i]);
+            term(far(e as usize), m.edges[i]);
         }
     }
     if m.vertex != 0.0 {
-        term(v as u32, m.vertex);
+        term(centre, m.vertex);
     }
 }
 

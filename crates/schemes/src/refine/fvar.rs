@@ -305,6 +305,20 @@ impl FaceVaryingRefinement {
             .collect()
     }
 
+    /// The state of the values of `level`, for limit masks (`refinement` is the one the
+    /// channel was refined with).
+    pub fn level_values<'a>(
+        &'a self,
+        refinement: &'a Refinement,
+        level: usize,
+    ) -> FVarLevelValues<'a> {
+        FVarLevelValues {
+            level: &self.levels[level],
+            topology: refinement.topology(level),
+            linear: self.mode == FVarLinearInterpolation::All,
+        }
+    }
+
     /// Stencils giving the values of `level` from those of `level - 1` (`level ≥ 1`).
     pub fn stencils(&self, level: usize) -> &StencilTable {
         &self.stencils[level - 1]
@@ -336,6 +350,67 @@ impl FaceVaryingRefinement {
             out.push(next);
         }
         out
+    }
+}
+
+/// The values of one level of a [`FaceVaryingRefinement`] as limit masks need them: which
+/// values each vertex has, whether they follow the geometry (matching) or are seam corners
+/// or seam creases, and a crease value's two end values (`Vtr::FVarLevel`'s state).
+///
+/// Values are named by their index at that level (at level 0, the channel's own indices).
+#[derive(Debug, Clone, Copy)]
+pub struct FVarLevelValues<'a> {
+    level: &'a ChannelLevel,
+    topology: &'a Topology,
+    linear: bool,
+}
+
+impl FVarLevelValues<'_> {
+    /// Whether the channel is linear everywhere (mode `all`): every value's limit is itself.
+    pub fn is_linear(&self) -> bool {
+        self.linear
+    }
+
+    /// Number of values of vertex `v` (its siblings).
+    pub fn num_vertex_values(&self, v: usize) -> usize {
+        self.level.count(v)
+    }
+
+    /// The `k`-th value of vertex `v`.
+    pub fn vertex_value(&self, v: usize, k: usize) -> u32 {
+        self.level.source(self.level.offset(v) + k)
+    }
+
+    /// Whether vertex `v`'s values follow the geometry's rules (one value, no seam, and
+    /// not pinned by the mode).
+    pub fn is_matching(&self, v: usize) -> bool {
+        !self.level.tags[self.level.offset(v)].mismatch
+    }
+
+    /// The value at corner `k` of face `f`.
+    pub fn corner_value(&self, f: usize, k: usize) -> u32 {
+        self.level.corner_source(self.topology, f, k)
+    }
+
+    /// The value at the far end of edge `e` from vertex `v`, seen from a vertex whose
+    /// values match (every edge there is continuous, so any of its faces gives it).
+    pub fn far_value(&self, e: usize, v: u32) -> u32 {
+        let [a, b] = self.level.edge_face_sources(self.topology, e, 0);
+        if self.topology.edge_vertices(e)[0] != v {
+            a
+        } else {
+            b
+        }
+    }
+
+    /// For a seam value `k` of a mismatched vertex `v` that is refined with the crease rule,
+    /// the values at the far ends of the two edges bounding its span; `None` for a value
+    /// pinned as a corner (including one still semi-sharp).
+    pub fn crease_ends(&self, v: usize, k: usize) -> Option<[u32; 2]> {
+        let slot = self.level.offset(v) + k;
+        let tag = self.level.tags[slot];
+        (tag.mismatch && !tag.is_corner())
+            .then(|| self.level.crease_end_sources(self.topology, v, slot))
     }
 }
 

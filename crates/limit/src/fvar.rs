@@ -1,0 +1,213 @@
+//! Limits of face-varying values (UVs): OpenSubdiv's `PrimvarRefiner::LimitFaceVarying`
+//! (digest: `docs/opensubdiv-face-varying.md` §5), with exact weights.
+//!
+//! A value that follows the geometry (its vertex has one value and no seam) takes its
+//! vertex's limit mask, read over values: the face terms at the corner opposite the vertex,
+//! the edge terms at the edge's far end, the centre at the value itself. A seam value refined
+//! with the crease rule takes the cubic B-spline's limit along its seam,
+//! `(e₀ + 4 v + e₁) / 6` over its two crease ends; a pinned (corner) value, and every value of
+//! a linear channel (mode `all`) or of Bilinear, is its own limit.
+//!
+//! Where this differs from OpenSubdiv, OpenSubdiv is the one off:
+//! * it writes the seam weights as `float` literals (`1.0f/6.0f`, `2.0f/3.0f`), about 3e-8
+//!   from 1/6 and 2/3 even in a double-precision refiner;
+//! * it applies that seam mask under Bilinear too, whose refinement of every value is
+//!   linear, so the limit of a Bilinear refinement is the value itself;
+//! * at interior Catmull-Clark vertices of valence 2 and darts on infinitely sharp edges it
+//!   uses closed forms that are not the limit there; subd takes the eigen limit, as for
+//!   positions ([`crate::eigen_limit_vertices`]).
+
+use std::ops::Range;
+
+use subd_mesh::Topology;
+use subd_mesh::fvar::{FVarChannel, FVarLinearInterpolation};
+use subd_schemes::{FaceVaryingRefinement, Options, Refinement, Scheme, StencilTable};
+
+use crate::LimitError;
+use crate::table::{LevelMasks, ring_terms_by};
+
+/// The cubic B-spline's limit along a crease: the ends' weight and the centre's.
+const CREASE_END: f64 = 1.0 / 6.0;
+const CREASE_CENTRE: f64 = 2.0 / 3.0;
+
+/// Limit stencils of every value of `level` (at least 1) of a channel refined with
+/// `refinement`, over the values of that level (see the [module docs](self)).
+///
+/// # Errors
+/// [`LimitError::Param`] for level 0 (its values are the channel's own, which a vertex may
+/// share with others: take [`base_fvar_limit`]), and the errors of the position limit masks
+/// at that level ([`crate::LimitStencilTable::at_level`]).
+pub fn limit_at_level(
+    refinement: &Refinement,
+    fvar: &FaceVaryingRefinement,
+    level: usize,
+) -> Result<StencilTable, LimitError> {
+    if level == 0 || level > refinement.num_levels() {
+        return Err(LimitError::Param(format!(
+            "face-varying limits are taken at a refined level (1 to {}), not {level}",
+            refinement.num_levels()
+        )));
+    }
+    let n = fvar.num_values(level);
+    let values = fvar.level_values(refinement, level);
+    if values.is_linear() || refinement.scheme() == Scheme::Bilinear {
+        return Ok(StencilTable::identity(n));
+    }
+    let t = refinement.topology(level);
+    let masks = LevelMasks::new(refinement, level)?;
+    // The vertex and sibling of each value (values are numbered vertex by vertex).
+    let mut owner = Vec::with_capacity(n);
+    for v in 0..t.num_vertices() {
+        for k in 0..values.num_vertex_values(v) {
+            owner.push((v as u32, k as u16));
+        }
+    }
+    Ok(StencilTable::build(n, n, |r, sink| {
+        let (v, k) = (owner[r].0 as usize, owner[r].1 as usize);
+        let own = values.vertex_value(v, k);
+        if t.vertex_edges(v).is_empty() {
+            sink.add(own, 1.0);
+        } else if values.is_matching(v) {
+            ring_terms_by(
+                t,
+                v,
+                &masks.of(v).position,
+                |f, c| values.corner_value(f, c),
+                |e| values.far_value(e, v as u32),
+                own,
+                |i, w| sink.add(i, w),
+            );
+        } else if let Some([a, b]) = values.crease_ends(v, k) {
+            sink.add(a, CREASE_END);
+            sink.add(b, CREASE_END);
+            sink.add(own, CREASE_CENTRE);
+        } else {
+            sink.add(own, 1.0);
+        }
+    }))
+}
+
+/// Limit stencils of a channel at the last level of `refinement`, applied to that level's
+/// values (`components` numbers each): the values' limits, in the same layout.
+///
+/// # Errors
+/// As [`limit_at_level`] at the last level.
+pub fn limit_values(
+    refinement: &Refinement,
+    fvar: &FaceVaryingRefinement,
+    values: &[f64],
+    components: usize,
+) -> Result<Vec<f64>, LimitError> {
+    let table = limit_at_level(refinement, fvar, refinement.num_levels())?;
+    let mut out = vec![0.0; values.len()];
+    table.apply(values, components, &mut out);
+    Ok(out)
+}
+
+/// The exact limit of every value of every base vertex of a channel: one row per (vertex,
+/// value) pair, vertex after vertex, over the channel's values.
+#[derive(Debug, Clone)]
+pub struct BaseFVarLimit {
+    /// Where each base vertex's rows start (one more entry than vertices).
+    offsets: Vec<u32>,
+    /// The channel value of each row.
+    values: Vec<u32>,
+    /// Limit stencils over the channel's values.
+    pub table: StencilTable,
+}
+
+impl BaseFVarLimit {
+    /// The rows of base vertex `v`, one per distinct value its corners name (in
+    /// OpenSubdiv's sibling order).
+    pub fn vertex_rows(&self, v: usize) -> Range<usize> {
+        self.offsets[v] as usize..self.offsets[v + 1] as usize
+    }
+
+    /// The channel value whose limit row `r` is.
+    pub fn value(&self, r: usize) -> u32 {
+        self.values[r]
+    }
+
+    /// Number of rows.
+    pub fn num_rows(&self) -> usize {
+        self.values.len()
+    }
+
+    /// The limits of `values` (`components` numbers per channel value), a row at a time.
+    pub fn apply(&self, values: &[f64], components: usize) -> Vec<f64> {
+        let mut out = vec![0.0; self.num_rows() * components];
+        self.table.apply(values, components, &mut out);
+        out
+    }
+}
+
+/// The exact limit of every base vertex's values of `channel` on `topology`, interpolated
+/// by `mode`: refined until semi-sharp features have decayed (at least one level, so that
+/// Catmull-Clark faces are quads and each value is its vertex's own), the limit masks taken
+/// there ([`limit_at_level`]) and composed back to the channel's values. Base vertex `v` is
+/// vertex `v` at every level, with the same values.
+///
+/// ```
+/// use subd_mesh::TopologyBuilder;
+/// use subd_mesh::fvar::{FVarChannel, FVarLinearInterpolation};
+/// use subd_schemes::{Options, Scheme};
+///
+/// // A 3x3 grid of quads whose UVs are the positions: a seamless planar layout.
+/// let mut faces = Vec::new();
+/// for i in 0..3u32 {
+///     for j in 0..3u32 {
+///         let a = 4 * i + j;
+///         faces.extend([a, a + 1, a + 5, a + 4]);
+///     }
+/// }
+/// let grid = TopologyBuilder::new(16).build(&[4; 9], &faces).unwrap();
+/// let uv: Vec<f64> = (0..16).flat_map(|v| [(v % 4) as f64, (v / 4) as f64]).collect();
+/// let channel = FVarChannel::new(&grid, 2, uv, faces.clone()).unwrap();
+/// let limit = subd_limit::fvar::base_fvar_limit(
+///     &grid, Scheme::CatmullClark, &Options::default(), &channel,
+///     FVarLinearInterpolation::CornersOnly,
+/// ).unwrap();
+/// let at = limit.apply(channel.values(), 2);
+/// // Catmull-Clark reproduces linear functions: an interior value is its own limit.
+/// let r = limit.vertex_rows(5).start;
+/// assert!((at[2 * r] - 1.0).abs() < 1e-12 && (at[2 * r + 1] - 1.0).abs() < 1e-12);
+/// ```
+///
+/// # Errors
+/// As [`crate::base_limit`], and [`LimitError::Param`] for a channel that does not fit
+/// `topology`.
+pub fn base_fvar_limit(
+    topology: &Topology,
+    scheme: Scheme,
+    options: &Options,
+    channel: &FVarChannel,
+    mode: FVarLinearInterpolation,
+) -> Result<BaseFVarLimit, LimitError> {
+    let levels = crate::levels_for_exact_limit(topology, scheme).0.max(1);
+    let r = Refinement::new(topology, scheme, options, levels)?;
+    let fr = FaceVaryingRefinement::new(&r, channel, mode)
+        .map_err(|e| LimitError::Param(e.to_string()))?;
+    let at = limit_at_level(&r, &fr, levels)?;
+    let base = fr.level_values(&r, 0);
+    let last = fr.level_values(&r, levels);
+    let nv = topology.num_vertices();
+    let mut offsets = Vec::with_capacity(nv + 1);
+    let mut values = Vec::new();
+    for v in 0..nv {
+        offsets.push(values.len() as u32);
+        for k in 0..base.num_vertex_values(v) {
+            values.push(base.vertex_value(v, k));
+        }
+    }
+    offsets.push(values.len() as u32);
+    // Base vertex v is vertex v at every level, and keeps its values: its rows are the first
+    // of the last level's values.
+    let rows = values.len();
+    debug_assert!((0..nv).all(|v| last.num_vertex_values(v) == base.num_vertex_values(v)));
+    let table = crate::first_rows(&fr.composed(levels).then(&at), rows);
+    Ok(BaseFVarLimit {
+        offsets,
+        values,
+        table,
+    })
+}
