@@ -101,7 +101,7 @@ fn compare_limit(
     let (mut left_out, mut left_worst) = (0usize, 0.0f64);
     let mut f32_worst = 0.0f64;
     let mut r = 0usize;
-    for v in 0..t.num_vertices() {
+    for (v, &at_eigen) in eigen.iter().enumerate() {
         for k in 0..values.num_vertex_values(v) {
             let d = (ours[2 * r] - theirs[2 * r])
                 .abs()
@@ -123,10 +123,10 @@ fn compare_limit(
                 left_out += 1;
                 left_worst = left_worst.max(d);
                 f32_worst = f32_worst.max(d);
-            } else if eigen[v] && values.is_matching(v) {
+            } else if at_eigen && values.is_matching(v) {
                 left_out += 1;
                 left_worst = left_worst.max(d);
-            } else if !(d <= worst) {
+            } else if d > worst || d.is_nan() {
                 worst = d;
                 at = r;
             }
@@ -230,7 +230,7 @@ pub fn compare(
                 let d = (ours[level][2 * a] - o.values[2 * b])
                     .abs()
                     .max((ours[level][2 * a + 1] - o.values[2 * b + 1]).abs());
-                if !(d <= worst) {
+                if d > worst || d.is_nan() {
                     worst = d;
                     at = k;
                 }
@@ -327,10 +327,10 @@ pub fn random_channel(rng: &mut Rng, topo: &Topology) -> FVarChannel {
     }
     let mut index: HashMap<(u32, usize), u32> = HashMap::new();
     let mut indices = Vec::with_capacity(topo.num_face_vertices());
-    for f in 0..nf {
+    for (f, &island) in label.iter().enumerate() {
         for &v in topo.face_vertices(f) {
             let n = index.len() as u32;
-            indices.push(*index.entry((v, label[f])).or_insert(n));
+            indices.push(*index.entry((v, island)).or_insert(n));
         }
     }
     let count = index.len() + rng.below(2) as usize;

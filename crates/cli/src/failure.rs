@@ -14,7 +14,14 @@ pub struct Failure {
 
 impl From<subd_io::IoError> for Failure {
     fn from(e: subd_io::IoError) -> Self {
-        let code = match e {
+        let code = match &e {
+            // The data cannot go into the format asked for (a PLY with UV seams): the
+            // request is at fault, not the disk.
+            subd_io::IoError::Write { source, .. }
+                if source.kind() == std::io::ErrorKind::InvalidData =>
+            {
+                EXIT_BAD_INPUT
+            }
             subd_io::IoError::Write { .. } => EXIT_FAILURE,
             _ => EXIT_BAD_INPUT,
         };

@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use clap::Args;
 use serde::Serialize;
 use subd_mesh::analysis::count_irregular;
+use subd_mesh::fvar::{FVarLinearInterpolation, FVarSeams};
 use subd_mesh::{BoundaryInterpolation, TopologySummary};
 
 use crate::{Failure, print_warnings};
@@ -27,6 +28,21 @@ struct Irregular {
     triangle: usize,
 }
 
+/// One face-varying channel: its size and where its values are discontinuous.
+#[derive(Serialize)]
+struct ChannelReport {
+    /// Numbers per value.
+    components: usize,
+    /// Values the file gives.
+    values: usize,
+    /// Distinct values at vertices (a vertex on a seam counts once per side).
+    vertex_values: usize,
+    /// Edges whose faces name different values at one of their ends.
+    seam_edges: usize,
+    /// Vertices with more than one value.
+    seam_vertices: usize,
+}
+
 #[derive(Serialize)]
 struct InfoReport<'a> {
     file: String,
@@ -35,6 +51,10 @@ struct InfoReport<'a> {
     irregular_vertices: Irregular,
     orientation_conflicts: usize,
     boundary_interpolation: Option<BoundaryInterpolation>,
+    /// Face-varying channels (the first is the texture coordinates).
+    fvar_channels: Vec<ChannelReport>,
+    /// The file's face-varying interpolation tag, if any.
+    fvar_interpolation: Option<FVarLinearInterpolation>,
     warnings: &'a [String],
 }
 
@@ -63,6 +83,22 @@ pub(crate) fn run(
         },
         orientation_conflicts: file.orientation_conflicts,
         boundary_interpolation: file.mesh.hints.boundary_interpolation,
+        fvar_channels: file
+            .mesh
+            .fvar
+            .iter()
+            .map(|c| {
+                let seams = FVarSeams::of(topo, c);
+                ChannelReport {
+                    components: c.components(),
+                    values: c.num_values(),
+                    vertex_values: seams.num_vertex_values(),
+                    seam_edges: seams.num_seam_edges(),
+                    seam_vertices: seams.num_seam_vertices(),
+                }
+            })
+            .collect(),
+        fvar_interpolation: file.mesh.hints.fvar_interpolation,
         warnings: &file.warnings,
     };
     let written = if args.json {
@@ -135,6 +171,21 @@ fn write_text(out: &mut dyn Write, r: &InfoReport) -> std::io::Result<()> {
                 .as_str()
                 .unwrap_or("")
         )?;
+    }
+    for (i, c) in r.fvar_channels.iter().enumerate() {
+        let what = if i == 0 {
+            "uv".to_string()
+        } else {
+            format!("fvar {i}")
+        };
+        writeln!(
+            out,
+            "{what:<17} {} values of {} components, {} at vertices; seams: {} edges, {} vertices",
+            c.values, c.components, c.vertex_values, c.seam_edges, c.seam_vertices
+        )?;
+    }
+    if let Some(m) = r.fvar_interpolation {
+        writeln!(out, "fvar rule         {}", m.name())?;
     }
     writeln!(out, "components        {}", s.components)?;
     writeln!(out, "euler             {}", s.euler)?;

@@ -31,6 +31,7 @@ mod refine;
 mod render;
 mod rule_args;
 mod tessellate;
+mod uv;
 mod vertex_data;
 
 use std::ffi::OsString;

@@ -184,7 +184,21 @@ fn run_one(
         }
         let limit = split_limit_points(topo, scheme, &file.mesh.positions)
             .map_err(|e| bad(format!("{}: {e}", job.input.display())))?;
-        write_limit(args, job, &limit, &file.mesh, is_text)?;
+        if file.mesh.uv().is_some() && !is_text {
+            print_warnings(
+                err,
+                &job.input,
+                &[format!(
+                    "texture coordinates are kept as given: --scheme {} has no face-varying limit",
+                    scheme.name()
+                )],
+            );
+        }
+        let kept = file.mesh.uv().map(|c| crate::uv::RefinedUv {
+            values: c.values().to_vec(),
+            indices: c.indices().to_vec(),
+        });
+        write_limit(args, job, &limit, &file.mesh, kept.as_ref(), is_text, err)?;
         if args.json {
             let report = LimitReport {
                 input: job.input.display().to_string(),
@@ -230,7 +244,22 @@ fn run_one(
         }
         None => None,
     };
-    write_limit(args, job, &limit, &file.mesh, is_text)?;
+    // Texture coordinates at their limit too (two-phase: Catmull-Clark's face-varying rules,
+    // which its second phase on is).
+    let uv = match file.mesh.uv() {
+        Some(c) if !is_text => Some(
+            crate::uv::limit_uv(
+                topo,
+                scheme,
+                &options,
+                c,
+                args.rules.fvar_mode(&file.mesh.hints),
+            )
+            .map_err(|e| bad(format!("{}: {e}", job.input.display())))?,
+        ),
+        _ => None,
+    };
+    write_limit(args, job, &limit, &file.mesh, uv.as_ref(), is_text, err)?;
     if let Some((path, json)) = acc {
         subd_io::atomic_write(path, |w| w.write_all(&json))?;
     }
@@ -257,7 +286,9 @@ fn write_limit(
     job: &Job,
     limit: &LimitPoints,
     input: &Mesh,
+    uv: Option<&crate::uv::RefinedUv>,
     is_text: bool,
+    err: &mut dyn Write,
 ) -> Result<(), Failure> {
     if is_text {
         let body = text(limit, args.normals);
@@ -266,6 +297,21 @@ fn write_limit(
         let mut mesh = Mesh::new(input.topology.clone(), limit.positions.clone())
             .map_err(|e| bad(format!("{}: {e}", job.input.display())))?;
         mesh.hints = input.hints;
+        if let Some(uv) = uv {
+            let in_file =
+                |e: subd_mesh::fvar::FVarError| bad(format!("{}: {e}", job.input.display()));
+            let channel = subd_mesh::fvar::FVarChannel::new(
+                &mesh.topology,
+                2,
+                uv.values.clone(),
+                uv.indices.clone(),
+            )
+            .map_err(in_file)?;
+            mesh = mesh.with_fvar(channel).map_err(in_file)?;
+            let mut dropped = Vec::new();
+            crate::uv::fit_ply(&mut mesh, &job.output, &mut dropped);
+            print_warnings(err, &job.input, &dropped);
+        }
         subd_io::write_mesh(&job.output, &mesh, &subd_io::WriteOptions::default())?;
     }
     Ok(())

@@ -242,6 +242,11 @@ fn run_one(
     let mut mesh = Mesh::new(topo.clone(), result.points.clone())
         .map_err(|e| bad(format!("{}: {e}", job.input.display())))?;
     mesh.hints = file.mesh.hints;
+    // The fitted mesh keeps the input's topology, so its texture coordinates stay as given.
+    mesh.fvar = file.mesh.fvar.clone();
+    let mut dropped = Vec::new();
+    crate::uv::fit_ply(&mut mesh, &job.output, &mut dropped);
+    print_warnings(err, &job.input, &dropped);
     subd_io::write_mesh(&job.output, &mesh, &subd_io::WriteOptions::default())?;
     let t_write = t3.elapsed().as_secs_f64();
 

@@ -278,7 +278,7 @@ fn run_one(
         faces: base.num_faces(),
     };
     let fvar_mode = args.rules.fvar_mode(&file.mesh.hints);
-    let uv = refined_uv(
+    let uv = crate::uv::refined_uv(
         &refinement,
         &file.mesh,
         fvar_mode,
@@ -287,6 +287,22 @@ fn run_one(
         &mut file.warnings,
     )
     .map_err(|e| in_file(&e))?;
+    // PLY holds one texture coordinate per vertex: a seamed layout is left out (a refined
+    // level gives a seamless layout exactly one value per vertex).
+    let uv = match uv {
+        Some(u)
+            if subd_io::Format::for_output(&job.output) == Some(subd_io::Format::Ply)
+                && if args.levels == 0 {
+                    !crate::uv::fits_ply(&file.mesh.topology, &u.values, &u.indices)
+                } else {
+                    u.values.len() / 2 != refinement_vertices(&refinement, args.levels)
+                } =>
+        {
+            file.warnings.push(crate::uv::ply_seam_warning(&job.output));
+            None
+        }
+        u => u,
+    };
     print_warnings(
         err,
         &job.input,
@@ -302,12 +318,6 @@ fn run_one(
     let osd = matches!(chosen, Chosen::Osd(_));
     let mut hints = output_hints(osd, &options, &file.mesh.hints, &args.rules);
     hints.fvar_interpolation = uv.as_ref().map(|_| fvar_mode);
-    let with_uv = |v: subd_io::MeshView<'a>| -> Result<subd_io::MeshView<'a>, subd_io::ViewError> {
-        match &uv {
-            Some(uv) => v.with_uv(&uv.values, 2, &uv.indices),
-            None => Ok(v),
-        }
-    };
     let in_view = |e: subd_io::ViewError| bad(format!("{}: {e}", job.input.display()));
     let streams = match &refinement {
         Refined::Osd(r) if !args.limit && args.levels > 0 => Some(r),
@@ -331,7 +341,7 @@ fn run_one(
         let tags = refinement.explicit_tags(args.levels);
         let view = subd_io::MeshView::streamed(source, &faces, faces.0.hole_faces())
             .and_then(|v| v.with_tags(tags.creases, tags.corners))
-            .and_then(with_uv)
+            .and_then(|v| crate::uv::with_uv(v, uv.as_ref()))
             .map_err(in_view)?;
         let counts = write_level(job, view, hints, refinement.num_edges(args.levels))?;
         (counts, t_positions, t2)
@@ -362,7 +372,7 @@ fn run_one(
         let holes = refinement.holes(args.levels);
         let mut view = subd_io::MeshView::new(&positions, offsets, vertices, &holes)
             .and_then(|v| v.with_tags(tags.creases, tags.corners))
-            .and_then(with_uv)
+            .and_then(|v| crate::uv::with_uv(v, uv.as_ref()))
             .map_err(in_view)?;
         let filled;
         if let Some(n) = &normals {
@@ -405,50 +415,12 @@ fn run_one(
     Ok(())
 }
 
-/// A refined face-varying channel: two numbers per value, one value index per face-vertex.
-pub(crate) struct RefinedUv {
-    pub(crate) values: Vec<f64>,
-    pub(crate) indices: Vec<u32>,
-}
-
-/// The mesh's texture coordinates at the last level of `refinement` (at their limit with
-/// `limit`), interpolated by `mode`; `None` when the mesh has none, or, with a warning, when
-/// the scheme does not carry them yet.
-pub(crate) fn refined_uv(
-    refinement: &Refined,
-    mesh: &subd_mesh::Mesh,
-    mode: subd_mesh::fvar::FVarLinearInterpolation,
-    limit: bool,
-    scheme: SchemeArg,
-    warnings: &mut Vec<String>,
-) -> Result<Option<RefinedUv>, String> {
-    let Some(channel) = mesh.uv() else {
-        return Ok(None);
-    };
-    let r = match refinement {
-        Refined::Osd(r) => r,
-        Refined::Split(_) => {
-            warnings.push(format!(
-                "texture coordinates are not refined by --scheme {} (only by catmull-clark, loop, bilinear and two-phase); the output has none",
-                scheme.name()
-            ));
-            return Ok(None);
-        }
-    };
-    let fr =
-        subd_schemes::FaceVaryingRefinement::new(r, channel, mode).map_err(|e| e.to_string())?;
-    let level = r.num_levels();
-    let mut values = fr
-        .refine_values(channel.values(), 2)
-        .pop()
-        .expect("level 0 at least");
-    if limit {
-        values = subd_limit::fvar::limit_values(r, &fr, &values, 2).map_err(|e| e.to_string())?;
+/// Number of vertices of `level` of either family.
+fn refinement_vertices(refinement: &Refined, level: usize) -> usize {
+    match refinement {
+        Refined::Osd(r) => r.num_vertices(level),
+        Refined::Split(r) => r.topology(level).num_vertices(),
     }
-    Ok(Some(RefinedUv {
-        values,
-        indices: fr.face_values(level),
-    }))
 }
 
 /// Writes the output level with its hints; its counts for the report.

@@ -1374,6 +1374,16 @@ fn refine_output_equals_the_fully_built_level() {
         let options = Options::from_hints(&file.mesh.hints);
         let r = Refinement::new(&file.mesh.topology, scheme, &options, 2).unwrap();
         let positions = r.refine_points(&file.mesh.positions).pop().unwrap();
+        let refined_uv = file.mesh.uv().map(|uv| {
+            let mode = file
+                .mesh
+                .hints
+                .fvar_interpolation
+                .unwrap_or(subd_mesh::fvar::FVarLinearInterpolation::CornersPlus1);
+            let fr = subd_schemes::FaceVaryingRefinement::new(&r, uv, mode).unwrap();
+            let values = fr.refine_values(uv.values(), 2).pop().unwrap();
+            (values, fr.face_values(2), mode)
+        });
         let mut t = r.into_topology(2);
         for e in 0..t.num_edges() {
             if t.is_boundary_edge(e) || t.is_non_manifold_edge(e) {
@@ -1397,6 +1407,18 @@ fn refine_output_equals_the_fully_built_level() {
             triangle_subdivision: file.mesh.hints.triangle_subdivision,
             fvar_interpolation: None,
         };
+        // Texture coordinates refined beside, in the file's mode or corners-plus1.
+        let mut textured = mesh.clone();
+        if let Some((values, indices, mode)) = refined_uv {
+            let channel =
+                subd_mesh::fvar::FVarChannel::new(&textured.topology, 2, values, indices).unwrap();
+            textured = textured.with_fvar(channel).unwrap();
+            textured.hints.fvar_interpolation = Some(mode);
+        }
+        // PLY keeps them where every vertex has one value.
+        let ply_keeps = textured
+            .uv()
+            .is_none_or(|uv| uv.num_values() == textured.topology.num_vertices());
         let tags = mesh.topology.tags();
         tagged += (tags.num_creased_edges() > 0 || tags.vertex_sharpness().iter().any(|&s| s > 0.0))
             as usize;
@@ -1418,7 +1440,12 @@ fn refine_output_equals_the_fully_built_level() {
             ]);
             assert_eq!(code, 0, "{name}: {err}");
             let mut expected = Vec::new();
-            encode_mesh(&mut expected, &mesh, format, &WriteOptions::default()).unwrap();
+            let with = if format != Format::Ply || ply_keeps {
+                &textured
+            } else {
+                &mesh
+            };
+            encode_mesh(&mut expected, with, format, &WriteOptions::default()).unwrap();
             assert!(
                 std::fs::read(&out).unwrap() == expected,
                 "{name}.{ext} differs"
@@ -2731,4 +2758,276 @@ fn batch_progress_bar_on_a_terminal_draws_and_finishes() {
         file_names(&out_dir),
         ["catmark_cube.obj", "catmark_torus.obj"]
     );
+}
+
+/// The texture coordinate of every corner of a mesh file, face after face.
+fn corner_uvs(path: &Path) -> Vec<[f64; 2]> {
+    let file = subd_io::read_mesh(path, &subd_io::ReadOptions::default()).unwrap();
+    let uv = file.mesh.uv().expect("texture coordinates");
+    uv.indices()
+        .iter()
+        .map(|&i| [uv.value(i as usize)[0], uv.value(i as usize)[1]])
+        .collect()
+}
+
+#[test]
+fn refine_carries_texture_coordinates_to_obj_and_glb() {
+    use subd_mesh::fvar::FVarLinearInterpolation;
+    let s = Scratch::new("uv");
+    let input = meshes().join("catmark_fvar_bound1.obj");
+    let obj = s.0.join("uv.obj");
+    let glb = s.0.join("uv.glb");
+    for out in [&obj, &glb] {
+        let args = ["refine", "--scheme", "catmull-clark", "--levels", "2"];
+        let (code, _, err) =
+            subd(&[&args[..], &[input.to_str().unwrap(), out.to_str().unwrap()]].concat());
+        assert_eq!(code, 0, "{err}");
+    }
+    // The OBJ's corners hold the library's refinement (corners-plus1: the file has no tag).
+    let file = subd_io::read_mesh(&input, &subd_io::ReadOptions::default()).unwrap();
+    let options = subd_schemes::Options::from_hints(&file.mesh.hints);
+    let r = subd_schemes::Refinement::new(
+        &file.mesh.topology,
+        subd_schemes::Scheme::CatmullClark,
+        &options,
+        2,
+    )
+    .unwrap();
+    let channel = file.mesh.uv().unwrap();
+    let fr = subd_schemes::FaceVaryingRefinement::new(
+        &r,
+        channel,
+        FVarLinearInterpolation::CornersPlus1,
+    )
+    .unwrap();
+    let values = fr.refine_values(channel.values(), 2).pop().unwrap();
+    let expected: Vec<[f64; 2]> = fr
+        .face_values(2)
+        .iter()
+        .map(|&i| [values[2 * i as usize], values[2 * i as usize + 1]])
+        .collect();
+    let written = corner_uvs(&obj);
+    assert_eq!(written, expected);
+    let text = std::fs::read_to_string(&obj).unwrap();
+    assert!(text.contains("\nt facevaryinginterpolateboundary 1/0/0 2\n"));
+    assert_eq!(
+        text.lines().filter(|l| l.starts_with("vt ")).count(),
+        fr.num_values(2)
+    );
+
+    // The .glb read back with the gltf crate: every triangle corner carries its corner's
+    // value, v flipped to glTF's origin, at its vertex's position.
+    let refined = subd_io::read_mesh(&obj, &subd_io::ReadOptions::default())
+        .unwrap()
+        .mesh;
+    let bytes = std::fs::read(&glb).unwrap();
+    let gltf = gltf::Gltf::from_slice(&bytes).unwrap();
+    let blob = gltf.blob.as_deref().unwrap();
+    let prim = gltf.meshes().next().unwrap().primitives().next().unwrap();
+    let reader = prim.reader(|_| Some(blob));
+    let tex: Vec<[f32; 2]> = reader
+        .read_tex_coords(0)
+        .expect("TEXCOORD_0")
+        .into_f32()
+        .collect();
+    let pos: Vec<[f32; 3]> = reader.read_positions().unwrap().collect();
+    let indices: Vec<u32> = reader.read_indices().unwrap().into_u32().collect();
+    let t = &refined.topology;
+    let mut k = 0;
+    for f in 0..t.num_faces() {
+        let fv = t.face_vertices(f);
+        let o = t.face_offsets()[f] as usize;
+        for i in 1..fv.len() - 1 {
+            for c in [0, i, i + 1] {
+                let g = indices[k] as usize;
+                k += 1;
+                let [u, v] = written[o + c];
+                assert_eq!(tex[g], [u as f32, (1.0 - v) as f32]);
+                let p = refined.positions[fv[c] as usize];
+                assert_eq!(pos[g], [p.x as f32, p.y as f32, p.z as f32]);
+            }
+        }
+    }
+    assert_eq!(k, indices.len());
+    // Read back by subd: the seams survive the welding.
+    let back = subd_io::read_mesh(&glb, &subd_io::ReadOptions::default())
+        .unwrap()
+        .mesh;
+    let seams = |m: &subd_mesh::Mesh| {
+        subd_mesh::fvar::FVarSeams::of(&m.topology, m.uv().unwrap()).num_seam_edges()
+    };
+    assert_eq!(seams(&back), seams(&refined));
+}
+
+#[test]
+fn ply_leaves_out_texture_coordinates_with_seams() {
+    let s = Scratch::new("uvply");
+    let input = meshes().join("catmark_fvar_bound1.obj");
+    let out = s.0.join("uv.ply");
+    let (code, _, err) = subd(&[
+        "refine",
+        "--scheme",
+        "catmull-clark",
+        "--levels",
+        "1",
+        input.to_str().unwrap(),
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.starts_with("subd: warning:") && err.contains("seams") && err.contains(".obj or .glb"),
+        "{err}"
+    );
+    let bytes = std::fs::read(&out).unwrap();
+    assert!(!String::from_utf8_lossy(&bytes).contains("property double u"));
+    // A seamless layout goes through PLY as u v and comes back the same.
+    let quad = s.file(
+        "quad.obj",
+        b"v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n",
+    );
+    let ply = s.0.join("quad.ply");
+    let (code, _, err) = subd(&[
+        "refine",
+        "--scheme",
+        "bilinear",
+        "--levels",
+        "1",
+        quad.to_str().unwrap(),
+        ply.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let bytes = std::fs::read(&ply).unwrap();
+    assert!(String::from_utf8_lossy(&bytes).contains("property double u\nproperty double v\n"));
+    // Bilinear UVs of a unit square laid out as its positions: u = x, v = y everywhere.
+    let back = subd_io::read_mesh(&ply, &subd_io::ReadOptions::default())
+        .unwrap()
+        .mesh;
+    let uv = back.uv().unwrap();
+    for (c, &v) in back.topology.all_face_vertices().iter().enumerate() {
+        let p = back.positions[v as usize];
+        assert_eq!(uv.value(uv.indices()[c] as usize), [p.x, p.y]);
+    }
+}
+
+#[test]
+fn fvar_interpolation_comes_from_the_option_then_the_tag_then_corners_plus1() {
+    let s = Scratch::new("uvmode");
+    let refine = |input: &Path, mode: Option<&str>, out: &str| -> Vec<u8> {
+        let out = s.0.join(out);
+        let mut args = vec![
+            "refine",
+            "--scheme",
+            "catmull-clark",
+            "--levels",
+            "2",
+            input.to_str().unwrap(),
+            out.to_str().unwrap(),
+        ];
+        if let Some(m) = mode {
+            args.extend(["--fvar-interpolation", m]);
+        }
+        let (code, _, err) = subd(&args);
+        assert_eq!(code, 0, "{err}");
+        std::fs::read(&out).unwrap()
+    };
+    // catmark_cubes_semisharp carries `t facevaryinginterpolateboundary 1/0/0 1`.
+    let tagged = meshes().join("catmark_cubes_semisharp.obj");
+    assert_eq!(
+        refine(&tagged, None, "a.obj"),
+        refine(&tagged, Some("corners-only"), "b.obj")
+    );
+    assert_ne!(
+        refine(&tagged, None, "a.obj"),
+        refine(&tagged, Some("all"), "c.obj")
+    );
+    let untagged = meshes().join("catmark_fvar_bound1.obj");
+    assert_eq!(
+        refine(&untagged, None, "d.obj"),
+        refine(&untagged, Some("corners-plus1"), "e.obj")
+    );
+    assert_ne!(
+        refine(&untagged, None, "d.obj"),
+        refine(&untagged, Some("none"), "f.obj")
+    );
+    let (code, _, err) = subd(&[
+        "refine",
+        "--scheme",
+        "loop",
+        "--levels",
+        "1",
+        "--fvar-interpolation",
+        "sideways",
+        untagged.to_str().unwrap(),
+        s.0.join("g.obj").to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+}
+
+#[test]
+fn info_pia_and_limit_keep_texture_coordinates() {
+    let s = Scratch::new("uvcmd");
+    let input = meshes().join("catmark_fvar_bound1.obj");
+    let (code, stdout, err) = subd(&["info", input.to_str().unwrap(), "--json"]);
+    assert_eq!(code, 0, "{err}");
+    let j: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    let file = subd_io::read_mesh(&input, &subd_io::ReadOptions::default()).unwrap();
+    let seams = subd_mesh::fvar::FVarSeams::of(&file.mesh.topology, file.mesh.uv().unwrap());
+    assert_eq!(j["fvar_channels"][0]["seam_edges"], seams.num_seam_edges());
+    assert_eq!(
+        j["fvar_channels"][0]["seam_vertices"],
+        seams.num_seam_vertices()
+    );
+    assert_eq!(
+        j["fvar_channels"][0]["values"],
+        file.mesh.uv().unwrap().num_values()
+    );
+    // PIA changes positions only: every corner keeps its texture coordinate.
+    let fitted = s.0.join("pia.obj");
+    let (code, _, err) = subd(&[
+        "pia",
+        "--scheme",
+        "catmull-clark",
+        input.to_str().unwrap(),
+        fitted.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(corner_uvs(&fitted), corner_uvs(&input));
+    // The limit command moves them to their limit: the library's base limit.
+    let limit = s.0.join("limit.obj");
+    let (code, _, err) = subd(&[
+        "limit",
+        "--scheme",
+        "catmull-clark",
+        input.to_str().unwrap(),
+        limit.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let options = subd_schemes::Options::from_hints(&file.mesh.hints);
+    let base = subd_limit::fvar::base_fvar_limit(
+        &file.mesh.topology,
+        subd_schemes::Scheme::CatmullClark,
+        &options,
+        file.mesh.uv().unwrap(),
+        subd_mesh::fvar::FVarLinearInterpolation::CornersPlus1,
+    )
+    .unwrap();
+    let at = base.apply(file.mesh.uv().unwrap().values(), 2);
+    let t = &file.mesh.topology;
+    let uvs = corner_uvs(&limit);
+    for f in 0..t.num_faces() {
+        let o = t.face_offsets()[f] as usize;
+        for (c, (&v, &x)) in t
+            .face_vertices(f)
+            .iter()
+            .zip(file.mesh.uv().unwrap().face_values(t, f))
+            .enumerate()
+        {
+            let r = base
+                .vertex_rows(v as usize)
+                .find(|&r| base.value(r) == x)
+                .unwrap();
+            assert_eq!(uvs[o + c], [at[2 * r], at[2 * r + 1]]);
+        }
+    }
 }

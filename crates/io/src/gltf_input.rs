@@ -9,8 +9,10 @@
 //! surface arrives cut open along its UV and normal seams. Subdividing that as it is would
 //! open cracks along every seam; the reader therefore welds vertices by position (exactly,
 //! or within [`ReadOptions::weld_tolerance`]) into one topology. Normals are dropped (the
-//! scheme makes its own) and so are UVs, with a warning, until subd carries face-varying
-//! data.
+//! scheme makes its own). `TEXCOORD_0` becomes the mesh's texture coordinates: each corner
+//! keeps its glTF vertex's value (v flipped back to OBJ's bottom-left origin), so vertices
+//! welded across a UV seam keep the seam as a face-varying discontinuity. Other sets are
+//! dropped with a warning, and so is `TEXCOORD_0` unless every primitive has it.
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -18,6 +20,7 @@ use std::path::Path;
 use glam::DMat4;
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::Mode;
+use subd_mesh::fvar::FVarChannel;
 use subd_mesh::{DVec3, Mesh, SchemeHints, TopologyBuilder};
 
 use crate::error::ReadError;
@@ -171,6 +174,12 @@ struct TriangleSoup {
     positions: Vec<DVec3>,
     triangles: Vec<[u32; 3]>,
     warnings: Vec<String>,
+    /// `TEXCOORD_0` per glTF vertex (flipped back to a bottom-left origin: `1 - v`),
+    /// parallel to `positions` while every primitive has it.
+    texcoords: Vec<[f64; 2]>,
+    /// A triangle primitive without `TEXCOORD_0` was read: the channel is dropped.
+    missing_uv: bool,
+    /// Texture coordinate sets beyond the first, which are not read.
     dropped_uv_sets: usize,
 }
 
@@ -233,6 +242,8 @@ impl TriangleSoup {
                 self.positions.push(q);
             }
             let count = self.positions.len() - first as usize;
+            self.read_texcoords(&primitive, &reader, count, buffers)
+                .map_err(|m| at(&m))?;
             let indices: Vec<u32> = match reader.read_indices() {
                 Some(i) => i.into_u32().collect(),
                 None => (0..count as u32).collect(),
@@ -250,8 +261,48 @@ impl TriangleSoup {
             }
             self.dropped_uv_sets += primitive
                 .attributes()
-                .filter(|(s, _)| matches!(s, gltf::Semantic::TexCoords(_)))
+                .filter(|(s, _)| matches!(s, gltf::Semantic::TexCoords(k) if *k > 0))
                 .count();
+        }
+        Ok(())
+    }
+
+    /// Appends the primitive's `TEXCOORD_0` (`count` vertices), or notes that it has none.
+    fn read_texcoords<'a, 's, F>(
+        &mut self,
+        primitive: &gltf::Primitive<'a>,
+        reader: &gltf::mesh::Reader<'a, 's, F>,
+        count: usize,
+        buffers: &[Vec<u8>],
+    ) -> Result<(), String>
+    where
+        F: Clone + Fn(gltf::Buffer<'a>) -> Option<&'s [u8]>,
+    {
+        let Some(accessor) = primitive.get(&gltf::Semantic::TexCoords(0)) else {
+            self.missing_uv = true;
+            return Ok(());
+        };
+        check_accessor(
+            &accessor,
+            &[DataType::F32, DataType::U8, DataType::U16],
+            Dimensions::Vec2,
+            buffers,
+        )
+        .map_err(|m| format!("TEXCOORD_0 {m}"))?;
+        if accessor.count() != count {
+            return Err(format!(
+                "TEXCOORD_0 has {} values for {count} vertices",
+                accessor.count()
+            ));
+        }
+        let uv = reader
+            .read_tex_coords(0)
+            .ok_or("TEXCOORD_0 cannot be read")?;
+        for [u, v] in uv.into_f32() {
+            if !(u.is_finite() && v.is_finite()) {
+                return Err("a TEXCOORD_0 value is not finite".into());
+            }
+            self.texcoords.push([f64::from(u), 1.0 - f64::from(v)]);
         }
         Ok(())
     }
@@ -260,6 +311,9 @@ impl TriangleSoup {
         let read = self.positions.len();
         let (remap, positions) = weld(&self.positions, options.weld_tolerance.unwrap_or(0.0));
         let mut face_vertices = Vec::with_capacity(self.triangles.len() * 3);
+        // Each corner keeps its glTF vertex's texture coordinate: welded vertices whose
+        // coordinates differ become a seam.
+        let mut uv_indices = Vec::with_capacity(self.triangles.len() * 3);
         let mut degenerate = 0;
         for t in &self.triangles {
             let [a, b, c] = t.map(|i| remap[i as usize]);
@@ -268,6 +322,7 @@ impl TriangleSoup {
                 continue;
             }
             face_vertices.extend([a, b, c]);
+            uv_indices.extend(t);
         }
         if read != positions.len() {
             self.warnings.push(format!(
@@ -281,8 +336,15 @@ impl TriangleSoup {
             ));
         }
         if self.dropped_uv_sets > 0 {
+            self.warnings.push(format!(
+                "{} texture coordinate sets beyond TEXCOORD_0 dropped",
+                self.dropped_uv_sets
+            ));
+        }
+        let with_uv = !self.missing_uv && self.texcoords.len() == read;
+        if self.missing_uv && !self.texcoords.is_empty() {
             self.warnings
-                .push("texture coordinates dropped: face-varying data is not supported yet".into());
+                .push("texture coordinates dropped: some primitives have no TEXCOORD_0".into());
         }
         if face_vertices.is_empty() {
             return Err(ReadError::general("every triangle is degenerate"));
@@ -297,8 +359,22 @@ impl TriangleSoup {
             .count();
         self.warnings
             .extend(build_warnings.iter().map(|w| w.to_string()));
+        let uv = if with_uv {
+            let values = self.texcoords.iter().flatten().copied().collect();
+            Some(
+                FVarChannel::new(&topology, 2, values, uv_indices)
+                    .map_err(|e| ReadError::general(format!("TEXCOORD_0: {e}")))?,
+            )
+        } else {
+            None
+        };
         let mut mesh = Mesh::new(topology, positions)?;
         mesh.hints = SchemeHints::default();
+        if let Some(uv) = uv {
+            mesh = mesh
+                .with_fvar(uv)
+                .map_err(|e| ReadError::general(e.to_string()))?;
+        }
         Ok(MeshFile {
             mesh,
             warnings: self.warnings,

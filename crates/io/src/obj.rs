@@ -684,7 +684,7 @@ fn write_tags(w: &mut dyn Write, mesh: &MeshView<'_>) -> std::io::Result<()> {
         };
         writeln!(w, "t creasemethod 0/0/1 {s}")?;
     }
-    if let (Some(m), Some(_)) = (mesh.hints.fvar_interpolation, mesh.uv()) {
+    if let Some(m) = mesh.hints.fvar_interpolation {
         writeln!(
             w,
             "t facevaryinginterpolateboundary 1/0/0 {}",

@@ -701,7 +701,7 @@ pub fn write_ply(
         };
         writeln!(w, "comment subd creasemethod {s}")?;
     }
-    if let (Some(m), Some(_)) = (mesh.hints.fvar_interpolation, &uv) {
+    if let Some(m) = mesh.hints.fvar_interpolation {
         writeln!(
             w,
             "comment subd facevaryinginterpolateboundary {}",

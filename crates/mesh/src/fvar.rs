@@ -243,7 +243,10 @@ impl FVarChannel {
 /// An edge is discontinuous when its faces name different values at either end. The values
 /// at a vertex are its *siblings*, numbered in the order the vertex's ordered faces
 /// ([`Topology::vertex_faces`]) first meet them: a value that comes back after another
-/// keeps its first number, so values A B A B around a vertex are siblings 0 1 0 1.
+/// keeps its first number, so values A B A B around a vertex are siblings 0 1 0 1. (This is
+/// the layout's own seam structure. OpenSubdiv's refinement numbers such a vertex 0 1 0 2,
+/// a shortcut in `FVarLevel::completeTopologyFromFaceValues` that
+/// `subd_schemes::FaceVaryingRefinement` reproduces.)
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct FVarSeams {
     discontinuous_edges: Vec<bool>,
@@ -343,8 +346,9 @@ impl FVarSeams {
         &self.vertex_face_siblings[o[v] as usize..o[v + 1] as usize]
     }
 
-    /// Total number of values, every vertex's siblings counted: what a refined level
-    /// numbers its values by.
+    /// Total number of distinct values at vertices, every vertex's siblings counted.
+    /// (`subd_schemes::FaceVaryingRefinement` numbers one more at a vertex whose values
+    /// come back A B A B, as OpenSubdiv does: see there.)
     pub fn num_vertex_values(&self) -> usize {
         *self.sibling_offsets.last().unwrap_or(&0) as usize
     }

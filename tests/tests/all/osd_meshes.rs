@@ -160,6 +160,16 @@ fn obj_reader_agrees_with_tobj() {
                         path.display()
                     );
                 }
+                // Texture coordinates corner by corner, through tobj's own vt indices.
+                if let Some(uv) = ours.mesh.uv() {
+                    for (c, &x) in uv.face_values(t, f).iter().enumerate() {
+                        let ti = mesh.texcoord_indices[k + c] as usize;
+                        let theirs = [mesh.texcoords[2 * ti], mesh.texcoords[2 * ti + 1]];
+                        assert_eq!(uv.value(x as usize), theirs, "{} face {f}", path.display());
+                    }
+                } else {
+                    assert!(mesh.texcoord_indices.is_empty(), "{}", path.display());
+                }
                 k += n as usize;
                 f += 1;
             }
@@ -211,6 +221,25 @@ fn assert_same_mesh(a: &Mesh, b: &Mesh, what: &str) {
     assert_eq!(bits(a), bits(b), "{what}");
     assert_eq!(tag_map(a), tag_map(b), "tags, {what}");
     assert_eq!(a.hints, b.hints, "hints, {what}");
+    assert_same_uv(a, b, what);
+}
+
+/// The same texture coordinate at every corner, bit for bit.
+fn assert_same_uv(a: &Mesh, b: &Mesh, what: &str) {
+    let corners = |m: &Mesh| {
+        m.uv().map(|uv| {
+            uv.indices()
+                .iter()
+                .map(|&i| {
+                    uv.value(i as usize)
+                        .iter()
+                        .map(|x| x.to_bits())
+                        .collect::<Vec<_>>()
+                })
+                .collect::<Vec<_>>()
+        })
+    };
+    assert_eq!(corners(a), corners(b), "texture coordinates, {what}");
 }
 
 #[test]
@@ -228,15 +257,28 @@ fn obj_and_ply_round_trip_every_shape() {
         let back = parse_mesh(&buf, Format::Obj, &accept()).unwrap();
         assert_same_mesh(&file.mesh, &back.mesh, &format!("{name} via OBJ"));
         assert_eq!(file.extra_tags, back.extra_tags, "{name}");
+        // PLY holds one texture coordinate per vertex: a layout with seams is refused, and
+        // the mesh goes without it.
+        let seams = file.mesh.uv().is_some_and(|uv| {
+            subd_mesh::fvar::FVarSeams::of(&file.mesh.topology, uv).num_seam_vertices() > 0
+        });
+        let mut plain = file.mesh.clone();
+        if seams {
+            let mut buf = Vec::new();
+            let e = encode_mesh(&mut buf, &file.mesh, Format::Ply, &WriteOptions::default())
+                .unwrap_err();
+            assert!(e.to_string().contains("UV seam"), "{name}: {e}");
+            plain.fvar.clear();
+        }
         for enc in [PlyEncoding::Ascii, PlyEncoding::BinaryLittleEndian] {
             let w = WriteOptions {
                 ply_encoding: enc,
                 ..Default::default()
             };
             let mut buf = Vec::new();
-            encode_mesh(&mut buf, &file.mesh, Format::Ply, &w).unwrap();
+            encode_mesh(&mut buf, &plain, Format::Ply, &w).unwrap();
             let back = parse_mesh(&buf, Format::Ply, &accept()).unwrap();
-            assert_same_mesh(&file.mesh, &back.mesh, &format!("{name} via PLY {enc:?}"));
+            assert_same_mesh(&plain, &back.mesh, &format!("{name} via PLY {enc:?}"));
         }
     }
 }
@@ -259,10 +301,6 @@ fn glb_output_reads_back_with_gltf() {
         let normals: Vec<[f32; 3]> = reader.read_normals().unwrap().collect();
         let indices: Vec<u32> = reader.read_indices().unwrap().into_u32().collect();
         let t = &file.mesh.topology;
-        assert_eq!(positions.len(), t.num_vertices());
-        for (p, q) in positions.iter().zip(&file.mesh.positions) {
-            assert_eq!(*p, [q.x as f32, q.y as f32, q.z as f32]);
-        }
         for n in &normals {
             let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
             assert!(
@@ -271,21 +309,64 @@ fn glb_output_reads_back_with_gltf() {
                 path.display()
             );
         }
-        let expected: Vec<u32> = (0..t.num_faces())
+        // Fan triangles of the non-hole faces, as (vertex, face-vertex) corners.
+        let corners: Vec<(u32, usize)> = (0..t.num_faces())
             .filter(|&f| !t.is_hole(f))
             .flat_map(|f| {
                 let fv = t.face_vertices(f);
-                (1..fv.len() - 1).flat_map(move |i| [fv[0], fv[i], fv[i + 1]])
+                let o = t.face_offsets()[f] as usize;
+                (1..fv.len() - 1)
+                    .flat_map(move |i| [(fv[0], o), (fv[i], o + i), (fv[i + 1], o + i + 1)])
             })
             .collect();
-        assert_eq!(indices, expected, "{}", path.display());
+        assert_eq!(indices.len(), corners.len(), "{}", path.display());
+        let f32s = |q: subd_mesh::DVec3| [q.x as f32, q.y as f32, q.z as f32];
+        match file.mesh.uv() {
+            None => {
+                assert!(reader.read_tex_coords(0).is_none());
+                assert_eq!(positions.len(), t.num_vertices());
+                for (p, q) in positions.iter().zip(&file.mesh.positions) {
+                    assert_eq!(*p, f32s(*q));
+                }
+                let expected: Vec<u32> = corners.iter().map(|c| c.0).collect();
+                assert_eq!(indices, expected, "{}", path.display());
+            }
+            Some(uv) => {
+                // One glTF vertex per (vertex, texture coordinate) pair the corners use, each
+                // with its vertex's position and its value, v flipped.
+                let tex: Vec<[f32; 2]> = reader.read_tex_coords(0).unwrap().into_f32().collect();
+                let pairs: std::collections::BTreeSet<(u32, u32)> = (0..t.num_faces())
+                    .flat_map(|f| {
+                        t.face_vertices(f)
+                            .iter()
+                            .copied()
+                            .zip(uv.face_values(t, f).iter().copied())
+                    })
+                    .collect();
+                assert_eq!(positions.len(), pairs.len(), "{}", path.display());
+                assert_eq!(tex.len(), pairs.len());
+                for (&i, &(v, k)) in indices.iter().zip(&corners) {
+                    let i = i as usize;
+                    assert_eq!(positions[i], f32s(file.mesh.positions[v as usize]));
+                    let value = uv.value(uv.indices()[k] as usize);
+                    assert_eq!(
+                        tex[i],
+                        [value[0] as f32, (1.0 - value[1]) as f32],
+                        "{}",
+                        path.display()
+                    );
+                }
+            }
+        }
     }
 }
 
 #[test]
 fn write_mesh_is_atomic_and_chooses_format_by_extension() {
     let dir = tempfile_dir();
-    let file = read_mesh(&osd_mesh_dir().join("catmark_cube.obj"), &accept()).unwrap();
+    let mut file = read_mesh(&osd_mesh_dir().join("catmark_cube.obj"), &accept()).unwrap();
+    // The cube's UV layout has seams, which PLY cannot hold (tested with the round trips).
+    file.mesh.fvar.clear();
     for ext in ["obj", "ply", "glb"] {
         let out = dir.join(format!("cube.{ext}"));
         subd_io::write_mesh(&out, &file.mesh, &WriteOptions::default()).unwrap();

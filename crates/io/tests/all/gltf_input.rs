@@ -123,10 +123,27 @@ fn split_seams_weld_into_a_closed_cube_placed_by_its_node() {
         warnings.contains("24 glTF vertices welded by position into 8"),
         "{warnings}"
     );
-    assert!(
-        warnings.contains("texture coordinates dropped"),
-        "{warnings}"
-    );
+    // TEXCOORD_0 comes along: each cube face is its own UV island (the unit square), so
+    // the 12 cube edges are seams, the 6 face diagonals are not, and every corner has 3
+    // values, one per face; v is flipped back from glTF's top-left origin.
+    let uv = file.mesh.uv().expect("TEXCOORD_0 read");
+    assert_eq!(uv.num_values(), 24);
+    let seams = subd_mesh::fvar::FVarSeams::of(topo, uv);
+    assert_eq!(seams.num_seam_edges(), 12);
+    assert!((0..8).all(|v| seams.siblings(v) == 3));
+    let mut corners: Vec<[u32; 2]> = uv
+        .indices()
+        .iter()
+        .map(|&i| {
+            let c = uv.value(i as usize);
+            [c[0] as u32, c[1] as u32]
+        })
+        .collect();
+    corners.sort();
+    corners.dedup();
+    assert_eq!(corners, [[0, 0], [0, 1], [1, 0], [1, 1]]);
+    // glTF vertex 0 has (0, 0): (0, 1) with v flipped.
+    assert_eq!(uv.value(0), [0.0, 1.0]);
 }
 
 #[test]

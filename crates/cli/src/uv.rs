@@ -1,0 +1,139 @@
+//! Texture coordinates through the commands: a mesh's first face-varying channel refined
+//! with the mesh (or taken to its limit) and handed to the writers.
+
+use subd_mesh::Topology;
+use subd_mesh::fvar::{FVarChannel, FVarLinearInterpolation};
+use subd_schemes::{Options, Scheme};
+
+/// `view` with the texture coordinates `uv`, if any.
+pub(crate) fn with_uv<'a>(
+    view: subd_io::MeshView<'a>,
+    uv: Option<&'a RefinedUv>,
+) -> Result<subd_io::MeshView<'a>, subd_io::ViewError> {
+    match uv {
+        Some(uv) => view.with_uv(&uv.values, 2, &uv.indices),
+        None => Ok(view),
+    }
+}
+
+/// A refined face-varying channel: two numbers per value, one value index per face-vertex.
+pub(crate) struct RefinedUv {
+    pub(crate) values: Vec<f64>,
+    pub(crate) indices: Vec<u32>,
+}
+
+/// The mesh's texture coordinates at the last level of `refinement` (at their limit with
+/// `limit`), interpolated by `mode`; `None` when the mesh has none, or, with a warning, when
+/// the scheme does not carry them yet.
+pub(crate) fn refined_uv(
+    refinement: &crate::refine::Refined,
+    mesh: &subd_mesh::Mesh,
+    mode: FVarLinearInterpolation,
+    limit: bool,
+    scheme: crate::refine::SchemeArg,
+    warnings: &mut Vec<String>,
+) -> Result<Option<RefinedUv>, String> {
+    let Some(channel) = mesh.uv() else {
+        return Ok(None);
+    };
+    let r = match refinement {
+        crate::refine::Refined::Osd(r) => r,
+        crate::refine::Refined::Split(_) => {
+            warnings.push(format!(
+                "texture coordinates are not refined by --scheme {} (only by catmull-clark, loop, bilinear and two-phase); the output has none",
+                scheme.name()
+            ));
+            return Ok(None);
+        }
+    };
+    let fr =
+        subd_schemes::FaceVaryingRefinement::new(r, channel, mode).map_err(|e| e.to_string())?;
+    let level = r.num_levels();
+    let values = fr
+        .refine_values(channel.values(), 2)
+        .pop()
+        .expect("level 0 at least");
+    let indices = fr.face_values(level);
+    if !limit {
+        return Ok(Some(RefinedUv { values, indices }));
+    }
+    // The exact limit of the output level's values, as the positions take theirs.
+    let topology = r.topology(level);
+    let at_level = FVarChannel::new(topology, 2, values, indices).map_err(|e| e.to_string())?;
+    limit_uv(topology, r.scheme(), r.options(), &at_level, mode).map(Some)
+}
+
+/// The exact limit of every value of `channel` (two components) on `topology`: one value
+/// per (vertex, value) pair, each corner naming its own.
+pub(crate) fn limit_uv(
+    topology: &Topology,
+    scheme: Scheme,
+    options: &Options,
+    channel: &FVarChannel,
+    mode: FVarLinearInterpolation,
+) -> Result<RefinedUv, String> {
+    let limit = subd_limit::fvar::base_fvar_limit(topology, scheme, options, channel, mode)
+        .map_err(|e| e.to_string())?;
+    let mut indices = Vec::with_capacity(topology.num_face_vertices());
+    for f in 0..topology.num_faces() {
+        for (&v, &x) in topology
+            .face_vertices(f)
+            .iter()
+            .zip(channel.face_values(topology, f))
+        {
+            // Refined levels give each (vertex, value) pair its own index; at a base level
+            // a vertex may name one value twice (OpenSubdiv's A B A B numbering): its first
+            // row then stands for both.
+            let rows = limit.vertex_rows(v as usize);
+            let row = rows
+                .clone()
+                .find(|&q| limit.value(q) == x)
+                .unwrap_or(rows.start);
+            indices.push(row as u32);
+        }
+    }
+    Ok(RefinedUv {
+        values: limit.apply(channel.values(), 2),
+        indices,
+    })
+}
+
+/// Whether a PLY output (one texture coordinate per vertex) can hold `channel` on
+/// `topology`: every vertex's corners carry equal values.
+pub(crate) fn fits_ply(topology: &Topology, values: &[f64], indices: &[u32]) -> bool {
+    let mut seen: Vec<Option<[f64; 2]>> = vec![None; topology.num_vertices()];
+    topology
+        .all_face_vertices()
+        .iter()
+        .zip(indices)
+        .all(|(&v, &i)| {
+            let uv = [values[2 * i as usize], values[2 * i as usize + 1]];
+            *seen[v as usize].get_or_insert(uv) == uv
+        })
+}
+
+/// The warning for texture coordinates a PLY output leaves out.
+pub(crate) fn ply_seam_warning(output: &std::path::Path) -> String {
+    format!(
+        "{}: texture coordinates left out: PLY stores one per vertex and these have seams (write .obj or .glb to keep them)",
+        output.display()
+    )
+}
+
+/// Drops `mesh`'s texture coordinates, with a warning, when `output` is a PLY file that
+/// cannot hold them.
+pub(crate) fn fit_ply(
+    mesh: &mut subd_mesh::Mesh,
+    output: &std::path::Path,
+    warnings: &mut Vec<String>,
+) {
+    if subd_io::Format::for_output(output) != Some(subd_io::Format::Ply) {
+        return;
+    }
+    if let Some(uv) = mesh.uv()
+        && !fits_ply(&mesh.topology, uv.values(), uv.indices())
+    {
+        mesh.fvar.clear();
+        warnings.push(ply_seam_warning(output));
+    }
+}

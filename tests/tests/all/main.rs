@@ -1,0 +1,19 @@
+//! Every workspace-level integration test, in one binary: one link instead of one per file
+//! (the release test build is most of CI's time).
+
+mod acc;
+mod adaptive;
+mod curves;
+mod editing;
+mod limit_eval;
+mod limit_shapes;
+mod osd_meshes;
+mod pia;
+mod point_stencil;
+mod proptest_adaptive;
+mod proptest_limit;
+mod proptest_refine;
+mod proptest_topology;
+mod refined_topology;
+mod split_schemes;
+mod streamed_output;
