@@ -6,6 +6,8 @@ use std::path::{Path, PathBuf};
 use subd_mesh::{DVec3, Topology};
 use subd_schemes::{Options, Refinement, Scheme};
 
+use rayon::prelude::*;
+
 use crate::osd;
 
 /// Tolerance on max |Δ| / bounding-box diagonal.
@@ -1079,48 +1081,52 @@ pub(crate) fn shape_paths(dir: &Path) -> Result<Vec<PathBuf>, String> {
     Ok(paths)
 }
 
-/// Every shape of the OpenSubdiv directory.
+/// Every shape of the OpenSubdiv directory. Shapes are compared in parallel (each mostly
+/// waits on its own harness process); the rows keep the shapes' order.
 pub fn shapes(exe: &Path, dir: &Path) -> Result<Vec<Row>, String> {
     let paths = shape_paths(dir)?;
-    let mut rows = Vec::new();
     let opts = subd_io::ReadOptions {
         accept_inconsistent_orientation: true,
         ..Default::default()
     };
-    for p in paths {
-        let name = p.file_stem().unwrap().to_string_lossy().to_string();
-        let Some(scheme) = scheme_of(&name) else {
-            continue;
-        };
-        let file = subd_io::read_mesh(&p, &opts).map_err(|e| e.to_string())?;
-        let options = Options::from_hints(&file.mesh.hints);
-        rows.extend(compare(
-            exe,
-            &name,
-            &file.mesh.topology,
-            &file.mesh.positions,
-            scheme,
-            &options,
-        ));
-    }
-    Ok(rows)
+    let per_shape = paths
+        .par_iter()
+        .map(|p| -> Result<Vec<Row>, String> {
+            let name = p.file_stem().unwrap().to_string_lossy().to_string();
+            let Some(scheme) = scheme_of(&name) else {
+                return Ok(Vec::new());
+            };
+            let file = subd_io::read_mesh(p, &opts).map_err(|e| e.to_string())?;
+            let options = Options::from_hints(&file.mesh.hints);
+            Ok(compare(
+                exe,
+                &name,
+                &file.mesh.topology,
+                &file.mesh.positions,
+                scheme,
+                &options,
+            ))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(per_shape.into_iter().flatten().collect())
 }
 
-/// `count` random meshes (see `random_mesh`).
+/// `count` random meshes (see `random_mesh`), in parallel, rows in seed order.
 pub fn random(exe: &Path, count: u64) -> Vec<Row> {
-    let mut rows = Vec::new();
-    for seed in 0..count {
-        let c = crate::random_mesh::case(seed);
-        rows.extend(compare(
-            exe,
-            &c.name,
-            &c.topology,
-            &c.positions,
-            c.scheme,
-            &c.options,
-        ));
-    }
-    rows
+    (0..count)
+        .into_par_iter()
+        .flat_map_iter(|seed| {
+            let c = crate::random_mesh::case(seed);
+            compare(
+                exe,
+                &c.name,
+                &c.topology,
+                &c.positions,
+                c.scheme,
+                &c.options,
+            )
+        })
+        .collect()
 }
 
 /// Prints the table and returns whether every row passed.

@@ -10,6 +10,8 @@ use subd_mesh::Topology;
 use subd_mesh::fvar::{FVarChannel, FVarLinearInterpolation};
 use subd_schemes::{FaceVaryingRefinement, Options, Refinement, Scheme};
 
+use rayon::prelude::*;
+
 use crate::conformance::{Row, levels_for};
 use crate::osd;
 use crate::random_mesh::Rng;
@@ -259,37 +261,43 @@ pub fn compare(
     rows
 }
 
-/// Every shape with texture coordinates, in every mode.
+/// Every shape with texture coordinates, in every mode (shapes in parallel, rows in order).
 pub fn shapes(exe: &Path, dir: &Path) -> Result<Vec<Row>, String> {
     let opts = subd_io::ReadOptions {
         accept_inconsistent_orientation: true,
         ..Default::default()
     };
-    let mut rows = Vec::new();
-    for p in crate::conformance::shape_paths(dir)? {
-        let name = p.file_stem().unwrap().to_string_lossy().to_string();
-        let Some(scheme) = crate::conformance::scheme_of(&name) else {
-            continue;
-        };
-        let file = subd_io::read_mesh(&p, &opts).map_err(|e| e.to_string())?;
-        let Some(uv) = file.mesh.uv() else {
-            continue;
-        };
-        let options = Options::from_hints(&file.mesh.hints);
-        for mode in FVarLinearInterpolation::ALL_MODES {
-            rows.extend(compare(
-                exe,
-                &name,
-                &file.mesh.topology,
-                &file.mesh.positions,
-                scheme,
-                &options,
-                uv,
-                mode,
-            ));
-        }
-    }
-    Ok(rows)
+    let paths = crate::conformance::shape_paths(dir)?;
+    let per_shape = paths
+        .par_iter()
+        .map(|p| -> Result<Vec<Row>, String> {
+            let name = p.file_stem().unwrap().to_string_lossy().to_string();
+            let Some(scheme) = crate::conformance::scheme_of(&name) else {
+                return Ok(Vec::new());
+            };
+            let file = subd_io::read_mesh(p, &opts).map_err(|e| e.to_string())?;
+            let Some(uv) = file.mesh.uv() else {
+                return Ok(Vec::new());
+            };
+            let options = Options::from_hints(&file.mesh.hints);
+            Ok(FVarLinearInterpolation::ALL_MODES
+                .iter()
+                .flat_map(|&mode| {
+                    compare(
+                        exe,
+                        &name,
+                        &file.mesh.topology,
+                        &file.mesh.positions,
+                        scheme,
+                        &options,
+                        uv,
+                        mode,
+                    )
+                })
+                .collect())
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(per_shape.into_iter().flatten().collect())
 }
 
 /// A random UV layout of `topo`: faces grouped into 1 to 4 islands grown from random seed
@@ -340,24 +348,26 @@ pub fn random_channel(rng: &mut Rng, topo: &Topology) -> FVarChannel {
     FVarChannel::new(topo, 2, values, indices).expect("indices made for the topology")
 }
 
-/// `count` random meshes (`random_mesh::case`) with random UV islands and a random mode.
+/// `count` random meshes (`random_mesh::case`) with random UV islands and a random mode, in
+/// parallel, rows in seed order.
 pub fn random(exe: &Path, count: u64) -> Vec<Row> {
-    let mut rows = Vec::new();
-    for seed in 0..count {
-        let c = crate::random_mesh::case(seed);
-        let mut rng = Rng(seed.wrapping_mul(0xD1B5_4A32_D192_ED03) | 1);
-        let channel = random_channel(&mut rng, &c.topology);
-        let mode = FVarLinearInterpolation::ALL_MODES[rng.below(6) as usize];
-        rows.extend(compare(
-            exe,
-            &c.name,
-            &c.topology,
-            &c.positions,
-            c.scheme,
-            &c.options,
-            &channel,
-            mode,
-        ));
-    }
-    rows
+    (0..count)
+        .into_par_iter()
+        .flat_map_iter(|seed| {
+            let c = crate::random_mesh::case(seed);
+            let mut rng = Rng(seed.wrapping_mul(0xD1B5_4A32_D192_ED03) | 1);
+            let channel = random_channel(&mut rng, &c.topology);
+            let mode = FVarLinearInterpolation::ALL_MODES[rng.below(6) as usize];
+            compare(
+                exe,
+                &c.name,
+                &c.topology,
+                &c.positions,
+                c.scheme,
+                &c.options,
+                &channel,
+                mode,
+            )
+        })
+        .collect()
 }

@@ -7,6 +7,7 @@
 //! diagonal. Neither library reads crease tags: shapes are compared with their tags taken
 //! off.
 
+use rayon::prelude::*;
 use std::path::Path;
 
 use subd_mesh::{DVec3, Topology, TopologyBuilder};
@@ -273,18 +274,21 @@ pub fn shapes(exe: &Path, dir: &Path) -> Result<Vec<Row>, String> {
         accept_inconsistent_orientation: true,
         ..Default::default()
     };
-    let mut rows = Vec::new();
-    for p in paths {
-        let name = p.file_stem().unwrap().to_string_lossy().to_string();
-        let file = subd_io::read_mesh(&p, &opts).map_err(|e| e.to_string())?;
-        rows.extend(compare(
-            exe,
-            &name,
-            &file.mesh.topology,
-            &file.mesh.positions,
-        ));
-    }
-    Ok(rows)
+    // Shapes in parallel (each mostly waits on its harness process), rows in order.
+    let per_shape = paths
+        .par_iter()
+        .map(|p| -> Result<Vec<Row>, String> {
+            let name = p.file_stem().unwrap().to_string_lossy().to_string();
+            let file = subd_io::read_mesh(p, &opts).map_err(|e| e.to_string())?;
+            Ok(compare(
+                exe,
+                &name,
+                &file.mesh.topology,
+                &file.mesh.positions,
+            ))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(per_shape.into_iter().flatten().collect())
 }
 
 /// A closed bipyramid whose two apices have valence `n` (an n-gon equator, wobbled).
@@ -313,9 +317,9 @@ pub fn random(exe: &Path, count: u64) -> Vec<Row> {
         let (t, p) = bipyramid(n);
         rows.extend(compare(exe, &format!("bipyramid_valence_{n}"), &t, &p));
     }
-    for seed in 0..count {
+    rows.par_extend((0..count).into_par_iter().flat_map_iter(|seed| {
         let c = crate::random_mesh::case(seed);
-        rows.extend(compare(exe, &c.name, &c.topology, &c.positions));
-    }
+        compare(exe, &c.name, &c.topology, &c.positions)
+    }));
     rows
 }

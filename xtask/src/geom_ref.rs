@@ -105,19 +105,33 @@ pub fn refine(
     topo: &Topology,
     positions: &[DVec3],
 ) -> Result<RefOutcome, String> {
-    let dir = std::env::temp_dir().join(format!("subd-geom-{}", std::process::id()));
+    // One folder per call: shapes are compared in parallel.
+    static CALLS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let dir = std::env::temp_dir().join(format!("subd-geom-{}-{call}", std::process::id()));
     std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
     let (input, output) = (dir.join("in.off"), dir.join("out.off"));
     write_off(&input, topo, positions)?;
-    let _ = std::fs::remove_file(&output);
     let result = Command::new(exe)
         .args([library.name(), scheme, &levels.to_string()])
         .arg(&input)
         .arg(&output)
         .output()
-        .map_err(|e| format!("cannot run {}: {e}", exe.display()))?;
+        .map_err(|e| format!("cannot run {}: {e}", exe.display()));
+    let outcome = result.and_then(|result| outcome(result, &output, library, scheme));
+    let _ = std::fs::remove_dir_all(&dir);
+    outcome
+}
+
+/// What one harness run gave.
+fn outcome(
+    result: std::process::Output,
+    output: &Path,
+    library: Library,
+    scheme: &str,
+) -> Result<RefOutcome, String> {
     match result.status.code() {
-        Some(0) => read_off(&output).map(RefOutcome::Mesh),
+        Some(0) => read_off(output).map(RefOutcome::Mesh),
         Some(3) => Ok(RefOutcome::Refused(
             String::from_utf8_lossy(&result.stderr).trim().to_string(),
         )),
