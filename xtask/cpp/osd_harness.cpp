@@ -29,6 +29,9 @@
 // u32 nfv, u32 faceValues[nfv] (GetFaceFVarValues, face after face), f64 values[2 nvalues].
 // --fvar-limit MODE then applies LimitFaceVarying at level L instead: u32 nvalues,
 // f64 values[2 nvalues].
+// --fvar-bench MODE REPEATS times the same instead: the medians of topology refinement with
+// the channel (Create + RefineUniform) and of InterpolateFaceVarying through every level,
+// one line of JSON.
 // With --bfr-bench RATE REPEATS: the median time of building the factory and, for every
 // face, its surface, tessellation coordinates, patch points and positions with first
 // derivatives; one line of JSON.
@@ -410,6 +413,37 @@ int main(int argc, char **argv) {
             std::fwrite(out.data(), 1, out.size(), stdout);
             delete table;
             delete refiner;
+            return 0;
+        }
+        if (argc > 3 && std::string(argv[1]) == "--fvar-bench") {
+            m.options.SetFVarLinearInterpolation((Sdc::Options::FVarLinearInterpolation)std::atoi(argv[2]));
+            readFVar(r, m);
+            int reps = std::atoi(argv[3]);
+            std::vector<double> topo, fvar;
+            for (int i = 0; i < reps; ++i) {
+                auto t0 = std::chrono::steady_clock::now();
+                Far::TopologyRefiner *refiner = createRefiner(m);
+                Far::TopologyRefiner::UniformOptions uo(m.levels);
+                refiner->RefineUniform(uo);
+                auto t1 = std::chrono::steady_clock::now();
+                Far::PrimvarRefinerReal<double> primvar(*refiner);
+                std::vector<std::vector<Uv>> values(m.levels + 1);
+                values[0] = m.fvarValues;
+                for (int l = 1; l <= m.levels; ++l) {
+                    values[l].resize(refiner->GetLevel(l).GetNumFVarValues(0));
+                    primvar.InterpolateFaceVarying(l, values[l - 1], values[l], 0);
+                }
+                auto t2 = std::chrono::steady_clock::now();
+                topo.push_back(std::chrono::duration<double>(t1 - t0).count());
+                fvar.push_back(std::chrono::duration<double>(t2 - t1).count());
+                delete refiner;
+            }
+            auto median = [](std::vector<double> v) {
+                std::sort(v.begin(), v.end());
+                return v[v.size() / 2];
+            };
+            std::printf("{\"topology_seconds\": %.9f, \"fvar_seconds\": %.9f}\n", median(topo),
+                        median(fvar));
             return 0;
         }
         bool fvarLimit = argc > 2 && std::string(argv[1]) == "--fvar-limit";

@@ -12,6 +12,7 @@ mod batch_bench;
 mod bench;
 mod conformance;
 mod editing_bench;
+mod fvar_bench;
 mod fvar_conformance;
 mod geom_conformance;
 mod geom_ref;
@@ -104,6 +105,10 @@ enum Task {
         /// Only the tessellation benchmark (`subd tessellate` against OpenSubdiv's Bfr).
         #[arg(long)]
         tess_only: bool,
+        /// Only the face-varying benchmark (UVs with seams against OpenSubdiv's
+        /// InterpolateFaceVarying).
+        #[arg(long)]
+        fvar_only: bool,
     },
     /// (internal) One subd split-scheme measurement for `bench`, in its own process.
     #[command(hide = true)]
@@ -276,6 +281,7 @@ fn main() -> ExitCode {
             split_only,
             batch_only,
             tess_only,
+            fvar_only,
         } => {
             let refinement = || {
                 bench::run(
@@ -291,7 +297,10 @@ fn main() -> ExitCode {
                 .join("../../shared/meshes/osd");
             let batch = || batch_bench::run_batch(rounds.max(1), &shapes);
             let tess = || tess_bench::run(repeats);
-            if tess_only {
+            let fvar = || fvar_bench::run(levels, repeats);
+            if fvar_only {
+                ensure_system_packages(REFERENCE_PACKAGES).and_then(|_| fvar())
+            } else if tess_only {
                 ensure_system_packages(REFERENCE_PACKAGES).and_then(|_| tess())
             } else if batch_only {
                 batch()
@@ -320,6 +329,7 @@ fn main() -> ExitCode {
                                 .and_then(|_| split())
                                 .and_then(|_| batch())
                                 .and_then(|_| tess())
+                                .and_then(|_| fvar())
                         }
                     })
             }

@@ -263,6 +263,13 @@ fn run_one(
     let levels = check_arguments(args, job)?;
     let file = subd_io::read_mesh(&job.input, &args.rules.read_options())?;
     print_warnings(err, &job.input, &file.warnings);
+    if file.mesh.uv().is_some() {
+        print_warnings(
+            err,
+            &job.input,
+            &["texture coordinates are not carried through adaptive refinement yet; the output has none".into()],
+        );
+    }
     let t_read = t_start.elapsed().as_secs_f64();
     let mesh = &file.mesh;
     let base = &mesh.topology;

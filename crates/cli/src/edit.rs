@@ -272,6 +272,11 @@ fn run_one(
     let mut mesh = Mesh::new(topo.clone(), edit.positions.clone())
         .map_err(|e| bad(format!("{}: {e}", job.input.display())))?;
     mesh.hints = file.mesh.hints;
+    // The edit moves control points only: texture coordinates stay as given.
+    mesh.fvar = file.mesh.fvar.clone();
+    let mut dropped = Vec::new();
+    crate::uv::fit_ply(&mut mesh, &job.output, &mut dropped);
+    print_warnings(err, &job.input, &dropped);
     subd_io::write_mesh(&job.output, &mesh, &subd_io::WriteOptions::default())?;
     let t_write = t_write.elapsed().as_secs_f64();
 
@@ -387,6 +392,9 @@ fn run_deform_one(
         .iter()
         .map(|c| (d.displacement(c.center) - c.displacement).length())
         .fold(0.0, f64::max);
+    let mut dropped = Vec::new();
+    crate::uv::fit_ply(&mut mesh, &job.output, &mut dropped);
+    print_warnings(err, &job.input, &dropped);
     subd_io::write_mesh(&job.output, &mesh, &subd_io::WriteOptions::default())?;
     if args.json {
         crate::print_json(

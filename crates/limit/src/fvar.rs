@@ -211,3 +211,102 @@ pub fn base_fvar_limit(
         table,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use subd_mesh::TopologyBuilder;
+
+    /// A 4 × 4 grid of quads (25 vertices) whose UV layout is cut along the middle column
+    /// into two islands, with an infinitely sharp crease across it; and its triangulation.
+    fn grid() -> (Topology, Topology, Vec<u32>, Vec<u32>) {
+        let mut quads = Vec::new();
+        for y in 0..4u32 {
+            for x in 0..4u32 {
+                let v = 5 * y + x;
+                quads.extend([v, v + 1, v + 6, v + 5]);
+            }
+        }
+        let tris: Vec<u32> = quads
+            .chunks(4)
+            .flat_map(|q| [q[0], q[1], q[2], q[0], q[2], q[3]])
+            .collect();
+        let mut q = TopologyBuilder::new(25).build(&[4; 16], &quads).unwrap();
+        let mut t = TopologyBuilder::new(25).build(&[3; 32], &tris).unwrap();
+        for topo in [&mut q, &mut t] {
+            for (a, b) in [(5, 6), (6, 7), (7, 8)] {
+                let e = topo.find_edge(a, b).unwrap() as usize;
+                topo.set_edge_sharpness(e, subd_mesh::tags::SHARPNESS_INFINITE);
+            }
+        }
+        // Value of a corner: its vertex, offset by 25 on the right island (x ≥ 2 faces).
+        let island = |face_vertices: &[u32], size: usize| -> Vec<u32> {
+            face_vertices
+                .chunks(size)
+                .flat_map(|f| {
+                    let right = f.iter().all(|&v| v % 5 >= 2);
+                    f.iter()
+                        .map(move |&v| v + 25 * u32::from(right))
+                        .collect::<Vec<_>>()
+                })
+                .collect()
+        };
+        let qi = island(&quads, 4);
+        let ti = island(&tris, 3);
+        (q, t, qi, ti)
+    }
+
+    /// Limits are left eigenvectors of the refinement: a value's limit taken at level 1
+    /// equals its child's limit taken at level 2, for smooth, seam-crease and corner values
+    /// in every mode (no semi-sharp features, so nothing decays in between).
+    #[test]
+    fn limits_agree_across_a_level_of_refinement() {
+        let (quads, tris, qi, ti) = grid();
+        let values: Vec<f64> = (0..100).map(|i| ((i * 37) % 101) as f64 / 101.0).collect();
+        for (scheme, topo, idx) in [
+            (Scheme::CatmullClark, &quads, &qi),
+            (Scheme::Loop, &tris, &ti),
+        ] {
+            let channel = FVarChannel::new(topo, 2, values.clone(), idx.clone()).unwrap();
+            let r = Refinement::new(topo, scheme, &Options::default(), 2).unwrap();
+            for mode in FVarLinearInterpolation::ALL_MODES {
+                let fr = FaceVaryingRefinement::new(&r, &channel, mode).unwrap();
+                let levels = fr.refine_values(channel.values(), 2);
+                let at = |l: usize| {
+                    let t = limit_at_level(&r, &fr, l).unwrap();
+                    let mut out = vec![0.0; levels[l].len()];
+                    t.apply(&levels[l], 2, &mut out);
+                    out
+                };
+                let (one, two) = (at(1), at(2));
+                // Level-1 vertices are vertices 0.. of level 2, with the same values.
+                let n = fr.num_values(1);
+                for i in 0..2 * n {
+                    assert!(
+                        (one[i] - two[i]).abs() < 1e-13,
+                        "{scheme:?} {mode:?} value {}: {} vs {}",
+                        i / 2,
+                        one[i],
+                        two[i]
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn level_zero_and_levels_past_the_refinement_are_refused() {
+        let (quads, _, qi, _) = grid();
+        let channel = FVarChannel::new(&quads, 2, vec![0.0; 100], qi).unwrap();
+        let r = Refinement::new(&quads, Scheme::CatmullClark, &Options::default(), 1).unwrap();
+        let fr = FaceVaryingRefinement::new(&r, &channel, FVarLinearInterpolation::None).unwrap();
+        assert!(matches!(
+            limit_at_level(&r, &fr, 0),
+            Err(LimitError::Param(_))
+        ));
+        assert!(matches!(
+            limit_at_level(&r, &fr, 2),
+            Err(LimitError::Param(_))
+        ));
+    }
+}

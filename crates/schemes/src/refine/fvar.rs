@@ -1052,12 +1052,20 @@ mod tests {
         let e = tris.find_edge(5, 6).unwrap() as usize;
         tris.set_edge_sharpness(e, 1.5);
         tris.set_vertex_sharpness(10, 2.25);
-        for (scheme, t) in [
-            (Scheme::CatmullClark, &t),
-            (Scheme::Bilinear, &t),
-            (Scheme::Loop, &tris),
+        // Seed 000's two-phase scheme too: its phase-1 vertex rule (here with λ varying per
+        // vertex) reaches matching values through the same rows.
+        let lambda: Vec<f64> = (0..16).map(|v| 0.4 + 0.03 * v as f64).collect();
+        let two_phase = crate::TwoPhase::new(lambda).unwrap();
+        for (scheme, t, phase) in [
+            (Scheme::CatmullClark, &t, None),
+            (Scheme::Bilinear, &t, None),
+            (Scheme::Loop, &tris, None),
+            (Scheme::CatmullClark, &t, Some(&two_phase)),
         ] {
-            let r = Refinement::new(t, scheme, &Options::default(), 3).unwrap();
+            let r = match phase {
+                Some(tp) => Refinement::two_phase(t, tp, &Options::default(), 3).unwrap(),
+                None => Refinement::new(t, scheme, &Options::default(), 3).unwrap(),
+            };
             let channel =
                 FVarChannel::new(t, 3, xyz.clone(), t.all_face_vertices().to_vec()).unwrap();
             let fr =
@@ -1167,5 +1175,46 @@ mod tests {
         // Face 0's child 1 is (E0, V1, E1, F); E1 of face 0 is edge 1-4, the seam.
         let seam_side0 = v[fv[4 + 2] as usize];
         assert_eq!(seam_side0, 0.5 * (1.0 + 2.0));
+    }
+
+    /// Four quads around vertex 4 of a 3 × 3 vertex grid, UV islands alternating A B A B
+    /// around it: OpenSubdiv's numbering gives that vertex three values (siblings 0 1 0 2),
+    /// the layout itself two.
+    #[test]
+    fn values_coming_back_a_b_a_b_make_three_siblings_as_opensubdiv() {
+        let faces = [0, 1, 4, 3, 1, 2, 5, 4, 4, 5, 8, 7, 3, 4, 7, 6];
+        let t = TopologyBuilder::new(9).build(&[4; 4], &faces).unwrap();
+        // Islands: faces 0 and 2 share island A, faces 1 and 3 island B; each island names
+        // its own value at every vertex it touches.
+        let mut index = std::collections::HashMap::new();
+        let indices: Vec<u32> = faces
+            .iter()
+            .enumerate()
+            .map(|(k, &v)| {
+                let island = (k / 4) % 2;
+                let n = index.len() as u32;
+                *index.entry((v, island)).or_insert(n)
+            })
+            .collect();
+        let values: Vec<f64> = (0..2 * index.len()).map(|i| i as f64).collect();
+        let channel = FVarChannel::new(&t, 2, values, indices).unwrap();
+        let seams = subd_mesh::fvar::FVarSeams::of(&t, &channel);
+        assert_eq!(seams.siblings(4), 2);
+        assert_eq!(seams.face_siblings(4), &[0, 1, 0, 1]);
+        let r = Refinement::new(&t, Scheme::CatmullClark, &Options::default(), 1).unwrap();
+        for mode in FVarLinearInterpolation::ALL_MODES {
+            let fr = FaceVaryingRefinement::new(&r, &channel, mode).unwrap();
+            // Vertex 4 is vertex 4 at level 1 and keeps its siblings.
+            let level = &fr.levels[1];
+            assert_eq!(level.count(4), 3, "{mode:?}");
+            let base = &fr.levels[0];
+            let walk: Vec<usize> = t
+                .vertex_faces(4)
+                .iter()
+                .zip(t.vertex_face_local_indices(4))
+                .map(|(&f, &k)| base.corner_slot(&t, f as usize, k as usize) - base.offset(4))
+                .collect();
+            assert_eq!(walk, [0, 1, 0, 2], "{mode:?}");
+        }
     }
 }

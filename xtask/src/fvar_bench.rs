@@ -1,0 +1,149 @@
+//! `cargo xtask bench --fvar-only`: face-varying refinement of a UV channel with seams on the
+//! quad bench torus, subd against OpenSubdiv's `InterpolateFaceVarying` (double precision),
+//! levels 1..L.
+
+use std::time::Instant;
+
+use subd_mesh::fvar::{FVarChannel, FVarLinearInterpolation};
+use subd_mesh::{Mesh, Topology};
+use subd_schemes::{FaceVaryingRefinement, Options, Refinement, Scheme};
+
+use crate::bench::{json_number, median, quad_bench_mesh};
+use crate::osd;
+
+/// The torus's own UV layout: u around the ring, v around the tube, each in [0, 1], cut
+/// where they wrap (one seam loop each way), so vertices on the cuts have two or four
+/// values.
+pub fn torus_uv(mesh: &Mesh) -> FVarChannel {
+    let t: &Topology = &mesh.topology;
+    let angle = |p: subd_mesh::DVec3| {
+        let u = p.y.atan2(p.x) / std::f64::consts::TAU;
+        let ring = (p.x * p.x + p.y * p.y).sqrt() - 3.0;
+        let v = p.z.atan2(ring) / std::f64::consts::TAU;
+        [u.rem_euclid(1.0), v.rem_euclid(1.0)]
+    };
+    let base: Vec<[f64; 2]> = mesh.positions.iter().map(|&p| angle(p)).collect();
+    // Value index: vertex × 4 + (u wrapped?) + 2 × (v wrapped?).
+    let mut indices = Vec::with_capacity(t.num_face_vertices());
+    for f in 0..t.num_faces() {
+        let fv = t.face_vertices(f);
+        let span = |k: usize| {
+            let lo = fv.iter().map(|&v| base[v as usize][k]).fold(1.0, f64::min);
+            let hi = fv.iter().map(|&v| base[v as usize][k]).fold(0.0, f64::max);
+            hi - lo > 0.5
+        };
+        let (wrap_u, wrap_v) = (span(0), span(1));
+        for &v in fv {
+            let [u, w] = base[v as usize];
+            let bump = u32::from(wrap_u && u < 0.5) + 2 * u32::from(wrap_v && w < 0.5);
+            indices.push(4 * v + bump);
+        }
+    }
+    let values = base
+        .iter()
+        .flat_map(|&[u, v]| [u, v, u + 1.0, v, u, v + 1.0, u + 1.0, v + 1.0])
+        .collect();
+    FVarChannel::new(t, 2, values, indices).expect("indices made for the topology")
+}
+
+/// Runs the benchmark and prints a table: setup (topology refinement with the channel) and
+/// values (the refinement of the UVs), medians of `repeats` runs.
+pub fn run(levels: usize, repeats: usize) -> Result<(), String> {
+    let mesh = quad_bench_mesh();
+    let uv = torus_uv(&mesh);
+    let exe = osd::build_harness()?;
+    let threads = rayon::current_num_threads();
+    println!(
+        "face-varying refinement: {} quads, {} UV values, seams on both wrap loops; medians of {repeats}",
+        mesh.topology.num_faces(),
+        uv.num_values()
+    );
+    println!(
+        "{:<14} {:>5} {:>11} {:>11} {:>11} {:>11} {:>9} {:>9}",
+        "mode",
+        "level",
+        "osd topo",
+        "osd values",
+        "subd setup",
+        "subd values",
+        "values×",
+        "values×N"
+    );
+    for mode in [
+        FVarLinearInterpolation::CornersPlus1,
+        FVarLinearInterpolation::All,
+    ] {
+        for l in 1..=levels {
+            let input = osd::encode_fvar(
+                osd::encode(
+                    &mesh.topology,
+                    &mesh.positions,
+                    Scheme::CatmullClark,
+                    &Options::default(),
+                    l as u32,
+                ),
+                uv.values(),
+                uv.indices(),
+            );
+            let out = osd::run(
+                &exe,
+                &input,
+                &[
+                    "--fvar-bench",
+                    &mode.to_shape_tag().to_string(),
+                    &repeats.to_string(),
+                ],
+            )?;
+            let line = String::from_utf8_lossy(&out);
+            let osd_topo = json_number(&line, "topology_seconds").ok_or("no topology time")?;
+            let osd_values = json_number(&line, "fvar_seconds").ok_or("no fvar time")?;
+            let measure = |n: usize| -> Result<(f64, f64), String> {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(n)
+                    .build()
+                    .map_err(|e| e.to_string())?;
+                let (mut setup, mut values) = (Vec::new(), Vec::new());
+                for _ in 0..repeats {
+                    pool.install(|| {
+                        let t0 = Instant::now();
+                        let r = Refinement::new(
+                            &mesh.topology,
+                            Scheme::CatmullClark,
+                            &Options::default(),
+                            l,
+                        )
+                        .expect("refine");
+                        let fr = FaceVaryingRefinement::new(&r, &uv, mode).expect("channel");
+                        let t1 = Instant::now();
+                        let out = fr.refine_values(uv.values(), 2);
+                        let t2 = Instant::now();
+                        std::hint::black_box(out);
+                        setup.push((t1 - t0).as_secs_f64());
+                        values.push((t2 - t1).as_secs_f64());
+                    });
+                }
+                Ok((median(setup), median(values)))
+            };
+            let (setup1, values1) = measure(1)?;
+            let (_, values_n) = measure(threads)?;
+            println!(
+                "{:<14} {:>5} {:>10.2}ms {:>10.2}ms {:>10.2}ms {:>10.2}ms {:>9.2} {:>9.2}",
+                mode.name(),
+                l,
+                1e3 * osd_topo,
+                1e3 * osd_values,
+                1e3 * setup1,
+                1e3 * values1,
+                values1 / osd_values,
+                values_n / osd_values
+            );
+        }
+    }
+    println!(
+        "osd topo: Create + RefineUniform with the channel; subd setup: Refinement + FaceVaryingRefinement (1 thread);"
+    );
+    println!(
+        "values×: subd's UV refinement (1 thread) over InterpolateFaceVarying's through every level; values×N: on {threads} threads"
+    );
+    Ok(())
+}
