@@ -352,6 +352,61 @@ pub fn parse_ply(bytes: &[u8], options: &ReadOptions) -> Result<MeshFile, ReadEr
             big_endian: header.encoding == Encoding::Be,
         },
     };
+    let d = read_elements(&header, &mut body)?;
+    check_faces(&d)?;
+    let nv = d.positions.len();
+    let (mut topology, build_warnings) = TopologyBuilder::new(nv)
+        .accept_inconsistent_orientation(options.accept_inconsistent_orientation)
+        .build_with_warnings(&d.face_sizes, &d.face_vertices)?;
+    let orientation_conflicts = build_warnings
+        .iter()
+        .filter(|w| matches!(w, subd_mesh::BuildWarning::InconsistentOrientation { .. }))
+        .count();
+    let mut warnings: Vec<String> = build_warnings.iter().map(|w| w.to_string()).collect();
+    apply_tags(&d, &mut topology, &mut warnings)?;
+    let uv = match d.texcoords {
+        // One value per vertex: the corners name their vertex's value.
+        Some(texcoords) => Some(
+            FVarChannel::new(&topology, 2, texcoords, d.face_vertices)
+                .map_err(|e| ReadError::general(format!("texture coordinates: {e}")))?,
+        ),
+        None => None,
+    };
+    let mut mesh = Mesh::new(topology, d.positions)?;
+    mesh.hints = header.hints;
+    if let Some(uv) = uv {
+        mesh = mesh
+            .with_fvar(uv)
+            .map_err(|e| ReadError::general(e.to_string()))?;
+    }
+    let face_levels = d.face_levels;
+    Ok(MeshFile {
+        mesh,
+        warnings,
+        extra_tags: Vec::new(),
+        orientation_conflicts,
+        face_levels: (!face_levels.is_empty()).then_some(face_levels),
+    })
+}
+
+/// What the elements of a PLY body give, before any checking across elements.
+struct PlyData {
+    positions: Vec<DVec3>,
+    /// `u v` per vertex, when the vertex element has them.
+    texcoords: Option<Vec<f64>>,
+    face_sizes: Vec<u32>,
+    face_vertices: Vec<u32>,
+    face_levels: Vec<u8>,
+    /// Tag elements as read (indices still numbers) with their text line, if any.
+    creases: Vec<(f64, f64, f64, Option<usize>)>,
+    corners: Vec<(f64, f64, Option<usize>)>,
+    holes: Vec<(f64, Option<usize>)>,
+    have_vertex: bool,
+    have_face: bool,
+}
+
+/// Reads every element instance of the body (see the module docs for the roles).
+fn read_elements(header: &Header, body: &mut Body<'_>) -> Result<PlyData, ReadError> {
     let mut positions: Vec<DVec3> = Vec::new();
     let mut face_sizes: Vec<u32> = Vec::new();
     let mut face_vertices: Vec<u32> = Vec::new();
@@ -518,15 +573,31 @@ pub fn parse_ply(bytes: &[u8], options: &ReadOptions) -> Result<MeshFile, ReadEr
             }
         }
     }
-    if !have_vertex || !have_face || face_sizes.is_empty() {
+    Ok(PlyData {
+        positions,
+        texcoords: uv_props.map(|_| texcoords),
+        face_sizes,
+        face_vertices,
+        face_levels,
+        creases,
+        corners,
+        holes,
+        have_vertex,
+        have_face,
+    })
+}
+
+/// Checks that there are faces and that every face names an existing vertex.
+fn check_faces(d: &PlyData) -> Result<(), ReadError> {
+    if !d.have_vertex || !d.have_face || d.face_sizes.is_empty() {
         return Err(ReadError::general(
             "PLY file has no faces (needs vertex and face elements)",
         ));
     }
-    let nv = positions.len();
+    let nv = d.positions.len();
     let mut offset = 0;
-    for (f, &n) in face_sizes.iter().enumerate() {
-        for &v in &face_vertices[offset..offset + n as usize] {
+    for (f, &n) in d.face_sizes.iter().enumerate() {
+        for &v in &d.face_vertices[offset..offset + n as usize] {
             if v as usize >= nv {
                 return Err(ReadError::general(format!(
                     "face {f} refers to vertex {v}, but there are only {nv} vertices"
@@ -535,14 +606,16 @@ pub fn parse_ply(bytes: &[u8], options: &ReadOptions) -> Result<MeshFile, ReadEr
         }
         offset += n as usize;
     }
-    let (mut topology, build_warnings) = TopologyBuilder::new(nv)
-        .accept_inconsistent_orientation(options.accept_inconsistent_orientation)
-        .build_with_warnings(&face_sizes, &face_vertices)?;
-    let orientation_conflicts = build_warnings
-        .iter()
-        .filter(|w| matches!(w, subd_mesh::BuildWarning::InconsistentOrientation { .. }))
-        .count();
-    let mut warnings: Vec<String> = build_warnings.iter().map(|w| w.to_string()).collect();
+    Ok(())
+}
+
+/// Applies the crease, corner and hole elements to `topology`.
+fn apply_tags(
+    d: &PlyData,
+    topology: &mut subd_mesh::Topology,
+    warnings: &mut Vec<String>,
+) -> Result<(), ReadError> {
+    let nv = d.positions.len();
     let at = |line: Option<usize>, e: subd_mesh::TopologyError| match line {
         Some(l) => ReadError::line(l, e.to_string()),
         None => ReadError::Topology(e),
@@ -563,7 +636,7 @@ pub fn parse_ply(bytes: &[u8], options: &ReadOptions) -> Result<MeshFile, ReadEr
                 ))
             }
         };
-    for &(a, b, s, line) in &creases {
+    for &(a, b, s, line) in &d.creases {
         let (a, b) = (
             index(a, "crease", "vertex", nv, line)?,
             index(b, "crease", "vertex", nv, line)?,
@@ -578,37 +651,16 @@ pub fn parse_ply(bytes: &[u8], options: &ReadOptions) -> Result<MeshFile, ReadEr
             ));
         }
     }
-    for &(v, s, line) in &corners {
+    for &(v, s, line) in &d.corners {
         let v = index(v, "corner", "vertex", nv, line)?;
         topology.set_corner(v, s).map_err(|e| at(line, e))?;
     }
-    let nf = face_sizes.len();
-    for &(f, line) in &holes {
+    let nf = d.face_sizes.len();
+    for &(f, line) in &d.holes {
         let f = index(f, "hole", "face", nf, line)?;
         topology.set_hole_checked(f).map_err(|e| at(line, e))?;
     }
-    let uv = match uv_props {
-        // One value per vertex: the corners name their vertex's value.
-        Some(_) => Some(
-            FVarChannel::new(&topology, 2, texcoords, face_vertices)
-                .map_err(|e| ReadError::general(format!("texture coordinates: {e}")))?,
-        ),
-        None => None,
-    };
-    let mut mesh = Mesh::new(topology, positions)?;
-    mesh.hints = header.hints;
-    if let Some(uv) = uv {
-        mesh = mesh
-            .with_fvar(uv)
-            .map_err(|e| ReadError::general(e.to_string()))?;
-    }
-    Ok(MeshFile {
-        mesh,
-        warnings,
-        extra_tags: Vec::new(),
-        orientation_conflicts,
-        face_levels: (!face_levels.is_empty()).then_some(face_levels),
-    })
+    Ok(())
 }
 
 /// The vertex properties holding texture coordinates: `u v`, `s t` or `texture_u
