@@ -494,12 +494,12 @@ fn read_elements(header: &Header, body: &mut Body<'_>) -> Result<PlyData, ReadEr
                     Property::List(_, cty, ity) => {
                         let n = body.read(*cty, &what)?;
                         if n < 0.0 {
-                            return Err(err_at(&body, format!("{}: negative list length", what())));
+                            return Err(err_at(body, format!("{}: negative list length", what())));
                         }
                         let n = n as usize;
                         if n > body.remaining_bytes() {
                             return Err(err_at(
-                                &body,
+                                body,
                                 format!("{}: list length {n} exceeds the file", what()),
                             ));
                         }
@@ -521,7 +521,7 @@ fn read_elements(header: &Header, body: &mut Body<'_>) -> Result<PlyData, ReadEr
                     let p = DVec3::new(values[x], values[y], values[z]);
                     if !p.is_finite() {
                         return Err(err_at(
-                            &body,
+                            body,
                             format!("vertex {k} has a non-finite coordinate"),
                         ));
                     }
@@ -529,7 +529,7 @@ fn read_elements(header: &Header, body: &mut Body<'_>) -> Result<PlyData, ReadEr
                     if let Some([u, v]) = uv_props {
                         if !(values[u].is_finite() && values[v].is_finite()) {
                             return Err(err_at(
-                                &body,
+                                body,
                                 format!("vertex {k} has a non-finite texture coordinate"),
                             ));
                         }
@@ -540,13 +540,13 @@ fn read_elements(header: &Header, body: &mut Body<'_>) -> Result<PlyData, ReadEr
                     if level != usize::MAX {
                         let l = values[level];
                         if !(0.0..=255.0).contains(&l) || l.fract() != 0.0 {
-                            return Err(err_at(&body, format!("face {k} has invalid level {l}")));
+                            return Err(err_at(body, format!("face {k} has invalid level {l}")));
                         }
                         face_levels.push(l as u8);
                     }
                     if list.len() < 3 {
                         return Err(err_at(
-                            &body,
+                            body,
                             format!(
                                 "face {k} has {} vertices; a face needs at least 3",
                                 list.len()
@@ -556,7 +556,7 @@ fn read_elements(header: &Header, body: &mut Body<'_>) -> Result<PlyData, ReadEr
                     for &v in &list {
                         if v < 0.0 || v.fract() != 0.0 || v >= u32::MAX as f64 {
                             return Err(err_at(
-                                &body,
+                                body,
                                 format!("face {k} has invalid vertex index {v}"),
                             ));
                         }
