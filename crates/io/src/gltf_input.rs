@@ -370,11 +370,7 @@ impl TriangleSoup {
         };
         let mut mesh = Mesh::new(topology, positions)?;
         mesh.hints = SchemeHints::default();
-        if let Some(uv) = uv {
-            mesh = mesh
-                .with_fvar(uv)
-                .map_err(|e| ReadError::general(e.to_string()))?;
-        }
+        mesh = crate::with_texcoords(mesh, uv)?;
         Ok(MeshFile {
             mesh,
             warnings: self.warnings,

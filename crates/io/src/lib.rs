@@ -236,3 +236,16 @@ pub fn atomic_write(
 #[cfg(doctest)]
 #[doc = include_str!("../README.md")]
 struct ReadmeDoctests;
+
+/// `mesh` with the texture coordinates a reader found, if any (made for its topology).
+pub(crate) fn with_texcoords(
+    mesh: subd_mesh::Mesh,
+    uv: Option<subd_mesh::fvar::FVarChannel>,
+) -> Result<subd_mesh::Mesh, ReadError> {
+    match uv {
+        Some(uv) => mesh
+            .with_fvar(uv)
+            .map_err(|e| ReadError::general(e.to_string())),
+        None => Ok(mesh),
+    }
+}

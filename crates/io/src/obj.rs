@@ -87,11 +87,7 @@ pub fn parse_obj(bytes: &[u8], options: &ReadOptions) -> Result<MeshFile, ReadEr
     let mut mesh =
         Mesh::new(topology, std::mem::take(&mut st.positions)).map_err(ReadError::Topology)?;
     mesh.hints = hints;
-    if let Some(uv) = uv {
-        mesh = mesh
-            .with_fvar(uv)
-            .map_err(|e| ReadError::general(e.to_string()))?;
-    }
+    mesh = crate::with_texcoords(mesh, uv)?;
     Ok(MeshFile {
         mesh,
         warnings: st.warnings,

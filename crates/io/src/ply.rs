@@ -374,11 +374,7 @@ pub fn parse_ply(bytes: &[u8], options: &ReadOptions) -> Result<MeshFile, ReadEr
     };
     let mut mesh = Mesh::new(topology, d.positions)?;
     mesh.hints = header.hints;
-    if let Some(uv) = uv {
-        mesh = mesh
-            .with_fvar(uv)
-            .map_err(|e| ReadError::general(e.to_string()))?;
-    }
+    mesh = crate::with_texcoords(mesh, uv)?;
     let face_levels = d.face_levels;
     Ok(MeshFile {
         mesh,
