@@ -146,11 +146,67 @@ fn malformed_obj_inputs_exit_2_with_the_line() {
             ":6: tag \"crease\" declares 2/1/0 arguments but has 2",
         ),
         ("no_faces.obj", quad.into(), "no faces"),
+        (
+            "uv_some_corners.obj",
+            format!("{quad}vt 0 0\nvt 1 0\nvt 1 1\nf 1/1 2/2 3\n"),
+            ":8: face gives texture coordinates at 2 of its 3 corners",
+        ),
+        (
+            "uv_index_beyond.obj",
+            format!("{quad}vt 0 0\nvt 1 0\nvt 1 1\nf 1/1 2/2 3/9\n"),
+            ":8: face refers to texture coordinate 9, but the file has 3",
+        ),
+        (
+            "uv_index_zero.obj",
+            format!("{quad}vt 0 0\nf 1/0 2/1 3/1\n"),
+            ":6: face index 0 is invalid (OBJ texture coordinate indices start at 1)",
+        ),
+        (
+            "uv_relative_before_start.obj",
+            format!("{quad}vt 0 0\nf 1/-1 2/-1 3/-2\n"),
+            ":6: relative face index -2 points before the first texture coordinate",
+        ),
+        (
+            "uv_not_an_index.obj",
+            format!("{quad}vt 0 0\nf 1/x 2/1 3/1\n"),
+            ":6: texture coordinate index \"x\" of \"1/x\" is not an index",
+        ),
+        (
+            "uv_nan.obj",
+            format!("{quad}vt 0 nan\nf 1/1 2/1 3/1\n"),
+            ":5: texture coordinate 1 has a non-finite coordinate",
+        ),
+        (
+            "uv_no_numbers.obj",
+            format!("{quad}vt\nf 1/1 2/1 3/1\n"),
+            ":5: texture coordinate has 0 coordinates",
+        ),
+        (
+            "fvar_tag_value.obj",
+            format!("{quad}f 1 2 3 4\nt facevaryinginterpolateboundary 1/0/0 7\n"),
+            ":6: facevaryinginterpolateboundary tag: unknown value 7",
+        ),
     ];
     for (name, text, expect) in cases {
         let p = s.file(name, text.as_bytes());
         assert_bad_input(&p, expect);
     }
+    // Faces without texture coordinates beside faces with them: the geometry is read, the
+    // texture coordinates are dropped with a warning naming the first such face.
+    let mixed = s.file(
+        "uv_mixed.obj",
+        format!("{quad}vt 0 0\nvt 1 0\nvt 1 1\nf 1/1 2/2 3/3\nf 1 3 4\n").as_bytes(),
+    );
+    let (code, out, err) = subd(&["info", mixed.to_str().unwrap(), "--json"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains(
+            "line 9: face has no texture coordinate indices while 1 other faces have them"
+        ),
+        "{err}"
+    );
+    let j: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(j["fvar_channels"].as_array().unwrap().len(), 0);
     // Binary garbage: bytes that are not text.
     let garbage: Vec<u8> = (0..4096u32)
         .map(|i| (i.wrapping_mul(2654435761) >> 13) as u8)

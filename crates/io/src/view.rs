@@ -67,6 +67,12 @@ pub enum ViewError {
         /// Number of texture coordinates.
         values: usize,
     },
+    /// A texture coordinate with a NaN or infinite component.
+    #[error("texture coordinate {value} is not finite")]
+    NonFiniteTexCoord {
+        /// The value.
+        value: usize,
+    },
     /// Normals or face levels, when given, must be one per vertex or per face.
     #[error("{given} {what} given for {expected}")]
     Count {
@@ -444,7 +450,7 @@ impl<'a> MeshView<'a> {
     /// # Errors
     /// [`ViewError::Count`] unless there is one index per face-vertex and a whole number
     /// of values of at least two components, [`ViewError::TexCoordOutOfRange`] for an
-    /// index without a value, [`ViewError::NonFinite`] for a non-finite value.
+    /// index without a value, [`ViewError::NonFiniteTexCoord`] for a non-finite value.
     pub fn with_uv(
         mut self,
         values: &'a [f64],
@@ -475,8 +481,8 @@ impl<'a> MeshView<'a> {
             });
         }
         if let Some(i) = values.iter().position(|x| !x.is_finite()) {
-            return Err(ViewError::NonFinite {
-                vertex: i / components,
+            return Err(ViewError::NonFiniteTexCoord {
+                value: i / components,
             });
         }
         self.uv = Some(TexCoords {
@@ -781,6 +787,31 @@ mod tests {
                 index: 1
             }
         );
+        let uv = [0.0, 0.0, 1.0, 0.0, 1.0, 1.0, 0.0, 1.0];
+        assert_eq!(
+            view.clone().with_uv(&uv, 2, &[0, 1, 2]).unwrap_err(),
+            ViewError::Count {
+                what: "texture coordinate indices",
+                given: 3,
+                expected: 4
+            }
+        );
+        assert_eq!(
+            view.clone().with_uv(&uv, 2, &[0, 1, 2, 4]).unwrap_err(),
+            ViewError::TexCoordOutOfRange {
+                face: 0,
+                index: 4,
+                values: 4
+            }
+        );
+        let nan_uv = [0.0, 0.0, 1.0, f64::NAN];
+        assert_eq!(
+            view.clone().with_uv(&nan_uv, 2, &[0, 1, 1, 0]).unwrap_err(),
+            ViewError::NonFiniteTexCoord { value: 1 }
+        );
+        assert!(view.clone().with_uv(&uv, 1, &[0, 1, 2, 3]).is_err());
+        let textured = view.clone().with_uv(&uv, 2, &[0, 1, 2, 3]).unwrap();
+        assert_eq!(textured.uv().unwrap().uv(2), [1.0, 1.0]);
         let tagged = view.with_tags(vec![([0, 1], 2.5)], vec![(3, 1.0)]).unwrap();
         assert_eq!(tagged.creases(), &[([0, 1], 2.5)]);
         assert_eq!(tagged.corners(), &[(3, 1.0)]);
