@@ -293,7 +293,15 @@ fn run_one(
         Some(u)
             if subd_io::Format::for_output(&job.output) == Some(subd_io::Format::Ply)
                 && if args.levels == 0 {
-                    !crate::uv::fits_ply(&file.mesh.topology, &u.values, &u.indices)
+                    let t = &file.mesh.topology;
+                    !subd_io::MeshView::new(
+                        &file.mesh.positions,
+                        t.face_offsets(),
+                        t.all_face_vertices(),
+                        &[],
+                    )
+                    .and_then(|v| v.with_uv(&u.values, 2, &u.indices))
+                    .is_ok_and(|v| subd_io::ply::holds_texcoords(&v))
                 } else {
                     u.values.len() / 2 != refinement_vertices(&refinement, args.levels)
                 } =>

@@ -98,20 +98,6 @@ pub(crate) fn limit_uv(
     })
 }
 
-/// Whether a PLY output (one texture coordinate per vertex) can hold `channel` on
-/// `topology`: every vertex's corners carry equal values.
-pub(crate) fn fits_ply(topology: &Topology, values: &[f64], indices: &[u32]) -> bool {
-    let mut seen: Vec<Option<[f64; 2]>> = vec![None; topology.num_vertices()];
-    topology
-        .all_face_vertices()
-        .iter()
-        .zip(indices)
-        .all(|(&v, &i)| {
-            let uv = [values[2 * i as usize], values[2 * i as usize + 1]];
-            *seen[v as usize].get_or_insert(uv) == uv
-        })
-}
-
 /// The warning for texture coordinates a PLY output leaves out.
 pub(crate) fn ply_seam_warning(output: &std::path::Path) -> String {
     format!(
@@ -130,9 +116,7 @@ pub(crate) fn fit_ply(
     if subd_io::Format::for_output(output) != Some(subd_io::Format::Ply) {
         return;
     }
-    if let Some(uv) = mesh.uv()
-        && !fits_ply(&mesh.topology, uv.values(), uv.indices())
-    {
+    if mesh.uv().is_some() && !subd_io::ply::holds_texcoords(&subd_io::MeshView::from_mesh(mesh)) {
         mesh.fvar.clear();
         warnings.push(ply_seam_warning(output));
     }

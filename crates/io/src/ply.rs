@@ -672,6 +672,12 @@ fn texcoord_properties(props: &[Property]) -> Option<[usize; 2]> {
         .find_map(|&(a, b)| Some([find(a)?, find(b)?]))
 }
 
+/// Whether `view`'s texture coordinates fit a PLY file: every vertex's corners carry the
+/// same value (no UV seam), or there are none.
+pub fn holds_texcoords(view: &MeshView<'_>) -> bool {
+    per_vertex_uv(view).is_ok()
+}
+
 /// One texture coordinate per vertex, for a format that has no per-corner values: an
 /// error naming the first vertex whose corners disagree (a UV seam). Vertices no face uses
 /// get (0, 0).

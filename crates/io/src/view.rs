@@ -581,11 +581,16 @@ impl<'a> MeshView<'a> {
             corners: Cow::Owned(corners),
             normals: None,
             face_levels: None,
-            uv: mesh.uv().map(|c| TexCoords {
-                values: c.values(),
-                components: c.components(),
-                indices: c.indices(),
-            }),
+            // Writers read u and v: a channel of fewer components is not texture
+            // coordinates.
+            uv: mesh
+                .uv()
+                .filter(|c| c.components() >= 2)
+                .map(|c| TexCoords {
+                    values: c.values(),
+                    components: c.components(),
+                    indices: c.indices(),
+                }),
             hints: mesh.hints,
         }
     }
