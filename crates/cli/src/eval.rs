@@ -29,7 +29,8 @@ pub(crate) struct EvalArgs {
     /// lines and `#` comments are skipped.
     #[arg(long)]
     at: PathBuf,
-    /// Output: one line `x y z nx ny nz` per point.
+    /// Output: one line `x y z nx ny nz` per point, followed by the limit texture
+    /// coordinates `u v` when the mesh has UVs (interpolated by `--fvar-interpolation`).
     output: PathBuf,
     /// Print a JSON report on stdout.
     #[arg(long)]
@@ -42,6 +43,8 @@ struct EvalReport {
     output: String,
     scheme: Scheme,
     points: usize,
+    /// Whether each line carries the limit texture coordinates.
+    uv: bool,
     seconds: f64,
 }
 
@@ -111,18 +114,50 @@ pub(crate) fn run(
     let sizes: Vec<u32> = topo.face_sizes().collect();
     let points = read_points(&args.at, &ev, &sizes, scheme == Scheme::CatmullClark)?;
     let patch_points = ev.prepare(&file.mesh.positions);
-    let mut body = String::with_capacity(points.len() * 120);
+    let at_point = |i: usize, p: &FaceParam, e: subd_limit::LimitError| {
+        bad(format!(
+            "{}: point {} (face {}): {e}",
+            args.at.display(),
+            i + 1,
+            p.face
+        ))
+    };
+    // The texture coordinates' evaluator and control values, when the mesh has UVs.
+    let uv = match file.mesh.uv() {
+        Some(channel) => {
+            let mode = args.rules.fvar_mode(&file.mesh.hints);
+            let uv_eval = ev.face_varying(channel, mode).map_err(|e| {
+                bad(format!(
+                    "{}: texture coordinates: {e}",
+                    args.input.display()
+                ))
+            })?;
+            let values = uv_eval.prepare(channel.values()).map_err(|e| {
+                bad(format!(
+                    "{}: texture coordinates: {e}",
+                    args.input.display()
+                ))
+            })?;
+            Some((uv_eval, values))
+        }
+        None => None,
+    };
+    let mut body = String::with_capacity(points.len() * 160);
     for (i, p) in points.iter().enumerate() {
-        let s = ev.evaluate(&patch_points, *p).map_err(|e| {
-            bad(format!(
-                "{}: point {} (face {}): {e}",
-                args.at.display(),
-                i + 1,
-                p.face
-            ))
-        })?;
+        let s = ev
+            .evaluate(&patch_points, *p)
+            .map_err(|e| at_point(i, p, e))?;
         let (x, n) = (s.position, s.normal());
-        let _ = writeln!(body, "{} {} {} {} {} {}", x.x, x.y, x.z, n.x, n.y, n.z);
+        let _ = write!(body, "{} {} {} {} {} {}", x.x, x.y, x.z, n.x, n.y, n.z);
+        if let Some((uv_eval, values)) = &uv {
+            let t = uv_eval
+                .evaluate(values, *p)
+                .map_err(|e| at_point(i, p, e))?;
+            for x in &t.value {
+                let _ = write!(body, " {x}");
+            }
+        }
+        body.push('\n');
     }
     subd_io::atomic_write(&args.output, |w| w.write_all(body.as_bytes()))?;
     if args.json {
@@ -131,6 +166,7 @@ pub(crate) fn run(
             output: args.output.display().to_string(),
             scheme,
             points: points.len(),
+            uv: uv.is_some(),
             seconds: t0.elapsed().as_secs_f64(),
         };
         crate::print_json(out, &report);

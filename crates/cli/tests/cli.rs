@@ -685,7 +685,9 @@ fn eval_writes_points_and_names_bad_lines() {
             rows[1]
         );
     }
-    assert_eq!(rows[1].len(), 6);
+    // catmark_cube has UVs: each line ends with the limit `u v`.
+    assert!(rows.iter().all(|r| r.len() == 8), "{rows:?}");
+    eval_uvs_are_linear_in_mode_all(&s, &cube, &at);
     for (args, expect) in [
         ("0 0.5 1.5\n", "at.txt:1: parameters"),
         ("1 0.5 0.5\n99 0.5 0.5\n", "at.txt:2: face 99 out of range"),
@@ -707,6 +709,63 @@ fn eval_writes_points_and_names_bad_lines() {
         assert!(err.contains(expect), "{args:?}: {err}");
         assert_eq!(err.lines().count(), 1, "{err}");
         assert!(!out2.exists());
+    }
+}
+
+/// Under `--fvar-interpolation all` the UVs are bilinear over each face's corners: the centre
+/// of face 0 is the mean of its four `vt`, read from the OBJ text, and a corner is its `vt`.
+fn eval_uvs_are_linear_in_mode_all(s: &Scratch, cube: &Path, at: &Path) {
+    let out = s.0.join("uv.txt");
+    let (code, _, err) = subd(&[
+        "eval",
+        "--scheme",
+        "catmull-clark",
+        "--fvar-interpolation",
+        "all",
+        cube.to_str().unwrap(),
+        "--at",
+        at.to_str().unwrap(),
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let rows: Vec<Vec<f64>> = std::fs::read_to_string(&out)
+        .unwrap()
+        .lines()
+        .map(|l| l.split_whitespace().map(|x| x.parse().unwrap()).collect())
+        .collect();
+    let text = std::fs::read_to_string(cube).unwrap();
+    let vt: Vec<[f64; 2]> = text
+        .lines()
+        .filter_map(|l| l.strip_prefix("vt "))
+        .map(|l| {
+            let x: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
+            [x[0], x[1]]
+        })
+        .collect();
+    let corner_vt = |face: usize| -> Vec<[f64; 2]> {
+        let line = text
+            .lines()
+            .filter(|l| l.starts_with("f "))
+            .nth(face)
+            .unwrap();
+        line.split_whitespace()
+            .skip(1)
+            .map(|c| vt[c.split('/').nth(1).unwrap().parse::<usize>().unwrap() - 1])
+            .collect()
+    };
+    let f0 = corner_vt(0);
+    for k in 0..2 {
+        let mean = f0.iter().map(|c| c[k]).sum::<f64>() / 4.0;
+        assert!(
+            (rows[0][6 + k] - mean).abs() < 1e-12,
+            "{:?} vs {f0:?}",
+            rows[0]
+        );
+        assert!(
+            (rows[1][6 + k] - corner_vt(2)[0][k]).abs() < 1e-12,
+            "{:?}",
+            rows[1]
+        );
     }
 }
 

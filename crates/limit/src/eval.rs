@@ -335,38 +335,7 @@ impl LimitEvaluator {
 
     /// Checks `at` against the topology: face and sub-face in range, parameters in [0, 1].
     pub fn check(&self, at: &FaceParam) -> Result<(), LimitError> {
-        let nf = self.base.num_faces();
-        if at.face >= nf {
-            return Err(LimitError::Param(format!(
-                "face {} out of range (the mesh has {nf} faces)",
-                at.face
-            )));
-        }
-        let size = self.base.face_size(at.face);
-        let subs = if size == 4 || self.scheme == Scheme::Loop {
-            1
-        } else {
-            size
-        };
-        if at.sub >= subs {
-            return Err(LimitError::Param(format!(
-                "sub-face {} out of range (face {} has {subs})",
-                at.sub, at.face
-            )));
-        }
-        if !(0.0..=1.0).contains(&at.u) || !(0.0..=1.0).contains(&at.v) {
-            return Err(LimitError::Param(format!(
-                "parameters ({}, {}) outside [0, 1]",
-                at.u, at.v
-            )));
-        }
-        if self.scheme == Scheme::Loop && at.u + at.v > 1.0 + 1e-12 {
-            return Err(LimitError::Param(format!(
-                "parameters ({}, {}) outside the triangle u + v ≤ 1",
-                at.u, at.v
-            )));
-        }
-        Ok(())
+        check_param(&self.base, self.scheme, at)
     }
 
     /// The limit surface at `at`: position and first and second derivatives.
@@ -466,6 +435,47 @@ impl LimitEvaluator {
     }
 }
 
+/// Checks `at` against `base`: face and sub-face in range, parameters in [0, 1] (and in the
+/// triangle for Loop).
+pub(crate) fn check_param(
+    base: &Topology,
+    scheme: Scheme,
+    at: &FaceParam,
+) -> Result<(), LimitError> {
+    let nf = base.num_faces();
+    if at.face >= nf {
+        return Err(LimitError::Param(format!(
+            "face {} out of range (the mesh has {nf} faces)",
+            at.face
+        )));
+    }
+    let size = base.face_size(at.face);
+    let subs = if size == 4 || scheme == Scheme::Loop {
+        1
+    } else {
+        size
+    };
+    if at.sub >= subs {
+        return Err(LimitError::Param(format!(
+            "sub-face {} out of range (face {} has {subs})",
+            at.sub, at.face
+        )));
+    }
+    if !(0.0..=1.0).contains(&at.u) || !(0.0..=1.0).contains(&at.v) {
+        return Err(LimitError::Param(format!(
+            "parameters ({}, {}) outside [0, 1]",
+            at.u, at.v
+        )));
+    }
+    if scheme == Scheme::Loop && at.u + at.v > 1.0 + 1e-12 {
+        return Err(LimitError::Param(format!(
+            "parameters ({}, {}) outside the triangle u + v ≤ 1",
+            at.u, at.v
+        )));
+    }
+    Ok(())
+}
+
 /// `e` naming base face `face` when it names a face (errors of local evaluation name the
 /// refined face they met).
 pub(crate) fn on_base_face(e: LimitError, face: usize) -> LimitError {
@@ -484,25 +494,39 @@ pub fn dyadic_vertex(r: &Refinement, level: usize, face: usize, u: f64, v: f64) 
     if r.topology(0).face_size(face) != if loop_scheme { 3 } else { 4 } {
         return None;
     }
-    let (mut f, mut s, mut t) = (face, u, v);
+    let at = FaceParam { face, sub: 0, u, v };
+    let (f, corner) = dyadic_corner(r, level, at)?;
+    Some(r.topology(level).face_vertices(f)[corner] as usize)
+}
+
+/// The face of level `level` (at least 1 for a Catmull-Clark face that is not a quad) of `r`
+/// whose corner is at `at`, and that corner, following the child faces that hold the point as
+/// [`LimitEvaluator::evaluate`] does (a sub-face of a face that is not a quad is its level-1
+/// child); `None` when `at` is not a corner at that level.
+pub fn dyadic_corner(r: &Refinement, level: usize, at: FaceParam) -> Option<(usize, usize)> {
+    let loop_scheme = r.scheme() == Scheme::Loop;
+    let (mut f, mut s, mut t) = (at.face, at.u, at.v);
     for l in 0..level {
         if loop_scheme {
             let (j, a, b, _) = tri_child(s, t);
             (f, s, t) = (4 * f + j, a, b);
-        } else {
+        } else if r.topology(l).face_size(f) == 4 {
             let (j, a, b) = quadrant(s, t);
             (f, s, t) = (r.topology(l).face_offsets()[f] as usize + j, a, b);
+        } else {
+            f = r.topology(l).face_offsets()[f] as usize + at.sub;
         }
     }
+    let size = r.topology(level).face_size(f);
     let corner = match (s, t) {
         (0.0, 0.0) => 0,
         (1.0, 0.0) => 1,
         (0.0, 1.0) if loop_scheme => 2,
-        (1.0, 1.0) => 2,
+        (1.0, 1.0) if !loop_scheme => 2,
         (0.0, 1.0) => 3,
         _ => return None,
     };
-    Some(r.topology(level).face_vertices(f)[corner] as usize)
+    (corner < size).then_some((f, corner))
 }
 
 /// The child of a quad holding (u, v) and the parameters in it: child j has the parent's

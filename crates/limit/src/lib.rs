@@ -44,6 +44,7 @@ pub mod acc;
 pub mod eigen;
 pub mod eval;
 pub mod fvar;
+pub mod fvar_eval;
 pub mod local;
 pub mod loop_patch;
 pub mod masks;

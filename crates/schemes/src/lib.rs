@@ -56,8 +56,8 @@ use subd_mesh::{BoundaryInterpolation, CreaseMethod, SchemeHints, TriangleSubdiv
 use thiserror::Error;
 
 pub use refine::{
-    FVarLevelValues, FaceStream, FaceVaryingRefinement, LevelCounts, PointStream, Refinement,
-    refined_counts, refined_split_counts,
+    FVarLevelValues, FVarValueKind, FaceStream, FaceVaryingRefinement, LevelCounts, PointStream,
+    Refinement, refined_counts, refined_split_counts,
 };
 pub use rules::Rule;
 pub use stencil::{RowSink, StencilTable};

@@ -5,6 +5,7 @@ mod acc;
 mod adaptive;
 mod curves;
 mod editing;
+mod fvar_eval;
 mod limit_eval;
 mod limit_shapes;
 mod osd_meshes;

@@ -414,6 +414,58 @@ impl FVarLevelValues<'_> {
     }
 }
 
+/// How a face-varying value is refined at its level (`Vtr::FVarLevel`'s value tags, in the
+/// terms of the vertex rules).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FVarValueKind {
+    /// The one value of a seamless vertex: it follows the vertex's own rule.
+    Matching,
+    /// Pinned by the mode or by infinitely sharp features: it stays put.
+    Corner,
+    /// On a seam: the crease rule along the two seam edges bounding its span.
+    Crease,
+    /// Pinned until the semi-sharp features around it decay, a crease after that.
+    SemiSharp,
+}
+
+impl FVarLevelValues<'_> {
+    /// Number of (vertex, value) pairs at this level. At refined levels that is the number of
+    /// values; at level 0 a channel value used at two vertices counts once at each.
+    pub fn num_slots(&self) -> usize {
+        self.level.num_values()
+    }
+
+    /// The slot of value `k` of vertex `v`: slots number the (vertex, value) pairs vertex by
+    /// vertex, and at refined levels a slot is the value's own index.
+    pub fn slot(&self, v: usize, k: usize) -> usize {
+        self.level.offset(v) + k
+    }
+
+    /// The slot at corner `k` of face `f`.
+    pub fn corner_slot(&self, f: usize, k: usize) -> usize {
+        self.level.corner_slot(self.topology, f, k)
+    }
+
+    /// The value (the channel's own index at level 0) of slot `slot`.
+    pub fn slot_value(&self, slot: usize) -> u32 {
+        self.level.source(slot)
+    }
+
+    /// How value `k` of vertex `v` is refined.
+    pub fn value_kind(&self, v: usize, k: usize) -> FVarValueKind {
+        let tag = self.level.tags[self.slot(v, k)];
+        if !self.level.tags[self.level.offset(v)].mismatch {
+            FVarValueKind::Matching
+        } else if tag.semi_sharp {
+            FVarValueKind::SemiSharp
+        } else if tag.crease {
+            FVarValueKind::Crease
+        } else {
+            FVarValueKind::Corner
+        }
+    }
+}
+
 /// Per-vertex classification of the base level (`FVarLevel::completeTopologyFromFaceValues`,
 /// §2.2–2.3).
 fn base_level(t: &Topology, indices: &[u32], flags: ModeFlags) -> ChannelLevel {

@@ -14,7 +14,7 @@ mod stream;
 
 pub use counts::{LevelCounts, refined_counts, refined_split_counts};
 pub(crate) use counts::{last_level_bytes, topology_bytes};
-pub use fvar::{FVarLevelValues, FaceVaryingRefinement};
+pub use fvar::{FVarLevelValues, FVarValueKind, FaceVaryingRefinement};
 pub use refinement::Refinement;
 pub use stream::{FaceStream, PointStream};
 
