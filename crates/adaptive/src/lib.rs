@@ -47,6 +47,7 @@
 
 mod conform;
 pub mod criteria;
+mod fvar;
 mod hierarchy;
 mod level;
 mod limit;
@@ -64,6 +65,7 @@ pub use criteria::{
     Criterion, DihedralAngle, EveryFace, FaceSelection, Flatness, GaussianCurvature, LevelView,
     LimitDistance, LimitSurface, RandomSelection,
 };
+pub use fvar::AdaptiveFVar;
 pub use hierarchy::{AdaptiveRefinement, Positions};
 pub use uniform::UniformCounts;
 

@@ -263,13 +263,6 @@ fn run_one(
     let levels = check_arguments(args, job)?;
     let file = subd_io::read_mesh(&job.input, &args.rules.read_options())?;
     print_warnings(err, &job.input, &file.warnings);
-    if file.mesh.uv().is_some() {
-        print_warnings(
-            err,
-            &job.input,
-            &["texture coordinates are not carried through adaptive refinement yet; the output has none".into()],
-        );
-    }
     let t_read = t_start.elapsed().as_secs_f64();
     let mesh = &file.mesh;
     let base = &mesh.topology;
@@ -324,9 +317,12 @@ fn run_one(
     };
     let t_report = t2.elapsed().as_secs_f64();
 
+    spinner.message("texture coordinates");
+    let uv = adaptive_uv(args, mesh, scheme, &options, &result, err, job);
     spinner.message("writing");
     let t3 = Instant::now();
-    write(job, &result, &options)?;
+    let written = write(job, &result, &options, uv.as_ref())?;
+    print_warnings(err, &job.input, &written);
     spinner.finish();
     let t_write = t3.elapsed().as_secs_f64();
 
@@ -429,7 +425,47 @@ fn measure(mesh: &AdaptiveMesh, surface: Option<&LimitSurface>) -> (Conformity, 
     (conformity, min_angle, distance)
 }
 
-fn write(job: &Job, mesh: &AdaptiveMesh, options: &subd_schemes::Options) -> Result<(), Failure> {
+/// The input's texture coordinates on the adaptive mesh: their exact limit at every corner's
+/// parameter (`None` without UVs, or with a warning where they cannot be evaluated).
+fn adaptive_uv(
+    args: &AdaptiveArgs,
+    mesh: &subd_mesh::Mesh,
+    scheme: Scheme,
+    options: &subd_schemes::Options,
+    result: &AdaptiveMesh,
+    err: &mut dyn Write,
+    job: &Job,
+) -> Option<crate::uv::RefinedUv> {
+    let channel = mesh.uv()?;
+    let mode = args.rules.fvar_mode(&mesh.hints);
+    let computed = subd_limit::eval::LimitEvaluator::new(&mesh.topology, scheme, options)
+        .and_then(|ev| ev.face_varying(channel, mode))
+        .and_then(|uv_eval| Ok((uv_eval.prepare(channel.values())?, uv_eval)))
+        .map_err(AdaptiveError::from)
+        .and_then(|(values, uv_eval)| result.face_varying_limit(&uv_eval, &values));
+    match computed {
+        Ok(uv) => Some(crate::uv::RefinedUv {
+            values: uv.values,
+            indices: uv.indices,
+        }),
+        Err(e) => {
+            print_warnings(
+                err,
+                &job.input,
+                &[format!("texture coordinates left out: {e}")],
+            );
+            None
+        }
+    }
+}
+
+/// Writes the adaptive mesh; returns the warnings of leaving out UVs a PLY cannot hold.
+fn write(
+    job: &Job,
+    mesh: &AdaptiveMesh,
+    options: &subd_schemes::Options,
+    uv: Option<&crate::uv::RefinedUv>,
+) -> Result<Vec<String>, Failure> {
     let fail = |e: subd_io::ViewError| bad(format!("{}: {e}", job.input.display()));
     let mut view = subd_io::MeshView::new(
         &mesh.positions,
@@ -448,6 +484,14 @@ fn write(job: &Job, mesh: &AdaptiveMesh, options: &subd_schemes::Options) -> Res
         triangle_subdivision: Some(options.triangle_subdivision),
         fvar_interpolation: None,
     };
+    let mut warnings = Vec::new();
+    let with_uv = crate::uv::with_uv(view.clone(), uv).map_err(fail)?;
+    let ply = subd_io::Format::for_output(&job.output) == Some(subd_io::Format::Ply);
+    if uv.is_some() && ply && !subd_io::ply::holds_texcoords(&with_uv) {
+        warnings.push(crate::uv::ply_seam_warning(&job.output));
+    } else {
+        view = with_uv;
+    }
     subd_io::write_view(&job.output, &view, &subd_io::WriteOptions::default())?;
-    Ok(())
+    Ok(warnings)
 }

@@ -3146,3 +3146,68 @@ fn info_pia_and_limit_keep_texture_coordinates() {
         }
     }
 }
+
+/// `subd adaptive` carries UVs: with every face selected its `--limit` output has the same
+/// (position, UV) pairs at its corners as `subd refine --limit` (limit masks on the refined
+/// values there, patch evaluation at each corner's parameter here), and a PLY output leaves
+/// seamed UVs out with a warning.
+#[test]
+fn adaptive_carries_limit_uvs() {
+    let s = Scratch::new("adaptiveuv");
+    let cube = meshes().join("catmark_cube.obj");
+    let (a, r) = (s.0.join("a.obj"), s.0.join("r.obj"));
+    let (code, _, err) = subd(&[
+        "adaptive",
+        "--scheme",
+        "catmull-clark",
+        "--levels",
+        "2",
+        "--limit",
+        cube.to_str().unwrap(),
+        a.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(!err.contains("texture"), "{err}");
+    let (code, _, err) = subd(&[
+        "refine",
+        "--scheme",
+        "catmull-clark",
+        "--levels",
+        "2",
+        "--limit",
+        cube.to_str().unwrap(),
+        r.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let corners = |path: &Path| {
+        let m = subd_io::read_mesh(path, &subd_io::ReadOptions::default())
+            .unwrap()
+            .mesh;
+        let uv = m.uv().expect("UVs written").clone();
+        let t = &m.topology;
+        let mut out: Vec<[i64; 5]> = Vec::new();
+        for f in 0..t.num_faces() {
+            for (&v, &x) in t.face_vertices(f).iter().zip(uv.face_values(t, f)) {
+                let p = m.positions[v as usize];
+                let q = uv.value(x as usize);
+                let key = |y: f64| (y * 1e9).round() as i64;
+                out.push([key(p.x), key(p.y), key(p.z), key(q[0]), key(q[1])]);
+            }
+        }
+        out.sort_unstable();
+        out
+    };
+    assert_eq!(corners(&a), corners(&r));
+    let ply = s.0.join("a.ply");
+    let (code, _, err) = subd(&[
+        "adaptive",
+        "--scheme",
+        "catmull-clark",
+        "--levels",
+        "1",
+        cube.to_str().unwrap(),
+        ply.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(err.contains("texture coordinates left out"), "{err}");
+}

@@ -117,7 +117,7 @@ struct ValuePatches {
 /// A channel's values prepared for [`FVarEvaluator::evaluate`].
 #[derive(Clone, Debug)]
 pub struct FVarPatchValues {
-    /// Linear mode: the channel's values.
+    /// The channel's values.
     values: Vec<f64>,
     /// Smooth modes: the patch points of each group of three components.
     groups: Vec<PatchPoints>,
@@ -367,7 +367,7 @@ impl FVarEvaluator {
             })
             .collect();
         Ok(FVarPatchValues {
-            values: Vec::new(),
+            values: values.to_vec(),
             groups,
         })
     }
@@ -413,6 +413,21 @@ impl FVarEvaluator {
             }
         }
         Ok(out)
+    }
+
+    /// The bilinear (Catmull-Clark) or linear (Loop) interpolation of the face's corner
+    /// values at `at`, as mode `all` refines them: a value for faces the limit does not
+    /// cover, such as holes, which have no surface of their own.
+    ///
+    /// # Errors
+    /// [`LimitError::Param`] for a point outside the mesh or the parameter domain.
+    pub fn evaluate_linear(
+        &self,
+        values: &FVarPatchValues,
+        at: FaceParam,
+    ) -> Result<FVarPoint, LimitError> {
+        crate::eval::check_param(&self.base, self.scheme, &at)?;
+        Ok(self.linear(&values.values, &at))
     }
 
     /// Mode `all`: the bilinear interpolation of the (sub-)face's corners (Catmull-Clark:

@@ -252,3 +252,76 @@ fn corner_parameters_locate_the_limit_surface() {
     }
     assert!(checked > 40, "{checked} shapes");
 }
+
+/// UVs on the adaptive mesh: with every face selected the mesh is uniform refinement, and each
+/// corner's UV, evaluated on the channel's patches at the corner's parameter, is the exact
+/// limit of uniform refinement's value at that face corner, taken with limit masks
+/// (`subd_limit::fvar::limit_at_level`), in every mode: an independent computation.
+#[test]
+fn adaptive_uvs_are_the_limits_of_uniform_refinement_values() {
+    use subd_limit::eval::LimitEvaluator;
+    use subd_mesh::fvar::FVarLinearInterpolation;
+    use subd_schemes::FaceVaryingRefinement;
+    let names = [
+        "catmark_cube",
+        "catmark_pyramid",
+        "catmark_fvar_bound1",
+        "catmark_cube_creases1",
+        "loop_cube",
+    ];
+    let mut checked = 0;
+    for s in shapes().iter().filter(|s| names.contains(&s.name.as_str())) {
+        let uv = s.mesh.uv().expect("these shapes have UVs");
+        let every = subd_adaptive::EveryFace;
+        let (t, p) = (&s.mesh.topology, &s.mesh.positions);
+        let a = AdaptiveRefinement::new(t, p, s.scheme, &s.options, &[&every], 2).unwrap();
+        let mesh = a.mesh(Positions::Limit).unwrap();
+        // Limits are taken where semi-sharp creases have decayed; a level-2 corner's vertex
+        // is the vertex at the same corner of its corner child at every deeper level.
+        let deepest = 2.max(levels_for_exact_limit(t, s.scheme).0);
+        let r = Refinement::new(t, s.scheme, &s.options, deepest).unwrap();
+        let at_deepest = |mut g: usize, k: usize| {
+            for l in 2..deepest {
+                g = if s.scheme == subd_schemes::Scheme::Loop {
+                    4 * g + k
+                } else {
+                    r.topology(l).face_offsets()[g] as usize + k
+                };
+            }
+            g
+        };
+        let ev = LimitEvaluator::new(t, s.scheme, &s.options).unwrap();
+        for mode in FVarLinearInterpolation::ALL_MODES {
+            let fr = FaceVaryingRefinement::new(&r, uv, mode).unwrap();
+            let refined = fr.refine_values(uv.values(), 2).pop().unwrap();
+            let mut limits = vec![0.0; refined.len()];
+            subd_limit::fvar::limit_at_level(&r, &fr, deepest)
+                .unwrap()
+                .apply(&refined, 2, &mut limits);
+            let corner_values = fr.face_values(deepest);
+            let offsets = r.topology(deepest).face_offsets();
+            let uv_eval = ev.face_varying(uv, mode).unwrap();
+            let values = uv_eval.prepare(uv.values()).unwrap();
+            let got = mesh.face_varying_limit(&uv_eval, &values).unwrap();
+            assert_eq!(got.indices.len(), mesh.face_vertices.len());
+            for f in 0..mesh.num_faces() {
+                assert_eq!(mesh.face_levels[f], 2, "{}: every face selected", s.name);
+                for k in 0..mesh.face(f).len() {
+                    let g = at_deepest(mesh.face_uniform[f] as usize, k);
+                    let i = corner_values[offsets[g] as usize + k] as usize;
+                    let j = got.indices[mesh.face_offsets[f] as usize + k] as usize;
+                    for c in 0..2 {
+                        let (x, want) = (got.values[2 * j + c], limits[2 * i + c]);
+                        assert!(
+                            (x - want).abs() < 1e-12,
+                            "{} {mode:?} face {f} corner {k}: {x} vs {want}",
+                            s.name
+                        );
+                    }
+                    checked += 1;
+                }
+            }
+        }
+    }
+    assert!(checked > 5000, "only {checked} corners checked");
+}
