@@ -6,7 +6,7 @@
 //! two, tearing the texture along the transition. The limit is the same from every level.
 
 use subd_limit::eval::FaceParam;
-use subd_limit::fvar_eval::{FVarEvaluator, FVarPatchValues};
+use subd_limit::fvar_eval::{FVarEvaluator, FVarPatchValues, FVarPoint};
 
 use crate::{AdaptiveError, AdaptiveMesh};
 
@@ -39,62 +39,74 @@ impl AdaptiveMesh {
     ) -> Result<AdaptiveFVar, AdaptiveError> {
         use rayon::prelude::*;
         let c = evaluator.components();
-        // Every face-vertex's value, face by face in parallel.
-        let per_face: Vec<Vec<f64>> = (0..self.num_faces())
-            .into_par_iter()
-            .map(|f| {
-                let range = self.face_offsets[f] as usize..self.face_offsets[f + 1] as usize;
-                let (face, sub) = self.face_domains[f];
-                let mut out = Vec::with_capacity(c * range.len());
-                for (k, i) in range.enumerate() {
-                    let [u, v] = self.corner_params[i];
-                    // A whole base face that is not a quad: its corners are its base vertices.
-                    let at = if sub == u16::MAX {
-                        FaceParam {
-                            face: face as usize,
-                            sub: k,
-                            u: 0.0,
-                            v: 0.0,
-                        }
-                    } else {
-                        FaceParam {
-                            face: face as usize,
-                            sub: sub as usize,
-                            u,
-                            v,
-                        }
-                    };
-                    let p = if self.holes[f] {
-                        evaluator.evaluate_linear(values, at)?
-                    } else {
-                        evaluator.evaluate(values, at)?
-                    };
-                    out.extend_from_slice(&p.value);
-                }
-                Ok(out)
+        let num_corners = self.face_vertices.len();
+        // Every face-vertex's value, in parallel, one scratch point per thread.
+        let mut corner_values = vec![0.0; c * num_corners];
+        let face_of: Vec<u32> = (0..self.num_faces() as u32)
+            .flat_map(|f| {
+                let n = self.face_offsets[f as usize + 1] - self.face_offsets[f as usize];
+                std::iter::repeat_n(f, n as usize)
             })
-            .collect::<Result<_, AdaptiveError>>()?;
-        // Corners of one vertex with bit-identical values share an index.
-        let mut index_of = std::collections::HashMap::new();
+            .collect();
+        corner_values
+            .par_chunks_mut(c)
+            .enumerate()
+            .try_for_each_init(FVarPoint::default, |point, (i, out)| {
+                let f = face_of[i] as usize;
+                let k = i - self.face_offsets[f] as usize;
+                let (face, sub) = self.face_domains[f];
+                let [u, v] = self.corner_params[i];
+                // A whole base face that is not a quad: its corners are its base vertices.
+                let at = if sub == u16::MAX {
+                    FaceParam {
+                        face: face as usize,
+                        sub: k,
+                        u: 0.0,
+                        v: 0.0,
+                    }
+                } else {
+                    FaceParam {
+                        face: face as usize,
+                        sub: sub as usize,
+                        u,
+                        v,
+                    }
+                };
+                if self.holes[f] {
+                    evaluator.evaluate_linear_into(values, at, point)?;
+                } else {
+                    evaluator.evaluate_into(values, at, point)?;
+                }
+                out.copy_from_slice(&point.value);
+                Ok::<(), AdaptiveError>(())
+            })?;
+        // Corners of one vertex with bit-identical values share an index: sort the corners
+        // by (vertex, value bits) and number the runs, vertex by vertex.
+        let value = |i: usize| &corner_values[c * i..c * (i + 1)];
+        let key_order = |&a: &u32, &b: &u32| {
+            let (a, b) = (a as usize, b as usize);
+            self.face_vertices[a]
+                .cmp(&self.face_vertices[b])
+                .then_with(|| {
+                    value(a)
+                        .iter()
+                        .map(|x| x.to_bits())
+                        .cmp(value(b).iter().map(|x| x.to_bits()))
+                })
+        };
+        let mut order: Vec<u32> = (0..num_corners as u32).collect();
+        order.par_sort_unstable_by(key_order);
         let mut out = AdaptiveFVar {
             components: c,
             values: Vec::new(),
-            indices: Vec::with_capacity(self.face_vertices.len()),
+            indices: vec![0; num_corners],
         };
-        for (f, corner_values) in per_face.iter().enumerate() {
-            let vertices = self.face(f);
-            for (k, value) in corner_values.chunks_exact(c.max(1)).enumerate() {
-                let key = (
-                    vertices[k],
-                    value.iter().map(|x| x.to_bits()).collect::<Vec<u64>>(),
-                );
-                let next = (out.values.len() / c.max(1)) as u32;
-                let index = *index_of.entry(key).or_insert_with(|| {
-                    out.values.extend_from_slice(value);
-                    next
-                });
-                out.indices.push(index);
+        for (n, &i) in order.iter().enumerate() {
+            let starts_run = n == 0 || key_order(&order[n - 1], &i) != std::cmp::Ordering::Equal;
+            if starts_run {
+                out.values.extend_from_slice(value(i as usize));
             }
+            out.indices[i as usize] = (out.values.len() / c - 1) as u32;
         }
         Ok(out)
     }

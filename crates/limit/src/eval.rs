@@ -414,24 +414,9 @@ impl LimitEvaluator {
     /// The level-2 face holding `at` of a base face that is refined, its parameters there,
     /// and the scale of the map from the base (sub-)face's parameters to the level-2 face's.
     pub(crate) fn level2_location(&self, at: &FaceParam) -> (usize, f64, f64, f64) {
-        let off = self.base.face_offsets()[at.face] as usize;
-        if self.scheme == Scheme::Loop {
-            // Four children per triangle at each level.
-            let (j, s, t, k1) = tri_child(at.u, at.v.min(1.0 - at.u));
-            let (k, s2, t2, k2) = tri_child(s, t.min(1.0 - s));
-            (4 * (4 * at.face + j) + k, s2, t2, k1 * k2)
-        } else {
-            // Level 1: a quad's child by quadrant, or a non-quad's sub-face; level 2: every
-            // level-1 face is a quad with 4 consecutive children.
-            let (c1, s, t, scale1) = if self.base.face_size(at.face) == 4 {
-                let (j, s, t) = quadrant(at.u, at.v);
-                (off + j, s, t, 2.0)
-            } else {
-                (off + at.sub, at.u, at.v, 1.0)
-            };
-            let (k, s2, t2) = quadrant(s, t);
-            (4 * c1 + k, s2, t2, 2.0 * scale1)
-        }
+        let r = self.refined.as_ref().expect("refined when a face needs it");
+        let (p, scale) = descend(r, 2, *at);
+        (p.face, p.u, p.v, scale)
     }
 }
 
@@ -505,18 +490,15 @@ pub fn dyadic_vertex(r: &Refinement, level: usize, face: usize, u: f64, v: f64) 
 /// child); `None` when `at` is not a corner at that level.
 pub fn dyadic_corner(r: &Refinement, level: usize, at: FaceParam) -> Option<(usize, usize)> {
     let loop_scheme = r.scheme() == Scheme::Loop;
-    let (mut f, mut s, mut t) = (at.face, at.u, at.v);
-    for l in 0..level {
-        if loop_scheme {
-            let (j, a, b, _) = tri_child(s, t);
-            (f, s, t) = (4 * f + j, a, b);
-        } else if r.topology(l).face_size(f) == 4 {
-            let (j, a, b) = quadrant(s, t);
-            (f, s, t) = (r.topology(l).face_offsets()[f] as usize + j, a, b);
-        } else {
-            f = r.topology(l).face_offsets()[f] as usize + at.sub;
-        }
-    }
+    let (
+        FaceParam {
+            face: f,
+            u: s,
+            v: t,
+            ..
+        },
+        _,
+    ) = descend(r, level, at);
     let size = r.topology(level).face_size(f);
     let corner = match (s, t) {
         (0.0, 0.0) => 0,
@@ -527,6 +509,34 @@ pub fn dyadic_corner(r: &Refinement, level: usize, at: FaceParam) -> Option<(usi
         _ => return None,
     };
     (corner < size).then_some((f, corner))
+}
+
+/// The face of `level` of `r` holding base point `at`, its parameters there, and the scale
+/// of the map from the base (sub-)face's parameters to that face's.
+pub(crate) fn descend(r: &Refinement, level: usize, at: FaceParam) -> (FaceParam, f64) {
+    let (mut f, mut s, mut t, mut scale) = (at.face, at.u, at.v, 1.0);
+    for l in 0..level {
+        if r.scheme() == Scheme::Loop {
+            let (j, a, b, k) = tri_child(s, t.min(1.0 - s));
+            (f, s, t, scale) = (4 * f + j, a, b, scale * k);
+        } else {
+            let first = r.topology(l).face_offsets()[f] as usize;
+            if r.topology(l).face_size(f) == 4 {
+                let (j, a, b) = quadrant(s, t);
+                (f, s, t, scale) = (first + j, a, b, 2.0 * scale);
+            } else {
+                // A sub-face is its level-1 child, with the same parameters.
+                f = first + at.sub;
+            }
+        }
+    }
+    let p = FaceParam {
+        face: f,
+        sub: 0,
+        u: s,
+        v: t,
+    };
+    (p, scale)
 }
 
 /// The child of a quad holding (u, v) and the parameters in it: child j has the parent's

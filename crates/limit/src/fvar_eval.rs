@@ -36,7 +36,7 @@ use subd_schemes::{
 };
 
 use crate::LimitError;
-use crate::eval::{FaceParam, LimitEvaluator, PatchPoints, quadrant, tri_child};
+use crate::eval::{FaceParam, LimitEvaluator, PatchPoints, descend};
 
 /// A face-varying value and its first derivatives with respect to the face parameters,
 /// `components` numbers each.
@@ -48,6 +48,15 @@ pub struct FVarPoint {
     pub du: Vec<f64>,
     /// ∂/∂v.
     pub dv: Vec<f64>,
+}
+
+impl FVarPoint {
+    /// Empties the three vectors, keeping their memory, for a point of another evaluation.
+    fn clear(&mut self) {
+        self.value.clear();
+        self.du.clear();
+        self.dv.clear();
+    }
 }
 
 /// Evaluates one face-varying channel on the limit surface of a [`LimitEvaluator`]'s mesh
@@ -381,6 +390,21 @@ impl FVarEvaluator {
         values: &FVarPatchValues,
         at: FaceParam,
     ) -> Result<FVarPoint, LimitError> {
+        let mut out = FVarPoint::default();
+        self.evaluate_into(values, at, &mut out)?;
+        Ok(out)
+    }
+
+    /// [`Self::evaluate`] into `out`, whose memory is reused: for loops over many points.
+    ///
+    /// # Errors
+    /// As [`Self::evaluate`]; `out` is then unspecified.
+    pub fn evaluate_into(
+        &self,
+        values: &FVarPatchValues,
+        at: FaceParam,
+        out: &mut FVarPoint,
+    ) -> Result<(), LimitError> {
         crate::eval::check_param(&self.base, self.scheme, &at)?;
         if self.blocked[at.face] && self.patches.is_some() {
             return Err(LimitError::Unsupported {
@@ -389,18 +413,18 @@ impl FVarEvaluator {
             });
         }
         let Some(p) = &self.patches else {
-            return Ok(self.linear(&values.values, &at));
+            self.linear(&values.values, &at, out);
+            return Ok(());
         };
         let (at_level, scale) = match &p.refined {
             Some((r, _)) => descend(r, p.level, at),
             None => (at, 1.0),
         };
         let c = self.components;
-        let mut out = FVarPoint {
-            value: vec![0.0; c],
-            du: vec![0.0; c],
-            dv: vec![0.0; c],
-        };
+        out.clear();
+        out.value.resize(c, 0.0);
+        out.du.resize(c, 0.0);
+        out.dv.resize(c, 0.0);
         for (g, points) in values.groups.iter().enumerate() {
             let s = p
                 .evaluator
@@ -412,7 +436,7 @@ impl FVarEvaluator {
                 out.dv[3 * g + i] = scale * s.dv[i];
             }
         }
-        Ok(out)
+        Ok(())
     }
 
     /// The bilinear (Catmull-Clark) or linear (Loop) interpolation of the face's corner
@@ -426,14 +450,30 @@ impl FVarEvaluator {
         values: &FVarPatchValues,
         at: FaceParam,
     ) -> Result<FVarPoint, LimitError> {
+        let mut out = FVarPoint::default();
+        self.evaluate_linear_into(values, at, &mut out)?;
+        Ok(out)
+    }
+
+    /// [`Self::evaluate_linear`] into `out`, whose memory is reused.
+    ///
+    /// # Errors
+    /// As [`Self::evaluate_linear`].
+    pub fn evaluate_linear_into(
+        &self,
+        values: &FVarPatchValues,
+        at: FaceParam,
+        out: &mut FVarPoint,
+    ) -> Result<(), LimitError> {
         crate::eval::check_param(&self.base, self.scheme, &at)?;
-        Ok(self.linear(&values.values, &at))
+        self.linear(&values.values, &at, out);
+        Ok(())
     }
 
     /// Mode `all`: the bilinear interpolation of the (sub-)face's corners (Catmull-Clark:
     /// a sub-face of a face that is not a quad runs corner, edge midpoint, centre, edge
     /// midpoint), or the linear one of the triangle's (Loop).
-    fn linear(&self, values: &[f64], at: &FaceParam) -> FVarPoint {
+    fn linear(&self, values: &[f64], at: &FaceParam, out: &mut FVarPoint) {
         let c = self.components;
         let off = self.base.face_offsets()[at.face] as usize;
         let n = self.base.face_size(at.face);
@@ -442,7 +482,7 @@ impl FVarEvaluator {
             &values[c * i..c * (i + 1)]
         };
         let (u, v) = (at.u, at.v);
-        let mut out = FVarPoint::default();
+        out.clear();
         for i in 0..c {
             let (x, du, dv) = if self.scheme == Scheme::Loop {
                 let (a, b, d) = (corner(0)[i], corner(1)[i], corner(2)[i]);
@@ -473,34 +513,5 @@ impl FVarEvaluator {
             out.du.push(du);
             out.dv.push(dv);
         }
-        out
     }
-}
-
-/// The face of `level` of `r` holding base point `at`, its parameters there, and the scale
-/// of the map from the base (sub-)face's parameters to that face's.
-fn descend(r: &Refinement, level: usize, at: FaceParam) -> (FaceParam, f64) {
-    let (mut f, mut s, mut t, mut scale) = (at.face, at.u, at.v, 1.0);
-    for l in 0..level {
-        if r.scheme() == Scheme::Loop {
-            let (j, a, b, k) = tri_child(s, t.min(1.0 - s));
-            (f, s, t, scale) = (4 * f + j, a, b, scale * k);
-        } else {
-            let first = r.topology(l).face_offsets()[f] as usize;
-            if r.topology(l).face_size(f) == 4 {
-                let (j, a, b) = quadrant(s, t);
-                (f, s, t, scale) = (first + j, a, b, 2.0 * scale);
-            } else {
-                // A sub-face is its level-1 child, with the same parameters.
-                f = first + at.sub;
-            }
-        }
-    }
-    let p = FaceParam {
-        face: f,
-        sub: 0,
-        u: s,
-        v: t,
-    };
-    (p, scale)
 }
