@@ -479,6 +479,12 @@ impl LimitSurface {
         Ok(LimitSurface { evaluator, points })
     }
 
+    /// The evaluator of the base mesh, for other data on the same surface (such as a
+    /// face-varying channel through [`LimitEvaluator::face_varying`]).
+    pub fn evaluator(&self) -> &LimitEvaluator {
+        &self.evaluator
+    }
+
     /// Position on the limit surface at `(u, v)` of sub-face `sub` of base face `face`.
     ///
     /// # Errors

@@ -301,16 +301,18 @@ fn run_one(
     let t_mesh = t1.elapsed().as_secs_f64();
 
     let t2 = Instant::now();
+    // One limit evaluator serves the distance criterion, the report and the UVs.
+    let own;
+    let surface = match &selection.distance {
+        Some(d) => Some(d.surface()),
+        None if args.json || mesh.uv().is_some() => {
+            own = LimitSurface::new(base, &mesh.positions, scheme, &options);
+            own.as_ref().ok()
+        }
+        None => None,
+    };
     let measured = if args.json {
         spinner.message("measuring");
-        let own;
-        let surface = match &selection.distance {
-            Some(d) => Some(d.surface()),
-            None => {
-                own = LimitSurface::new(base, &mesh.positions, scheme, &options);
-                own.as_ref().ok()
-            }
-        };
         Some(measure(&result, surface))
     } else {
         None
@@ -318,7 +320,7 @@ fn run_one(
     let t_report = t2.elapsed().as_secs_f64();
 
     spinner.message("texture coordinates");
-    let uv = adaptive_uv(args, mesh, scheme, &options, &result, err, job);
+    let uv = adaptive_uv(args, mesh, surface, (scheme, &options), &result, err, job);
     spinner.message("writing");
     let t3 = Instant::now();
     let written = write(job, &result, &options, uv.as_ref())?;
@@ -430,19 +432,36 @@ fn measure(mesh: &AdaptiveMesh, surface: Option<&LimitSurface>) -> (Conformity, 
 fn adaptive_uv(
     args: &AdaptiveArgs,
     mesh: &subd_mesh::Mesh,
-    scheme: Scheme,
-    options: &subd_schemes::Options,
+    surface: Option<&LimitSurface>,
+    (scheme, options): (Scheme, &subd_schemes::Options),
     result: &AdaptiveMesh,
     err: &mut dyn Write,
     job: &Job,
 ) -> Option<crate::uv::RefinedUv> {
     let channel = mesh.uv()?;
     let mode = args.rules.fvar_mode(&mesh.hints);
-    let computed = subd_limit::eval::LimitEvaluator::new(&mesh.topology, scheme, options)
-        .and_then(|ev| ev.face_varying(channel, mode))
-        .and_then(|uv_eval| Ok((uv_eval.prepare(channel.values())?, uv_eval)))
-        .map_err(AdaptiveError::from)
-        .and_then(|(values, uv_eval)| result.face_varying_limit(&uv_eval, &values));
+    // The surface's evaluator when there is one; otherwise building one names the problem.
+    let mut own = None;
+    let evaluator = match surface {
+        Some(s) => Ok(s.evaluator()),
+        None => own
+            .insert(subd_limit::eval::LimitEvaluator::new(
+                &mesh.topology,
+                scheme,
+                options,
+            ))
+            .as_ref()
+            .map_err(|e| e.to_string()),
+    };
+    let computed = evaluator.and_then(|ev| {
+        let uv_eval = ev.face_varying(channel, mode).map_err(|e| e.to_string())?;
+        let values = uv_eval
+            .prepare(channel.values())
+            .map_err(|e| e.to_string())?;
+        result
+            .face_varying_limit(&uv_eval, &values)
+            .map_err(|e| e.to_string())
+    });
     match computed {
         Ok(uv) => Some(crate::uv::RefinedUv {
             values: uv.values,
