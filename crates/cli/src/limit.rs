@@ -184,20 +184,22 @@ fn run_one(
         }
         let limit = split_limit_points(topo, scheme, &file.mesh.positions)
             .map_err(|e| bad(format!("{}: {e}", job.input.display())))?;
-        if file.mesh.uv().is_some() && !is_text {
-            print_warnings(
-                err,
-                &job.input,
-                &[format!(
-                    "texture coordinates are kept as given: --scheme {} has no face-varying limit",
-                    scheme.name()
-                )],
-            );
-        }
-        let kept = file.mesh.uv().map(|c| crate::uv::RefinedUv {
-            values: c.values().to_vec(),
-            indices: c.indices().to_vec(),
-        });
+        // Texture coordinates at their limit too, where the scheme carries them.
+        let mut uv_warnings = Vec::new();
+        let kept = match file.mesh.uv() {
+            Some(c) if !is_text => Some(
+                crate::uv::split_limit_uv(
+                    topo,
+                    scheme,
+                    c,
+                    args.rules.fvar_mode(&file.mesh.hints),
+                    &mut uv_warnings,
+                )
+                .map_err(|e| bad(format!("{}: {e}", job.input.display())))?,
+            ),
+            _ => None,
+        };
+        print_warnings(err, &job.input, &uv_warnings);
         write_limit(args, job, &limit, &file.mesh, kept.as_ref(), is_text, err)?;
         if args.json {
             let report = LimitReport {

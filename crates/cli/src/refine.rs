@@ -283,7 +283,6 @@ fn run_one(
         &file.mesh,
         fvar_mode,
         args.limit,
-        args.scheme,
         &mut file.warnings,
     )
     .map_err(|e| in_file(&e))?;

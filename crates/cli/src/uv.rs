@@ -1,8 +1,10 @@
 //! Texture coordinates through the commands: a mesh's first face-varying channel refined
 //! with the mesh (or taken to its limit) and handed to the writers.
 
+use subd_mesh::DVec3;
 use subd_mesh::Topology;
 use subd_mesh::fvar::{FVarChannel, FVarLinearInterpolation};
+use subd_schemes::split_schemes::{SplitFVarError, SplitFaceVarying, SplitRefinement, SplitScheme};
 use subd_schemes::{Options, Scheme};
 
 /// `view` with the texture coordinates `uv`, if any.
@@ -24,13 +26,12 @@ pub(crate) struct RefinedUv {
 
 /// The mesh's texture coordinates at the last level of `refinement` (at their limit with
 /// `limit`), interpolated by `mode`; `None` when the mesh has none, or, with a warning, when
-/// the scheme does not carry them yet.
+/// a split scheme cannot carry their seams.
 pub(crate) fn refined_uv(
     refinement: &crate::refine::Refined,
     mesh: &subd_mesh::Mesh,
     mode: FVarLinearInterpolation,
     limit: bool,
-    scheme: crate::refine::SchemeArg,
     warnings: &mut Vec<String>,
 ) -> Result<Option<RefinedUv>, String> {
     let Some(channel) = mesh.uv() else {
@@ -38,13 +39,7 @@ pub(crate) fn refined_uv(
     };
     let r = match refinement {
         crate::refine::Refined::Osd(r) => r,
-        crate::refine::Refined::Split(_) => {
-            warnings.push(format!(
-                "texture coordinates are not refined by --scheme {} (only by catmull-clark, loop, bilinear and two-phase); the output has none",
-                scheme.name()
-            ));
-            return Ok(None);
-        }
+        crate::refine::Refined::Split(r) => return split_uv(r, channel, mode, limit, warnings),
     };
     let fr =
         subd_schemes::FaceVaryingRefinement::new(r, channel, mode).map_err(|e| e.to_string())?;
@@ -61,6 +56,93 @@ pub(crate) fn refined_uv(
     let topology = r.topology(level);
     let at_level = FVarChannel::new(topology, 2, values, indices).map_err(|e| e.to_string())?;
     limit_uv(topology, r.scheme(), r.options(), &at_level, mode).map(Some)
+}
+
+/// A split scheme's refined texture coordinates ([`SplitFaceVarying`]); `None` with a warning
+/// for seams that Doo-Sabin or √3 cannot carry.
+fn split_uv(
+    r: &SplitRefinement,
+    channel: &FVarChannel,
+    mode: FVarLinearInterpolation,
+    limit: bool,
+    warnings: &mut Vec<String>,
+) -> Result<Option<RefinedUv>, String> {
+    let fv = match SplitFaceVarying::new(r, channel, mode) {
+        Ok(fv) => fv,
+        Err(e @ SplitFVarError::Seam { .. }) => {
+            warnings.push(format!("texture coordinates left out: {e}"));
+            return Ok(None);
+        }
+        Err(e) => return Err(e.to_string()),
+    };
+    let level = r.num_levels();
+    let values = fv
+        .refine_values(channel.values(), 2)
+        .pop()
+        .expect("level 0 at least");
+    let values = if limit {
+        split_values_limit(&fv, level, values)?
+    } else {
+        values
+    };
+    Ok(Some(RefinedUv {
+        values,
+        indices: fv.face_values(level),
+    }))
+}
+
+/// The limit of the values of `level` of `fv`: the butterflies interpolate, so each value
+/// is its own limit; Doo-Sabin's and √3's values (one per vertex) take the positions' limit
+/// masks.
+fn split_values_limit(
+    fv: &SplitFaceVarying,
+    level: usize,
+    values: Vec<f64>,
+) -> Result<Vec<f64>, String> {
+    if fv.values_scheme().is_interpolating() {
+        return Ok(values);
+    }
+    let points: Vec<DVec3> = values
+        .chunks_exact(2)
+        .map(|x| DVec3::new(x[0], x[1], 0.0))
+        .collect();
+    let limit =
+        crate::limit::split_limit_points(fv.values_topology(level), fv.values_scheme(), &points)?;
+    Ok(limit.positions.iter().flat_map(|p| [p.x, p.y]).collect())
+}
+
+/// The limit of a base mesh's texture coordinates under a split scheme (see
+/// [`split_values_limit`]), one value per (vertex, value); the values as given, with a
+/// warning, where Doo-Sabin or √3 cannot carry their seams.
+pub(crate) fn split_limit_uv(
+    topology: &Topology,
+    scheme: SplitScheme,
+    channel: &FVarChannel,
+    mode: FVarLinearInterpolation,
+    warnings: &mut Vec<String>,
+) -> Result<RefinedUv, String> {
+    let r = SplitRefinement::new(topology, scheme, 0).map_err(|e| e.to_string())?;
+    let fv = match SplitFaceVarying::new(&r, channel, mode) {
+        Ok(fv) => fv,
+        Err(e @ SplitFVarError::Seam { .. }) => {
+            warnings.push(format!("texture coordinates kept as given: {e}"));
+            return Ok(RefinedUv {
+                values: channel.values().to_vec(),
+                indices: channel.indices().to_vec(),
+            });
+        }
+        Err(e) => return Err(e.to_string()),
+    };
+    // The base mesh of values: one value per wedge, its faces on wedges.
+    let values: Vec<f64> = fv
+        .wedge_values()
+        .iter()
+        .flat_map(|&x| channel.value(x as usize).iter().copied())
+        .collect();
+    Ok(RefinedUv {
+        values: split_values_limit(&fv, 0, values)?,
+        indices: fv.values_topology(0).all_face_vertices().to_vec(),
+    })
 }
 
 /// The exact limit of every value of `channel` (two components) on `topology`: one value

@@ -3211,3 +3211,97 @@ fn adaptive_carries_limit_uvs() {
     assert_eq!(code, 0, "{err}");
     assert!(err.contains("texture coordinates left out"), "{err}");
 }
+
+/// The split schemes carry texture coordinates: the butterflies with their seams (every base
+/// corner keeps its value, the scheme interpolates; `limit` leaves them as they are, each
+/// its own limit), Doo-Sabin and √3 only without seams (else a warning and none written).
+#[test]
+fn split_schemes_carry_texture_coordinates() {
+    let s = Scratch::new("splituv");
+    let input = meshes().join("loop_cube.obj");
+    let given = corner_uvs(&input);
+    let out = s.0.join("b.obj");
+    let (code, _, err) = subd(&[
+        "refine",
+        "--scheme",
+        "modified-butterfly",
+        "--levels",
+        "2",
+        input.to_str().unwrap(),
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(err.is_empty(), "{err}");
+    let written = corner_uvs(&out);
+    assert_eq!(written.len(), 16 * given.len());
+    for f in 0..given.len() / 3 {
+        for (k, child) in [(0, 0), (1, 5), (2, 10)] {
+            assert_eq!(written[3 * (16 * f + child) + k], given[3 * f + k]);
+        }
+    }
+    let limit = s.0.join("bl.obj");
+    let (code, _, err) = subd(&[
+        "limit",
+        "--scheme",
+        "butterfly",
+        input.to_str().unwrap(),
+        limit.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(err.is_empty(), "{err}");
+    assert_eq!(corner_uvs(&limit), given);
+
+    // Doo-Sabin: the cube's UVs have seams.
+    let ds = s.0.join("ds.obj");
+    let (code, _, err) = subd(&[
+        "refine",
+        "--scheme",
+        "doo-sabin",
+        "--levels",
+        "1",
+        input.to_str().unwrap(),
+        ds.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.starts_with("subd: warning:") && err.contains("texture seam"),
+        "{err}"
+    );
+    let text = std::fs::read_to_string(&ds).unwrap();
+    assert!(!text.contains("\nvt "), "no texture coordinates");
+
+    // A seamless square grid: √3 writes one value per vertex, the vertex's x y where the
+    // UVs are the positions (√3 maps the plane to itself).
+    let grid = s.file(
+        "grid.obj",
+        b"v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nv 1 1 0\nv 2 1 0\n\
+         vt 0 0\nvt 1 0\nvt 2 0\nvt 0 1\nvt 1 1\nvt 2 1\n\
+         f 1/1 2/2 5/5\nf 1/1 5/5 4/4\nf 2/2 3/3 6/6\nf 2/2 6/6 5/5\n",
+    );
+    let s3 = s.0.join("s3.obj");
+    let (code, _, err) = subd(&[
+        "refine",
+        "--scheme",
+        "sqrt3",
+        "--levels",
+        "2",
+        grid.to_str().unwrap(),
+        s3.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(err.is_empty(), "{err}");
+    let refined = subd_io::read_mesh(&s3, &subd_io::ReadOptions::default())
+        .unwrap()
+        .mesh;
+    let uvs = corner_uvs(&s3);
+    let t = &refined.topology;
+    for (i, &v) in t.all_face_vertices().iter().enumerate() {
+        let p = refined.positions[v as usize];
+        assert!(
+            (uvs[i][0] - p.x).abs() < 1e-12 && (uvs[i][1] - p.y).abs() < 1e-12,
+            "corner {i}: {:?} at {p:?}",
+            uvs[i]
+        );
+    }
+}

@@ -16,5 +16,6 @@ mod proptest_limit;
 mod proptest_refine;
 mod proptest_topology;
 mod refined_topology;
+mod split_fvar;
 mod split_schemes;
 mod streamed_output;

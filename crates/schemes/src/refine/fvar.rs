@@ -453,8 +453,15 @@ impl FVarLevelValues<'_> {
 
     /// How value `k` of vertex `v` is refined.
     pub fn value_kind(&self, v: usize, k: usize) -> FVarValueKind {
-        let tag = self.level.tags[self.slot(v, k)];
-        if !self.level.tags[self.level.offset(v)].mismatch {
+        self.level.kind(v, self.slot(v, k))
+    }
+}
+
+impl ChannelLevel {
+    /// How per-vertex value `slot` of vertex `v` is refined.
+    fn kind(&self, v: usize, slot: usize) -> FVarValueKind {
+        let tag = self.tags[slot];
+        if !self.tags[self.offset(v)].mismatch {
             FVarValueKind::Matching
         } else if tag.semi_sharp {
             FVarValueKind::SemiSharp
@@ -464,6 +471,27 @@ impl FVarLevelValues<'_> {
             FVarValueKind::Corner
         }
     }
+}
+
+/// How the value at every face-vertex of `t` (value indices `indices`) is refined at level 0
+/// under `mode`, with `boundary` the rule of the mesh boundary: OpenSubdiv's classification,
+/// for schemes refined without a [`Refinement`] (the split schemes' face-varying data).
+pub(crate) fn base_corner_kinds(
+    t: &Topology,
+    indices: &[u32],
+    mode: FVarLinearInterpolation,
+    boundary: BoundaryInterpolation,
+) -> Vec<FVarValueKind> {
+    let level = base_level(t, indices, ModeFlags::new(mode, boundary));
+    (0..t.num_faces())
+        .flat_map(|f| {
+            let level = &level;
+            t.face_vertices(f)
+                .iter()
+                .enumerate()
+                .map(move |(k, &v)| level.kind(v as usize, level.corner_slot(t, f, k)))
+        })
+        .collect()
 }
 
 /// Per-vertex classification of the base level (`FVarLevel::completeTopologyFromFaceValues`,

@@ -12,6 +12,9 @@
 //! | Butterfly | triangles | 1 → 4 | yes | 4-point rule | infinitely sharp |
 //! | Modified Butterfly | triangles | 1 → 4 | yes | 4-point rule (see [`butterfly`]) | infinitely sharp |
 //!
+//! Face-varying data (UVs) goes through the butterflies with any seams and through
+//! Doo-Sabin and √3 where it has none: [`SplitFaceVarying`].
+//!
 //! Every level is a new [`Topology`]; rows of the stencil tables are built in parallel and do
 //! not depend on the number of threads.
 //!
@@ -32,6 +35,7 @@
 pub mod butterfly;
 pub mod doo_sabin;
 mod features;
+pub mod fvar;
 pub mod sqrt3;
 
 use std::sync::OnceLock;
@@ -44,6 +48,7 @@ use thiserror::Error;
 use crate::{MAX_LEVELS, RowSink, StencilTable};
 
 pub use features::Features;
+pub use fvar::{SplitFVarError, SplitFaceVarying};
 
 /// A scheme of seed 001 §4 defined by a split and masks (see the [module docs](self)).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
