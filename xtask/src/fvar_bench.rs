@@ -115,7 +115,7 @@ pub fn run(levels: usize, repeats: usize) -> Result<(), String> {
                         .expect("refine");
                         let fr = FaceVaryingRefinement::new(&r, &uv, mode).expect("channel");
                         let t1 = Instant::now();
-                        let out = fr.refine_values(uv.values(), 2);
+                        let out = fr.refine_values(&r, uv.values(), 2);
                         let t2 = Instant::now();
                         std::hint::black_box(out);
                         setup.push((t1 - t0).as_secs_f64());

@@ -205,7 +205,7 @@ pub fn compare(
         Ok(r) => r,
         Err(e) => return vec![fail(format!("subd: {e}"))],
     };
-    let ours = fr.refine_values(channel.values(), 2);
+    let ours = fr.refine_values(&refinement, channel.values(), 2);
     let diag = uv_diagonal(channel.values());
     let mut rows = Vec::new();
     for (l, o) in theirs.iter().enumerate() {

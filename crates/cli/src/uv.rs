@@ -45,7 +45,7 @@ pub(crate) fn refined_uv(
         subd_schemes::FaceVaryingRefinement::new(r, channel, mode).map_err(|e| e.to_string())?;
     let level = r.num_levels();
     let values = fr
-        .refine_values(channel.values(), 2)
+        .refine_values(r, channel.values(), 2)
         .pop()
         .expect("level 0 at least");
     let indices = fr.face_values(level);

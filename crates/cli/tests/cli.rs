@@ -1496,7 +1496,7 @@ fn refine_output_equals_the_fully_built_level() {
                 .fvar_interpolation
                 .unwrap_or(subd_mesh::fvar::FVarLinearInterpolation::CornersPlus1);
             let fr = subd_schemes::FaceVaryingRefinement::new(&r, uv, mode).unwrap();
-            let values = fr.refine_values(uv.values(), 2).pop().unwrap();
+            let values = fr.refine_values(&r, uv.values(), 2).pop().unwrap();
             (values, fr.face_values(2), mode)
         });
         let mut t = r.into_topology(2);
@@ -2915,7 +2915,7 @@ fn refine_carries_texture_coordinates_to_obj_and_glb() {
         FVarLinearInterpolation::CornersPlus1,
     )
     .unwrap();
-    let values = fr.refine_values(channel.values(), 2).pop().unwrap();
+    let values = fr.refine_values(&r, channel.values(), 2).pop().unwrap();
     let expected: Vec<[f64; 2]> = fr
         .face_values(2)
         .iter()

@@ -204,7 +204,7 @@ pub fn base_fvar_limit(
     // of the last level's values.
     let rows = values.len();
     debug_assert!((0..nv).all(|v| last.num_vertex_values(v) == base.num_vertex_values(v)));
-    let table = crate::first_rows(&fr.composed(levels).then(&at), rows);
+    let table = crate::first_rows(&fr.composed(&r, levels).then(&at), rows);
     Ok(BaseFVarLimit {
         offsets,
         values,
@@ -271,7 +271,7 @@ mod tests {
             let r = Refinement::new(topo, scheme, &Options::default(), 2).unwrap();
             for mode in FVarLinearInterpolation::ALL_MODES {
                 let fr = FaceVaryingRefinement::new(&r, &channel, mode).unwrap();
-                let levels = fr.refine_values(channel.values(), 2);
+                let levels = fr.refine_values(&r, channel.values(), 2);
                 let at = |l: usize| {
                     let t = limit_at_level(&r, &fr, l).unwrap();
                     let mut out = vec![0.0; levels[l].len()];

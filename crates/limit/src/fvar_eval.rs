@@ -356,7 +356,7 @@ impl FVarEvaluator {
         };
         // The values of the mesh of values' vertices, `c` numbers each.
         let level_values = match &p.refined {
-            Some((_, fr)) => fr.refine_values(values, c).swap_remove(p.level),
+            Some((r, fr)) => fr.refine_values(r, values, c).swap_remove(p.level),
             None => p
                 .slot_values
                 .iter()

@@ -293,7 +293,7 @@ fn adaptive_uvs_are_the_limits_of_uniform_refinement_values() {
         let ev = LimitEvaluator::new(t, s.scheme, &s.options).unwrap();
         for mode in FVarLinearInterpolation::ALL_MODES {
             let fr = FaceVaryingRefinement::new(&r, uv, mode).unwrap();
-            let refined = fr.refine_values(uv.values(), 2).pop().unwrap();
+            let refined = fr.refine_values(&r, uv.values(), 2).pop().unwrap();
             let mut limits = vec![0.0; refined.len()];
             subd_limit::fvar::limit_at_level(&r, &fr, deepest)
                 .unwrap()

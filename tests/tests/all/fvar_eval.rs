@@ -99,7 +99,7 @@ fn uvs_at_dyadic_points_are_limits_of_refined_values() {
         let degenerate = (0..t.num_edges()).any(|e| t.is_degenerate_edge(e));
         for mode in FVarLinearInterpolation::ALL_MODES {
             let fr = FaceVaryingRefinement::new(&r, uv, mode).unwrap();
-            let refined = fr.refine_values(uv.values(), 2).swap_remove(level);
+            let refined = fr.refine_values(&r, uv.values(), 2).swap_remove(level);
             let mut limits = vec![0.0; refined.len()];
             limit_at_level(&r, &fr, level)
                 .unwrap()

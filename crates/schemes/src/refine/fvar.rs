@@ -8,6 +8,9 @@
 //! vertex; values on a seam (or, in the boundary modes, the mesh boundary) follow
 //! OpenSubdiv's face-varying crease and corner rules, chosen by [`FVarLinearInterpolation`].
 
+use std::sync::OnceLock;
+
+use glam::DVec3;
 use subd_mesh::Topology;
 use subd_mesh::fvar::{FVarChannel, FVarError, FVarLinearInterpolation};
 use subd_mesh::tags::{is_infinite, is_semi_sharp};
@@ -155,13 +158,43 @@ impl ChannelLevel {
     }
 }
 
-/// Where a mask of a matching value reads: face-varying values in place of vertices.
-struct ValueSink<'a, 'b> {
-    level: &'a ChannelLevel,
-    row: &'a mut RowSink<'b>,
+/// Where a value's mask goes: a stencil row, or the value being summed.
+trait ValueTerms {
+    /// Adds `w` times source value `i`.
+    fn add(&mut self, i: u32, w: f64);
 }
 
-impl MaskSink for ValueSink<'_, '_> {
+impl ValueTerms for RowSink<'_> {
+    #[inline]
+    fn add(&mut self, i: u32, w: f64) {
+        RowSink::add(self, i, w);
+    }
+}
+
+/// A value summed straight from the source values, `acc.len()` numbers each.
+struct ValueSum<'a> {
+    src: &'a [f64],
+    acc: &'a mut [f64],
+}
+
+impl ValueTerms for ValueSum<'_> {
+    #[inline]
+    fn add(&mut self, i: u32, w: f64) {
+        let c = self.acc.len();
+        let s = &self.src[c * i as usize..c * (i as usize + 1)];
+        for (a, x) in self.acc.iter_mut().zip(s) {
+            *a += w * x;
+        }
+    }
+}
+
+/// Where a mask of a matching value reads: face-varying values in place of vertices.
+struct ValueSink<'a, S> {
+    level: &'a ChannelLevel,
+    row: &'a mut S,
+}
+
+impl<S: ValueTerms> MaskSink for ValueSink<'_, S> {
     #[inline]
     fn vertex(&mut self, i: u32, w: f64) {
         // Only the centre vertex of a vertex mask comes here; it matches, so has one value.
@@ -199,7 +232,8 @@ impl MaskSink for ValueSink<'_, '_> {
 }
 
 /// A face-varying channel refined with a [`Refinement`]: per level, the values of every
-/// face corner and the [`StencilTable`] giving a level's values from the level above.
+/// face corner, and on request the [`StencilTable`] giving a level's values from the level
+/// above ([`Self::refine_values`] evaluates the masks without them).
 ///
 /// ```
 /// use subd_mesh::TopologyBuilder;
@@ -212,7 +246,7 @@ impl MaskSink for ValueSink<'_, '_> {
 /// let channel = FVarChannel::new(&t, 2, uv, (0..8).collect()).unwrap();
 /// let r = Refinement::new(&t, Scheme::CatmullClark, &Options::default(), 1).unwrap();
 /// let fr = FaceVaryingRefinement::new(&r, &channel, FVarLinearInterpolation::All).unwrap();
-/// let level1 = fr.refine_values(channel.values(), 2).pop().unwrap();
+/// let level1 = fr.refine_values(&r, channel.values(), 2).pop().unwrap();
 /// // The seam's midpoint has one value per side.
 /// assert_eq!(fr.num_values(1), 18);
 /// assert_eq!(level1.len(), 2 * 18);
@@ -220,9 +254,11 @@ impl MaskSink for ValueSink<'_, '_> {
 #[derive(Debug, Clone)]
 pub struct FaceVaryingRefinement {
     mode: FVarLinearInterpolation,
+    flags: ModeFlags,
     num_user_values: usize,
     levels: Vec<ChannelLevel>,
-    stencils: Vec<StencilTable>,
+    /// Per level, built on first request.
+    stencils: Vec<OnceLock<StencilTable>>,
 }
 
 impl FaceVaryingRefinement {
@@ -251,27 +287,18 @@ impl FaceVaryingRefinement {
         let options = refinement.options();
         let flags = ModeFlags::new(mode, options.boundary_interpolation);
         let mut levels = vec![base_level(base, channel.indices(), flags)];
-        let mut stencils = Vec::with_capacity(refinement.num_levels());
         for l in 1..=refinement.num_levels() {
-            let step = refinement.step(l);
-            let parent = &levels[l - 1];
-            let child = child_level(&step, parent, flags);
-            let num_sources = if l == 1 {
-                channel.num_values()
-            } else {
-                parent.num_values()
-            };
-            let table = StencilTable::build(child.num_values(), num_sources, |r, sink| {
-                value_row(&step, parent, &child, flags, r, sink)
-            });
-            stencils.push(table);
+            let child = child_level(&refinement.step(l), &levels[l - 1], flags);
             levels.push(child);
         }
         Ok(FaceVaryingRefinement {
             mode,
+            flags,
             num_user_values: channel.num_values(),
+            stencils: (0..refinement.num_levels())
+                .map(|_| OnceLock::new())
+                .collect(),
             levels,
-            stencils,
         })
     }
 
@@ -319,38 +346,196 @@ impl FaceVaryingRefinement {
         }
     }
 
-    /// Stencils giving the values of `level` from those of `level - 1` (`level ≥ 1`).
-    pub fn stencils(&self, level: usize) -> &StencilTable {
-        &self.stencils[level - 1]
+    /// Stencils giving the values of `level` from those of `level - 1` (`level ≥ 1`),
+    /// built on first request (`refinement` is the one the channel was refined with).
+    pub fn stencils(&self, refinement: &Refinement, level: usize) -> &StencilTable {
+        self.stencils[level - 1].get_or_init(|| {
+            let step = refinement.step(level);
+            let (parent, child) = (&self.levels[level - 1], &self.levels[level]);
+            let num_sources = if level == 1 {
+                self.num_user_values
+            } else {
+                parent.num_values()
+            };
+            StencilTable::build(child.num_values(), num_sources, |r, sink| {
+                let cv = child.value_offsets.partition_point(|&o| o as usize <= r) - 1;
+                value_row(&step, parent, child, self.flags, r, cv, sink)
+            })
+        })
     }
 
     /// One table from the channel's values to the values of `level`.
-    pub fn composed(&self, level: usize) -> StencilTable {
+    pub fn composed(&self, refinement: &Refinement, level: usize) -> StencilTable {
         let mut t = StencilTable::identity(self.num_user_values);
-        for s in &self.stencils[..level] {
-            t = t.then(s);
+        for l in 1..=level {
+            t = t.then(self.stencils(refinement, l));
         }
         t
     }
 
-    /// The values of every level (`result[0]` is `values`), `components` numbers each.
+    /// The values of every level (`result[0]` is `values`), `components` numbers each, as
+    /// `InterpolateFaceVarying` gives them (`refinement` is the one the channel was refined
+    /// with). The masks are evaluated directly, without stencil tables: values whose masks
+    /// reach only seamless vertices take the geometry's own point evaluation (one value per
+    /// vertex, three numbers at a time), the others walk their masks.
     ///
     /// # Panics
     /// If `values` is not `components` numbers per value of the channel.
-    pub fn refine_values(&self, values: &[f64], components: usize) -> Vec<Vec<f64>> {
+    pub fn refine_values(
+        &self,
+        refinement: &Refinement,
+        values: &[f64],
+        components: usize,
+    ) -> Vec<Vec<f64>> {
         assert_eq!(
             values.len(),
             components * self.num_user_values,
             "components numbers per value"
         );
         let mut out = vec![values.to_vec()];
-        for s in &self.stencils {
-            let mut next = vec![0.0; s.num_rows() * components];
-            s.apply(out.last().expect("level 0"), components, &mut next);
+        for l in 1..self.levels.len() {
+            let next = next_values(
+                &refinement.step(l),
+                &self.levels[l - 1],
+                &self.levels[l],
+                self.flags,
+                out.last().expect("level 0"),
+                components,
+            );
             out.push(next);
         }
         out
     }
+}
+
+/// Three numbers of a level's values as points, one per vertex, and the geometry's face
+/// points over them: what the geometric rows of the child level read.
+struct GeometricRows {
+    points: Vec<DVec3>,
+    face_points: Vec<DVec3>,
+}
+
+/// The values of the child level of `step` from the parent level's `src`, `c` numbers each
+/// (see [`FaceVaryingRefinement::refine_values`]).
+fn next_values(
+    step: &super::Step<'_>,
+    parent: &ChannelLevel,
+    child: &ChannelLevel,
+    flags: ModeFlags,
+    src: &[f64],
+    c: usize,
+) -> Vec<f64> {
+    use rayon::prelude::*;
+    let p = step.parent;
+    let l = step.layout;
+    let linear = flags.linear_all || step.scheme == Scheme::Bilinear;
+    let matching = |u: usize| parent.count(u) > 0 && !parent.tags[parent.offset(u)].mismatch;
+    // Faces whose corners all have one value, and the geometry's rows over one value per
+    // vertex (three numbers at a time, face points first): a mask that reads only such faces
+    // is the geometric mask, value for vertex.
+    let (clean_face, groups): (Vec<bool>, Vec<GeometricRows>) = if linear || c == 0 {
+        (Vec::new(), Vec::new())
+    } else {
+        let clean = (0..p.num_faces())
+            .into_par_iter()
+            .map(|f| p.face_vertices(f).iter().all(|&u| matching(u as usize)))
+            .collect();
+        let groups = (0..c.div_ceil(3))
+            .map(|g| {
+                let points: Vec<DVec3> = (0..p.num_vertices())
+                    .into_par_iter()
+                    .map(|u| {
+                        if parent.count(u) == 0 {
+                            return DVec3::ZERO;
+                        }
+                        let x = parent.source(parent.offset(u)) as usize;
+                        let at = |i: usize| {
+                            if 3 * g + i < c {
+                                src[c * x + 3 * g + i]
+                            } else {
+                                0.0
+                            }
+                        };
+                        DVec3::new(at(0), at(1), at(2))
+                    })
+                    .collect();
+                let face_points =
+                    super::rows::build_middle(&super::StepRows { step, src: &points });
+                GeometricRows {
+                    points,
+                    face_points,
+                }
+            })
+            .collect();
+        (clean, groups)
+    };
+    let clean = |faces: &[u32]| faces.iter().all(|&f| clean_face[f as usize]);
+    let is_face_child = |cv: u32| cv >= l.face_vertex_base && cv < l.edge_vertex_base;
+    let geometric = |cv: usize, r: usize| {
+        let cv32 = cv as u32;
+        if linear {
+            false
+        } else if is_face_child(cv32) {
+            clean_face[(cv32 - l.face_vertex_base) as usize]
+        } else if cv32 >= l.edge_vertex_base {
+            let e = (cv32 - l.edge_vertex_base) as usize;
+            !child.tags[r].mismatch && clean(p.edge_faces(e))
+        } else {
+            matching(cv) && clean(p.vertex_faces(cv))
+        }
+    };
+    const CHUNK: usize = 4096;
+    // Huge pages for a large level: its first writes are otherwise mostly 4 KiB faults.
+    let mut out: Vec<f64> = crate::memory::zeroed(c * child.num_values());
+    if c == 0 {
+        return out;
+    }
+    out.par_chunks_mut(CHUNK * c)
+        .enumerate()
+        .for_each(|(chunk, values)| {
+            let first = chunk * CHUNK;
+            let mut cv = child
+                .value_offsets
+                .partition_point(|&o| o as usize <= first)
+                - 1;
+            for (i, acc) in values.chunks_exact_mut(c).enumerate() {
+                let r = first + i;
+                while child.value_offsets[cv + 1] as usize <= r {
+                    cv += 1;
+                }
+                if geometric(cv, r) {
+                    for (g, rows) in groups.iter().enumerate() {
+                        let cv32 = cv as u32;
+                        let q = if is_face_child(cv32) {
+                            rows.face_points[(cv32 - l.face_vertex_base) as usize]
+                        } else {
+                            super::rows::PointRows::row(
+                                &super::StepRows {
+                                    step,
+                                    src: &rows.points,
+                                },
+                                cv,
+                                &rows.face_points,
+                            )
+                        }
+                        .to_array();
+                        let n = 3.min(c - 3 * g);
+                        acc[3 * g..3 * g + n].copy_from_slice(&q[..n]);
+                    }
+                } else {
+                    value_row(
+                        step,
+                        parent,
+                        child,
+                        flags,
+                        r,
+                        cv,
+                        &mut ValueSum { src, acc },
+                    );
+                }
+            }
+        });
+    out
 }
 
 /// The values of one level of a [`FaceVaryingRefinement`] as limit masks need them: which
@@ -991,18 +1176,18 @@ fn span_interior_edges(s: u16, e: u16, num_edges: usize) -> impl Iterator<Item =
 }
 
 /// The mask of child value `r` (§4).
-fn value_row(
+fn value_row<S: ValueTerms>(
     step: &super::Step<'_>,
     parent: &ChannelLevel,
     child: &ChannelLevel,
     flags: ModeFlags,
     r: usize,
-    sink: &mut RowSink,
+    cv: usize,
+    sink: &mut S,
 ) {
     let p = step.parent;
     let l = step.layout;
     let linear = flags.linear_all || step.scheme == Scheme::Bilinear;
-    let cv = child.value_offsets.partition_point(|&o| o as usize <= r) - 1;
     let k = r - child.offset(cv);
     let cv32 = cv as u32;
     if cv32 >= l.face_vertex_base && cv32 < l.edge_vertex_base {
@@ -1105,8 +1290,14 @@ mod tests {
     }
 
     /// Per face-vertex values of a refined channel.
-    fn corners(fr: &FaceVaryingRefinement, values: &[f64], c: usize, level: usize) -> Vec<f64> {
-        let v = fr.refine_values(values, c).swap_remove(level);
+    fn corners(
+        r: &Refinement,
+        fr: &FaceVaryingRefinement,
+        values: &[f64],
+        c: usize,
+        level: usize,
+    ) -> Vec<f64> {
+        let v = fr.refine_values(r, values, c).swap_remove(level);
         fr.face_values(level)
             .iter()
             .flat_map(|&i| v[c * i as usize..c * (i as usize + 1)].to_vec())
@@ -1153,7 +1344,7 @@ mod tests {
             let pts = r.refine_points(&p);
             for (level, level_points) in pts.iter().enumerate().skip(1) {
                 assert_eq!(fr.num_values(level), r.num_vertices(level));
-                let got = corners(&fr, &xyz, 3, level);
+                let got = corners(&r, &fr, &xyz, 3, level);
                 let (_, fv) = r.faces(level);
                 for (k, &v) in fv.iter().enumerate() {
                     let want = level_points[v as usize].to_array();
@@ -1199,7 +1390,7 @@ mod tests {
         let fr = FaceVaryingRefinement::new(&r, &channel, FVarLinearInterpolation::All).unwrap();
         let lr = Refinement::new(&layout, Scheme::Bilinear, &Options::default(), 3).unwrap();
         for (level, level_points) in bilinear.iter().enumerate().skip(1) {
-            let got = corners(&fr, &uv, 2, level);
+            let got = corners(&r, &fr, &uv, 2, level);
             let (_, fv) = lr.faces(level);
             for (k, &v) in fv.iter().enumerate() {
                 let want = level_points[v as usize];
@@ -1217,7 +1408,7 @@ mod tests {
         let r = Refinement::new(&t, Scheme::CatmullClark, &Options::default(), 2).unwrap();
         let at_vertex0 = |mode| {
             let fr = FaceVaryingRefinement::new(&r, &channel, mode).unwrap();
-            let v = fr.refine_values(&uv, 2).swap_remove(2);
+            let v = fr.refine_values(&r, &uv, 2).swap_remove(2);
             // Vertex 0 keeps its index at every level and has one value.
             [v[0], v[1]]
         };
@@ -1229,10 +1420,55 @@ mod tests {
         // Every stencil row of every mode sums to one.
         for mode in FVarLinearInterpolation::ALL_MODES {
             let fr = FaceVaryingRefinement::new(&r, &channel, mode).unwrap();
-            let table = fr.composed(2);
+            let table = fr.composed(&r, 2);
             for i in 0..table.num_rows() {
                 let s: f64 = table.row(i).1.iter().sum();
                 assert!((s - 1.0).abs() < 1e-14, "{mode:?} row {i}");
+            }
+        }
+    }
+
+    /// The direct evaluation of `refine_values` (geometric rows away from seams, walked
+    /// masks near them) equals the stencil tables' rows applied, in every mode, on one
+    /// thread and on several.
+    #[test]
+    fn direct_values_equal_the_stencil_tables() {
+        let (mut t, p) = grid();
+        let e = t.find_edge(9, 10).unwrap() as usize;
+        t.set_edge_sharpness(e, 1.5);
+        // Islands: the left column of faces apart from the rest (a seam along x = 1), with
+        // three numbers per value.
+        let mut indices = Vec::new();
+        for f in 0..9 {
+            for &v in t.face_vertices(f) {
+                indices.push(if f % 3 == 0 { v } else { 16 + v });
+            }
+        }
+        let values: Vec<f64> = (0..32)
+            .flat_map(|i| {
+                let q = p[i % 16];
+                [q.x + 0.3 * (i / 16) as f64, q.y, q.z]
+            })
+            .collect();
+        let channel = FVarChannel::new(&t, 3, values.clone(), indices).unwrap();
+        let r = Refinement::new(&t, Scheme::CatmullClark, &Options::default(), 3).unwrap();
+        for mode in FVarLinearInterpolation::ALL_MODES {
+            let fr = FaceVaryingRefinement::new(&r, &channel, mode).unwrap();
+            let direct = fr.refine_values(&r, &values, 3);
+            let one = rayon::ThreadPoolBuilder::new()
+                .num_threads(1)
+                .build()
+                .unwrap()
+                .install(|| fr.refine_values(&r, &values, 3));
+            assert_eq!(one, direct, "{mode:?}: 1 thread and many");
+            for (level, got) in direct.iter().enumerate().skip(1) {
+                let table = fr.composed(&r, level);
+                let mut want = vec![0.0; 3 * table.num_rows()];
+                table.apply(&values, 3, &mut want);
+                assert_eq!(want.len(), got.len());
+                for (i, (a, b)) in got.iter().zip(&want).enumerate() {
+                    assert!((a - b).abs() < 1e-13, "{mode:?} L{level} [{i}]: {a} vs {b}");
+                }
             }
         }
     }
@@ -1249,7 +1485,7 @@ mod tests {
             .unwrap();
         // Level 1: 6 vertices (1 and 4 doubled: 8), 2 face points, 7 edges (1-4 doubled: 8).
         assert_eq!(fr.num_values(1), 18);
-        let v = fr.refine_values(channel.values(), 1).swap_remove(1);
+        let v = fr.refine_values(&r, channel.values(), 1).swap_remove(1);
         // The seam's edge child on each side is the midpoint of that side's values.
         let fv = fr.face_values(1);
         // Face 0's child 1 is (E0, V1, E1, F); E1 of face 0 is edge 1-4, the seam.
