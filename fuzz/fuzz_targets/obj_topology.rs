@@ -25,6 +25,18 @@ fuzz_target!(|data: &[u8]| {
             encode_mesh(&mut out, &file.mesh, Format::Obj, &WriteOptions::default()).unwrap();
             let again = parse_mesh(&out, Format::Obj, &opts).expect("written OBJ must read back");
             assert_eq!(again.mesh.topology.all_face_vertices(), topo.all_face_vertices());
+            // `vt` with `f v/vt` survives it too, corner by corner.
+            assert_eq!(corner_uvs(&again.mesh), corner_uvs(&file.mesh));
         }
     }
 });
+
+/// The texture coordinate of every face corner, if the mesh has any.
+fn corner_uvs(mesh: &subd_mesh::Mesh) -> Option<Vec<Vec<f64>>> {
+    mesh.uv().map(|c| {
+        c.indices()
+            .iter()
+            .map(|&i| c.value(i as usize).to_vec())
+            .collect()
+    })
+}

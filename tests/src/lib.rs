@@ -247,6 +247,17 @@ pub fn random_mesh(kind: u8, m: u32, n: u32, choices: &[u8], jitter: &[(f64, f64
     }
 }
 
+/// The topology of a random mesh with every face fanned into triangles from its first
+/// corner.
+pub fn triangulated(m: &RandomMesh) -> Topology {
+    let faces: Vec<Vec<u32>> = m
+        .faces
+        .iter()
+        .flat_map(|f| (1..f.len() - 1).map(move |i| vec![f[0], f[i], f[i + 1]]))
+        .collect();
+    build(m.num_vertices, &faces)
+}
+
 /// Builds the topology of a face list.
 pub fn build(nv: usize, faces: &[Vec<u32>]) -> Topology {
     let sizes: Vec<u32> = faces.iter().map(|f| f.len() as u32).collect();

@@ -369,8 +369,12 @@ fn main() -> ExitCode {
                 ],
             };
             targets.iter().try_for_each(|t| {
-                run(cargo().args([
-                    "+nightly",
+                // `$CARGO` is the toolchain's own cargo, which takes no `+nightly`: go
+                // through rustup.
+                run(Command::new("rustup").args([
+                    "run",
+                    "nightly",
+                    "cargo",
                     "fuzz",
                     "run",
                     t,

@@ -3270,6 +3270,18 @@ fn split_schemes_carry_texture_coordinates() {
     );
     let text = std::fs::read_to_string(&ds).unwrap();
     assert!(!text.contains("\nvt "), "no texture coordinates");
+    // `limit` keeps them as given, with the same warning.
+    let dsl = s.0.join("dsl.obj");
+    let (code, _, err) = subd(&[
+        "limit",
+        "--scheme",
+        "doo-sabin",
+        input.to_str().unwrap(),
+        dsl.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(err.contains("texture seam"), "{err}");
+    assert_eq!(corner_uvs(&dsl), given);
 
     // A seamless square grid: √3 writes one value per vertex, the vertex's x y where the
     // UVs are the positions (√3 maps the plane to itself).
@@ -3291,17 +3303,35 @@ fn split_schemes_carry_texture_coordinates() {
     ]);
     assert_eq!(code, 0, "{err}");
     assert!(err.is_empty(), "{err}");
-    let refined = subd_io::read_mesh(&s3, &subd_io::ReadOptions::default())
-        .unwrap()
-        .mesh;
-    let uvs = corner_uvs(&s3);
-    let t = &refined.topology;
-    for (i, &v) in t.all_face_vertices().iter().enumerate() {
-        let p = refined.positions[v as usize];
-        assert!(
-            (uvs[i][0] - p.x).abs() < 1e-12 && (uvs[i][1] - p.y).abs() < 1e-12,
-            "corner {i}: {:?} at {p:?}",
-            uvs[i]
-        );
+    // The same for √3's limit points (`refine --limit` and `limit`).
+    let s3l = s.0.join("s3l.obj");
+    let gl = s.0.join("gl.obj");
+    for (args, out) in [
+        (
+            &["refine", "--scheme", "sqrt3", "--levels", "2", "--limit"][..],
+            &s3l,
+        ),
+        (&["limit", "--scheme", "sqrt3"][..], &gl),
+    ] {
+        let (code, _, err) =
+            subd(&[args, &[grid.to_str().unwrap(), out.to_str().unwrap()]].concat());
+        assert_eq!(code, 0, "{err}");
+        assert!(err.is_empty(), "{err}");
+    }
+    for path in [&s3, &s3l, &gl] {
+        let refined = subd_io::read_mesh(path, &subd_io::ReadOptions::default())
+            .unwrap()
+            .mesh;
+        let uvs = corner_uvs(path);
+        let t = &refined.topology;
+        for (i, &v) in t.all_face_vertices().iter().enumerate() {
+            let p = refined.positions[v as usize];
+            assert!(
+                (uvs[i][0] - p.x).abs() < 1e-12 && (uvs[i][1] - p.y).abs() < 1e-12,
+                "{}: corner {i}: {:?} at {p:?}",
+                path.display(),
+                uvs[i]
+            );
+        }
     }
 }

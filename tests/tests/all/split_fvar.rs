@@ -7,7 +7,7 @@ use proptest::prelude::*;
 use subd_mesh::fvar::{FVarChannel, FVarLinearInterpolation as Mode};
 use subd_mesh::{DVec3, Topology, tags};
 use subd_schemes::split_schemes::{SplitFVarError, SplitFaceVarying, SplitRefinement, SplitScheme};
-use subd_tests::{RandomMesh, build, mesh_strategy};
+use subd_tests::{build, mesh_strategy, triangulated};
 
 const MODES: [Mode; 6] = [
     Mode::None,
@@ -17,16 +17,6 @@ const MODES: [Mode; 6] = [
     Mode::Boundaries,
     Mode::All,
 ];
-
-/// Every face fanned into triangles from its first corner.
-fn triangulated(m: &RandomMesh) -> Topology {
-    let faces: Vec<Vec<u32>> = m
-        .faces
-        .iter()
-        .flat_map(|f| (1..f.len() - 1).map(move |i| vec![f[0], f[i], f[i + 1]]))
-        .collect();
-    build(m.num_vertices, &faces)
-}
 
 /// Two numbers per vertex that vary irregularly with its index.
 fn vertex_uv(v: usize) -> [f64; 2] {

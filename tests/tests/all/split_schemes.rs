@@ -7,7 +7,7 @@ use subd_limit::split_limit::split_limit_stencils;
 use subd_mesh::{DVec3, Topology, tags};
 use subd_schemes::StencilTable;
 use subd_schemes::split_schemes::{SplitError, SplitRefinement, SplitScheme};
-use subd_tests::{RandomMesh, build, mesh_strategy};
+use subd_tests::{RandomMesh, build, mesh_strategy, triangulated};
 
 const SCHEMES: [SplitScheme; 4] = [
     SplitScheme::DooSabin,
@@ -15,16 +15,6 @@ const SCHEMES: [SplitScheme; 4] = [
     SplitScheme::BUTTERFLY,
     SplitScheme::ModifiedButterfly,
 ];
-
-/// Every face fanned into triangles from its first corner.
-fn triangulated(m: &RandomMesh) -> Topology {
-    let faces: Vec<Vec<u32>> = m
-        .faces
-        .iter()
-        .flat_map(|f| (1..f.len() - 1).map(move |i| vec![f[0], f[i], f[i + 1]]))
-        .collect();
-    build(m.num_vertices, &faces)
-}
 
 /// Positions for a random mesh: its planar ones lifted by a wave, or points on a torus-ish
 /// surface from the vertex index.

@@ -275,15 +275,7 @@ impl FaceVaryingRefinement {
         mode: FVarLinearInterpolation,
     ) -> Result<FaceVaryingRefinement, FVarError> {
         let base = refinement.topology(0);
-        if channel.num_values() == 0 {
-            return Err(FVarError::NoValues);
-        }
-        if channel.indices().len() != base.num_face_vertices() {
-            return Err(FVarError::IndexCount {
-                given: channel.indices().len(),
-                expected: base.num_face_vertices(),
-            });
-        }
+        check_channel(base, channel)?;
         let options = refinement.options();
         let flags = ModeFlags::new(mode, options.boundary_interpolation);
         let mut levels = vec![base_level(base, channel.indices(), flags)];
@@ -677,6 +669,21 @@ pub(crate) fn base_corner_kinds(
                 .map(move |(k, &v)| level.kind(v as usize, level.corner_slot(t, f, k)))
         })
         .collect()
+}
+
+/// The checks every refinement of a channel makes: it has values (OpenSubdiv refuses a
+/// channel without), and one index per face-vertex of `base`.
+pub(crate) fn check_channel(base: &Topology, channel: &FVarChannel) -> Result<(), FVarError> {
+    if channel.num_values() == 0 {
+        return Err(FVarError::NoValues);
+    }
+    if channel.indices().len() != base.num_face_vertices() {
+        return Err(FVarError::IndexCount {
+            given: channel.indices().len(),
+            expected: base.num_face_vertices(),
+        });
+    }
+    Ok(())
 }
 
 /// Per-vertex classification of the base level (`FVarLevel::completeTopologyFromFaceValues`,

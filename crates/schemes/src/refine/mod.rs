@@ -14,8 +14,8 @@ mod stream;
 
 pub use counts::{LevelCounts, refined_counts, refined_split_counts};
 pub(crate) use counts::{last_level_bytes, topology_bytes};
-pub(crate) use fvar::base_corner_kinds;
 pub use fvar::{FVarLevelValues, FVarValueKind, FaceVaryingRefinement};
+pub(crate) use fvar::{base_corner_kinds, check_channel};
 pub use refinement::Refinement;
 pub use stream::{FaceStream, PointStream};
 

@@ -99,17 +99,8 @@ impl SplitFaceVarying {
         mode: FVarLinearInterpolation,
     ) -> Result<SplitFaceVarying, SplitFVarError> {
         let base = refinement.topology(0);
-        if channel.num_values() == 0 {
-            return Err(FVarError::NoValues.into());
-        }
+        crate::refine::check_channel(base, channel)?;
         let indices = channel.indices();
-        if indices.len() != base.num_face_vertices() {
-            return Err(FVarError::IndexCount {
-                given: indices.len(),
-                expected: base.num_face_vertices(),
-            }
-            .into());
-        }
         let wedges = Wedges::of(base, indices);
         let scheme = refinement.scheme();
         if !scheme.is_interpolating()
