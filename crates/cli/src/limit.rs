@@ -7,7 +7,7 @@ use std::time::Instant;
 
 use clap::{Args, ValueEnum};
 use serde::Serialize;
-use subd_limit::split_limit::split_limit_stencils;
+use subd_limit::split_limit::{SplitLimitStencils, split_limit_stencils};
 use subd_limit::{LimitPoints, base_limit, levels_for_exact_limit, two_phase_base_limit};
 use subd_mesh::Mesh;
 use subd_schemes::Scheme;
@@ -182,15 +182,17 @@ fn run_one(
                 "--acc: ACC patches approximate catmull-clark surfaces only".into(),
             ));
         }
-        let limit = split_limit_points(topo, scheme, &file.mesh.positions)
-            .map_err(|e| bad(format!("{}: {e}", job.input.display())))?;
+        let in_file = |e: String| bad(format!("{}: {e}", job.input.display()));
+        // One set of stencils for the positions and the texture coordinates.
+        let stencils = checked_split_limit_stencils(topo, scheme).map_err(in_file)?;
+        let limit = split_limit_points(&stencils, scheme, &file.mesh.positions).map_err(in_file)?;
         // Texture coordinates at their limit too, where the scheme carries them.
         let mut uv_warnings = Vec::new();
         let kept = match file.mesh.uv() {
             Some(c) if !is_text => Some(
                 crate::uv::split_limit_uv(
                     topo,
-                    scheme,
+                    (scheme, &stencils),
                     c,
                     args.rules.fvar_mode(&file.mesh.hints),
                     &mut uv_warnings,
@@ -319,17 +321,24 @@ fn write_limit(
     Ok(())
 }
 
-/// The limit of a split scheme at every vertex (`nan` normals where none is defined); a
-/// vertex without a limit is an error naming it.
-pub(crate) fn split_limit_points(
+/// A split scheme's limit stencils at every vertex of `topo`, after the refinement's own
+/// checks (so bad input reads as it does for `subd refine`).
+pub(crate) fn checked_split_limit_stencils(
     topo: &subd_mesh::Topology,
+    scheme: SplitScheme,
+) -> Result<SplitLimitStencils, String> {
+    subd_schemes::split_schemes::SplitRefinement::new(topo, scheme, 0)
+        .map_err(|e| e.to_string())?;
+    split_limit_stencils(topo, scheme).map_err(|e| e.to_string())
+}
+
+/// The limit of a split scheme at every vertex from its `stencils` (`nan` normals where none
+/// is defined); a vertex without a limit is an error naming it.
+pub(crate) fn split_limit_points(
+    stencils: &SplitLimitStencils,
     scheme: SplitScheme,
     positions: &[subd_mesh::DVec3],
 ) -> Result<LimitPoints, String> {
-    // The refinement's own checks first, so bad input reads as it does for `subd refine`.
-    subd_schemes::split_schemes::SplitRefinement::new(topo, scheme, 0)
-        .map_err(|e| e.to_string())?;
-    let stencils = split_limit_stencils(topo, scheme).map_err(|e| e.to_string())?;
     let points = stencils.evaluate(positions);
     if let Some(v) = points.positions.iter().position(Option::is_none) {
         let why = if scheme == SplitScheme::DooSabin {

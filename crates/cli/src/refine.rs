@@ -6,6 +6,7 @@ use std::time::Instant;
 
 use clap::{Args, ValueEnum};
 use serde::Serialize;
+use subd_limit::split_limit::SplitLimitStencils;
 use subd_mesh::{BoundaryInterpolation, CreaseMethod, SchemeHints, TriangleSubdivision};
 use subd_schemes::split_schemes::{SplitRefinement, SplitScheme};
 use subd_schemes::{ExplicitTags, Refinement, Scheme};
@@ -145,7 +146,34 @@ struct RefineReport {
 /// A refinement of either family, reduced to what writing its last level needs.
 pub(crate) enum Refined {
     Osd(Refinement),
-    Split(Box<SplitRefinement>),
+    Split(Box<SplitRefined>),
+}
+
+/// A split scheme's refinement, and the limit stencils of its last level once asked for:
+/// the positions and the texture coordinates take their limits through the same ones.
+pub(crate) struct SplitRefined {
+    refinement: SplitRefinement,
+    last_limit: std::sync::OnceLock<Result<SplitLimitStencils, String>>,
+}
+
+impl std::ops::Deref for SplitRefined {
+    type Target = SplitRefinement;
+    fn deref(&self) -> &SplitRefinement {
+        &self.refinement
+    }
+}
+
+impl SplitRefined {
+    /// The limit stencils of the last level, built on first request.
+    pub(crate) fn last_limit(&self) -> Result<&SplitLimitStencils, String> {
+        self.last_limit
+            .get_or_init(|| {
+                let last = self.topology(self.num_levels());
+                crate::limit::checked_split_limit_stencils(last, self.scheme())
+            })
+            .as_ref()
+            .map_err(Clone::clone)
+    }
 }
 
 impl Refined {
@@ -166,9 +194,10 @@ impl Refined {
             (Chosen::Osd(scheme), None) => {
                 Refined::Osd(Refinement::new(base, *scheme, options, levels).map_err(|x| e(&x))?)
             }
-            (Chosen::Split(scheme), _) => Refined::Split(Box::new(
-                SplitRefinement::new(base, *scheme, levels).map_err(|x| e(&x))?,
-            )),
+            (Chosen::Split(scheme), _) => Refined::Split(Box::new(SplitRefined {
+                refinement: SplitRefinement::new(base, *scheme, levels).map_err(|x| e(&x))?,
+                last_limit: std::sync::OnceLock::new(),
+            })),
         })
     }
 
@@ -519,7 +548,14 @@ pub(crate) fn output_limit(
             Ok(table.apply(positions))
         }
         Refined::Split(r) => {
-            crate::limit::split_limit_points(r.topology(level), r.scheme(), positions)
+            let own;
+            let stencils = if level == r.num_levels() {
+                r.last_limit()?
+            } else {
+                own = crate::limit::checked_split_limit_stencils(r.topology(level), r.scheme())?;
+                &own
+            };
+            crate::limit::split_limit_points(stencils, r.scheme(), positions)
         }
     }
 }

@@ -1,6 +1,7 @@
 //! Texture coordinates through the commands: a mesh's first face-varying channel refined
 //! with the mesh (or taken to its limit) and handed to the writers.
 
+use subd_limit::split_limit::SplitLimitStencils;
 use subd_mesh::DVec3;
 use subd_mesh::Topology;
 use subd_mesh::fvar::{FVarChannel, FVarLinearInterpolation};
@@ -61,7 +62,7 @@ pub(crate) fn refined_uv(
 /// A split scheme's refined texture coordinates ([`SplitFaceVarying`]); `None` with a warning
 /// for seams that Doo-Sabin or √3 cannot carry.
 fn split_uv(
-    r: &SplitRefinement,
+    r: &crate::refine::SplitRefined,
     channel: &FVarChannel,
     mode: FVarLinearInterpolation,
     limit: bool,
@@ -81,7 +82,7 @@ fn split_uv(
         .pop()
         .expect("level 0 at least");
     let values = if limit {
-        split_values_limit(&fv, level, values)?
+        split_values_limit(&fv, || r.last_limit(), values)?
     } else {
         values
     };
@@ -91,12 +92,12 @@ fn split_uv(
     }))
 }
 
-/// The limit of the values of `level` of `fv`: the butterflies interpolate, so each value
-/// is its own limit; Doo-Sabin's and √3's values (one per vertex) take the positions' limit
-/// masks.
-fn split_values_limit(
+/// The limit of the values of `fv`'s output level: the butterflies interpolate, so each
+/// value is its own limit; Doo-Sabin's and √3's values (one per vertex; their mesh of values
+/// is the geometry) take the positions' limit stencils, from `stencils`.
+fn split_values_limit<'a>(
     fv: &SplitFaceVarying,
-    level: usize,
+    stencils: impl FnOnce() -> Result<&'a SplitLimitStencils, String>,
     values: Vec<f64>,
 ) -> Result<Vec<f64>, String> {
     if fv.values_scheme().is_interpolating() {
@@ -106,8 +107,7 @@ fn split_values_limit(
         .chunks_exact(2)
         .map(|x| DVec3::new(x[0], x[1], 0.0))
         .collect();
-    let limit =
-        crate::limit::split_limit_points(fv.values_topology(level), fv.values_scheme(), &points)?;
+    let limit = crate::limit::split_limit_points(stencils()?, fv.values_scheme(), &points)?;
     Ok(limit.positions.iter().flat_map(|p| [p.x, p.y]).collect())
 }
 
@@ -116,7 +116,7 @@ fn split_values_limit(
 /// warning, where Doo-Sabin or √3 cannot carry their seams.
 pub(crate) fn split_limit_uv(
     topology: &Topology,
-    scheme: SplitScheme,
+    (scheme, stencils): (SplitScheme, &SplitLimitStencils),
     channel: &FVarChannel,
     mode: FVarLinearInterpolation,
     warnings: &mut Vec<String>,
@@ -140,7 +140,7 @@ pub(crate) fn split_limit_uv(
         .flat_map(|&x| channel.value(x as usize).iter().copied())
         .collect();
     Ok(RefinedUv {
-        values: split_values_limit(&fv, 0, values)?,
+        values: split_values_limit(&fv, || Ok(stencils), values)?,
         indices: fv.values_topology(0).all_face_vertices().to_vec(),
     })
 }

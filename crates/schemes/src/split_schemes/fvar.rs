@@ -218,7 +218,8 @@ impl SplitFaceVarying {
             "components numbers per value"
         );
         let mut out = vec![values.to_vec()];
-        let mut level: Vec<f64> = self
+        // Level 0 of the mesh of values: the channel's value at each wedge.
+        let wedges: Vec<f64> = self
             .slot_values
             .iter()
             .flat_map(|&x| {
@@ -227,11 +228,11 @@ impl SplitFaceVarying {
             })
             .collect();
         for l in 1..=self.num_levels() {
+            let src = if l == 1 { &wedges } else { &out[l - 1] };
             let s = self.values.stencils(l);
             let mut next = vec![0.0; s.num_rows() * components];
-            s.apply(&level, components, &mut next);
-            level = next;
-            out.push(level.clone());
+            s.apply(src, components, &mut next);
+            out.push(next);
         }
         out
     }
