@@ -47,14 +47,17 @@ pub fn torus_uv(mesh: &Mesh) -> FVarChannel {
 }
 
 /// Runs the benchmark and prints a table: setup (topology refinement with the channel) and
-/// values (the refinement of the UVs), medians of `repeats` runs.
-pub fn run(levels: usize, repeats: usize) -> Result<(), String> {
+/// values (the refinement of the UVs), medians of `repeats` runs. Each level is measured in
+/// `rounds` back-to-back rounds of (OpenSubdiv, subd on one thread, subd on all threads);
+/// times are medians over the rounds and each ratio the median of the rounds' ratios, so a
+/// slow spell of the shared machine hits both sides of a ratio.
+pub fn run(levels: usize, repeats: usize, rounds: usize) -> Result<(), String> {
     let mesh = quad_bench_mesh();
     let uv = torus_uv(&mesh);
     let exe = osd::build_harness()?;
     let threads = rayon::current_num_threads();
     println!(
-        "face-varying refinement: {} quads, {} UV values, seams on both wrap loops; medians of {repeats}",
+        "face-varying refinement: {} quads, {} UV values, seams on both wrap loops; {rounds} rounds of (OpenSubdiv, subd 1 thread, subd all threads), each the median of {repeats} runs",
         mesh.topology.num_faces(),
         uv.num_values()
     );
@@ -85,18 +88,6 @@ pub fn run(levels: usize, repeats: usize) -> Result<(), String> {
                 uv.values(),
                 uv.indices(),
             );
-            let out = osd::run(
-                &exe,
-                &input,
-                &[
-                    "--fvar-bench",
-                    &mode.to_shape_tag().to_string(),
-                    &repeats.to_string(),
-                ],
-            )?;
-            let line = String::from_utf8_lossy(&out);
-            let osd_topo = json_number(&line, "topology_seconds").ok_or("no topology time")?;
-            let osd_values = json_number(&line, "fvar_seconds").ok_or("no fvar time")?;
             let measure = |n: usize| -> Result<(f64, f64), String> {
                 let pool = rayon::ThreadPoolBuilder::new()
                     .num_threads(n)
@@ -124,8 +115,30 @@ pub fn run(levels: usize, repeats: usize) -> Result<(), String> {
                 }
                 Ok((median(setup), median(values)))
             };
-            let (setup1, values1) = measure(1)?;
-            let (_, values_n) = measure(threads)?;
+            // Per round: OpenSubdiv topology and values, subd setup and values on one
+            // thread, subd values on all threads.
+            let mut runs: Vec<[f64; 5]> = Vec::with_capacity(rounds);
+            for _ in 0..rounds {
+                let out = osd::run(
+                    &exe,
+                    &input,
+                    &[
+                        "--fvar-bench",
+                        &mode.to_shape_tag().to_string(),
+                        &repeats.to_string(),
+                    ],
+                )?;
+                let line = String::from_utf8_lossy(&out);
+                let osd_topo = json_number(&line, "topology_seconds").ok_or("no topology time")?;
+                let osd_values = json_number(&line, "fvar_seconds").ok_or("no fvar time")?;
+                let (setup1, values1) = measure(1)?;
+                let (_, values_n) = measure(threads)?;
+                runs.push([osd_topo, osd_values, setup1, values1, values_n]);
+            }
+            let col = |i: usize| median(runs.iter().map(|r| r[i]).collect());
+            let ratio = |i: usize| median(runs.iter().map(|r| r[i] / r[1]).collect());
+            let (osd_topo, osd_values, setup1, values1) = (col(0), col(1), col(2), col(3));
+            let (ratio1, ratio_n) = (ratio(3), ratio(4));
             println!(
                 "{:<14} {:>5} {:>10.2}ms {:>10.2}ms {:>10.2}ms {:>10.2}ms {:>9.2} {:>9.2}",
                 mode.name(),
@@ -134,8 +147,8 @@ pub fn run(levels: usize, repeats: usize) -> Result<(), String> {
                 1e3 * osd_values,
                 1e3 * setup1,
                 1e3 * values1,
-                values1 / osd_values,
-                values_n / osd_values
+                ratio1,
+                ratio_n
             );
         }
     }

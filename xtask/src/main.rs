@@ -63,9 +63,10 @@ enum Task {
         /// Runs per measurement (the median is reported).
         #[arg(long, default_value_t = 5)]
         repeats: usize,
-        /// Refinement: rounds of (OpenSubdiv, subd 1 thread, subd all threads) run back to
-        /// back; times are medians over rounds, ratios the medians of each round's ratio, so
-        /// a slow spell of a shared machine hits both sides of a ratio.
+        /// Refinement, split schemes and face-varying data: rounds of (reference, subd 1
+        /// thread, subd all threads) run back to back; times are medians over rounds, ratios
+        /// the medians of each round's ratio, so a slow spell of a shared machine hits both
+        /// sides of a ratio.
         #[arg(long, default_value_t = 3)]
         rounds: usize,
         /// Run both OpenSubdiv and subd with glibc's transparent-huge-page malloc
@@ -297,7 +298,7 @@ fn main() -> ExitCode {
                 .join("../../shared/meshes/osd");
             let batch = || batch_bench::run_batch(rounds.max(1), &shapes);
             let tess = || tess_bench::run(repeats);
-            let fvar = || fvar_bench::run(levels, repeats);
+            let fvar = || fvar_bench::run(levels, repeats, rounds.max(1));
             if fvar_only {
                 ensure_system_packages(REFERENCE_PACKAGES).and_then(|_| fvar())
             } else if tess_only {

@@ -8,6 +8,7 @@
 //! vertex; values on a seam (or, in the boundary modes, the mesh boundary) follow
 //! OpenSubdiv's face-varying crease and corner rules, chosen by [`FVarLinearInterpolation`].
 
+use std::mem::MaybeUninit;
 use std::sync::OnceLock;
 
 use glam::DVec3;
@@ -15,7 +16,9 @@ use subd_mesh::Topology;
 use subd_mesh::fvar::{FVarChannel, FVarError, FVarLinearInterpolation};
 use subd_mesh::tags::{is_infinite, is_semi_sharp};
 
-use super::{Layout, MaskSink, Refinement, half_sharpness, nm_vertex};
+use rayon::prelude::*;
+
+use super::{Lanes, Layout, MaskSink, Refinement, half_sharpness, nm_vertex};
 use crate::Scheme;
 use crate::rules;
 use crate::stencil::{RowSink, StencilTable};
@@ -90,6 +93,10 @@ struct ChannelLevel {
     edge_mismatch: Vec<bool>,
     /// Per edge: kept linear by the mode.
     edge_linear: Vec<bool>,
+    /// Refined levels: per vertex, whether its one value is the geometric mask over one
+    /// value per parent vertex (its mask reads only faces whose corners all have one value);
+    /// empty in the linear modes.
+    geometric: Vec<bool>,
 }
 
 impl ChannelLevel {
@@ -280,7 +287,9 @@ impl FaceVaryingRefinement {
         let flags = ModeFlags::new(mode, options.boundary_interpolation);
         let mut levels = vec![base_level(base, channel.indices(), flags)];
         for l in 1..=refinement.num_levels() {
-            let child = child_level(&refinement.step(l), &levels[l - 1], flags);
+            let step = refinement.step(l);
+            let mut child = child_level(&step, &levels[l - 1], flags);
+            child.geometric = geometric_vertices(&step, &levels[l - 1], &child, flags);
             levels.push(child);
         }
         Ok(FaceVaryingRefinement {
@@ -368,8 +377,9 @@ impl FaceVaryingRefinement {
     /// The values of every level (`result[0]` is `values`), `components` numbers each, as
     /// `InterpolateFaceVarying` gives them (`refinement` is the one the channel was refined
     /// with). The masks are evaluated directly, without stencil tables: values whose masks
-    /// reach only seamless vertices take the geometry's own point evaluation (one value per
-    /// vertex, three numbers at a time), the others walk their masks.
+    /// reach only seamless vertices take the geometry's own point evaluation (over one value
+    /// per vertex, kept level to level, one to three numbers at a time), the others walk
+    /// their masks.
     ///
     /// # Panics
     /// If `values` is not `components` numbers per value of the channel.
@@ -384,150 +394,228 @@ impl FaceVaryingRefinement {
             components * self.num_user_values,
             "components numbers per value"
         );
+        match components {
+            1 => self.refine_lanes::<f64>(refinement, values, components),
+            2 => self.refine_lanes::<glam::DVec2>(refinement, values, components),
+            _ => self.refine_lanes::<DVec3>(refinement, values, components),
+        }
+    }
+
+    /// [`Self::refine_values`] with the geometric rows `V::WIDTH` numbers at a time.
+    fn refine_lanes<V: Lanes>(
+        &self,
+        refinement: &Refinement,
+        values: &[f64],
+        c: usize,
+    ) -> Vec<Vec<f64>> {
+        let linear = self.flags.linear_all || refinement.scheme() == Scheme::Bilinear;
+        let groups = if linear { 0 } else { c.div_ceil(V::WIDTH) };
+        let base = &self.levels[0];
+        // One value per base vertex (its first), for the geometric rows of level 1.
+        let mut points: Vec<Vec<V>> = (0..groups)
+            .map(|g| {
+                (0..base.value_offsets.len() - 1)
+                    .into_par_iter()
+                    .map(|u| {
+                        if base.count(u) == 0 {
+                            return V::default();
+                        }
+                        let x = base.source(base.offset(u)) as usize;
+                        V::load(&values[c * x + V::WIDTH * g..c * (x + 1)])
+                    })
+                    .collect()
+            })
+            .collect();
         let mut out = vec![values.to_vec()];
         for l in 1..self.levels.len() {
-            let next = next_values(
-                &refinement.step(l),
-                &self.levels[l - 1],
-                &self.levels[l],
-                self.flags,
-                out.last().expect("level 0"),
-                components,
-            );
+            let level = NextValues {
+                step: &refinement.step(l),
+                parent: &self.levels[l - 1],
+                child: &self.levels[l],
+                flags: self.flags,
+                c,
+            };
+            let (next, next_points) =
+                level.compute(out.last().expect("level 0"), &points, l < self.num_levels());
             out.push(next);
+            points = next_points;
         }
         out
     }
 }
 
-/// Three numbers of a level's values as points, one per vertex, and the geometry's face
-/// points over them: what the geometric rows of the child level read.
-struct GeometricRows {
-    points: Vec<DVec3>,
-    face_points: Vec<DVec3>,
-}
-
-/// The values of the child level of `step` from the parent level's `src`, `c` numbers each
-/// (see [`FaceVaryingRefinement::refine_values`]).
-fn next_values(
+/// Per child vertex of `step`, whether its value is the geometric mask over one value per
+/// parent vertex: its mask reads only parent faces whose corners all have one value (no
+/// seam, nothing mismatched), and the mode is not linear. Such a vertex has one value.
+fn geometric_vertices(
     step: &super::Step<'_>,
     parent: &ChannelLevel,
     child: &ChannelLevel,
     flags: ModeFlags,
-    src: &[f64],
-    c: usize,
-) -> Vec<f64> {
-    use rayon::prelude::*;
+) -> Vec<bool> {
+    if flags.linear_all || step.scheme == Scheme::Bilinear {
+        return Vec::new();
+    }
     let p = step.parent;
     let l = step.layout;
-    let linear = flags.linear_all || step.scheme == Scheme::Bilinear;
     let matching = |u: usize| parent.count(u) > 0 && !parent.tags[parent.offset(u)].mismatch;
-    // Faces whose corners all have one value, and the geometry's rows over one value per
-    // vertex (three numbers at a time, face points first): a mask that reads only such faces
-    // is the geometric mask, value for vertex.
-    let (clean_face, groups): (Vec<bool>, Vec<GeometricRows>) = if linear || c == 0 {
-        (Vec::new(), Vec::new())
-    } else {
-        let clean = (0..p.num_faces())
-            .into_par_iter()
-            .map(|f| p.face_vertices(f).iter().all(|&u| matching(u as usize)))
-            .collect();
-        let groups = (0..c.div_ceil(3))
-            .map(|g| {
-                let points: Vec<DVec3> = (0..p.num_vertices())
-                    .into_par_iter()
-                    .map(|u| {
-                        if parent.count(u) == 0 {
-                            return DVec3::ZERO;
-                        }
-                        let x = parent.source(parent.offset(u)) as usize;
-                        let at = |i: usize| {
-                            if 3 * g + i < c {
-                                src[c * x + 3 * g + i]
-                            } else {
-                                0.0
-                            }
-                        };
-                        DVec3::new(at(0), at(1), at(2))
-                    })
-                    .collect();
-                let face_points =
-                    super::rows::build_middle(&super::StepRows { step, src: &points });
-                GeometricRows {
-                    points,
-                    face_points,
-                }
+    let clean_face: Vec<bool> = (0..p.num_faces())
+        .into_par_iter()
+        .map(|f| p.face_vertices(f).iter().all(|&u| matching(u as usize)))
+        .collect();
+    let clean = |faces: &[u32]| faces.iter().all(|&f| clean_face[f as usize]);
+    (0..l.num_child_vertices)
+        .into_par_iter()
+        .with_min_len(CHUNK)
+        .map(|cv| {
+            let cv32 = cv as u32;
+            if child.count(cv) != 1 {
+                false
+            } else if cv32 < l.face_vertex_base {
+                matching(cv) && clean(p.vertex_faces(cv))
+            } else if cv32 < l.edge_vertex_base {
+                clean_face[(cv32 - l.face_vertex_base) as usize]
+            } else {
+                let e = (cv32 - l.edge_vertex_base) as usize;
+                !child.tags[child.offset(cv)].mismatch && clean(p.edge_faces(e))
+            }
+        })
+        .collect()
+}
+
+/// Child vertices per parallel task.
+const CHUNK: usize = 4096;
+
+/// One step of [`FaceVaryingRefinement::refine_values`]: the child level's values from the
+/// parent level's, `c` numbers each.
+struct NextValues<'a> {
+    step: &'a super::Step<'a>,
+    parent: &'a ChannelLevel,
+    child: &'a ChannelLevel,
+    flags: ModeFlags,
+    c: usize,
+}
+
+impl NextValues<'_> {
+    /// The child level's values from `src`, the parent level's, and `points`, one value per
+    /// parent vertex in groups of `V::WIDTH` numbers (what the geometric rows read; empty in
+    /// the linear modes). With `with_points`, also the child level's one value per vertex.
+    ///
+    /// Geometric vertices take the positions' rows ([`super::Step::lane_point`]) over
+    /// `points`, face points first, as `PrimvarRefiner` computes them; the others, next to
+    /// seams and in the linear modes, walk their masks over `src`. Every vertex is computed
+    /// alone, so the result does not depend on the number of threads.
+    fn compute<V: Lanes>(
+        &self,
+        src: &[f64],
+        points: &[Vec<V>],
+        with_points: bool,
+    ) -> (Vec<f64>, Vec<Vec<V>>) {
+        let (step, child, c) = (self.step, self.child, self.c);
+        if c == 0 {
+            return (Vec::new(), Vec::new());
+        }
+        let l = step.layout;
+        let faces = l.face_vertex_base as usize..l.edge_vertex_base as usize;
+        // The face points over one value per vertex; those of faces with seams are unused.
+        let face_points: Vec<Vec<V>> = points
+            .iter()
+            .map(|src| {
+                let mut fp = crate::memory::with_capacity(faces.len());
+                fp.par_extend(
+                    faces
+                        .clone()
+                        .into_par_iter()
+                        .with_min_len(CHUNK)
+                        .map(|r| step.lane_face_point(r, src)),
+                );
+                fp
             })
             .collect();
-        (clean, groups)
-    };
-    let clean = |faces: &[u32]| faces.iter().all(|&f| clean_face[f as usize]);
-    let is_face_child = |cv: u32| cv >= l.face_vertex_base && cv < l.edge_vertex_base;
-    let geometric = |cv: usize, r: usize| {
-        let cv32 = cv as u32;
-        if linear {
-            false
-        } else if is_face_child(cv32) {
-            clean_face[(cv32 - l.face_vertex_base) as usize]
-        } else if cv32 >= l.edge_vertex_base {
-            let e = (cv32 - l.edge_vertex_base) as usize;
-            !child.tags[r].mismatch && clean(p.edge_faces(e))
-        } else {
-            matching(cv) && clean(p.vertex_faces(cv))
+        let nv = l.num_child_vertices;
+        let total = c * child.num_values();
+        let mut out: Vec<f64> = crate::memory::with_capacity(total);
+        let mut next: Vec<Vec<V>> = (0..if with_points { points.len() } else { 0 })
+            .map(|_| crate::memory::with_capacity(nv))
+            .collect();
+        // Disjoint pieces of the outputs, CHUNK child vertices each, written once below.
+        let mut pieces = Vec::with_capacity(nv.div_ceil(CHUNK));
+        let mut rest_out = &mut out.spare_capacity_mut()[..total];
+        let mut rest_next: Vec<&mut [MaybeUninit<V>]> = next
+            .iter_mut()
+            .map(|v| &mut v.spare_capacity_mut()[..nv])
+            .collect();
+        for first in (0..nv).step_by(CHUNK) {
+            let end = (first + CHUNK).min(nv);
+            let len = c * (child.offset(end) - child.offset(first));
+            let (o, tail) = std::mem::take(&mut rest_out).split_at_mut(len);
+            rest_out = tail;
+            let n: Vec<&mut [MaybeUninit<V>]> = rest_next
+                .iter_mut()
+                .map(|r| {
+                    let (h, t) = std::mem::take(r).split_at_mut(end - first);
+                    *r = t;
+                    h
+                })
+                .collect();
+            pieces.push((first..end, o, n));
         }
-    };
-    const CHUNK: usize = 4096;
-    // Huge pages for a large level: its first writes are otherwise mostly 4 KiB faults.
-    let mut out: Vec<f64> = crate::memory::zeroed(c * child.num_values());
-    if c == 0 {
-        return out;
-    }
-    out.par_chunks_mut(CHUNK * c)
-        .enumerate()
-        .for_each(|(chunk, values)| {
-            let first = chunk * CHUNK;
-            let mut cv = child
-                .value_offsets
-                .partition_point(|&o| o as usize <= first)
-                - 1;
-            for (i, acc) in values.chunks_exact_mut(c).enumerate() {
-                let r = first + i;
-                while child.value_offsets[cv + 1] as usize <= r {
-                    cv += 1;
-                }
-                if geometric(cv, r) {
-                    for (g, rows) in groups.iter().enumerate() {
-                        let cv32 = cv as u32;
-                        let q = if is_face_child(cv32) {
-                            rows.face_points[(cv32 - l.face_vertex_base) as usize]
+        pieces.into_par_iter().for_each(|(range, out, mut next)| {
+            let base = child.offset(range.start);
+            let mut acc = vec![0.0; c];
+            for cv in range.clone() {
+                let slots = child.offset(cv) - base..child.offset(cv + 1) - base;
+                let values = &mut out[c * slots.start..c * slots.end];
+                if child.geometric.get(cv) == Some(&true) {
+                    for (g, (src, fp)) in points.iter().zip(&face_points).enumerate() {
+                        let q = if faces.contains(&cv) {
+                            fp[cv - faces.start]
                         } else {
-                            super::rows::PointRows::row(
-                                &super::StepRows {
-                                    step,
-                                    src: &rows.points,
-                                },
-                                cv,
-                                &rows.face_points,
-                            )
+                            step.lane_point(cv, src, fp)
+                        };
+                        q.store(&mut values[V::WIDTH * g..(V::WIDTH * (g + 1)).min(c)]);
+                        if let Some(n) = next.get_mut(g) {
+                            n[cv - range.start].write(q);
                         }
-                        .to_array();
-                        let n = 3.min(c - 3 * g);
-                        acc[3 * g..3 * g + n].copy_from_slice(&q[..n]);
                     }
-                } else {
-                    value_row(
-                        step,
-                        parent,
-                        child,
-                        flags,
-                        r,
-                        cv,
-                        &mut ValueSum { src, acc },
-                    );
+                    continue;
+                }
+                for (k, value) in values.chunks_exact_mut(c).enumerate() {
+                    acc.fill(0.0);
+                    let r = child.offset(cv) + k;
+                    let mut sum = ValueSum { src, acc: &mut acc };
+                    value_row(step, self.parent, child, self.flags, r, cv, &mut sum);
+                    for (d, &x) in value.iter_mut().zip(&acc) {
+                        d.write(x);
+                    }
+                    // The first value stands for the vertex in the next level's geometric
+                    // rows (which read only vertices with one value).
+                    if k == 0 {
+                        for (g, n) in next.iter_mut().enumerate() {
+                            n[cv - range.start].write(V::load(&acc[V::WIDTH * g..]));
+                        }
+                    }
+                }
+                if slots.is_empty() {
+                    for n in next.iter_mut() {
+                        n[cv - range.start].write(V::default());
+                    }
                 }
             }
         });
-    out
+        #[allow(unsafe_code)]
+        // SAFETY: the pieces cover `0..total` of `out` and `0..nv` of every `next`, and the
+        // loop writes every element of them: a geometric vertex its one value (all `c`
+        // numbers, over the groups) and its point, any other vertex each of its values and
+        // its point (the first value, or zero without values).
+        unsafe {
+            out.set_len(total);
+            for n in &mut next {
+                n.set_len(nv);
+            }
+        }
+        (out, next)
+    }
 }
 
 /// The values of one level of a [`FaceVaryingRefinement`] as limit masks need them: which
@@ -845,6 +933,7 @@ fn base_level(t: &Topology, indices: &[u32], flags: ModeFlags) -> ChannelLevel {
         ends,
         edge_mismatch,
         edge_linear,
+        geometric: Vec::new(),
     }
 }
 
@@ -1107,6 +1196,7 @@ fn child_level(step: &super::Step<'_>, parent: &ChannelLevel, flags: ModeFlags) 
         ends,
         edge_mismatch,
         edge_linear,
+        geometric: Vec::new(),
     }
 }
 
@@ -1436,45 +1526,52 @@ mod tests {
     }
 
     /// The direct evaluation of `refine_values` (geometric rows away from seams, walked
-    /// masks near them) equals the stencil tables' rows applied, in every mode, on one
-    /// thread and on several.
+    /// masks near them) equals the stencil tables' rows applied, in every mode, with one to
+    /// five numbers per value, on one thread and on several.
     #[test]
     fn direct_values_equal_the_stencil_tables() {
         let (mut t, p) = grid();
         let e = t.find_edge(9, 10).unwrap() as usize;
         t.set_edge_sharpness(e, 1.5);
-        // Islands: the left column of faces apart from the rest (a seam along x = 1), with
-        // three numbers per value.
+        // Islands: the left column of faces apart from the rest (a seam along x = 1).
         let mut indices = Vec::new();
         for f in 0..9 {
             for &v in t.face_vertices(f) {
                 indices.push(if f % 3 == 0 { v } else { 16 + v });
             }
         }
-        let values: Vec<f64> = (0..32)
-            .flat_map(|i| {
-                let q = p[i % 16];
-                [q.x + 0.3 * (i / 16) as f64, q.y, q.z]
-            })
-            .collect();
-        let channel = FVarChannel::new(&t, 3, values.clone(), indices).unwrap();
         let r = Refinement::new(&t, Scheme::CatmullClark, &Options::default(), 3).unwrap();
-        for mode in FVarLinearInterpolation::ALL_MODES {
-            let fr = FaceVaryingRefinement::new(&r, &channel, mode).unwrap();
-            let direct = fr.refine_values(&r, &values, 3);
-            let one = rayon::ThreadPoolBuilder::new()
-                .num_threads(1)
-                .build()
-                .unwrap()
-                .install(|| fr.refine_values(&r, &values, 3));
-            assert_eq!(one, direct, "{mode:?}: 1 thread and many");
-            for (level, got) in direct.iter().enumerate().skip(1) {
-                let table = fr.composed(&r, level);
-                let mut want = vec![0.0; 3 * table.num_rows()];
-                table.apply(&values, 3, &mut want);
-                assert_eq!(want.len(), got.len());
-                for (i, (a, b)) in got.iter().zip(&want).enumerate() {
-                    assert!((a - b).abs() < 1e-13, "{mode:?} L{level} [{i}]: {a} vs {b}");
+        // One, two, three and five numbers per value: one group of lanes narrower than,
+        // equal to and wider than a point, and two groups with a padded second.
+        for c in [1, 2, 3, 5] {
+            let values: Vec<f64> = (0..32)
+                .flat_map(|i| {
+                    let q = p[i % 16];
+                    let shift = 0.3 * (i / 16) as f64;
+                    [q.x + shift, q.y, q.z, q.x * q.y - shift, q.z - q.y][..c].to_vec()
+                })
+                .collect();
+            let channel = FVarChannel::new(&t, c, values.clone(), indices.clone()).unwrap();
+            for mode in FVarLinearInterpolation::ALL_MODES {
+                let fr = FaceVaryingRefinement::new(&r, &channel, mode).unwrap();
+                let direct = fr.refine_values(&r, &values, c);
+                let one = rayon::ThreadPoolBuilder::new()
+                    .num_threads(1)
+                    .build()
+                    .unwrap()
+                    .install(|| fr.refine_values(&r, &values, c));
+                assert_eq!(one, direct, "{mode:?}, {c} numbers: 1 thread and many");
+                for (level, got) in direct.iter().enumerate().skip(1) {
+                    let table = fr.composed(&r, level);
+                    let mut want = vec![0.0; c * table.num_rows()];
+                    table.apply(&values, c, &mut want);
+                    assert_eq!(want.len(), got.len());
+                    for (i, (a, b)) in got.iter().zip(&want).enumerate() {
+                        assert!(
+                            (a - b).abs() < 1e-13,
+                            "{mode:?}, {c} numbers, L{level} [{i}]: {a} vs {b}"
+                        );
+                    }
                 }
             }
         }

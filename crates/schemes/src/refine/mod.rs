@@ -406,21 +406,86 @@ impl MaskSink for RowSink<'_> {
     }
 }
 
-/// Accumulates a child point from parent points and the already computed child face points.
-struct PointSink<'a> {
-    src: &'a [DVec3],
-    face_points: &'a [DVec3],
-    acc: DVec3,
+/// Numbers refined together as one point: positions (`DVec3`), or a face-varying channel's
+/// values one, two or three numbers at a time.
+pub(crate) trait Lanes:
+    Copy
+    + Default
+    + Send
+    + Sync
+    + bytemuck::Zeroable
+    + std::ops::Add<Output = Self>
+    + std::ops::AddAssign
+    + std::ops::Mul<f64, Output = Self>
+{
+    /// Numbers per point.
+    const WIDTH: usize;
+    /// Number `i` (below `WIDTH`) of the point.
+    fn lane(self, i: usize) -> f64;
+    /// The point made of `s` (at most `WIDTH` numbers), the rest zero.
+    fn load(s: &[f64]) -> Self;
+    /// Writes the first `d.len()` (at most `WIDTH`) numbers of the point to `d`.
+    #[inline]
+    fn store(self, d: &mut [std::mem::MaybeUninit<f64>]) {
+        for (i, x) in d.iter_mut().enumerate() {
+            x.write(self.lane(i));
+        }
+    }
 }
 
-impl MaskSink for PointSink<'_> {
+impl Lanes for f64 {
+    const WIDTH: usize = 1;
+    #[inline]
+    fn lane(self, _i: usize) -> f64 {
+        self
+    }
+    #[inline]
+    fn load(s: &[f64]) -> f64 {
+        s.first().copied().unwrap_or(0.0)
+    }
+}
+
+impl Lanes for glam::DVec2 {
+    const WIDTH: usize = 2;
+    #[inline]
+    fn lane(self, i: usize) -> f64 {
+        self[i]
+    }
+    #[inline]
+    fn load(s: &[f64]) -> glam::DVec2 {
+        let at = |i: usize| s.get(i).copied().unwrap_or(0.0);
+        glam::DVec2::new(at(0), at(1))
+    }
+}
+
+impl Lanes for DVec3 {
+    const WIDTH: usize = 3;
+    #[inline]
+    fn lane(self, i: usize) -> f64 {
+        self[i]
+    }
+    #[inline]
+    fn load(s: &[f64]) -> DVec3 {
+        let at = |i: usize| s.get(i).copied().unwrap_or(0.0);
+        DVec3::new(at(0), at(1), at(2))
+    }
+}
+
+/// Accumulates a child point from parent points and the already computed child face points.
+struct PointSink<'a, V> {
+    src: &'a [V],
+    face_points: &'a [V],
+    acc: V,
+}
+
+impl<V: Lanes> MaskSink for PointSink<'_, V> {
     #[inline]
     fn vertex(&mut self, i: u32, w: f64) {
-        self.acc += w * self.src[i as usize];
+        self.acc += self.src[i as usize] * w;
     }
     #[inline]
     fn face(&mut self, _p: &Topology, f: usize, w: f64) {
-        self.acc += w * self.face_points[f];
+        self.acc += self.face_points[f] * w;
     }
 }
 
@@ -675,14 +740,29 @@ impl Step<'_> {
     }
 
     /// The child point of row `r` through the general mask machinery.
-    fn general_point(&self, r: usize, src: &[DVec3], face_points: &[DVec3]) -> DVec3 {
+    fn general_point<V: Lanes>(&self, r: usize, src: &[V], face_points: &[V]) -> V {
         let mut s = PointSink {
             src,
             face_points,
-            acc: DVec3::ZERO,
+            acc: V::default(),
         };
         self.row(r, &mut s);
         s.acc
+    }
+
+    /// The child point of row `r` from parent points `src` and the child face points
+    /// `face_points` (which row `r` must not be one of): what [`StepRows`] gives, for points
+    /// of any width.
+    #[inline]
+    pub(crate) fn lane_point<V: Lanes>(&self, r: usize, src: &[V], face_points: &[V]) -> V {
+        self.smooth_catmark_point(r, src, face_points)
+            .unwrap_or_else(|| self.general_point(r, src, face_points))
+    }
+
+    /// The child point of face row `r` from parent points `src`.
+    #[inline]
+    pub(crate) fn lane_face_point<V: Lanes>(&self, r: usize, src: &[V]) -> V {
+        self.general_point(r, src, &[])
     }
 }
 
@@ -720,12 +800,7 @@ impl Step<'_> {
     /// smooth-triangle rule. Same sums in the same order as [`Step::row`] with a
     /// [`PointSink`], so the results are identical bit for bit; `None` for every other row.
     #[inline]
-    fn smooth_catmark_point(
-        &self,
-        r: usize,
-        src: &[DVec3],
-        face_points: &[DVec3],
-    ) -> Option<DVec3> {
+    fn smooth_catmark_point<V: Lanes>(&self, r: usize, src: &[V], face_points: &[V]) -> Option<V> {
         if self.scheme != Scheme::CatmullClark {
             return None;
         }
@@ -741,15 +816,16 @@ impl Step<'_> {
             let faces = p.vertex_faces(r);
             let n = faces.len();
             let w = 1.0 / (n * n) as f64;
-            let mut acc = DVec3::ZERO;
+            // `x * w` rather than `w * x`: the same product, for any width.
+            let mut acc = V::default();
             for &f in faces {
-                acc += w * face_points[f as usize];
+                acc += face_points[f as usize] * w;
             }
             for &e in p.vertex_edges(r) {
-                acc += w * src[p.edge_other_vertex(e as usize, r32) as usize];
+                acc += src[p.edge_other_vertex(e as usize, r32) as usize] * w;
             }
             let nf = n as f64;
-            return Some(acc + ((nf - 2.0) / nf) * src[r]);
+            return Some(acc + src[r] * ((nf - 2.0) / nf));
         }
         let e = (r32 - l.edge_vertex_base) as usize;
         let faces = p.edge_faces(e);
@@ -760,10 +836,10 @@ impl Step<'_> {
             return None;
         }
         let [a, b] = p.edge_vertices(e);
-        let mut acc = 0.25 * src[a as usize];
-        acc += 0.25 * src[b as usize];
-        acc += 0.25 * face_points[faces[0] as usize];
-        acc += 0.25 * face_points[faces[1] as usize];
+        let mut acc = src[a as usize] * 0.25;
+        acc += src[b as usize] * 0.25;
+        acc += face_points[faces[0] as usize] * 0.25;
+        acc += face_points[faces[1] as usize] * 0.25;
         Some(acc)
     }
 }
