@@ -129,6 +129,17 @@ impl ChannelLevel {
         self.source(self.corner_slot(t, f, k))
     }
 
+    /// The sources of edge `e`'s two ends inside its `j`-th face, in that face's order
+    /// (which end comes first is not looked up).
+    fn edge_face_corner_sources(&self, t: &Topology, e: usize, j: usize) -> [u32; 2] {
+        let f = t.edge_faces(e)[j] as usize;
+        let l = t.edge_face_local_indices(e)[j] as usize;
+        let first = t.face_offsets()[f] as usize;
+        let n = t.face_offsets()[f + 1] as usize - first;
+        let slot = |k: usize| self.source(self.face_values[first + k] as usize);
+        [slot(l), slot((l + 1) % n)]
+    }
+
     /// The sources of edge `e`'s two ends (in edge order) inside its `j`-th face.
     fn edge_face_sources(&self, t: &Topology, e: usize, j: usize) -> [u32; 2] {
         let f = t.edge_faces(e)[j] as usize;
@@ -656,7 +667,9 @@ impl NextValues<'_> {
             } else {
                 0
             };
-            let [a, b] = parent.edge_face_sources(p, e, side);
+            // The mean does not depend on which end comes first (0 + x/2 is exact, and the
+            // second sum commutes), so the ends are taken in the face's order.
+            let [a, b] = parent.edge_face_corner_sources(p, e, side);
             acc += at(a) * 0.5;
             acc += at(b) * 0.5;
         }
