@@ -72,6 +72,11 @@ impl ModeFlags {
         }
     }
 
+    /// Whether every value is interpolated linearly: mode `all`, or the Bilinear scheme.
+    fn linear(self, scheme: Scheme) -> bool {
+        self.linear_all || scheme == Scheme::Bilinear
+    }
+
     fn smooth_boundaries(self) -> bool {
         !self.linear_boundaries
     }
@@ -142,13 +147,9 @@ impl ChannelLevel {
 
     /// The sources of edge `e`'s two ends (in edge order) inside its `j`-th face.
     fn edge_face_sources(&self, t: &Topology, e: usize, j: usize) -> [u32; 2] {
+        let [here, next] = self.edge_face_corner_sources(t, e, j);
         let f = t.edge_faces(e)[j] as usize;
         let l = t.edge_face_local_indices(e)[j] as usize;
-        let n = t.face_size(f);
-        let (here, next) = (
-            self.corner_source(t, f, l),
-            self.corner_source(t, f, (l + 1) % n),
-        );
         if t.face_vertices(f)[l] == t.edge_vertices(e)[0] {
             [here, next]
         } else {
@@ -419,7 +420,7 @@ impl FaceVaryingRefinement {
         values: &[f64],
         c: usize,
     ) -> Vec<Vec<f64>> {
-        let linear = self.flags.linear_all || refinement.scheme() == Scheme::Bilinear;
+        let linear = self.flags.linear(refinement.scheme());
         let groups = if linear { 0 } else { c.div_ceil(V::WIDTH) };
         let base = &self.levels[0];
         // One value per base vertex (its first), for the geometric rows of level 1.
@@ -464,7 +465,7 @@ fn geometric_vertices(
     child: &ChannelLevel,
     flags: ModeFlags,
 ) -> Vec<bool> {
-    if flags.linear_all || step.scheme == Scheme::Bilinear {
+    if flags.linear(step.scheme) {
         return Vec::new();
     }
     let p = step.parent;
@@ -571,7 +572,7 @@ impl NextValues<'_> {
                 .collect();
             pieces.push((first..end, o, n));
         }
-        let linear = self.flags.linear_all || step.scheme == Scheme::Bilinear;
+        let linear = self.flags.linear(step.scheme);
         pieces.into_par_iter().for_each(|(range, out, mut next)| {
             let base = child.offset(range.start);
             let mut acc = vec![0.0; c];
@@ -1343,7 +1344,7 @@ fn value_row<S: ValueTerms>(
 ) {
     let p = step.parent;
     let l = step.layout;
-    let linear = flags.linear_all || step.scheme == Scheme::Bilinear;
+    let linear = flags.linear(step.scheme);
     let k = r - child.offset(cv);
     let cv32 = cv as u32;
     if cv32 >= l.face_vertex_base && cv32 < l.edge_vertex_base {
