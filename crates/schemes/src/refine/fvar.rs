@@ -18,7 +18,7 @@ use subd_mesh::tags::{is_infinite, is_semi_sharp};
 
 use rayon::prelude::*;
 
-use super::{Lanes, Layout, MaskSink, Refinement, half_sharpness, nm_vertex};
+use super::{Lanes, Layout, MaskSink, Points, Refinement, half_sharpness, nm_vertex};
 use crate::Scheme;
 use crate::rules;
 use crate::stencil::{RowSink, StencilTable};
@@ -190,20 +190,17 @@ impl ValueTerms for RowSink<'_> {
     }
 }
 
-/// A value summed straight from the source values, `acc.len()` numbers each.
-struct ValueSum<'a> {
-    src: &'a [f64],
-    acc: &'a mut [f64],
+/// A value summed straight from the source values.
+struct ValueSum<'a, V> {
+    src: &'a [V],
+    acc: V,
 }
 
-impl ValueTerms for ValueSum<'_> {
+impl<V: Lanes> ValueTerms for ValueSum<'_, V> {
     #[inline]
     fn add(&mut self, i: u32, w: f64) {
-        let c = self.acc.len();
-        let s = &self.src[c * i as usize..c * (i as usize + 1)];
-        for (a, x) in self.acc.iter_mut().zip(s) {
-            *a += w * x;
-        }
+        // `x * w`, the same product as the tables' `w * x`.
+        self.acc += self.src[i as usize] * w;
     }
 }
 
@@ -389,9 +386,9 @@ impl FaceVaryingRefinement {
     /// The values of every level (`result[0]` is `values`), `components` numbers each, as
     /// `InterpolateFaceVarying` gives them (`refinement` is the one the channel was refined
     /// with). The masks are evaluated directly, without stencil tables: values whose masks
-    /// reach only seamless vertices take the geometry's own point evaluation (over one value
-    /// per vertex, kept level to level, one to three numbers at a time), the others walk
-    /// their masks.
+    /// reach only seamless vertices take the geometry's own point evaluation (over the one
+    /// value of each vertex), the others walk their masks. Values of more than three numbers
+    /// are refined three numbers at a time.
     ///
     /// # Panics
     /// If `values` is not `components` numbers per value of the channel.
@@ -406,53 +403,65 @@ impl FaceVaryingRefinement {
             components * self.num_user_values,
             "components numbers per value"
         );
-        match components {
-            1 => self.refine_lanes::<f64>(refinement, values, components),
-            2 => self.refine_lanes::<glam::DVec2>(refinement, values, components),
-            _ => self.refine_lanes::<DVec3>(refinement, values, components),
+        let c = components;
+        if c <= 3 {
+            return self.refine_columns(refinement, values, c);
+        }
+        // Three numbers at a time (the last group one to three), interleaved back per level.
+        let starts: Vec<usize> = (0..c).step_by(3).collect();
+        let groups: Vec<Vec<Vec<f64>>> = starts
+            .iter()
+            .map(|&first| {
+                let w = (c - first).min(3);
+                let part: Vec<f64> = values
+                    .chunks_exact(c)
+                    .flat_map(|v| &v[first..first + w])
+                    .copied()
+                    .collect();
+                self.refine_columns(refinement, &part, w)
+            })
+            .collect();
+        (0..self.levels.len())
+            .map(|l| {
+                let n = groups[0][l].len() / 3;
+                let mut level = Vec::with_capacity(c * n);
+                for i in 0..n {
+                    for (&first, g) in starts.iter().zip(&groups) {
+                        let w = (c - first).min(3);
+                        level.extend_from_slice(&g[l][w * i..w * (i + 1)]);
+                    }
+                }
+                level
+            })
+            .collect()
+    }
+
+    /// [`Self::refine_values`] for values of `c` (at most three) numbers, refined as one
+    /// [`Lanes`] point each.
+    fn refine_columns(&self, refinement: &Refinement, values: &[f64], c: usize) -> Vec<Vec<f64>> {
+        match c {
+            0 => vec![Vec::new(); self.levels.len()],
+            1 => self.refine_lanes::<f64>(refinement, values),
+            2 => self.refine_lanes::<glam::DVec2>(refinement, values),
+            _ => self.refine_lanes::<DVec3>(refinement, values),
         }
     }
 
-    /// [`Self::refine_values`] with the geometric rows `V::WIDTH` numbers at a time.
-    fn refine_lanes<V: Lanes>(
-        &self,
-        refinement: &Refinement,
-        values: &[f64],
-        c: usize,
-    ) -> Vec<Vec<f64>> {
-        let linear = self.flags.linear(refinement.scheme());
-        let groups = if linear { 0 } else { c.div_ceil(V::WIDTH) };
-        let base = &self.levels[0];
-        // One value per base vertex (its first), for the geometric rows of level 1.
-        let mut points: Vec<Vec<V>> = (0..groups)
-            .map(|g| {
-                (0..base.value_offsets.len() - 1)
-                    .into_par_iter()
-                    .map(|u| {
-                        if base.count(u) == 0 {
-                            return V::default();
-                        }
-                        let x = base.source(base.offset(u)) as usize;
-                        V::load(&values[c * x + V::WIDTH * g..c * (x + 1)])
-                    })
-                    .collect()
-            })
-            .collect();
-        let mut out = vec![values.to_vec()];
+    fn refine_lanes<V: Lanes>(&self, refinement: &Refinement, values: &[f64]) -> Vec<Vec<f64>> {
+        let mut out: Vec<Vec<V>> = vec![bytemuck::cast_slice(values).to_vec()];
         for l in 1..self.levels.len() {
             let level = NextValues {
                 step: &refinement.step(l),
                 parent: &self.levels[l - 1],
                 child: &self.levels[l],
                 flags: self.flags,
-                c,
             };
-            let (next, next_points) =
-                level.compute(out.last().expect("level 0"), &points, l < self.num_levels());
+            let next = level.compute(out.last().expect("level 0"));
             out.push(next);
-            points = next_points;
         }
-        out
+        out.into_iter()
+            .map(bytemuck::allocation::cast_vec::<V, f64>)
+            .collect()
     }
 }
 
@@ -498,157 +507,134 @@ fn geometric_vertices(
 /// Child vertices per parallel task.
 const CHUNK: usize = 4096;
 
+/// The one value of each vertex of a level (its first; the geometric rows read only vertices
+/// with one value), as the points of [`super::Step::lane_point`].
+struct FirstValues<'a, V> {
+    level: &'a ChannelLevel,
+    values: &'a [V],
+}
+
+impl<V: Lanes> Points<V> for FirstValues<'_, V> {
+    #[inline]
+    fn point(&self, v: usize) -> V {
+        self.values[self.level.source(self.level.offset(v)) as usize]
+    }
+}
+
+/// The slots of child vertices `vertices`, `slots`, cut into pieces of [`CHUNK`] vertices,
+/// each with its vertices.
+fn pieces<'s, V>(
+    child: &ChannelLevel,
+    vertices: std::ops::Range<usize>,
+    mut slots: &'s mut [MaybeUninit<V>],
+) -> Vec<(std::ops::Range<usize>, &'s mut [MaybeUninit<V>])> {
+    let mut out = Vec::with_capacity(vertices.len().div_ceil(CHUNK));
+    for first in vertices.clone().step_by(CHUNK) {
+        let end = (first + CHUNK).min(vertices.end);
+        let (piece, rest) =
+            std::mem::take(&mut slots).split_at_mut(child.offset(end) - child.offset(first));
+        slots = rest;
+        out.push((first..end, piece));
+    }
+    out
+}
+
 /// One step of [`FaceVaryingRefinement::refine_values`]: the child level's values from the
-/// parent level's, `c` numbers each.
+/// parent level's.
 struct NextValues<'a> {
     step: &'a super::Step<'a>,
     parent: &'a ChannelLevel,
     child: &'a ChannelLevel,
     flags: ModeFlags,
-    c: usize,
 }
 
 impl NextValues<'_> {
-    /// The child level's values from `src`, the parent level's, and `points`, one value per
-    /// parent vertex in groups of `V::WIDTH` numbers (what the geometric rows read; empty in
-    /// the linear modes). With `with_points`, also the child level's one value per vertex.
+    /// The child level's values from `src`, the parent level's.
     ///
-    /// Geometric vertices take the positions' rows ([`super::Step::lane_point`]) over
-    /// `points`, face points first, as `PrimvarRefiner` computes them; the others, next to
-    /// seams and in the linear modes, walk their masks over `src`. Every vertex is computed
-    /// alone, so the result does not depend on the number of threads.
-    fn compute<V: Lanes>(
-        &self,
-        src: &[f64],
-        points: &[Vec<V>],
-        with_points: bool,
-    ) -> (Vec<f64>, Vec<Vec<V>>) {
-        let (step, child, c) = (self.step, self.child, self.c);
-        if c == 0 {
-            return (Vec::new(), Vec::new());
-        }
-        let l = step.layout;
+    /// Geometric vertices take the positions' rows ([`super::Step::lane_point`]) over the
+    /// one value of each parent vertex; the others, next to seams and in the linear modes,
+    /// compute their values from `src` directly. Face children come first, as
+    /// `PrimvarRefiner` computes them: each has one value, so their values are one block of
+    /// the output, in face order, which the vertex and edge rows then read as their face
+    /// points. Every vertex is computed alone, so the result does not depend on the number
+    /// of threads.
+    fn compute<V: Lanes>(&self, src: &[V]) -> Vec<V> {
+        let (l, child) = (self.step.layout, self.child);
         let faces = l.face_vertex_base as usize..l.edge_vertex_base as usize;
-        // The face points over one value per vertex; those of faces with seams are unused.
-        let face_points: Vec<Vec<V>> = points
-            .iter()
-            .map(|src| {
-                let mut fp = crate::memory::with_capacity(faces.len());
-                fp.par_extend(
-                    faces
-                        .clone()
-                        .into_par_iter()
-                        .with_min_len(CHUNK)
-                        .map(|r| step.lane_face_point(r, src)),
-                );
-                fp
-            })
-            .collect();
-        let nv = l.num_child_vertices;
-        let total = c * child.num_values();
-        let mut out: Vec<f64> = crate::memory::with_capacity(total);
-        let mut next: Vec<Vec<V>> = (0..if with_points { points.len() } else { 0 })
-            .map(|_| crate::memory::with_capacity(nv))
-            .collect();
-        // Disjoint pieces of the outputs, CHUNK child vertices each, written once below.
-        let mut pieces = Vec::with_capacity(nv.div_ceil(CHUNK));
-        let mut rest_out = &mut out.spare_capacity_mut()[..total];
-        let mut rest_next: Vec<&mut [MaybeUninit<V>]> = next
-            .iter_mut()
-            .map(|v| &mut v.spare_capacity_mut()[..nv])
-            .collect();
-        for first in (0..nv).step_by(CHUNK) {
-            let end = (first + CHUNK).min(nv);
-            let len = c * (child.offset(end) - child.offset(first));
-            let (o, tail) = std::mem::take(&mut rest_out).split_at_mut(len);
-            rest_out = tail;
-            let n: Vec<&mut [MaybeUninit<V>]> = rest_next
-                .iter_mut()
-                .map(|r| {
-                    let (h, t) = std::mem::take(r).split_at_mut(end - first);
-                    *r = t;
-                    h
-                })
-                .collect();
-            pieces.push((first..end, o, n));
-        }
-        let linear = self.flags.linear(step.scheme);
-        pieces.into_par_iter().for_each(|(range, out, mut next)| {
-            let base = child.offset(range.start);
-            let mut acc = vec![0.0; c];
-            for cv in range.clone() {
-                let slots = child.offset(cv) - base..child.offset(cv + 1) - base;
-                let values = &mut out[c * slots.start..c * slots.end];
+        let total = child.num_values();
+        let mut out: Vec<V> = crate::memory::with_capacity(total);
+        let slots = &mut out.spare_capacity_mut()[..total];
+        let (head, rest) = slots.split_at_mut(child.offset(faces.start));
+        let (middle, tail) = rest.split_at_mut(child.offset(faces.end) - child.offset(faces.start));
+        self.fill(pieces(child, faces.clone(), middle), src, &[]);
+        #[allow(unsafe_code)]
+        // SAFETY: `fill` wrote every slot of the face children (the pieces cover `middle`,
+        // and each vertex writes all of its slots), so viewing them as initialised is sound;
+        // `MaybeUninit<V>` has `V`'s layout.
+        let face_points: &[V] =
+            unsafe { std::slice::from_raw_parts(middle.as_ptr().cast::<V>(), middle.len()) };
+        let mut rest = pieces(child, 0..faces.start, head);
+        rest.extend(pieces(child, faces.end..l.num_child_vertices, tail));
+        self.fill(rest, src, face_points);
+        #[allow(unsafe_code)]
+        // SAFETY: the two `fill`s wrote every slot of `0..total` (head, middle and tail
+        // partition it, and each vertex writes all of its slots), within the capacity
+        // `with_capacity` reserved. A panic unwinds before this, leaving the length 0.
+        unsafe {
+            out.set_len(total)
+        };
+        out
+    }
+
+    /// Writes the values of the child vertices of each piece into its slots, reading the
+    /// child face points `face_points` (empty while the face children themselves are
+    /// filled, whose rows read none).
+    fn fill<V: Lanes>(
+        &self,
+        pieces: Vec<(std::ops::Range<usize>, &mut [MaybeUninit<V>])>,
+        src: &[V],
+        face_points: &[V],
+    ) {
+        let (step, parent, child, flags) = (self.step, self.parent, self.child, self.flags);
+        let linear = flags.linear(step.scheme);
+        let firsts = FirstValues {
+            level: parent,
+            values: src,
+        };
+        pieces.into_par_iter().for_each(|(vertices, out)| {
+            let base = child.offset(vertices.start);
+            for cv in vertices {
+                let first = child.offset(cv);
+                let values = &mut out[first - base..child.offset(cv + 1) - base];
                 if linear {
-                    for (k, value) in values.chunks_exact_mut(c).enumerate() {
-                        for first in (0..c).step_by(V::WIDTH) {
-                            let lanes = first..(first + V::WIDTH).min(c);
-                            self.linear_value::<V>(src, cv, k, first)
-                                .store(&mut value[lanes]);
-                        }
+                    for (k, value) in values.iter_mut().enumerate() {
+                        value.write(self.linear_value(src, cv, k));
                     }
-                    continue;
-                }
-                if child.geometric.get(cv) == Some(&true) {
-                    for (g, (src, fp)) in points.iter().zip(&face_points).enumerate() {
-                        let q = if faces.contains(&cv) {
-                            fp[cv - faces.start]
-                        } else {
-                            step.lane_point(cv, src, fp)
+                } else if child.geometric[cv] {
+                    values[0].write(step.lane_point(cv, &firsts, face_points));
+                } else {
+                    for (k, value) in values.iter_mut().enumerate() {
+                        let mut sum = ValueSum {
+                            src,
+                            acc: V::default(),
                         };
-                        q.store(&mut values[V::WIDTH * g..(V::WIDTH * (g + 1)).min(c)]);
-                        if let Some(n) = next.get_mut(g) {
-                            n[cv - range.start].write(q);
-                        }
-                    }
-                    continue;
-                }
-                for (k, value) in values.chunks_exact_mut(c).enumerate() {
-                    acc.fill(0.0);
-                    let r = child.offset(cv) + k;
-                    let mut sum = ValueSum { src, acc: &mut acc };
-                    value_row(step, self.parent, child, self.flags, r, cv, &mut sum);
-                    for (d, &x) in value.iter_mut().zip(&acc) {
-                        d.write(x);
-                    }
-                    // The first value stands for the vertex in the next level's geometric
-                    // rows (which read only vertices with one value).
-                    if k == 0 {
-                        for (g, n) in next.iter_mut().enumerate() {
-                            n[cv - range.start].write(V::load(&acc[V::WIDTH * g..]));
-                        }
-                    }
-                }
-                if slots.is_empty() {
-                    for n in next.iter_mut() {
-                        n[cv - range.start].write(V::default());
+                        value_row(step, parent, child, flags, first + k, cv, &mut sum);
+                        value.write(sum.acc);
                     }
                 }
             }
         });
-        #[allow(unsafe_code)]
-        // SAFETY: the pieces cover `0..total` of `out` and `0..nv` of every `next`, and the
-        // loop writes every element of them: a geometric vertex its one value (all `c`
-        // numbers, over the groups) and its point, any other vertex each of its values and
-        // its point (the first value, or zero without values).
-        unsafe {
-            out.set_len(total);
-            for n in &mut next {
-                n.set_len(nv);
-            }
-        }
-        (out, next)
     }
 
-    /// In the linear modes, numbers `first..` of value `k` of child vertex `cv`: what
-    /// [`value_row`] gives (the same products in the same order) without walking a mask. A
-    /// vertex's values stay, a face's value is the mean of its corners' values, and an
-    /// edge's the mean of its ends' values on the value's side.
+    /// In the linear modes, value `k` of child vertex `cv`: what [`value_row`] gives (the
+    /// same products in the same order) without walking a mask. A vertex's values stay, a
+    /// face's value is the mean of its corners' values, and an edge's the mean of its ends'
+    /// values on the value's side.
     #[inline]
-    fn linear_value<V: Lanes>(&self, src: &[f64], cv: usize, k: usize, first: usize) -> V {
-        let (step, parent, c) = (self.step, self.parent, self.c);
+    fn linear_value<V: Lanes>(&self, src: &[V], cv: usize, k: usize) -> V {
+        let (step, parent) = (self.step, self.parent);
         let (p, l) = (step.parent, step.layout);
-        let at = |i: u32| V::load(&src[c * i as usize + first..c * (i as usize + 1)]);
+        let at = |i: u32| src[i as usize];
         let cv32 = cv as u32;
         if cv32 < l.face_vertex_base {
             return at(parent.source(parent.offset(cv) + k));

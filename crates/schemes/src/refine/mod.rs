@@ -407,85 +407,53 @@ impl MaskSink for RowSink<'_> {
 }
 
 /// Numbers refined together as one point: positions (`DVec3`), or a face-varying channel's
-/// values one, two or three numbers at a time.
+/// values one, two or three numbers at a time (a value is then a plain run of `f64`s, hence
+/// `Pod`).
 pub(crate) trait Lanes:
     Copy
     + Default
     + Send
     + Sync
-    + bytemuck::Zeroable
+    + bytemuck::Pod
     + std::ops::Add<Output = Self>
     + std::ops::AddAssign
     + std::ops::Mul<f64, Output = Self>
 {
-    /// Numbers per point.
-    const WIDTH: usize;
-    /// Number `i` (below `WIDTH`) of the point.
-    fn lane(self, i: usize) -> f64;
-    /// The point made of `s` (at most `WIDTH` numbers), the rest zero.
-    fn load(s: &[f64]) -> Self;
-    /// Writes the first `d.len()` (at most `WIDTH`) numbers of the point to `d`.
-    #[inline]
-    fn store(self, d: &mut [std::mem::MaybeUninit<f64>]) {
-        for (i, x) in d.iter_mut().enumerate() {
-            x.write(self.lane(i));
-        }
-    }
 }
 
-impl Lanes for f64 {
-    const WIDTH: usize = 1;
-    #[inline]
-    fn lane(self, _i: usize) -> f64 {
-        self
-    }
-    #[inline]
-    fn load(s: &[f64]) -> f64 {
-        s.first().copied().unwrap_or(0.0)
-    }
+impl Lanes for f64 {}
+impl Lanes for glam::DVec2 {}
+impl Lanes for DVec3 {}
+
+/// Points a row reads by index: a slice of them, or (face-varying) the one value of each
+/// vertex of a level, found through the level's value offsets.
+pub(crate) trait Points<V>: Sync {
+    /// Point `i`.
+    fn point(&self, i: usize) -> V;
 }
 
-impl Lanes for glam::DVec2 {
-    const WIDTH: usize = 2;
+impl<V: Copy + Sync> Points<V> for [V] {
     #[inline]
-    fn lane(self, i: usize) -> f64 {
+    fn point(&self, i: usize) -> V {
         self[i]
-    }
-    #[inline]
-    fn load(s: &[f64]) -> glam::DVec2 {
-        let at = |i: usize| s.get(i).copied().unwrap_or(0.0);
-        glam::DVec2::new(at(0), at(1))
-    }
-}
-
-impl Lanes for DVec3 {
-    const WIDTH: usize = 3;
-    #[inline]
-    fn lane(self, i: usize) -> f64 {
-        self[i]
-    }
-    #[inline]
-    fn load(s: &[f64]) -> DVec3 {
-        let at = |i: usize| s.get(i).copied().unwrap_or(0.0);
-        DVec3::new(at(0), at(1), at(2))
     }
 }
 
 /// Accumulates a child point from parent points and the already computed child face points.
-struct PointSink<'a, V> {
-    src: &'a [V],
-    face_points: &'a [V],
+struct PointSink<'a, V, S: ?Sized, F: ?Sized> {
+    src: &'a S,
+    face_points: &'a F,
     acc: V,
 }
 
-impl<V: Lanes> MaskSink for PointSink<'_, V> {
+impl<V: Lanes, S: Points<V> + ?Sized, F: Points<V> + ?Sized> MaskSink for PointSink<'_, V, S, F> {
     #[inline]
     fn vertex(&mut self, i: u32, w: f64) {
-        self.acc += self.src[i as usize] * w;
+        self.acc += self.src.point(i as usize) * w;
     }
     #[inline]
     fn face(&mut self, _p: &Topology, f: usize, w: f64) {
-        self.acc += self.face_points[f] * w;
+        self.acc += self.face_points.point(f) * w;
     }
 }
 
@@ -740,7 +708,12 @@ impl Step<'_> {
     }
 
     /// The child point of row `r` through the general mask machinery.
-    fn general_point<V: Lanes>(&self, r: usize, src: &[V], face_points: &[V]) -> V {
+    fn general_point<V: Lanes, S: Points<V> + ?Sized, F: Points<V> + ?Sized>(
+        &self,
+        r: usize,
+        src: &S,
+        face_points: &F,
+    ) -> V {
         let mut s = PointSink {
             src,
             face_points,
@@ -750,19 +723,18 @@ impl Step<'_> {
         s.acc
     }
 
-    /// The child point of row `r` from parent points `src` and the child face points
-    /// `face_points` (which row `r` must not be one of): what [`StepRows`] gives, for points
-    /// of any width.
+    /// The child point of row `r` from parent points `src` and, unless `r` is a face row,
+    /// the child face points `face_points` (indexed by parent face): what [`StepRows`]
+    /// gives, for points of any width read through any [`Points`].
     #[inline]
-    pub(crate) fn lane_point<V: Lanes>(&self, r: usize, src: &[V], face_points: &[V]) -> V {
+    pub(crate) fn lane_point<V: Lanes, S: Points<V> + ?Sized, F: Points<V> + ?Sized>(
+        &self,
+        r: usize,
+        src: &S,
+        face_points: &F,
+    ) -> V {
         self.smooth_catmark_point(r, src, face_points)
             .unwrap_or_else(|| self.general_point(r, src, face_points))
-    }
-
-    /// The child point of face row `r` from parent points `src`.
-    #[inline]
-    pub(crate) fn lane_face_point<V: Lanes>(&self, r: usize, src: &[V]) -> V {
-        self.general_point(r, src, &[])
     }
 }
 
@@ -784,13 +756,11 @@ impl rows::PointRows for StepRows<'_> {
     }
 
     fn middle_row(&self, r: usize) -> DVec3 {
-        self.step.general_point(r, self.src, &[])
+        self.step.general_point(r, self.src, &[][..])
     }
 
     fn row(&self, r: usize, face_points: &[DVec3]) -> DVec3 {
-        self.step
-            .smooth_catmark_point(r, self.src, face_points)
-            .unwrap_or_else(|| self.step.general_point(r, self.src, face_points))
+        self.step.lane_point(r, self.src, face_points)
     }
 }
 
@@ -800,7 +770,12 @@ impl Step<'_> {
     /// smooth-triangle rule. Same sums in the same order as [`Step::row`] with a
     /// [`PointSink`], so the results are identical bit for bit; `None` for every other row.
     #[inline]
-    fn smooth_catmark_point<V: Lanes>(&self, r: usize, src: &[V], face_points: &[V]) -> Option<V> {
+    fn smooth_catmark_point<V: Lanes, S: Points<V> + ?Sized, F: Points<V> + ?Sized>(
+        &self,
+        r: usize,
+        src: &S,
+        face_points: &F,
+    ) -> Option<V> {
         if self.scheme != Scheme::CatmullClark {
             return None;
         }
@@ -819,13 +794,17 @@ impl Step<'_> {
             // `x * w` rather than `w * x`: the same product, for any width.
             let mut acc = V::default();
             for &f in faces {
-                acc += face_points[f as usize] * w;
+                acc += face_points.point(f as usize) * w;
             }
             for &e in p.vertex_edges(r) {
-                acc += src[p.edge_other_vertex(e as usize, r32) as usize] * w;
+                acc += src.point(p.edge_other_vertex(e as usize, r32) as usize) * w;
             }
             let nf = n as f64;
-            return Some(acc + src[r] * ((nf - 2.0) / nf));
+            return Some(acc + src.point(r) * ((nf - 2.0) / nf));
+        }
+        if r32 < l.edge_vertex_base {
+            // A face row: the general mask, which reads no face points.
+            return None;
         }
         let e = (r32 - l.edge_vertex_base) as usize;
         let faces = p.edge_faces(e);
@@ -836,10 +815,10 @@ impl Step<'_> {
             return None;
         }
         let [a, b] = p.edge_vertices(e);
-        let mut acc = src[a as usize] * 0.25;
-        acc += src[b as usize] * 0.25;
-        acc += face_points[faces[0] as usize] * 0.25;
-        acc += face_points[faces[1] as usize] * 0.25;
+        let mut acc = src.point(a as usize) * 0.25;
+        acc += src.point(b as usize) * 0.25;
+        acc += face_points.point(faces[0] as usize) * 0.25;
+        acc += face_points.point(faces[1] as usize) * 0.25;
         Some(acc)
     }
 }
