@@ -346,6 +346,59 @@ fn vertex_child_edges(p: &Topology, hb: u32, out: &mut [u32]) {
 /// Every relation is filled in parallel blocks; offsets come in closed form from the
 /// parent's offsets.
 pub(crate) fn quad_split(p: &Topology) -> TopologyParts {
+    let nh = p.num_face_vertices();
+    let (face_vertices, face_edges) = quad_face_relations(p);
+    let (edge_face_offsets, edge_faces, edge_face_local) = quad_edge_faces(p);
+    let (vertex_face_offsets, vertex_faces, vertex_face_local) = quad_vertex_faces(p);
+    let (vertex_edge_offsets, vertex_edges) = quad_vertex_edges(p);
+    let (edge_boundary, edge_non_manifold, vertex_non_manifold) =
+        inherited_flags(p, nh, p.num_faces());
+    TopologyParts {
+        num_vertices: p.num_vertices() + p.num_faces() + p.num_edges(),
+        face_offsets: uniform_offsets(nh, 4),
+        face_vertices,
+        face_edges,
+        edge_vertices: quad_edge_vertices(p),
+        edge_face_offsets,
+        edge_faces,
+        edge_face_local,
+        vertex_face_offsets,
+        vertex_faces,
+        vertex_face_local,
+        vertex_edge_offsets,
+        vertex_edges,
+        edge_boundary,
+        edge_non_manifold,
+        vertex_non_manifold,
+        ..TopologyParts::default()
+    }
+}
+
+/// The quad split's child faces' vertices and edges, four each per parent face-vertex.
+fn quad_face_relations(p: &Topology) -> (Vec<u32>, Vec<u32>) {
+    let (nf, nh) = (p.num_faces(), p.num_face_vertices());
+    if all_quads(p) {
+        return (
+            per_face(nf, |f| quad_child_vertices(p, f)),
+            per_face(nf, |f| quad_child_edges(p, f)),
+        );
+    }
+    let off = p.face_offsets();
+    let mut face_vertices = memory::zeroed(4 * nh);
+    let mut face_edges = memory::zeroed(4 * nh);
+    par::fill_pair(
+        &mut face_vertices,
+        &mut face_edges,
+        nf,
+        |f| 4 * off[f] as usize,
+        |r, verts, edges| quad_face_block(p, r, verts, Some(edges)),
+    );
+    (face_vertices, face_edges)
+}
+
+/// The quad split's child edges' vertices: I_f[j] = (F, E_j) for the face edges, then
+/// H(e, k) = (E, V_{e.v[k]}).
+fn quad_edge_vertices(p: &Topology) -> Vec<[u32; 2]> {
     let (nv, nf, ne, nh) = (
         p.num_vertices(),
         p.num_faces(),
@@ -353,34 +406,8 @@ pub(crate) fn quad_split(p: &Topology) -> TopologyParts {
         p.num_face_vertices(),
     );
     let off = p.face_offsets();
-    let pefo = p.edge_face_offsets();
-    let pvfo = p.vertex_face_offsets();
-    let pveo = p.vertex_edge_offsets();
     let face_point = |f: usize| (nv + f) as u32;
     let edge_point = |e: usize| (nv + nf + e) as u32;
-    let hb = nh as u32;
-    let size = |f: usize| (off[f + 1] - off[f]) as usize;
-
-    let (face_vertices, face_edges) = if all_quads(p) {
-        (
-            per_face(nf, |f| quad_child_vertices(p, f)),
-            per_face(nf, |f| quad_child_edges(p, f)),
-        )
-    } else {
-        let mut face_vertices = memory::zeroed(4 * nh);
-        let mut face_edges = memory::zeroed(4 * nh);
-        par::fill_pair(
-            &mut face_vertices,
-            &mut face_edges,
-            nf,
-            |f| 4 * off[f] as usize,
-            |r, verts, edges| quad_face_block(p, r, verts, Some(edges)),
-        );
-        (face_vertices, face_edges)
-    };
-    let face_offsets = uniform_offsets(nh, 4);
-
-    // Edges: I_f[j] = (F, E_j) for the face edges, then H(e, k) = (E, V_{e.v[k]}).
     let mut edge_vertices = memory::zeroed::<[u32; 2]>(nh + 2 * ne);
     let (interior, halves) = edge_vertices.split_at_mut(nh);
     par::fill(
@@ -398,40 +425,50 @@ pub(crate) fn quad_split(p: &Topology) -> TopologyParts {
         },
     );
     half_edge_vertices(p, nv + nf, halves);
+    edge_vertices
+}
 
-    // Edge -> faces: two per interior edge; as many per half as the parent edge has faces.
+/// The quad split's edge -> faces (offsets, faces, local indices): two per interior edge;
+/// as many per half as the parent edge has faces.
+fn quad_edge_faces(p: &Topology) -> (Vec<u32>, Vec<u32>, Vec<u16>) {
+    let (nf, ne, nh) = (p.num_faces(), p.num_edges(), p.num_face_vertices());
+    let off = p.face_offsets();
+    let pefo = p.edge_face_offsets();
     let total_ef = 2 * nh + 2 * pefo[ne] as usize;
     let edge_face_offsets = child_edge_face_offsets(p, nh);
-    let ef_start = |e: usize| 2 * pefo[e] as usize;
     let mut edge_faces = memory::zeroed(total_ef);
     let mut edge_face_local = memory::zeroed(total_ef);
-    {
-        let (fa, fb) = edge_faces.split_at_mut(2 * nh);
-        let (la, lb) = edge_face_local.split_at_mut(2 * nh);
-        par::fill_pair(
-            fa,
-            la,
-            nf,
-            |f| 2 * off[f] as usize,
-            |r, faces, local| {
-                let mut i = 0;
-                for f in r {
-                    let n = size(f);
-                    let base = off[f];
-                    for j in 0..n {
-                        faces[i] = base + j as u32;
-                        faces[i + 1] = base + ((j + 1) % n) as u32;
-                        (local[i], local[i + 1]) = if n == 4 {
-                            (((j + 1) % 4) as u16, ((j + 3) % 4) as u16)
-                        } else {
-                            (1, 2)
-                        };
-                        i += 2;
-                    }
+    let (fa, fb) = edge_faces.split_at_mut(2 * nh);
+    let (la, lb) = edge_face_local.split_at_mut(2 * nh);
+    par::fill_pair(
+        fa,
+        la,
+        nf,
+        |f| 2 * off[f] as usize,
+        |r, faces, local| {
+            let mut i = 0;
+            for f in r {
+                let n = p.face_size(f);
+                let base = off[f];
+                for j in 0..n {
+                    faces[i] = base + j as u32;
+                    faces[i + 1] = base + ((j + 1) % n) as u32;
+                    (local[i], local[i + 1]) = if n == 4 {
+                        (((j + 1) % 4) as u16, ((j + 3) % 4) as u16)
+                    } else {
+                        (1, 2)
+                    };
+                    i += 2;
                 }
-            },
-        );
-        par::fill_pair(fb, lb, ne, ef_start, |r, faces, local| {
+            }
+        },
+    );
+    par::fill_pair(
+        fb,
+        lb,
+        ne,
+        |e| 2 * pefo[e] as usize,
+        |r, faces, local| {
             let mut i = 0;
             for e in r {
                 let ev = p.edge_vertices(e);
@@ -439,7 +476,7 @@ pub(crate) fn quad_split(p: &Topology) -> TopologyParts {
                 for k in 0..2usize {
                     for (&pf, &l) in p.edge_faces(e).iter().zip(p.edge_face_local_indices(e)) {
                         let (pf, l) = (pf as usize, l as usize);
-                        let n = size(pf);
+                        let n = p.face_size(pf);
                         let c = if degenerate {
                             k
                         } else {
@@ -457,10 +494,23 @@ pub(crate) fn quad_split(p: &Topology) -> TopologyParts {
                     }
                 }
             }
-        });
-    }
+        },
+    );
+    (edge_face_offsets, edge_faces, edge_face_local)
+}
 
-    // Vertex -> faces: V_v (as the parent), F_f (n), E_e (two per parent face).
+/// The quad split's vertex -> faces (offsets, faces, local indices): V_v (as the parent),
+/// F_f (n), E_e (two per parent face).
+fn quad_vertex_faces(p: &Topology) -> (Vec<u32>, Vec<u32>, Vec<u16>) {
+    let (nv, nf, ne, nh) = (
+        p.num_vertices(),
+        p.num_faces(),
+        p.num_edges(),
+        p.num_face_vertices(),
+    );
+    let off = p.face_offsets();
+    let pefo = p.edge_face_offsets();
+    let pvfo = p.vertex_face_offsets();
     let nvf = pvfo[nv] as usize;
     let vertex_face_offsets = child_vertex_offsets(
         pvfo,
@@ -472,50 +522,54 @@ pub(crate) fn quad_split(p: &Topology) -> TopologyParts {
     let total_vf = nvf + nh + 2 * pefo[ne] as usize;
     let mut vertex_faces = memory::zeroed(total_vf);
     let mut vertex_face_local = memory::zeroed(total_vf);
-    {
-        let (fa, rest) = vertex_faces.split_at_mut(nvf);
-        let (fb, fc) = rest.split_at_mut(nh);
-        let (la, rest) = vertex_face_local.split_at_mut(nvf);
-        let (lb, lc) = rest.split_at_mut(nh);
-        par::fill_pair(
-            fa,
-            la,
-            nv,
-            |v| pvfo[v] as usize,
-            |r, faces, local| {
-                let mut i = 0;
-                for v in r {
-                    for (&pf, &c) in p.vertex_faces(v).iter().zip(p.vertex_face_local_indices(v)) {
-                        faces[i] = off[pf as usize] + c as u32;
-                        local[i] = if size(pf as usize) == 4 { c } else { 0 };
-                        i += 1;
-                    }
+    let (fa, rest) = vertex_faces.split_at_mut(nvf);
+    let (fb, fc) = rest.split_at_mut(nh);
+    let (la, rest) = vertex_face_local.split_at_mut(nvf);
+    let (lb, lc) = rest.split_at_mut(nh);
+    par::fill_pair(
+        fa,
+        la,
+        nv,
+        |v| pvfo[v] as usize,
+        |r, faces, local| {
+            let mut i = 0;
+            for v in r {
+                for (&pf, &c) in p.vertex_faces(v).iter().zip(p.vertex_face_local_indices(v)) {
+                    faces[i] = off[pf as usize] + c as u32;
+                    local[i] = if p.face_size(pf as usize) == 4 { c } else { 0 };
+                    i += 1;
                 }
-            },
-        );
-        par::fill_pair(
-            fb,
-            lb,
-            nf,
-            |f| off[f] as usize,
-            |r, faces, local| {
-                let mut i = 0;
-                for f in r {
-                    let n = size(f);
-                    for j in 0..n {
-                        faces[i] = off[f] + j as u32;
-                        local[i] = if n == 4 { ((j + 2) % 4) as u16 } else { 2 };
-                        i += 1;
-                    }
+            }
+        },
+    );
+    par::fill_pair(
+        fb,
+        lb,
+        nf,
+        |f| off[f] as usize,
+        |r, faces, local| {
+            let mut i = 0;
+            for f in r {
+                let n = p.face_size(f);
+                for j in 0..n {
+                    faces[i] = off[f] + j as u32;
+                    local[i] = if n == 4 { ((j + 2) % 4) as u16 } else { 2 };
+                    i += 1;
                 }
-            },
-        );
-        par::fill_pair(fc, lc, ne, ef_start, |r, faces, local| {
+            }
+        },
+    );
+    par::fill_pair(
+        fc,
+        lc,
+        ne,
+        |e| 2 * pefo[e] as usize,
+        |r, faces, local| {
             let mut i = 0;
             for e in r {
                 for (&pf, &l) in p.edge_faces(e).iter().zip(p.edge_face_local_indices(e)) {
                     let (pf, l) = (pf as usize, l as usize);
-                    let n = size(pf);
+                    let n = p.face_size(pf);
                     faces[i] = off[pf] + ((l + 1) % n) as u32;
                     faces[i + 1] = off[pf] + l as u32;
                     (local[i], local[i + 1]) = if n == 4 {
@@ -526,11 +580,25 @@ pub(crate) fn quad_split(p: &Topology) -> TopologyParts {
                     i += 2;
                 }
             }
-        });
-    }
+        },
+    );
+    (vertex_face_offsets, vertex_faces, vertex_face_local)
+}
 
-    // Vertex -> edges: V_v (halves, as the parent), F_f (interior, leading edges first),
-    // E_e (halves and interior edges interleaved, in OpenSubdiv's order).
+/// The quad split's vertex -> edges (offsets, edges): V_v (halves, as the parent), F_f
+/// (interior, leading edges first), E_e (halves and interior edges interleaved, in
+/// OpenSubdiv's order).
+fn quad_vertex_edges(p: &Topology) -> (Vec<u32>, Vec<u32>) {
+    let (nv, nf, ne, nh) = (
+        p.num_vertices(),
+        p.num_faces(),
+        p.num_edges(),
+        p.num_face_vertices(),
+    );
+    let off = p.face_offsets();
+    let pefo = p.edge_face_offsets();
+    let pveo = p.vertex_edge_offsets();
+    let hb = nh as u32;
     let nve = pveo[nv] as usize;
     let vertex_edge_offsets = child_vertex_offsets(
         pveo,
@@ -541,78 +609,55 @@ pub(crate) fn quad_split(p: &Topology) -> TopologyParts {
     );
     let total_ve = nve + nh + pefo[ne] as usize + 2 * ne;
     let mut vertex_edges = memory::zeroed(total_ve);
-    {
-        let (a, rest) = vertex_edges.split_at_mut(nve);
-        let (b, c) = rest.split_at_mut(nh);
-        vertex_child_edges(p, hb, a);
-        par::fill(
-            b,
-            nf,
-            |f| off[f] as usize,
-            |r, out| {
-                let mut i = 0;
-                for f in r {
-                    let n = size(f) as u32;
-                    let base = off[f];
-                    out[i] = base + n - 1;
-                    for j in 0..n - 1 {
-                        out[i + 1 + j as usize] = base + j;
-                    }
-                    i += n as usize;
+    let (a, rest) = vertex_edges.split_at_mut(nve);
+    let (b, c) = rest.split_at_mut(nh);
+    vertex_child_edges(p, hb, a);
+    par::fill(
+        b,
+        nf,
+        |f| off[f] as usize,
+        |r, out| {
+            let mut i = 0;
+            for f in r {
+                let n = p.face_size(f) as u32;
+                let base = off[f];
+                out[i] = base + n - 1;
+                for j in 0..n - 1 {
+                    out[i + 1 + j as usize] = base + j;
                 }
-            },
-        );
-        par::fill(
-            c,
-            ne,
-            |e| pefo[e] as usize + 2 * e,
-            |r, out| {
-                let mut i = 0;
-                for e in r {
-                    let ev = p.edge_vertices(e);
-                    let ef = p.edge_faces(e);
-                    let el = p.edge_face_local_indices(e);
-                    let (h0, h1) = (hb + half(e as u32, 0), hb + half(e as u32, 1));
-                    let first = off[ef[0] as usize] + el[0] as u32;
-                    let same_dir =
-                        ev[0] != ev[1] && p.face_vertices(ef[0] as usize)[el[0] as usize] == ev[0];
-                    let head = if same_dir {
-                        [h1, first, h0]
-                    } else {
-                        [h0, first, h1]
-                    };
-                    out[i..i + 3].copy_from_slice(&head);
-                    i += 3;
-                    for (&pf, &l) in ef.iter().zip(el).skip(1) {
-                        out[i] = off[pf as usize] + l as u32;
-                        i += 1;
-                    }
+                i += n as usize;
+            }
+        },
+    );
+    par::fill(
+        c,
+        ne,
+        |e| pefo[e] as usize + 2 * e,
+        |r, out| {
+            let mut i = 0;
+            for e in r {
+                let ev = p.edge_vertices(e);
+                let ef = p.edge_faces(e);
+                let el = p.edge_face_local_indices(e);
+                let (h0, h1) = (hb + half(e as u32, 0), hb + half(e as u32, 1));
+                let first = off[ef[0] as usize] + el[0] as u32;
+                let same_dir =
+                    ev[0] != ev[1] && p.face_vertices(ef[0] as usize)[el[0] as usize] == ev[0];
+                let head = if same_dir {
+                    [h1, first, h0]
+                } else {
+                    [h0, first, h1]
+                };
+                out[i..i + 3].copy_from_slice(&head);
+                i += 3;
+                for (&pf, &l) in ef.iter().zip(el).skip(1) {
+                    out[i] = off[pf as usize] + l as u32;
+                    i += 1;
                 }
-            },
-        );
-    }
-
-    let (edge_boundary, edge_non_manifold, vertex_non_manifold) = inherited_flags(p, nh, nf);
-
-    TopologyParts {
-        num_vertices: nv + nf + ne,
-        face_offsets,
-        face_vertices,
-        face_edges,
-        edge_vertices,
-        edge_face_offsets,
-        edge_faces,
-        edge_face_local,
-        vertex_face_offsets,
-        vertex_faces,
-        vertex_face_local,
-        vertex_edge_offsets,
-        vertex_edges,
-        edge_boundary,
-        edge_non_manifold,
-        vertex_non_manifold,
-        ..TopologyParts::default()
-    }
+            }
+        },
+    );
+    (vertex_edge_offsets, vertex_edges)
 }
 
 /// The triangle split of Loop: every triangle becomes four (the relations; the caller adds
