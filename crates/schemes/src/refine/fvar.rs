@@ -447,6 +447,8 @@ impl FaceVaryingRefinement {
         }
     }
 
+    /// Every level's values from `values`, one `V` per value: refined as slices of `V`,
+    /// handed back as `f64`s in the same allocations.
     fn refine_lanes<V: Lanes>(&self, refinement: &Refinement, values: &[f64]) -> Vec<Vec<f64>> {
         let mut out: Vec<Vec<V>> = vec![bytemuck::cast_slice(values).to_vec()];
         for l in 1..self.levels.len() {
