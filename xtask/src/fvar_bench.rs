@@ -46,8 +46,9 @@ pub fn torus_uv(mesh: &Mesh) -> FVarChannel {
     FVarChannel::new(t, 2, values, indices).expect("indices made for the topology")
 }
 
-/// Runs the benchmark and prints a table: setup (topology refinement with the channel) and
-/// values (the refinement of the UVs), medians of `repeats` runs. Each level is measured in
+/// Runs the benchmark and prints a table: setup (topology refinement with the channel),
+/// values (the refinement of the UVs, allocating each level's output) and values again into
+/// those outputs, medians of `repeats` runs. Each level is measured in
 /// `rounds` back-to-back rounds of (OpenSubdiv, subd on one thread, subd on all threads);
 /// times are medians over the rounds and each ratio the median of the rounds' ratios, so a
 /// slow spell of the shared machine hits both sides of a ratio.
@@ -62,7 +63,7 @@ pub fn run(levels: usize, repeats: usize, rounds: usize) -> Result<(), String> {
         uv.num_values()
     );
     println!(
-        "{:<14} {:>5} {:>11} {:>11} {:>11} {:>11} {:>9} {:>9}",
+        "{:<14} {:>5} {:>11} {:>11} {:>11} {:>11} {:>9} {:>9} {:>11} {:>11} {:>9} {:>9}",
         "mode",
         "level",
         "osd topo",
@@ -70,7 +71,11 @@ pub fn run(levels: usize, repeats: usize, rounds: usize) -> Result<(), String> {
         "subd setup",
         "subd values",
         "values×",
-        "values×N"
+        "values×N",
+        "osd into",
+        "subd into",
+        "into×",
+        "into×N"
     );
     for mode in [
         FVarLinearInterpolation::CornersPlus1,
@@ -88,12 +93,12 @@ pub fn run(levels: usize, repeats: usize, rounds: usize) -> Result<(), String> {
                 uv.values(),
                 uv.indices(),
             );
-            let measure = |n: usize| -> Result<(f64, f64), String> {
+            let measure = |n: usize| -> Result<[f64; 3], String> {
                 let pool = rayon::ThreadPoolBuilder::new()
                     .num_threads(n)
                     .build()
                     .map_err(|e| e.to_string())?;
-                let (mut setup, mut values) = (Vec::new(), Vec::new());
+                let (mut setup, mut values, mut into) = (Vec::new(), Vec::new(), Vec::new());
                 for _ in 0..repeats {
                     pool.install(|| {
                         let t0 = Instant::now();
@@ -106,18 +111,26 @@ pub fn run(levels: usize, repeats: usize, rounds: usize) -> Result<(), String> {
                         .expect("refine");
                         let fr = FaceVaryingRefinement::new(&r, &uv, mode).expect("channel");
                         let t1 = Instant::now();
-                        let out = fr.refine_values(&r, uv.values(), 2);
+                        let mut out = fr.refine_values(&r, uv.values(), 2);
                         let t2 = Instant::now();
+                        // Again into the same buffers, as the OpenSubdiv side does.
+                        for level in 1..=l {
+                            let (done, rest) = out.split_at_mut(level);
+                            fr.refine_level_into(&r, level, &done[level - 1], &mut rest[0], 2);
+                        }
+                        let t3 = Instant::now();
                         std::hint::black_box(out);
                         setup.push((t1 - t0).as_secs_f64());
                         values.push((t2 - t1).as_secs_f64());
+                        into.push((t3 - t2).as_secs_f64());
                     });
                 }
-                Ok((median(setup), median(values)))
+                Ok([median(setup), median(values), median(into)])
             };
-            // Per round: OpenSubdiv topology and values, subd setup and values on one
-            // thread, subd values on all threads.
-            let mut runs: Vec<[f64; 5]> = Vec::with_capacity(rounds);
+            // Per round: OpenSubdiv topology, values and values into its buffers; subd
+            // setup, values and values into its buffers on one thread, and values on all
+            // threads.
+            let mut runs: Vec<[f64; 8]> = Vec::with_capacity(rounds);
             for _ in 0..rounds {
                 let out = osd::run(
                     &exe,
@@ -131,24 +144,30 @@ pub fn run(levels: usize, repeats: usize, rounds: usize) -> Result<(), String> {
                 let line = String::from_utf8_lossy(&out);
                 let osd_topo = json_number(&line, "topology_seconds").ok_or("no topology time")?;
                 let osd_values = json_number(&line, "fvar_seconds").ok_or("no fvar time")?;
-                let (setup1, values1) = measure(1)?;
-                let (_, values_n) = measure(threads)?;
-                runs.push([osd_topo, osd_values, setup1, values1, values_n]);
+                let osd_into =
+                    json_number(&line, "fvar_into_seconds").ok_or("no fvar into time")?;
+                let [setup1, values1, into1] = measure(1)?;
+                let [_, values_n, into_n] = measure(threads)?;
+                runs.push([
+                    osd_topo, osd_values, setup1, values1, values_n, osd_into, into1, into_n,
+                ]);
             }
             let col = |i: usize| median(runs.iter().map(|r| r[i]).collect());
-            let ratio = |i: usize| median(runs.iter().map(|r| r[i] / r[1]).collect());
-            let (osd_topo, osd_values, setup1, values1) = (col(0), col(1), col(2), col(3));
-            let (ratio1, ratio_n) = (ratio(3), ratio(4));
+            let ratio = |i: usize, of: usize| median(runs.iter().map(|r| r[i] / r[of]).collect());
             println!(
-                "{:<14} {:>5} {:>10.2}ms {:>10.2}ms {:>10.2}ms {:>10.2}ms {:>9.2} {:>9.2}",
+                "{:<14} {:>5} {:>10.2}ms {:>10.2}ms {:>10.2}ms {:>10.2}ms {:>9.2} {:>9.2} {:>10.2}ms {:>10.2}ms {:>9.2} {:>9.2}",
                 mode.name(),
                 l,
-                1e3 * osd_topo,
-                1e3 * osd_values,
-                1e3 * setup1,
-                1e3 * values1,
-                ratio1,
-                ratio_n
+                1e3 * col(0),
+                1e3 * col(1),
+                1e3 * col(2),
+                1e3 * col(3),
+                ratio(3, 1),
+                ratio(4, 1),
+                1e3 * col(5),
+                1e3 * col(6),
+                ratio(6, 5),
+                ratio(7, 5)
             );
         }
     }
@@ -156,7 +175,10 @@ pub fn run(levels: usize, repeats: usize, rounds: usize) -> Result<(), String> {
         "osd topo: Create + RefineUniform with the channel; subd setup: Refinement + FaceVaryingRefinement (1 thread);"
     );
     println!(
-        "values×: subd's UV refinement (1 thread) over InterpolateFaceVarying's through every level; values×N: on {threads} threads"
+        "values×: subd's UV refinement (1 thread) over InterpolateFaceVarying's through every level, each allocating its outputs; values×N: on {threads} threads"
+    );
+    println!(
+        "into×: the same again into those outputs (refine_level_into; InterpolateFaceVarying into the caller's vectors), 1 thread; into×N: on {threads} threads"
     );
     Ok(())
 }

@@ -436,6 +436,81 @@ impl FaceVaryingRefinement {
             .collect()
     }
 
+    /// The values of `level` (`level ≥ 1`) from those of `level - 1`, written into `dst`, a
+    /// buffer the caller owns: OpenSubdiv's `PrimvarRefiner::InterpolateFaceVarying`. `src`
+    /// holds `components` numbers per value of `level - 1` (at level 1, the channel's own
+    /// values), `dst` as many per value of `level` ([`Self::num_values`]); every number of
+    /// `dst` is overwritten, with what [`Self::refine_values`] gives for that level. For
+    /// loops that refine new values over the same channel layout (animated UVs, many
+    /// channels of one layout) without allocating; values of more than three numbers go
+    /// through scratch copies, three numbers at a time.
+    ///
+    /// ```
+    /// use subd_mesh::TopologyBuilder;
+    /// use subd_mesh::fvar::{FVarChannel, FVarLinearInterpolation};
+    /// use subd_schemes::{FaceVaryingRefinement, Options, Refinement, Scheme};
+    ///
+    /// let t = TopologyBuilder::new(6).build(&[4, 4], &[0, 1, 4, 3, 1, 2, 5, 4]).unwrap();
+    /// let uv = vec![0., 0., 1., 0., 1., 1., 0., 1., 2., 0., 3., 0., 3., 1., 2., 1.];
+    /// let channel = FVarChannel::new(&t, 2, uv, (0..8).collect()).unwrap();
+    /// let r = Refinement::new(&t, Scheme::CatmullClark, &Options::default(), 2).unwrap();
+    /// let mode = FVarLinearInterpolation::CornersPlus1;
+    /// let fr = FaceVaryingRefinement::new(&r, &channel, mode).unwrap();
+    /// // One buffer per level, allocated once.
+    /// let mut levels: Vec<Vec<f64>> = (0..=2).map(|l| vec![0.0; 2 * fr.num_values(l)]).collect();
+    /// levels[0].copy_from_slice(channel.values());
+    /// for l in 1..=2 {
+    ///     let (done, rest) = levels.split_at_mut(l);
+    ///     fr.refine_level_into(&r, l, &done[l - 1], &mut rest[0], 2);
+    /// }
+    /// assert_eq!(levels, fr.refine_values(&r, channel.values(), 2));
+    /// ```
+    ///
+    /// # Panics
+    /// If `level` is 0 or deeper than the refinement, or `src` or `dst` does not hold
+    /// `components` numbers per value of its level.
+    pub fn refine_level_into(
+        &self,
+        refinement: &Refinement,
+        level: usize,
+        src: &[f64],
+        dst: &mut [f64],
+        components: usize,
+    ) {
+        assert!(
+            (1..self.levels.len()).contains(&level),
+            "level {level} is not a refined level (1..={})",
+            self.num_levels()
+        );
+        let c = components;
+        assert_eq!(src.len(), c * self.num_values(level - 1), "source numbers");
+        assert_eq!(dst.len(), c * self.num_values(level), "destination numbers");
+        let next = NextValues {
+            step: &refinement.step(level),
+            parent: &self.levels[level - 1],
+            child: &self.levels[level],
+            flags: self.flags,
+        };
+        if c <= 3 {
+            next.columns_into(src, dst, c);
+            return;
+        }
+        // Three numbers at a time (the last group one to three), through scratch copies.
+        for first in (0..c).step_by(3) {
+            let w = (c - first).min(3);
+            let part: Vec<f64> = src
+                .chunks_exact(c)
+                .flat_map(|v| &v[first..first + w])
+                .copied()
+                .collect();
+            let mut out = vec![0.0; w * self.num_values(level)];
+            next.columns_into(&part, &mut out, w);
+            for (d, o) in dst.chunks_exact_mut(c).zip(out.chunks_exact(w)) {
+                d[first..first + w].copy_from_slice(o);
+            }
+        }
+    }
+
     /// [`Self::refine_values`] for values of `c` (at most three) numbers, refined as one
     /// [`Lanes`] point each.
     fn refine_columns(&self, refinement: &Refinement, values: &[f64], c: usize) -> Vec<Vec<f64>> {
@@ -551,7 +626,50 @@ struct NextValues<'a> {
 }
 
 impl NextValues<'_> {
-    /// The child level's values from `src`, the parent level's.
+    /// The child level's values from `src`, the parent level's, in a new vector
+    /// ([`Self::write`]).
+    fn compute<V: Lanes>(&self, src: &[V]) -> Vec<V> {
+        let total = self.child.num_values();
+        let mut out: Vec<V> = crate::memory::with_capacity(total);
+        self.write(src, &mut out.spare_capacity_mut()[..total]);
+        #[allow(unsafe_code)]
+        // SAFETY: `write` wrote every slot of `0..total` within the capacity
+        // `with_capacity` reserved. A panic unwinds before this, leaving the length 0.
+        unsafe {
+            out.set_len(total)
+        };
+        out
+    }
+
+    /// [`Self::compute`] into `dst`, `c` (at most three) numbers per value, as one
+    /// [`Lanes`] point each.
+    fn columns_into(&self, src: &[f64], dst: &mut [f64], c: usize) {
+        match c {
+            0 => {}
+            1 => self.compute_into::<f64>(src, dst),
+            2 => self.compute_into::<glam::DVec2>(
+                bytemuck::cast_slice(src),
+                bytemuck::cast_slice_mut(dst),
+            ),
+            _ => {
+                self.compute_into::<DVec3>(bytemuck::cast_slice(src), bytemuck::cast_slice_mut(dst))
+            }
+        }
+    }
+
+    /// [`Self::compute`] into `dst`, one slot per child value.
+    fn compute_into<V: Lanes>(&self, src: &[V], dst: &mut [V]) {
+        #[allow(unsafe_code)]
+        // SAFETY: `MaybeUninit<V>` has `V`'s layout, and `write` stores only initialised
+        // values through the view, so `dst` stays initialised.
+        let slots: &mut [MaybeUninit<V>] = unsafe {
+            std::slice::from_raw_parts_mut(dst.as_mut_ptr().cast::<MaybeUninit<V>>(), dst.len())
+        };
+        self.write(src, slots);
+    }
+
+    /// Writes every child value, computed from `src` (the parent level's values), into
+    /// `slots` (one per value of the child level).
     ///
     /// Geometric vertices take the positions' rows ([`super::Step::lane_point`]) over the
     /// one value of each parent vertex; the others, next to seams and in the linear modes,
@@ -560,37 +678,60 @@ impl NextValues<'_> {
     /// the output, in face order, which the vertex and edge rows then read as their face
     /// points. Every vertex is computed alone, so the result does not depend on the number
     /// of threads.
-    fn compute<V: Lanes>(&self, src: &[V]) -> Vec<V> {
+    fn write<V: Lanes>(&self, src: &[V], slots: &mut [MaybeUninit<V>]) {
         let (l, child) = (self.step.layout, self.child);
         let faces = l.face_vertex_base as usize..l.edge_vertex_base as usize;
-        let total = child.num_values();
-        let mut out: Vec<V> = crate::memory::with_capacity(total);
-        let slots = &mut out.spare_capacity_mut()[..total];
+        assert_eq!(slots.len(), child.num_values(), "one slot per child value");
         let (head, rest) = slots.split_at_mut(child.offset(faces.start));
         let (middle, tail) = rest.split_at_mut(child.offset(faces.end) - child.offset(faces.start));
-        self.fill(pieces(child, faces.clone(), middle), src, &[]);
+        self.fill_faces(faces.start, middle, src);
         #[allow(unsafe_code)]
-        // SAFETY: `fill` wrote every slot of the face children (the pieces cover `middle`,
-        // and each vertex writes all of its slots), so viewing them as initialised is sound;
+        // SAFETY: `fill_faces` wrote every slot of the face children (one each, `middle`
+        // whole), so viewing them as initialised is sound;
         // `MaybeUninit<V>` has `V`'s layout.
         let face_points: &[V] =
             unsafe { std::slice::from_raw_parts(middle.as_ptr().cast::<V>(), middle.len()) };
         let mut rest = pieces(child, 0..faces.start, head);
         rest.extend(pieces(child, faces.end..l.num_child_vertices, tail));
+        // Head, middle and tail partition `slots`, and each vertex writes all of its slots,
+        // so every slot is written.
         self.fill(rest, src, face_points);
-        #[allow(unsafe_code)]
-        // SAFETY: the two `fill`s wrote every slot of `0..total` (head, middle and tail
-        // partition it, and each vertex writes all of its slots), within the capacity
-        // `with_capacity` reserved. A panic unwinds before this, leaving the length 0.
-        unsafe {
-            out.set_len(total)
-        };
-        out
     }
 
-    /// Writes the values of the child vertices of each piece into its slots, reading the
-    /// child face points `face_points` (empty while the face children themselves are
-    /// filled, whose rows read none).
+    /// Writes the values of the face children, `slots` (one value each, in face order, the
+    /// first being child vertex `first`): each the mean of its face's corner values, in
+    /// every mode (`value_row`'s face rows, the same products in the same order; for faces
+    /// away from seams also the geometric face rows). The corners' values are read through
+    /// the face's own value list, which lies in face order, rather than through each
+    /// corner vertex's value offset.
+    fn fill_faces<V: Lanes>(&self, first: usize, slots: &mut [MaybeUninit<V>], src: &[V]) {
+        let base = first - self.step.layout.face_vertex_base as usize;
+        slots
+            .par_chunks_mut(CHUNK)
+            .enumerate()
+            .for_each(|(i, out)| {
+                let start = base + i * CHUNK;
+                for (j, value) in out.iter_mut().enumerate() {
+                    value.write(self.face_value(src, start + j));
+                }
+            });
+    }
+
+    /// The value of the child of parent face `f`: the mean of its corners' values.
+    #[inline]
+    fn face_value<V: Lanes>(&self, src: &[V], f: usize) -> V {
+        let (p, parent) = (self.step.parent, self.parent);
+        let n = p.face_size(f);
+        let inv = 1.0 / n as f64;
+        let mut acc = V::default();
+        for j in 0..n {
+            acc += src[parent.corner_source(p, f, j) as usize] * inv;
+        }
+        acc
+    }
+
+    /// Writes the values of the child vertices and edges of each piece into its slots,
+    /// reading the child face points `face_points`.
     fn fill<V: Lanes>(
         &self,
         pieces: Vec<(std::ops::Range<usize>, &mut [MaybeUninit<V>])>,
@@ -641,27 +782,28 @@ impl NextValues<'_> {
         if cv32 < l.face_vertex_base {
             return at(parent.source(parent.offset(cv) + k));
         }
-        let mut acc = V::default();
         if cv32 < l.edge_vertex_base {
-            let f = (cv32 - l.face_vertex_base) as usize;
-            let n = p.face_size(f);
-            let inv = 1.0 / n as f64;
-            for j in 0..n {
-                acc += at(parent.corner_source(p, f, j)) * inv;
-            }
+            return self.face_value(src, (cv32 - l.face_vertex_base) as usize);
+        }
+        let e = (cv32 - l.edge_vertex_base) as usize;
+        // The mean does not depend on which end comes first (0 + x/2 is exact, and the
+        // second sum commutes), so the ends are taken in whichever order is at hand.
+        let [u, w] = p.edge_vertices(e);
+        let [a, b] = if parent.count(u as usize) == 1 && parent.count(w as usize) == 1 {
+            // Ends of one value each, so the edge is continuous: their values, found
+            // through the ends' offsets rather than through an edge-face's corners.
+            [u, w].map(|v| parent.source(parent.offset(v as usize)))
         } else {
-            let e = (cv32 - l.edge_vertex_base) as usize;
             let side = if self.child.tags[self.child.offset(cv) + k].mismatch {
                 k
             } else {
                 0
             };
-            // The mean does not depend on which end comes first (0 + x/2 is exact, and the
-            // second sum commutes), so the ends are taken in the face's order.
-            let [a, b] = parent.edge_face_corner_sources(p, e, side);
-            acc += at(a) * 0.5;
-            acc += at(b) * 0.5;
-        }
+            parent.edge_face_corner_sources(p, e, side)
+        };
+        let mut acc = V::default();
+        acc += at(a) * 0.5;
+        acc += at(b) * 0.5;
         acc
     }
 }
@@ -1575,7 +1717,8 @@ mod tests {
 
     /// The direct evaluation of `refine_values` (geometric rows away from seams, walked
     /// masks near them) equals the stencil tables' rows applied, in every mode, with one to
-    /// five numbers per value, on one thread and on several.
+    /// five numbers per value, on one thread and on several, and level by level into
+    /// buffers.
     #[test]
     fn direct_values_equal_the_stencil_tables() {
         let (mut t, p) = grid();
@@ -1609,6 +1752,12 @@ mod tests {
                     .unwrap()
                     .install(|| fr.refine_values(&r, &values, c));
                 assert_eq!(one, direct, "{mode:?}, {c} numbers: 1 thread and many");
+                // Level by level into buffers that held something else.
+                for level in 1..direct.len() {
+                    let mut dst = vec![f64::NAN; direct[level].len()];
+                    fr.refine_level_into(&r, level, &direct[level - 1], &mut dst, c);
+                    assert_eq!(dst, direct[level], "{mode:?}, {c} numbers, L{level} into");
+                }
                 for (level, got) in direct.iter().enumerate().skip(1) {
                     let table = fr.composed(&r, level);
                     let mut want = vec![0.0; c * table.num_rows()];
