@@ -413,12 +413,7 @@ impl FaceVaryingRefinement {
             .iter()
             .map(|&first| {
                 let w = (c - first).min(3);
-                let part: Vec<f64> = values
-                    .chunks_exact(c)
-                    .flat_map(|v| &v[first..first + w])
-                    .copied()
-                    .collect();
-                self.refine_columns(refinement, &part, w)
+                self.refine_columns(refinement, &column_group(values, c, first, w), w)
             })
             .collect();
         (0..self.levels.len())
@@ -498,13 +493,8 @@ impl FaceVaryingRefinement {
         // Three numbers at a time (the last group one to three), through scratch copies.
         for first in (0..c).step_by(3) {
             let w = (c - first).min(3);
-            let part: Vec<f64> = src
-                .chunks_exact(c)
-                .flat_map(|v| &v[first..first + w])
-                .copied()
-                .collect();
             let mut out = vec![0.0; w * self.num_values(level)];
-            next.columns_into(&part, &mut out, w);
+            next.columns_into(&column_group(src, c, first, w), &mut out, w);
             for (d, o) in dst.chunks_exact_mut(c).zip(out.chunks_exact(w)) {
                 d[first..first + w].copy_from_slice(o);
             }
@@ -583,6 +573,15 @@ fn geometric_vertices(
 
 /// Child vertices per parallel task.
 const CHUNK: usize = 4096;
+
+/// Numbers `first..first + w` of each value of `values` (`c` numbers a value), packed.
+fn column_group(values: &[f64], c: usize, first: usize, w: usize) -> Vec<f64> {
+    values
+        .chunks_exact(c)
+        .flat_map(|v| &v[first..first + w])
+        .copied()
+        .collect()
+}
 
 /// The one value of each vertex of a level (its first; the geometric rows read only vertices
 /// with one value), as the points of [`super::Step::lane_point`].
