@@ -480,12 +480,7 @@ impl FaceVaryingRefinement {
         let c = components;
         assert_eq!(src.len(), c * self.num_values(level - 1), "source numbers");
         assert_eq!(dst.len(), c * self.num_values(level), "destination numbers");
-        let next = NextValues {
-            step: &refinement.step(level),
-            parent: &self.levels[level - 1],
-            child: &self.levels[level],
-            flags: self.flags,
-        };
+        let next = self.next_values(refinement, level);
         if c <= 3 {
             next.columns_into(src, dst, c);
             return;
@@ -498,6 +493,16 @@ impl FaceVaryingRefinement {
             for (d, o) in dst.chunks_exact_mut(c).zip(out.chunks_exact(w)) {
                 d[first..first + w].copy_from_slice(o);
             }
+        }
+    }
+
+    /// The step from level `level - 1` of the channel to level `level`.
+    fn next_values<'a>(&'a self, refinement: &'a Refinement, level: usize) -> NextValues<'a> {
+        NextValues {
+            step: refinement.step(level),
+            parent: &self.levels[level - 1],
+            child: &self.levels[level],
+            flags: self.flags,
         }
     }
 
@@ -517,13 +522,9 @@ impl FaceVaryingRefinement {
     fn refine_lanes<V: Lanes>(&self, refinement: &Refinement, values: &[f64]) -> Vec<Vec<f64>> {
         let mut out: Vec<Vec<V>> = vec![bytemuck::cast_slice(values).to_vec()];
         for l in 1..self.levels.len() {
-            let level = NextValues {
-                step: &refinement.step(l),
-                parent: &self.levels[l - 1],
-                child: &self.levels[l],
-                flags: self.flags,
-            };
-            let next = level.compute(out.last().expect("level 0"));
+            let next = self
+                .next_values(refinement, l)
+                .compute(out.last().expect("level 0"));
             out.push(next);
         }
         out.into_iter()
@@ -618,7 +619,7 @@ fn pieces<'s, V>(
 /// One step of [`FaceVaryingRefinement::refine_values`]: the child level's values from the
 /// parent level's.
 struct NextValues<'a> {
-    step: &'a super::Step<'a>,
+    step: super::Step<'a>,
     parent: &'a ChannelLevel,
     child: &'a ChannelLevel,
     flags: ModeFlags,
@@ -737,7 +738,7 @@ impl NextValues<'_> {
         src: &[V],
         face_points: &[V],
     ) {
-        let (step, parent, child, flags) = (self.step, self.parent, self.child, self.flags);
+        let (step, parent, child, flags) = (&self.step, self.parent, self.child, self.flags);
         let linear = flags.linear(step.scheme);
         let firsts = FirstValues {
             level: parent,
@@ -774,7 +775,7 @@ impl NextValues<'_> {
     /// values on the value's side.
     #[inline]
     fn linear_value<V: Lanes>(&self, src: &[V], cv: usize, k: usize) -> V {
-        let (step, parent) = (self.step, self.parent);
+        let (step, parent) = (&self.step, self.parent);
         let (p, l) = (step.parent, step.layout);
         let at = |i: u32| src[i as usize];
         let cv32 = cv as u32;
