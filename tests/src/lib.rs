@@ -360,7 +360,7 @@ pub fn tagged_case_strategy(schemes: &'static [Scheme]) -> impl Strategy<Value =
         any::<u64>(),
     )
         .prop_map(move |(mut mesh, s, chaikin, creases, corners, seed)| {
-            let scheme = schemes[s];
+            let scheme = schemes[s].clone();
             if scheme == Scheme::Loop {
                 // Fan-triangulate every face for Loop.
                 mesh.faces = mesh

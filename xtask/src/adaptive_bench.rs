@@ -106,7 +106,7 @@ struct Outcome {
 
 fn adaptive(
     m: &Mesh,
-    scheme: Scheme,
+    scheme: &Scheme,
     criteria: &[&dyn Criterion],
     levels: usize,
     positions: Positions,
@@ -155,15 +155,15 @@ fn table_one() -> Result<(), String> {
     let paper = [[0.70, 0.39], [0.75, 0.35]];
     for (k, (name, _, m)) in meshes.iter().enumerate() {
         let o = Options::from_hints(&m.hints);
-        let surface = LimitSurface::new(&m.topology, &m.positions, Scheme::Loop, &o)
+        let surface = LimitSurface::new(&m.topology, &m.positions, &Scheme::Loop, &o)
             .map_err(|e| e.to_string())?;
         for level in 1..=2 {
-            let u = adaptive(m, Scheme::Loop, &[], level, Positions::Refined, &surface)?;
+            let u = adaptive(m, &Scheme::Loop, &[], level, Positions::Refined, &surface)?;
             for eps in TABLE_FLATNESS_DEGREES {
                 let flat = Flatness::new(eps).map_err(|e| e.to_string())?;
                 let a = adaptive(
                     m,
-                    Scheme::Loop,
+                    &Scheme::Loop,
                     &[&flat],
                     level,
                     Positions::Refined,
@@ -195,17 +195,17 @@ fn table_one() -> Result<(), String> {
     );
     for (name, _, m) in &meshes {
         let o = Options::from_hints(&m.hints);
-        let surface = LimitSurface::new(&m.topology, &m.positions, Scheme::Loop, &o)
+        let surface = LimitSurface::new(&m.topology, &m.positions, &Scheme::Loop, &o)
             .map_err(|e| e.to_string())?;
         for level in 2..=3 {
-            let u = adaptive(m, Scheme::Loop, &[], level, Positions::Limit, &surface)?;
+            let u = adaptive(m, &Scheme::Loop, &[], level, Positions::Limit, &surface)?;
             let d = u.distance * diagonal(m);
-            let s2 = LimitSurface::new(&m.topology, &m.positions, Scheme::Loop, &o)
+            let s2 = LimitSurface::new(&m.topology, &m.positions, &Scheme::Loop, &o)
                 .map_err(|e| e.to_string())?;
             let c = LimitDistance::new(s2, d, true).map_err(|e| e.to_string())?;
             let a = adaptive(
                 m,
-                Scheme::Loop,
+                &Scheme::Loop,
                 &[&c],
                 level + 3,
                 Positions::Limit,
@@ -228,7 +228,7 @@ fn table_one() -> Result<(), String> {
 }
 
 /// Median seconds of subd's uniform refinement (topology from the face lists, positions).
-fn subd_uniform(m: &Mesh, scheme: Scheme, level: usize, repeats: usize) -> (f64, usize) {
+fn subd_uniform(m: &Mesh, scheme: &Scheme, level: usize, repeats: usize) -> (f64, usize) {
     let t = &m.topology;
     let sizes: Vec<u32> = (0..t.num_faces()).map(|f| t.face_size(f) as u32).collect();
     let mut faces = 0;
@@ -239,7 +239,8 @@ fn subd_uniform(m: &Mesh, scheme: Scheme, level: usize, repeats: usize) -> (f64,
                 .accept_inconsistent_orientation(true)
                 .build(&sizes, t.all_face_vertices())
                 .expect("valid");
-            let r = Refinement::new(&topo, scheme, &Options::default(), level).expect("refine");
+            let r =
+                Refinement::new(&topo, scheme.clone(), &Options::default(), level).expect("refine");
             let p = r.refine_points(&m.positions);
             faces = r.faces(level).0.len() - 1;
             std::hint::black_box(p);
@@ -253,7 +254,7 @@ fn subd_uniform(m: &Mesh, scheme: Scheme, level: usize, repeats: usize) -> (f64,
 fn osd_uniform(
     exe: &Path,
     m: &Mesh,
-    scheme: Scheme,
+    scheme: &Scheme,
     level: usize,
     repeats: usize,
 ) -> Result<f64, String> {
@@ -322,7 +323,7 @@ fn speed(exe: &Path, repeats: usize) -> Result<(), String> {
                     let a = AdaptiveRefinement::new(
                         &m.topology,
                         &m.positions,
-                        *scheme,
+                        &*scheme,
                         &o,
                         &[&flat],
                         level,
@@ -334,8 +335,8 @@ fn speed(exe: &Path, repeats: usize) -> Result<(), String> {
                 })
                 .collect();
             let at = median(times);
-            let (ut, uf) = subd_uniform(m, *scheme, level, repeats);
-            let osd = osd_uniform(exe, m, *scheme, level, repeats).ok();
+            let (ut, uf) = subd_uniform(m, scheme, level, repeats);
+            let osd = osd_uniform(exe, m, scheme, level, repeats).ok();
             let ar = faces as f64 / at;
             let ur = uf as f64 / ut;
             let or = osd.map(|s| uf as f64 / s);

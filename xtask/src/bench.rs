@@ -65,7 +65,7 @@ pub(crate) fn median(mut v: Vec<f64>) -> f64 {
 /// line.
 pub fn run_subd(
     mesh: &Path,
-    scheme: Scheme,
+    scheme: &Scheme,
     levels: usize,
     threads: usize,
     repeats: usize,
@@ -91,7 +91,8 @@ pub fn run_subd(
             let topo = TopologyBuilder::new(base.num_vertices())
                 .build(&sizes, base.all_face_vertices())
                 .expect("valid base");
-            let r = Refinement::new(&topo, scheme, &Options::default(), levels).expect("refine");
+            let r = Refinement::new(&topo, scheme.clone(), &Options::default(), levels)
+                .expect("refine");
             let t1 = Instant::now();
             let p = r.refine_points(pos);
             let t2 = Instant::now();
@@ -198,7 +199,7 @@ pub fn run(
             let input = osd::encode(
                 &mesh.topology,
                 &mesh.positions,
-                scheme,
+                &scheme,
                 &Options::default(),
                 level as u32,
             );
@@ -291,7 +292,7 @@ pub fn run_subd_eval(mesh: &Path, repeats: usize) -> Result<(), String> {
         subd_io::read_mesh(mesh, &subd_io::ReadOptions::default()).map_err(|e| e.to_string())?;
     let (topo, pos) = (&file.mesh.topology, &file.mesh.positions);
     let t0 = Instant::now();
-    let ev = LimitEvaluator::new(topo, Scheme::CatmullClark, &Options::default())
+    let ev = LimitEvaluator::new(topo, &Scheme::CatmullClark, &Options::default())
         .map_err(|e| e.to_string())?;
     let pts = ev.prepare(pos);
     let setup = t0.elapsed().as_secs_f64();
@@ -335,7 +336,7 @@ pub fn run_eval(repeats: usize) -> Result<(), String> {
         osd::encode(
             &mesh.topology,
             &mesh.positions,
-            Scheme::CatmullClark,
+            &Scheme::CatmullClark,
             &Options::default(),
             10,
         ),

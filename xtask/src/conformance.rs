@@ -60,7 +60,7 @@ impl Row {
 }
 
 /// Levels to check: up to 3, fewer where the mesh would grow past [`MAX_VERTICES`].
-pub(crate) fn levels_for(topo: &Topology, scheme: Scheme) -> usize {
+pub(crate) fn levels_for(topo: &Topology, scheme: &Scheme) -> usize {
     let mut faces = topo.num_face_vertices() as f64;
     let mut levels = 0;
     while levels < 3 {
@@ -84,7 +84,7 @@ pub fn compare(
     name: &str,
     topo: &Topology,
     positions: &[DVec3],
-    scheme: Scheme,
+    scheme: &Scheme,
     options: &Options,
 ) -> Vec<Row> {
     let levels = levels_for(topo, scheme);
@@ -97,7 +97,7 @@ pub fn compare(
         Ok(l) => l,
         Err(e) => return vec![fail(0, format!("OpenSubdiv: {e}"))],
     };
-    let refinement = match Refinement::new(topo, scheme, options, levels) {
+    let refinement = match Refinement::new(topo, scheme.clone(), options, levels) {
         Ok(r) => r,
         Err(e) => return vec![fail(0, format!("subd: {e}"))],
     };
@@ -169,7 +169,7 @@ pub fn compare(
             problem,
         });
     }
-    if scheme != Scheme::Bilinear {
+    if *scheme != Scheme::Bilinear {
         rows.push(compare_adaptive(
             name,
             topo,
@@ -183,7 +183,7 @@ pub fn compare(
             exe, name, topo, positions, scheme, options, diag,
         ));
     }
-    if scheme != Scheme::Bilinear {
+    if *scheme != Scheme::Bilinear {
         rows.push(compare_eval(
             exe, name, topo, positions, scheme, options, diag,
         ));
@@ -194,7 +194,7 @@ pub fn compare(
             exe, name, topo, positions, scheme, options, diag,
         ));
         for method in [EditCheck::LeastSquares, EditCheck::Energy] {
-            if method == EditCheck::Energy && scheme != Scheme::CatmullClark {
+            if method == EditCheck::Energy && *scheme != Scheme::CatmullClark {
                 continue;
             }
             rows.push(compare_edit(
@@ -241,7 +241,7 @@ fn compare_edit(
     name: &str,
     topo: &Topology,
     positions: &[DVec3],
-    scheme: Scheme,
+    scheme: &Scheme,
     options: &Options,
     diag: f64,
     method: EditCheck,
@@ -262,7 +262,7 @@ fn compare_edit(
         return row;
     }
     row.level = level;
-    let prepared = match Refinement::new(topo, scheme, options, level) {
+    let prepared = match Refinement::new(topo, scheme.clone(), options, level) {
         Ok(r) => r,
         Err(e) => {
             row.problem = Some(format!("subd: {e}"));
@@ -308,7 +308,7 @@ fn compare_edit(
     let normal_vertex = (0..nv).map(|k| (k + seed as usize) % nv).find(|&v| {
         usable(v)
             && !chosen.contains(&v)
-            && scheme == Scheme::CatmullClark
+            && *scheme == Scheme::CatmullClark
             && !t0.is_boundary_vertex(v)
             && rules0[v] == subd_schemes::Rule::Smooth
             && t0.vertex_faces(v).len() >= 3
@@ -430,7 +430,7 @@ fn compare_adaptive(
     name: &str,
     topo: &Topology,
     positions: &[DVec3],
-    scheme: Scheme,
+    scheme: &Scheme,
     options: &Options,
     osd_levels: &[osd::OsdLevel],
     diag: f64,
@@ -501,11 +501,11 @@ fn compare_pia(
     name: &str,
     topo: &Topology,
     positions: &[DVec3],
-    scheme: Scheme,
+    scheme: &Scheme,
     options: &Options,
     diag: f64,
 ) -> Row {
-    use subd_pia::{Moving, Pia, PiaOptions, PiaScheme, Solver};
+    use subd_pia::{Moving, Pia, PiaOptions, Solver};
     let mut row = Row::pending(name, "pia", 0);
     let level = subd_limit::levels_for_exact_limit(topo, scheme).0.max(1);
     if topo.num_face_vertices() << (2 * level) > MAX_LIMIT_FACE_VERTICES {
@@ -515,8 +515,8 @@ fn compare_pia(
     }
     row.level = level;
     let pia_scheme = match scheme {
-        Scheme::Loop => PiaScheme::Loop,
-        _ => PiaScheme::CatmullClark,
+        Scheme::Loop => Scheme::Loop,
+        _ => Scheme::CatmullClark,
     };
     let pia = match Pia::new(topo, &pia_scheme, options) {
         Ok(p) => p,
@@ -554,7 +554,7 @@ fn compare_pia(
                 return row;
             }
         };
-    let inexact = match Refinement::new(topo, scheme, options, level) {
+    let inexact = match Refinement::new(topo, scheme.clone(), options, level) {
         Ok(r) => subd_limit::eigen_limit_vertices(&r, level),
         Err(e) => {
             row.problem = Some(format!("subd: {e}"));
@@ -635,7 +635,7 @@ fn compare_eval(
     name: &str,
     topo: &Topology,
     positions: &[DVec3],
-    scheme: Scheme,
+    scheme: &Scheme,
     options: &Options,
     diag: f64,
 ) -> Row {
@@ -650,12 +650,12 @@ fn compare_eval(
     };
     let pts = ev.prepare(positions);
     let near = 1.0 / f64::from(1u32 << ISOLATION);
-    let regular_valence = if scheme == Scheme::Loop { 6 } else { 4 };
+    let regular_valence = if *scheme == Scheme::Loop { 6 } else { 4 };
     // Irregular: anything but a smooth vertex of the regular valence or (Catmull-Clark) a
     // vertex on a straight infinitely sharp crease, regular boundary or sharp corner — the
     // vertices OpenSubdiv's patches isolate and cap at level 10. Darts, turning creases and
     // semi-sharp vertices count as irregular.
-    let prepared = match Refinement::new(topo, scheme, options, 0) {
+    let prepared = match Refinement::new(topo, scheme.clone(), options, 0) {
         Ok(r) => r,
         Err(e) => {
             row.problem = Some(format!("subd: {e}"));
@@ -673,7 +673,7 @@ fn compare_eval(
                 .vertex_edges(v)
                 .iter()
                 .all(|&e| t0.edge_sharpness(e as usize) == 0.0);
-        let sharp_regular = scheme == Scheme::CatmullClark
+        let sharp_regular = *scheme == Scheme::CatmullClark
             && subd_limit::patch::regular_sharp_corner(t0, rules0, v);
         !(smooth_regular || sharp_regular)
     };
@@ -687,7 +687,7 @@ fn compare_eval(
     for f in 0..topo.num_faces() {
         let fv = topo.face_vertices(f);
         let n = fv.len();
-        let loop_scheme = scheme == Scheme::Loop;
+        let loop_scheme = *scheme == Scheme::Loop;
         let subs = if n == 4 || loop_scheme { 1 } else { n };
         for sub in 0..subs {
             // The irregular corners of this ptex face, in its (u, v).
@@ -872,14 +872,14 @@ impl RefinedLimits {
     pub(crate) fn new(
         topo: &Topology,
         positions: &[DVec3],
-        scheme: Scheme,
+        scheme: &Scheme,
         options: &Options,
     ) -> Option<RefinedLimits> {
         let level = subd_limit::levels_for_exact_limit(topo, scheme).0.max(4);
         if topo.num_face_vertices() << (2 * level) > 1 << 23 {
             return None;
         }
-        let refinement = Refinement::new(topo, scheme, options, level).ok()?;
+        let refinement = Refinement::new(topo, scheme.clone(), options, level).ok()?;
         let table = subd_limit::LimitStencilTable::at_level(&refinement, level).ok()?;
         let limits = table.apply(&refinement.refine_points(positions)[level]);
         Some(RefinedLimits {
@@ -934,7 +934,7 @@ fn compare_limit(
     name: &str,
     topo: &Topology,
     positions: &[DVec3],
-    scheme: Scheme,
+    scheme: &Scheme,
     options: &Options,
     diag: f64,
 ) -> Row {
@@ -952,7 +952,7 @@ fn compare_limit(
             return row;
         }
     };
-    let topo_at = match Refinement::new(topo, scheme, options, level) {
+    let topo_at = match Refinement::new(topo, scheme.clone(), options, level) {
         Ok(r) => r,
         Err(e) => {
             row.problem = Some(format!("subd: {e}"));
@@ -1103,7 +1103,7 @@ pub fn shapes(exe: &Path, dir: &Path) -> Result<Vec<Row>, String> {
                 &name,
                 &file.mesh.topology,
                 &file.mesh.positions,
-                scheme,
+                &scheme,
                 &options,
             ))
         })
@@ -1122,7 +1122,7 @@ pub fn random(exe: &Path, count: u64) -> Vec<Row> {
                 &c.name,
                 &c.topology,
                 &c.positions,
-                c.scheme,
+                &c.scheme,
                 &c.options,
             )
         })

@@ -50,7 +50,7 @@ fn open_grid(n: u32) -> Mesh {
 
 /// `count` regular iso-lines of 4 faces, spread over the mesh.
 fn isolines(m: &Mesh, count: usize, faces: usize) -> Vec<Constraint> {
-    let ev = LimitEvaluator::new(&m.topology, Scheme::CatmullClark, &Options::default())
+    let ev = LimitEvaluator::new(&m.topology, &Scheme::CatmullClark, &Options::default())
         .expect("evaluator");
     let nf = m.topology.num_faces();
     let mut out = Vec::new();
@@ -145,7 +145,7 @@ fn time(repeats: usize, mut f: impl FnMut()) -> f64 {
 /// evaluator built beforehand, and the editor.
 fn edit_time(m: &Mesh, cs: &[Constraint], method: Method, repeats: usize) -> (f64, Editor) {
     let ev = Arc::new(
-        LimitEvaluator::new(&m.topology, Scheme::CatmullClark, &Options::default())
+        LimitEvaluator::new(&m.topology, &Scheme::CatmullClark, &Options::default())
             .expect("evaluator"),
     );
     let build = || {
@@ -153,7 +153,7 @@ fn edit_time(m: &Mesh, cs: &[Constraint], method: Method, repeats: usize) -> (f6
             ev.clone(),
             &m.topology,
             &m.positions,
-            Scheme::CatmullClark,
+            &Scheme::CatmullClark,
             cs,
             method,
         )
@@ -182,7 +182,7 @@ pub fn run(repeats: usize) -> Result<(), String> {
         let nv = m.topology.num_vertices();
         let evaluator = time(repeats, || {
             std::hint::black_box(
-                LimitEvaluator::new(&m.topology, Scheme::CatmullClark, &Options::default())
+                LimitEvaluator::new(&m.topology, &Scheme::CatmullClark, &Options::default())
                     .expect("evaluator"),
             );
         });

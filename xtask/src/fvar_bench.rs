@@ -86,7 +86,7 @@ pub fn run(levels: usize, repeats: usize, rounds: usize) -> Result<(), String> {
                 osd::encode(
                     &mesh.topology,
                     &mesh.positions,
-                    Scheme::CatmullClark,
+                    &Scheme::CatmullClark,
                     &Options::default(),
                     l as u32,
                 ),

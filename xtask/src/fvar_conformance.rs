@@ -93,7 +93,7 @@ fn compare_limit(
     let t = refinement.topology(levels);
     let values = fr.level_values(refinement, levels);
     let mut eigen = vec![false; t.num_vertices()];
-    if refinement.scheme() != Scheme::Bilinear {
+    if *refinement.scheme() != Scheme::Bilinear {
         for v in subd_limit::eigen_limit_vertices(refinement, levels) {
             eigen[v] = true;
         }
@@ -110,7 +110,7 @@ fn compare_limit(
                 .max((ours[2 * r + 1] - theirs[2 * r + 1]).abs())
                 / diag;
             let seam_crease = !linear && values.crease_ends(v, k).is_some();
-            if seam_crease && refinement.scheme() == Scheme::Bilinear {
+            if seam_crease && *refinement.scheme() == Scheme::Bilinear {
                 left_out += 1;
                 left_worst = left_worst.max(d);
                 // subd keeps the value: Bilinear's refinement never moves it.
@@ -174,7 +174,7 @@ pub fn compare(
     name: &str,
     topo: &Topology,
     positions: &[subd_mesh::DVec3],
-    scheme: Scheme,
+    scheme: &Scheme,
     options: &Options,
     channel: &FVarChannel,
     mode: FVarLinearInterpolation,
@@ -197,7 +197,7 @@ pub fn compare(
         Ok(l) => l,
         Err(e) => return vec![fail(format!("OpenSubdiv: {e}"))],
     };
-    let refinement = match Refinement::new(topo, scheme, options, levels) {
+    let refinement = match Refinement::new(topo, scheme.clone(), options, levels) {
         Ok(r) => r,
         Err(e) => return vec![fail(format!("subd: {e}"))],
     };
@@ -288,7 +288,7 @@ pub fn shapes(exe: &Path, dir: &Path) -> Result<Vec<Row>, String> {
                         &name,
                         &file.mesh.topology,
                         &file.mesh.positions,
-                        scheme,
+                        &scheme,
                         &options,
                         uv,
                         mode,
@@ -363,7 +363,7 @@ pub fn random(exe: &Path, count: u64) -> Vec<Row> {
                 &c.name,
                 &c.topology,
                 &c.positions,
-                c.scheme,
+                &c.scheme,
                 &c.options,
                 &channel,
                 mode,

@@ -11,7 +11,6 @@ use rayon::prelude::*;
 use std::path::Path;
 
 use subd_mesh::{DVec3, Topology, TopologyBuilder};
-use subd_schemes::split_schemes::{SplitRefinement, SplitScheme};
 use subd_schemes::{Options, Refinement, Scheme};
 
 use crate::conformance::Row;
@@ -26,19 +25,12 @@ const MAX_VERTICES: usize = 400_000;
 /// such meshes are compared rather than skipped, and their rows say so.
 const OPENMESH_MAX_VALENCE: usize = 50;
 
-/// A scheme as subd runs it.
-#[derive(Clone, Copy)]
-enum Ours {
-    Split(SplitScheme),
-    Osd(Scheme),
-}
-
 /// One comparison: which library, its name for the scheme, ours, and on which meshes.
 struct Pairing {
     check: &'static str,
     library: Library,
     harness_scheme: &'static str,
-    ours: Ours,
+    ours: Scheme,
     triangles: bool,
     /// Open meshes too (the library implements the boundary rule subd does).
     open: bool,
@@ -51,7 +43,7 @@ const PAIRINGS: &[Pairing] = &[
         check: "cgal-sqrt3",
         library: Library::Cgal,
         harness_scheme: "sqrt3",
-        ours: Ours::Split(SplitScheme::Sqrt3),
+        ours: Scheme::Sqrt3,
         triangles: true,
         open: true,
         valence_limit: false,
@@ -60,7 +52,7 @@ const PAIRINGS: &[Pairing] = &[
         check: "om-sqrt3",
         library: Library::OpenMesh,
         harness_scheme: "sqrt3",
-        ours: Ours::Split(SplitScheme::Sqrt3),
+        ours: Scheme::Sqrt3,
         triangles: true,
         open: true,
         valence_limit: true,
@@ -69,7 +61,7 @@ const PAIRINGS: &[Pairing] = &[
         check: "cgal-doo-sabin",
         library: Library::Cgal,
         harness_scheme: "doo-sabin",
-        ours: Ours::Split(SplitScheme::DooSabin),
+        ours: Scheme::DooSabin,
         triangles: false,
         open: false,
         valence_limit: false,
@@ -78,7 +70,7 @@ const PAIRINGS: &[Pairing] = &[
         check: "om-mod-butterfly",
         library: Library::OpenMesh,
         harness_scheme: "modified-butterfly",
-        ours: Ours::Split(SplitScheme::ModifiedButterfly),
+        ours: Scheme::ModifiedButterfly,
         triangles: true,
         open: true,
         valence_limit: false,
@@ -87,7 +79,7 @@ const PAIRINGS: &[Pairing] = &[
         check: "cgal-loop",
         library: Library::Cgal,
         harness_scheme: "loop",
-        ours: Ours::Osd(Scheme::Loop),
+        ours: Scheme::Loop,
         triangles: true,
         open: false,
         valence_limit: false,
@@ -96,7 +88,7 @@ const PAIRINGS: &[Pairing] = &[
         check: "om-loop",
         library: Library::OpenMesh,
         harness_scheme: "loop",
-        ours: Ours::Osd(Scheme::Loop),
+        ours: Scheme::Loop,
         triangles: true,
         open: false,
         valence_limit: true,
@@ -105,7 +97,7 @@ const PAIRINGS: &[Pairing] = &[
         check: "cgal-catmull-clark",
         library: Library::Cgal,
         harness_scheme: "catmull-clark",
-        ours: Ours::Osd(Scheme::CatmullClark),
+        ours: Scheme::CatmullClark,
         triangles: false,
         open: false,
         valence_limit: false,
@@ -114,7 +106,7 @@ const PAIRINGS: &[Pairing] = &[
         check: "om-catmull-clark",
         library: Library::OpenMesh,
         harness_scheme: "catmull-clark",
-        ours: Ours::Osd(Scheme::CatmullClark),
+        ours: Scheme::CatmullClark,
         triangles: false,
         open: false,
         valence_limit: false,
@@ -137,30 +129,17 @@ fn untagged(topo: &Topology) -> Option<Topology> {
 
 /// Positions of every level of ours, level 0 included.
 fn our_levels(
-    ours: Ours,
+    ours: Scheme,
     topo: &Topology,
     positions: &[DVec3],
     levels: usize,
 ) -> Result<Vec<(Vec<DVec3>, usize)>, String> {
-    match ours {
-        Ours::Split(s) => {
-            let r = SplitRefinement::new(topo, s, levels).map_err(|e| e.to_string())?;
-            Ok(r.refine_points(positions)
-                .into_iter()
-                .enumerate()
-                .map(|(l, p)| (p, r.topology(l).num_faces()))
-                .collect())
-        }
-        Ours::Osd(s) => {
-            let r =
-                Refinement::new(topo, s, &Options::default(), levels).map_err(|e| e.to_string())?;
-            Ok(r.refine_points(positions)
-                .into_iter()
-                .enumerate()
-                .map(|(l, p)| (p, r.faces(l).0.len() - 1))
-                .collect())
-        }
-    }
+    let r = Refinement::new(topo, ours, &Options::default(), levels).map_err(|e| e.to_string())?;
+    Ok(r.refine_points(positions)
+        .into_iter()
+        .enumerate()
+        .map(|(l, p)| (p, r.faces(l).0.len() - 1))
+        .collect())
 }
 
 /// Levels to compare: up to 3, fewer where a level would pass [`MAX_VERTICES`].
@@ -208,7 +187,7 @@ fn compare(exe: &Path, name: &str, topo: &Topology, positions: &[DVec3]) -> Vec<
                 "valence {max_valence}: OpenMesh's tables (valences < {OPENMESH_MAX_VALENCE}) enlarged with its init_weights"
             )
         });
-        let ours = match our_levels(p.ours, &t, positions, levels) {
+        let ours = match our_levels(p.ours.clone(), &t, positions, levels) {
             Ok(o) => o,
             Err(e) => {
                 let mut row = Row::pending(name, p.check, 1);

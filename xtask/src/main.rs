@@ -357,7 +357,7 @@ fn main() -> ExitCode {
             } else {
                 subd_schemes::Scheme::CatmullClark
             };
-            bench::run_subd(&mesh, scheme, levels, threads, repeats)
+            bench::run_subd(&mesh, &scheme, levels, threads, repeats)
         }
         Task::Fuzz { seconds, target } => {
             let targets = match target {

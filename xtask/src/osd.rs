@@ -76,11 +76,14 @@ pub fn build_harness() -> Result<PathBuf, String> {
     .build()
 }
 
-fn scheme_code(s: Scheme) -> u32 {
+/// The harness's scheme code (OpenSubdiv's `Sdc::SchemeType`); the two-phase scheme's
+/// refined levels are Catmull-Clark's.
+fn scheme_code(s: &Scheme) -> u32 {
     match s {
         Scheme::Bilinear => 0,
-        Scheme::CatmullClark => 1,
+        Scheme::CatmullClark | Scheme::TwoPhase(_) => 1,
         Scheme::Loop => 2,
+        other => unreachable!("OpenSubdiv has no {other} scheme"),
     }
 }
 
@@ -88,7 +91,7 @@ fn scheme_code(s: Scheme) -> u32 {
 pub fn encode(
     topo: &Topology,
     positions: &[DVec3],
-    scheme: Scheme,
+    scheme: &Scheme,
     options: &Options,
     levels: u32,
 ) -> Vec<u8> {

@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
 
-use subd_pia::{Method, Moving, Pia, PiaError, PiaOptions, PiaScheme, Solver};
-use subd_schemes::{Options, TwoPhase};
+use subd_pia::{Method, Moving, Pia, PiaError, PiaOptions, Solver};
+use subd_schemes::{Options, Scheme, TwoPhase};
 
 use crate::bench::{median, quad_bench_mesh};
 use crate::random_mesh::Rng;
@@ -39,14 +39,14 @@ pub fn run(repeats: usize) -> Result<(), String> {
         "max error"
     );
     let schemes = [
-        ("catmull-clark", PiaScheme::CatmullClark),
+        ("catmull-clark", Scheme::CatmullClark),
         (
             "two-phase 0.5",
-            PiaScheme::TwoPhase(TwoPhase::uniform(nv, 0.5).map_err(|e| e.to_string())?),
+            Scheme::TwoPhase(TwoPhase::uniform(0.5).map_err(|e| e.to_string())?),
         ),
         (
             "two-phase 0.4",
-            PiaScheme::TwoPhase(TwoPhase::uniform(nv, 0.4).map_err(|e| e.to_string())?),
+            Scheme::TwoPhase(TwoPhase::uniform(0.4).map_err(|e| e.to_string())?),
         ),
     ];
     for (name, scheme) in schemes {
@@ -262,7 +262,7 @@ fn scan() -> Result<(), String> {
         .count();
     let options = Options::from_hints(&file.mesh.hints);
     let t1 = Instant::now();
-    let pia = Pia::new(topo, &PiaScheme::Loop, &options).map_err(|e| e.to_string())?;
+    let pia = Pia::new(topo, &Scheme::Loop, &options).map_err(|e| e.to_string())?;
     let t_setup = t1.elapsed().as_secs_f64();
     let t2 = Instant::now();
     let r = pia
@@ -270,7 +270,7 @@ fn scan() -> Result<(), String> {
         .map_err(|e| e.to_string())?;
     let t_solve = t2.elapsed().as_secs_f64();
     let t3 = Instant::now();
-    let check = subd_limit::base_limit_positions(topo, subd_schemes::Scheme::Loop, &options)
+    let check = subd_limit::base_limit_positions(topo, &subd_schemes::Scheme::Loop, &options)
         .map_err(|e| e.to_string())?;
     let limit = check.apply_points(&r.points);
     let err = limit

@@ -247,6 +247,7 @@ pub fn case(seed: u64) -> RandomCase {
                 Scheme::CatmullClark => "catmark",
                 Scheme::Loop => "loop",
                 Scheme::Bilinear => "bilinear",
+                other => unreachable!("random cases use OpenSubdiv's schemes, not {other}"),
             }
         ),
         topology,

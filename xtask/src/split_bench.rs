@@ -13,7 +13,6 @@ use std::time::Instant;
 
 use subd_mesh::{Mesh, TopologyBuilder};
 
-use subd_schemes::split_schemes::{SplitRefinement, SplitScheme};
 use subd_schemes::{Options, Refinement, Scheme};
 
 use crate::bench::{json_number, median, peak_rss_bytes, quad_bench_mesh, split_quads};
@@ -30,14 +29,8 @@ pub fn tri_100k_mesh() -> Mesh {
     split_quads(&Mesh::new(r.into_topology(1), pts).expect("finite"))
 }
 
-fn scheme_named(name: &str) -> Option<SplitScheme> {
-    match name {
-        "doo-sabin" => Some(SplitScheme::DooSabin),
-        "sqrt3" => Some(SplitScheme::Sqrt3),
-        "butterfly" => Some(SplitScheme::BUTTERFLY),
-        "modified-butterfly" => Some(SplitScheme::ModifiedButterfly),
-        _ => None,
-    }
+fn scheme_named(name: &str) -> Option<Scheme> {
+    name.parse::<Scheme>().ok().filter(|s| !s.is_opensubdiv())
 }
 
 /// The subd side, in a child process: from the face lists of `mesh`, build the topology and
@@ -66,7 +59,8 @@ pub fn run_subd(
             let topo = TopologyBuilder::new(base.num_vertices())
                 .build(&sizes, base.all_face_vertices())
                 .expect("valid base");
-            let r = SplitRefinement::new(&topo, scheme, levels).expect("refine");
+            let r = Refinement::new(&topo, scheme.clone(), &Options::default(), levels)
+                .expect("refine");
             let p = r.refine_points(pos);
             times.push(t0.elapsed().as_secs_f64());
             vertices = p[levels].len();

@@ -31,7 +31,7 @@ pub fn run(repeats: usize) -> Result<(), String> {
         (Scheme::Loop, tri_bench_mesh()),
     ] {
         let options = Options::default();
-        let input = osd::encode(&mesh.topology, &mesh.positions, scheme, &options, 0);
+        let input = osd::encode(&mesh.topology, &mesh.positions, &scheme, &options, 0);
         for rate in [4usize, 8] {
             let out = osd::run(
                 &exe,
@@ -45,7 +45,7 @@ pub fn run(repeats: usize) -> Result<(), String> {
             let mut samples = 0;
             for _ in 0..repeats {
                 let t = Instant::now();
-                let ev = LimitEvaluator::new(&mesh.topology, scheme, &options)
+                let ev = LimitEvaluator::new(&mesh.topology, &scheme, &options)
                     .map_err(|e| e.to_string())?;
                 let pts = ev.prepare(&mesh.positions);
                 setups.push(t.elapsed().as_secs_f64());

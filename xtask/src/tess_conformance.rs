@@ -71,7 +71,7 @@ pub fn compare(
     name: &str,
     topo: &Topology,
     positions: &[DVec3],
-    scheme: Scheme,
+    scheme: &Scheme,
     options: &Options,
     diag: f64,
 ) -> Row {
@@ -106,7 +106,7 @@ pub fn compare(
         let m = f64::from(g.segments);
         let (i, j) = ((at.u * m).round(), (at.v * m).round());
         let on_grid = (at.u * m - i).abs() < 1e-9 && (at.v * m - j).abs() < 1e-9;
-        let triangle = scheme == Scheme::Loop;
+        let triangle = *scheme == Scheme::Loop;
         (on_grid && i + if triangle { j } else { 0.0 } <= m && j <= m)
             .then(|| t.positions[t.grid_vertex(g, triangle, i as u32, j as u32) as usize])
     };
@@ -158,7 +158,7 @@ pub fn compare(
         .then(|| crate::conformance::RefinedLimits::new(topo, positions, scheme, options))
         .flatten();
     let refinement_agrees = |at: &FaceParam, p: DVec3| {
-        let quad_or_tri = at.sub == 0 && (scheme == Scheme::Loop || topo.face_size(at.face) == 4);
+        let quad_or_tri = at.sub == 0 && (*scheme == Scheme::Loop || topo.face_size(at.face) == 4);
         quad_or_tri
             && refined
                 .as_ref()
@@ -241,7 +241,7 @@ fn far_positions(
     exe: &Path,
     topo: &Topology,
     positions: &[DVec3],
-    scheme: Scheme,
+    scheme: &Scheme,
     options: &Options,
     points: &[(FaceParam, DVec3, f64)],
 ) -> Result<Vec<DVec3>, String> {
@@ -251,7 +251,7 @@ fn far_positions(
     for f in 0..topo.num_faces() {
         first_ptex.push(next);
         let n = topo.face_size(f);
-        next += if n == 4 || scheme == Scheme::Loop {
+        next += if n == 4 || *scheme == Scheme::Loop {
             1
         } else {
             n as u32

@@ -37,14 +37,15 @@ fn bench(c: &mut Criterion) {
     ] {
         g.bench_function(format!("{name}_flatness_level3"), |b| {
             b.iter(|| {
-                let a = AdaptiveRefinement::new(&m.topology, &m.positions, scheme, &o, &[&flat], 3)
-                    .expect("adaptive");
+                let a =
+                    AdaptiveRefinement::new(&m.topology, &m.positions, &scheme, &o, &[&flat], 3)
+                        .expect("adaptive");
                 a.mesh(Positions::Refined).expect("mesh").num_faces()
             })
         });
         g.bench_function(format!("{name}_uniform_level3"), |b| {
             b.iter(|| {
-                let r = Refinement::new(&m.topology, scheme, &o, 3).expect("refine");
+                let r = Refinement::new(&m.topology, scheme.clone(), &o, 3).expect("refine");
                 r.refine_points(&m.positions).len()
             })
         });

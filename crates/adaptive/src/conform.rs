@@ -40,7 +40,7 @@ use Point::{Corner as C, Edge as E};
 /// The polygons replacing a leaf of `n` corners whose edges `split` are split, choosing
 /// between alternative cuts by the smallest angle (positions from `pos`).
 fn pattern(
-    scheme: Scheme,
+    scheme: &Scheme,
     n: usize,
     split: &[bool],
     pos: &dyn Fn(Point) -> DVec3,
@@ -328,7 +328,7 @@ impl AdaptiveRefinement {
             }
         };
         let pos = |p: Point| out.positions[vertex(p) as usize];
-        let polygons = pattern(self.scheme, n, &split, &pos);
+        let polygons = pattern(&self.scheme, n, &split, &pos);
         for poly in polygons {
             let m = poly.len();
             for i in 0..m {

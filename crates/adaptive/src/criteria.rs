@@ -471,7 +471,7 @@ impl LimitSurface {
     pub fn new(
         base: &Topology,
         points: &[DVec3],
-        scheme: Scheme,
+        scheme: &Scheme,
         options: &Options,
     ) -> Result<Self, AdaptiveError> {
         let evaluator = LimitEvaluator::new(base, scheme, options)?;
@@ -728,7 +728,7 @@ mod tests {
     }
 
     fn selected(c: &dyn Criterion, t: &Topology, p: &[DVec3]) -> Vec<bool> {
-        let a = AdaptiveRefinement::new(t, p, Scheme::Loop, &Options::default(), &[], 0).unwrap();
+        let a = AdaptiveRefinement::new(t, p, &Scheme::Loop, &Options::default(), &[], 0).unwrap();
         let mut s = vec![false; t.num_faces()];
         c.select(&level0(&a), &mut s).unwrap();
         s
@@ -796,7 +796,8 @@ mod tests {
         // Octahedron: 4 faces of 60° at each vertex, defect 2π − 4π/3 = 2π/3, six vertices
         // sum to 4π (Gauss–Bonnet for a sphere).
         let (t, p) = octahedron();
-        let a = AdaptiveRefinement::new(&t, &p, Scheme::Loop, &Options::default(), &[], 0).unwrap();
+        let a =
+            AdaptiveRefinement::new(&t, &p, &Scheme::Loop, &Options::default(), &[], 0).unwrap();
         let view = level0(&a);
         let area = 3f64.sqrt() / 2.0; // each face: an equilateral triangle of side √2
         for v in 0..6 {
@@ -831,10 +832,10 @@ mod tests {
         let (t, p) = octahedron();
         let o = Options::default();
         for limit in [false, true] {
-            let surface = LimitSurface::new(&t, &p, Scheme::Loop, &o).unwrap();
+            let surface = LimitSurface::new(&t, &p, &Scheme::Loop, &o).unwrap();
             let tol = 2e-3;
             let c = LimitDistance::new(surface, tol, limit).unwrap();
-            let a = AdaptiveRefinement::new(&t, &p, Scheme::Loop, &o, &[&c], 8).unwrap();
+            let a = AdaptiveRefinement::new(&t, &p, &Scheme::Loop, &o, &[&c], 8).unwrap();
             let positions = if limit {
                 Positions::Limit
             } else {

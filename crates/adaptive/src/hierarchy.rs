@@ -46,7 +46,7 @@ use crate::{AdaptiveError, MAX_LEVELS};
 /// let topo = TopologyBuilder::new(6).build(&[3; 8], &fv).unwrap();
 /// let points = [DVec3::Z, DVec3::X, DVec3::Y, -DVec3::X, -DVec3::Y, -DVec3::Z];
 /// let select = FaceSelection::from_faces(8, &[0]).unwrap();
-/// let a = AdaptiveRefinement::new(&topo, &points, Scheme::Loop, &Options::default(), &[&select], 3)
+/// let a = AdaptiveRefinement::new(&topo, &points, &Scheme::Loop, &Options::default(), &[&select], 3)
 ///     .unwrap();
 /// let mesh = a.mesh(Positions::Refined).unwrap();
 /// // Far fewer faces than uniform level 3 (512), closed and crack-free.
@@ -80,12 +80,13 @@ impl AdaptiveRefinement {
     /// `criteria` is empty) and what the closure adds.
     ///
     /// # Errors
+    /// [`AdaptiveError::Scheme`] for a scheme other than Catmull-Clark, Loop and Bilinear,
     /// [`AdaptiveError::TooManyLevels`], [`AdaptiveError::PointCount`], a refinement error
     /// (Loop on a face that is not a triangle), or a criterion's error.
     pub fn new(
         base: &Topology,
         points: &[DVec3],
-        scheme: Scheme,
+        scheme: &Scheme,
         options: &Options,
         criteria: &[&dyn Criterion],
         max_level: usize,
@@ -108,12 +109,20 @@ impl AdaptiveRefinement {
     pub fn with_progress(
         base: &Topology,
         points: &[DVec3],
-        scheme: Scheme,
+        scheme: &Scheme,
         options: &Options,
         criteria: &[&dyn Criterion],
         max_level: usize,
         progress: &mut dyn FnMut(usize, usize),
     ) -> Result<Self, AdaptiveError> {
+        if !matches!(
+            scheme,
+            Scheme::CatmullClark | Scheme::Loop | Scheme::Bilinear
+        ) {
+            return Err(AdaptiveError::Scheme {
+                scheme: scheme.to_string(),
+            });
+        }
         if max_level > MAX_LEVELS {
             return Err(AdaptiveError::TooManyLevels {
                 levels: max_level,
@@ -157,7 +166,7 @@ impl AdaptiveRefinement {
             // Criteria that judge the conforming mesh: refine the leaves of the faces they
             // reject, and go back to the coarsest such level.
             let mut h = AdaptiveRefinement {
-                scheme,
+                scheme: scheme.clone(),
                 options: *options,
                 levels,
                 uniform,
@@ -187,8 +196,8 @@ impl AdaptiveRefinement {
     }
 
     /// The scheme.
-    pub fn scheme(&self) -> Scheme {
-        self.scheme
+    pub fn scheme(&self) -> &Scheme {
+        &self.scheme
     }
 
     /// The options.
@@ -259,7 +268,7 @@ fn decide(
     l: usize,
     criteria: &[&dyn Criterion],
     requests: &HashSet<u64>,
-    scheme: Scheme,
+    scheme: &Scheme,
 ) -> Result<Vec<bool>, AdaptiveError> {
     let mut sel = vec![false; level.num_faces()];
     let view = LevelView {
@@ -282,7 +291,7 @@ fn decide(
 
 /// Whether a face left unrefined with `split` edges split by finer neighbours has no
 /// transition pattern, and must be refined.
-fn needs_refining(scheme: Scheme, size: usize, split: usize) -> bool {
+fn needs_refining(scheme: &Scheme, size: usize, split: usize) -> bool {
     match (scheme, size) {
         (Scheme::Loop, _) => split >= 3,
         (_, 4) => split >= 3,
@@ -303,7 +312,7 @@ fn split_edges(t: &Topology, sel: &[bool], f: usize) -> usize {
 }
 
 /// Refines every face that the transition patterns cannot close, until none is left.
-fn red_green(t: &Topology, sel: &mut [bool], scheme: Scheme) {
+fn red_green(t: &Topology, sel: &mut [bool], scheme: &Scheme) {
     let mut queue: Vec<u32> = (0..t.num_faces())
         .into_par_iter()
         .filter(|&f| !sel[f] && split_edges(t, sel, f) > 0)

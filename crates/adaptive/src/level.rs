@@ -67,7 +67,7 @@ impl SparseLevel {
     pub(crate) fn base(
         base: &Topology,
         points: &[DVec3],
-        scheme: Scheme,
+        scheme: &Scheme,
         options: &Options,
     ) -> Result<SparseLevel, AdaptiveError> {
         if points.len() != base.num_vertices() {
@@ -76,7 +76,7 @@ impl SparseLevel {
                 vertices: base.num_vertices(),
             });
         }
-        let r = Refinement::new(base, scheme, options, 0)?;
+        let r = Refinement::new(base, scheme.clone(), options, 0)?;
         let rules = r.vertex_rules(0).to_vec();
         let topology = r.into_topology(0);
         let (nv, ne, nf) = (
@@ -96,7 +96,7 @@ impl SparseLevel {
         }
         let sub_face = (0..nf)
             .map(|f| {
-                if scheme == Scheme::Loop || topology.face_size(f) == 4 {
+                if *scheme == Scheme::Loop || topology.face_size(f) == 4 {
                     0
                 } else {
                     WHOLE_FACE
@@ -178,7 +178,7 @@ impl SparseLevel {
     pub(crate) fn refine(
         &mut self,
         level: usize,
-        scheme: Scheme,
+        scheme: &Scheme,
         options: &Options,
         uniform: &UniformLayout,
     ) -> Result<SparseLevel, AdaptiveError> {
@@ -207,11 +207,11 @@ impl SparseLevel {
             cut.topology.num_face_vertices(),
         );
         let piece_offsets = cut.topology.face_offsets().to_vec();
-        let r = Refinement::from_prepared(cut.topology, rules, scheme, options, 1)?;
+        let r = Refinement::from_prepared(cut.topology, rules, scheme.clone(), options, 1)?;
         let child_points = r.refine_points(&points).pop().expect("one level");
         let c = r.topology(1);
         let child_rules = r.vertex_rules(1);
-        let loop_scheme = scheme == Scheme::Loop;
+        let loop_scheme = *scheme == Scheme::Loop;
         let edge_point_base = if loop_scheme { pnv } else { pnv + pnf };
         let half_base = if loop_scheme { 3 * pnf } else { pnh };
 

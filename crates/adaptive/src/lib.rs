@@ -38,7 +38,7 @@
 //!     .map(|i| DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64))
 //!     .collect();
 //! let flat = Flatness::new(20.0).unwrap();
-//! let a = AdaptiveRefinement::new(&cube, &p, Scheme::CatmullClark, &Options::default(), &[&flat], 4)
+//! let a = AdaptiveRefinement::new(&cube, &p, &Scheme::CatmullClark, &Options::default(), &[&flat], 4)
 //!     .unwrap();
 //! let mesh = a.mesh(Positions::Limit).unwrap();
 //! assert!(mesh.num_faces() < 6 * 256); // uniform level 4 has 1536
@@ -82,6 +82,14 @@ pub enum AdaptiveError {
     /// A limit computation or evaluation failed.
     #[error(transparent)]
     Limit(#[from] LimitError),
+    /// A scheme adaptive refinement has no rules for.
+    #[error(
+        "adaptive refinement needs catmull-clark, loop or bilinear (the {scheme} scheme has no adaptive hierarchy)"
+    )]
+    Scheme {
+        /// The scheme given.
+        scheme: String,
+    },
     /// Not one position per base vertex.
     #[error("{given} positions given for {vertices} vertices")]
     PointCount {

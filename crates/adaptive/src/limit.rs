@@ -121,7 +121,7 @@ fn level_limits(
     };
     // Edge points exist one level down: refine the cut once and take the limits there.
     let (topology, pts) = if edge_points {
-        let r = Refinement::from_prepared(cut.topology, rules, h.scheme, &h.options, 1)?;
+        let r = Refinement::from_prepared(cut.topology, rules, h.scheme.clone(), &h.options, 1)?;
         let pts = r.refine_points(&points).pop().expect("one level");
         (r.into_topology(1), pts)
     } else {
@@ -132,11 +132,11 @@ fn level_limits(
     // vertices on its cut, whose limits are not read.
     // Past a couple of decay levels refining the whole piece costs 4^levels; subd-limit's
     // local path refines only around the semi-sharp features.
-    let (decay, _) = subd_limit::levels_for_exact_limit(&topology, h.scheme);
+    let (decay, _) = subd_limit::levels_for_exact_limit(&topology, &h.scheme);
     let exact = if decay <= LOCAL_DECAY {
-        subd_limit::base_limit(&topology, h.scheme, &h.options)
+        subd_limit::base_limit(&topology, &h.scheme, &h.options)
     } else {
-        subd_limit::local::base_limit(&topology, h.scheme, &h.options)
+        subd_limit::local::base_limit(&topology, &h.scheme, &h.options)
     };
     let table = match exact {
         Err(e @ subd_limit::LimitError::Unsupported { .. }) => whole_limit(h, topology, &pts, e)?,
@@ -172,14 +172,14 @@ fn whole_limit(
     pts: &[DVec3],
     refused: subd_limit::LimitError,
 ) -> Result<subd_limit::LimitStencilTable, AdaptiveError> {
-    let (levels, _) = subd_limit::levels_for_exact_limit(&topology, h.scheme);
+    let (levels, _) = subd_limit::levels_for_exact_limit(&topology, &h.scheme);
     let size = topology
         .num_face_vertices()
         .saturating_mul(4usize.saturating_pow(levels as u32));
     if size > subd_limit::MAX_DECAY_FACE_VERTICES {
         return Err(refused.into());
     }
-    let r = Refinement::new(&topology, h.scheme, &h.options, levels)?;
+    let r = Refinement::new(&topology, h.scheme.clone(), &h.options, levels)?;
     let mut table = subd_limit::LimitStencilTable::at_level(&r, levels)?;
     for l in (1..=levels).rev() {
         table = table.after(r.stencils(l));

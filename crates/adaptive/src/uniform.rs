@@ -31,7 +31,7 @@ pub(crate) struct UniformLayout {
 }
 
 impl UniformLayout {
-    pub(crate) fn new(base: &Topology, scheme: Scheme, levels: usize) -> UniformLayout {
+    pub(crate) fn new(base: &Topology, scheme: &Scheme, levels: usize) -> UniformLayout {
         let mut c = UniformCounts {
             vertices: base.num_vertices() as u64,
             faces: base.num_faces() as u64,
@@ -57,7 +57,7 @@ impl UniformLayout {
             counts.push(c);
         }
         UniformLayout {
-            scheme,
+            scheme: scheme.clone(),
             counts,
             base_offsets: base.face_offsets().to_vec(),
         }
@@ -140,7 +140,7 @@ mod tests {
             .build(&[4, 3, 3, 3, 3], &fv)
             .unwrap();
         let r = Refinement::new(&t, Scheme::CatmullClark, &Options::default(), 3).unwrap();
-        let u = UniformLayout::new(&t, Scheme::CatmullClark, 3);
+        let u = UniformLayout::new(&t, &Scheme::CatmullClark, 3);
         for l in 0..=3 {
             let c = u.counts(l);
             let tl = r.topology(l);
@@ -153,7 +153,7 @@ mod tests {
             .build(&[3; 4], &[0, 1, 2, 0, 3, 1, 1, 3, 2, 2, 3, 0])
             .unwrap();
         let r = Refinement::new(&tri, Scheme::Loop, &Options::default(), 3).unwrap();
-        let u = UniformLayout::new(&tri, Scheme::Loop, 3);
+        let u = UniformLayout::new(&tri, &Scheme::Loop, 3);
         for l in 0..=3 {
             let tl = r.topology(l);
             assert_eq!(u.counts(l).edges, tl.num_edges() as u64);

@@ -178,7 +178,7 @@ impl Selection {
         args: &AdaptiveArgs,
         job: &Job,
         mesh: &subd_mesh::Mesh,
-        scheme: Scheme,
+        scheme: &Scheme,
         options: &subd_schemes::Options,
         diagonal: f64,
     ) -> Result<Selection, Failure> {
@@ -275,14 +275,14 @@ fn run_one(
     let diagonal = mesh
         .bounding_box()
         .map_or(0.0, |(lo, hi)| (hi - lo).length());
-    let selection = Selection::new(args, job, mesh, scheme, &options, diagonal)?;
+    let selection = Selection::new(args, job, mesh, &scheme, &options, diagonal)?;
 
     let spinner = Spinner::new(args.json || job.quiet, "refining");
     let t0 = Instant::now();
     let hierarchy = AdaptiveRefinement::with_progress(
         base,
         &mesh.positions,
-        scheme,
+        &scheme,
         &options,
         &selection.criteria(),
         levels,
@@ -306,7 +306,7 @@ fn run_one(
     let surface = match &selection.distance {
         Some(d) => Some(d.surface()),
         None if args.json || mesh.uv().is_some() => {
-            own = LimitSurface::new(base, &mesh.positions, scheme, &options);
+            own = LimitSurface::new(base, &mesh.positions, &scheme, &options);
             own.as_ref().ok()
         }
         None => None,
@@ -447,7 +447,7 @@ fn adaptive_uv(
         None => own
             .insert(subd_limit::eval::LimitEvaluator::new(
                 &mesh.topology,
-                scheme,
+                &scheme,
                 options,
             ))
             .as_ref()

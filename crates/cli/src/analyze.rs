@@ -8,7 +8,6 @@ use serde::Serialize;
 use subd_limit::split_eigen::{FourierEigenvalue, SpectrumTest, split_spectrum};
 use subd_schemes::Scheme;
 use subd_schemes::analysis::{Lattice, analyze, analyze_bivariate};
-use subd_schemes::split_schemes::SplitScheme;
 
 use crate::Failure;
 use crate::failure::bad;
@@ -88,12 +87,12 @@ pub(crate) fn run(args: &AnalyzeArgs, out: &mut dyn Write) -> Result<(), Failure
     if let (Some(surface), Some(n)) = (args.surface, args.valence) {
         let split = match surface {
             SurfaceArg::CatmullClark | SurfaceArg::Loop => None,
-            SurfaceArg::DooSabin => Some(SplitScheme::DooSabin),
-            SurfaceArg::Sqrt3 => Some(SplitScheme::Sqrt3),
-            SurfaceArg::Butterfly => Some(SplitScheme::Butterfly {
+            SurfaceArg::DooSabin => Some(subd_schemes::Scheme::DooSabin),
+            SurfaceArg::Sqrt3 => Some(subd_schemes::Scheme::Sqrt3),
+            SurfaceArg::Butterfly => Some(subd_schemes::Scheme::Butterfly {
                 tension: crate::rule_args::butterfly_tension(args.tension)?,
             }),
-            SurfaceArg::ModifiedButterfly => Some(SplitScheme::ModifiedButterfly),
+            SurfaceArg::ModifiedButterfly => Some(subd_schemes::Scheme::ModifiedButterfly),
         };
         return match split {
             Some(scheme) => run_split_surface(scheme, n, args.json, out),
@@ -248,7 +247,7 @@ fn run_surface(
     if !(min..=64).contains(&n) {
         return Err(bad(format!("--valence {n}: must be {min} to 64")));
     }
-    let m = subd_limit::eigen::ring_matrix(scheme, n, subd_limit::eigen::RingFeature::Smooth)
+    let m = subd_limit::eigen::ring_matrix(&scheme, n, subd_limit::eigen::RingFeature::Smooth)
         .map_err(|e| bad(format!("--surface {name}: {e}")))?;
     let ev =
         subd_limit::eigen::eigenvalues(&m).map_err(|e| bad(format!("--surface {name}: {e}")))?;
@@ -300,7 +299,7 @@ struct SplitSurfaceReport {
 
 /// The eigenvalue test of a split scheme (Fourier blocks of its local subdivision matrix).
 fn run_split_surface(
-    scheme: SplitScheme,
+    scheme: subd_schemes::Scheme,
     n: usize,
     json: bool,
     out: &mut dyn Write,
@@ -309,19 +308,16 @@ fn run_split_surface(
     if !(3..=64).contains(&n) {
         return Err(bad(format!("--valence {n}: must be 3 to 64")));
     }
-    let spectrum = split_spectrum(scheme, n).map_err(|e| bad(format!("--surface {name}: {e}")))?;
+    let spectrum = split_spectrum(&scheme, n).map_err(|e| bad(format!("--surface {name}: {e}")))?;
     let test = spectrum.test();
-    let steps = if scheme == SplitScheme::Sqrt3 { 2 } else { 1 };
+    let steps = scheme.period();
     if json {
         crate::print_json(
             out,
             &SplitSurfaceReport {
                 scheme: name,
                 valence: n,
-                tension: match scheme {
-                    SplitScheme::Butterfly { tension } => Some(tension),
-                    _ => None,
-                },
+                tension: scheme.tension(),
                 steps,
                 ball_size: spectrum.ball_size,
                 eigenvalues: spectrum.eigenvalues,
@@ -336,7 +332,7 @@ fn run_split_surface(
         .take(6)
         .map(|e| format!("{:.6} (k={})", e.norm(), e.frequency))
         .collect();
-    let centre = if scheme == SplitScheme::DooSabin {
+    let centre = if scheme == subd_schemes::Scheme::DooSabin {
         format!("{n}-sided face")
     } else {
         format!("valence {n}")

@@ -137,33 +137,23 @@ const GLB_PER_VERTEX: u64 = 24;
 const STREAMED_GLB_PER_VERTEX: u64 = 50;
 
 impl PeakModel {
-    /// OpenSubdiv's schemes (and the two-phase scheme, Catmull-Clark's after level 1).
-    pub(crate) fn osd(scheme: subd_schemes::Scheme) -> PeakModel {
+    /// The measured bytes per output vertex of `scheme` (the two-phase scheme is
+    /// Catmull-Clark's after level 1; the split schemes hold every level and stream
+    /// nothing).
+    pub(crate) fn of(scheme: &subd_schemes::Scheme) -> PeakModel {
         use subd_schemes::Scheme;
         let (per_vertex, streamed) = match scheme {
-            Scheme::CatmullClark => (105, 70),
-            Scheme::Bilinear => (120, 70),
-            Scheme::Loop => (120, 90),
+            Scheme::CatmullClark | Scheme::TwoPhase(_) => (105, Some(70)),
+            Scheme::Bilinear => (120, Some(70)),
+            Scheme::Loop => (120, Some(90)),
+            Scheme::DooSabin => (145, None),
+            Scheme::Butterfly { .. } | Scheme::ModifiedButterfly => (190, None),
+            Scheme::Sqrt3 => (235, None),
         };
         PeakModel {
             per_vertex,
-            streamed_per_vertex: Some(streamed),
-            limit_per_vertex: 1150,
-        }
-    }
-
-    /// The split schemes.
-    pub(crate) fn split(scheme: subd_schemes::split_schemes::SplitScheme) -> PeakModel {
-        use subd_schemes::split_schemes::SplitScheme;
-        let per_vertex = match scheme {
-            SplitScheme::DooSabin => 145,
-            SplitScheme::Butterfly { .. } | SplitScheme::ModifiedButterfly => 190,
-            SplitScheme::Sqrt3 => 235,
-        };
-        PeakModel {
-            per_vertex,
-            streamed_per_vertex: None,
-            limit_per_vertex: 2800,
+            streamed_per_vertex: streamed,
+            limit_per_vertex: if streamed.is_some() { 1150 } else { 2800 },
         }
     }
 

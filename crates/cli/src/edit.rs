@@ -227,14 +227,14 @@ fn run_one(
         e => bad(format!("{}: {e}", job.input.display())),
     };
     let mut editor =
-        Editor::new(topo, x0, scheme, &options, &constraints, method).map_err(named)?;
+        Editor::new(topo, x0, &scheme, &options, &constraints, method).map_err(named)?;
     let edit = editor.solve_timed(&constraints).map_err(named)?;
 
     // Residuals measured afresh: a new evaluator on the output positions.
     let t_check = Instant::now();
-    let ev = subd_limit::eval::LimitEvaluator::new(topo, scheme, &options)
+    let ev = subd_limit::eval::LimitEvaluator::new(topo, &scheme, &options)
         .map_err(|e| bad(format!("{}: {e}", job.input.display())))?;
-    let res = subd_editing::check::residuals(&ev, topo, scheme, &constraints, x0, &edit.positions)
+    let res = subd_editing::check::residuals(&ev, topo, &scheme, &constraints, x0, &edit.positions)
         .map_err(named)?;
     let diag = subd_pia::bbox_diagonal(x0).max(f64::MIN_POSITIVE);
     let max_rel = constraints

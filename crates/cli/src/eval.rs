@@ -109,7 +109,7 @@ pub(crate) fn run(
     let scheme = args.scheme.scheme();
     let options = args.rules.options(&file.mesh.hints);
     let topo = &file.mesh.topology;
-    let ev = LimitEvaluator::new(topo, scheme, &options)
+    let ev = LimitEvaluator::new(topo, &scheme, &options)
         .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
     let sizes: Vec<u32> = topo.face_sizes().collect();
     let points = read_points(&args.at, &ev, &sizes, scheme == Scheme::CatmullClark)?;

@@ -7,11 +7,9 @@ use std::time::Instant;
 
 use clap::{Args, ValueEnum};
 use serde::Serialize;
-use subd_limit::split_limit::{SplitLimitStencils, split_limit_stencils};
 use subd_limit::{LimitPoints, base_limit, levels_for_exact_limit, two_phase_base_limit};
 use subd_mesh::Mesh;
 use subd_schemes::Scheme;
-use subd_schemes::split_schemes::SplitScheme;
 
 use crate::batch::{self, Files, Job, OutputFormat};
 use crate::failure::{bad, refuse_overwrite};
@@ -163,12 +161,12 @@ fn run_one(
         return Err(bad("--tension applies to --scheme butterfly only".into()));
     }
     let split = match args.scheme {
-        LimitCommandScheme::DooSabin => Some(SplitScheme::DooSabin),
-        LimitCommandScheme::Sqrt3 => Some(SplitScheme::Sqrt3),
-        LimitCommandScheme::Butterfly => Some(SplitScheme::Butterfly {
+        LimitCommandScheme::DooSabin => Some(Scheme::DooSabin),
+        LimitCommandScheme::Sqrt3 => Some(Scheme::Sqrt3),
+        LimitCommandScheme::Butterfly => Some(Scheme::Butterfly {
             tension: crate::rule_args::butterfly_tension(args.tension)?,
         }),
-        LimitCommandScheme::ModifiedButterfly => Some(SplitScheme::ModifiedButterfly),
+        LimitCommandScheme::ModifiedButterfly => Some(Scheme::ModifiedButterfly),
         _ => None,
     };
     if let Some(scheme) = split {
@@ -184,15 +182,18 @@ fn run_one(
         }
         let in_file = |e: String| bad(format!("{}: {e}", job.input.display()));
         // One set of stencils for the positions and the texture coordinates.
-        let stencils = checked_split_limit_stencils(topo, scheme).map_err(in_file)?;
-        let limit = split_limit_points(&stencils, scheme, &file.mesh.positions).map_err(in_file)?;
+        let stencils = subd_limit::split_limit::checked_split_limit_stencils(topo, &scheme)
+            .map_err(|e| in_file(e.to_string()))?;
+        let limit = stencils
+            .limit_points(&scheme, &file.mesh.positions)
+            .map_err(|e| in_file(e.to_string()))?;
         // Texture coordinates at their limit too, where the scheme carries them.
         let mut uv_warnings = Vec::new();
         let kept = match file.mesh.uv() {
             Some(c) if !is_text => Some(
                 crate::uv::split_limit_uv(
                     topo,
-                    (scheme, &stencils),
+                    (&scheme, &stencils),
                     c,
                     args.rules.fvar_mode(&file.mesh.hints),
                     &mut uv_warnings,
@@ -227,7 +228,7 @@ fn run_one(
                 "--lambda and --lambda-file apply to --scheme two-phase only".into(),
             ));
         }
-        _ => base_limit(topo, scheme, &options),
+        _ => base_limit(topo, &scheme, &options),
     }
     .map_err(|e| bad(format!("{}: {e}", job.input.display())))?;
     let limit = table.apply(&file.mesh.positions);
@@ -254,7 +255,7 @@ fn run_one(
         Some(c) if !is_text => Some(
             crate::uv::limit_uv(
                 topo,
-                scheme,
+                &scheme,
                 &options,
                 c,
                 args.rules.fvar_mode(&file.mesh.hints),
@@ -273,7 +274,7 @@ fn run_one(
             output: job.output.display().to_string(),
             scheme: name,
             vertices: topo.num_vertices(),
-            levels_refined: levels_for_exact_limit(topo, scheme)
+            levels_refined: levels_for_exact_limit(topo, &scheme)
                 .0
                 .max(usize::from(name == "two-phase")),
             seconds: t0.elapsed().as_secs_f64(),
@@ -319,44 +320,4 @@ fn write_limit(
         subd_io::write_mesh(&job.output, &mesh, &subd_io::WriteOptions::default())?;
     }
     Ok(())
-}
-
-/// A split scheme's limit stencils at every vertex of `topo`, after the refinement's own
-/// checks (so bad input reads as it does for `subd refine`).
-pub(crate) fn checked_split_limit_stencils(
-    topo: &subd_mesh::Topology,
-    scheme: SplitScheme,
-) -> Result<SplitLimitStencils, String> {
-    subd_schemes::split_schemes::SplitRefinement::new(topo, scheme, 0)
-        .map_err(|e| e.to_string())?;
-    split_limit_stencils(topo, scheme).map_err(|e| e.to_string())
-}
-
-/// The limit of a split scheme at every vertex from its `stencils` (`nan` normals where none
-/// is defined); a vertex without a limit is an error naming it.
-pub(crate) fn split_limit_points(
-    stencils: &SplitLimitStencils,
-    scheme: SplitScheme,
-    positions: &[subd_mesh::DVec3],
-) -> Result<LimitPoints, String> {
-    let points = stencils.evaluate(positions);
-    if let Some(v) = points.positions.iter().position(Option::is_none) {
-        let why = if scheme == SplitScheme::DooSabin {
-            "an interior vertex of valence 2 has no vertex face"
-        } else {
-            "its neighbourhood never became one with a known limit mask (a dart or boundary vertex whose refined neighbourhood stays irregular)"
-        };
-        return Err(format!("vertex {v}: no {} limit: {why}", scheme.name()));
-    }
-    let nan = subd_mesh::DVec3::splat(f64::NAN);
-    Ok(LimitPoints {
-        positions: points.positions.into_iter().flatten().collect(),
-        tangent1: vec![nan; positions.len()],
-        tangent2: vec![nan; positions.len()],
-        normals: points
-            .normals
-            .into_iter()
-            .map(|n| n.unwrap_or(nan))
-            .collect(),
-    })
 }

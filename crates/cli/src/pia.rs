@@ -8,7 +8,7 @@ use std::time::Instant;
 use clap::{Args, ValueEnum};
 use serde::Serialize;
 use subd_mesh::Mesh;
-use subd_pia::{Method, Moving, Pia, PiaOptions, PiaScheme, Solver, bbox_diagonal};
+use subd_pia::{Method, Moving, Pia, PiaOptions, Solver, bbox_diagonal};
 use subd_schemes::Scheme;
 
 use crate::batch::{self, Files, Job};
@@ -19,7 +19,7 @@ use crate::vertex_data::{LambdaArgs, read_indices};
 use crate::{EXIT_FAILURE, Failure, print_warnings};
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
-pub(crate) enum PiaSchemeArg {
+pub(crate) enum SchemeArg {
     /// Catmull-Clark limit surface (Chen et al. 2008).
     CatmullClark,
     /// Loop limit surface (Cheng et al. 2009).
@@ -51,7 +51,7 @@ pub(crate) enum SolverArg {
 pub(crate) struct PiaArgs {
     /// Scheme whose limit surface interpolates.
     #[arg(long, value_enum)]
-    scheme: PiaSchemeArg,
+    scheme: SchemeArg,
     #[command(flatten)]
     lambda: LambdaArgs,
     /// Only these vertices move (a file of 0-based indices); the others keep their
@@ -155,14 +155,14 @@ fn run_one(
     let nv = topo.num_vertices();
     let options = args.rules.options(&file.mesh.hints);
     let (scheme, name) = match args.scheme {
-        PiaSchemeArg::CatmullClark => (PiaScheme::CatmullClark, "catmull-clark"),
-        PiaSchemeArg::Loop => (PiaScheme::Loop, "loop"),
-        PiaSchemeArg::TwoPhase => (
-            PiaScheme::TwoPhase(args.lambda.two_phase(&job.input, nv)?),
+        SchemeArg::CatmullClark => (Scheme::CatmullClark, "catmull-clark"),
+        SchemeArg::Loop => (Scheme::Loop, "loop"),
+        SchemeArg::TwoPhase => (
+            Scheme::TwoPhase(args.lambda.two_phase(&job.input, nv)?),
             "two-phase",
         ),
     };
-    if !matches!(args.scheme, PiaSchemeArg::TwoPhase) && args.lambda.given() {
+    if !matches!(args.scheme, SchemeArg::TwoPhase) && args.lambda.given() {
         return Err(bad(
             "--lambda and --lambda-file apply to --scheme two-phase only".into(),
         ));
@@ -203,11 +203,8 @@ fn run_one(
     spinner.message("checking");
     let t2 = Instant::now();
     let check = match &scheme {
-        PiaScheme::CatmullClark => {
-            subd_limit::base_limit_positions(topo, Scheme::CatmullClark, &options)
-        }
-        PiaScheme::Loop => subd_limit::base_limit_positions(topo, Scheme::Loop, &options),
-        PiaScheme::TwoPhase(tp) => subd_limit::two_phase_base_limit_positions(topo, tp, &options),
+        Scheme::TwoPhase(tp) => subd_limit::two_phase_base_limit_positions(topo, tp, &options),
+        s => subd_limit::base_limit_positions(topo, s, &options),
     }
     .map_err(|e| at_input(e.into()))?;
     let limit = check.apply_points(&result.points);

@@ -8,8 +8,7 @@ use clap::{Args, ValueEnum};
 use serde::Serialize;
 use subd_limit::split_limit::SplitLimitStencils;
 use subd_mesh::{BoundaryInterpolation, CreaseMethod, SchemeHints, TriangleSubdivision};
-use subd_schemes::split_schemes::{SplitRefinement, SplitScheme};
-use subd_schemes::{ExplicitTags, Refinement, Scheme};
+use subd_schemes::{Refinement, Scheme, TwoPhase};
 
 use crate::batch::{self, Files, Job};
 use crate::budget::{Budget, PeakModel};
@@ -35,25 +34,18 @@ pub(crate) enum SchemeArg {
     ModifiedButterfly,
 }
 
-/// Which family a scheme argument belongs to.
-pub(crate) enum Chosen {
-    /// OpenSubdiv's schemes and the two-phase scheme, which refines with Catmull-Clark's
-    /// topology and rules after its first step.
-    Osd(Scheme),
-    /// A scheme of `subd_schemes::split_schemes`.
-    Split(SplitScheme),
-}
-
 impl SchemeArg {
-    pub(crate) fn chosen(self, tension: f64) -> Chosen {
+    /// The scheme, with the butterfly's `tension` and the two-phase scheme's `λ`.
+    pub(crate) fn scheme(self, tension: f64, two_phase: Option<TwoPhase>) -> Scheme {
         match self {
-            SchemeArg::CatmullClark | SchemeArg::TwoPhase => Chosen::Osd(Scheme::CatmullClark),
-            SchemeArg::Loop => Chosen::Osd(Scheme::Loop),
-            SchemeArg::Bilinear => Chosen::Osd(Scheme::Bilinear),
-            SchemeArg::DooSabin => Chosen::Split(SplitScheme::DooSabin),
-            SchemeArg::Sqrt3 => Chosen::Split(SplitScheme::Sqrt3),
-            SchemeArg::Butterfly => Chosen::Split(SplitScheme::Butterfly { tension }),
-            SchemeArg::ModifiedButterfly => Chosen::Split(SplitScheme::ModifiedButterfly),
+            SchemeArg::CatmullClark => Scheme::CatmullClark,
+            SchemeArg::TwoPhase => Scheme::TwoPhase(two_phase.unwrap_or_else(TwoPhase::unset)),
+            SchemeArg::Loop => Scheme::Loop,
+            SchemeArg::Bilinear => Scheme::Bilinear,
+            SchemeArg::DooSabin => Scheme::DooSabin,
+            SchemeArg::Sqrt3 => Scheme::Sqrt3,
+            SchemeArg::Butterfly => Scheme::Butterfly { tension },
+            SchemeArg::ModifiedButterfly => Scheme::ModifiedButterfly,
         }
     }
 
@@ -143,101 +135,60 @@ struct RefineReport {
     warnings: Vec<String>,
 }
 
-/// A refinement of either family, reduced to what writing its last level needs.
-pub(crate) enum Refined {
-    Osd(Refinement),
-    Split(Box<SplitRefined>),
-}
-
-/// A split scheme's refinement, and the limit stencils of its last level once asked for:
-/// the positions and the texture coordinates take their limits through the same ones.
-pub(crate) struct SplitRefined {
-    refinement: SplitRefinement,
+/// A refinement, and the limit stencils of a split scheme's last level once asked for: the
+/// positions and the texture coordinates take their limits through the same ones.
+pub(crate) struct Refined {
+    refinement: Refinement,
     last_limit: std::sync::OnceLock<Result<SplitLimitStencils, String>>,
 }
 
-impl std::ops::Deref for SplitRefined {
-    type Target = SplitRefinement;
-    fn deref(&self) -> &SplitRefinement {
+impl std::ops::Deref for Refined {
+    type Target = Refinement;
+    fn deref(&self) -> &Refinement {
         &self.refinement
     }
 }
 
-impl SplitRefined {
-    /// The limit stencils of the last level, built on first request.
+impl Refined {
+    /// Refines `base` with `scheme`; the error names the element.
+    pub(crate) fn new(
+        base: &subd_mesh::Topology,
+        scheme: Scheme,
+        options: &subd_schemes::Options,
+        levels: usize,
+    ) -> Result<Refined, String> {
+        Ok(Refined {
+            refinement: Refinement::new(base, scheme, options, levels)
+                .map_err(|e| e.to_string())?,
+            last_limit: std::sync::OnceLock::new(),
+        })
+    }
+
+    /// The limit stencils of a split scheme's last level, built on first request.
     pub(crate) fn last_limit(&self) -> Result<&SplitLimitStencils, String> {
         self.last_limit
             .get_or_init(|| {
                 let last = self.topology(self.num_levels());
-                crate::limit::checked_split_limit_stencils(last, self.scheme())
+                subd_limit::split_limit::checked_split_limit_stencils(last, self.scheme())
+                    .map_err(|e| e.to_string())
             })
             .as_ref()
             .map_err(Clone::clone)
     }
-}
-
-impl Refined {
-    /// Refines `base` with the chosen scheme (the two-phase scheme when `two_phase` is
-    /// given); the error names the element.
-    pub(crate) fn new(
-        base: &subd_mesh::Topology,
-        chosen: &Chosen,
-        two_phase: Option<&subd_schemes::TwoPhase>,
-        options: &subd_schemes::Options,
-        levels: usize,
-    ) -> Result<Refined, String> {
-        let e = |e: &dyn std::fmt::Display| e.to_string();
-        Ok(match (chosen, two_phase) {
-            (Chosen::Osd(_), Some(tp)) => {
-                Refined::Osd(Refinement::two_phase(base, tp, options, levels).map_err(|x| e(&x))?)
-            }
-            (Chosen::Osd(scheme), None) => {
-                Refined::Osd(Refinement::new(base, *scheme, options, levels).map_err(|x| e(&x))?)
-            }
-            (Chosen::Split(scheme), _) => Refined::Split(Box::new(SplitRefined {
-                refinement: SplitRefinement::new(base, *scheme, levels).map_err(|x| e(&x))?,
-                last_limit: std::sync::OnceLock::new(),
-            })),
-        })
-    }
-
-    /// Hole flags of the faces of `level` (the split schemes have no holes).
-    pub(crate) fn holes(&self, level: usize) -> std::borrow::Cow<'_, [bool]> {
-        match self {
-            Refined::Osd(r) => std::borrow::Cow::Borrowed(r.holes(level)),
-            Refined::Split(r) => std::borrow::Cow::Owned(vec![false; r.faces(level).0.len() - 1]),
-        }
-    }
-
-    pub(crate) fn faces(&self, level: usize) -> (&[u32], &[u32]) {
-        match self {
-            Refined::Osd(r) => r.faces(level),
-            Refined::Split(r) => r.faces(level),
-        }
-    }
-
-    fn explicit_tags(&self, level: usize) -> ExplicitTags {
-        match self {
-            Refined::Osd(r) => r.explicit_tags(level),
-            Refined::Split(r) => r.explicit_tags(level),
-        }
-    }
 
     /// Edges of the level; not counted for a split scheme's last level, whose edges are
     /// never built.
-    fn num_edges(&self, level: usize) -> Option<usize> {
-        match self {
-            Refined::Osd(r) => Some(r.num_edges(level)),
-            Refined::Split(_) => None,
+    fn edges(&self, level: usize) -> Option<usize> {
+        if self.scheme().is_opensubdiv() {
+            self.num_edges(level)
+        } else {
+            None
         }
     }
 
     pub(crate) fn last_positions(&self, base: &[subd_mesh::DVec3]) -> Vec<subd_mesh::DVec3> {
-        match self {
-            // Each level dropped once the next is computed.
-            Refined::Osd(r) => r.points_at(base, r.num_levels()),
-            Refined::Split(r) => r.refine_points(base).pop().expect("last level"),
-        }
+        // Each level dropped once the next is computed.
+        self.points_at(base, self.num_levels())
     }
 }
 
@@ -293,14 +244,14 @@ fn run_one(
         }
         _ => None,
     };
-    let chosen = args.scheme.chosen(tension);
-    check_memory(args, job, &file, &chosen)?;
+    let scheme = args.scheme.scheme(tension, two_phase);
+    check_memory(args, job, &file, &scheme)?;
 
     let progress = Progress::new(args.levels, args.json || job.quiet);
     let t0 = Instant::now();
     let in_file = |e: &dyn std::fmt::Display| bad(format!("{}: {e}", job.input.display()));
-    let refinement = Refined::new(base, &chosen, two_phase.as_ref(), &options, args.levels)
-        .map_err(|e| in_file(&e))?;
+    let refinement =
+        Refined::new(base, scheme.clone(), &options, args.levels).map_err(|e| in_file(&e))?;
     let input_counts = Counts {
         vertices: base.num_vertices(),
         edges: Some(base.num_edges()),
@@ -331,7 +282,7 @@ fn run_one(
                     .and_then(|v| v.with_uv(&u.values, 2, &u.indices))
                     .is_ok_and(|v| subd_io::ply::holds_texcoords(&v))
                 } else {
-                    u.values.len() / 2 != refinement_vertices(&refinement, args.levels)
+                    u.values.len() / 2 != refinement.topology(args.levels).num_vertices()
                 } =>
         {
             file.warnings.push(crate::uv::ply_seam_warning(&job.output));
@@ -351,12 +302,12 @@ fn run_one(
     progress.step("topology");
     let t_topology = t0.elapsed().as_secs_f64();
     let t1 = Instant::now();
-    let osd = matches!(chosen, Chosen::Osd(_));
+    let osd = scheme.is_opensubdiv();
     let mut hints = output_hints(osd, &options, &file.mesh.hints, &args.rules);
     hints.fvar_interpolation = uv.as_ref().map(|_| fvar_mode);
     let in_view = |e: subd_io::ViewError| bad(format!("{}: {e}", job.input.display()));
     let streams = match &refinement {
-        Refined::Osd(r) if !args.limit && args.levels > 0 => Some(r),
+        r if osd && !args.limit && args.levels > 0 => Some(r),
         _ => None,
     };
     let (out_counts, t_positions, t2) = if let Some(r) = streams {
@@ -379,19 +330,13 @@ fn run_one(
             .and_then(|v| v.with_tags(tags.creases, tags.corners))
             .and_then(|v| crate::uv::with_uv(v, uv.as_ref()))
             .map_err(in_view)?;
-        let counts = write_level(job, view, hints, refinement.num_edges(args.levels))?;
+        let counts = write_level(job, view, hints, refinement.edges(args.levels))?;
         (counts, t_positions, t2)
     } else {
         let mut positions = refinement.last_positions(&file.mesh.positions);
         let normals = if args.limit {
-            let limit = output_limit(
-                &refinement,
-                args.levels,
-                two_phase.as_ref(),
-                &options,
-                &positions,
-            )
-            .map_err(|e| in_file(&e))?;
+            let limit = output_limit(&refinement, args.levels, &options, &positions)
+                .map_err(|e| in_file(&e))?;
             positions = limit.positions;
             Some(limit.normals)
         } else {
@@ -415,7 +360,7 @@ fn run_one(
             filled = normals_or_faces(n, &view);
             view = view.with_normals(&filled).map_err(in_view)?;
         }
-        let counts = write_level(job, view, hints, refinement.num_edges(args.levels))?;
+        let counts = write_level(job, view, hints, refinement.edges(args.levels))?;
         (counts, t_positions, t2)
     };
     progress.finish();
@@ -427,10 +372,7 @@ fn run_one(
             output: job.output.display().to_string(),
             scheme: args.scheme.name(),
             levels: args.levels,
-            tension: match chosen {
-                Chosen::Split(SplitScheme::Butterfly { tension }) => Some(tension),
-                _ => None,
-            },
+            tension: scheme.tension(),
             boundary_interpolation: osd.then_some(options.boundary_interpolation),
             crease_method: osd.then_some(options.crease_method),
             triangle_subdivision: osd.then_some(options.triangle_subdivision),
@@ -449,14 +391,6 @@ fn run_one(
         crate::print_json(out, &report);
     }
     Ok(())
-}
-
-/// Number of vertices of `level` of either family.
-fn refinement_vertices(refinement: &Refined, level: usize) -> usize {
-    match refinement {
-        Refined::Osd(r) => r.num_vertices(level),
-        Refined::Split(r) => r.topology(level).num_vertices(),
-    }
 }
 
 /// Writes the output level with its hints; its counts for the report.
@@ -502,19 +436,11 @@ fn check_memory(
     args: &RefineArgs,
     job: &Job,
     file: &subd_io::MeshFile,
-    chosen: &Chosen,
+    scheme: &Scheme,
 ) -> Result<(), Failure> {
     let base = &file.mesh.topology;
-    let (counts, model) = match chosen {
-        Chosen::Osd(scheme) => (
-            subd_schemes::refined_counts(base, *scheme, args.levels),
-            PeakModel::osd(*scheme),
-        ),
-        Chosen::Split(scheme) => (
-            subd_schemes::refined_split_counts(base, *scheme, args.levels),
-            PeakModel::split(*scheme),
-        ),
-    };
+    let counts = subd_schemes::refined_counts(base, scheme, args.levels);
+    let model = PeakModel::of(scheme);
     let file_bytes = std::fs::metadata(&job.input).map_or(0, |m| m.len());
     let glb = subd_io::Format::for_output(&job.output) == Some(subd_io::Format::Glb);
     let budget = Budget::detect(args.max_memory).map(|b| b.share(job.concurrent));
@@ -531,33 +457,24 @@ fn check_memory(
 pub(crate) fn output_limit(
     refinement: &Refined,
     level: usize,
-    two_phase: Option<&subd_schemes::TwoPhase>,
     options: &subd_schemes::Options,
     positions: &[subd_mesh::DVec3],
 ) -> Result<subd_limit::LimitPoints, String> {
-    match refinement {
-        Refined::Osd(r) => {
-            let topology = r.topology(level);
-            let table = match two_phase {
-                // Level 0 of the two-phase scheme is its phase-1 input; from level 1 on it
-                // is Catmull-Clark.
-                Some(tp) if level == 0 => subd_limit::two_phase_base_limit(topology, tp, options),
-                _ => subd_limit::base_limit(topology, r.scheme(), options),
-            }
-            .map_err(|e| e.to_string())?;
-            Ok(table.apply(positions))
-        }
-        Refined::Split(r) => {
-            let own;
-            let stencils = if level == r.num_levels() {
-                r.last_limit()?
-            } else {
-                own = crate::limit::checked_split_limit_stencils(r.topology(level), r.scheme())?;
-                &own
-            };
-            crate::limit::split_limit_points(stencils, r.scheme(), positions)
-        }
+    let scheme = match refinement.scheme() {
+        // Level 0 of the two-phase scheme is its phase-1 input; from level 1 on it is
+        // Catmull-Clark.
+        Scheme::TwoPhase(_) if level > 0 => &Scheme::CatmullClark,
+        s => s,
+    };
+    if scheme.is_opensubdiv() || level < refinement.num_levels() {
+        return subd_limit::limit_points(refinement.topology(level), scheme, options, positions)
+            .map_err(|e| e.to_string());
     }
+    // A split scheme's last level: the stencils its texture coordinates share.
+    refinement
+        .last_limit()?
+        .limit_points(scheme, positions)
+        .map_err(|e| e.to_string())
 }
 
 /// `normals` where they are unit vectors; elsewhere (a split scheme's creases and corners,

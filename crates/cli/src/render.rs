@@ -183,12 +183,12 @@ pub(crate) fn run(
     let surface = if refining {
         let tension = crate::rule_args::butterfly_tension(args.tension)?;
         let options = args.rules.options(&file.mesh.hints);
-        let refinement = Refined::new(base, &scheme.chosen(tension), None, &options, levels)
+        let refinement = Refined::new(base, scheme.scheme(tension, None), &options, levels)
             .map_err(|e| in_file(&e))?;
         let mut positions = refinement.last_positions(&file.mesh.positions);
         let limit_normals = if args.limit {
-            let limit = output_limit(&refinement, levels, None, &options, &positions)
-                .map_err(|e| in_file(&e))?;
+            let limit =
+                output_limit(&refinement, levels, &options, &positions).map_err(|e| in_file(&e))?;
             positions = limit.positions;
             Some(limit.normals)
         } else {

@@ -76,7 +76,7 @@ pub(crate) fn run(
     let options = args.rules.options(&file.mesh.hints);
     let scheme = args.scheme.scheme();
     let evaluator =
-        LimitEvaluator::new(&file.mesh.topology, scheme, &options).map_err(|e| in_file(&e))?;
+        LimitEvaluator::new(&file.mesh.topology, &scheme, &options).map_err(|e| in_file(&e))?;
     let points = evaluator.prepare(&file.mesh.positions);
     let t_setup = t1.elapsed().as_secs_f64();
     let t2 = Instant::now();

@@ -5,8 +5,8 @@ use subd_limit::split_limit::SplitLimitStencils;
 use subd_mesh::DVec3;
 use subd_mesh::Topology;
 use subd_mesh::fvar::{FVarChannel, FVarLinearInterpolation};
-use subd_schemes::split_schemes::{SplitFVarError, SplitFaceVarying, SplitRefinement, SplitScheme};
-use subd_schemes::{Options, Scheme};
+use subd_schemes::split_schemes::{SplitFVarError, SplitFaceVarying};
+use subd_schemes::{Options, Refinement, Scheme};
 
 /// `view` with the texture coordinates `uv`, if any.
 pub(crate) fn with_uv<'a>(
@@ -38,10 +38,10 @@ pub(crate) fn refined_uv(
     let Some(channel) = mesh.uv() else {
         return Ok(None);
     };
-    let r = match refinement {
-        crate::refine::Refined::Osd(r) => r,
-        crate::refine::Refined::Split(r) => return split_uv(r, channel, mode, limit, warnings),
-    };
+    if !refinement.scheme().is_opensubdiv() {
+        return split_uv(refinement, channel, mode, limit, warnings);
+    }
+    let r: &Refinement = refinement;
     let fr =
         subd_schemes::FaceVaryingRefinement::new(r, channel, mode).map_err(|e| e.to_string())?;
     let level = r.num_levels();
@@ -56,13 +56,19 @@ pub(crate) fn refined_uv(
     // The exact limit of the output level's values, as the positions take theirs.
     let topology = r.topology(level);
     let at_level = FVarChannel::new(topology, 2, values, indices).map_err(|e| e.to_string())?;
-    limit_uv(topology, r.scheme(), r.options(), &at_level, mode).map(Some)
+    // The two-phase scheme's levels take Catmull-Clark's rules (its phase 1 is level 1's
+    // making, already in the values).
+    let scheme = match r.scheme() {
+        Scheme::TwoPhase(_) => Scheme::CatmullClark,
+        s => s.clone(),
+    };
+    limit_uv(topology, &scheme, r.options(), &at_level, mode).map(Some)
 }
 
 /// A split scheme's refined texture coordinates ([`SplitFaceVarying`]); `None` with a warning
 /// for seams that Doo-Sabin or √3 cannot carry.
 fn split_uv(
-    r: &crate::refine::SplitRefined,
+    r: &crate::refine::Refined,
     channel: &FVarChannel,
     mode: FVarLinearInterpolation,
     limit: bool,
@@ -107,7 +113,9 @@ fn split_values_limit<'a>(
         .chunks_exact(2)
         .map(|x| DVec3::new(x[0], x[1], 0.0))
         .collect();
-    let limit = crate::limit::split_limit_points(stencils()?, fv.values_scheme(), &points)?;
+    let limit = stencils()?
+        .limit_points(fv.values_scheme(), &points)
+        .map_err(|e| e.to_string())?;
     Ok(limit.positions.iter().flat_map(|p| [p.x, p.y]).collect())
 }
 
@@ -116,12 +124,13 @@ fn split_values_limit<'a>(
 /// warning, where Doo-Sabin or √3 cannot carry their seams.
 pub(crate) fn split_limit_uv(
     topology: &Topology,
-    (scheme, stencils): (SplitScheme, &SplitLimitStencils),
+    (scheme, stencils): (&Scheme, &SplitLimitStencils),
     channel: &FVarChannel,
     mode: FVarLinearInterpolation,
     warnings: &mut Vec<String>,
 ) -> Result<RefinedUv, String> {
-    let r = SplitRefinement::new(topology, scheme, 0).map_err(|e| e.to_string())?;
+    let r = Refinement::new(topology, scheme.clone(), &Options::default(), 0)
+        .map_err(|e| e.to_string())?;
     let fv = match SplitFaceVarying::new(&r, channel, mode) {
         Ok(fv) => fv,
         Err(e @ SplitFVarError::Seam { .. }) => {
@@ -149,7 +158,7 @@ pub(crate) fn split_limit_uv(
 /// per (vertex, value) pair, each corner naming its own.
 pub(crate) fn limit_uv(
     topology: &Topology,
-    scheme: Scheme,
+    scheme: &Scheme,
     options: &Options,
     channel: &FVarChannel,
     mode: FVarLinearInterpolation,

@@ -3121,7 +3121,7 @@ fn info_pia_and_limit_keep_texture_coordinates() {
     let options = subd_schemes::Options::from_hints(&file.mesh.hints);
     let base = subd_limit::fvar::base_fvar_limit(
         &file.mesh.topology,
-        subd_schemes::Scheme::CatmullClark,
+        &subd_schemes::Scheme::CatmullClark,
         &options,
         file.mesh.uv().unwrap(),
         subd_mesh::fvar::FVarLinearInterpolation::CornersPlus1,

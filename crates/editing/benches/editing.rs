@@ -36,7 +36,7 @@ fn constraints(nf: usize) -> Vec<Constraint> {
 fn bench(c: &mut Criterion) {
     let m = subd_mesh::primitives::torus(40, 40, 3.0, 1.0);
     let ev = Arc::new(
-        LimitEvaluator::new(&m.topology, Scheme::CatmullClark, &Options::default()).unwrap(),
+        LimitEvaluator::new(&m.topology, &Scheme::CatmullClark, &Options::default()).unwrap(),
     );
     let cs = constraints(m.topology.num_faces());
     let energy = Method::Energy {
@@ -55,7 +55,7 @@ fn bench(c: &mut Criterion) {
                     ev.clone(),
                     &m.topology,
                     &m.positions,
-                    Scheme::CatmullClark,
+                    &Scheme::CatmullClark,
                     &cs,
                     method,
                 )
@@ -68,7 +68,7 @@ fn bench(c: &mut Criterion) {
         ev.clone(),
         &m.topology,
         &m.positions,
-        Scheme::CatmullClark,
+        &Scheme::CatmullClark,
         &cs,
         energy,
     )

@@ -19,7 +19,7 @@ use crate::isoline::{SAMPLES_PER_FACE, bspline_point, is_regular, strip};
 pub fn residuals(
     ev: &LimitEvaluator,
     topology: &Topology,
-    scheme: Scheme,
+    scheme: &Scheme,
     constraints: &[Constraint],
     before: &[DVec3],
     after: &[DVec3],
@@ -39,7 +39,7 @@ pub fn residuals(
 fn residual(
     ev: &LimitEvaluator,
     topology: &Topology,
-    scheme: Scheme,
+    scheme: &Scheme,
     c: &Constraint,
     p0: &PatchPoints,
     p1: &PatchPoints,

@@ -133,7 +133,7 @@ impl ConstraintRows {
     pub fn new(
         ev: &LimitEvaluator,
         topology: &Topology,
-        scheme: Scheme,
+        scheme: &Scheme,
         constraints: &[Constraint],
     ) -> Result<ConstraintRows, EditError> {
         let mut out = ConstraintRows {
@@ -239,7 +239,7 @@ fn check_goal(g: &Goal) -> Result<Goal, String> {
 /// The parameter of a base vertex as a corner of its first face.
 pub(crate) fn vertex_param(
     topology: &Topology,
-    scheme: Scheme,
+    scheme: &Scheme,
     v: usize,
 ) -> Result<FaceParam, String> {
     if v >= topology.num_vertices() {
@@ -273,7 +273,7 @@ pub(crate) fn vertex_param(
 /// The stencil of a location, with a one-line reason when it is not on the surface.
 pub(crate) fn stencil_at(
     ev: &LimitEvaluator,
-    scheme: Scheme,
+    scheme: &Scheme,
     at: &Location,
 ) -> Result<PointStencil, String> {
     let p = match at {

@@ -36,7 +36,7 @@
 //!     region_rings: Some(2),
 //!     energy: Default::default(),
 //! };
-//! let editor = Editor::new(&mesh.topology, &mesh.positions, Scheme::CatmullClark,
+//! let editor = Editor::new(&mesh.topology, &mesh.positions, &Scheme::CatmullClark,
 //!                          &Options::default(), &constraints, method).unwrap();
 //! let edit = editor.solve(&constraints).unwrap();
 //! // Only vertices near face 5 moved.

@@ -90,7 +90,7 @@ pub struct Edit {
 ///     at: Location::Vertex(0),
 ///     goal: Goal::Displacement(DVec3::new(0.0, 0.0, 0.1)),
 /// }];
-/// let ed = Editor::new(&mesh.topology, &mesh.positions, Scheme::CatmullClark,
+/// let ed = Editor::new(&mesh.topology, &mesh.positions, &Scheme::CatmullClark,
 ///                      &Options::default(), &c, Method::LeastSquares).unwrap();
 /// let edit = ed.solve(&c).unwrap();
 /// // The limit point moved by exactly the displacement.
@@ -134,7 +134,7 @@ impl Editor {
     pub fn new(
         topology: &Topology,
         positions: &[DVec3],
-        scheme: Scheme,
+        scheme: &Scheme,
         options: &Options,
         constraints: &[Constraint],
         method: Method,
@@ -156,7 +156,7 @@ impl Editor {
         ev: Arc<LimitEvaluator>,
         topology: &Topology,
         positions: &[DVec3],
-        scheme: Scheme,
+        scheme: &Scheme,
         constraints: &[Constraint],
         method: Method,
     ) -> Result<Editor, EditError> {
@@ -191,7 +191,7 @@ impl Editor {
                 region_rings,
                 energy,
             } => {
-                if scheme != Scheme::CatmullClark {
+                if *scheme != Scheme::CatmullClark {
                     return Err(EditError::EnergyScheme);
                 }
                 let t1 = Instant::now();
@@ -226,7 +226,7 @@ impl Editor {
         };
         Ok(Editor {
             topology: topology.clone(),
-            scheme,
+            scheme: scheme.clone(),
             ev,
             base: positions.to_vec(),
             constraints: constraints.to_vec(),
@@ -279,7 +279,7 @@ impl Editor {
                 });
             }
         }
-        let goals = ConstraintRows::new(&self.ev, &self.topology, self.scheme, constraints)?;
+        let goals = ConstraintRows::new(&self.ev, &self.topology, &self.scheme, constraints)?;
         let r = goals.residual(&self.base);
         Ok(self.apply(&r))
     }
@@ -365,7 +365,7 @@ impl Editor {
     pub fn limit_of(&self, c: &Constraint, x: &[DVec3]) -> Option<DVec3> {
         match c {
             Constraint::Point { at, .. } => {
-                crate::constraint::stencil_at(&self.ev, self.scheme, at)
+                crate::constraint::stencil_at(&self.ev, &self.scheme, at)
                     .ok()
                     .map(|s| s.apply(x).position)
             }

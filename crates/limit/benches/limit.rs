@@ -69,7 +69,7 @@ fn bench(c: &mut Criterion) {
         ("torus_25k", torus.topology.clone(), torus.positions.clone()),
         ("cube_level3", cube(3).0, cube(3).1),
     ] {
-        let ev = LimitEvaluator::new(&topo, Scheme::CatmullClark, &opts).unwrap();
+        let ev = LimitEvaluator::new(&topo, &Scheme::CatmullClark, &opts).unwrap();
         let pp = ev.prepare(&pts);
         let at = params(topo.num_faces(), 10_000);
         g.throughput(Throughput::Elements(at.len() as u64));

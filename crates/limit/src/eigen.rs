@@ -32,7 +32,7 @@ pub enum RingFeature {
 }
 
 /// The 1-ring mesh around a centre of valence `n`: quads (Catmull-Clark) or triangles (Loop).
-fn ring_mesh(scheme: Scheme, n: usize, feature: RingFeature) -> Result<Topology, LimitError> {
+fn ring_mesh(scheme: &Scheme, n: usize, feature: RingFeature) -> Result<Topology, LimitError> {
     let (sizes, verts, nv): (Vec<u32>, Vec<u32>, usize) = match scheme {
         Scheme::Loop => {
             let f = (0..n).flat_map(|i| [0, 1 + i as u32, 1 + ((i + 1) % n) as u32]);
@@ -64,25 +64,29 @@ fn ring_mesh(scheme: Scheme, n: usize, feature: RingFeature) -> Result<Topology,
 
 /// The local subdivision matrix `S` (ring order as in the module docs) of a centre of
 /// valence `n ≥ 2` under `scheme` (Catmull-Clark or Loop), read off one refinement step.
-pub fn ring_matrix(scheme: Scheme, n: usize, feature: RingFeature) -> Result<Mat<f64>, LimitError> {
-    if n < 2 || scheme == Scheme::Bilinear {
+pub fn ring_matrix(
+    scheme: &Scheme,
+    n: usize,
+    feature: RingFeature,
+) -> Result<Mat<f64>, LimitError> {
+    if n < 2 || *scheme == Scheme::Bilinear {
         return Err(LimitError::Analysis(format!(
             "no local subdivision matrix for {scheme:?} at valence {n}"
         )));
     }
     let t = ring_mesh(scheme, n, feature)?;
-    let r = Refinement::new(&t, scheme, &Options::default(), 1)
+    let r = Refinement::new(&t, scheme.clone(), &Options::default(), 1)
         .map_err(|e| LimitError::Analysis(e.to_string()))?;
     let st = r.stencils(1);
     let nv = t.num_vertices();
-    let size = if scheme == Scheme::Loop {
+    let size = if *scheme == Scheme::Loop {
         n + 1
     } else {
         2 * n + 1
     };
     // Child of each ring position: the centre stays 0; spoke e_i's child is the child of
     // edge (0, 1+i); f_i's is the child of face i.
-    let edge_child_base = if scheme == Scheme::Loop {
+    let edge_child_base = if *scheme == Scheme::Loop {
         nv
     } else {
         nv + t.num_faces()
@@ -93,7 +97,7 @@ pub fn ring_matrix(scheme: Scheme, n: usize, feature: RingFeature) -> Result<Mat
             .find_edge(0, 1 + i as u32)
             .ok_or_else(|| LimitError::Analysis("ring mesh has no spoke edge".into()))?;
         child[1 + i] = edge_child_base + e as usize;
-        if scheme != Scheme::Loop {
+        if *scheme != Scheme::Loop {
             child[1 + n + i] = nv + i;
         }
     }
@@ -182,14 +186,14 @@ fn left_vectors_by_modulus(s: &Mat<f64>) -> Result<Vec<Vec<Vec<f64>>>, LimitErro
 
 /// A planar embedding of the ring (the spoke ends on the unit circle, the diagonal vertices
 /// at the sum of their neighbours), used to orient numerically computed tangent masks.
-fn planar_ring(scheme: Scheme, n: usize) -> Vec<[f64; 2]> {
+fn planar_ring(scheme: &Scheme, n: usize) -> Vec<[f64; 2]> {
     let dir = |i: usize| {
         let t = 2.0 * PI * (i % n) as f64 / n as f64;
         [t.cos(), t.sin()]
     };
     let mut p = vec![[0.0, 0.0]];
     p.extend((0..n).map(dir));
-    if scheme != Scheme::Loop {
+    if *scheme != Scheme::Loop {
         p.extend((0..n).map(|i| {
             let (a, b) = (dir(i), dir(i + 1));
             // For valence 2 the two spoke directions cancel: push the diagonal off the line.
@@ -208,7 +212,7 @@ fn planar_ring(scheme: Scheme, n: usize) -> Vec<[f64; 2]> {
 /// tangents from the subdominant pair, combined so that on the planar ring they give the
 /// x and y directions (tangent 1 along edge 0, tangent 2 counter-clockwise from it).
 pub fn ring_limit_mask(
-    scheme: Scheme,
+    scheme: &Scheme,
     n: usize,
     feature: RingFeature,
 ) -> Result<LimitMask, LimitError> {
@@ -271,7 +275,7 @@ pub fn ring_limit_mask(
         w.iter_mut()
             .filter(|x| x.abs() < 1e-14 * big)
             .for_each(|x| *x = 0.0);
-        let faces = if scheme == Scheme::Loop {
+        let faces = if *scheme == Scheme::Loop {
             Vec::new()
         } else {
             w[1 + n..].to_vec()
@@ -301,7 +305,7 @@ mod tests {
     #[test]
     fn catmark_subdominant_matches_closed_form() {
         for n in 3..=16 {
-            let s = ring_matrix(Scheme::CatmullClark, n, RingFeature::Smooth).unwrap();
+            let s = ring_matrix(&Scheme::CatmullClark, n, RingFeature::Smooth).unwrap();
             let ev = eigenvalues(&s).unwrap();
             assert!(close(ev[0].re, 1.0, 1e-12), "n={n} {:?}", ev[0]);
             let lam = masks::catmark_subdominant(n);
@@ -312,7 +316,7 @@ mod tests {
 
     #[test]
     fn catmark_valence_four_spectrum() {
-        let s = ring_matrix(Scheme::CatmullClark, 4, RingFeature::Smooth).unwrap();
+        let s = ring_matrix(&Scheme::CatmullClark, 4, RingFeature::Smooth).unwrap();
         let ev: Vec<f64> = eigenvalues(&s).unwrap().iter().map(|z| z.re).collect();
         let expect = [1.0, 0.5, 0.5, 0.25];
         for (k, e) in expect.iter().enumerate() {
@@ -323,7 +327,7 @@ mod tests {
     #[test]
     fn loop_subdominant_matches_closed_form() {
         for n in 3..=16 {
-            let s = ring_matrix(Scheme::Loop, n, RingFeature::Smooth).unwrap();
+            let s = ring_matrix(&Scheme::Loop, n, RingFeature::Smooth).unwrap();
             let ev = eigenvalues(&s).unwrap();
             assert!(close(ev[0].re, 1.0, 1e-12));
             let lam = masks::loop_subdominant(n);
@@ -334,7 +338,7 @@ mod tests {
     #[test]
     fn dominant_left_eigenvector_is_the_closed_form_limit_mask() {
         for n in 3..=12 {
-            let s = ring_matrix(Scheme::CatmullClark, n, RingFeature::Smooth).unwrap();
+            let s = ring_matrix(&Scheme::CatmullClark, n, RingFeature::Smooth).unwrap();
             let l = dominant_left_eigenvector(&s).unwrap();
             let m = masks::catmark_smooth(n).position;
             assert!(close(l[0], m.vertex, 1e-13), "n={n}");
@@ -342,7 +346,7 @@ mod tests {
                 assert!(close(l[1 + i], m.edges[i], 1e-13));
                 assert!(close(l[1 + n + i], m.faces[i], 1e-13));
             }
-            let s = ring_matrix(Scheme::Loop, n, RingFeature::Smooth).unwrap();
+            let s = ring_matrix(&Scheme::Loop, n, RingFeature::Smooth).unwrap();
             let l = dominant_left_eigenvector(&s).unwrap();
             let m = masks::loop_smooth(n).position;
             assert!(close(l[0], m.vertex, 1e-13), "loop n={n}");
@@ -356,7 +360,7 @@ mod tests {
     fn numeric_tangents_span_the_closed_form_tangent_plane() {
         // On a non-planar ring, the normal from the eigen tangents equals the closed-form one.
         for n in 3..=9 {
-            let num = ring_limit_mask(Scheme::CatmullClark, n, RingFeature::Smooth).unwrap();
+            let num = ring_limit_mask(&Scheme::CatmullClark, n, RingFeature::Smooth).unwrap();
             let cf = masks::catmark_smooth(n);
             let pts: Vec<[f64; 3]> = (0..2 * n + 1)
                 .map(|i| {

@@ -98,9 +98,9 @@ fn piece_of(
     t: &Topology,
     rules: &[subd_schemes::Rule],
     f: usize,
-    scheme: Scheme,
+    scheme: &Scheme,
 ) -> Result<Piece, LimitError> {
-    if scheme == Scheme::Loop {
+    if *scheme == Scheme::Loop {
         return loop_piece(t, rules, f);
     }
     Ok(match piece_kind(t, rules, f) {
@@ -199,7 +199,7 @@ fn piece_kind(
 /// let s = [(-1., -1., 1.), (1., -1., 1.), (-1., 1., 1.), (1., 1., 1.),
 ///          (-1., 1., -1.), (1., 1., -1.), (-1., -1., -1.), (1., -1., -1.)];
 /// let p: Vec<DVec3> = s.iter().map(|&(x, y, z)| DVec3::new(x, y, z)).collect();
-/// let eval = LimitEvaluator::new(&topo, Scheme::CatmullClark, &Options::default()).unwrap();
+/// let eval = LimitEvaluator::new(&topo, &Scheme::CatmullClark, &Options::default()).unwrap();
 /// let points = eval.prepare(&p);
 /// // The centre of face 0 (z = 1): on the z axis, below the face, normal +z.
 /// let c = eval.evaluate(&points, FaceParam { face: 0, sub: 0, u: 0.5, v: 0.5 }).unwrap();
@@ -248,22 +248,22 @@ pub(crate) fn project_all(pieces: &[Piece], pts: &[DVec3]) -> Vec<Option<Project
 
 impl LimitEvaluator {
     /// Prepares evaluation on `topology` (the rules of `options`; Catmull-Clark only).
-    pub fn new(topology: &Topology, scheme: Scheme, options: &Options) -> Result<Self, LimitError> {
-        match scheme {
-            Scheme::CatmullClark => {}
-            Scheme::Loop => {
-                box_spline()?;
-            }
-            Scheme::Bilinear => return Err(LimitError::Scheme),
+    pub fn new(
+        topology: &Topology,
+        scheme: &Scheme,
+        options: &Options,
+    ) -> Result<Self, LimitError> {
+        if crate::masks_scheme(scheme, false)? == Scheme::Loop {
+            box_spline()?;
         }
-        let r0 = Refinement::new(topology, scheme, options, 0)?;
+        let r0 = Refinement::new(topology, scheme.clone(), options, 0)?;
         let base = r0.topology(0).clone();
         let rules0 = r0.vertex_rules(0);
         let base_pieces = (0..base.num_faces())
             .map(|f| piece_of(&base, rules0, f, scheme))
             .collect::<Result<Vec<_>, _>>()?;
         let (refined, level2_pieces) = if base_pieces.iter().any(|p| matches!(p, Piece::Refined)) {
-            let r = Refinement::new(topology, scheme, options, 2)?;
+            let r = Refinement::new(topology, scheme.clone(), options, 2)?;
             let t1 = r.topology(1);
             let t2 = r.topology(2);
             let rules2 = r.vertex_rules(2);
@@ -271,14 +271,14 @@ impl LimitEvaluator {
             let mut pieces = vec![Piece::Unsupported("not a refined face"); t2.num_faces()];
             for f in (0..base.num_faces()).filter(|&f| matches!(base_pieces[f], Piece::Refined)) {
                 let children = base.face_offsets()[f] as usize..base.face_offsets()[f + 1] as usize;
-                let children = if scheme == Scheme::Loop {
+                let children = if *scheme == Scheme::Loop {
                     4 * f..4 * f + 4
                 } else {
                     children
                 };
                 for c in children {
                     let grand = t1.face_offsets()[c] as usize..t1.face_offsets()[c + 1] as usize;
-                    let grand = if scheme == Scheme::Loop {
+                    let grand = if *scheme == Scheme::Loop {
                         4 * c..4 * c + 4
                     } else {
                         grand
@@ -296,7 +296,7 @@ impl LimitEvaluator {
             (None, Vec::new())
         };
         Ok(LimitEvaluator {
-            scheme,
+            scheme: scheme.clone(),
             options: *options,
             base,
             base_pieces,
@@ -335,7 +335,7 @@ impl LimitEvaluator {
 
     /// Checks `at` against the topology: face and sub-face in range, parameters in [0, 1].
     pub fn check(&self, at: &FaceParam) -> Result<(), LimitError> {
-        check_param(&self.base, self.scheme, at)
+        check_param(&self.base, &self.scheme, at)
     }
 
     /// The limit surface at `at`: position and first and second derivatives.
@@ -356,7 +356,7 @@ impl LimitEvaluator {
                         r.vertex_rules(2),
                         &points.level2,
                         f2,
-                        self.scheme,
+                        &self.scheme,
                         &self.options,
                         s2,
                         t2,
@@ -424,7 +424,7 @@ impl LimitEvaluator {
 /// triangle for Loop).
 pub(crate) fn check_param(
     base: &Topology,
-    scheme: Scheme,
+    scheme: &Scheme,
     at: &FaceParam,
 ) -> Result<(), LimitError> {
     let nf = base.num_faces();
@@ -435,7 +435,7 @@ pub(crate) fn check_param(
         )));
     }
     let size = base.face_size(at.face);
-    let subs = if size == 4 || scheme == Scheme::Loop {
+    let subs = if size == 4 || *scheme == Scheme::Loop {
         1
     } else {
         size
@@ -452,7 +452,7 @@ pub(crate) fn check_param(
             at.u, at.v
         )));
     }
-    if scheme == Scheme::Loop && at.u + at.v > 1.0 + 1e-12 {
+    if *scheme == Scheme::Loop && at.u + at.v > 1.0 + 1e-12 {
         return Err(LimitError::Param(format!(
             "parameters ({}, {}) outside the triangle u + v ≤ 1",
             at.u, at.v
@@ -475,7 +475,7 @@ pub(crate) fn on_base_face(e: LimitError, face: usize) -> LimitError {
 /// point as [`LimitEvaluator::evaluate`] does; `None` when (u, v) is not a corner at that
 /// level (not a multiple of 2^-level) or the face is not a quad or triangle.
 pub fn dyadic_vertex(r: &Refinement, level: usize, face: usize, u: f64, v: f64) -> Option<usize> {
-    let loop_scheme = r.scheme() == Scheme::Loop;
+    let loop_scheme = *r.scheme() == Scheme::Loop;
     if r.topology(0).face_size(face) != if loop_scheme { 3 } else { 4 } {
         return None;
     }
@@ -489,7 +489,7 @@ pub fn dyadic_vertex(r: &Refinement, level: usize, face: usize, u: f64, v: f64) 
 /// [`LimitEvaluator::evaluate`] does (a sub-face of a face that is not a quad is its level-1
 /// child); `None` when `at` is not a corner at that level.
 pub fn dyadic_corner(r: &Refinement, level: usize, at: FaceParam) -> Option<(usize, usize)> {
-    let loop_scheme = r.scheme() == Scheme::Loop;
+    let loop_scheme = *r.scheme() == Scheme::Loop;
     let (
         FaceParam {
             face: f,
@@ -516,7 +516,7 @@ pub fn dyadic_corner(r: &Refinement, level: usize, at: FaceParam) -> Option<(usi
 pub(crate) fn descend(r: &Refinement, level: usize, at: FaceParam) -> (FaceParam, f64) {
     let (mut f, mut s, mut t, mut scale) = (at.face, at.u, at.v, 1.0);
     for l in 0..level {
-        if r.scheme() == Scheme::Loop {
+        if *r.scheme() == Scheme::Loop {
             let (j, a, b, k) = tri_child(s, t.min(1.0 - s));
             (f, s, t, scale) = (4 * f + j, a, b, scale * k);
         } else {
@@ -572,7 +572,7 @@ pub(crate) fn direct_evaluation(
     rules: &[subd_schemes::Rule],
     pts: &[DVec3],
     f: usize,
-    scheme: Scheme,
+    scheme: &Scheme,
     s: f64,
     tp: f64,
 ) -> Result<Option<SurfacePoint>, LimitError> {
@@ -592,7 +592,7 @@ pub(crate) fn is_direct(
     t: &Topology,
     rules: &[subd_schemes::Rule],
     f: usize,
-    scheme: Scheme,
+    scheme: &Scheme,
 ) -> Result<bool, LimitError> {
     Ok(!matches!(
         piece_of(t, rules, f, scheme)?,
@@ -703,7 +703,7 @@ pub(crate) fn eval_piece(
 fn at_extraordinary_vertex(c: &[DVec3], n: usize) -> Result<SurfacePoint, LimitError> {
     // Valence 2 has no closed form (OpenSubdiv's is not the limit): the eigen analysis.
     let m = if n == 2 {
-        crate::eigen::ring_limit_mask(Scheme::CatmullClark, 2, crate::eigen::RingFeature::Smooth)?
+        crate::eigen::ring_limit_mask(&Scheme::CatmullClark, 2, crate::eigen::RingFeature::Smooth)?
     } else {
         masks::catmark_smooth(n)
     };

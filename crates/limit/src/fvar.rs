@@ -50,7 +50,7 @@ pub fn limit_at_level(
     }
     let n = fvar.num_values(level);
     let values = fvar.level_values(refinement, level);
-    if values.is_linear() || refinement.scheme() == Scheme::Bilinear {
+    if values.is_linear() || *refinement.scheme() == Scheme::Bilinear {
         return Ok(StencilTable::identity(n));
     }
     let t = refinement.topology(level);
@@ -164,7 +164,7 @@ impl BaseFVarLimit {
 /// let uv: Vec<f64> = (0..16).flat_map(|v| [(v % 4) as f64, (v / 4) as f64]).collect();
 /// let channel = FVarChannel::new(&grid, 2, uv, faces.clone()).unwrap();
 /// let limit = subd_limit::fvar::base_fvar_limit(
-///     &grid, Scheme::CatmullClark, &Options::default(), &channel,
+///     &grid, &Scheme::CatmullClark, &Options::default(), &channel,
 ///     FVarLinearInterpolation::CornersOnly,
 /// ).unwrap();
 /// let at = limit.apply(channel.values(), 2);
@@ -178,13 +178,13 @@ impl BaseFVarLimit {
 /// `topology`.
 pub fn base_fvar_limit(
     topology: &Topology,
-    scheme: Scheme,
+    scheme: &Scheme,
     options: &Options,
     channel: &FVarChannel,
     mode: FVarLinearInterpolation,
 ) -> Result<BaseFVarLimit, LimitError> {
     let levels = crate::levels_for_exact_limit(topology, scheme).0.max(1);
-    let r = Refinement::new(topology, scheme, options, levels)?;
+    let r = Refinement::new(topology, scheme.clone(), options, levels)?;
     let fr = FaceVaryingRefinement::new(&r, channel, mode)
         .map_err(|e| LimitError::Param(e.to_string()))?;
     let at = limit_at_level(&r, &fr, levels)?;
@@ -268,7 +268,7 @@ mod tests {
             (Scheme::Loop, &tris, &ti),
         ] {
             let channel = FVarChannel::new(topo, 2, values.clone(), idx.clone()).unwrap();
-            let r = Refinement::new(topo, scheme, &Options::default(), 2).unwrap();
+            let r = Refinement::new(topo, scheme.clone(), &Options::default(), 2).unwrap();
             for mode in FVarLinearInterpolation::ALL_MODES {
                 let fr = FaceVaryingRefinement::new(&r, &channel, mode).unwrap();
                 let levels = fr.refine_values(&r, channel.values(), 2);

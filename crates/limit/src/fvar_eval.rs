@@ -88,7 +88,7 @@ impl FVarPoint {
 ///     .flat_map(|i| [(i % 4) as f64 + 4.0 * (i / 16) as f64, ((i % 16) / 4) as f64])
 ///     .collect();
 /// let channel = FVarChannel::new(&grid, 2, uv, indices).unwrap();
-/// let eval = LimitEvaluator::new(&grid, Scheme::CatmullClark, &Options::default()).unwrap();
+/// let eval = LimitEvaluator::new(&grid, &Scheme::CatmullClark, &Options::default()).unwrap();
 /// let uv_eval = eval.face_varying(&channel, FVarLinearInterpolation::All).unwrap();
 /// let values = uv_eval.prepare(channel.values()).unwrap();
 /// // Mode `all` is linear: the middle of face 4 is the average of its corners' UVs.
@@ -159,14 +159,14 @@ impl LimitEvaluator {
         } else {
             Some(value_patches(
                 base,
-                self.scheme,
+                &self.scheme,
                 &self.options,
                 channel,
                 mode,
             )?)
         };
         Ok(FVarEvaluator {
-            scheme: self.scheme,
+            scheme: self.scheme.clone(),
             components: channel.components(),
             num_values: channel.num_values(),
             base: base.clone(),
@@ -214,14 +214,14 @@ fn near_split_degenerate_edges(t: &Topology, indices: &[u32]) -> Vec<bool> {
 /// The mesh of values at the first level where no value is semi-sharp, and its evaluator.
 fn value_patches(
     base: &Topology,
-    scheme: Scheme,
+    scheme: &Scheme,
     options: &subd_schemes::Options,
     channel: &FVarChannel,
     mode: FVarLinearInterpolation,
 ) -> Result<ValuePatches, LimitError> {
     let mut level = 0;
     loop {
-        let r = Refinement::new(base, scheme, options, level)?;
+        let r = Refinement::new(base, scheme.clone(), options, level)?;
         let fr = FaceVaryingRefinement::new(&r, channel, mode)
             .map_err(|e| LimitError::Param(e.to_string()))?;
         let values = fr.level_values(&r, level);
@@ -405,7 +405,7 @@ impl FVarEvaluator {
         at: FaceParam,
         out: &mut FVarPoint,
     ) -> Result<(), LimitError> {
-        crate::eval::check_param(&self.base, self.scheme, &at)?;
+        crate::eval::check_param(&self.base, &self.scheme, &at)?;
         if self.blocked[at.face] && self.patches.is_some() {
             return Err(LimitError::Unsupported {
                 face: at.face,
@@ -465,7 +465,7 @@ impl FVarEvaluator {
         at: FaceParam,
         out: &mut FVarPoint,
     ) -> Result<(), LimitError> {
-        crate::eval::check_param(&self.base, self.scheme, &at)?;
+        crate::eval::check_param(&self.base, &self.scheme, &at)?;
         self.linear(&values.values, &at, out);
         Ok(())
     }

@@ -33,7 +33,7 @@
 //! let topo = TopologyBuilder::new(16).build(&[4; 9], &faces).unwrap();
 //! let points: Vec<DVec3> =
 //!     (0..16).map(|v| DVec3::new((v % 4) as f64, (v / 4) as f64, 0.0)).collect();
-//! let table = subd_limit::base_limit(&topo, Scheme::CatmullClark, &Options::default()).unwrap();
+//! let table = subd_limit::base_limit(&topo, &Scheme::CatmullClark, &Options::default()).unwrap();
 //! let limit = table.apply(&points);
 //! // A flat grid stays flat and the interior vertex 5 is a regular B-spline point.
 //! assert!((limit.positions[5] - DVec3::new(1.0, 1.0, 0.0)).length() < 1e-15);
@@ -70,9 +70,15 @@ pub use table::{LimitPoints, LimitStencilTable, eigen_limit_vertices};
 /// What can go wrong computing limits.
 #[derive(Debug, Error)]
 pub enum LimitError {
-    /// Bilinear has no limit masks (its limit is the mesh itself).
-    #[error("limit masks exist for catmull-clark and loop only")]
-    Scheme,
+    /// A scheme without what was asked for (Bilinear has no limit masks: its limit is the
+    /// mesh itself; exact evaluation covers Catmull-Clark and Loop).
+    #[error("the {scheme} scheme: {what}")]
+    Scheme {
+        /// The scheme, as its `Display` writes it.
+        scheme: String,
+        /// What it is missing.
+        what: &'static str,
+    },
     /// Catmull-Clark limit masks at a level with a face that is not a quad.
     #[error(
         "level {level}, face {face}: {size} vertices; catmull-clark limit masks need quads (refine one level first)"
@@ -111,9 +117,35 @@ pub enum LimitError {
         /// Why.
         reason: &'static str,
     },
+    /// A vertex of a split scheme without a limit.
+    #[error("vertex {vertex}: no {scheme} limit: {why}")]
+    NoLimit {
+        /// The vertex.
+        vertex: usize,
+        /// The scheme's name.
+        scheme: &'static str,
+        /// Why it has none.
+        why: &'static str,
+    },
     /// The eigen analysis failed (a degenerate local configuration).
     #[error("eigen analysis: {0}")]
     Analysis(String),
+}
+
+/// The scheme whose limit masks a level refined with `scheme` takes: Catmull-Clark's for a
+/// refined level of the two-phase scheme (`refined`; phase 1 is its first step only), the
+/// scheme's own for Catmull-Clark and Loop. The others have none here: Bilinear's limit is
+/// the mesh itself, the split schemes' are in [`split_limit`].
+pub(crate) fn masks_scheme(scheme: &Scheme, refined: bool) -> Result<Scheme, LimitError> {
+    match scheme {
+        Scheme::CatmullClark => Ok(Scheme::CatmullClark),
+        Scheme::TwoPhase(_) if refined => Ok(Scheme::CatmullClark),
+        Scheme::Loop => Ok(Scheme::Loop),
+        s => Err(LimitError::Scheme {
+            scheme: s.to_string(),
+            what: "these limit masks exist for catmull-clark and loop only",
+        }),
+    }
 }
 
 /// Decay levels past which [`two_phase_base_limit`] refines only around semi-sharp
@@ -126,13 +158,13 @@ pub const MAX_DECAY_FACE_VERTICES: usize = 1 << 26;
 /// Levels of uniform refinement after which no semi-sharp feature is left (every finite
 /// sharpness `s` decays by at least 1 per level, Chaikin included), and, for Catmull-Clark,
 /// at least one level when a face is not a quad.
-pub fn levels_for_exact_limit(topology: &Topology, scheme: Scheme) -> (usize, f32) {
+pub fn levels_for_exact_limit(topology: &Topology, scheme: &Scheme) -> (usize, f32) {
     let semi = (0..topology.num_edges())
         .map(|e| topology.edge_sharpness(e))
         .chain((0..topology.num_vertices()).map(|v| topology.vertex_sharpness(v)))
         .filter(|&s| is_semi_sharp(s))
         .fold(0.0f32, f32::max);
-    let quads = scheme != Scheme::CatmullClark
+    let quads = *scheme != Scheme::CatmullClark
         || (0..topology.num_faces()).all(|f| topology.face_size(f) == 4);
     let decay = semi.ceil() as usize;
     (decay.max(usize::from(!quads)), semi)
@@ -149,6 +181,47 @@ pub(crate) fn first_rows(t: &StencilTable, k: usize) -> StencilTable {
     )
 }
 
+/// The exact limit of every vertex of `topology` under any `scheme`, applied to `positions`:
+/// the one limit entry. Catmull-Clark and Loop take [`base_limit`], the two-phase scheme
+/// [`two_phase_base_limit`] (its phase 1 included), the split schemes
+/// [`split_limit::checked_split_limit_stencils`] with NaN tangents and normals where none
+/// exists (√3's and the butterflies' creases and corners).
+///
+/// ```
+/// use subd_mesh::{DVec3, TopologyBuilder};
+/// use subd_schemes::{Options, Scheme};
+///
+/// // A tetrahedron: every scheme on triangles gives a limit point per vertex.
+/// let tet = TopologyBuilder::new(4)
+///     .build(&[3; 4], &[0, 2, 1, 0, 1, 3, 1, 2, 3, 0, 3, 2])
+///     .unwrap();
+/// let p = [DVec3::X, DVec3::Y, DVec3::Z, DVec3::ONE];
+/// for name in ["loop", "sqrt3", "butterfly", "modified-butterfly"] {
+///     let scheme: Scheme = name.parse().unwrap();
+///     let limit = subd_limit::limit_points(&tet, &scheme, &Options::default(), &p).unwrap();
+///     assert_eq!(limit.positions.len(), 4);
+/// }
+/// // The butterflies interpolate: each vertex is its own limit.
+/// let b = subd_limit::limit_points(&tet, &Scheme::BUTTERFLY, &Options::default(), &p).unwrap();
+/// assert_eq!(b.positions, p);
+/// ```
+///
+/// # Errors
+/// [`LimitError::Scheme`] for Bilinear (its limit is the mesh itself), and as the entry of
+/// the scheme's family.
+pub fn limit_points(
+    topology: &Topology,
+    scheme: &Scheme,
+    options: &Options,
+    positions: &[glam::DVec3],
+) -> Result<LimitPoints, LimitError> {
+    match scheme {
+        Scheme::TwoPhase(tp) => Ok(two_phase_base_limit(topology, tp, options)?.apply(positions)),
+        s if s.is_opensubdiv() => Ok(base_limit(topology, s, options)?.apply(positions)),
+        s => split_limit::checked_split_limit_stencils(topology, s)?.limit_points(s, positions),
+    }
+}
+
 /// The exact limit (position, tangents, normal) of every base vertex, as stencils over the
 /// base vertices. Refines uniformly until semi-sharp creases and corners have decayed (and,
 /// for Catmull-Clark, until every face is a quad), takes the limit masks there
@@ -158,7 +231,7 @@ pub(crate) fn first_rows(t: &StencilTable, k: usize) -> StencilTable {
 /// refined ([`local::base_limit`], same limits).
 pub fn base_limit(
     topology: &Topology,
-    scheme: Scheme,
+    scheme: &Scheme,
     options: &Options,
 ) -> Result<LimitStencilTable, LimitError> {
     match whole_refinement(topology, scheme, options)? {
@@ -180,8 +253,8 @@ pub fn base_limit(
 /// let faces = [0, 1, 3, 2, 2, 3, 5, 4, 4, 5, 7, 6, 6, 7, 1, 0, 1, 7, 5, 3, 6, 0, 2, 4];
 /// let cube = TopologyBuilder::new(8).build(&[4; 6], &faces).unwrap();
 /// let o = Options::default();
-/// let positions = subd_limit::base_limit_positions(&cube, Scheme::CatmullClark, &o).unwrap();
-/// let full = subd_limit::base_limit(&cube, Scheme::CatmullClark, &o).unwrap();
+/// let positions = subd_limit::base_limit_positions(&cube, &Scheme::CatmullClark, &o).unwrap();
+/// let full = subd_limit::base_limit(&cube, &Scheme::CatmullClark, &o).unwrap();
 /// assert_eq!(positions, full.position);
 /// ```
 ///
@@ -189,7 +262,7 @@ pub fn base_limit(
 /// As [`base_limit`].
 pub fn base_limit_positions(
     topology: &Topology,
-    scheme: Scheme,
+    scheme: &Scheme,
     options: &Options,
 ) -> Result<StencilTable, LimitError> {
     if smooth_closed::applies(topology, scheme) {
@@ -206,12 +279,10 @@ pub fn base_limit_positions(
 /// neighbourhoods of the semi-sharp features are refined).
 fn whole_refinement(
     topology: &Topology,
-    scheme: Scheme,
+    scheme: &Scheme,
     options: &Options,
 ) -> Result<Option<(Refinement, usize)>, LimitError> {
-    if scheme == Scheme::Bilinear {
-        return Err(LimitError::Scheme);
-    }
+    masks_scheme(scheme, false)?;
     let (levels, _) = levels_for_exact_limit(topology, scheme);
     let estimate = topology
         .num_face_vertices()
@@ -220,7 +291,7 @@ fn whole_refinement(
         return Ok(None);
     }
     Ok(Some((
-        Refinement::new(topology, scheme, options, levels)?,
+        Refinement::new(topology, scheme.clone(), options, levels)?,
         levels,
     )))
 }
@@ -237,7 +308,7 @@ fn whole_refinement(
 /// // A cube (every vertex of valence 3), λ = 1/2: formula (2) of seed 000.
 /// let faces = [0, 1, 3, 2, 2, 3, 5, 4, 4, 5, 7, 6, 6, 7, 1, 0, 1, 7, 5, 3, 6, 0, 2, 4];
 /// let cube = TopologyBuilder::new(8).build(&[4; 6], &faces).unwrap();
-/// let tp = TwoPhase::uniform(8, 0.5).unwrap();
+/// let tp = TwoPhase::uniform(0.5).unwrap();
 /// let table = subd_limit::two_phase_base_limit(&cube, &tp, &Options::default()).unwrap();
 /// let (n, l) = (3.0, 0.5);
 /// let beta = n * (1.0 - l) * 10.0 / 13.0 + 2.5;
@@ -274,8 +345,10 @@ pub fn two_phase_base_limit_positions(
     two_phase: &TwoPhase,
     options: &Options,
 ) -> Result<StencilTable, LimitError> {
-    if two_phase_closed::applies(topology, two_phase) {
-        return Ok(two_phase_closed::positions(topology, two_phase));
+    if let Ok(lambda) = two_phase.lambda_for(topology.num_vertices())
+        && two_phase_closed::applies(topology)
+    {
+        return Ok(two_phase_closed::positions(topology, &lambda));
     }
     match two_phase_refinement(topology, two_phase, options)? {
         (r, Some(levels)) => positions_through(&r, levels),
@@ -292,18 +365,23 @@ fn two_phase_refinement(
     two_phase: &TwoPhase,
     options: &Options,
 ) -> Result<(Refinement, Option<usize>), LimitError> {
-    let (decay, _) = levels_for_exact_limit(topology, Scheme::CatmullClark);
+    let (decay, _) = levels_for_exact_limit(topology, &Scheme::CatmullClark);
     let levels = decay.max(1);
     let estimate = topology
         .num_face_vertices()
         .saturating_mul(4usize.saturating_pow(levels as u32));
     if levels > 1 && (estimate > MAX_DECAY_FACE_VERTICES || levels > LOCAL_DECAY_LEVELS) {
         return Ok((
-            Refinement::two_phase(topology, two_phase, options, 1)?,
+            Refinement::new(topology, Scheme::TwoPhase(two_phase.clone()), options, 1)?,
             None,
         ));
     }
-    let r = Refinement::two_phase(topology, two_phase, options, levels)?;
+    let r = Refinement::new(
+        topology,
+        Scheme::TwoPhase(two_phase.clone()),
+        options,
+        levels,
+    )?;
     Ok((r, Some(levels)))
 }
 

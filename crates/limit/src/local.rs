@@ -103,14 +103,14 @@ impl<P> Neighbourhood<P> {
     /// One uniform step of the piece, continuing the refinement it was cut from.
     fn refine(
         &self,
-        scheme: Scheme,
+        scheme: &Scheme,
         options: &Options,
         levels: usize,
     ) -> Result<Refinement, LimitError> {
         Ok(Refinement::from_prepared(
             self.topology.clone(),
             self.rules.clone(),
-            scheme,
+            scheme.clone(),
             options,
             levels,
         )?)
@@ -256,12 +256,12 @@ impl Cut {
 
 /// The corner of the face that (u, v) is exactly at, if any (quads: (0,0), (1,0), (1,1),
 /// (0,1); triangles: (0,0), (1,0), (0,1)).
-fn exact_corner(scheme: Scheme, u: f64, v: f64) -> Option<usize> {
+fn exact_corner(scheme: &Scheme, u: f64, v: f64) -> Option<usize> {
     match (scheme, u, v) {
         (_, 0.0, 0.0) => Some(0),
         (_, 1.0, 0.0) => Some(1),
-        (Scheme::Loop, 0.0, 1.0) => Some(2),
-        (Scheme::Loop, _, _) => None,
+        (&Scheme::Loop, 0.0, 1.0) => Some(2),
+        (&Scheme::Loop, _, _) => None,
         (_, 1.0, 1.0) => Some(2),
         (_, 0.0, 1.0) => Some(3),
         _ => None,
@@ -269,8 +269,8 @@ fn exact_corner(scheme: Scheme, u: f64, v: f64) -> Option<usize> {
 }
 
 /// The corner nearest to (u, v).
-fn nearest_corner(scheme: Scheme, u: f64, v: f64) -> usize {
-    if scheme == Scheme::Loop {
+fn nearest_corner(scheme: &Scheme, u: f64, v: f64) -> usize {
+    if *scheme == Scheme::Loop {
         if u + v < 0.5 {
             0
         } else if u >= v {
@@ -294,7 +294,7 @@ fn nearest_corner(scheme: Scheme, u: f64, v: f64) -> usize {
 fn corner_limit<P>(
     nb: &Neighbourhood<P>,
     base_points: &[DVec3],
-    scheme: Scheme,
+    scheme: &Scheme,
     options: &Options,
     c: usize,
 ) -> Result<SurfacePoint, LimitError> {
@@ -340,8 +340,8 @@ fn corner_limit<P>(
 
 /// The child of face `f` of `t` (level 0 of a one-level refinement) that holds (u, v), the
 /// parameters there and the scale of the parameter map.
-fn child_at(t: &Topology, scheme: Scheme, f: usize, u: f64, v: f64) -> (usize, f64, f64, f64) {
-    if scheme == Scheme::Loop {
+fn child_at(t: &Topology, scheme: &Scheme, f: usize, u: f64, v: f64) -> (usize, f64, f64, f64) {
+    if *scheme == Scheme::Loop {
         let (j, s, tt, k) = crate::eval::tri_child(u, v.min(1.0 - u));
         (4 * f + j, s, tt, k)
     } else {
@@ -360,7 +360,7 @@ pub(crate) fn evaluate(
     rules: &[Rule],
     points: &[DVec3],
     f: usize,
-    scheme: Scheme,
+    scheme: &Scheme,
     options: &Options,
     u: f64,
     v: f64,
@@ -381,7 +381,7 @@ pub(crate) fn stencil(
     t: &Topology,
     rules: &[Rule],
     f: usize,
-    scheme: Scheme,
+    scheme: &Scheme,
     options: &Options,
     u: f64,
     v: f64,
@@ -446,7 +446,7 @@ impl<P> Ending<P> {
 
     /// The surface point there for positions `pts` of the piece's vertices (`f` names the
     /// face the descent started from in errors).
-    fn value(&self, pts: &[DVec3], scheme: Scheme, f: usize) -> Result<SurfacePoint, LimitError> {
+    fn value(&self, pts: &[DVec3], scheme: &Scheme, f: usize) -> Result<SurfacePoint, LimitError> {
         match self {
             Ending::Patch { nb, u, v, scale } => crate::eval::direct_evaluation(
                 &nb.topology,
@@ -476,7 +476,7 @@ impl<P> Ending<P> {
 /// [`MAX_LOCAL_LEVELS`], indistinguishable from) a corner.
 fn descend<P: Carried>(
     mut nb: Neighbourhood<P>,
-    scheme: Scheme,
+    scheme: &Scheme,
     options: &Options,
     u: f64,
     v: f64,
@@ -556,13 +556,13 @@ fn inline<R: Send>(work: impl FnOnce() -> R + Send) -> R {
 /// [`crate::MAX_DECAY_FACE_VERTICES`] face-vertices.
 pub fn base_limit(
     topology: &Topology,
-    scheme: Scheme,
+    scheme: &Scheme,
     options: &Options,
 ) -> Result<LimitStencilTable, LimitError> {
-    let quads = scheme != Scheme::CatmullClark
+    let quads = *scheme != Scheme::CatmullClark
         || (0..topology.num_faces()).all(|f| topology.face_size(f) == 4);
     let pre = usize::from(!quads);
-    let r = Refinement::new(topology, scheme, options, pre)?;
+    let r = Refinement::new(topology, scheme.clone(), options, pre)?;
     base_limit_after(&r, options)
 }
 
@@ -614,7 +614,7 @@ pub(crate) fn base_limit_after(
                 max: crate::MAX_DECAY_FACE_VERTICES,
             });
         }
-        let rc = Refinement::from_prepared(cut.topology, cut.rules, scheme, &options, 1)?;
+        let rc = Refinement::from_prepared(cut.topology, cut.rules, scheme.clone(), &options, 1)?;
         let child_rows = rows.then(rc.stencils(1));
         let next = Cut::new(
             rc.topology(1),
@@ -625,7 +625,7 @@ pub(crate) fn base_limit_after(
         targets_in_cut = positions_in(&next.vertices, &targets_in_cut);
         cut = next;
     }
-    let rc = Refinement::from_prepared(cut.topology, cut.rules, scheme, &options, 0)?;
+    let rc = Refinement::from_prepared(cut.topology, cut.rules, scheme.clone(), &options, 0)?;
     let cut_rows = LimitStencilTable::at_level(&rc, 0)?.after(&rows);
     let mut local = vec![u32::MAX; nv];
     for (&v, &i) in targets.iter().zip(&targets_in_cut) {

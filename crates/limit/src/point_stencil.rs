@@ -39,7 +39,7 @@ use crate::stam::CornerPatchMatrices;
 /// let s = [(-1., -1., 1.), (1., -1., 1.), (-1., 1., 1.), (1., 1., 1.),
 ///          (-1., 1., -1.), (1., 1., -1.), (-1., -1., -1.), (1., -1., -1.)];
 /// let p: Vec<DVec3> = s.iter().map(|&(x, y, z)| DVec3::new(x, y, z)).collect();
-/// let eval = LimitEvaluator::new(&topo, Scheme::CatmullClark, &Options::default()).unwrap();
+/// let eval = LimitEvaluator::new(&topo, &Scheme::CatmullClark, &Options::default()).unwrap();
 /// let at = FaceParam { face: 0, sub: 0, u: 0.3, v: 0.6 };
 /// let direct = eval.evaluate(&eval.prepare(&p), at).unwrap();
 /// let stencil = eval.stencil(at).unwrap();
@@ -281,7 +281,7 @@ impl LimitEvaluator {
                     t2top,
                     r.vertex_rules(2),
                     f2,
-                    self.scheme,
+                    &self.scheme,
                     &self.options,
                     s2,
                     t2,

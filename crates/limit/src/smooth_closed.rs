@@ -19,16 +19,16 @@ use crate::table::emit;
 const CHUNK: usize = 4096;
 
 /// Whether every vertex's limit position is its scheme's classical smooth mask.
-pub(crate) fn applies(t: &Topology, scheme: Scheme) -> bool {
+pub(crate) fn applies(t: &Topology, scheme: &Scheme) -> bool {
     match scheme {
         Scheme::CatmullClark => t.is_closed_smooth_uniform(4),
         Scheme::Loop => t.is_closed_smooth_uniform(3),
-        Scheme::Bilinear => false,
+        _ => false,
     }
 }
 
 /// The limit-position table from the classical masks. Call only where [`applies`] holds.
-pub(crate) fn positions(t: &Topology, scheme: Scheme) -> StencilTable {
+pub(crate) fn positions(t: &Topology, scheme: &Scheme) -> StencilTable {
     let nv = t.num_vertices();
     let valence = |v: usize| t.vertex_faces(v).len();
     let most = (0..nv)

@@ -25,7 +25,7 @@ use std::f64::consts::TAU;
 use faer::{Mat, c64};
 use glam::DVec3;
 use subd_mesh::{Topology, TopologyBuilder};
-use subd_schemes::split_schemes::{SplitRefinement, SplitScheme};
+use subd_schemes::{Options, RefineError, Refinement, Scheme};
 
 use crate::LimitError;
 
@@ -405,10 +405,10 @@ fn dominant_left(block: &Mat<c64>) -> Result<(c64, Vec<c64>), LimitError> {
 ///
 /// ```
 /// use subd_limit::split_eigen::split_spectrum;
-/// use subd_schemes::split_schemes::SplitScheme;
+/// use subd_schemes::Scheme;
 ///
 /// // The modified butterfly is C¹ at every valence; its subdominant eigenvalue is ½.
-/// let s = split_spectrum(SplitScheme::ModifiedButterfly, 9).unwrap();
+/// let s = split_spectrum(&Scheme::ModifiedButterfly, 9).unwrap();
 /// let test = s.test();
 /// assert!(test.passes);
 /// assert!((test.subdominant - 0.5).abs() < 1e-12);
@@ -416,7 +416,7 @@ fn dominant_left(block: &Mat<c64>) -> Result<(c64, Vec<c64>), LimitError> {
 ///
 /// # Errors
 /// [`LimitError::Analysis`] for a valence out of range, or when no invariant ball is found.
-pub fn split_spectrum(scheme: SplitScheme, n: usize) -> Result<SplitSpectrum, LimitError> {
+pub fn split_spectrum(scheme: &Scheme, n: usize) -> Result<SplitSpectrum, LimitError> {
     let local = local_system(scheme, n)?;
     Ok(SplitSpectrum {
         valence: n,
@@ -432,19 +432,20 @@ struct LocalSystem {
     rot: Vec<usize>,
 }
 
-fn local_system(scheme: SplitScheme, n: usize) -> Result<LocalSystem, LimitError> {
+fn local_system(scheme: &Scheme, n: usize) -> Result<LocalSystem, LimitError> {
     if !(3..=64).contains(&n) {
         return Err(LimitError::Analysis(format!(
             "valence {n}: must be 3 to 64"
         )));
     }
-    let analysis = |e: subd_schemes::split_schemes::SplitError| LimitError::Analysis(e.to_string());
+    let analysis = |e: RefineError| LimitError::Analysis(e.to_string());
     for radius in 1..=6 {
         let rings = 2 * radius + 4;
-        let (parent, child, stencils, old, new) = if scheme == SplitScheme::DooSabin {
+        let (parent, child, stencils, old, new) = if *scheme == Scheme::DooSabin {
             // The n-gon: the vertex face of a valence-n vertex after one step.
             let d = disc(n, rings + 1, true)?;
-            let r = SplitRefinement::new(&d, scheme, 2).map_err(analysis)?;
+            let r =
+                Refinement::new(&d, scheme.clone(), &Options::default(), 2).map_err(analysis)?;
             let level1 = r.topology(1);
             // F-faces, then E-faces, then V-faces in vertex order: vertex 0's comes first.
             let v_face = d.num_faces() + d.num_edges();
@@ -462,12 +463,13 @@ fn local_system(scheme: SplitScheme, n: usize) -> Result<LocalSystem, LimitError
             let d = disc(n, rings, false)?;
             let first = d.vertex_ring(0).next().expect("centre has a ring");
             let old = vertex_centre(&d, 0, first);
-            if scheme == SplitScheme::Sqrt3 {
+            if *scheme == Scheme::Sqrt3 {
                 // One step turns the mesh by π/n; two steps bring it back into line. The
                 // root spoke of level 2 is the one along the root spoke of level 0: through
                 // the centroid of the level-1 face right of the level-1 root spoke, itself
                 // through the centroid of the level-0 face left of the root spoke.
-                let r = SplitRefinement::new(&d, scheme, 2).map_err(analysis)?;
+                let r = Refinement::new(&d, scheme.clone(), &Options::default(), 2)
+                    .map_err(analysis)?;
                 let level1 = r.topology(1);
                 let f0 = face_with_edge(&d, 0, first);
                 let first1 = (d.num_vertices() + f0) as u32;
@@ -476,7 +478,8 @@ fn local_system(scheme: SplitScheme, n: usize) -> Result<LocalSystem, LimitError
                 let new = vertex_centre(r.topology(2), 0, first2);
                 (d.clone(), r.topology(2).clone(), r.composed(2), old, new)
             } else {
-                let r = SplitRefinement::new(&d, scheme, 1).map_err(analysis)?;
+                let r = Refinement::new(&d, scheme.clone(), &Options::default(), 1)
+                    .map_err(analysis)?;
                 // The root spoke's point.
                 let e = d.find_edge(0, first).expect("root spoke");
                 let new = vertex_centre(r.topology(1), 0, (d.num_vertices() + e as usize) as u32);
@@ -537,8 +540,8 @@ impl LocalMasks {
 /// # Errors
 /// [`LimitError::Analysis`] for Doo-Sabin (its centres are faces), a valence out of range or
 /// a failed eigen solve.
-pub fn local_masks(scheme: SplitScheme, n: usize) -> Result<LocalMasks, LimitError> {
-    if scheme == SplitScheme::DooSabin {
+pub fn local_masks(scheme: &Scheme, n: usize) -> Result<LocalMasks, LimitError> {
+    if *scheme == Scheme::DooSabin {
         return Err(LimitError::Analysis(
             "Doo-Sabin's limit points are face centroids, not vertex masks".into(),
         ));
@@ -760,7 +763,7 @@ pub fn expand_row(row: &[(u32, f64)], table: &subd_schemes::StencilTable) -> Vec
 }
 
 /// A row of `r` from level `from` to level `to`, for vertex `c` of level `to`.
-pub fn row_between(r: &SplitRefinement, from: usize, to: usize, c: u32) -> Vec<(u32, f64)> {
+pub fn row_between(r: &Refinement, from: usize, to: usize, c: u32) -> Vec<(u32, f64)> {
     let mut row = vec![(c, 1.0)];
     for level in (from + 1..=to).rev() {
         row = expand_row(&row, r.stencils(level));
@@ -773,11 +776,8 @@ pub fn row_between(r: &SplitRefinement, from: usize, to: usize, c: u32) -> Vec<(
 /// # Errors
 /// [`LimitError::Analysis`] for Doo-Sabin, a centre out of range (3 to 64 edges; 1 to 32
 /// boundary triangles), no invariant ball of radius ≤ 6, or a failed eigen solve.
-pub fn feature_masks(
-    scheme: SplitScheme,
-    centre: FeatureCentre,
-) -> Result<FeatureMasks, LimitError> {
-    if scheme == SplitScheme::DooSabin {
+pub fn feature_masks(scheme: &Scheme, centre: FeatureCentre) -> Result<FeatureMasks, LimitError> {
+    if *scheme == Scheme::DooSabin {
         return Err(LimitError::Analysis(
             "Doo-Sabin's limit points are face centroids, not vertex masks".into(),
         ));
@@ -791,8 +791,8 @@ pub fn feature_masks(
             )));
         }
     };
-    let steps = if scheme == SplitScheme::Sqrt3 { 2 } else { 1 };
-    let analysis = |e: subd_schemes::split_schemes::SplitError| LimitError::Analysis(e.to_string());
+    let steps = if *scheme == Scheme::Sqrt3 { 2 } else { 1 };
+    let analysis = |e: RefineError| LimitError::Analysis(e.to_string());
     for radius in 1..=6 {
         let (mut fan, positions) = triangle_fan(sectors, 2 * radius + 4, closed);
         if closed {
@@ -810,7 +810,8 @@ pub fn feature_masks(
                 (prev, next) = (next, ring[3]);
             }
         }
-        let r = SplitRefinement::new(&fan, scheme, steps).map_err(analysis)?;
+        let r =
+            Refinement::new(&fan, scheme.clone(), &Options::default(), steps).map_err(analysis)?;
         let rows = |c: u32| row_between(&r, 0, steps, c);
         let Some(s) = feature_matrix(&fan, r.topology(steps), &rows, 0, radius) else {
             continue;
@@ -883,7 +884,7 @@ fn left_masks(
 mod tests {
     use super::*;
 
-    fn test_at(scheme: SplitScheme, n: usize) -> SpectrumTest {
+    fn test_at(scheme: &Scheme, n: usize) -> SpectrumTest {
         split_spectrum(scheme, n).unwrap().test()
     }
 
@@ -892,7 +893,7 @@ mod tests {
     #[test]
     fn classic_butterfly_fails_at_three_and_above_seven() {
         for n in 3..=16 {
-            let t = test_at(SplitScheme::BUTTERFLY, n);
+            let t = test_at(&Scheme::BUTTERFLY, n);
             assert_eq!(t.passes, (4..=7).contains(&n), "valence {n}: {t:?}");
             if n >= 8 {
                 // Frequency 2 from valence 8, frequency 3 from valence 14.
@@ -900,14 +901,14 @@ mod tests {
             }
         }
         // The regular case is the three-direction box spline's neighbour: λ = ½.
-        assert!((test_at(SplitScheme::BUTTERFLY, 6).subdominant - 0.5).abs() < 1e-12);
+        assert!((test_at(&Scheme::BUTTERFLY, 6).subdominant - 0.5).abs() < 1e-12);
     }
 
     /// Zorin's rules put the subdominant eigenvalue at exactly ½ at every valence.
     #[test]
     fn modified_butterfly_is_c1_at_every_valence() {
         for n in 3..=20 {
-            let t = test_at(SplitScheme::ModifiedButterfly, n);
+            let t = test_at(&Scheme::ModifiedButterfly, n);
             assert!(t.passes, "valence {n}: {t:?}");
             assert!((t.subdominant - 0.5).abs() < 1e-12, "valence {n}: {t:?}");
         }
@@ -919,7 +920,7 @@ mod tests {
     #[test]
     fn doo_sabin_is_c1_with_one_half() {
         for n in 3..=16 {
-            let t = test_at(SplitScheme::DooSabin, n);
+            let t = test_at(&Scheme::DooSabin, n);
             assert!(t.passes, "valence {n}: {t:?}");
             assert!((t.subdominant - 0.5).abs() < 1e-12, "valence {n}: {t:?}");
         }
@@ -930,7 +931,7 @@ mod tests {
     #[test]
     fn sqrt3_is_c1_with_kobbelts_eigenvalue() {
         for n in 3..=20 {
-            let t = test_at(SplitScheme::Sqrt3, n);
+            let t = test_at(&Scheme::Sqrt3, n);
             let expected = 4.0 * (std::f64::consts::PI / n as f64).cos().powi(2) / 9.0;
             assert!(t.passes, "valence {n}: {t:?}");
             assert!(
@@ -945,7 +946,7 @@ mod tests {
     #[test]
     fn limit_masks_match_closed_forms() {
         for n in 3..=12 {
-            let m = local_masks(SplitScheme::Sqrt3, n).unwrap();
+            let m = local_masks(&Scheme::Sqrt3, n).unwrap();
             let a = subd_schemes::split_schemes::sqrt3::alpha(n);
             let beta = 3.0 * a / (1.0 + 3.0 * a);
             assert!((m.limit[0] - (1.0 - beta)).abs() < 1e-12, "valence {n}");
@@ -953,8 +954,8 @@ mod tests {
                 assert!((m.limit[j] - beta / n as f64).abs() < 1e-12, "valence {n}");
             }
             assert!(m.limit[n + 1..].iter().all(|w| w.abs() < 1e-12));
-            for scheme in [SplitScheme::BUTTERFLY, SplitScheme::ModifiedButterfly] {
-                let m = local_masks(scheme, n).unwrap();
+            for scheme in [Scheme::BUTTERFLY, Scheme::ModifiedButterfly] {
+                let m = local_masks(&scheme, n).unwrap();
                 assert!((m.limit[0] - 1.0).abs() < 1e-12, "{scheme:?} {n}");
                 assert!(m.limit[1..].iter().all(|w| w.abs() < 1e-12));
             }
@@ -966,7 +967,7 @@ mod tests {
     #[test]
     fn modified_butterfly_tangents_are_ring_fourier_modes() {
         for n in [3, 4, 5, 7, 9] {
-            let m = local_masks(SplitScheme::ModifiedButterfly, n).unwrap();
+            let m = local_masks(&Scheme::ModifiedButterfly, n).unwrap();
             let [t1, t2] = m.tangents.unwrap();
             assert!(t1[0].abs() < 1e-12 && t2[0].abs() < 1e-12);
             assert!(
@@ -989,7 +990,7 @@ mod tests {
         }
         // The classic butterfly at valence 8 is not C¹: no tangents.
         assert!(
-            local_masks(SplitScheme::BUTTERFLY, 8)
+            local_masks(&Scheme::BUTTERFLY, 8)
                 .unwrap()
                 .tangents
                 .is_none()
@@ -1003,7 +1004,7 @@ mod tests {
     fn boundary_masks_match_the_curve_rules() {
         for faces in 1..=6 {
             let centre = FeatureCentre::Boundary { faces };
-            let m = feature_masks(SplitScheme::Sqrt3, centre).unwrap();
+            let m = feature_masks(&Scheme::Sqrt3, centre).unwrap();
             // Labels: 0 the vertex, 1 its outgoing boundary neighbour, faces + 1 the other.
             assert!(
                 (m.limit[0] - 4.0 / 6.0).abs() < 1e-12,
@@ -1022,8 +1023,8 @@ mod tests {
                 (2..=5).contains(&faces),
                 "√3 boundary {faces}"
             );
-            for scheme in [SplitScheme::BUTTERFLY, SplitScheme::ModifiedButterfly] {
-                let m = feature_masks(scheme, centre).unwrap();
+            for scheme in [Scheme::BUTTERFLY, Scheme::ModifiedButterfly] {
+                let m = feature_masks(&scheme, centre).unwrap();
                 assert!((m.limit[0] - 1.0).abs() < 1e-12, "{scheme:?} {faces}");
                 assert!(
                     faces == 1 || m.tangents.is_some(),
@@ -1038,8 +1039,8 @@ mod tests {
     #[test]
     fn dart_masks_are_left_eigenvectors() {
         for valence in [4, 5, 6, 7] {
-            for scheme in [SplitScheme::Sqrt3, SplitScheme::ModifiedButterfly] {
-                let m = feature_masks(scheme, FeatureCentre::Dart { valence }).unwrap();
+            for scheme in [Scheme::Sqrt3, Scheme::ModifiedButterfly] {
+                let m = feature_masks(&scheme, FeatureCentre::Dart { valence }).unwrap();
                 let sum: f64 = m.limit.iter().sum();
                 assert!((sum - 1.0).abs() < 1e-12);
                 for j in 0..m.limit.len() {
@@ -1054,7 +1055,7 @@ mod tests {
 
     #[test]
     fn valence_out_of_range_is_an_error() {
-        assert!(split_spectrum(SplitScheme::Sqrt3, 2).is_err());
-        assert!(split_spectrum(SplitScheme::Sqrt3, 65).is_err());
+        assert!(split_spectrum(&Scheme::Sqrt3, 2).is_err());
+        assert!(split_spectrum(&Scheme::Sqrt3, 65).is_err());
     }
 }

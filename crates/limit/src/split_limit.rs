@@ -32,7 +32,8 @@ use std::f64::consts::TAU;
 use glam::DVec3;
 use subd_mesh::Topology;
 use subd_schemes::StencilTable;
-use subd_schemes::split_schemes::{Features, SplitRefinement, SplitScheme, doo_sabin};
+use subd_schemes::split_schemes::{Features, doo_sabin};
+use subd_schemes::{Options, Refinement, Scheme};
 
 use crate::LimitError;
 use crate::split_eigen::{
@@ -93,22 +94,76 @@ fn to_base(row: &Row, composed: &StencilTable) -> Row {
     expand_row(row, composed)
 }
 
+/// The stencils of `scheme`'s limit at every vertex of `base`, after the refinement's own
+/// checks of the mesh, so a mesh the scheme cannot take is refused as [`Refinement::new`]
+/// refuses it (face kind, tags, non-manifold parts), with the element named.
+///
+/// # Errors
+/// [`LimitError::Refine`] for a mesh the scheme cannot refine; as [`split_limit_stencils`].
+pub fn checked_split_limit_stencils(
+    base: &Topology,
+    scheme: &Scheme,
+) -> Result<SplitLimitStencils, LimitError> {
+    Refinement::new(base, scheme.clone(), &Options::default(), 0)?;
+    split_limit_stencils(base, scheme)
+}
+
+impl SplitLimitStencils {
+    /// The limit of every vertex from `positions` (NaN normals and tangents where none is
+    /// defined: creases and corners of √3 and the butterflies); a vertex without a limit is
+    /// an error naming it.
+    ///
+    /// # Errors
+    /// [`LimitError::NoLimit`] naming the first vertex without a limit.
+    pub fn limit_points(
+        &self,
+        scheme: &Scheme,
+        positions: &[DVec3],
+    ) -> Result<crate::LimitPoints, LimitError> {
+        let points = self.evaluate(positions);
+        if let Some(v) = points.positions.iter().position(Option::is_none) {
+            let why = if *scheme == Scheme::DooSabin {
+                "an interior vertex of valence 2 has no vertex face"
+            } else {
+                "its neighbourhood never became one with a known limit mask (a dart or boundary vertex whose refined neighbourhood stays irregular)"
+            };
+            return Err(LimitError::NoLimit {
+                vertex: v,
+                scheme: scheme.name(),
+                why,
+            });
+        }
+        let nan = DVec3::splat(f64::NAN);
+        Ok(crate::LimitPoints {
+            positions: points.positions.into_iter().flatten().collect(),
+            tangent1: vec![nan; positions.len()],
+            tangent2: vec![nan; positions.len()],
+            normals: points
+                .normals
+                .into_iter()
+                .map(|n| n.unwrap_or(nan))
+                .collect(),
+        })
+    }
+}
+
 /// The stencils of `scheme`'s limit at every vertex of `base`.
 ///
 /// # Errors
 /// [`LimitError::Analysis`] when `base` is not a mesh `scheme` refines (see
-/// [`SplitRefinement::new`]) or an eigen solve fails.
+/// [`Refinement::new`]) or an eigen solve fails.
 pub fn split_limit_stencils(
     base: &Topology,
-    scheme: SplitScheme,
+    scheme: &Scheme,
 ) -> Result<SplitLimitStencils, LimitError> {
     let nv = base.num_vertices();
     let refinement = |levels| {
-        SplitRefinement::new(base, scheme, levels).map_err(|e| LimitError::Analysis(e.to_string()))
+        Refinement::new(base, scheme.clone(), &Options::default(), levels)
+            .map_err(|e| LimitError::Analysis(e.to_string()))
     };
     let mut position: Vec<Option<Row>> = vec![None; nv];
     let mut tangents: Vec<Option<[Row; 2]>> = vec![None; nv];
-    if scheme == SplitScheme::DooSabin {
+    if *scheme == Scheme::DooSabin {
         let r = refinement(1)?;
         doo_sabin_rows(base, &r, &mut position, &mut tangents);
     } else {
@@ -145,7 +200,7 @@ pub fn split_limit_stencils(
 /// Doo-Sabin: centroid and first Fourier mode of each vertex's vertex face.
 fn doo_sabin_rows(
     base: &Topology,
-    r: &SplitRefinement,
+    r: &Refinement,
     position: &mut [Option<Row>],
     tangents: &mut [Option<[Row; 2]>],
 ) {
@@ -187,8 +242,8 @@ fn regular_ball(t: &Topology, features: &Features, v: u32, ball: &[u32], expecte
 /// at the first level with a regular ball.
 fn vertex_rows(
     base: &Topology,
-    scheme: SplitScheme,
-    refinement: &dyn Fn(usize) -> Result<SplitRefinement, LimitError>,
+    scheme: &Scheme,
+    refinement: &dyn Fn(usize) -> Result<Refinement, LimitError>,
     position: &mut [Option<Row>],
     tangents: &mut [Option<[Row; 2]>],
 ) -> Result<(), LimitError> {
@@ -210,7 +265,7 @@ fn vertex_rows(
             if (dart || boundary_curve) && !features.is_corner(vi) {
                 feature_pending.push(v);
             }
-            if scheme == SplitScheme::Sqrt3 {
+            if *scheme == Scheme::Sqrt3 {
                 if features.is_corner(vi) {
                     position[vi] = Some(vec![(v, 1.0)]);
                 } else if features.is_curve_vertex(vi) {
@@ -224,7 +279,7 @@ fn vertex_rows(
     }
     let mut masks: HashMap<usize, (LocalMasks, usize)> = HashMap::new();
     let mut level = 0;
-    let mut refined: Option<SplitRefinement> = None;
+    let mut refined: Option<Refinement> = None;
     while !pending.is_empty() && level <= MAX_LEVELS {
         let (t, composed) = match &refined {
             None => (base, None),
@@ -285,7 +340,7 @@ fn sqrt3_curve_limit(
     base: &Topology,
     features: &Features,
     v: u32,
-    refinement: &dyn Fn(usize) -> Result<SplitRefinement, LimitError>,
+    refinement: &dyn Fn(usize) -> Result<Refinement, LimitError>,
 ) -> Result<Row, LimitError> {
     let curve = |t: &Topology, f: &Features| -> Row {
         let [e0, e1] = f.curve_edges(v as usize);
@@ -310,8 +365,8 @@ fn sqrt3_curve_limit(
 /// refinement, is that centre's (so its neighbourhood has become regular but for it). √3's
 /// matrix covers an odd and an even step, so only even levels are tried there.
 fn feature_rows(
-    scheme: SplitScheme,
-    refinement: &dyn Fn(usize) -> Result<SplitRefinement, LimitError>,
+    scheme: &Scheme,
+    refinement: &dyn Fn(usize) -> Result<Refinement, LimitError>,
     vertices: &[u32],
     position: &mut [Option<Row>],
     tangents: &mut [Option<[Row; 2]>],
@@ -319,7 +374,7 @@ fn feature_rows(
     if vertices.is_empty() {
         return Ok(());
     }
-    let steps = if scheme == SplitScheme::Sqrt3 { 2 } else { 1 };
+    let steps = if *scheme == Scheme::Sqrt3 { 2 } else { 1 };
     let mut masks: HashMap<FeatureCentre, Option<FeatureMasks>> = HashMap::new();
     let mut pending = vertices.to_vec();
     for level in (0..=MAX_LEVELS - steps).step_by(steps) {

@@ -492,7 +492,7 @@ mod tests {
             let m = CornerPatchMatrices::new(n).unwrap();
             let big = m.eigenvalues();
             let ring = crate::eigen::ring_matrix(
-                Scheme::CatmullClark,
+                &Scheme::CatmullClark,
                 n,
                 crate::eigen::RingFeature::Smooth,
             )

@@ -75,15 +75,15 @@ enum VertexCase {
 /// The smooth case of a vertex with `nf` faces and `ne` edges: the closed form, except at
 /// an interior Catmull-Clark vertex of valence 2, where it is not the limit (OpenSubdiv
 /// copies the vertex there) and the eigen analysis gives it.
-fn smooth_case(nf: usize, ne: usize, scheme: Scheme) -> VertexCase {
-    if scheme == Scheme::CatmullClark && nf == 2 && ne == 2 {
+fn smooth_case(nf: usize, ne: usize, scheme: &Scheme) -> VertexCase {
+    if *scheme == Scheme::CatmullClark && nf == 2 && ne == 2 {
         VertexCase::Numeric(RingFeature::Smooth, 0)
     } else {
         VertexCase::Smooth
     }
 }
 
-fn classify(t: &Topology, v: usize, rule: Rule, scheme: Scheme) -> VertexCase {
+fn classify(t: &Topology, v: usize, rule: Rule, scheme: &Scheme) -> VertexCase {
     let ve = t.vertex_edges(v);
     if ve.is_empty() {
         return VertexCase::Isolated;
@@ -159,12 +159,9 @@ impl<'a> LevelMasks<'a> {
         refinement: &'a Refinement,
         level: usize,
     ) -> Result<LevelMasks<'a>, LimitError> {
-        let scheme = refinement.scheme();
-        if scheme == Scheme::Bilinear {
-            return Err(LimitError::Scheme);
-        }
+        let scheme = &crate::masks_scheme(refinement.scheme(), level > 0)?;
         let t = refinement.topology(level);
-        if scheme == Scheme::CatmullClark
+        if *scheme == Scheme::CatmullClark
             && let Some(f) = (0..t.num_faces()).find(|&f| t.face_size(f) != 4)
         {
             return Err(LimitError::NotQuad {
@@ -233,7 +230,7 @@ impl<'a> LevelMasks<'a> {
 /// The limit mask of a vertex case with `ne` edges and `nf` faces (numeric masks are shared
 /// between rotations through `numeric`).
 fn case_mask(
-    scheme: Scheme,
+    scheme: &Scheme,
     case: VertexCase,
     ne: usize,
     nf: usize,
@@ -241,7 +238,9 @@ fn case_mask(
 ) -> Result<LimitMask, LimitError> {
     Ok(match case {
         VertexCase::Isolated => masks::corner(0, 0, 0.0),
-        VertexCase::Corner => masks::corner(ne, nf, if scheme == Scheme::Loop { 3.0 } else { 1.0 }),
+        VertexCase::Corner => {
+            masks::corner(ne, nf, if *scheme == Scheme::Loop { 3.0 } else { 1.0 })
+        }
         VertexCase::Crease(a, b) => match scheme {
             Scheme::Loop => masks::loop_crease(ne, (a, b)),
             _ => masks::catmark_crease(ne, nf, (a, b)),
@@ -390,7 +389,7 @@ pub(crate) fn crease_side_mask(
     t: &Topology,
     v: usize,
     rule: Rule,
-    scheme: Scheme,
+    scheme: &Scheme,
     f: usize,
 ) -> Option<LimitMask> {
     let (ve, vf) = (t.vertex_edges(v), t.vertex_faces(v));

@@ -93,7 +93,7 @@ impl Tessellation {
 /// let s = [(-1., -1., 1.), (1., -1., 1.), (-1., 1., 1.), (1., 1., 1.),
 ///          (-1., 1., -1.), (1., 1., -1.), (-1., -1., -1.), (1., -1., -1.)];
 /// let p: Vec<DVec3> = s.iter().map(|&(x, y, z)| DVec3::new(x, y, z)).collect();
-/// let eval = LimitEvaluator::new(&cube, Scheme::CatmullClark, &Options::default()).unwrap();
+/// let eval = LimitEvaluator::new(&cube, &Scheme::CatmullClark, &Options::default()).unwrap();
 /// let t = tessellate(&eval, &eval.prepare(&p), 4).unwrap();
 /// assert_eq!(t.face_offsets.len() - 1, 6 * 16);
 /// // Shared samples: V - E + F = 2 for the closed grid, 6·16 quads.
@@ -407,8 +407,8 @@ mod tests {
     #[test]
     fn one_thread_gives_the_same_bits_as_many() {
         let mesh = subd_mesh::primitives::torus_with_hexagons(12, 8, 4, 3.0, 1.0);
-        let ev =
-            LimitEvaluator::new(&mesh.topology, Scheme::CatmullClark, &Options::default()).unwrap();
+        let ev = LimitEvaluator::new(&mesh.topology, &Scheme::CatmullClark, &Options::default())
+            .unwrap();
         let pts = ev.prepare(&mesh.positions);
         let many = tessellate(&ev, &pts, 6).unwrap();
         let one = rayon::ThreadPoolBuilder::new()

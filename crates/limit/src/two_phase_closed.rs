@@ -18,21 +18,20 @@
 //! comes from the eigen analysis.
 
 use subd_mesh::Topology;
+use subd_schemes::StencilTable;
 use subd_schemes::two_phase::ALPHA;
-use subd_schemes::{StencilTable, TwoPhase};
 
-/// Whether formula (2) gives every vertex's two-phase limit: one `λ` per vertex, the mesh
-/// closed and smooth, all faces quads with four distinct vertices, every vertex of valence
-/// at least 3 ([`Topology::is_closed_smooth_uniform`]).
-pub(crate) fn applies(t: &Topology, two_phase: &TwoPhase) -> bool {
-    two_phase.lambda().len() == t.num_vertices() && t.is_closed_smooth_uniform(4)
+/// Whether formula (2) gives every vertex's two-phase limit: the mesh closed and smooth, all
+/// faces quads with four distinct vertices, every vertex of valence at least 3
+/// ([`Topology::is_closed_smooth_uniform`]).
+pub(crate) fn applies(t: &Topology) -> bool {
+    t.is_closed_smooth_uniform(4)
 }
 
 /// The limit-position table of formula (2), rows in the order of the general path's limit
 /// masks (face-diagonal vertices, then edge neighbours, then the vertex). Call only where
 /// [`applies`] holds.
-pub(crate) fn positions(t: &Topology, two_phase: &TwoPhase) -> StencilTable {
-    let lambda = two_phase.lambda();
+pub(crate) fn positions(t: &Topology, lambda: &[f64]) -> StencilTable {
     StencilTable::build(t.num_vertices(), t.num_vertices(), |v, sink| {
         let (faces, edges) = (t.vertex_faces(v), t.vertex_edges(v));
         let (n, l) = (faces.len() as f64, lambda[v]);
@@ -55,7 +54,7 @@ pub(crate) fn positions(t: &Topology, two_phase: &TwoPhase) -> StencilTable {
 mod tests {
     use super::*;
     use subd_mesh::TopologyBuilder;
-    use subd_schemes::{Options, Refinement};
+    use subd_schemes::{Options, Refinement, Scheme, TwoPhase};
 
     /// Rows as sorted (source, weight) lists.
     fn rows(t: &StencilTable) -> Vec<Vec<(u32, f64)>> {
@@ -96,11 +95,11 @@ mod tests {
             let lambda: Vec<f64> = (0..nv)
                 .map(|v| 0.36 + 0.64 * ((v * 5) % 9) as f64 / 8.0)
                 .collect();
-            let tp = TwoPhase::new(lambda).unwrap();
-            assert!(applies(&t, &tp));
-            let closed = rows(&positions(&t, &tp));
+            let tp = TwoPhase::new(lambda.clone()).unwrap();
+            assert!(applies(&t));
+            let closed = rows(&positions(&t, &lambda));
             // The general path: phase 1 refined, Catmull-Clark limit masks there, composed back.
-            let r = Refinement::two_phase(&t, &tp, &Options::default(), 1).unwrap();
+            let r = Refinement::new(&t, Scheme::TwoPhase(tp), &Options::default(), 1).unwrap();
             let general = rows(&crate::positions_through(&r, 1).unwrap());
             for v in 0..nv {
                 assert_eq!(closed[v].len(), general[v].len(), "vertex {v}");
@@ -121,18 +120,19 @@ mod tests {
     fn open_creased_or_valence_two_meshes_take_the_general_path() {
         // A single quad: boundary.
         let quad = TopologyBuilder::new(4).build(&[4], &[0, 1, 2, 3]).unwrap();
-        assert!(!applies(&quad, &TwoPhase::uniform(4, 0.5).unwrap()));
+        assert!(!applies(&quad));
         // Two quads glued along their whole boundary: closed, every vertex of valence 2.
         let pillow = TopologyBuilder::new(4)
             .build(&[4, 4], &[0, 1, 2, 3, 3, 2, 1, 0])
             .unwrap();
-        assert!(!applies(&pillow, &TwoPhase::uniform(4, 0.5).unwrap()));
-        // A cube with a wrong λ count.
+        assert!(!applies(&pillow));
+        // A cube qualifies; a wrong λ count is refused before the formula is reached.
         let faces = [
             0, 1, 3, 2, 2, 3, 5, 4, 4, 5, 7, 6, 6, 7, 1, 0, 1, 7, 5, 3, 6, 0, 2, 4,
         ];
         let cube = TopologyBuilder::new(8).build(&[4; 6], &faces).unwrap();
-        assert!(!applies(&cube, &TwoPhase::uniform(7, 0.5).unwrap()));
-        assert!(applies(&cube, &TwoPhase::uniform(8, 0.5).unwrap()));
+        assert!(applies(&cube));
+        let seven = TwoPhase::new(vec![0.5; 7]).unwrap();
+        assert!(crate::two_phase_base_limit_positions(&cube, &seven, &Options::default()).is_err());
     }
 }

@@ -85,6 +85,15 @@ impl FVarLinearInterpolation {
 #[derive(Debug, Clone, PartialEq, Error)]
 #[non_exhaustive]
 pub enum FVarError {
+    /// A scheme that refines face-varying data as a mesh of values, not in OpenSubdiv's
+    /// interpolation modes.
+    #[error(
+        "the {scheme} scheme refines face-varying data as a mesh of values (SplitFaceVarying), not in OpenSubdiv's modes"
+    )]
+    Scheme {
+        /// The scheme's name.
+        scheme: String,
+    },
     /// A channel needs at least one component per value.
     #[error("a face-varying channel needs at least one component per value")]
     NoComponents,

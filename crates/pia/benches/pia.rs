@@ -4,7 +4,7 @@
 
 use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
 use subd_mesh::{DVec3, Topology};
-use subd_pia::{Moving, Pia, PiaOptions, PiaScheme, Solver};
+use subd_pia::{Moving, Pia, PiaOptions, Solver};
 use subd_schemes::{Options, Refinement, Scheme};
 
 /// A 160 × 160 torus grid in which every 8th quad pair is merged into a hexagon, refined
@@ -20,7 +20,7 @@ fn torus() -> (Topology, Vec<DVec3>) {
 
 fn bench(c: &mut Criterion) {
     let (topo, targets) = torus();
-    let new = || Pia::new(&topo, &PiaScheme::CatmullClark, &Options::default()).expect("limit");
+    let new = || Pia::new(&topo, &Scheme::CatmullClark, &Options::default()).expect("limit");
     let pia = new();
     assert!(pia.prepare(), "the torus has the Chebyshev operator");
     let mut g = c.benchmark_group("pia_torus_101k");

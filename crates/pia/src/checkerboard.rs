@@ -262,10 +262,11 @@ mod tests {
     use super::*;
     use crate::solvers::{Controls, Method, Solver, solve};
     use crate::system::ReducedSystem;
-    use crate::{Moving, Pia, PiaScheme};
+    use crate::{Moving, Pia};
     use glam::DVec3;
     use subd_mesh::TopologyBuilder;
     use subd_schemes::Options;
+    use subd_schemes::Scheme;
 
     /// An `n × n` quad grid on a torus: every vertex regular (valence 4).
     fn regular_torus(n: usize) -> (Topology, Vec<DVec3>) {
@@ -304,7 +305,7 @@ mod tests {
         // eigenvalues. Every diagonal entry is 4/9, so T = (9/4) S and K's interval is
         // (81/16) [1/9, 16/81] = [9/16, 1].
         let (t, points) = regular_torus(16);
-        let pia = Pia::new(&t, &PiaScheme::CatmullClark, &Options::default()).unwrap();
+        let pia = Pia::new(&t, &Scheme::CatmullClark, &Options::default()).unwrap();
         assert!(pia.prepare());
         let s = whole_system(&pia, &points);
         let pre = s.whole_preconditioned(false).expect("prepared");
@@ -351,7 +352,7 @@ mod tests {
             .map(|v| t.vertex_edges(v).len())
             .collect();
         assert_eq!(valences.into_iter().collect::<Vec<_>>(), [3, 4, 6]);
-        let pia = Pia::new(&t, &PiaScheme::CatmullClark, &Options::default()).unwrap();
+        let pia = Pia::new(&t, &Scheme::CatmullClark, &Options::default()).unwrap();
         let (_, m) = pia.moving_matrix(&Moving::All).unwrap();
         let signs = checkerboard_signs(&t).unwrap();
         let diag: Vec<f64> = (0..m.nrows()).map(|i| m[(i, i)]).collect();
@@ -368,7 +369,7 @@ mod tests {
     #[test]
     fn a_wrong_interval_falls_back_to_cg() {
         let (t, points) = regular_torus(16);
-        let pia = Pia::new(&t, &PiaScheme::CatmullClark, &Options::default()).unwrap();
+        let pia = Pia::new(&t, &Scheme::CatmullClark, &Options::default()).unwrap();
         let s = whole_system(&pia, &points);
         let good = Preconditioned::new(
             &s.matrix,

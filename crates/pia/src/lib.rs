@@ -25,8 +25,8 @@
 //!
 //! ```
 //! use subd_mesh::{DVec3, TopologyBuilder};
-//! use subd_pia::{Moving, Pia, PiaOptions, PiaScheme};
-//! use subd_schemes::Options;
+//! use subd_pia::{Moving, Pia, PiaOptions};
+//! use subd_schemes::{Options, Scheme};
 //!
 //! // Make the Catmull-Clark limit surface of a cube pass through its 8 corners.
 //! let faces = [0, 1, 3, 2, 2, 3, 5, 4, 4, 5, 7, 6, 6, 7, 1, 0, 1, 7, 5, 3, 6, 0, 2, 4];
@@ -34,7 +34,7 @@
 //! let targets: Vec<DVec3> = (0..8)
 //!     .map(|i| DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64))
 //!     .collect();
-//! let pia = Pia::new(&cube, &PiaScheme::CatmullClark, &Options::default()).unwrap();
+//! let pia = Pia::new(&cube, &Scheme::CatmullClark, &Options::default()).unwrap();
 //! let result = pia.solve(&targets, &Moving::All, &PiaOptions::default()).unwrap();
 //! assert!(result.converged);
 //! let limit = pia.limit_table().apply_points(&result.points);
@@ -52,7 +52,7 @@ use std::sync::Arc;
 use glam::DVec3;
 use subd_limit::LimitError;
 use subd_mesh::Topology;
-use subd_schemes::{Options, Scheme, StencilTable, TwoPhase};
+use subd_schemes::{Options, Scheme, StencilTable};
 use thiserror::Error;
 
 pub use solvers::{Method, Solver};
@@ -87,20 +87,17 @@ pub enum PiaError {
     /// A tolerance that is not a positive number.
     #[error("tolerance {0} is not a positive number")]
     Tolerance(f64),
+    /// A scheme without a limit-position matrix here.
+    #[error(
+        "interpolation needs catmull-clark, loop or two-phase (the {scheme} scheme has no limit matrix here)"
+    )]
+    Scheme {
+        /// The scheme given.
+        scheme: String,
+    },
     /// The linear algebra failed (a singular system).
     #[error("solver: {0}")]
     Solver(String),
-}
-
-/// The scheme whose limit surface is to interpolate.
-#[derive(Debug, Clone, PartialEq)]
-pub enum PiaScheme {
-    /// Catmull-Clark (Chen et al. 2008).
-    CatmullClark,
-    /// Loop (Cheng et al. 2009).
-    Loop,
-    /// The two-phase modified Catmull-Clark scheme with per-vertex `λ` (seed 000).
-    TwoPhase(TwoPhase),
 }
 
 /// Which vertices move.
@@ -206,27 +203,27 @@ impl Pia {
     /// # Errors
     /// [`PiaError::Limit`] when the scheme does not apply (Loop on a non-triangle,
     /// two-phase on a non-quad or with a wrong `λ` count).
-    pub fn new(
-        topology: &Topology,
-        scheme: &PiaScheme,
-        options: &Options,
-    ) -> Result<Pia, PiaError> {
+    pub fn new(topology: &Topology, scheme: &Scheme, options: &Options) -> Result<Pia, PiaError> {
         let table = match scheme {
-            PiaScheme::CatmullClark => {
-                subd_limit::base_limit_positions(topology, Scheme::CatmullClark, options)?
+            Scheme::CatmullClark | Scheme::Loop => {
+                subd_limit::base_limit_positions(topology, scheme, options)?
             }
-            PiaScheme::Loop => subd_limit::base_limit_positions(topology, Scheme::Loop, options)?,
-            PiaScheme::TwoPhase(tp) => {
+            Scheme::TwoPhase(tp) => {
                 subd_limit::two_phase_base_limit_positions(topology, tp, options)?
+            }
+            other => {
+                return Err(PiaError::Scheme {
+                    scheme: other.to_string(),
+                });
             }
         };
         // Loop's mask has no checkerboard structure (and triangles no two-colouring).
         let signs = match scheme {
-            PiaScheme::Loop => None,
+            Scheme::Loop => None,
             _ => checkerboard::checkerboard_signs(topology),
         };
         let face_size = match scheme {
-            PiaScheme::Loop => 3,
+            Scheme::Loop => 3,
             _ => 4,
         };
         // Where every vertex takes its scheme's classical smooth mask, row `i` is `c_i` times

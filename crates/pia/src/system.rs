@@ -781,7 +781,7 @@ mod tests {
 
     #[test]
     fn classical_masks_have_the_symmetric_form_the_pairwise_check_finds() {
-        use crate::{Pia, PiaScheme};
+        use crate::Pia;
         use subd_mesh::TopologyBuilder;
         use subd_schemes::{Options, Refinement, Scheme, TwoPhase};
 
@@ -792,7 +792,7 @@ mod tests {
             .into_topology(1);
         let nv = quads.num_vertices();
         let lambda = (0..nv).map(|v| 0.36 + 0.64 * ((v * 37) % 101) as f64 / 101.0);
-        let two_phase = PiaScheme::TwoPhase(TwoPhase::new(lambda.collect()).unwrap());
+        let two_phase = Scheme::TwoPhase(TwoPhase::new(lambda.collect()).unwrap());
         // Triangles: a torus grid split along one diagonal (valence 6) and an octahedron
         // (valence 4).
         let (m, n) = (6u32, 8u32);
@@ -816,10 +816,10 @@ mod tests {
             )
             .unwrap();
         let cases = [
-            (&quads, PiaScheme::CatmullClark),
+            (&quads, Scheme::CatmullClark),
             (&quads, two_phase),
-            (&torus_tris, PiaScheme::Loop),
-            (&octahedron, PiaScheme::Loop),
+            (&torus_tris, Scheme::Loop),
+            (&octahedron, Scheme::Loop),
         ];
         for (t, scheme) in &cases {
             let pia = Pia::new(t, scheme, &Options::default()).unwrap();
@@ -828,12 +828,7 @@ mod tests {
             assert!(pia.full.matrix.symmetrizes(c), "{scheme:?}");
         }
         // Hexagons (not classical): found by the check when first asked for.
-        let pia = Pia::new(
-            &base.topology,
-            &PiaScheme::CatmullClark,
-            &Options::default(),
-        )
-        .unwrap();
+        let pia = Pia::new(&base.topology, &Scheme::CatmullClark, &Options::default()).unwrap();
         assert!(!pia.full.symmetric_form_known());
         assert!(pia.full.symmetrizer().is_some());
     }

@@ -1,18 +1,35 @@
-//! Subdivision rules for subd.
+//! Subdivision rules for subd: every surface scheme behind one [`Scheme`] and one
+//! [`Refinement`].
 //!
-//! Uniform refinement with Catmull-Clark, Loop and Bilinear that reproduces Pixar's
-//! OpenSubdiv (Far/Vtr/Sdc 3.5): the same vertex, face and face-vertex order, the same crease
-//! semantics (infinitely sharp and semi-sharp creases decaying in `f32`, uniform and Chaikin
-//! crease methods, corners, holes, the three boundary interpolation modes, non-manifold
-//! edges and vertices), and positions within 1e-12 of OpenSubdiv run in double precision.
+//! | [`Scheme`] | input | split | family |
+//! |---|---|---|---|
+//! | `CatmullClark`, `Bilinear` | any polygons | quads, 1 → n | OpenSubdiv's |
+//! | `Loop` | triangles | 1 → 4 | OpenSubdiv's |
+//! | `TwoPhase` (seed 000) | quads | quads | OpenSubdiv's (phase 1, then Catmull-Clark) |
+//! | `DooSabin` | any polygons | dual | split |
+//! | `Sqrt3` | triangles | 1 → 3 with edge flips | split |
+//! | `Butterfly { tension }`, `ModifiedButterfly` | triangles | 1 → 4 | split |
 //!
-//! [`Refinement::two_phase`] adds the two-phase modified Catmull-Clark scheme of seed 000
-//! (see [`two_phase`]).
+//! OpenSubdiv's family reproduces Pixar's OpenSubdiv (Far/Vtr/Sdc 3.5): the same vertex, face
+//! and face-vertex order, the same crease semantics (infinitely sharp and semi-sharp creases
+//! decaying in `f32`, uniform and Chaikin crease methods, corners, holes, the three boundary
+//! interpolation modes, non-manifold edges and vertices), and positions within 1e-12 of
+//! OpenSubdiv run in double precision. The split family ([`split_schemes`]) holds the
+//! schemes of seed 001 that OpenSubdiv does not have.
 //!
 //! Refinement is data: [`Refinement::new`] computes the topology of every level and a
 //! [`StencilTable`] per level (child vertices as weighted sums of parent vertices), which
 //! [`Refinement::composed`] chains into one table from the base mesh to any level. Apply a
 //! table to positions, UVs, colours or every frame of an animation.
+//!
+//! # What a scheme implements
+//!
+//! A scheme is a split plus masks. Behind [`Refinement`] each family implements one trait
+//! (the level's child faces and tags, the mask of every child vertex, the level's topology
+//! on request); a split scheme is one rule file in [`split_schemes`] (its step: child faces
+//! and a row of weights per child vertex) plus its [`Scheme`] variant, whose methods state
+//! the facts callers need ([`Scheme::input_faces`], [`Scheme::split`], [`Scheme::period`],
+//! [`Scheme::is_interpolating`], [`Scheme::tags`], [`Scheme::regular_valence`]).
 //!
 //! # Ordering (OpenSubdiv's default uniform order)
 //!
@@ -45,9 +62,12 @@
 
 pub mod analysis;
 pub mod curve;
+mod family;
 pub mod memory;
 mod refine;
+mod refinement;
 pub mod rules;
+mod scheme;
 pub mod split_schemes;
 pub mod stencil;
 pub mod two_phase;
@@ -57,9 +77,12 @@ use thiserror::Error;
 
 pub use refine::{
     FVarLevelValues, FVarValueKind, FaceStream, FaceVaryingRefinement, LevelCounts, PointStream,
-    Refinement, refined_counts, refined_split_counts,
+    refined_counts,
 };
+pub use refinement::Refinement;
 pub use rules::Rule;
+pub use scheme::{FaceKind, ParseSchemeError, Scheme, Split, TagSupport};
+pub use split_schemes::SplitFaceVarying;
 pub use stencil::{RowSink, StencilTable};
 pub use two_phase::TwoPhase;
 
@@ -77,28 +100,6 @@ pub struct ExplicitTags {
     pub creases: Vec<([u32; 2], f32)>,
     /// Corner tags: vertex and sharpness.
     pub corners: Vec<(u32, f32)>,
-}
-
-/// A surface subdivision scheme.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Scheme {
-    /// Catmull-Clark: any polygons, quads after one level.
-    CatmullClark,
-    /// Loop: triangles only.
-    Loop,
-    /// Bilinear: the quad split with linear interpolation.
-    Bilinear,
-}
-
-impl Scheme {
-    /// Regular interior valence: 4 for the quad schemes, 6 for Loop.
-    pub fn regular_valence(self) -> usize {
-        match self {
-            Scheme::Loop => 6,
-            _ => 4,
-        }
-    }
 }
 
 /// Scheme options, as OpenSubdiv's `Sdc::Options`.
@@ -127,9 +128,11 @@ impl Options {
 #[derive(Debug, Clone, PartialEq, Error)]
 #[non_exhaustive]
 pub enum RefineError {
-    /// Loop subdivision needs triangles.
-    #[error("face {face} has {size} vertices; the Loop scheme needs triangles")]
+    /// The scheme needs triangles (Loop, √3, the butterflies).
+    #[error("face {face} has {size} vertices; the {scheme} scheme needs triangles")]
     NotTriangle {
+        /// The scheme's name.
+        scheme: &'static str,
         /// Face index.
         face: usize,
         /// Its size.
@@ -161,6 +164,9 @@ pub enum RefineError {
         /// What is wrong with it.
         reason: &'static str,
     },
+    /// A two-phase scheme named without its `λ` ([`TwoPhase::unset`]).
+    #[error("the two-phase scheme needs lambda (one for every vertex, or one per vertex)")]
+    MissingLambda,
     /// A two-phase refinement given a `λ` list of the wrong length.
     #[error("{given} lambda values given for {vertices} vertices")]
     LambdaCount {
@@ -182,6 +188,55 @@ pub enum RefineError {
     TooLarge {
         /// The level that overflows.
         level: usize,
+    },
+    /// A non-manifold edge, which the split schemes have no rule for.
+    #[error("edge {edge} ({a}-{b}) is non-manifold; the {scheme} scheme needs a manifold mesh")]
+    NonManifoldEdge {
+        /// The scheme's name.
+        scheme: &'static str,
+        /// Edge index.
+        edge: usize,
+        /// Its end vertices.
+        a: u32,
+        /// Its end vertices.
+        b: u32,
+    },
+    /// A non-manifold vertex (faces around it that are not one fan).
+    #[error("vertex {vertex} is non-manifold; the {scheme} scheme needs a manifold mesh")]
+    NonManifoldVertex {
+        /// The scheme's name.
+        scheme: &'static str,
+        /// Vertex index.
+        vertex: usize,
+    },
+    /// A tag the scheme has no rule for (see [`Scheme::tags`]).
+    #[error("{what}: the {scheme} scheme {why}")]
+    UnsupportedTag {
+        /// The scheme's name.
+        scheme: &'static str,
+        /// The tagged element, e.g. `edge 4 (1-2)`.
+        what: String,
+        /// Why it cannot be used.
+        why: &'static str,
+    },
+    /// A butterfly tension that is not a finite number.
+    #[error("tension {0} is not a finite number")]
+    Tension(f64),
+    /// A feature the scheme does not have.
+    #[error("the {scheme} scheme: {what}")]
+    Unsupported {
+        /// The scheme, as [`Scheme`]'s `Display` writes it.
+        scheme: String,
+        /// What is missing.
+        what: &'static str,
+    },
+    /// Building a refined level's topology failed (a bug if it ever happens).
+    #[error("level {level}: {source}")]
+    Topology {
+        /// The level.
+        level: usize,
+        /// What the topology builder said.
+        source: subd_mesh::TopologyError,
     },
     /// The memory for a level could not be allocated (an address-space limit, or the
     /// system's memory): the request is refused before anything is written, instead of the

@@ -49,19 +49,46 @@ pub const LAMBDA_MIN: f64 = 7.0 / 20.0;
 /// The inclusive upper end of the `λ` range.
 pub const LAMBDA_MAX: f64 = 1.0;
 
-/// Per-vertex shape parameters of the two-phase scheme.
+/// The shape parameters of the two-phase scheme: one `λ` for every vertex, one per vertex,
+/// or none yet (a scheme named without its `λ`, which a refinement refuses until it is
+/// given).
 ///
 /// ```
 /// use subd_schemes::two_phase::TwoPhase;
 ///
-/// let tp = TwoPhase::uniform(8, 0.5).unwrap();
-/// assert_eq!(tp.lambda().len(), 8);
-/// assert!(TwoPhase::uniform(8, 0.3).is_err()); // below 7/20
+/// let tp = TwoPhase::uniform(0.5).unwrap();
+/// assert_eq!(tp.lambda_for(8).unwrap().len(), 8);
+/// assert!(TwoPhase::uniform(0.3).is_err()); // below 7/20
 /// assert!(TwoPhase::with_any_lambda(vec![0.3; 8]).is_ok());
+/// assert!(TwoPhase::unset().lambda_for(8).is_err());
 /// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct TwoPhase {
-    lambda: Vec<f64>,
+    lambda: Lambda,
+}
+
+/// Where a [`TwoPhase`]'s `λ` comes from.
+#[derive(Debug, Clone, PartialEq)]
+enum Lambda {
+    Unset,
+    Uniform(f64),
+    PerVertex(std::sync::Arc<[f64]>),
+}
+
+/// The first value outside `(7/20, 1]` (or not finite), as an error.
+fn check_range(lambda: &[f64]) -> Result<(), RefineError> {
+    match lambda
+        .iter()
+        .enumerate()
+        .find(|&(_, &x)| !(x > LAMBDA_MIN && x <= LAMBDA_MAX))
+    {
+        Some((v, &x)) => Err(RefineError::Lambda {
+            vertex: v,
+            value: x,
+            reason: "outside (7/20, 1], where interpolation is proven to converge",
+        }),
+        None => Ok(()),
+    }
 }
 
 impl TwoPhase {
@@ -70,18 +97,10 @@ impl TwoPhase {
     /// # Errors
     /// [`RefineError::Lambda`] naming the first vertex whose `λ` is out of range or not finite.
     pub fn new(lambda: Vec<f64>) -> Result<TwoPhase, RefineError> {
-        if let Some((v, &x)) = lambda
-            .iter()
-            .enumerate()
-            .find(|&(_, &x)| !(x > LAMBDA_MIN && x <= LAMBDA_MAX))
-        {
-            return Err(RefineError::Lambda {
-                vertex: v,
-                value: x,
-                reason: "outside (7/20, 1], where interpolation is proven to converge",
-            });
-        }
-        Ok(TwoPhase { lambda })
+        check_range(&lambda)?;
+        Ok(TwoPhase {
+            lambda: Lambda::PerVertex(lambda.into()),
+        })
     }
 
     /// One `λ` per base vertex, any finite value (the scheme is defined for every `λ`; only
@@ -97,20 +116,58 @@ impl TwoPhase {
                 reason: "not a finite number",
             });
         }
-        Ok(TwoPhase { lambda })
+        Ok(TwoPhase {
+            lambda: Lambda::PerVertex(lambda.into()),
+        })
     }
 
-    /// The same `λ` for all `num_vertices` vertices, checked as by [`Self::new`].
+    /// The same `λ` for every vertex, checked as by [`Self::new`].
     ///
     /// # Errors
-    /// As [`Self::new`].
-    pub fn uniform(num_vertices: usize, lambda: f64) -> Result<TwoPhase, RefineError> {
-        TwoPhase::new(vec![lambda; num_vertices])
+    /// As [`Self::new`] (the error names vertex 0).
+    pub fn uniform(lambda: f64) -> Result<TwoPhase, RefineError> {
+        check_range(&[lambda])?;
+        Ok(TwoPhase {
+            lambda: Lambda::Uniform(lambda),
+        })
     }
 
-    /// `λ` of every base vertex.
-    pub fn lambda(&self) -> &[f64] {
-        &self.lambda
+    /// No `λ` yet: what `"two-phase".parse::<Scheme>()` gives. A refinement with it fails
+    /// with [`RefineError::MissingLambda`].
+    pub fn unset() -> TwoPhase {
+        TwoPhase {
+            lambda: Lambda::Unset,
+        }
+    }
+
+    /// Whether a `λ` was given.
+    pub fn is_set(&self) -> bool {
+        self.lambda != Lambda::Unset
+    }
+
+    /// The one `λ` of every vertex, when it was given that way.
+    pub fn uniform_lambda(&self) -> Option<f64> {
+        match self.lambda {
+            Lambda::Uniform(l) => Some(l),
+            _ => None,
+        }
+    }
+
+    /// `λ` of every vertex of a base mesh of `num_vertices` vertices.
+    ///
+    /// # Errors
+    /// [`RefineError::LambdaCount`] when one `λ` per vertex was given for another number of
+    /// vertices; [`RefineError::MissingLambda`] when none was given.
+    pub fn lambda_for(&self, num_vertices: usize) -> Result<Vec<f64>, RefineError> {
+        match &self.lambda {
+            Lambda::Unset => Err(RefineError::MissingLambda),
+            Lambda::Uniform(l) => Ok(vec![*l; num_vertices]),
+            Lambda::PerVertex(l) if l.len() == num_vertices => Ok(l.to_vec()),
+            Lambda::PerVertex(l) => Err(RefineError::LambdaCount {
+                given: l.len(),
+                vertices: num_vertices,
+            }),
+        }
     }
 }
 
@@ -140,6 +197,14 @@ mod tests {
     fn lambda_checks() {
         assert!(TwoPhase::new(vec![0.36, 1.0]).is_ok());
         let e = TwoPhase::new(vec![0.5, 0.35]).unwrap_err();
+        assert!(TwoPhase::uniform(0.35).is_err() && TwoPhase::uniform(1.0).is_ok());
+        assert_eq!(
+            TwoPhase::new(vec![0.5; 3]).unwrap().lambda_for(4),
+            Err(RefineError::LambdaCount {
+                given: 3,
+                vertices: 4
+            })
+        );
         assert!(matches!(e, RefineError::Lambda { vertex: 1, .. }));
         assert!(TwoPhase::new(vec![1.0 + 1e-12]).is_err());
         assert!(TwoPhase::with_any_lambda(vec![f64::NAN]).is_err());

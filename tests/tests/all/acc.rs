@@ -22,7 +22,7 @@ const GRID: [f64; 5] = [0.0, 0.25, 0.5, 0.75, 1.0];
 /// Max and RMS distance between ACC and the exact surface over a 5 × 5 grid per face, and
 /// the largest angle between their normals, relative to the bounding-box diagonal.
 fn compare(t: &Topology, p: &[DVec3], patches: &[AccPatch]) -> (f64, f64, f64) {
-    let ev = LimitEvaluator::new(t, Scheme::CatmullClark, &Options::default()).unwrap();
+    let ev = LimitEvaluator::new(t, &Scheme::CatmullClark, &Options::default()).unwrap();
     let pp = ev.prepare(p);
     let (lo, hi) = subd_mesh::bounding_box(p.iter().copied()).unwrap();
     let diag = (hi - lo).length();
@@ -69,7 +69,7 @@ fn acc_approximates_the_limit_and_converges_under_refinement() {
         let (t, p) = prism(levels);
         let patches = acc_patches(&t, &p).unwrap();
         // Corners are the exact limit points.
-        let ev = LimitEvaluator::new(&t, Scheme::CatmullClark, &Options::default()).unwrap();
+        let ev = LimitEvaluator::new(&t, &Scheme::CatmullClark, &Options::default()).unwrap();
         let pp = ev.prepare(&p);
         for patch in &patches {
             for (u, v) in [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)] {

@@ -57,14 +57,14 @@ fn scattered_selections_give_uniform_vertices_on_every_shape() {
     let levels = 3;
     let mut checked = 0;
     for s in shapes() {
-        let r = Refinement::new(&s.mesh.topology, s.scheme, &s.options, levels).unwrap();
+        let r = Refinement::new(&s.mesh.topology, s.scheme.clone(), &s.options, levels).unwrap();
         let uniform = r.refine_points(&s.mesh.positions);
         for seed in 0..2 {
             let pick = RandomSelection::new(seed, 0.35).unwrap();
             let a = AdaptiveRefinement::new(
                 &s.mesh.topology,
                 &s.mesh.positions,
-                s.scheme,
+                &s.scheme,
                 &s.options,
                 &[&pick],
                 levels,
@@ -81,11 +81,11 @@ fn scattered_selections_give_uniform_vertices_on_every_shape() {
 fn selecting_every_face_is_uniform_refinement() {
     let levels = 2;
     for s in shapes() {
-        let r = Refinement::new(&s.mesh.topology, s.scheme, &s.options, levels).unwrap();
+        let r = Refinement::new(&s.mesh.topology, s.scheme.clone(), &s.options, levels).unwrap();
         let a = AdaptiveRefinement::new(
             &s.mesh.topology,
             &s.mesh.positions,
-            s.scheme,
+            &s.scheme,
             &s.options,
             &[],
             levels,
@@ -137,7 +137,7 @@ fn limit_positions_are_the_uniform_limit() {
     let levels = 2;
     let mut checked = 0;
     for s in shapes() {
-        let (decay, _) = levels_for_exact_limit(&s.mesh.topology, s.scheme);
+        let (decay, _) = levels_for_exact_limit(&s.mesh.topology, &s.scheme);
         let deep = levels + decay.max(1);
         if s.mesh.topology.num_face_vertices() << (2 * deep) > 4_000_000 {
             continue;
@@ -146,7 +146,7 @@ fn limit_positions_are_the_uniform_limit() {
         let a = AdaptiveRefinement::new(
             &s.mesh.topology,
             &s.mesh.positions,
-            s.scheme,
+            &s.scheme,
             &s.options,
             &[&pick],
             levels,
@@ -156,7 +156,7 @@ fn limit_positions_are_the_uniform_limit() {
             Ok(m) => m,
             Err(e) => panic!("{}: {e}", s.name),
         };
-        let r = Refinement::new(&s.mesh.topology, s.scheme, &s.options, deep).unwrap();
+        let r = Refinement::new(&s.mesh.topology, s.scheme.clone(), &s.options, deep).unwrap();
         let pts = r.refine_points(&s.mesh.positions).pop().unwrap();
         let limit = LimitStencilTable::at_level(&r, deep).unwrap().apply(&pts);
         let rules = r.vertex_rules(deep);
@@ -206,7 +206,7 @@ fn corner_parameters_locate_the_limit_surface() {
         let Ok(surface) = subd_adaptive::LimitSurface::new(
             &s.mesh.topology,
             &s.mesh.positions,
-            s.scheme,
+            &s.scheme,
             &s.options,
         ) else {
             continue;
@@ -215,7 +215,7 @@ fn corner_parameters_locate_the_limit_surface() {
         let a = AdaptiveRefinement::new(
             &s.mesh.topology,
             &s.mesh.positions,
-            s.scheme,
+            &s.scheme,
             &s.options,
             &[&pick],
             2,
@@ -274,12 +274,12 @@ fn adaptive_uvs_are_the_limits_of_uniform_refinement_values() {
         let uv = s.mesh.uv().expect("these shapes have UVs");
         let every = subd_adaptive::EveryFace;
         let (t, p) = (&s.mesh.topology, &s.mesh.positions);
-        let a = AdaptiveRefinement::new(t, p, s.scheme, &s.options, &[&every], 2).unwrap();
+        let a = AdaptiveRefinement::new(t, p, &s.scheme, &s.options, &[&every], 2).unwrap();
         let mesh = a.mesh(Positions::Limit).unwrap();
         // Limits are taken where semi-sharp creases have decayed; a level-2 corner's vertex
         // is the vertex at the same corner of its corner child at every deeper level.
-        let deepest = 2.max(levels_for_exact_limit(t, s.scheme).0);
-        let r = Refinement::new(t, s.scheme, &s.options, deepest).unwrap();
+        let deepest = 2.max(levels_for_exact_limit(t, &s.scheme).0);
+        let r = Refinement::new(t, s.scheme.clone(), &s.options, deepest).unwrap();
         let at_deepest = |mut g: usize, k: usize| {
             for l in 2..deepest {
                 g = if s.scheme == subd_schemes::Scheme::Loop {
@@ -290,7 +290,7 @@ fn adaptive_uvs_are_the_limits_of_uniform_refinement_values() {
             }
             g
         };
-        let ev = LimitEvaluator::new(t, s.scheme, &s.options).unwrap();
+        let ev = LimitEvaluator::new(t, &s.scheme, &s.options).unwrap();
         for mode in FVarLinearInterpolation::ALL_MODES {
             let fr = FaceVaryingRefinement::new(&r, uv, mode).unwrap();
             let refined = fr.refine_values(&r, uv.values(), 2).pop().unwrap();

@@ -61,7 +61,7 @@ fn mixed(d: f64) -> Vec<Constraint> {
 /// The worst violation of the constraints by positions `x` relative to `diag`, measured with
 /// a fresh evaluator (points: distance; normals: |n · t| / |t|; iso-lines: control points).
 fn violation(topo: &Topology, x0: &[DVec3], x: &[DVec3], cs: &[Constraint]) -> f64 {
-    let ev = LimitEvaluator::new(topo, Scheme::CatmullClark, &Options::default()).unwrap();
+    let ev = LimitEvaluator::new(topo, &Scheme::CatmullClark, &Options::default()).unwrap();
     let p0 = ev.prepare(x0);
     let p = ev.prepare(x);
     let diag = subd_pia::bbox_diagonal(x0);
@@ -120,7 +120,7 @@ fn edit(m: &subd_mesh::Mesh, cs: &[Constraint], method: Method) -> (Editor, Vec<
     let ed = Editor::new(
         &m.topology,
         &m.positions,
-        Scheme::CatmullClark,
+        &Scheme::CatmullClark,
         &Options::default(),
         cs,
         method,
@@ -179,7 +179,7 @@ fn normal_constraint_gives_the_target_normal() {
     for method in [Method::LeastSquares, energy_method(Some(2))] {
         let (_, x) = edit(&m, &cs, method);
         let ev =
-            LimitEvaluator::new(&m.topology, Scheme::CatmullClark, &Options::default()).unwrap();
+            LimitEvaluator::new(&m.topology, &Scheme::CatmullClark, &Options::default()).unwrap();
         let got = ev.evaluate(&ev.prepare(&x), q).unwrap().normal();
         assert!((got.dot(n).abs() - 1.0).abs() < 1e-12, "{got} vs {n}");
     }
@@ -194,7 +194,7 @@ fn isoline_on_a_regular_strip_equals_the_target_curve() {
         at: 0.25,
         faces: 4,
     };
-    let ev = LimitEvaluator::new(&m.topology, Scheme::CatmullClark, &Options::default()).unwrap();
+    let ev = LimitEvaluator::new(&m.topology, &Scheme::CatmullClark, &Options::default()).unwrap();
     let cp = current_control_points(&ev, &m.topology, &line, &m.positions)
         .unwrap()
         .unwrap();
@@ -253,7 +253,7 @@ fn isoline_through_an_extraordinary_region_is_sampled() {
         3 * 4 * subd_editing::isoline::SAMPLES_PER_FACE
     );
     let ev =
-        LimitEvaluator::new(&mesh.topology, Scheme::CatmullClark, &Options::default()).unwrap();
+        LimitEvaluator::new(&mesh.topology, &Scheme::CatmullClark, &Options::default()).unwrap();
     let (a, b) = (ev.prepare(&mesh.positions), ev.prepare(&x));
     for f in subd_editing::isoline::strip(&mesh.topology, &line).unwrap() {
         for s in [0.125, 0.375, 0.625, 0.875] {
@@ -283,7 +283,7 @@ fn edits_are_reversible_commutative_and_additive() {
         let x1 = Editor::new(
             &m.topology,
             &m.positions,
-            Scheme::CatmullClark,
+            &Scheme::CatmullClark,
             &Options::default(),
             &fwd,
             method,
@@ -426,7 +426,7 @@ fn conflicting_constraints_give_the_least_squares_solution() {
             ed.rank
         );
         let ev =
-            LimitEvaluator::new(&m.topology, Scheme::CatmullClark, &Options::default()).unwrap();
+            LimitEvaluator::new(&m.topology, &Scheme::CatmullClark, &Options::default()).unwrap();
         let Location::Face(q) = p else { unreachable!() };
         let moved = ev.evaluate(&ev.prepare(&x), q).unwrap().position
             - ev.evaluate(&ev.prepare(&m.positions), q).unwrap().position;
@@ -445,7 +445,7 @@ fn editor_resolves_new_targets_like_a_fresh_solve() {
     let ed = Editor::new(
         &m.topology,
         &m.positions,
-        Scheme::CatmullClark,
+        &Scheme::CatmullClark,
         &Options::default(),
         &cs,
         energy_method(Some(3)),
@@ -517,7 +517,7 @@ fn bad_constraints_are_named() {
         let e = Editor::new(
             &m.topology,
             &m.positions,
-            Scheme::CatmullClark,
+            &Scheme::CatmullClark,
             &Options::default(),
             &cs,
             Method::LeastSquares,
@@ -544,14 +544,14 @@ fn least_squares_edits_loop_surfaces_too() {
     let ed = Editor::new(
         &tri.topology,
         &tri.positions,
-        Scheme::Loop,
+        &Scheme::Loop,
         &Options::default(),
         &cs,
         Method::LeastSquares,
     )
     .unwrap();
     let x = ed.solve(&cs).unwrap().positions;
-    let ev = LimitEvaluator::new(&tri.topology, Scheme::Loop, &Options::default()).unwrap();
+    let ev = LimitEvaluator::new(&tri.topology, &Scheme::Loop, &Options::default()).unwrap();
     let q = FaceParam {
         face: 9,
         sub: 0,
@@ -566,7 +566,7 @@ fn least_squares_edits_loop_surfaces_too() {
     let energy = Editor::new(
         &tri.topology,
         &tri.positions,
-        Scheme::Loop,
+        &Scheme::Loop,
         &Options::default(),
         &cs,
         energy_method(Some(2)),
@@ -592,7 +592,7 @@ fn constraints_at_boundaries_creases_and_extraordinary_vertices_are_met() {
         let topo = &shape.mesh.topology;
         let p = &shape.mesh.positions;
         let diag = subd_pia::bbox_diagonal(p);
-        let ev = LimitEvaluator::new(topo, Scheme::CatmullClark, &shape.options).unwrap();
+        let ev = LimitEvaluator::new(topo, &Scheme::CatmullClark, &shape.options).unwrap();
         let cs: Vec<Constraint> = [0usize, topo.num_vertices() / 2]
             .into_iter()
             .map(|v| Constraint::Point {
@@ -606,7 +606,7 @@ fn constraints_at_boundaries_creases_and_extraordinary_vertices_are_met() {
             .collect();
         for method in [Method::LeastSquares, energy_method(Some(2))] {
             let ed =
-                Editor::new(topo, p, Scheme::CatmullClark, &shape.options, &cs, method).unwrap();
+                Editor::new(topo, p, &Scheme::CatmullClark, &shape.options, &cs, method).unwrap();
             if ed.rank_deficient {
                 // Constraints too close together on a tiny mesh: least squares, not exact.
                 continue;
@@ -713,7 +713,7 @@ fn mirror_extension_reproduces_the_boundary_rules() {
             boundary_interpolation: boundary,
             ..Options::default()
         };
-        let ev = LimitEvaluator::new(&topo, Scheme::CatmullClark, &opts).unwrap();
+        let ev = LimitEvaluator::new(&topo, &Scheme::CatmullClark, &opts).unwrap();
         let pts = ev.prepare(&p);
         for f in faces_to_check {
             let (fi, fj) = ((f % (n - 1)) as isize, (f / (n - 1)) as isize);
@@ -839,7 +839,7 @@ fn corner_check(n: usize, rings: usize) {
         .find(|&v| topo.vertex_faces(v).len() == n && !topo.is_boundary_vertex(v))
         .unwrap();
     let face = topo.vertex_faces(centre)[0] as usize;
-    let ev = LimitEvaluator::new(topo, Scheme::CatmullClark, &Options::default()).unwrap();
+    let ev = LimitEvaluator::new(topo, &Scheme::CatmullClark, &Options::default()).unwrap();
     let patches = ev.face_patches(face).unwrap();
     let subd_limit::PatchForm::Corner(m) = &patches[0].form else {
         panic!("not a corner patch")
@@ -864,7 +864,7 @@ fn corner_check(n: usize, rings: usize) {
     let r = Refinement::new(topo, Scheme::CatmullClark, &Options::default(), rings).unwrap();
     let pts = r.refine_points(&b.positions).pop().unwrap();
     let tl = r.topology(rings);
-    let ev_l = LimitEvaluator::new(tl, Scheme::CatmullClark, &Options::default()).unwrap();
+    let ev_l = LimitEvaluator::new(tl, &Scheme::CatmullClark, &Options::default()).unwrap();
     let mut desc = vec![face];
     for l in 0..rings {
         let t = r.topology(l);
@@ -1019,7 +1019,7 @@ fn deformation_applies_to_an_adaptive_mesh_and_refinement_continues() {
     let ar = subd_adaptive::AdaptiveRefinement::new(
         &m.topology,
         &m.positions,
-        Scheme::CatmullClark,
+        &Scheme::CatmullClark,
         &Options::default(),
         &[&sel],
         2,

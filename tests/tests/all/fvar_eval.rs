@@ -63,16 +63,16 @@ fn uvs_at_dyadic_points_are_limits_of_refined_values() {
         let mesh = read_mesh(&path, &opts).unwrap().mesh;
         let Some(uv) = mesh.uv() else { continue };
         let options = Options::from_hints(&mesh.hints);
-        let Ok(ev) = LimitEvaluator::new(&mesh.topology, scheme, &options) else {
+        let Ok(ev) = LimitEvaluator::new(&mesh.topology, &scheme, &options) else {
             continue;
         };
-        let level = 2.max(subd_limit::levels_for_exact_limit(&mesh.topology, scheme).0);
+        let level = 2.max(subd_limit::levels_for_exact_limit(&mesh.topology, &scheme).0);
         if mesh.topology.num_face_vertices() << (2 * level) > 1 << 22 {
             continue;
         }
         shapes += 1;
         let positions = ev.prepare(&mesh.positions);
-        let r = Refinement::new(&mesh.topology, scheme, &options, level).unwrap();
+        let r = Refinement::new(&mesh.topology, scheme.clone(), &options, level).unwrap();
         let t = r.topology(0);
         let diagonal = {
             let (mut lo, mut hi) = ([f64::MAX; 2], [f64::MIN; 2]);
@@ -93,7 +93,7 @@ fn uvs_at_dyadic_points_are_limits_of_refined_values() {
         let stride = t.num_faces().div_ceil(if nonmanifold { 12 } else { 40 });
         let covered: Vec<FaceParam> = (0..t.num_faces())
             .step_by(stride)
-            .flat_map(|f| dyadic_params(t, scheme, f))
+            .flat_map(|f| dyadic_params(t, scheme.clone(), f))
             .filter(|&at| ev.evaluate(&positions, at).is_ok())
             .collect();
         let degenerate = (0..t.num_edges()).any(|e| t.is_degenerate_edge(e));

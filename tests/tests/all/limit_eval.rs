@@ -37,7 +37,7 @@ fn shapes(scheme: Scheme, whole: bool) -> Vec<Shape> {
         }
         let mesh = read_mesh(&path, &opts).unwrap().mesh;
         let options = Options::from_hints(&mesh.hints);
-        let Ok(ev) = LimitEvaluator::new(&mesh.topology, scheme, &options) else {
+        let Ok(ev) = LimitEvaluator::new(&mesh.topology, &scheme, &options) else {
             continue;
         };
         let pts = ev.prepare(&mesh.positions);
@@ -77,11 +77,11 @@ fn exact_limits(
     options: &Options,
     level: usize,
 ) -> Option<(Refinement, subd_limit::LimitPoints)> {
-    let deepest = level.max(subd_limit::levels_for_exact_limit(&mesh.topology, scheme).0);
+    let deepest = level.max(subd_limit::levels_for_exact_limit(&mesh.topology, &scheme).0);
     if mesh.topology.num_face_vertices() << (2 * deepest) > 1 << 22 {
         return None;
     }
-    let r = Refinement::new(&mesh.topology, scheme, options, deepest).unwrap();
+    let r = Refinement::new(&mesh.topology, scheme.clone(), options, deepest).unwrap();
     let refined = r.refine_points(&mesh.positions);
     let limit = LimitStencilTable::at_level(&r, deepest)
         .unwrap()
@@ -224,7 +224,7 @@ fn prism_level2() -> (Topology, Vec<DVec3>) {
 #[test]
 fn refined_points_approach_the_exact_surface_at_the_subdominant_rate() {
     let (topo, pts) = prism_level2();
-    let ev = LimitEvaluator::new(&topo, Scheme::CatmullClark, &Options::default()).unwrap();
+    let ev = LimitEvaluator::new(&topo, &Scheme::CatmullClark, &Options::default()).unwrap();
     let patch_points = ev.prepare(&pts);
     let r = Refinement::new(&topo, Scheme::CatmullClark, &Options::default(), 9).unwrap();
     let refined = r.refine_points(&pts);
@@ -297,7 +297,7 @@ fn normals_are_continuous_across_faces() {
         _ => (0.0, 1.0 - t),
     };
     for (name, topo, pts) in &cases {
-        let ev = LimitEvaluator::new(topo, Scheme::CatmullClark, &Options::default()).unwrap();
+        let ev = LimitEvaluator::new(topo, &Scheme::CatmullClark, &Options::default()).unwrap();
         let pp = ev.prepare(pts);
         for e in 0..topo.num_edges() {
             let ef = topo.edge_faces(e);

@@ -31,17 +31,17 @@ fn shapes() -> Vec<SurfaceShape> {
 fn limit_is_invariant_under_refinement() {
     let mut checked = 0;
     for s in shapes() {
-        let base = match base_limit(&s.mesh.topology, s.scheme, &s.options) {
+        let base = match base_limit(&s.mesh.topology, &s.scheme, &s.options) {
             Ok(t) => t,
             Err(LimitError::TooDeep { .. }) => continue,
             Err(e) => panic!("{}: {e}", s.name),
         };
-        let (levels, _) = levels_for_exact_limit(&s.mesh.topology, s.scheme);
+        let (levels, _) = levels_for_exact_limit(&s.mesh.topology, &s.scheme);
         let deeper = levels + 2;
         if s.mesh.topology.num_face_vertices() << (2 * deeper) > 4_000_000 {
             continue;
         }
-        let r = Refinement::new(&s.mesh.topology, s.scheme, &s.options, deeper).unwrap();
+        let r = Refinement::new(&s.mesh.topology, s.scheme.clone(), &s.options, deeper).unwrap();
         let pts = r.refine_points(&s.mesh.positions);
         let at = LimitStencilTable::at_level(&r, deeper)
             .unwrap()
@@ -80,7 +80,7 @@ fn darts_and_valence_two_converge_to_the_eigen_limit() {
         "catmark_val2_back2back",
     ] {
         let s = all.iter().find(|s| s.name == name).unwrap();
-        let r = Refinement::new(&s.mesh.topology, s.scheme, &s.options, 0).unwrap();
+        let r = Refinement::new(&s.mesh.topology, s.scheme.clone(), &s.options, 0).unwrap();
         let t = r.topology(0);
         for v in 0..t.num_vertices() {
             let rule = r.vertex_rules(0)[v];
@@ -96,10 +96,10 @@ fn darts_and_valence_two_converge_to_the_eigen_limit() {
     assert!(cases.len() >= 3, "{} cases", cases.len());
     for (s, v) in cases {
         let name = &s.name;
-        let exact = base_limit(&s.mesh.topology, s.scheme, &s.options)
+        let exact = base_limit(&s.mesh.topology, &s.scheme, &s.options)
             .unwrap()
             .apply(&s.mesh.positions);
-        let r = Refinement::new(&s.mesh.topology, s.scheme, &s.options, 7).unwrap();
+        let r = Refinement::new(&s.mesh.topology, s.scheme.clone(), &s.options, 7).unwrap();
         let pts = r.refine_points(&s.mesh.positions);
         let mut errors = Vec::new();
         for level in 1..=7 {
@@ -142,24 +142,24 @@ fn darts_and_valence_two_converge_to_the_eigen_limit() {
 fn local_decay_refinement_equals_global() {
     let mut checked = 0;
     for s in shapes() {
-        let (levels, _) = levels_for_exact_limit(&s.mesh.topology, s.scheme);
+        let (levels, _) = levels_for_exact_limit(&s.mesh.topology, &s.scheme);
         // Keep the global refinement this compares with small enough for a test.
         if levels == 0 || s.mesh.topology.num_face_vertices() << (2 * levels) > 1 << 20 {
             continue;
         }
-        let global = match base_limit(&s.mesh.topology, s.scheme, &s.options) {
+        let global = match base_limit(&s.mesh.topology, &s.scheme, &s.options) {
             Ok(t) => t.apply(&s.mesh.positions),
             Err(LimitError::TooDeep { .. }) => continue,
             Err(e) => panic!("{}: {e}", s.name),
         };
-        let local = match subd_limit::local::base_limit(&s.mesh.topology, s.scheme, &s.options) {
+        let local = match subd_limit::local::base_limit(&s.mesh.topology, &s.scheme, &s.options) {
             Ok(t) => t.apply(&s.mesh.positions),
             // A non-manifold neighbourhood a cut cannot reproduce is refused, not guessed.
             Err(LimitError::Unsupported { .. }) => continue,
             Err(e) => panic!("{}: {e}", s.name),
         };
         let diag = bbox_diagonal(&s.mesh.positions);
-        let r0 = Refinement::new(&s.mesh.topology, s.scheme, &s.options, 0).unwrap();
+        let r0 = Refinement::new(&s.mesh.topology, s.scheme.clone(), &s.options, 0).unwrap();
         for v in 0..s.mesh.topology.num_vertices() {
             let d = (global.positions[v] - local.positions[v]).length() / diag;
             assert!(d < 1e-13, "{} vertex {v}: {d:e}", s.name);
@@ -219,10 +219,10 @@ fn large_mesh_with_a_semi_sharp_crease_gets_exact_limits() {
             DVec3::new(x, y, (0.1 * x).sin() * (0.13 * y).cos())
         })
         .collect();
-    let (levels, _) = levels_for_exact_limit(&topo, Scheme::CatmullClark);
+    let (levels, _) = levels_for_exact_limit(&topo, &Scheme::CatmullClark);
     assert_eq!(levels, 7);
     assert!(topo.num_face_vertices() << (2 * levels) > subd_limit::MAX_DECAY_FACE_VERTICES);
-    let limit = base_limit(&topo, Scheme::CatmullClark, &Options::default())
+    let limit = base_limit(&topo, &Scheme::CatmullClark, &Options::default())
         .unwrap()
         .apply(&pts);
     let r0 = Refinement::new(&topo, Scheme::CatmullClark, &Options::default(), 0).unwrap();
@@ -246,15 +246,15 @@ fn positions_alone_equal_the_full_tables() {
     for s in shapes() {
         let t = &s.mesh.topology;
         // Deep semi-sharp decay only repeats the same composition at more levels.
-        if levels_for_exact_limit(t, s.scheme).0 > 2 {
+        if levels_for_exact_limit(t, &s.scheme).0 > 2 {
             continue;
         }
-        let full = match base_limit(t, s.scheme, &s.options) {
+        let full = match base_limit(t, &s.scheme, &s.options) {
             Ok(f) => f,
             Err(LimitError::TooDeep { .. }) => continue,
             Err(e) => panic!("{}: {e}", s.name),
         };
-        let positions = subd_limit::base_limit_positions(t, s.scheme, &s.options).unwrap();
+        let positions = subd_limit::base_limit_positions(t, &s.scheme, &s.options).unwrap();
         // Closed smooth meshes take the classical masks directly, bit for bit the same.
         assert_eq!(positions, full.position, "{}", s.name);
         checked += 1;

@@ -5,6 +5,7 @@ mod acc;
 mod adaptive;
 mod curves;
 mod editing;
+mod front_door;
 mod fvar_eval;
 mod limit_eval;
 mod limit_shapes;

@@ -7,8 +7,8 @@
 use faer::Mat;
 use glam::DVec3;
 use subd_mesh::Topology;
-use subd_pia::{Method, Moving, Pia, PiaOptions, PiaScheme, Solver, bbox_diagonal};
-use subd_schemes::{Options, TwoPhase, two_phase};
+use subd_pia::{Method, Moving, Pia, PiaOptions, Solver, bbox_diagonal};
+use subd_schemes::{Options, Scheme, TwoPhase, two_phase};
 use subd_tests::osd_meshes;
 
 /// The λ grid over (7/20, 1].
@@ -155,14 +155,14 @@ fn formula_two_equals_the_catmull_clark_limit_of_the_phase_one_mesh() {
         // λ = 1 freezes the phase-1 vertex points: it is not ordinary Catmull-Clark.
         let frozen = subd_limit::two_phase_base_limit(
             &s.topology,
-            &TwoPhase::uniform(nv, 1.0).unwrap(),
+            &TwoPhase::uniform(1.0).unwrap(),
             &s.options,
         )
         .unwrap()
         .apply(&s.points)
         .positions;
         let cc =
-            subd_limit::base_limit(&s.topology, subd_schemes::Scheme::CatmullClark, &s.options)
+            subd_limit::base_limit(&s.topology, &subd_schemes::Scheme::CatmullClark, &s.options)
                 .unwrap()
                 .apply(&s.points)
                 .positions;
@@ -180,15 +180,16 @@ fn formula_two_equals_the_catmull_clark_limit_of_the_phase_one_mesh() {
 }
 
 /// The limit table of `scheme`, built afresh (not the one inside a [`Pia`]).
-fn fresh_limit_table(s: &Shape, scheme: &PiaScheme) -> subd_schemes::StencilTable {
+fn fresh_limit_table(s: &Shape, scheme: &Scheme) -> subd_schemes::StencilTable {
     let table = match scheme {
-        PiaScheme::CatmullClark => {
-            subd_limit::base_limit(&s.topology, subd_schemes::Scheme::CatmullClark, &s.options)
+        Scheme::CatmullClark => {
+            subd_limit::base_limit(&s.topology, &subd_schemes::Scheme::CatmullClark, &s.options)
         }
-        PiaScheme::Loop => {
-            subd_limit::base_limit(&s.topology, subd_schemes::Scheme::Loop, &s.options)
+        Scheme::Loop => {
+            subd_limit::base_limit(&s.topology, &subd_schemes::Scheme::Loop, &s.options)
         }
-        PiaScheme::TwoPhase(tp) => subd_limit::two_phase_base_limit(&s.topology, tp, &s.options),
+        Scheme::TwoPhase(tp) => subd_limit::two_phase_base_limit(&s.topology, tp, &s.options),
+        other => panic!("no limit table for {other}"),
     };
     table.unwrap().position
 }
@@ -201,7 +202,7 @@ struct Case<'a> {
 }
 
 impl<'a> Case<'a> {
-    fn new(s: &'a Shape, scheme: &PiaScheme) -> Case<'a> {
+    fn new(s: &'a Shape, scheme: &Scheme) -> Case<'a> {
         Case {
             s,
             pia: Pia::new(&s.topology, scheme, &s.options).unwrap(),
@@ -250,7 +251,7 @@ fn two_phase_pia_converges_for_every_lambda_on_closed_quad_meshes() {
         let nv = s.topology.num_vertices();
         let pia_moving = [Moving::All, fixed_every_third(nv)];
         for &l in &LAMBDAS {
-            let scheme = PiaScheme::TwoPhase(TwoPhase::uniform(nv, l).unwrap());
+            let scheme = Scheme::TwoPhase(TwoPhase::uniform(l).unwrap());
             let case = Case::new(&s, &scheme);
             let pia = &case.pia;
             for moving in &pia_moving {
@@ -267,7 +268,7 @@ fn two_phase_pia_converges_for_every_lambda_on_closed_quad_meshes() {
         let lambda: Vec<f64> = (0..nv)
             .map(|v| 0.36 + 0.64 * rand01(7 * v as u64 + 1))
             .collect();
-        let case = Case::new(&s, &PiaScheme::TwoPhase(TwoPhase::new(lambda).unwrap()));
+        let case = Case::new(&s, &Scheme::TwoPhase(TwoPhase::new(lambda).unwrap()));
         for solver in [
             Solver::Iterate,
             Solver::Weighted,
@@ -288,7 +289,7 @@ fn theorem_two_gives_the_final_limits_of_the_fixed_vertices() {
         let lambda: Vec<f64> = (0..nv)
             .map(|v| 0.36 + 0.64 * rand01(3 * v as u64 + 2))
             .collect();
-        let scheme = PiaScheme::TwoPhase(TwoPhase::new(lambda).unwrap());
+        let scheme = Scheme::TwoPhase(TwoPhase::new(lambda).unwrap());
         let pia = Pia::new(&s.topology, &scheme, &s.options).unwrap();
         let moving = fixed_every_third(nv);
         let flags = moving.flags(nv).unwrap();
@@ -347,7 +348,7 @@ fn two_phase_pia_converges_on_open_and_creased_meshes() {
         let t0 = std::time::Instant::now();
         let nv = s.topology.num_vertices();
         for &l in &LAMBDAS {
-            let scheme = PiaScheme::TwoPhase(TwoPhase::uniform(nv, l).unwrap());
+            let scheme = Scheme::TwoPhase(TwoPhase::uniform(l).unwrap());
             let pia = Pia::new(&s.topology, &scheme, &s.options).unwrap();
             for moving in [Moving::All, fixed_every_third(nv)] {
                 let (_, m) = pia.moving_matrix(&moving).unwrap();
@@ -358,7 +359,7 @@ fn two_phase_pia_converges_on_open_and_creased_meshes() {
         let lambda: Vec<f64> = (0..nv)
             .map(|v| 0.36 + 0.64 * rand01(5 * v as u64))
             .collect();
-        let case = Case::new(&s, &PiaScheme::TwoPhase(TwoPhase::new(lambda).unwrap()));
+        let case = Case::new(&s, &Scheme::TwoPhase(TwoPhase::new(lambda).unwrap()));
         for solver in [Solver::Iterate, Solver::Cg, Solver::Direct] {
             case.solve_and_check(&Moving::All, solver);
         }
@@ -406,7 +407,7 @@ fn catmull_clark_and_loop_pia_converge_on_open_and_closed_meshes() {
     let lp = shapes("loop_", 700, manifold);
     assert!(cc.len() > 20 && lp.len() > 10);
     let (mut singular, mut divergent) = (Vec::new(), Vec::new());
-    for (list, scheme) in [(cc, PiaScheme::CatmullClark), (lp, PiaScheme::Loop)] {
+    for (list, scheme) in [(cc, Scheme::CatmullClark), (lp, Scheme::Loop)] {
         for s in &list {
             let nv = s.topology.num_vertices();
             let case = Case::new(s, &scheme);
@@ -417,7 +418,7 @@ fn catmull_clark_and_loop_pia_converge_on_open_and_closed_meshes() {
             let symmetric = case.pia.is_symmetrizable(&Moving::All).unwrap();
             // Closed, untagged, manifold meshes (quads only for Catmull-Clark: elsewhere the
             // limit comes through a refinement) have the C·D form.
-            let quads = matches!(scheme, PiaScheme::Loop) || all_quads(&s.topology);
+            let quads = matches!(scheme, Scheme::Loop) || all_quads(&s.topology);
             if closed(&s.topology) && untagged(&s.topology) && quads {
                 assert!(symmetric, "{} {scheme:?} should be symmetrisable", s.name);
             }
@@ -461,7 +462,7 @@ fn catmull_clark_and_loop_pia_converge_on_open_and_closed_meshes() {
 #[test]
 fn solvers_report_what_ran_and_cg_beats_the_plain_iteration() {
     let s = load(&subd_tests::osd_mesh_dir().join("catmark_torus.obj"));
-    let pia = Pia::new(&s.topology, &PiaScheme::CatmullClark, &s.options).unwrap();
+    let pia = Pia::new(&s.topology, &Scheme::CatmullClark, &s.options).unwrap();
     let run = |solver| {
         pia.solve(
             &s.points,
@@ -523,7 +524,7 @@ fn solvers_report_what_ran_and_cg_beats_the_plain_iteration() {
     let nv = s.topology.num_vertices();
     let slow = Pia::new(
         &s.topology,
-        &PiaScheme::TwoPhase(TwoPhase::uniform(nv, 0.36).unwrap()),
+        &Scheme::TwoPhase(TwoPhase::uniform(0.36).unwrap()),
         &s.options,
     )
     .unwrap();
@@ -562,7 +563,7 @@ fn solvers_report_what_ran_and_cg_beats_the_plain_iteration() {
         .enumerate()
         .map(|(v, p)| *p + 0.1 * DVec3::new(rand01(v as u64), rand01(v as u64 + 500), 0.0))
         .collect();
-    let lp = Pia::new(&topology, &PiaScheme::Loop, &tri.options).unwrap();
+    let lp = Pia::new(&topology, &Scheme::Loop, &tri.options).unwrap();
     let r = lp
         .solve(&rough, &fixed_every_third(tn), &PiaOptions::default())
         .unwrap();
@@ -585,7 +586,7 @@ fn solvers_report_what_ran_and_cg_beats_the_plain_iteration() {
 #[test]
 fn results_do_not_depend_on_the_thread_count() {
     let s = load(&subd_tests::osd_mesh_dir().join("catmark_car.obj"));
-    let pia = Pia::new(&s.topology, &PiaScheme::CatmullClark, &s.options).unwrap();
+    let pia = Pia::new(&s.topology, &Scheme::CatmullClark, &s.options).unwrap();
     for solver in [
         Solver::Iterate,
         Solver::Weighted,
@@ -612,7 +613,7 @@ fn results_do_not_depend_on_the_thread_count() {
 #[test]
 fn pia_commutes_with_affine_maps() {
     let s = load(&subd_tests::osd_mesh_dir().join("catmark_xord_boundary.obj"));
-    let pia = Pia::new(&s.topology, &PiaScheme::CatmullClark, &s.options).unwrap();
+    let pia = Pia::new(&s.topology, &Scheme::CatmullClark, &s.options).unwrap();
     let m = glam::DMat3::from_cols_array(&[1.2, 0.3, -0.1, 0.2, 0.9, 0.4, -0.3, 0.1, 1.1]);
     let shift = DVec3::new(3.0, -2.0, 0.5);
     let moved: Vec<DVec3> = s.points.iter().map(|p| m * *p + shift).collect();
@@ -635,7 +636,7 @@ fn pia_commutes_with_affine_maps() {
 #[test]
 fn bad_input_is_a_typed_error() {
     let s = load(&subd_tests::osd_mesh_dir().join("catmark_cube.obj"));
-    let pia = Pia::new(&s.topology, &PiaScheme::CatmullClark, &s.options).unwrap();
+    let pia = Pia::new(&s.topology, &Scheme::CatmullClark, &s.options).unwrap();
     let err = pia.solve(
         &s.points,
         &Moving::Only(vec![0, 99]),
@@ -648,9 +649,9 @@ fn bad_input_is_a_typed_error() {
     let err = pia.solve(&s.points[..3], &Moving::All, &PiaOptions::default());
     assert!(matches!(err, Err(subd_pia::PiaError::Targets { .. })));
     let tri = load(&subd_tests::osd_mesh_dir().join("loop_cube.obj"));
-    let tp = TwoPhase::uniform(tri.topology.num_vertices(), 0.5).unwrap();
-    assert!(Pia::new(&tri.topology, &PiaScheme::TwoPhase(tp), &tri.options).is_err());
-    assert!(Pia::new(&s.topology, &PiaScheme::Loop, &s.options).is_err());
+    let tp = TwoPhase::uniform(0.5).unwrap();
+    assert!(Pia::new(&tri.topology, &Scheme::TwoPhase(tp), &tri.options).is_err());
+    assert!(Pia::new(&s.topology, &Scheme::Loop, &s.options).is_err());
 }
 
 #[test]
@@ -660,7 +661,7 @@ fn two_phase_limits_near_deep_semi_sharp_creases_equal_global_refinement() {
     let mut checked = 0;
     for s in shapes("catmark_", 200, |t| all_quads(t) && manifold(t)) {
         let (levels, _) =
-            subd_limit::levels_for_exact_limit(&s.topology, subd_schemes::Scheme::CatmullClark);
+            subd_limit::levels_for_exact_limit(&s.topology, &subd_schemes::Scheme::CatmullClark);
         if levels <= 3 || s.topology.num_face_vertices() << (2 * levels) > 1 << 24 {
             continue;
         }
@@ -670,7 +671,13 @@ fn two_phase_limits_near_deep_semi_sharp_creases_equal_global_refinement() {
             .collect();
         let tp = TwoPhase::new(lambda).unwrap();
         let local = subd_limit::two_phase_base_limit(&s.topology, &tp, &s.options).unwrap();
-        let r = subd_schemes::Refinement::two_phase(&s.topology, &tp, &s.options, levels).unwrap();
+        let r = subd_schemes::Refinement::new(
+            &s.topology,
+            subd_schemes::Scheme::TwoPhase(tp.clone()),
+            &s.options,
+            levels,
+        )
+        .unwrap();
         let at = subd_limit::LimitStencilTable::at_level(&r, levels).unwrap();
         let fine = r.composed(levels).apply_points(&s.points);
         let global = at.position.apply_points(&fine);
@@ -703,11 +710,11 @@ fn repeated_solves_on_one_pia_agree_with_fresh_ones() {
             tol: 1e-12,
             max_iter: 10_000,
         };
-        let warm = Pia::new(&s.topology, &PiaScheme::CatmullClark, &s.options).unwrap();
+        let warm = Pia::new(&s.topology, &Scheme::CatmullClark, &s.options).unwrap();
         let global = warm.solve(&s.points, &Moving::All, &opts).unwrap();
         assert!(global.converged, "{}: global", s.name);
         let local_warm = warm.solve(&s.points, &fixed, &opts).unwrap();
-        let fresh = Pia::new(&s.topology, &PiaScheme::CatmullClark, &s.options).unwrap();
+        let fresh = Pia::new(&s.topology, &Scheme::CatmullClark, &s.options).unwrap();
         let local_fresh = fresh.solve(&s.points, &fixed, &opts).unwrap();
         assert!(local_warm.converged && local_fresh.converged, "{}", s.name);
         assert_eq!(local_warm.moving, local_fresh.moving);

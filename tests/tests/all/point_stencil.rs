@@ -30,7 +30,7 @@ fn stencils_reproduce_the_evaluator_on_every_shape() {
     let mut checked = 0;
     for shape in surface_shapes() {
         let topo = &shape.mesh.topology;
-        let Ok(ev) = LimitEvaluator::new(topo, shape.scheme, &shape.options) else {
+        let Ok(ev) = LimitEvaluator::new(topo, &shape.scheme, &shape.options) else {
             continue;
         };
         let p = &shape.mesh.positions;
@@ -43,7 +43,7 @@ fn stencils_reproduce_the_evaluator_on_every_shape() {
                 1
             };
             for sub in 0..subs {
-                let (u, v) = params(shape.scheme, face + 7 * sub);
+                let (u, v) = params(shape.scheme.clone(), face + 7 * sub);
                 let at = FaceParam { face, sub, u, v };
                 let Ok(direct) = ev.evaluate(&pts, at) else {
                     continue;
@@ -95,7 +95,7 @@ fn face_patches_reproduce_the_evaluator() {
         .filter(|s| s.scheme == Scheme::CatmullClark)
     {
         let topo = &shape.mesh.topology;
-        let Ok(ev) = LimitEvaluator::new(topo, shape.scheme, &shape.options) else {
+        let Ok(ev) = LimitEvaluator::new(topo, &shape.scheme, &shape.options) else {
             continue;
         };
         let p = &shape.mesh.positions;

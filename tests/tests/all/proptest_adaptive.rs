@@ -21,7 +21,7 @@ fn cases() -> impl Strategy<Value = TaggedCase> {
 
 fn adaptive(c: &TaggedCase, criteria: &[&dyn Criterion], levels: usize) -> AdaptiveRefinement {
     let t = c.topology(&c.mesh.faces);
-    AdaptiveRefinement::new(&t, &c.positions, c.scheme, &c.options(), criteria, levels).unwrap()
+    AdaptiveRefinement::new(&t, &c.positions, &c.scheme, &c.options(), criteria, levels).unwrap()
 }
 
 /// Faces as lists of corner positions (bits), each rotated to start at its smallest corner.
@@ -46,7 +46,7 @@ proptest! {
     fn hierarchy_is_exact_and_the_mesh_conforming(c in cases(), seed in any::<u64>()) {
         let levels = 3;
         let t = c.topology(&c.mesh.faces);
-        let uniform = Refinement::new(&t, c.scheme, &c.options(), levels)
+        let uniform = Refinement::new(&t, c.scheme.clone(), &c.options(), levels)
             .unwrap()
             .refine_points(&c.positions);
         let a = adaptive(&c, &[&RandomSelection::new(seed, 0.4).unwrap()], levels);
@@ -69,7 +69,7 @@ proptest! {
     fn selecting_every_face_gives_uniform_faces(c in cases()) {
         let levels = 2;
         let t = c.topology(&c.mesh.faces);
-        let r = Refinement::new(&t, c.scheme, &c.options(), levels).unwrap();
+        let r = Refinement::new(&t, c.scheme.clone(), &c.options(), levels).unwrap();
         let a = adaptive(&c, &[], levels);
         let mesh = a.mesh(Positions::Refined).unwrap();
         let (off, fv) = r.faces(levels);
@@ -90,8 +90,8 @@ proptest! {
         let picked: Vec<u64> = (0..t.num_faces() as u64).filter(|f| (f ^ seed) % 3 == 0).collect();
         let select = FaceSelection::from_faces(t.num_faces(), &picked).unwrap();
         let o = c.options();
-        let a = AdaptiveRefinement::new(&t, &c.positions, c.scheme, &o, &[&flatness, &select], 3).unwrap();
-        let b = AdaptiveRefinement::new(&u, &pos, c.scheme, &o, &[&flatness, &select], 3).unwrap();
+        let a = AdaptiveRefinement::new(&t, &c.positions, &c.scheme, &o, &[&flatness, &select], 3).unwrap();
+        let b = AdaptiveRefinement::new(&u, &pos, &c.scheme, &o, &[&flatness, &select], 3).unwrap();
         let (ma, mb) = (a.mesh(Positions::Refined).unwrap(), b.mesh(Positions::Refined).unwrap());
         prop_assert_eq!(ma.faces_per_level(), mb.faces_per_level());
         prop_assert_eq!(face_set(&ma), face_set(&mb));
@@ -112,7 +112,7 @@ fn one_thread_equals_many_threads() {
                 let flat = Flatness::new(20.0).unwrap();
                 let o = subd_schemes::Options::default();
                 let a =
-                    AdaptiveRefinement::new(&t, &positions, Scheme::CatmullClark, &o, &[&flat], 3)
+                    AdaptiveRefinement::new(&t, &positions, &Scheme::CatmullClark, &o, &[&flat], 3)
                         .unwrap();
                 let m = a.mesh(Positions::Limit).unwrap();
                 let bits = |v: &[DVec3]| {

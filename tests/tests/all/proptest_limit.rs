@@ -50,7 +50,7 @@ proptest! {
         };
         let topo = build(mesh.num_vertices, &mesh.faces);
         let p = positions(&mesh, seed);
-        let r = Refinement::new(&topo, scheme, &Options::default(), 1).unwrap();
+        let r = Refinement::new(&topo, scheme.clone(), &Options::default(), 1).unwrap();
         let table = LimitStencilTable::at_level(&r, 1).unwrap();
         for row in 0..table.num_rows() {
             let sum = |t: &subd_schemes::StencilTable| t.row(row).1.iter().sum::<f64>();
@@ -66,7 +66,7 @@ proptest! {
             prop_assert!((affine(*x) - *y).length() < 1e-11);
         }
         // Exact evaluation commutes with the same map, wherever it is covered.
-        let ev = LimitEvaluator::new(&topo, scheme, &Options::default()).unwrap();
+        let ev = LimitEvaluator::new(&topo, &scheme, &Options::default()).unwrap();
         let (pa, pb) = (ev.prepare(&p), ev.prepare(&p.iter().map(|&x| affine(x)).collect::<Vec<_>>()));
         for f in 0..topo.num_faces() {
             for (u, v) in [(0.3, 0.2), (0.05, 0.01), (0.0, 0.0)] {

@@ -35,7 +35,7 @@ proptest! {
     #[test]
     fn stencil_rows_sum_to_one(c in case_strategy()) {
         let t = topology(&c, &c.mesh.faces);
-        let r = Refinement::new(&t, c.scheme, &options(&c), 2).unwrap();
+        let r = Refinement::new(&t, c.scheme.clone(), &options(&c), 2).unwrap();
         for table in [r.stencils(1).clone(), r.stencils(2).clone(), r.composed(2)] {
             for row in 0..table.num_rows() {
                 let (_, w) = table.row(row);
@@ -48,7 +48,7 @@ proptest! {
     #[test]
     fn refinement_commutes_with_affine_maps(c in case_strategy(), a in prop::array::uniform9(-2.0f64..2.0), b in prop::array::uniform3(-5.0f64..5.0)) {
         let t = topology(&c, &c.mesh.faces);
-        let r = Refinement::new(&t, c.scheme, &options(&c), 2).unwrap();
+        let r = Refinement::new(&t, c.scheme.clone(), &options(&c), 2).unwrap();
         let m = glam::DMat3::from_cols_array(&a);
         let shift = DVec3::from_array(b);
         let map = |p: DVec3| m * p + shift;
@@ -62,8 +62,8 @@ proptest! {
     fn relabelling_vertices_permutes_the_result(c in case_strategy(), seed in any::<u64>()) {
         let nv = c.mesh.num_vertices;
         let (perm, t, u, pos) = relabelled(&c, seed);
-        let a = Refinement::new(&t, c.scheme, &options(&c), 2).unwrap().refine_points(&c.positions);
-        let b = Refinement::new(&u, c.scheme, &options(&c), 2).unwrap().refine_points(&pos);
+        let a = Refinement::new(&t, c.scheme.clone(), &options(&c), 2).unwrap().refine_points(&c.positions);
+        let b = Refinement::new(&u, c.scheme.clone(), &options(&c), 2).unwrap().refine_points(&pos);
         // Edges are numbered by first appearance in face order, which relabelling keeps, so
         // only the base-vertex block of each level is permuted.
         for level in 1..=2 {
@@ -79,7 +79,7 @@ proptest! {
     #[test]
     fn stencil_tables_agree_with_direct_evaluation(c in case_strategy()) {
         let t = topology(&c, &c.mesh.faces);
-        let r = Refinement::new(&t, c.scheme, &options(&c), 3).unwrap();
+        let r = Refinement::new(&t, c.scheme.clone(), &options(&c), 3).unwrap();
         let direct = r.refine_points(&c.positions);
         let composed = r.composed(3).apply_points(&c.positions);
         prop_assert!(max_diff(&direct[3], &composed) < 1e-12);

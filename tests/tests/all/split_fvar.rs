@@ -6,7 +6,8 @@
 use proptest::prelude::*;
 use subd_mesh::fvar::{FVarChannel, FVarLinearInterpolation as Mode};
 use subd_mesh::{DVec3, Topology, tags};
-use subd_schemes::split_schemes::{SplitFVarError, SplitFaceVarying, SplitRefinement, SplitScheme};
+use subd_schemes::split_schemes::{SplitFVarError, SplitFaceVarying};
+use subd_schemes::{Options, Refinement, Scheme};
 use subd_tests::{build, mesh_strategy, triangulated};
 
 const MODES: [Mode; 6] = [
@@ -46,9 +47,9 @@ fn assert_close(got: [f64; 2], want: [f64; 2], what: &str) {
 /// A seamless channel (one value per vertex) at each face corner of level 2 equals the
 /// scheme's refined positions with the value as (u, v, 0): the direct masks of
 /// `refine_points` against the composed stencils of the mesh of values.
-fn seamless_matches_positions(t: &Topology, scheme: SplitScheme) -> Result<(), TestCaseError> {
+fn seamless_matches_positions(t: &Topology, scheme: Scheme) -> Result<(), TestCaseError> {
     let levels = 2;
-    let r = SplitRefinement::new(t, scheme, levels).expect("valid input");
+    let r = Refinement::new(t, scheme.clone(), &Options::default(), levels).expect("valid input");
     let uv: Vec<[f64; 2]> = (0..t.num_vertices()).map(vertex_uv).collect();
     let values: Vec<f64> = uv.iter().flatten().copied().collect();
     let channel =
@@ -102,14 +103,14 @@ proptest! {
 
     #[test]
     fn seamless_channels_are_refined_as_positions(m in mesh_strategy(), crease_every in 3usize..9) {
-        seamless_matches_positions(&build(m.num_vertices, &m.faces), SplitScheme::DooSabin)?;
+        seamless_matches_positions(&build(m.num_vertices, &m.faces), Scheme::DooSabin)?;
         let mut tri = triangulated(&m);
         for e in (0..tri.num_edges()).step_by(crease_every) {
             if !tri.is_boundary_edge(e) {
                 tri.set_edge_sharpness(e, tags::SHARPNESS_INFINITE);
             }
         }
-        for scheme in [SplitScheme::Sqrt3, SplitScheme::BUTTERFLY, SplitScheme::ModifiedButterfly] {
+        for scheme in [Scheme::Sqrt3, Scheme::BUTTERFLY, Scheme::ModifiedButterfly] {
             seamless_matches_positions(&tri, scheme)?;
         }
     }
@@ -175,8 +176,9 @@ fn butterfly_islands_refine_as_their_own_meshes() {
     let levels = 2;
     let (values, indices) = island_channel(&t, &island, true);
     let channel = FVarChannel::new(&t, 2, values.clone(), indices.clone()).expect("channel");
-    for scheme in [SplitScheme::BUTTERFLY, SplitScheme::ModifiedButterfly] {
-        let r = SplitRefinement::new(&t, scheme, levels).expect("valid input");
+    for scheme in [Scheme::BUTTERFLY, Scheme::ModifiedButterfly] {
+        let r =
+            Refinement::new(&t, scheme.clone(), &Options::default(), levels).expect("valid input");
         let fv = SplitFaceVarying::new(&r, &channel, Mode::None).expect("butterflies take seams");
         let got = corner_values(&fv, &values, levels);
         let per_face = 4usize.pow(levels as u32) * 3;
@@ -192,7 +194,8 @@ fn butterfly_islands_refine_as_their_own_meshes() {
             let points: Vec<DVec3> = (0..n)
                 .map(|x| DVec3::new(values[2 * x], values[2 * x + 1], 0.0))
                 .collect();
-            let ir = SplitRefinement::new(&own, scheme, levels).expect("an island is manifold");
+            let ir = Refinement::new(&own, scheme.clone(), &Options::default(), levels)
+                .expect("an island is manifold");
             let refined = ir.refine_points(&points).swap_remove(levels);
             let (_, island_vertices) = ir.faces(levels);
             // Child faces of island face j are those of geometry face faces[j], in order.
@@ -244,8 +247,9 @@ fn mode_all_is_midpoint_subdivision_and_boundaries_is_linear_along_seams() {
             })
             .collect();
     }
-    for scheme in [SplitScheme::BUTTERFLY, SplitScheme::ModifiedButterfly] {
-        let r = SplitRefinement::new(&t, scheme, levels).expect("valid input");
+    for scheme in [Scheme::BUTTERFLY, Scheme::ModifiedButterfly] {
+        let r =
+            Refinement::new(&t, scheme.clone(), &Options::default(), levels).expect("valid input");
         let fv = SplitFaceVarying::new(&r, &channel, Mode::All).expect("any channel");
         let got = corner_values(&fv, &values, levels);
         for (i, (g, e)) in got.iter().zip(expected.iter().flatten()).enumerate() {
@@ -281,8 +285,8 @@ fn dual_and_sqrt3_refuse_seams_by_vertex() {
     let (t, island) = grid_with_islands(4);
     let (values, indices) = island_channel(&t, &island, true);
     let channel = FVarChannel::new(&t, 2, values, indices.clone()).expect("channel");
-    for scheme in [SplitScheme::DooSabin, SplitScheme::Sqrt3] {
-        let r = SplitRefinement::new(&t, scheme, 1).expect("valid input");
+    for scheme in [Scheme::DooSabin, Scheme::Sqrt3] {
+        let r = Refinement::new(&t, scheme.clone(), &Options::default(), 1).expect("valid input");
         match SplitFaceVarying::new(&r, &channel, Mode::CornersPlus1) {
             Err(SplitFVarError::Seam { vertex, .. }) => {
                 let distinct: std::collections::BTreeSet<u32> = (0..t.num_face_vertices())
@@ -310,7 +314,7 @@ fn butterflies_keep_every_corner_value_on_the_osd_shapes() {
         let (t, Some(channel)) = (&file.mesh.topology, file.mesh.uv()) else {
             continue;
         };
-        let Ok(r) = SplitRefinement::new(t, SplitScheme::ModifiedButterfly, 2) else {
+        let Ok(r) = Refinement::new(t, Scheme::ModifiedButterfly, &Options::default(), 2) else {
             continue;
         };
         shapes += 1;

@@ -6,14 +6,14 @@ use proptest::prelude::*;
 use subd_limit::split_limit::split_limit_stencils;
 use subd_mesh::{DVec3, Topology, tags};
 use subd_schemes::StencilTable;
-use subd_schemes::split_schemes::{SplitError, SplitRefinement, SplitScheme};
+use subd_schemes::{Options, RefineError, Refinement, Scheme};
 use subd_tests::{RandomMesh, build, mesh_strategy, triangulated};
 
-const SCHEMES: [SplitScheme; 4] = [
-    SplitScheme::DooSabin,
-    SplitScheme::Sqrt3,
-    SplitScheme::BUTTERFLY,
-    SplitScheme::ModifiedButterfly,
+const SCHEMES: [Scheme; 4] = [
+    Scheme::DooSabin,
+    Scheme::Sqrt3,
+    Scheme::BUTTERFLY,
+    Scheme::ModifiedButterfly,
 ];
 
 /// Positions for a random mesh: its planar ones lifted by a wave, or points on a torus-ish
@@ -74,13 +74,13 @@ proptest! {
     fn invariants_on_random_meshes(m in mesh_strategy(), crease_every in 3usize..9) {
         let p = positions(&m);
         for scheme in SCHEMES {
-            let t = if scheme == SplitScheme::DooSabin {
+            let t = if scheme == Scheme::DooSabin {
                 build(m.num_vertices, &m.faces)
             } else {
                 with_creases(triangulated(&m), crease_every)
             };
-            let one = in_pool(1, || SplitRefinement::new(&t, scheme, 3).unwrap());
-            let four = in_pool(4, || SplitRefinement::new(&t, scheme, 3).unwrap());
+            let one = in_pool(1, || Refinement::new(&t, scheme.clone(), &Options::default(), 3).unwrap());
+            let four = in_pool(4, || Refinement::new(&t, scheme.clone(), &Options::default(), 3).unwrap());
             for l in 1..=3 {
                 rows_sum_to_one(one.stencils(l)).map_err(|e| TestCaseError::fail(format!("{scheme:?} level {l}: {e}")))?;
                 prop_assert_eq!(one.stencils(l), four.stencils(l));
@@ -130,8 +130,8 @@ fn butterflies_reproduce_cubics_on_a_regular_grid() {
     for q in &mut p {
         q.z = cubic(q.x, q.y);
     }
-    for scheme in [SplitScheme::BUTTERFLY, SplitScheme::ModifiedButterfly] {
-        let r = SplitRefinement::new(&t, scheme, 1).unwrap();
+    for scheme in [Scheme::BUTTERFLY, Scheme::ModifiedButterfly] {
+        let r = Refinement::new(&t, scheme.clone(), &Options::default(), 1).unwrap();
         let out = r.refine_points(&p).pop().unwrap();
         let mut checked = 0;
         for q in &out {
@@ -144,7 +144,13 @@ fn butterflies_reproduce_cubics_on_a_regular_grid() {
         assert!(checked > 50);
     }
     // Tension 0 is linear interpolation: every new point is its edge's midpoint.
-    let r = SplitRefinement::new(&t, SplitScheme::Butterfly { tension: 0.0 }, 1).unwrap();
+    let r = Refinement::new(
+        &t,
+        Scheme::Butterfly { tension: 0.0 },
+        &Options::default(),
+        1,
+    )
+    .unwrap();
     let out = r.refine_points(&p).pop().unwrap();
     for e in 0..t.num_edges() {
         let [a, b] = t.edge_vertices(e);
@@ -193,7 +199,7 @@ fn boundary_curves_follow_their_univariate_schemes() {
         ternary.push((at(i - 1) + at(i) * 16.0 + at(i + 1) * 10.0) / 27.0);
         ternary.push((at(i) * 10.0 + at(i + 1) * 16.0 + at(i + 2)) / 27.0);
     }
-    let r = SplitRefinement::new(&t, SplitScheme::Sqrt3, 2).unwrap();
+    let r = Refinement::new(&t, Scheme::Sqrt3, &Options::default(), 2).unwrap();
     let out = r.refine_points(&p).pop().unwrap();
     let mut ours = boundary_loop(r.topology(2));
     assert_eq!(ours.len(), 3 * n);
@@ -215,7 +221,7 @@ fn boundary_curves_follow_their_univariate_schemes() {
     };
     let base = boundary_loop(&tq);
     let n = base.len();
-    let r = SplitRefinement::new(&tq, SplitScheme::DooSabin, 1).unwrap();
+    let r = Refinement::new(&tq, Scheme::DooSabin, &Options::default(), 1).unwrap();
     let out = r.refine_points(&pq).pop().unwrap();
     let ours: Vec<DVec3> = boundary_loop(r.topology(1))
         .iter()
@@ -240,20 +246,20 @@ fn counts_per_step() {
     let m = subd_tests::random_mesh(0, 5, 6, &[0, 2, 3, 1, 2], &[(0.0, 0.0)]);
     let quads = build(m.num_vertices, &m.faces);
     let tris = triangulated(&m);
-    let ds = SplitRefinement::new(&quads, SplitScheme::DooSabin, 1).unwrap();
+    let ds = Refinement::new(&quads, Scheme::DooSabin, &Options::default(), 1).unwrap();
     assert_eq!(ds.topology(1).num_vertices(), quads.num_face_vertices());
     assert_eq!(
         ds.topology(1).num_faces(),
         quads.num_faces() + quads.num_edges() + quads.num_vertices()
     );
-    let s3 = SplitRefinement::new(&tris, SplitScheme::Sqrt3, 1).unwrap();
+    let s3 = Refinement::new(&tris, Scheme::Sqrt3, &Options::default(), 1).unwrap();
     assert_eq!(
         s3.topology(1).num_vertices(),
         tris.num_vertices() + tris.num_faces()
     );
     assert_eq!(s3.topology(1).num_faces(), 3 * tris.num_faces());
-    for scheme in [SplitScheme::BUTTERFLY, SplitScheme::ModifiedButterfly] {
-        let b = SplitRefinement::new(&tris, scheme, 1).unwrap();
+    for scheme in [Scheme::BUTTERFLY, Scheme::ModifiedButterfly] {
+        let b = Refinement::new(&tris, scheme.clone(), &Options::default(), 1).unwrap();
         assert_eq!(
             b.topology(1).num_vertices(),
             tris.num_vertices() + tris.num_edges()
@@ -277,20 +283,16 @@ fn creases_are_carried_and_use_the_curve_rule() {
         let e = t.find_edge(w[0], w[1]).unwrap() as usize;
         t.set_edge_sharpness(e, tags::SHARPNESS_INFINITE);
     }
-    for scheme in [
-        SplitScheme::Sqrt3,
-        SplitScheme::BUTTERFLY,
-        SplitScheme::ModifiedButterfly,
-    ] {
-        let r = SplitRefinement::new(&t, scheme, 2).unwrap();
+    for scheme in [Scheme::Sqrt3, Scheme::BUTTERFLY, Scheme::ModifiedButterfly] {
+        let r = Refinement::new(&t, scheme.clone(), &Options::default(), 2).unwrap();
         let t2 = r.topology(2);
         let creased = (0..t2.num_edges())
             .filter(|&e| !t2.is_boundary_edge(e) && tags::is_infinite(t2.edge_sharpness(e)))
             .count();
-        let expected = if scheme == SplitScheme::Sqrt3 { 18 } else { 24 };
+        let expected = if scheme == Scheme::Sqrt3 { 18 } else { 24 };
         assert_eq!(creased, expected, "{scheme:?}");
     }
-    let r = SplitRefinement::new(&t, SplitScheme::BUTTERFLY, 1).unwrap();
+    let r = Refinement::new(&t, Scheme::BUTTERFLY, &Options::default(), 1).unwrap();
     let out = r.refine_points(&p).pop().unwrap();
     for i in 1..5 {
         let e = t.find_edge(row[i], row[i + 1]).unwrap() as usize;
@@ -303,14 +305,10 @@ fn creases_are_carried_and_use_the_curve_rule() {
 #[test]
 fn bad_input_is_a_typed_error() {
     let quad = build(4, &[vec![0, 1, 2, 3]]);
-    for scheme in [
-        SplitScheme::Sqrt3,
-        SplitScheme::BUTTERFLY,
-        SplitScheme::ModifiedButterfly,
-    ] {
+    for scheme in [Scheme::Sqrt3, Scheme::BUTTERFLY, Scheme::ModifiedButterfly] {
         assert!(matches!(
-            SplitRefinement::new(&quad, scheme, 1),
-            Err(SplitError::NotTriangle {
+            Refinement::new(&quad, scheme.clone(), &Options::default(), 1),
+            Err(RefineError::NotTriangle {
                 face: 0,
                 size: 4,
                 ..
@@ -328,27 +326,32 @@ fn bad_input_is_a_typed_error() {
         });
     for scheme in SCHEMES {
         assert!(matches!(
-            SplitRefinement::new(&fin, scheme, 1),
-            Err(SplitError::NonManifoldEdge { .. })
+            Refinement::new(&fin, scheme.clone(), &Options::default(), 1),
+            Err(RefineError::NonManifoldEdge { .. })
         ));
     }
     let (mut t, _) = regular_grid(3);
     t.set_edge_sharpness(t.find_edge(5, 6).unwrap() as usize, 2.0);
     assert!(matches!(
-        SplitRefinement::new(&t, SplitScheme::Sqrt3, 1),
-        Err(SplitError::UnsupportedTag { .. })
+        Refinement::new(&t, Scheme::Sqrt3, &Options::default(), 1),
+        Err(RefineError::UnsupportedTag { .. })
     ));
     assert!(matches!(
-        SplitRefinement::new(&t, SplitScheme::DooSabin, 1),
-        Err(SplitError::UnsupportedTag { .. })
+        Refinement::new(&t, Scheme::DooSabin, &Options::default(), 1),
+        Err(RefineError::UnsupportedTag { .. })
     ));
     assert!(matches!(
-        SplitRefinement::new(&t, SplitScheme::Butterfly { tension: f64::NAN }, 1),
-        Err(SplitError::Tension(_))
+        Refinement::new(
+            &t,
+            Scheme::Butterfly { tension: f64::NAN },
+            &Options::default(),
+            1
+        ),
+        Err(RefineError::Tension(_))
     ));
     assert!(matches!(
-        SplitRefinement::new(&quad, SplitScheme::DooSabin, 16),
-        Err(SplitError::TooManyLevels { .. })
+        Refinement::new(&quad, Scheme::DooSabin, &Options::default(), 16),
+        Err(RefineError::TooManyLevels { .. })
     ));
 }
 
@@ -392,16 +395,12 @@ fn limits_are_invariant_under_refinement() {
     }
     let pd = po.clone();
     for (t, p) in [(tc, pc), (to, po), (td, pd)] {
-        for scheme in [
-            SplitScheme::Sqrt3,
-            SplitScheme::BUTTERFLY,
-            SplitScheme::ModifiedButterfly,
-        ] {
-            let base = split_limit_stencils(&t, scheme).unwrap().evaluate(&p);
-            let r = SplitRefinement::new(&t, scheme, 2).unwrap();
+        for scheme in [Scheme::Sqrt3, Scheme::BUTTERFLY, Scheme::ModifiedButterfly] {
+            let base = split_limit_stencils(&t, &scheme).unwrap().evaluate(&p);
+            let r = Refinement::new(&t, scheme.clone(), &Options::default(), 2).unwrap();
             let p2 = r.refine_points(&p).pop().unwrap();
             // √3's boundary rule depends on the step's parity: level 2 starts a new pair.
-            let deep = split_limit_stencils(r.topology(2), scheme)
+            let deep = split_limit_stencils(r.topology(2), &scheme)
                 .unwrap()
                 .evaluate(&p2);
             let mut normals = 0;
@@ -421,7 +420,7 @@ fn limits_are_invariant_under_refinement() {
                 }
             }
             assert!(normals > 0, "{scheme:?}: no normals compared");
-            if scheme != SplitScheme::BUTTERFLY {
+            if scheme != Scheme::BUTTERFLY {
                 // Every interior vertex has a normal and every vertex a position.
                 assert!(base.positions.iter().all(Option::is_some), "{scheme:?}");
             }
@@ -436,10 +435,10 @@ fn doo_sabin_limit_points_and_normals() {
     // A torus with a hexagon every few quads (valence-3 vertices, 6-sided faces).
     let mesh = subd_mesh::primitives::torus_with_hexagons(8, 10, 3, 3.0, 1.0);
     let (t, p) = (mesh.topology, mesh.positions);
-    let limits = split_limit_stencils(&t, SplitScheme::DooSabin)
+    let limits = split_limit_stencils(&t, &Scheme::DooSabin)
         .unwrap()
         .evaluate(&p);
-    let r = SplitRefinement::new(&t, SplitScheme::DooSabin, 1).unwrap();
+    let r = Refinement::new(&t, Scheme::DooSabin, &Options::default(), 1).unwrap();
     let p1 = r.refine_points(&p).pop().unwrap();
     let vface = subd_schemes::split_schemes::doo_sabin::vertex_face_indices(&t);
     for (v, face) in vface.iter().enumerate() {
@@ -507,12 +506,8 @@ fn normals_point_outwards() {
     let file = subd_io::read_mesh(&path, &subd_io::ReadOptions::default()).unwrap();
     let (t, p) = (&file.mesh.topology, &file.mesh.positions);
     let centre = p.iter().copied().sum::<DVec3>() / p.len() as f64;
-    for scheme in [
-        SplitScheme::Sqrt3,
-        SplitScheme::BUTTERFLY,
-        SplitScheme::ModifiedButterfly,
-    ] {
-        let l = split_limit_stencils(t, scheme).unwrap().evaluate(p);
+    for scheme in [Scheme::Sqrt3, Scheme::BUTTERFLY, Scheme::ModifiedButterfly] {
+        let l = split_limit_stencils(t, &scheme).unwrap().evaluate(p);
         for (v, (n, q)) in l.normals.iter().zip(p).enumerate() {
             assert!(n.unwrap().dot(*q - centre) > 0.0, "{scheme:?} vertex {v}");
         }
@@ -521,7 +516,7 @@ fn normals_point_outwards() {
     let file = subd_io::read_mesh(&cube, &subd_io::ReadOptions::default()).unwrap();
     let (t, p) = (&file.mesh.topology, &file.mesh.positions);
     let centre = p.iter().copied().sum::<DVec3>() / p.len() as f64;
-    let l = split_limit_stencils(t, SplitScheme::DooSabin)
+    let l = split_limit_stencils(t, &Scheme::DooSabin)
         .unwrap()
         .evaluate(p);
     for (v, (n, q)) in l.normals.iter().zip(p).enumerate() {
@@ -534,12 +529,8 @@ fn normals_point_outwards() {
 #[test]
 fn normals_of_a_flat_grid_are_the_plane_normal() {
     let (t, p) = regular_grid(7);
-    for scheme in [
-        SplitScheme::Sqrt3,
-        SplitScheme::BUTTERFLY,
-        SplitScheme::ModifiedButterfly,
-    ] {
-        let l = split_limit_stencils(&t, scheme).unwrap().evaluate(&p);
+    for scheme in [Scheme::Sqrt3, Scheme::BUTTERFLY, Scheme::ModifiedButterfly] {
+        let l = split_limit_stencils(&t, &scheme).unwrap().evaluate(&p);
         let mut boundary = 0;
         for v in 0..p.len() {
             let corner = t.vertex_faces(v).len() < 2 && t.is_boundary_vertex(v);

@@ -82,23 +82,23 @@ fn streamed_last_level_files_equal_the_held_ones() {
             triangle_subdivision: file.mesh.hints.triangle_subdivision,
             fvar_interpolation: None,
         };
-        for &scheme in schemes {
+        for scheme in schemes {
             for levels in 1..=2 {
                 let what = format!("{name} {scheme:?} L{levels}");
-                let held_r = Refinement::new(base, scheme, &options, levels).unwrap();
+                let held_r = Refinement::new(base, scheme.clone(), &options, levels).unwrap();
                 let positions = held_r.refine_points(&file.mesh.positions).pop().unwrap();
                 let (offsets, vertices) = held_r.faces(levels);
                 let holes = held_r.holes(levels);
                 let tags = held_r.explicit_tags(levels);
                 with_holes += usize::from(holes.iter().any(|&h| h));
                 with_tags += usize::from(!tags.creases.is_empty() || !tags.corners.is_empty());
-                let mut held = MeshView::new(&positions, offsets, vertices, holes)
+                let mut held = MeshView::new(&positions, offsets, vertices, &holes)
                     .unwrap()
                     .with_tags(tags.creases.clone(), tags.corners.clone())
                     .unwrap();
                 held.hints = hints;
 
-                let r = Refinement::new(base, scheme, &options, levels).unwrap();
+                let r = Refinement::new(base, scheme.clone(), &options, levels).unwrap();
                 let above = r.points_at(&file.mesh.positions, levels - 1);
                 let points = StreamedPoints(r.point_stream(&above).unwrap());
                 let faces = StreamedFaces(r.face_stream().unwrap());
@@ -200,7 +200,8 @@ fn streamed_levels_larger_than_a_window_equal_the_held_ones() {
         );
         let (offsets, vertices) = held_r.faces(levels);
         let tags = held_r.explicit_tags(levels);
-        let held = MeshView::new(&positions, offsets, vertices, held_r.holes(levels))
+        let held_holes = held_r.holes(levels);
+        let held = MeshView::new(&positions, offsets, vertices, &held_holes)
             .unwrap()
             .with_tags(tags.creases.clone(), tags.corners.clone())
             .unwrap();

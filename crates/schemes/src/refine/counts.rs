@@ -3,8 +3,7 @@
 
 use subd_mesh::Topology;
 
-use crate::Scheme;
-use crate::split_schemes::SplitScheme;
+use crate::{Scheme, Split};
 
 /// Element counts of one level.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -30,61 +29,46 @@ impl LevelCounts {
         }
     }
 
-    /// The counts one uniform step of `scheme` gives. Exact for every input: Catmull-Clark
-    /// and Bilinear split an n-gon into n quads around a face point (V + E + F vertices,
-    /// 2E + FV edges); Loop splits a triangle into 4 (V + E vertices, 2E + 3F edges).
-    pub fn refined(self, scheme: Scheme) -> LevelCounts {
+    /// The counts one uniform step of `scheme` gives. Exact for OpenSubdiv's schemes on
+    /// every input: Catmull-Clark and Bilinear split an n-gon into n quads around a face
+    /// point (V + E + F vertices, 2E + FV edges); Loop and the butterflies split a triangle
+    /// into 4 (V + E vertices, 2E + 3F edges). Exact for Doo-Sabin and √3 on closed
+    /// manifolds; on open meshes the boundary's extra elements (Doo-Sabin's Chaikin points,
+    /// √3's boundary trisection) are within a small fraction of the total.
+    pub fn refined(self, scheme: &Scheme) -> LevelCounts {
         let LevelCounts {
             vertices: v,
             edges: e,
             faces: f,
             face_vertices: fv,
         } = self;
-        match scheme {
-            Scheme::CatmullClark | Scheme::Bilinear => LevelCounts {
+        match scheme.split() {
+            Split::Quad => LevelCounts {
                 vertices: v + e + f,
                 edges: 2 * e + fv,
                 faces: fv,
                 face_vertices: 4 * fv,
             },
-            Scheme::Loop => LevelCounts {
+            Split::Triangle => LevelCounts {
                 vertices: v + e,
                 edges: 2 * e + 3 * f,
                 faces: 4 * f,
                 face_vertices: 12 * f,
             },
-        }
-    }
-
-    /// The counts one step of a split scheme gives: exact on closed manifolds; on open
-    /// meshes the boundary's extra elements (Doo-Sabin's Chaikin points, √3's boundary
-    /// trisection) are within a small fraction of the total.
-    pub fn refined_split(self, scheme: SplitScheme) -> LevelCounts {
-        let LevelCounts {
-            vertices: v,
-            edges: e,
-            faces: f,
-            face_vertices: fv,
-        } = self;
-        match scheme {
             // F-faces, E-faces and V-faces; a vertex per face corner.
-            SplitScheme::DooSabin => LevelCounts {
+            Split::Dual => LevelCounts {
                 vertices: fv,
                 edges: fv + 2 * e,
                 faces: f + e + v,
                 face_vertices: fv + 4 * e + 2 * e,
             },
             // A centroid per triangle, each triangle into three after the flips.
-            SplitScheme::Sqrt3 => LevelCounts {
+            Split::Sqrt3 => LevelCounts {
                 vertices: v + f,
                 edges: e + 3 * f,
                 faces: 3 * f,
                 face_vertices: 9 * f,
             },
-            // Loop's 1 → 4 split.
-            SplitScheme::Butterfly { .. } | SplitScheme::ModifiedButterfly => {
-                self.refined(Scheme::Loop)
-            }
         }
     }
 }
@@ -97,31 +81,16 @@ impl LevelCounts {
 ///
 /// let faces = [0, 1, 3, 2, 2, 3, 5, 4, 4, 5, 7, 6, 6, 7, 1, 0, 1, 7, 5, 3, 6, 0, 2, 4];
 /// let cube = TopologyBuilder::new(8).build(&[4; 6], &faces).unwrap();
-/// let counts = refined_counts(&cube, Scheme::CatmullClark, 3);
+/// let counts = refined_counts(&cube, &Scheme::CatmullClark, 3);
 /// let r = Refinement::new(&cube, Scheme::CatmullClark, &Default::default(), 2).unwrap();
 /// assert_eq!(counts[2], LevelCounts::of(r.topology(2)));
 /// assert_eq!(counts[3].faces, 6 * 64);
 /// ```
-pub fn refined_counts(base: &Topology, scheme: Scheme, levels: usize) -> Vec<LevelCounts> {
+pub fn refined_counts(base: &Topology, scheme: &Scheme, levels: usize) -> Vec<LevelCounts> {
     let mut out = vec![LevelCounts::of(base)];
     for _ in 0..levels {
         let last = *out.last().expect("level 0");
         out.push(last.refined(scheme));
-    }
-    out
-}
-
-/// The counts of levels `0..=levels` of a split scheme's refinement of `base` (see
-/// [`LevelCounts::refined_split`]).
-pub fn refined_split_counts(
-    base: &Topology,
-    scheme: SplitScheme,
-    levels: usize,
-) -> Vec<LevelCounts> {
-    let mut out = vec![LevelCounts::of(base)];
-    for _ in 0..levels {
-        let last = *out.last().expect("level 0");
-        out.push(last.refined_split(scheme));
     }
     out
 }
@@ -140,7 +109,6 @@ pub(crate) fn last_level_bytes(c: LevelCounts) -> u64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::split_schemes::SplitRefinement;
     use crate::{Options, Refinement};
     use subd_mesh::TopologyBuilder;
 
@@ -166,20 +134,12 @@ mod tests {
             (&mixed, Scheme::CatmullClark),
             (&mixed, Scheme::Bilinear),
             (&tri, Scheme::Loop),
+            (&mixed, Scheme::DooSabin),
+            (&tri, Scheme::Sqrt3),
+            (&tri, Scheme::ModifiedButterfly),
         ] {
-            let r = Refinement::new(base, scheme, &Options::default(), 3).unwrap();
-            let counts = refined_counts(base, scheme, 3);
-            for (l, c) in counts.iter().enumerate() {
-                assert_eq!(*c, LevelCounts::of(r.topology(l)), "{scheme:?} level {l}");
-            }
-        }
-        for (base, scheme) in [
-            (&mixed, SplitScheme::DooSabin),
-            (&tri, SplitScheme::Sqrt3),
-            (&tri, SplitScheme::ModifiedButterfly),
-        ] {
-            let r = SplitRefinement::new(base, scheme, 3).unwrap();
-            let counts = refined_split_counts(base, scheme, 3);
+            let r = Refinement::new(base, scheme.clone(), &Options::default(), 3).unwrap();
+            let counts = refined_counts(base, &scheme, 3);
             for (l, c) in counts.iter().enumerate() {
                 assert_eq!(*c, LevelCounts::of(r.topology(l)), "{scheme:?} level {l}");
             }

@@ -23,73 +23,73 @@ use subd_mesh::Topology;
 
 use std::ops::Range;
 
+use super::Sdc;
 use super::rows::{self, PointRows};
 use super::{loop_smooth_weights, split};
-use crate::Scheme;
 use crate::rules::Rule;
 
 /// Whether the level after the child of `g` can be built from `g` directly: the scheme is
 /// Catmull-Clark on an all-quad `g` or Loop (all triangles), and `g` is closed and
 /// manifold (every edge has two faces and two distinct ends, no vertex is non-manifold or
 /// isolated), has no sharpness and no holes, and every vertex is smooth.
-pub(crate) fn applies(g: &Topology, rules: &[Rule], scheme: Scheme) -> bool {
+pub(crate) fn applies(g: &Topology, rules: &[Rule], scheme: Sdc) -> bool {
     let faces = match scheme {
-        Scheme::CatmullClark => split::all_quads(g),
+        Sdc::CatmullClark => split::all_quads(g),
         // Loop refines triangles only (checked before refining).
-        Scheme::Loop => true,
-        Scheme::Bilinear => false,
+        Sdc::Loop => true,
+        Sdc::Bilinear => false,
     };
     faces && rules.par_iter().all(|&r| r == Rule::Smooth) && g.is_closed_and_smooth()
 }
 
 /// Face size of every level that [`applies`] accepts, and of its children.
-fn face_size(scheme: Scheme) -> usize {
-    if scheme == Scheme::Loop { 3 } else { 4 }
+fn face_size(scheme: Sdc) -> usize {
+    if scheme == Sdc::Loop { 3 } else { 4 }
 }
 
 /// Counts of the child `M` of a closed level `g` that [`applies`]: (vertices, faces,
 /// edges).
-fn child_counts(g: &Topology, scheme: Scheme) -> (usize, usize, usize) {
+fn child_counts(g: &Topology, scheme: Sdc) -> (usize, usize, usize) {
     let (nv, nf, ne) = (g.num_vertices(), g.num_faces(), g.num_edges());
     match scheme {
-        Scheme::Loop => (nv + ne, 4 * nf, 3 * nf + 2 * ne),
+        Sdc::Loop => (nv + ne, 4 * nf, 3 * nf + 2 * ne),
         _ => (nv + nf + ne, 4 * nf, 4 * nf + 2 * ne),
     }
 }
 
 /// Whether `M` is too large to refine: the bound `Refinement::new` puts on every parent
 /// level (its child's face-vertices and edges must stay below `u32::MAX`).
-pub(crate) fn child_too_large(g: &Topology, scheme: Scheme) -> bool {
+pub(crate) fn child_too_large(g: &Topology, scheme: Sdc) -> bool {
     let (_, nf, ne) = child_counts(g, scheme);
     4 * (face_size(scheme) * nf) as u64 + 4 * ne as u64 >= u32::MAX as u64
 }
 
 /// Number of vertices of the grandchild of `g`: children of `M`'s vertices, faces (quad
 /// split only) and edges.
-pub(crate) fn grandchild_num_vertices(g: &Topology, scheme: Scheme) -> usize {
+pub(crate) fn grandchild_num_vertices(g: &Topology, scheme: Sdc) -> usize {
     let (nv, nf, ne) = child_counts(g, scheme);
-    nv + if scheme == Scheme::Loop { 0 } else { nf } + ne
+    nv + if scheme == Sdc::Loop { 0 } else { nf } + ne
 }
 
 /// Number of edges of the grandchild of `g`: the interior edges of `M`'s faces (one per
 /// face-vertex) and two halves per edge of `M`.
-pub(crate) fn grandchild_num_edges(g: &Topology, scheme: Scheme) -> usize {
+pub(crate) fn grandchild_num_edges(g: &Topology, scheme: Sdc) -> usize {
     let (_, nf, ne) = child_counts(g, scheme);
     face_size(scheme) * nf + 2 * ne
 }
 
 /// Face offsets and face-vertex lists of the grandchild of `g`.
-pub(crate) fn grandchild_faces(g: &Topology, scheme: Scheme) -> (Vec<u32>, Vec<u32>) {
+pub(crate) fn grandchild_faces(g: &Topology, scheme: Sdc) -> (Vec<u32>, Vec<u32>) {
     match scheme {
-        Scheme::Loop => grandchild_triangles(g),
+        Sdc::Loop => grandchild_triangles(g),
         _ => grandchild_quads(g),
     }
 }
 
 /// Points of the grandchild of `g` from `src`, the points of its child `M`.
-pub(crate) fn grandchild_points(g: &Topology, scheme: Scheme, src: &[DVec3]) -> Vec<DVec3> {
+pub(crate) fn grandchild_points(g: &Topology, scheme: Sdc, src: &[DVec3]) -> Vec<DVec3> {
     match scheme {
-        Scheme::Loop => rows::build(&LoopGrandchildRows::new(g, src)),
+        Sdc::Loop => rows::build(&LoopGrandchildRows::new(g, src)),
         _ => rows::build(&CatmarkGrandchildRows::new(g, src)),
     }
 }
@@ -105,7 +105,7 @@ fn grandchild_quads(g: &Topology) -> (Vec<u32>, Vec<u32>) {
 
 /// The 16 grandchild quads of face `f` of `g`, 4 vertices each.
 pub(crate) fn grandchild_quad_block(g: &Topology, f: usize) -> [u32; 64] {
-    let (nv_m, nf_m, _) = child_counts(g, Scheme::CatmullClark);
+    let (nv_m, nf_m, _) = child_counts(g, Sdc::CatmullClark);
     let (nv_m, nf_m) = (nv_m as u32, nf_m as u32);
     let cv = split::quad_child_vertices(g, f);
     let ce = split::quad_child_edges(g, f);
@@ -132,7 +132,7 @@ pub(crate) struct CatmarkGrandchildRows<'a> {
 
 impl<'a> CatmarkGrandchildRows<'a> {
     pub(crate) fn new(g: &'a Topology, src: &'a [DVec3]) -> Self {
-        let (nv_m, _, _) = child_counts(g, Scheme::CatmullClark);
+        let (nv_m, _, _) = child_counts(g, Sdc::CatmullClark);
         assert_eq!(src.len(), nv_m, "one point per vertex of the child level");
         CatmarkGrandchildRows { g, src }
     }
@@ -140,11 +140,11 @@ impl<'a> CatmarkGrandchildRows<'a> {
 
 impl PointRows for CatmarkGrandchildRows<'_> {
     fn len(&self) -> usize {
-        grandchild_num_vertices(self.g, Scheme::CatmullClark)
+        grandchild_num_vertices(self.g, Sdc::CatmullClark)
     }
 
     fn middle(&self) -> Range<usize> {
-        let (nv_m, nf_m, _) = child_counts(self.g, Scheme::CatmullClark);
+        let (nv_m, nf_m, _) = child_counts(self.g, Sdc::CatmullClark);
         nv_m..nv_m + nf_m
     }
 
@@ -268,7 +268,7 @@ fn grandchild_triangles(g: &Topology) -> (Vec<u32>, Vec<u32>) {
 
 /// The 16 grandchild triangles of triangle `f` of `g`, 3 vertices each.
 pub(crate) fn grandchild_triangle_block(g: &Topology, f: usize) -> [u32; 48] {
-    let nv_m = child_counts(g, Scheme::Loop).0 as u32;
+    let nv_m = child_counts(g, Sdc::Loop).0 as u32;
     let cv = split::tri_child_vertices(g, f);
     let ce = split::tri_child_edges(g, f);
     let mut out = [0u32; 48];
@@ -291,7 +291,7 @@ pub(crate) struct LoopGrandchildRows<'a> {
 
 impl<'a> LoopGrandchildRows<'a> {
     pub(crate) fn new(g: &'a Topology, src: &'a [DVec3]) -> Self {
-        let (nv_m, _, _) = child_counts(g, Scheme::Loop);
+        let (nv_m, _, _) = child_counts(g, Sdc::Loop);
         assert_eq!(src.len(), nv_m, "one point per vertex of the child level");
         LoopGrandchildRows { g, src }
     }
@@ -299,7 +299,7 @@ impl<'a> LoopGrandchildRows<'a> {
 
 impl PointRows for LoopGrandchildRows<'_> {
     fn len(&self) -> usize {
-        grandchild_num_vertices(self.g, Scheme::Loop)
+        grandchild_num_vertices(self.g, Sdc::Loop)
     }
 
     fn middle(&self) -> Range<usize> {
@@ -313,7 +313,7 @@ impl PointRows for LoopGrandchildRows<'_> {
     fn row(&self, r: usize, _middle: &[DVec3]) -> DVec3 {
         let (g, src) = (self.g, self.src);
         let (nv, nf) = (g.num_vertices(), g.num_faces());
-        let (nv_m, _, _) = child_counts(g, Scheme::Loop);
+        let (nv_m, _, _) = child_counts(g, Sdc::Loop);
         let edge_point = |e: usize| nv + e;
         let third = |f: usize, k: usize| edge_point(g.face_edges(f)[k % 3] as usize);
         let interior = 3 * nf;

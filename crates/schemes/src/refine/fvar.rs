@@ -18,11 +18,19 @@ use subd_mesh::tags::{is_infinite, is_semi_sharp};
 
 use rayon::prelude::*;
 
-use super::{Lanes, Layout, MaskSink, Points, Refinement, half_sharpness, nm_vertex};
-use crate::Scheme;
+use super::Sdc;
+use super::{Lanes, Layout, MaskSink, OsdRefinement, Points, half_sharpness, nm_vertex};
+use crate::Refinement;
 use crate::rules;
 use crate::stencil::{RowSink, StencilTable};
 use subd_mesh::BoundaryInterpolation;
+
+/// OpenSubdiv's family behind `refinement`, which a [`FaceVaryingRefinement`] was made with.
+fn osd(refinement: &Refinement) -> &OsdRefinement {
+    refinement
+        .opensubdiv()
+        .expect("a FaceVaryingRefinement is made with one of OpenSubdiv's schemes")
+}
 
 /// The tags of one face-varying value (`Vtr::FVarLevel::ValueTag`, the bits that change
 /// interpolation).
@@ -73,8 +81,8 @@ impl ModeFlags {
     }
 
     /// Whether every value is interpolated linearly: mode `all`, or the Bilinear scheme.
-    fn linear(self, scheme: Scheme) -> bool {
-        self.linear_all || scheme == Scheme::Bilinear
+    fn linear(self, scheme: Sdc) -> bool {
+        self.linear_all || scheme == Sdc::Bilinear
     }
 
     fn smooth_boundaries(self) -> bool {
@@ -290,13 +298,18 @@ impl FaceVaryingRefinement {
         channel: &FVarChannel,
         mode: FVarLinearInterpolation,
     ) -> Result<FaceVaryingRefinement, FVarError> {
+        if refinement.opensubdiv().is_none() {
+            return Err(FVarError::Scheme {
+                scheme: refinement.scheme().to_string(),
+            });
+        }
         let base = refinement.topology(0);
         check_channel(base, channel)?;
         let options = refinement.options();
         let flags = ModeFlags::new(mode, options.boundary_interpolation);
         let mut levels = vec![base_level(base, channel.indices(), flags)];
         for l in 1..=refinement.num_levels() {
-            let step = refinement.step(l);
+            let step = osd(refinement).step(l);
             let mut child = child_level(&step, &levels[l - 1], flags);
             child.geometric = geometric_vertices(&step, &levels[l - 1], &child, flags);
             levels.push(child);
@@ -360,7 +373,7 @@ impl FaceVaryingRefinement {
     /// built on first request (`refinement` is the one the channel was refined with).
     pub fn stencils(&self, refinement: &Refinement, level: usize) -> &StencilTable {
         self.stencils[level - 1].get_or_init(|| {
-            let step = refinement.step(level);
+            let step = osd(refinement).step(level);
             let (parent, child) = (&self.levels[level - 1], &self.levels[level]);
             let num_sources = if level == 1 {
                 self.num_user_values
@@ -499,7 +512,7 @@ impl FaceVaryingRefinement {
     /// The step from level `level - 1` of the channel to level `level`.
     fn next_values<'a>(&'a self, refinement: &'a Refinement, level: usize) -> NextValues<'a> {
         NextValues {
-            step: refinement.step(level),
+            step: osd(refinement).step(level),
             parent: &self.levels[level - 1],
             child: &self.levels[level],
             flags: self.flags,
@@ -1259,7 +1272,7 @@ fn child_level(step: &super::Step<'_>, parent: &ChannelLevel, flags: ModeFlags) 
     let l: Layout = step.layout;
     let (nv, nf, ne) = (p.num_vertices(), p.num_faces(), p.num_edges());
     let ncv = l.num_child_vertices;
-    let quads = step.scheme != Scheme::Loop;
+    let quads = step.scheme != Sdc::Loop;
     // Counts by child vertex, in child vertex order.
     let mut offsets = Vec::with_capacity(ncv + 1);
     let mut total = 0u32;
@@ -1554,7 +1567,7 @@ fn fractional_weight(step: &super::Step<'_>, parent: &ChannelLevel, v: usize, sl
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::Options;
+    use crate::{Options, Scheme};
     use subd_mesh::{DVec3, TopologyBuilder};
 
     /// A 3 × 3 grid of quads (16 vertices), z bumped so no two rules agree by accident.
@@ -1614,16 +1627,13 @@ mod tests {
         // vertex) reaches matching values through the same rows.
         let lambda: Vec<f64> = (0..16).map(|v| 0.4 + 0.03 * v as f64).collect();
         let two_phase = crate::TwoPhase::new(lambda).unwrap();
-        for (scheme, t, phase) in [
-            (Scheme::CatmullClark, &t, None),
-            (Scheme::Bilinear, &t, None),
-            (Scheme::Loop, &tris, None),
-            (Scheme::CatmullClark, &t, Some(&two_phase)),
+        for (scheme, t) in [
+            (Scheme::CatmullClark, &t),
+            (Scheme::Bilinear, &t),
+            (Scheme::Loop, &tris),
+            (Scheme::TwoPhase(two_phase), &t),
         ] {
-            let r = match phase {
-                Some(tp) => Refinement::two_phase(t, tp, &Options::default(), 3).unwrap(),
-                None => Refinement::new(t, scheme, &Options::default(), 3).unwrap(),
-            };
+            let r = Refinement::new(t, scheme.clone(), &Options::default(), 3).unwrap();
             let channel =
                 FVarChannel::new(t, 3, xyz.clone(), t.all_face_vertices().to_vec()).unwrap();
             let fr =

@@ -6,17 +6,17 @@
 mod counts;
 mod fused;
 mod fvar;
+mod osd;
 mod par;
-mod refinement;
 mod rows;
 mod split;
 mod stream;
 
-pub use counts::{LevelCounts, refined_counts, refined_split_counts};
+pub use counts::{LevelCounts, refined_counts};
 pub(crate) use counts::{last_level_bytes, topology_bytes};
 pub use fvar::{FVarLevelValues, FVarValueKind, FaceVaryingRefinement};
 pub(crate) use fvar::{base_corner_kinds, check_channel};
-pub use refinement::Refinement;
+pub(crate) use osd::OsdRefinement;
 pub use stream::{FaceStream, PointStream};
 
 pub(crate) use fused::{
@@ -32,7 +32,39 @@ use subd_mesh::{BoundaryInterpolation, CreaseMethod, Topology, TriangleSubdivisi
 use crate::memory;
 use crate::rules::{self, Rule};
 use crate::stencil::{RowSink, StencilTable};
-use crate::{Options, Scheme, two_phase};
+use crate::{Options, two_phase};
+
+/// The mask set of OpenSubdiv's family (its `Sdc::SchemeType`): which split and which
+/// vertex, edge and face masks a level takes. The two-phase scheme is Catmull-Clark with its
+/// first step's vertex masks changed (`Step::phase_one`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Sdc {
+    CatmullClark,
+    Loop,
+    Bilinear,
+}
+
+impl Sdc {
+    /// The mask set of `scheme`, when it is one of OpenSubdiv's family.
+    pub(crate) fn of(scheme: &crate::Scheme) -> Option<Sdc> {
+        use crate::Scheme as S;
+        match scheme {
+            S::CatmullClark | S::TwoPhase(_) => Some(Sdc::CatmullClark),
+            S::Loop => Some(Sdc::Loop),
+            S::Bilinear => Some(Sdc::Bilinear),
+            S::DooSabin | S::Sqrt3 | S::Butterfly { .. } | S::ModifiedButterfly => None,
+        }
+    }
+
+    /// The public scheme of these masks.
+    pub(crate) fn scheme(self) -> crate::Scheme {
+        match self {
+            Sdc::CatmullClark => crate::Scheme::CatmullClark,
+            Sdc::Loop => crate::Scheme::Loop,
+            Sdc::Bilinear => crate::Scheme::Bilinear,
+        }
+    }
+}
 
 /// Rows per parallel task when evaluating points.
 const CHUNK: usize = 4096;
@@ -49,11 +81,11 @@ fn nm_vertex(t: &Topology, v: usize) -> bool {
 /// boundary `None` the faces around unsharpened boundaries become holes.
 pub(crate) fn prepare_base(
     base: &Topology,
-    scheme: Scheme,
+    scheme: Sdc,
     options: &Options,
 ) -> (Topology, Vec<Rule>) {
     let mut t = base.clone();
-    if options.boundary_interpolation == BoundaryInterpolation::None && scheme != Scheme::Bilinear {
+    if options.boundary_interpolation == BoundaryInterpolation::None && scheme != Sdc::Bilinear {
         let mut holes = Vec::new();
         for v in 0..t.num_vertices() {
             let (ve, vf) = (t.vertex_edges(v), t.vertex_faces(v));
@@ -128,14 +160,14 @@ pub(crate) struct Layout {
 }
 
 impl Layout {
-    pub(crate) fn new(p: &Topology, scheme: Scheme) -> Layout {
+    pub(crate) fn new(p: &Topology, scheme: Sdc) -> Layout {
         let (nv, nf, ne) = (
             p.num_vertices() as u32,
             p.num_faces() as u32,
             p.num_edges() as u32,
         );
         match scheme {
-            Scheme::Loop => Layout {
+            Sdc::Loop => Layout {
                 face_vertex_base: nv,
                 edge_vertex_base: nv,
                 half_edge_base: 3 * nf,
@@ -198,7 +230,7 @@ pub(crate) fn explicit_tags(t: &Topology, options: &Options) -> crate::ExplicitT
 /// children keep a vertex sharpness, with their parent's face and edge counts and kind.
 pub(crate) fn child_explicit_tags(
     p: &Topology,
-    scheme: Scheme,
+    scheme: Sdc,
     options: &Options,
 ) -> crate::ExplicitTags {
     let method = options.crease_method;
@@ -238,9 +270,9 @@ pub(crate) struct ChildFaces {
 }
 
 /// Hole flags of the child faces: children of holes are holes ([`FaceStream::hole_faces`]).
-fn child_holes(p: &Topology, scheme: Scheme, num_child_faces: usize) -> Vec<bool> {
+fn child_holes(p: &Topology, scheme: Sdc, num_child_faces: usize) -> Vec<bool> {
     let faces = match scheme {
-        Scheme::Loop => FaceStream::tri_split(p),
+        Sdc::Loop => FaceStream::tri_split(p),
         _ => FaceStream::quad_split(p),
     };
     let mut holes: Vec<bool> = memory::zeroed(num_child_faces);
@@ -251,9 +283,9 @@ fn child_holes(p: &Topology, scheme: Scheme, num_child_faces: usize) -> Vec<bool
 }
 
 /// The child faces only (face-vertex lists and holes).
-pub(crate) fn child_faces(p: &Topology, scheme: Scheme) -> ChildFaces {
+pub(crate) fn child_faces(p: &Topology, scheme: Sdc) -> ChildFaces {
     let (offsets, vertices) = match scheme {
-        Scheme::Loop => split::tri_faces(p),
+        Sdc::Loop => split::tri_faces(p),
         _ => split::quad_faces(p),
     };
     let holes = child_holes(p, scheme, offsets.len() - 1);
@@ -267,12 +299,12 @@ pub(crate) fn child_faces(p: &Topology, scheme: Scheme) -> ChildFaces {
 /// The full child topology with its tags: holes, decayed edge and vertex sharpness.
 pub(crate) fn child_topology(
     p: &Topology,
-    scheme: Scheme,
+    scheme: Sdc,
     options: &Options,
     layout: Layout,
 ) -> Topology {
     let mut child = match scheme {
-        Scheme::Loop => split::tri_split(p),
+        Sdc::Loop => split::tri_split(p),
         _ => split::quad_split(p),
     };
     let method = options.crease_method;
@@ -462,7 +494,7 @@ pub(crate) struct Step<'a> {
     pub parent: &'a Topology,
     pub parent_rules: &'a [Rule],
     pub child_rules: &'a [Rule],
-    pub scheme: Scheme,
+    pub scheme: Sdc,
     pub options: &'a Options,
     pub layout: Layout,
     /// `λ` per parent vertex when this step is phase 1 of the two-phase scheme.
@@ -477,7 +509,7 @@ impl Step<'_> {
         let l = self.layout;
         if r32 < l.face_vertex_base {
             match self.scheme {
-                Scheme::Bilinear => sink.vertex(r32, 1.0),
+                Sdc::Bilinear => sink.vertex(r32, 1.0),
                 _ => self.vertex_row(r, sink),
             }
         } else if r32 < l.edge_vertex_base {
@@ -490,7 +522,7 @@ impl Step<'_> {
         } else {
             let e = (r32 - l.edge_vertex_base) as usize;
             match self.scheme {
-                Scheme::Bilinear => {
+                Sdc::Bilinear => {
                     let [a, b] = p.edge_vertices(e);
                     sink.vertex(a, 0.5);
                     sink.vertex(b, 0.5);
@@ -512,7 +544,7 @@ impl Step<'_> {
         let faces = p.edge_faces(e);
         let nf = faces.len();
         let (mut vw, mut fw) = match self.scheme {
-            Scheme::Loop => (
+            Sdc::Loop => (
                 0.375,
                 if nf == 2 {
                     0.125
@@ -546,7 +578,7 @@ impl Step<'_> {
         sink.edge_vertex(p, e, 1, vw);
         for (&f, &l) in faces.iter().zip(p.edge_face_local_indices(e)) {
             match self.scheme {
-                Scheme::Loop => {
+                Sdc::Loop => {
                     // The vertex opposite the edge, from the edge's first position in the face.
                     let fe = p.face_edges(f as usize);
                     let k = if fe[0] as usize == e {
@@ -776,7 +808,7 @@ impl Step<'_> {
         src: &S,
         face_points: &F,
     ) -> Option<V> {
-        if self.scheme != Scheme::CatmullClark {
+        if self.scheme != Sdc::CatmullClark {
             return None;
         }
         let p = self.parent;
@@ -838,10 +870,10 @@ enum Mask {
 }
 
 impl Mask {
-    fn smooth(p: &Topology, v: usize, scheme: Scheme) -> Mask {
+    fn smooth(p: &Topology, v: usize, scheme: Sdc) -> Mask {
         let nf = p.vertex_faces(v).len();
         match scheme {
-            Scheme::Loop => {
+            Sdc::Loop => {
                 let (e, vw) = loop_smooth_weights(nf);
                 Mask::Smooth {
                     vertex: vw,
@@ -866,7 +898,7 @@ impl Mask {
         p: &Topology,
         v: usize,
         rule: Rule,
-        scheme: Scheme,
+        scheme: Sdc,
         sharpness: impl Fn(usize) -> f32,
     ) -> Mask {
         match rule {

@@ -25,13 +25,14 @@
 //! ```
 //! use subd_mesh::TopologyBuilder;
 //! use subd_mesh::fvar::{FVarChannel, FVarLinearInterpolation};
-//! use subd_schemes::split_schemes::{SplitFaceVarying, SplitRefinement, SplitScheme};
+//! use subd_schemes::split_schemes::SplitFaceVarying;
+//! use subd_schemes::{Options, Refinement, Scheme};
 //!
 //! // Two triangles whose UVs are cut apart along their shared edge 1-2.
 //! let t = TopologyBuilder::new(4).build(&[3, 3], &[0, 1, 2, 2, 1, 3]).unwrap();
 //! let uv = vec![0., 0., 1., 0., 0., 1., 3., 1., 3., 0., 4., 0.];
 //! let channel = FVarChannel::new(&t, 2, uv, (0..6).collect()).unwrap();
-//! let r = SplitRefinement::new(&t, SplitScheme::BUTTERFLY, 1).unwrap();
+//! let r = Refinement::new(&t, Scheme::BUTTERFLY, &Options::default(), 1).unwrap();
 //! let fv = SplitFaceVarying::new(&r, &channel, FVarLinearInterpolation::All).unwrap();
 //! let level1 = fv.refine_values(channel.values(), 2).pop().unwrap();
 //! // Six corner values, and the midpoints of 3 + 3 edges (the seam's once per side).
@@ -45,13 +46,20 @@ use subd_mesh::fvar::{FVarChannel, FVarError, FVarLinearInterpolation};
 use subd_mesh::{BoundaryInterpolation, Topology, TopologyBuilder, TopologyError, tags};
 use thiserror::Error;
 
-use super::{SplitError, SplitRefinement, SplitScheme};
-use crate::{FVarValueKind, StencilTable};
+use super::{SplitError, SplitRefinement};
+use crate::{FVarValueKind, Refinement, Scheme, StencilTable};
 
-/// Why a face-varying channel cannot be refined with a [`SplitRefinement`].
+/// Why a face-varying channel cannot be refined with a split scheme.
 #[derive(Debug, Clone, PartialEq, Error)]
 #[non_exhaustive]
 pub enum SplitFVarError {
+    /// OpenSubdiv's schemes refine face-varying data in their own modes
+    /// ([`crate::FaceVaryingRefinement`]).
+    #[error("the {scheme} scheme refines face-varying data with FaceVaryingRefinement")]
+    Scheme {
+        /// The scheme's name.
+        scheme: &'static str,
+    },
     /// Doo-Sabin and √3 carry seamless channels only (see the [module docs](self)).
     #[error(
         "vertex {vertex} is on a texture seam; the {scheme} split cuts across every edge, so it carries only seamless face-varying data (use a butterfly scheme, or one of OpenSubdiv's)"
@@ -74,7 +82,7 @@ pub enum SplitFVarError {
     Topology(#[from] TopologyError),
 }
 
-/// A face-varying channel refined with a [`SplitRefinement`] (see the [module docs](self)).
+/// A face-varying channel refined with a split scheme (see the [module docs](self)).
 #[derive(Debug)]
 pub struct SplitFaceVarying {
     mode: FVarLinearInterpolation,
@@ -94,10 +102,15 @@ impl SplitFaceVarying {
     /// [`SplitFVarError::Channel`] for a channel without values or without one index per
     /// face-vertex of the base topology.
     pub fn new(
-        refinement: &SplitRefinement,
+        refinement: &Refinement,
         channel: &FVarChannel,
         mode: FVarLinearInterpolation,
     ) -> Result<SplitFaceVarying, SplitFVarError> {
+        if refinement.scheme().is_opensubdiv() {
+            return Err(SplitFVarError::Scheme {
+                scheme: refinement.scheme().name(),
+            });
+        }
         let base = refinement.topology(0);
         crate::refine::check_channel(base, channel)?;
         let indices = channel.indices();
@@ -128,14 +141,14 @@ impl SplitFaceVarying {
             }
         }
         let value_scheme = match scheme {
-            SplitScheme::Butterfly { .. } | SplitScheme::ModifiedButterfly
+            Scheme::Butterfly { .. } | Scheme::ModifiedButterfly
                 if mode == FVarLinearInterpolation::All =>
             {
-                SplitScheme::Butterfly { tension: 0.0 }
+                Scheme::Butterfly { tension: 0.0 }
             }
-            s => s,
+            s => s.clone(),
         };
-        let values = SplitRefinement::new(&topology, value_scheme, refinement.num_levels())?;
+        let values = SplitRefinement::new(&topology, &value_scheme, refinement.num_levels())?;
         Ok(SplitFaceVarying {
             mode,
             num_user_values: channel.num_values(),
@@ -183,7 +196,7 @@ impl SplitFaceVarying {
 
     /// The scheme the values are refined with: the geometry's, or the linear butterfly
     /// (tension 0) in mode `all`.
-    pub fn values_scheme(&self) -> SplitScheme {
+    pub fn values_scheme(&self) -> &Scheme {
         self.values.scheme()
     }
 

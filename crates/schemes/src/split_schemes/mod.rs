@@ -1,9 +1,14 @@
 //! The schemes of seed 001 §4 that OpenSubdiv does not have: Doo-Sabin, √3 (Kobbelt),
 //! Butterfly (Dyn, Levin, Gregory) and Modified Butterfly (Zorin, Schröder, Sweldens).
 //!
-//! Each is a topology split plus masks, refined one level at a time into a [`SplitRefinement`]:
-//! the topology of every level and a [`StencilTable`] per level, which compose into one table
-//! from the base mesh to any level, as [`crate::Refinement`] does for OpenSubdiv's schemes.
+//! Each is a topology split plus masks (one rule file: [`doo_sabin`], [`sqrt3`],
+//! [`butterfly`]), refined one level at a time behind [`crate::Refinement`]: the topology of
+//! every level and a [`StencilTable`] per level, which compose into one table from the base
+//! mesh to any level, as for OpenSubdiv's schemes.
+//!
+//! A rule file gives, for one step over a parent level, the child faces (with the tags the
+//! child keeps) and the mask of every child vertex as weights of parent vertices; a new
+//! scheme is such a file plus its [`Scheme`](crate::Scheme) variant.
 //!
 //! | scheme | input faces | split | interpolating | boundary | creases |
 //! |---|---|---|---|---|---|
@@ -20,12 +25,12 @@
 //!
 //! ```
 //! use subd_mesh::{DVec3, TopologyBuilder};
-//! use subd_schemes::split_schemes::{SplitRefinement, SplitScheme};
+//! use subd_schemes::{Options, Refinement, Scheme};
 //!
 //! // A tetrahedron, three √3 steps: 4 → 12 → 36 → 108 faces.
 //! let faces = [0, 2, 1, 0, 1, 3, 1, 2, 3, 0, 3, 2];
 //! let topo = TopologyBuilder::new(4).build(&[3; 4], &faces).unwrap();
-//! let r = SplitRefinement::new(&topo, SplitScheme::Sqrt3, 3).unwrap();
+//! let r = Refinement::new(&topo, Scheme::Sqrt3, &Options::default(), 3).unwrap();
 //! assert_eq!(r.topology(3).num_faces(), 108);
 //! let points = [DVec3::X, DVec3::Y, DVec3::Z, DVec3::ONE];
 //! let level3 = r.refine_points(&points).pop().unwrap();
@@ -43,145 +48,15 @@ use std::sync::OnceLock;
 use glam::DVec3;
 use rayon::prelude::*;
 use subd_mesh::{Topology, TopologyBuilder, TopologyError, tags};
-use thiserror::Error;
 
-use crate::{MAX_LEVELS, RowSink, StencilTable};
+use crate::rules::Rule;
+use crate::{MAX_LEVELS, RefineError, RowSink, Scheme, StencilTable};
 
 pub use features::Features;
 pub use fvar::{SplitFVarError, SplitFaceVarying};
 
-/// A scheme of seed 001 §4 defined by a split and masks (see the [module docs](self)).
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum SplitScheme {
-    /// Doo-Sabin's dual scheme on any polygons.
-    DooSabin,
-    /// Kobbelt's √3 scheme on triangles.
-    Sqrt3,
-    /// The butterfly scheme of Dyn, Levin and Gregory with tension `w` (1/16 is the classic
-    /// one; 0 is linear interpolation).
-    Butterfly {
-        /// The tension `w`.
-        tension: f64,
-    },
-    /// The modified butterfly scheme of Zorin, Schröder and Sweldens.
-    ModifiedButterfly,
-}
-
-impl SplitScheme {
-    /// The classic butterfly, `w = 1/16`.
-    pub const BUTTERFLY: SplitScheme = SplitScheme::Butterfly {
-        tension: 1.0 / 16.0,
-    };
-
-    /// The scheme's name as the command line spells it.
-    pub fn name(self) -> &'static str {
-        match self {
-            SplitScheme::DooSabin => "doo-sabin",
-            SplitScheme::Sqrt3 => "sqrt3",
-            SplitScheme::Butterfly { .. } => "butterfly",
-            SplitScheme::ModifiedButterfly => "modified-butterfly",
-        }
-    }
-
-    /// Whether the scheme keeps the vertices of every level (the butterflies).
-    pub fn is_interpolating(self) -> bool {
-        matches!(
-            self,
-            SplitScheme::Butterfly { .. } | SplitScheme::ModifiedButterfly
-        )
-    }
-
-    /// Whether the scheme needs triangles (all but Doo-Sabin).
-    pub fn needs_triangles(self) -> bool {
-        self != SplitScheme::DooSabin
-    }
-
-    /// Regular interior valence: 4 for Doo-Sabin's quads, 6 for the triangle schemes.
-    pub fn regular_valence(self) -> usize {
-        if self == SplitScheme::DooSabin { 4 } else { 6 }
-    }
-}
-
-/// Why a mesh cannot be refined with a [`SplitScheme`].
-#[derive(Debug, Clone, PartialEq, Error)]
-#[non_exhaustive]
-pub enum SplitError {
-    /// The scheme needs triangles.
-    #[error("face {face} has {size} vertices; the {scheme} scheme needs triangles")]
-    NotTriangle {
-        /// The scheme's name.
-        scheme: &'static str,
-        /// Face index.
-        face: usize,
-        /// Its size.
-        size: usize,
-    },
-    /// A non-manifold edge.
-    #[error("edge {edge} ({a}-{b}) is non-manifold; the {scheme} scheme needs a manifold mesh")]
-    NonManifoldEdge {
-        /// The scheme's name.
-        scheme: &'static str,
-        /// Edge index.
-        edge: usize,
-        /// Its end vertices.
-        a: u32,
-        /// Its end vertices.
-        b: u32,
-    },
-    /// A non-manifold vertex (faces around it that are not one fan).
-    #[error("vertex {vertex} is non-manifold; the {scheme} scheme needs a manifold mesh")]
-    NonManifoldVertex {
-        /// The scheme's name.
-        scheme: &'static str,
-        /// Vertex index.
-        vertex: usize,
-    },
-    /// A tag the scheme has no rule for.
-    #[error("{what}: the {scheme} scheme {why}")]
-    UnsupportedTag {
-        /// The scheme's name.
-        scheme: &'static str,
-        /// The tagged element, e.g. `edge 4 (1-2)`.
-        what: String,
-        /// Why it cannot be used.
-        why: &'static str,
-    },
-    /// A butterfly tension that is not a finite number.
-    #[error("tension {0} is not a finite number")]
-    Tension(f64),
-    /// Too many levels.
-    #[error("{levels} levels requested; at most {max} are supported")]
-    TooManyLevels {
-        /// Requested levels.
-        levels: usize,
-        /// The maximum.
-        max: usize,
-    },
-    /// The refined mesh would not fit 32-bit indices.
-    #[error("level {level} would have more than 2^32 face-vertices")]
-    TooLarge {
-        /// The level that overflows.
-        level: usize,
-    },
-    /// The memory for a level could not be allocated (see
-    /// [`crate::RefineError::OutOfMemory`]).
-    #[error("level {level} needs about {} more memory, which cannot be allocated", crate::memory::human_bytes(*bytes))]
-    OutOfMemory {
-        /// The level that does not fit.
-        level: usize,
-        /// About how many bytes it needs.
-        bytes: u64,
-    },
-    /// Building a refined level's topology failed (a bug if it ever happens).
-    #[error("level {level}: {source}")]
-    Topology {
-        /// The level.
-        level: usize,
-        /// What the topology builder said.
-        source: TopologyError,
-    },
-}
+/// The error of a split step or refinement (one type for both families).
+pub(crate) type SplitError = RefineError;
 
 /// The faces and tags of a refined level, before its topology is built.
 #[derive(Debug, Clone)]
@@ -274,17 +149,18 @@ enum Step<'a> {
 }
 
 impl Step<'_> {
-    fn new(p: &Topology, scheme: SplitScheme, level: usize) -> Step<'_> {
+    fn new<'a>(p: &'a Topology, scheme: &Scheme, level: usize) -> Step<'a> {
         match scheme {
-            SplitScheme::DooSabin => Step::DooSabin(doo_sabin::Step::new(p)),
-            SplitScheme::Sqrt3 => Step::Sqrt3(sqrt3::Step::new(p, level % 2 == 0)),
-            SplitScheme::Butterfly { tension } => Step::Butterfly(butterfly::Step::new(
+            Scheme::DooSabin => Step::DooSabin(doo_sabin::Step::new(p)),
+            Scheme::Sqrt3 => Step::Sqrt3(sqrt3::Step::new(p, level % 2 == 0)),
+            Scheme::Butterfly { tension } => Step::Butterfly(butterfly::Step::new(
                 p,
-                butterfly::EdgeRule::Classic { tension },
+                butterfly::EdgeRule::Classic { tension: *tension },
             )),
-            SplitScheme::ModifiedButterfly => {
+            Scheme::ModifiedButterfly => {
                 Step::Butterfly(butterfly::Step::new(p, butterfly::EdgeRule::Modified))
             }
+            _ => unreachable!("the split family refines split schemes only"),
         }
     }
 
@@ -343,19 +219,22 @@ struct SplitLevel {
     faces: ChildFaces,
     topology: OnceLock<Topology>,
     stencils: OnceLock<StencilTable>,
+    rules: OnceLock<Vec<Rule>>,
 }
 
-/// A uniform refinement with a [`SplitScheme`]: the topology of every level and the stencils
-/// between levels.
+/// A uniform refinement with a split scheme: the topology of every level and the stencils
+/// between levels (the family behind [`crate::Refinement`] for Doo-Sabin, √3 and the
+/// butterflies).
 ///
 /// Like [`crate::Refinement`], it computes what a refinement always needs up front (the
 /// faces of every level, the topology of every level but the last) and the rest on request:
 /// the last level's full topology, and the stencil tables. [`Self::refine_points`] evaluates
 /// the masks directly, level by level, in parallel, with the same rows the tables hold.
 #[derive(Debug)]
-pub struct SplitRefinement {
-    scheme: SplitScheme,
+pub(crate) struct SplitRefinement {
+    scheme: Scheme,
     base: Topology,
+    base_rules: OnceLock<Vec<Rule>>,
     levels: Vec<SplitLevel>,
 }
 
@@ -368,7 +247,7 @@ impl SplitRefinement {
     /// crease for Doo-Sabin), a tension that is not finite, or too many levels.
     pub fn new(
         base: &Topology,
-        scheme: SplitScheme,
+        scheme: &Scheme,
         levels: usize,
     ) -> Result<SplitRefinement, SplitError> {
         check_input(base, scheme, levels)?;
@@ -379,7 +258,7 @@ impl SplitRefinement {
                 Some(s) => s.topology.get().expect("levels above the last are built"),
             };
             // Refuse a level whose arrays cannot be allocated before filling any of them.
-            let child = crate::LevelCounts::of(parent).refined_split(scheme);
+            let child = crate::LevelCounts::of(parent).refined(scheme);
             let need = if l < levels {
                 crate::refine::topology_bytes(child)
             } else {
@@ -405,18 +284,20 @@ impl SplitRefinement {
                 faces,
                 topology,
                 stencils: OnceLock::new(),
+                rules: OnceLock::new(),
             });
         }
         Ok(SplitRefinement {
-            scheme,
+            scheme: scheme.clone(),
             base: base.clone(),
+            base_rules: OnceLock::new(),
             levels: out,
         })
     }
 
     /// The scheme.
-    pub fn scheme(&self) -> SplitScheme {
-        self.scheme
+    pub fn scheme(&self) -> &Scheme {
+        &self.scheme
     }
 
     /// Number of refined levels.
@@ -494,37 +375,105 @@ impl SplitRefinement {
     pub fn stencils(&self, level: usize) -> &StencilTable {
         self.levels[level - 1].stencils.get_or_init(|| {
             let parent = self.topology(level - 1);
-            Step::new(parent, self.scheme, level).stencils(parent.num_vertices())
+            Step::new(parent, &self.scheme, level).stencils(parent.num_vertices())
         })
     }
 
-    /// One table from the base vertices to the vertices of `level`.
-    pub fn composed(&self, level: usize) -> StencilTable {
-        let mut t = StencilTable::identity(self.base.num_vertices());
-        for l in 1..=level {
-            t = t.then(self.stencils(l));
-        }
-        t
+    /// Points of `level` from those of the level above, the masks evaluated directly, in
+    /// parallel, with the same rows the tables hold.
+    pub fn next_points(&self, level: usize, above: &[DVec3]) -> Vec<DVec3> {
+        Step::new(self.topology(level - 1), &self.scheme, level).points(above)
     }
 
-    /// Positions of every level from base positions (`result[0]` is `base`), the masks
-    /// evaluated directly, level by level, in parallel.
-    ///
-    /// # Panics
-    /// If `base.len()` differs from the number of base vertices.
-    pub fn refine_points(&self, base: &[DVec3]) -> Vec<Vec<DVec3>> {
-        assert_eq!(
-            base.len(),
-            self.base.num_vertices(),
-            "one position per base vertex"
-        );
-        let mut out = vec![base.to_vec()];
-        for l in 1..=self.levels.len() {
-            let parent = self.topology(l - 1);
-            let next = Step::new(parent, self.scheme, l).points(out.last().expect("level 0"));
-            out.push(next);
+    /// The rule of every vertex of `level`, as OpenSubdiv would name it from the level's
+    /// feature edges (boundary and infinitely sharp) and corner tags.
+    pub fn vertex_rules(&self, level: usize) -> &[Rule] {
+        let cell = match level {
+            0 => &self.base_rules,
+            l => &self.levels[l - 1].rules,
+        };
+        cell.get_or_init(|| {
+            let t = self.topology(level);
+            (0..t.num_vertices())
+                .map(|v| {
+                    let sharp = t
+                        .vertex_edges(v)
+                        .iter()
+                        .filter(|&&e| {
+                            let e = e as usize;
+                            t.is_boundary_edge(e) || t.edge_sharpness(e) > 0.0
+                        })
+                        .count();
+                    Rule::determine(t.vertex_sharpness(v), sharp)
+                })
+                .collect()
+        })
+    }
+
+    /// Takes the topology of `level` out of the refinement.
+    pub fn into_topology(mut self, level: usize) -> Topology {
+        self.topology(level);
+        match level {
+            0 => self.base,
+            l => self
+                .levels
+                .swap_remove(l - 1)
+                .topology
+                .into_inner()
+                .expect("built just above"),
         }
-        out
+    }
+}
+
+impl crate::family::Family for SplitRefinement {
+    fn num_levels(&self) -> usize {
+        SplitRefinement::num_levels(self)
+    }
+    fn num_vertices(&self, level: usize) -> usize {
+        SplitRefinement::num_vertices(self, level)
+    }
+    fn num_edges(&self, level: usize) -> Option<usize> {
+        // The last level's edges are never built unless its topology is asked for.
+        (level == 0 || level < self.levels.len() || self.levels[level - 1].topology.get().is_some())
+            .then(|| self.topology(level).num_edges())
+    }
+    fn faces(&self, level: usize) -> (&[u32], &[u32]) {
+        SplitRefinement::faces(self, level)
+    }
+    fn holes(&self, level: usize) -> std::borrow::Cow<'_, [bool]> {
+        // The split schemes refuse holes.
+        std::borrow::Cow::Owned(vec![false; self.faces(level).0.len() - 1])
+    }
+    fn has_sharpness(&self, level: usize) -> bool {
+        let tags = SplitRefinement::explicit_tags(self, level);
+        !tags.creases.is_empty() || !tags.corners.is_empty()
+    }
+    fn explicit_tags(&self, level: usize) -> crate::ExplicitTags {
+        SplitRefinement::explicit_tags(self, level)
+    }
+    fn topology(&self, level: usize) -> &Topology {
+        SplitRefinement::topology(self, level)
+    }
+    fn has_topology(&self, level: usize) -> bool {
+        level == 0 || self.levels[level - 1].topology.get().is_some()
+    }
+    fn into_topology(self: Box<Self>, level: usize) -> Topology {
+        SplitRefinement::into_topology(*self, level)
+    }
+    fn vertex_rules(&self, level: usize) -> &[Rule] {
+        SplitRefinement::vertex_rules(self, level)
+    }
+    fn stencils(&self, level: usize) -> &StencilTable {
+        SplitRefinement::stencils(self, level)
+    }
+    fn next_points(&self, level: usize, above: &[DVec3]) -> Vec<DVec3> {
+        SplitRefinement::next_points(self, level, above)
+    }
+    fn face_stream(&self) -> Option<crate::FaceStream<'_>> {
+        None
+    }
+    fn point_stream<'a>(&'a self, _above: &'a [DVec3]) -> Option<crate::PointStream<'a>> {
+        None
     }
 }
 
@@ -551,7 +500,7 @@ impl From<TopologyError> for StepError {
 }
 
 /// The checks every split scheme makes on its input before the first step.
-fn check_input(base: &Topology, scheme: SplitScheme, levels: usize) -> Result<(), SplitError> {
+fn check_input(base: &Topology, scheme: &Scheme, levels: usize) -> Result<(), SplitError> {
     let name = scheme.name();
     if levels > MAX_LEVELS {
         return Err(SplitError::TooManyLevels {
@@ -559,12 +508,12 @@ fn check_input(base: &Topology, scheme: SplitScheme, levels: usize) -> Result<()
             max: MAX_LEVELS,
         });
     }
-    if let SplitScheme::Butterfly { tension } = scheme
+    if let Scheme::Butterfly { tension } = *scheme
         && !tension.is_finite()
     {
         return Err(SplitError::Tension(tension));
     }
-    if scheme.needs_triangles()
+    if scheme.input_faces() == crate::FaceKind::Triangles
         && let Some(f) = (0..base.num_faces()).find(|&f| base.face_size(f) != 3)
     {
         return Err(SplitError::NotTriangle {
@@ -602,7 +551,7 @@ fn check_input(base: &Topology, scheme: SplitScheme, levels: usize) -> Result<()
         }
         let [a, b] = base.edge_vertices(e);
         let what = format!("edge {e} ({a}-{b}) crease {s}");
-        if scheme == SplitScheme::DooSabin {
+        if *scheme == Scheme::DooSabin {
             return Err(SplitError::UnsupportedTag {
                 scheme: name,
                 what,
@@ -617,7 +566,7 @@ fn check_input(base: &Topology, scheme: SplitScheme, levels: usize) -> Result<()
             });
         }
     }
-    if scheme == SplitScheme::DooSabin
+    if *scheme == Scheme::DooSabin
         && let Some(v) = (0..base.num_vertices()).find(|&v| base.vertex_sharpness(v) > 0.0)
     {
         return Err(SplitError::UnsupportedTag {

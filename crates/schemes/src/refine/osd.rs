@@ -1,14 +1,16 @@
-//! [`Refinement`]: the topology of every level of a uniform refinement and the stencils
-//! between levels, for OpenSubdiv's schemes and the two-phase scheme.
+//! [`OsdRefinement`]: the topology of every level of a uniform refinement and the stencils
+//! between levels, for OpenSubdiv's schemes and the two-phase scheme (the family behind
+//! [`crate::Refinement`] for those schemes).
 
 use std::sync::OnceLock;
 
 use subd_mesh::{DVec3, Topology};
 
+use super::Sdc;
 use crate::memory;
 use crate::rules::Rule;
 use crate::stencil::StencilTable;
-use crate::{ExplicitTags, MAX_LEVELS, Options, RefineError, Scheme, TwoPhase};
+use crate::{ExplicitTags, MAX_LEVELS, Options, RefineError};
 
 /// One level of a refinement.
 #[derive(Debug)]
@@ -41,8 +43,8 @@ struct Level {
 /// built either: the last level's faces, rules and points are derived from the level two
 /// above, with the same results bit for bit ([`Self::has_topology`]).
 #[derive(Debug)]
-pub struct Refinement {
-    scheme: Scheme,
+pub(crate) struct OsdRefinement {
+    scheme: Sdc,
     options: Options,
     levels: Vec<Level>,
     stencils: Vec<OnceLock<StencilTable>>,
@@ -51,17 +53,18 @@ pub struct Refinement {
 }
 
 /// What every refinement checks first: the level count, and triangles for Loop.
-fn check_request(t: &Topology, scheme: Scheme, levels: usize) -> Result<(), RefineError> {
+fn check_request(t: &Topology, scheme: Sdc, levels: usize) -> Result<(), RefineError> {
     if levels > MAX_LEVELS {
         return Err(RefineError::TooManyLevels {
             levels,
             max: MAX_LEVELS,
         });
     }
-    if scheme == Scheme::Loop
+    if scheme == Sdc::Loop
         && let Some(f) = (0..t.num_faces()).find(|&f| t.face_size(f) != 3)
     {
         return Err(RefineError::NotTriangle {
+            scheme: "Loop",
             face: f,
             size: t.face_size(f),
         });
@@ -69,11 +72,11 @@ fn check_request(t: &Topology, scheme: Scheme, levels: usize) -> Result<(), Refi
     Ok(())
 }
 
-impl Refinement {
+impl OsdRefinement {
     /// Refines `base` uniformly `levels` times.
     pub fn new(
         base: &Topology,
-        scheme: Scheme,
+        scheme: Sdc,
         options: &Options,
         levels: usize,
     ) -> Result<Self, RefineError> {
@@ -94,7 +97,7 @@ impl Refinement {
     pub fn from_prepared(
         level: Topology,
         rules: Vec<Rule>,
-        scheme: Scheme,
+        scheme: Sdc,
         options: &Options,
         levels: usize,
     ) -> Result<Self, RefineError> {
@@ -111,11 +114,11 @@ impl Refinement {
     fn refine_prepared(
         t0: Topology,
         rules0: Vec<Rule>,
-        scheme: Scheme,
+        scheme: Sdc,
         options: &Options,
         levels: usize,
     ) -> Result<Self, RefineError> {
-        let mut r = Refinement {
+        let mut r = OsdRefinement {
             scheme,
             options: *options,
             levels: vec![Level {
@@ -138,10 +141,10 @@ impl Refinement {
                 return Err(RefineError::TooLarge { level: l });
             }
             // Refuse a level whose arrays cannot be allocated before filling any of them.
-            let child = super::LevelCounts::of(p).refined(scheme);
+            let child = super::LevelCounts::of(p).refined(&scheme.scheme());
             let fused = l + 1 == levels;
             let need = match (l < levels, fused) {
-                (true, true) => super::last_level_bytes(child.refined(scheme)),
+                (true, true) => super::last_level_bytes(child.refined(&scheme.scheme())),
                 (true, false) => super::topology_bytes(child),
                 (false, _) => super::last_level_bytes(child),
             };
@@ -199,33 +202,16 @@ impl Refinement {
     }
 
     /// Refines `base` with the two-phase modified Catmull-Clark scheme of seed 000: level 1
-    /// is phase 1 (the modified vertex rule with `two_phase`'s `λ`, see [`two_phase`](crate::two_phase)),
-    /// levels 2 and on are ordinary Catmull-Clark. Topology and vertex order are
-    /// Catmull-Clark's; [`Self::scheme`] reports [`Scheme::CatmullClark`] and
-    /// [`Self::phase_one_lambda`] the `λ`.
-    ///
-    /// ```
-    /// use subd_mesh::{DVec3, TopologyBuilder};
-    /// use subd_schemes::{Options, Refinement, TwoPhase};
-    ///
-    /// let faces = [0, 1, 3, 2, 2, 3, 5, 4, 4, 5, 7, 6, 6, 7, 1, 0, 1, 7, 5, 3, 6, 0, 2, 4];
-    /// let cube = TopologyBuilder::new(8).build(&[4; 6], &faces).unwrap();
-    /// let points: Vec<DVec3> = (0..8)
-    ///     .map(|i| DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64))
-    ///     .collect();
-    /// // λ = 1 freezes the vertices in phase 1.
-    /// let tp = TwoPhase::uniform(8, 1.0).unwrap();
-    /// let r = Refinement::two_phase(&cube, &tp, &Options::default(), 1).unwrap();
-    /// let level1 = r.refine_points(&points).pop().unwrap();
-    /// assert_eq!(level1[..8], points[..]);
-    /// ```
+    /// is phase 1 (the modified vertex rule with `two_phase`'s `λ`, see
+    /// [`two_phase`](crate::two_phase)), levels 2 and on are ordinary Catmull-Clark.
     ///
     /// # Errors
     /// [`RefineError::NotQuad`] for a face that is not a quad, [`RefineError::LambdaCount`]
-    /// when there is not one `λ` per vertex, and as [`Self::new`].
+    /// or [`RefineError::MissingLambda`] when there is not one `λ` per vertex, and as
+    /// [`Self::new`].
     pub fn two_phase(
         base: &Topology,
-        two_phase: &TwoPhase,
+        two_phase: &crate::TwoPhase,
         options: &Options,
         levels: usize,
     ) -> Result<Self, RefineError> {
@@ -235,31 +221,15 @@ impl Refinement {
                 size: base.face_size(f),
             });
         }
-        let lambda = two_phase.lambda();
-        if lambda.len() != base.num_vertices() {
-            return Err(RefineError::LambdaCount {
-                given: lambda.len(),
-                vertices: base.num_vertices(),
-            });
-        }
-        let mut r = Self::new(base, Scheme::CatmullClark, options, levels)?;
-        r.phase_one = Some(lambda.to_vec());
+        let lambda = two_phase.lambda_for(base.num_vertices())?;
+        let mut r = Self::new(base, Sdc::CatmullClark, options, levels)?;
+        r.phase_one = Some(lambda);
         Ok(r)
     }
 
     /// `λ` of every base vertex when this is a two-phase refinement.
     pub fn phase_one_lambda(&self) -> Option<&[f64]> {
         self.phase_one.as_deref()
-    }
-
-    /// The scheme.
-    pub fn scheme(&self) -> Scheme {
-        self.scheme
-    }
-
-    /// The options.
-    pub fn options(&self) -> &Options {
-        &self.options
     }
 
     /// Number of refined levels (level 0 is the base).
@@ -364,26 +334,12 @@ impl Refinement {
     /// the one above that, see [`Self::has_topology`]) without building them all: for
     /// writing a deep level to a file. `None` when nothing is refined (level 0 is the
     /// last).
-    ///
-    /// ```
-    /// use subd_mesh::TopologyBuilder;
-    /// use subd_schemes::{Options, Refinement, Scheme};
-    ///
-    /// let faces = [0, 1, 3, 2, 2, 3, 5, 4, 4, 5, 7, 6, 6, 7, 1, 0, 1, 7, 5, 3, 6, 0, 2, 4];
-    /// let cube = TopologyBuilder::new(8).build(&[4; 6], &faces).unwrap();
-    /// let r = Refinement::new(&cube, Scheme::CatmullClark, &Options::default(), 3).unwrap();
-    /// let stream = r.face_stream().unwrap();
-    /// assert_eq!(stream.num_faces(), 6 * 64);
-    /// let mut part = Vec::new();
-    /// stream.fill(100..110, &mut part);
-    /// assert_eq!(part[..], r.faces(3).1[4 * 100..4 * 110]);
-    /// ```
     pub fn face_stream(&self) -> Option<super::FaceStream<'_>> {
         let last = self.num_levels();
         if last == 0 {
             return None;
         }
-        let quads = self.scheme != Scheme::Loop;
+        let quads = self.scheme != Sdc::Loop;
         Some(if self.skips_parent(last) {
             super::FaceStream::grandchild(self.topology(last - 2), quads)
         } else if quads {
@@ -396,23 +352,6 @@ impl Refinement {
     /// The points of the last level, a range at a time, from `above`, the points of the
     /// level before it ([`Self::points_at`]): bit for bit those of [`Self::refine_points`],
     /// without holding them all. `None` when nothing is refined.
-    ///
-    /// ```
-    /// use subd_mesh::{DVec3, TopologyBuilder};
-    /// use subd_schemes::{Options, Refinement, Scheme};
-    ///
-    /// let faces = [0, 1, 3, 2, 2, 3, 5, 4, 4, 5, 7, 6, 6, 7, 1, 0, 1, 7, 5, 3, 6, 0, 2, 4];
-    /// let cube = TopologyBuilder::new(8).build(&[4; 6], &faces).unwrap();
-    /// let points: Vec<DVec3> = (0..8)
-    ///     .map(|i| DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64))
-    ///     .collect();
-    /// let r = Refinement::new(&cube, Scheme::CatmullClark, &Options::default(), 2).unwrap();
-    /// let above = r.points_at(&points, 1);
-    /// let stream = r.point_stream(&above).unwrap();
-    /// let mut part = vec![DVec3::ZERO; 20];
-    /// stream.fill(50, &mut part);
-    /// assert_eq!(part[..], r.refine_points(&points)[2][50..70]);
-    /// ```
     ///
     /// # Panics
     /// If `above` does not have one point per vertex of the level before the last.
@@ -430,7 +369,7 @@ impl Refinement {
         Some(if self.skips_parent(last) {
             let g = self.topology(last - 2);
             match self.scheme {
-                Scheme::Loop => super::PointStream::loop_grandchild(g, above),
+                Sdc::Loop => super::PointStream::loop_grandchild(g, above),
                 _ => super::PointStream::catmark_grandchild(g, above),
             }
         } else {
@@ -452,21 +391,6 @@ impl Refinement {
     /// request; so is the level before it on a closed, smooth Catmull-Clark (all-quad) or Loop
     /// mesh, whose last level is then derived from the level two above (every result is the
     /// same as with the level built, bit for bit).
-    ///
-    /// ```
-    /// use subd_mesh::TopologyBuilder;
-    /// use subd_schemes::{Options, Refinement, Scheme};
-    ///
-    /// // A cube: closed, smooth, all quads.
-    /// let faces = [0, 1, 3, 2, 2, 3, 5, 4, 4, 5, 7, 6, 6, 7, 1, 0, 1, 7, 5, 3, 6, 0, 2, 4];
-    /// let cube = TopologyBuilder::new(8).build(&[4; 6], &faces).unwrap();
-    /// let r = Refinement::new(&cube, Scheme::CatmullClark, &Options::default(), 3).unwrap();
-    /// assert!(r.has_topology(1));
-    /// assert!(!r.has_topology(2) && !r.has_topology(3));
-    /// assert_eq!(r.faces(3).1.len(), 4 * 6 * 64);
-    /// assert_eq!(r.topology(3).num_faces(), 6 * 64); // builds levels 2 and 3
-    /// assert!(r.has_topology(2));
-    /// ```
     pub fn has_topology(&self, level: usize) -> bool {
         self.levels[level].topology.get().is_some()
     }
@@ -510,66 +434,69 @@ impl Refinement {
         self.stencils[level - 1].get_or_init(|| self.step(level).stencils())
     }
 
-    /// One table from the base vertices to the vertices of `level`.
-    pub fn composed(&self, level: usize) -> StencilTable {
-        let mut t = StencilTable::identity(self.levels[0].num_vertices);
-        for l in 1..=level {
-            t = t.then(self.stencils(l));
-        }
-        t
-    }
-
-    /// Positions of every level from base positions (`result[0]` is `base`), evaluating the
-    /// masks directly, level by level, in parallel.
-    ///
-    /// # Panics
-    /// If `base.len()` differs from the number of base vertices.
-    pub fn refine_points(&self, base: &[DVec3]) -> Vec<Vec<DVec3>> {
-        self.check_base(base);
-        let mut out = vec![base.to_vec()];
-        for l in 1..self.levels.len() {
-            let next = self.next_points(l, out.last().expect("level 0"));
-            out.push(next);
-        }
-        out
-    }
-
-    /// Positions of `level` alone from base positions, each level dropped once the next is
-    /// computed: [`Self::refine_points`]`(base)[level]` in less memory.
-    ///
-    /// # Panics
-    /// If `base.len()` differs from the number of base vertices, or `level` is beyond
-    /// [`Self::num_levels`].
-    pub fn points_at(&self, base: &[DVec3], level: usize) -> Vec<DVec3> {
-        self.check_base(base);
-        assert!(level <= self.num_levels(), "level {level} is not refined");
-        let mut points = base.to_vec();
-        for l in 1..=level {
-            points = self.next_points(l, &points);
-        }
-        points
-    }
-
     /// Whether `level` comes from its grandparent with the level between still unbuilt
     /// (so its faces and points are derived from `level - 2`).
     fn skips_parent(&self, level: usize) -> bool {
         self.levels[level].from_grandparent && !self.has_topology(level - 1)
     }
 
-    fn check_base(&self, base: &[DVec3]) {
-        assert_eq!(
-            base.len(),
-            self.levels[0].num_vertices,
-            "one position per base vertex"
-        );
-    }
-
     /// Points of `level` from those of the level above.
-    fn next_points(&self, level: usize, src: &[DVec3]) -> Vec<DVec3> {
+    pub(crate) fn next_points(&self, level: usize, src: &[DVec3]) -> Vec<DVec3> {
         if self.skips_parent(level) {
             super::grandchild_points(self.topology(level - 2), self.scheme, src)
         } else {
             self.step(level).points(src)
         }
+    }
+}
+
+impl crate::family::Family for OsdRefinement {
+    fn num_levels(&self) -> usize {
+        OsdRefinement::num_levels(self)
+    }
+    fn num_vertices(&self, level: usize) -> usize {
+        OsdRefinement::num_vertices(self, level)
+    }
+    fn num_edges(&self, level: usize) -> Option<usize> {
+        Some(OsdRefinement::num_edges(self, level))
+    }
+    fn faces(&self, level: usize) -> (&[u32], &[u32]) {
+        OsdRefinement::faces(self, level)
+    }
+    fn holes(&self, level: usize) -> std::borrow::Cow<'_, [bool]> {
+        std::borrow::Cow::Borrowed(OsdRefinement::holes(self, level))
+    }
+    fn has_sharpness(&self, level: usize) -> bool {
+        OsdRefinement::has_sharpness(self, level)
+    }
+    fn explicit_tags(&self, level: usize) -> ExplicitTags {
+        OsdRefinement::explicit_tags(self, level)
+    }
+    fn topology(&self, level: usize) -> &Topology {
+        OsdRefinement::topology(self, level)
+    }
+    fn has_topology(&self, level: usize) -> bool {
+        OsdRefinement::has_topology(self, level)
+    }
+    fn into_topology(self: Box<Self>, level: usize) -> Topology {
+        OsdRefinement::into_topology(*self, level)
+    }
+    fn vertex_rules(&self, level: usize) -> &[Rule] {
+        OsdRefinement::vertex_rules(self, level)
+    }
+    fn stencils(&self, level: usize) -> &StencilTable {
+        OsdRefinement::stencils(self, level)
+    }
+    fn next_points(&self, level: usize, above: &[DVec3]) -> Vec<DVec3> {
+        OsdRefinement::next_points(self, level, above)
+    }
+    fn face_stream(&self) -> Option<super::FaceStream<'_>> {
+        OsdRefinement::face_stream(self)
+    }
+    fn point_stream<'a>(&'a self, above: &'a [DVec3]) -> Option<super::PointStream<'a>> {
+        OsdRefinement::point_stream(self, above)
+    }
+    fn as_opensubdiv(&self) -> Option<&OsdRefinement> {
+        Some(self)
     }
 }
