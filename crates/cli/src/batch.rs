@@ -86,6 +86,10 @@ pub(crate) const MESH_OUTPUTS: &[OutputFormat] =
 
 #[derive(Serialize)]
 struct FileError<'a> {
+    /// The input's place in the batch (batch mode only), so a report in completion order
+    /// can be put back in input order.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    index: Option<usize>,
     input: String,
     output: String,
     error: &'a str,
@@ -106,6 +110,26 @@ struct SummaryLine {
     summary: Summary,
 }
 
+/// A command's JSON report lines with the input's place in the batch as their first field
+/// (`{"index":3,...}`); lines that are not JSON objects pass unchanged.
+fn with_index(report: &[u8], index: usize) -> Vec<u8> {
+    let mut out = Vec::with_capacity(report.len() + 16);
+    for line in report.split_inclusive(|&b| b == b'\n') {
+        match line.strip_prefix(b"{") {
+            Some(rest) if rest.first().is_some_and(|&b| b != b'}') => {
+                out.extend_from_slice(format!("{{\"index\":{index},").as_bytes());
+                out.extend_from_slice(rest);
+            }
+            Some(rest) => {
+                out.extend_from_slice(format!("{{\"index\":{index}").as_bytes());
+                out.extend_from_slice(rest);
+            }
+            None => out.extend_from_slice(line),
+        }
+    }
+    out
+}
+
 /// What one file's run left behind, sent from a worker to the thread that owns the
 /// output streams.
 struct Outcome {
@@ -117,7 +141,8 @@ struct Outcome {
 
 /// Runs `one` on the command's file(s): once with `IN OUT`, or on every input with
 /// `--out-dir`. `json` is the command's `--json`: batch mode then prints one line per file
-/// (the command's report, or the error) and a summary line.
+/// (the command's report, or the error, with the input's `index` in the batch first: lines
+/// come in completion order) and a summary line last.
 pub(crate) fn run<F>(
     files: &Files,
     command: &Command,
@@ -209,13 +234,18 @@ where
                     let _ = writeln!(err, "subd: {}", f.message);
                 }
             });
-            let _ = out.write_all(&outcome.stdout);
+            if json && jobs.len() > 1 {
+                let _ = out.write_all(&with_index(&outcome.stdout, outcome.index));
+            } else {
+                let _ = out.write_all(&outcome.stdout);
+            }
             if let Some(f) = outcome.failure {
                 failed += 1;
                 if json {
                     crate::print_json(
                         out,
                         &FileError {
+                            index: (jobs.len() > 1).then_some(outcome.index),
                             input: job.input.display().to_string(),
                             output: job.output.display().to_string(),
                             error: &f.message,
@@ -400,6 +430,25 @@ impl FilesBar {
     fn finish(&self) {
         if let Some(b) = &self.bar {
             b.finish_and_clear();
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::with_index;
+
+    #[test]
+    fn index_goes_first_in_every_report_line() {
+        let report = b"{\"input\":\"a.obj\",\"levels\":2}\n{}\nnot json\n";
+        let got = String::from_utf8(with_index(report, 7)).unwrap();
+        assert_eq!(
+            got,
+            "{\"index\":7,\"input\":\"a.obj\",\"levels\":2}\n{\"index\":7}\nnot json\n"
+        );
+        for line in got.lines().take(2) {
+            let v: serde_json::Value = serde_json::from_str(line).unwrap();
+            assert_eq!(v["index"], 7);
         }
     }
 }

@@ -63,27 +63,30 @@ enum Command {
     /// Topology summary: counts, face-size and valence histograms, boundary, non-manifold
     /// elements, tags, components, Euler characteristic and genus.
     Info(info::InfoArgs),
-    /// Uniform refinement with Catmull-Clark, Loop or Bilinear, agreeing with OpenSubdiv.
+    /// Uniform refinement with any surface scheme: Catmull-Clark, Loop and Bilinear (agreeing
+    /// with OpenSubdiv), two-phase, Doo-Sabin, √3, Butterfly and Modified Butterfly.
     Refine(refine::RefineArgs),
-    /// Limit position (and normal) of every vertex, exact: semi-sharp creases are refined
-    /// until they decay, darts and valence-2 vertices use the eigen analysis.
+    /// Limit position (and normal) of every vertex with any scheme but Bilinear, exact:
+    /// semi-sharp creases are refined until they decay, darts, valence-2 vertices and the
+    /// split schemes use the eigen analysis.
     Limit(limit::LimitArgs),
-    /// The exact limit surface (position and unit normal) at given (face, u, v) parameters,
-    /// in OpenSubdiv's parameterisation.
+    /// The exact Catmull-Clark or Loop limit surface (position and unit normal) at given
+    /// (face, u, v) parameters, in OpenSubdiv's parameterisation.
     Eval(eval::EvalArgs),
-    /// The limit surface on a uniform grid of N segments per base edge, positions and
-    /// normals, watertight (OpenSubdiv Bfr's uniform tessellation).
+    /// The Catmull-Clark or Loop limit surface on a uniform grid of N segments per base edge,
+    /// positions and normals, watertight (OpenSubdiv Bfr's uniform tessellation).
     Tessellate(tessellate::TessellateArgs),
     /// Adaptive Loop or Catmull-Clark refinement: only where criteria select (flatness,
     /// distance to the limit, curvature, dihedral angle, chosen faces or vertices), closed
     /// into a crack-free mesh whose every vertex is uniform refinement's (or the limit's).
     Adaptive(adaptive::AdaptiveArgs),
-    /// Progressive iterative interpolation: a control mesh with IN's topology whose limit
-    /// surface passes through IN's vertices (all, or those chosen with --moving/--fixed).
+    /// Progressive iterative interpolation (Catmull-Clark, Loop, two-phase): a control mesh
+    /// with IN's topology whose limit surface passes through IN's vertices (all, or those
+    /// chosen with --moving/--fixed).
     Pia(pia::PiaArgs),
-    /// Constraint-based editing of the limit surface (points, normals, iso-lines): the
-    /// control vertices that meet the constraints with the least change or the least
-    /// thin-plate energy.
+    /// Constraint-based editing of the Catmull-Clark or Loop limit surface (points, normals,
+    /// iso-lines): the control vertices that meet the constraints with the least change or
+    /// the least thin-plate energy.
     Edit(edit::EditArgs),
     /// Simple constrained deformation: points move by radial blends around constraint
     /// points, each constraint point exactly by its displacement (any mesh level).

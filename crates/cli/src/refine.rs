@@ -1,5 +1,6 @@
-//! `subd refine`: uniform refinement of a mesh file with Catmull-Clark, Loop or Bilinear
-//! (OpenSubdiv's schemes), seed 000's two-phase scheme, or Doo-Sabin, √3 and the butterflies.
+//! `subd refine`: uniform refinement of a mesh file with any surface scheme (one
+//! `subd_schemes::Refinement`): Catmull-Clark, Loop or Bilinear (OpenSubdiv's schemes), seed
+//! 000's two-phase scheme, or Doo-Sabin, √3 and the butterflies.
 
 use std::io::{IsTerminal, Write};
 use std::time::Instant;

@@ -2141,6 +2141,23 @@ fn batch_refine_goes_on_past_a_bad_file_and_matches_single_runs() {
     assert_eq!(failed.len(), 1);
     assert!(failed[0]["input"].as_str().unwrap().ends_with("broken.obj"));
     assert_eq!(failed[0]["code"], 2);
+    // Lines come in completion order; each names its input's place in the batch, the
+    // inputs sorted by name, once each.
+    let mut by_index: Vec<(u64, String)> = lines[..4]
+        .iter()
+        .map(|l| {
+            (
+                l["index"].as_u64().unwrap(),
+                l["input"].as_str().unwrap().to_string(),
+            )
+        })
+        .collect();
+    by_index.sort();
+    assert_eq!(
+        by_index.iter().map(|x| x.0).collect::<Vec<_>>(),
+        [0, 1, 2, 3]
+    );
+    assert!(by_index.windows(2).all(|w| w[0].1 < w[1].1), "{by_index:?}");
     // The bad file's usual one-line error, and the summary line.
     let broken = input.join("broken.obj");
     let errors: Vec<&str> = err
