@@ -499,9 +499,10 @@ impl From<TopologyError> for StepError {
     }
 }
 
-/// The checks every split scheme makes on its input before the first step.
+/// The checks every split scheme makes on its input before the first step: the level count,
+/// the butterfly's tension, and then what [`Scheme::input_faces`] and [`Scheme::tags`] say
+/// the scheme takes.
 fn check_input(base: &Topology, scheme: &Scheme, levels: usize) -> Result<(), SplitError> {
-    let name = scheme.name();
     if levels > MAX_LEVELS {
         return Err(SplitError::TooManyLevels {
             levels,
@@ -513,19 +514,34 @@ fn check_input(base: &Topology, scheme: &Scheme, levels: usize) -> Result<(), Sp
     {
         return Err(SplitError::Tension(tension));
     }
+    check_faces(base, scheme)?;
+    check_manifold(base, scheme)?;
+    check_tags(base, scheme)
+}
+
+/// Faces of the kind the scheme takes.
+fn check_faces(base: &Topology, scheme: &Scheme) -> Result<(), SplitError> {
     if scheme.input_faces() == crate::FaceKind::Triangles
         && let Some(f) = (0..base.num_faces()).find(|&f| base.face_size(f) != 3)
     {
         return Err(SplitError::NotTriangle {
-            scheme: name,
+            scheme: scheme.name(),
             face: f,
             size: base.face_size(f),
         });
     }
+    Ok(())
+}
+
+/// No non-manifold edge or vertex unless the scheme has rules for them.
+fn check_manifold(base: &Topology, scheme: &Scheme) -> Result<(), SplitError> {
+    if scheme.tags().non_manifold {
+        return Ok(());
+    }
     if let Some(e) = (0..base.num_edges()).find(|&e| base.is_non_manifold_edge(e)) {
         let [a, b] = base.edge_vertices(e);
         return Err(SplitError::NonManifoldEdge {
-            scheme: name,
+            scheme: scheme.name(),
             edge: e,
             a,
             b,
@@ -533,16 +549,27 @@ fn check_input(base: &Topology, scheme: &Scheme, levels: usize) -> Result<(), Sp
     }
     if let Some(v) = (0..base.num_vertices()).find(|&v| base.is_non_manifold_vertex(v)) {
         return Err(SplitError::NonManifoldVertex {
-            scheme: name,
+            scheme: scheme.name(),
             vertex: v,
         });
     }
-    if let Some(f) = (0..base.num_faces()).find(|&f| base.is_hole(f)) {
-        return Err(SplitError::UnsupportedTag {
+    Ok(())
+}
+
+/// Holes, interior creases and corners only where the scheme has a rule for them.
+fn check_tags(base: &Topology, scheme: &Scheme) -> Result<(), SplitError> {
+    let (name, rules) = (scheme.name(), scheme.tags());
+    let refuse = |what: String, why| {
+        Err(SplitError::UnsupportedTag {
             scheme: name,
-            what: format!("face {f}"),
-            why: "has no rule for holes",
-        });
+            what,
+            why,
+        })
+    };
+    if !rules.holes
+        && let Some(f) = (0..base.num_faces()).find(|&f| base.is_hole(f))
+    {
+        return refuse(format!("face {f}"), "has no rule for holes");
     }
     for e in 0..base.num_edges() {
         let s = base.edge_sharpness(e);
@@ -551,29 +578,20 @@ fn check_input(base: &Topology, scheme: &Scheme, levels: usize) -> Result<(), Sp
         }
         let [a, b] = base.edge_vertices(e);
         let what = format!("edge {e} ({a}-{b}) crease {s}");
-        if *scheme == Scheme::DooSabin {
-            return Err(SplitError::UnsupportedTag {
-                scheme: name,
-                what,
-                why: "has no crease rule",
-            });
+        if !rules.infinite_creases {
+            return refuse(what, "has no crease rule");
         }
-        if !tags::is_infinite(s) {
-            return Err(SplitError::UnsupportedTag {
-                scheme: name,
-                what,
-                why: "supports only infinitely sharp creases",
-            });
+        if !rules.semi_sharp_creases && !tags::is_infinite(s) {
+            return refuse(what, "supports only infinitely sharp creases");
         }
     }
-    if *scheme == Scheme::DooSabin
+    if !rules.corners
         && let Some(v) = (0..base.num_vertices()).find(|&v| base.vertex_sharpness(v) > 0.0)
     {
-        return Err(SplitError::UnsupportedTag {
-            scheme: name,
-            what: format!("vertex {v} corner {}", base.vertex_sharpness(v)),
-            why: "has no corner rule",
-        });
+        return refuse(
+            format!("vertex {v} corner {}", base.vertex_sharpness(v)),
+            "has no corner rule",
+        );
     }
     Ok(())
 }
