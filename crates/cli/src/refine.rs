@@ -461,12 +461,7 @@ pub(crate) fn output_limit(
     options: &subd_schemes::Options,
     positions: &[subd_mesh::DVec3],
 ) -> Result<subd_limit::LimitPoints, String> {
-    let scheme = match refinement.scheme() {
-        // Level 0 of the two-phase scheme is its phase-1 input; from level 1 on it is
-        // Catmull-Clark.
-        Scheme::TwoPhase(_) if level > 0 => &Scheme::CatmullClark,
-        s => s,
-    };
+    let scheme = &refinement.scheme().at_level(level);
     if scheme.is_opensubdiv() || level < refinement.num_levels() {
         return subd_limit::limit_points(refinement.topology(level), scheme, options, positions)
             .map_err(|e| e.to_string());

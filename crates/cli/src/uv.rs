@@ -56,13 +56,16 @@ pub(crate) fn refined_uv(
     // The exact limit of the output level's values, as the positions take theirs.
     let topology = r.topology(level);
     let at_level = FVarChannel::new(topology, 2, values, indices).map_err(|e| e.to_string())?;
-    // The two-phase scheme's levels take Catmull-Clark's rules (its phase 1 is level 1's
-    // making, already in the values).
-    let scheme = match r.scheme() {
-        Scheme::TwoPhase(_) => Scheme::CatmullClark,
-        s => s.clone(),
-    };
-    limit_uv(topology, &scheme, r.options(), &at_level, mode).map(Some)
+    // At level 0 too the values take Catmull-Clark's limit, as before the one front door
+    // (the two-phase phase-1 rule is left out there: noted on issue 39).
+    limit_uv(
+        topology,
+        &r.scheme().at_level(level.max(1)),
+        r.options(),
+        &at_level,
+        mode,
+    )
+    .map(Some)
 }
 
 /// A split scheme's refined texture coordinates ([`SplitFaceVarying`]); `None` with a warning

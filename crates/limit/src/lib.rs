@@ -137,10 +137,8 @@ pub enum LimitError {
 /// scheme's own for Catmull-Clark and Loop. The others have none here: Bilinear's limit is
 /// the mesh itself, the split schemes' are in [`split_limit`].
 pub(crate) fn masks_scheme(scheme: &Scheme, refined: bool) -> Result<Scheme, LimitError> {
-    match scheme {
-        Scheme::CatmullClark => Ok(Scheme::CatmullClark),
-        Scheme::TwoPhase(_) if refined => Ok(Scheme::CatmullClark),
-        Scheme::Loop => Ok(Scheme::Loop),
+    match scheme.at_level(usize::from(refined)) {
+        s @ (Scheme::CatmullClark | Scheme::Loop) => Ok(s),
         s => Err(LimitError::Scheme {
             scheme: s.to_string(),
             what: "these limit masks exist for catmull-clark and loop only",

@@ -257,6 +257,25 @@ impl Scheme {
         }
     }
 
+    /// The scheme whose rules a mesh at `level` of a refinement with this scheme follows
+    /// from then on: Catmull-Clark for the two-phase scheme's refined levels (phase 1 is its
+    /// first step only), the scheme itself otherwise.
+    ///
+    /// ```
+    /// use subd_schemes::Scheme;
+    ///
+    /// let tp: Scheme = "two-phase:0.6".parse().unwrap();
+    /// assert_eq!(tp.at_level(0), tp);
+    /// assert_eq!(tp.at_level(2), Scheme::CatmullClark);
+    /// assert_eq!(Scheme::Sqrt3.at_level(3), Scheme::Sqrt3);
+    /// ```
+    pub fn at_level(&self, level: usize) -> Scheme {
+        match self {
+            Scheme::TwoPhase(_) if level > 0 => Scheme::CatmullClark,
+            s => s.clone(),
+        }
+    }
+
     /// The butterfly's tension, when this is the butterfly scheme.
     pub fn tension(&self) -> Option<f64> {
         match self {

@@ -46,7 +46,7 @@ use subd_mesh::fvar::{FVarChannel, FVarError, FVarLinearInterpolation};
 use subd_mesh::{BoundaryInterpolation, Topology, TopologyBuilder, TopologyError, tags};
 use thiserror::Error;
 
-use super::{SplitError, SplitRefinement};
+use super::SplitRefinement;
 use crate::{FVarValueKind, Refinement, Scheme, StencilTable};
 
 /// Why a face-varying channel cannot be refined with a split scheme.
@@ -76,7 +76,7 @@ pub enum SplitFVarError {
     /// The mesh of values cannot be refined (a bug if it ever happens: it has the
     /// geometry's faces and tags).
     #[error("the mesh of face-varying values: {0}")]
-    Values(#[from] SplitError),
+    Values(#[from] crate::RefineError),
     /// The mesh of values cannot be built (a bug if it ever happens).
     #[error("the mesh of face-varying values: {0}")]
     Topology(#[from] TopologyError),

@@ -55,9 +55,6 @@ use crate::{MAX_LEVELS, RefineError, RowSink, Scheme, StencilTable};
 pub use features::Features;
 pub use fvar::{SplitFVarError, SplitFaceVarying};
 
-/// The error of a split step or refinement (one type for both families).
-pub(crate) type SplitError = RefineError;
-
 /// The faces and tags of a refined level, before its topology is built.
 #[derive(Debug, Clone)]
 pub(crate) struct ChildFaces {
@@ -242,14 +239,14 @@ impl SplitRefinement {
     /// Refines `base` uniformly `levels` times with `scheme`.
     ///
     /// # Errors
-    /// [`SplitError`] for a face the scheme cannot take (triangles for all but Doo-Sabin),
+    /// [`RefineError`] for a face the scheme cannot take (triangles for all but Doo-Sabin),
     /// non-manifold input, tags the scheme has no rule for (semi-sharp creases, holes; any
     /// crease for Doo-Sabin), a tension that is not finite, or too many levels.
     pub fn new(
         base: &Topology,
         scheme: &Scheme,
         levels: usize,
-    ) -> Result<SplitRefinement, SplitError> {
+    ) -> Result<SplitRefinement, RefineError> {
         check_input(base, scheme, levels)?;
         let mut out: Vec<SplitLevel> = Vec::with_capacity(levels);
         for l in 1..=levels {
@@ -265,7 +262,7 @@ impl SplitRefinement {
                 crate::refine::last_level_bytes(child)
             };
             if !crate::memory::can_allocate(need) {
-                return Err(SplitError::OutOfMemory {
+                return Err(RefineError::OutOfMemory {
                     level: l,
                     bytes: need,
                 });
@@ -485,10 +482,10 @@ pub(crate) enum StepError {
 }
 
 impl StepError {
-    fn at_level(self, level: usize) -> SplitError {
+    fn at_level(self, level: usize) -> RefineError {
         match self {
-            StepError::TooLarge => SplitError::TooLarge { level },
-            StepError::Topology(source) => SplitError::Topology { level, source },
+            StepError::TooLarge => RefineError::TooLarge { level },
+            StepError::Topology(source) => RefineError::Topology { level, source },
         }
     }
 }
@@ -502,9 +499,9 @@ impl From<TopologyError> for StepError {
 /// The checks every split scheme makes on its input before the first step: the level count,
 /// the butterfly's tension, and then what [`Scheme::input_faces`] and [`Scheme::tags`] say
 /// the scheme takes.
-fn check_input(base: &Topology, scheme: &Scheme, levels: usize) -> Result<(), SplitError> {
+fn check_input(base: &Topology, scheme: &Scheme, levels: usize) -> Result<(), RefineError> {
     if levels > MAX_LEVELS {
-        return Err(SplitError::TooManyLevels {
+        return Err(RefineError::TooManyLevels {
             levels,
             max: MAX_LEVELS,
         });
@@ -512,7 +509,7 @@ fn check_input(base: &Topology, scheme: &Scheme, levels: usize) -> Result<(), Sp
     if let Scheme::Butterfly { tension } = *scheme
         && !tension.is_finite()
     {
-        return Err(SplitError::Tension(tension));
+        return Err(RefineError::Tension(tension));
     }
     check_faces(base, scheme)?;
     check_manifold(base, scheme)?;
@@ -520,11 +517,11 @@ fn check_input(base: &Topology, scheme: &Scheme, levels: usize) -> Result<(), Sp
 }
 
 /// Faces of the kind the scheme takes.
-fn check_faces(base: &Topology, scheme: &Scheme) -> Result<(), SplitError> {
+fn check_faces(base: &Topology, scheme: &Scheme) -> Result<(), RefineError> {
     if scheme.input_faces() == crate::FaceKind::Triangles
         && let Some(f) = (0..base.num_faces()).find(|&f| base.face_size(f) != 3)
     {
-        return Err(SplitError::NotTriangle {
+        return Err(RefineError::NotTriangle {
             scheme: scheme.name(),
             face: f,
             size: base.face_size(f),
@@ -534,13 +531,13 @@ fn check_faces(base: &Topology, scheme: &Scheme) -> Result<(), SplitError> {
 }
 
 /// No non-manifold edge or vertex unless the scheme has rules for them.
-fn check_manifold(base: &Topology, scheme: &Scheme) -> Result<(), SplitError> {
+fn check_manifold(base: &Topology, scheme: &Scheme) -> Result<(), RefineError> {
     if scheme.tags().non_manifold {
         return Ok(());
     }
     if let Some(e) = (0..base.num_edges()).find(|&e| base.is_non_manifold_edge(e)) {
         let [a, b] = base.edge_vertices(e);
-        return Err(SplitError::NonManifoldEdge {
+        return Err(RefineError::NonManifoldEdge {
             scheme: scheme.name(),
             edge: e,
             a,
@@ -548,7 +545,7 @@ fn check_manifold(base: &Topology, scheme: &Scheme) -> Result<(), SplitError> {
         });
     }
     if let Some(v) = (0..base.num_vertices()).find(|&v| base.is_non_manifold_vertex(v)) {
-        return Err(SplitError::NonManifoldVertex {
+        return Err(RefineError::NonManifoldVertex {
             scheme: scheme.name(),
             vertex: v,
         });
@@ -557,10 +554,10 @@ fn check_manifold(base: &Topology, scheme: &Scheme) -> Result<(), SplitError> {
 }
 
 /// Holes, interior creases and corners only where the scheme has a rule for them.
-fn check_tags(base: &Topology, scheme: &Scheme) -> Result<(), SplitError> {
+fn check_tags(base: &Topology, scheme: &Scheme) -> Result<(), RefineError> {
     let (name, rules) = (scheme.name(), scheme.tags());
     let refuse = |what: String, why| {
-        Err(SplitError::UnsupportedTag {
+        Err(RefineError::UnsupportedTag {
             scheme: name,
             what,
             why,
