@@ -1,0 +1,177 @@
+//! `subd edit` and `subd deform`.
+
+use super::*;
+
+#[test]
+fn edit_meets_constraints_and_reports_json() {
+    let s = Scratch::new("edit");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+    let input = root.join("meshes/torus_creased.obj");
+    let constraints = root.join("edit/torus_edit.json");
+    for (method, extra) in [
+        ("least-squares", vec![]),
+        ("energy", vec![]),
+        ("energy", vec!["--region-rings", "1"]),
+        ("energy", vec!["--penalty", "1e10", "--membrane", "0.1"]),
+    ] {
+        let out = s.0.join(format!("edit-{method}-{}.obj", extra.len()));
+        let mut args = vec![
+            "edit",
+            "--constraints",
+            constraints.to_str().unwrap(),
+            "--method",
+            method,
+        ];
+        args.extend(&extra);
+        args.extend([input.to_str().unwrap(), out.to_str().unwrap(), "--json"]);
+        let (code, stdout, err) = subd(&args);
+        assert_eq!(code, 0, "{err}");
+        let j: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+        let tol = if extra.contains(&"--penalty") {
+            1e-6
+        } else {
+            1e-10
+        };
+        assert!(
+            j["max_residual_relative"].as_f64().unwrap() < tol,
+            "{stdout}"
+        );
+        for r in j["residuals"].as_array().unwrap() {
+            assert!(r["residual"].as_f64().unwrap() < 100.0 * tol, "{stdout}");
+        }
+        assert_eq!(j["constraints"], 4);
+        assert!(j["energy_after"].as_f64().is_some());
+        let moved = j["moved_vertices"].as_array().unwrap().len();
+        assert!(moved > 0 && moved <= j["free_vertices"].as_u64().unwrap() as usize);
+        assert!(out.exists());
+    }
+}
+
+#[test]
+fn edit_and_deform_bad_input_exit_2_without_output() {
+    let s = Scratch::new("edit-bad");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+    let input = root.join("meshes/torus_creased.obj");
+    let cases = [
+        (
+            r#"{"constraints": [{"kind": "pin", "vertex": 1}]}"#,
+            "constraint 0: unknown kind \"pin\"",
+        ),
+        (
+            r#"{"constraints": [{"kind": "point", "vertex": 1, "target": [0,0,0]}, {"kind": "point", "face": 999, "uv": [0.5, 0.5], "target": [0,0,0]}]}"#,
+            "constraint 1: face 999 out of range",
+        ),
+        (
+            r#"{"constraints": [{"kind": "point", "vertex": 720, "target": [0,0,0]}]}"#,
+            "constraint 0: vertex 720 out of range",
+        ),
+        (
+            r#"{"constraints": [{"kind": "point", "face": 3, "uv": [1.5, 0.5], "target": [0,0,0]}]}"#,
+            "constraint 0: parameters (1.5, 0.5) outside [0, 1]",
+        ),
+        (
+            r#"{"constraints": [{"kind": "normal", "vertex": 3, "normal": [0, 0, 0]}]}"#,
+            "constraint 0: the normal is zero",
+        ),
+        (
+            r#"{"constraints": [{"kind": "point", "vertex": 3, "target": [NaN, 0, 0]}]}"#,
+            "not JSON",
+        ),
+        (
+            r#"{"constraints": [{"kind": "isoline", "face": 3, "along": "u", "at": 0.5, "faces": 2, "targets": [[0,0,0]]}]}"#,
+            "constraint 0: an iso-line over 2 faces needs 5 control points",
+        ),
+    ];
+    for (k, (text, want)) in cases.iter().enumerate() {
+        let c = s.file(&format!("c{k}.json"), text.as_bytes());
+        let out = s.0.join(format!("out{k}.obj"));
+        let (code, _, err) = subd(&[
+            "edit",
+            "--constraints",
+            c.to_str().unwrap(),
+            input.to_str().unwrap(),
+            out.to_str().unwrap(),
+        ]);
+        assert_eq!(code, 2, "{text}: {err}");
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(
+            err.starts_with(&format!("subd: {}", c.display())) && err.contains(want),
+            "{err:?} lacks {want:?}"
+        );
+        assert!(!out.exists());
+    }
+    // Energy on Loop, and energy options with least squares.
+    let c = root.join("edit/torus_edit.json");
+    let out = s.0.join("x.obj");
+    let (code, _, err) = subd(&[
+        "edit",
+        "--constraints",
+        c.to_str().unwrap(),
+        "--penalty",
+        "5",
+        input.to_str().unwrap(),
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--method energy only"), "{err}");
+    let (code, _, err) = subd(&[
+        "edit",
+        "--constraints",
+        c.to_str().unwrap(),
+        "--method",
+        "energy",
+        "--region-rings",
+        "many",
+        input.to_str().unwrap(),
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(!out.exists());
+    // Deformation: a zero radius, and coinciding centres.
+    for (k, (text, want)) in [
+        (r#"{"constraints": [{"center": [0,0,0], "radius": 0, "displacement": [0,0,1]}]}"#, "deformation constraint 0: the radius must be positive"),
+        (r#"{"constraints": [{"center": [0,0,0], "radius": 1, "displacement": [0,0,1]}, {"center": [0,0,0], "radius": 2, "displacement": [0,0,1]}]}"#, "deformation constraint 1: its centre coincides"),
+        (r#"{"constraints": [{"centre": [0,0,0], "radius": 1, "displacement": [0,0,1]}]}"#, "constraint 0: unknown field \"centre\""),
+    ]
+    .iter()
+    .enumerate()
+    {
+        let c = s.file(&format!("d{k}.json"), text.as_bytes());
+        let out = s.0.join(format!("d{k}.obj"));
+        let (code, _, err) = subd(&["deform", "--constraints", c.to_str().unwrap(), input.to_str().unwrap(), out.to_str().unwrap()]);
+        assert_eq!(code, 2, "{err}");
+        assert!(err.contains(want), "{err:?} lacks {want:?}");
+        assert!(!out.exists());
+    }
+}
+
+#[test]
+fn deform_moves_constraint_points_and_keeps_the_rest() {
+    let s = Scratch::new("deform");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+    let input = root.join("meshes/torus_creased.obj");
+    let out = s.0.join("deformed.obj");
+    let (code, stdout, err) = subd(&[
+        "deform",
+        "--constraints",
+        root.join("edit/torus_deform.json").to_str().unwrap(),
+        input.to_str().unwrap(),
+        out.to_str().unwrap(),
+        "--json",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let j: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    assert!(j["moved"].as_u64().unwrap() > 0);
+    let (a, b) = (obj_vertices(&input), obj_vertices(&out));
+    // Vertex 0 is the first centre (2.6, 0, 0): moved by exactly (0.4, 0, 0.3).
+    assert!((b[0][0] - 3.0).abs() < 1e-12 && (b[0][2] - 0.3).abs() < 1e-12);
+    let centres = [[2.6, 0.0, 0.0, 1.0], [-1.4, 0.0, 0.0, 0.6]];
+    for (p, q) in a.iter().zip(&b) {
+        let inside = centres.iter().any(|c| {
+            ((p[0] - c[0]).powi(2) + (p[1] - c[1]).powi(2) + (p[2] - c[2]).powi(2)).sqrt() < c[3]
+        });
+        if !inside {
+            assert_eq!(p, q);
+        }
+    }
+}
