@@ -75,7 +75,7 @@ enum Task {
         #[arg(long)]
         huge_pages: bool,
         /// Run subd with its huge-page advice for large arrays turned off
-        /// (`subd_schemes::memory::set_huge_pages(false)`).
+        /// (`subd_mesh::memory::set_huge_pages(false)`).
         #[arg(long)]
         no_huge_page_advice: bool,
         /// Only the refinement benchmark.
@@ -351,7 +351,7 @@ fn main() -> ExitCode {
             repeats,
             no_huge_page_advice,
         } => {
-            subd_schemes::memory::set_huge_pages(!no_huge_page_advice);
+            subd_mesh::memory::set_huge_pages(!no_huge_page_advice);
             let scheme = if scheme == "loop" {
                 subd_schemes::Scheme::Loop
             } else {

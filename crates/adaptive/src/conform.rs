@@ -24,8 +24,8 @@ use subd_schemes::Scheme;
 
 use crate::hierarchy::{AdaptiveRefinement, Positions};
 use crate::level::WHOLE_FACE;
-use crate::submesh::NONE;
 use crate::{AdaptiveError, AdaptiveMesh, EdgeOrigin};
+use subd_mesh::cut::NONE;
 
 /// A point of a transition pattern: corner `i` of the leaf, or the edge point of its edge `i`
 /// (from corner `i` to corner `i + 1`).

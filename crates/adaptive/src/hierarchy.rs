@@ -28,9 +28,9 @@ use subd_schemes::{Options, Scheme};
 
 use crate::criteria::{Criterion, EveryFace, LevelView};
 use crate::level::SparseLevel;
-use crate::submesh::NONE;
-use crate::uniform::{UniformCounts, UniformLayout};
 use crate::{AdaptiveError, MAX_LEVELS};
+use subd_mesh::cut::NONE;
+use subd_schemes::{ChildLayout, LevelCounts};
 
 /// Adaptive refinement of a mesh: the hierarchy of levels, each with the faces of uniform
 /// refinement that exist there (exact positions, uniform indices), and which of them are
@@ -60,7 +60,7 @@ pub struct AdaptiveRefinement {
     pub(crate) scheme: Scheme,
     pub(crate) options: Options,
     pub(crate) levels: Vec<SparseLevel>,
-    pub(crate) uniform: UniformLayout,
+    pub(crate) uniform: ChildLayout,
     level_builds: usize,
 }
 
@@ -135,7 +135,7 @@ impl AdaptiveRefinement {
         } else {
             criteria.to_vec()
         };
-        let mut uniform = UniformLayout::new(base, scheme, max_level);
+        let mut uniform = ChildLayout::new(base, scheme, max_level);
         let mut levels = vec![SparseLevel::base(base, points, scheme, options)?];
         let mut requests: Vec<HashSet<u64>> = vec![HashSet::new(); max_level];
         let mut level_builds = 1;
@@ -221,7 +221,7 @@ impl AdaptiveRefinement {
     }
 
     /// Element counts of uniform refinement at `level` (up to the level cap).
-    pub fn uniform_counts(&self, level: usize) -> UniformCounts {
+    pub fn uniform_counts(&self, level: usize) -> LevelCounts {
         self.uniform.counts(level)
     }
 

@@ -7,15 +7,15 @@
 //! around a refined face's vertices exists at its level (see [`crate::hierarchy`]), so the
 //! piece that is refined — every face sharing a vertex with a refined face — gives the
 //! children of the refined faces from complete rings, kept in the uniform level's order
-//! ([`crate::submesh`]): the same operations as uniform refinement, bit for bit.
+//! ([`subd_mesh::cut`]): the same operations as uniform refinement, bit for bit.
 
 use glam::DVec3;
 use subd_mesh::Topology;
 use subd_schemes::{Options, Refinement, Rule, Scheme};
 
 use crate::AdaptiveError;
-use crate::submesh::{self, NONE};
-use crate::uniform::UniformLayout;
+use subd_mesh::cut::{self as submesh, NONE};
+use subd_schemes::ChildLayout;
 
 /// Where a vertex of a level comes from in the level above.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -180,7 +180,7 @@ impl SparseLevel {
         level: usize,
         scheme: &Scheme,
         options: &Options,
-        uniform: &UniformLayout,
+        uniform: &ChildLayout,
     ) -> Result<SparseLevel, AdaptiveError> {
         self.vertex_child.fill(NONE);
         self.edge_child.fill(NONE);

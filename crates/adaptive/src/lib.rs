@@ -51,8 +51,6 @@ mod fvar;
 mod hierarchy;
 mod level;
 mod limit;
-mod submesh;
-mod uniform;
 
 use glam::DVec3;
 use serde::Serialize;
@@ -67,7 +65,6 @@ pub use criteria::{
 };
 pub use fvar::AdaptiveFVar;
 pub use hierarchy::{AdaptiveRefinement, Positions};
-pub use uniform::UniformCounts;
 
 /// The deepest level adaptive refinement goes to (uniform refinement's limit too).
 pub const MAX_LEVELS: usize = subd_schemes::MAX_LEVELS;

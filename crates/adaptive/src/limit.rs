@@ -16,7 +16,7 @@ use subd_schemes::{Refinement, Scheme};
 use crate::AdaptiveError;
 use crate::hierarchy::AdaptiveRefinement;
 use crate::level::Origin;
-use crate::submesh::NONE;
+use subd_mesh::cut::NONE;
 
 /// Decay levels up to which a piece is refined whole for its limits.
 const LOCAL_DECAY: usize = 2;

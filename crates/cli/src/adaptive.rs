@@ -5,7 +5,7 @@ use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;
 
-use clap::{Args, ValueEnum};
+use clap::Args;
 use serde::Serialize;
 use subd_adaptive::{
     AdaptiveError, AdaptiveMesh, AdaptiveRefinement, Conformity, Criterion, DihedralAngle,
@@ -15,26 +15,21 @@ use subd_mesh::{BoundaryInterpolation, CreaseMethod, SchemeHints, TriangleSubdiv
 use subd_schemes::Scheme;
 
 use crate::batch::{self, Files, Job};
-use crate::failure::{bad, refuse_overwrite};
+use crate::failure::bad;
 use crate::progress::Spinner;
 use crate::rule_args::RuleArgs;
+use crate::scheme_arg;
 use crate::vertex_data::read_indices;
 use crate::{Failure, print_warnings};
 
 /// Level cap when `--levels` is not given.
 const DEFAULT_LEVELS: usize = 4;
 
-#[derive(Debug, Clone, Copy, ValueEnum)]
-pub(crate) enum AdaptiveScheme {
-    Loop,
-    CatmullClark,
-}
-
 #[derive(Debug, Args)]
 pub(crate) struct AdaptiveArgs {
     /// Subdivision scheme.
-    #[arg(long, value_enum)]
-    scheme: AdaptiveScheme,
+    #[arg(long, value_parser = scheme_arg::parser(scheme_arg::EVALUATED))]
+    scheme: Scheme,
     /// Seed 002's flatness: refine every face that is not dead, a vertex being dead when the
     /// largest angle between its faces' normals is below DEG degrees.
     #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
@@ -131,16 +126,9 @@ fn in_range(name: &str, value: f64, ok: bool, what: &str) -> Result<(), Failure>
     Ok(())
 }
 
-/// Checks what can be checked before reading the input: the output's extension, the
-/// thresholds and the level cap (returned).
-fn check_arguments(args: &AdaptiveArgs, job: &Job) -> Result<usize, Failure> {
-    refuse_overwrite(&job.input, &job.output)?;
-    if subd_io::Format::for_output(&job.output).is_none() {
-        return Err(bad(format!(
-            "{}: unsupported output extension (expected .obj, .ply or .glb)",
-            job.output.display()
-        )));
-    }
+/// Checks what can be checked before reading the input: the thresholds and the level cap
+/// (returned).
+fn check_arguments(args: &AdaptiveArgs) -> Result<usize, Failure> {
     let degrees = |d: f64| (0.0..=180.0).contains(&d);
     if let Some(d) = args.flatness {
         in_range("flatness", d, degrees(d), "expected degrees in [0, 180]")?;
@@ -234,23 +222,20 @@ impl Selection {
     }
 }
 
+/// `subd adaptive` writes meshes.
+const ADAPTIVE: batch::Command = batch::Command {
+    name: "adaptive",
+    formats: batch::MESH_OUTPUTS,
+};
+
 pub(crate) fn run(
     args: &AdaptiveArgs,
     out: &mut dyn Write,
     err: &mut dyn Write,
 ) -> Result<(), Failure> {
-    let command = batch::Command {
-        name: "adaptive",
-        formats: batch::MESH_OUTPUTS,
-    };
-    batch::run(
-        &args.files,
-        &command,
-        args.json,
-        out,
-        err,
-        |job, out, err| run_one(args, job, out, err),
-    )
+    ADAPTIVE.run(&args.files, args.json, out, err, |job, out, err| {
+        run_one(args, job, out, err)
+    })
 }
 
 fn run_one(
@@ -259,17 +244,13 @@ fn run_one(
     out: &mut dyn Write,
     err: &mut dyn Write,
 ) -> Result<(), Failure> {
-    let t_start = Instant::now();
-    let levels = check_arguments(args, job)?;
-    let file = subd_io::read_mesh(&job.input, &args.rules.read_options())?;
-    print_warnings(err, &job.input, &file.warnings);
-    let t_read = t_start.elapsed().as_secs_f64();
+    let started = ADAPTIVE.start(&job.input, &job.output)?;
+    let levels = check_arguments(args)?;
+    let opened = started.read(&args.rules, err)?;
+    let (file, t_read) = (&opened.file, opened.read_seconds);
     let mesh = &file.mesh;
     let base = &mesh.topology;
-    let scheme = match args.scheme {
-        AdaptiveScheme::Loop => Scheme::Loop,
-        AdaptiveScheme::CatmullClark => Scheme::CatmullClark,
-    };
+    let scheme = args.scheme.clone();
     let options = args.rules.options(&mesh.hints);
     let input_err = |e: AdaptiveError| bad(format!("{}: {e}", job.input.display()));
     let diagonal = mesh
@@ -335,7 +316,7 @@ fn run_one(
             mesh: t_mesh,
             report: t_report,
             write: t_write,
-            total: t_start.elapsed().as_secs_f64(),
+            total: opened.elapsed(),
         };
         let context = ReportContext {
             args,
@@ -378,10 +359,7 @@ impl ReportContext<'_> {
         AdaptiveReport {
             input: job.input.display().to_string(),
             output: job.output.display().to_string(),
-            scheme: match hierarchy.scheme() {
-                Scheme::Loop => "loop",
-                _ => "catmull-clark",
-            },
+            scheme: hierarchy.scheme().name(),
             levels: self.levels,
             depth,
             limit: args.limit,

@@ -11,19 +11,7 @@ use subd_schemes::analysis::{Lattice, analyze, analyze_bivariate};
 
 use crate::Failure;
 use crate::failure::bad;
-
-#[derive(Debug, Clone, Copy, ValueEnum)]
-pub(crate) enum SurfaceArg {
-    CatmullClark,
-    Loop,
-    /// Around an n-sided face.
-    DooSabin,
-    /// Over two steps (one step turns the mesh).
-    Sqrt3,
-    /// With --tension (default 1/16).
-    Butterfly,
-    ModifiedButterfly,
-}
+use crate::scheme_arg;
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
 pub(crate) enum LatticeArg {
@@ -57,8 +45,8 @@ pub(crate) struct AnalyzeArgs {
     max_levels: usize,
     /// Instead of a mask: the eigenvalue test of this surface scheme's local subdivision
     /// matrix at an interior vertex of valence --valence.
-    #[arg(long, value_enum, requires = "valence")]
-    surface: Option<SurfaceArg>,
+    #[arg(long, value_parser = scheme_arg::parser(scheme_arg::ANALYSED), requires = "valence")]
+    surface: Option<Scheme>,
     /// Valence for --surface (the number of sides of the centre face for doo-sabin).
     #[arg(long)]
     valence: Option<usize>,
@@ -81,22 +69,14 @@ struct SurfaceReport {
 }
 
 pub(crate) fn run(args: &AnalyzeArgs, out: &mut dyn Write) -> Result<(), Failure> {
-    if args.tension.is_some() && !matches!(args.surface, Some(SurfaceArg::Butterfly)) {
-        return Err(bad("--tension applies to --surface butterfly only".into()));
-    }
-    if let (Some(surface), Some(n)) = (args.surface, args.valence) {
-        let split = match surface {
-            SurfaceArg::CatmullClark | SurfaceArg::Loop => None,
-            SurfaceArg::DooSabin => Some(subd_schemes::Scheme::DooSabin),
-            SurfaceArg::Sqrt3 => Some(subd_schemes::Scheme::Sqrt3),
-            SurfaceArg::Butterfly => Some(subd_schemes::Scheme::Butterfly {
-                tension: crate::rule_args::butterfly_tension(args.tension)?,
-            }),
-            SurfaceArg::ModifiedButterfly => Some(subd_schemes::Scheme::ModifiedButterfly),
-        };
-        return match split {
-            Some(scheme) => run_split_surface(scheme, n, args.json, out),
-            None => run_surface(surface, n, args.json, out),
+    let surface = match &args.surface {
+        Some(s) => Some(scheme_arg::with_tension(s, args.tension, "--surface")?),
+        None => None,
+    };
+    if let (Some(scheme), Some(n)) = (surface, args.valence) {
+        return match scheme {
+            Scheme::CatmullClark | Scheme::Loop => run_surface(&scheme, n, args.json, out),
+            scheme => run_split_surface(scheme, n, args.json, out),
         };
     }
     if let Some(text) = &args.mask2 {
@@ -234,20 +214,13 @@ fn parse_number(t: &str) -> Option<f64> {
     }
 }
 
-fn run_surface(
-    surface: SurfaceArg,
-    n: usize,
-    json: bool,
-    out: &mut dyn Write,
-) -> Result<(), Failure> {
-    let (scheme, name, min) = match surface {
-        SurfaceArg::Loop => (Scheme::Loop, "loop", 3),
-        _ => (Scheme::CatmullClark, "catmull-clark", 3),
-    };
+/// The eigenvalue test of Catmull-Clark or Loop at an interior vertex of valence `n`.
+fn run_surface(scheme: &Scheme, n: usize, json: bool, out: &mut dyn Write) -> Result<(), Failure> {
+    let (name, min) = (scheme.name(), 3);
     if !(min..=64).contains(&n) {
         return Err(bad(format!("--valence {n}: must be {min} to 64")));
     }
-    let m = subd_limit::eigen::ring_matrix(&scheme, n, subd_limit::eigen::RingFeature::Smooth)
+    let m = subd_limit::eigen::ring_matrix(scheme, n, subd_limit::eigen::RingFeature::Smooth)
         .map_err(|e| bad(format!("--surface {name}: {e}")))?;
     let ev =
         subd_limit::eigen::eigenvalues(&m).map_err(|e| bad(format!("--surface {name}: {e}")))?;

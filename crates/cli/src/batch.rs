@@ -52,7 +52,25 @@ pub(crate) enum OutputFormat {
 }
 
 impl OutputFormat {
-    fn extension(self) -> &'static str {
+    /// The format an output path names by its extension (case-insensitive), if subd
+    /// writes it.
+    pub(crate) fn of(path: &Path) -> Option<OutputFormat> {
+        if path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("txt"))
+        {
+            return Some(OutputFormat::Txt);
+        }
+        match subd_io::Format::for_output(path)? {
+            subd_io::Format::Obj => Some(OutputFormat::Obj),
+            subd_io::Format::Ply => Some(OutputFormat::Ply),
+            subd_io::Format::Glb => Some(OutputFormat::Glb),
+            subd_io::Format::Gltf => None,
+        }
+    }
+
+    /// The file extension, without the dot.
+    pub(crate) fn extension(self) -> &'static str {
         match self {
             OutputFormat::Obj => "obj",
             OutputFormat::Ply => "ply",

@@ -6,8 +6,8 @@
 //! available (`MemAvailable`) and the headroom under the address-space limit (`ulimit -v`).
 //! In batch mode it is shared by the files processed at once.
 
+use subd_mesh::memory::human_bytes;
 use subd_schemes::LevelCounts;
-use subd_schemes::memory::human_bytes;
 
 use crate::Failure;
 use crate::failure::bad;
@@ -108,70 +108,6 @@ pub(crate) fn parse_size(s: &str) -> Result<u64, String> {
         return Err(format!("{s:?}: expected a size of at least one byte"));
     }
     Ok(bytes as u64)
-}
-
-/// How a refinement's peak memory scales: bytes per vertex of the output level, with every
-/// level above it, the output arrays and the encoder's buffers. Measured with
-/// `/usr/bin/time -f %M` on the 101,600-quad bench torus and its triangulation, levels 1–4
-/// (BENCHMARKS.md, "Memory estimates"), rounded up by a sixth or more.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct PeakModel {
-    /// Bytes per output vertex.
-    per_vertex: u64,
-    /// Bytes per output vertex when the output level is streamed to the file from the level
-    /// above (OpenSubdiv's schemes without `--limit`): the level above's topology, its
-    /// points and the output level's face points.
-    streamed_per_vertex: Option<u64>,
-    /// Bytes per output vertex that `--limit` adds (the output level's limit stencils).
-    limit_per_vertex: u64,
-}
-
-/// Process, binary and allocator overhead.
-const FIXED_BYTES: u64 = 24 << 20;
-/// The input file and what parsing it holds at once (its bytes, tokens, the base topology).
-const PER_INPUT_BYTE: u64 = 4;
-/// A `.glb` writer's f32 position, normal and index arrays, per output vertex.
-const GLB_PER_VERTEX: u64 = 24;
-/// A streamed `.glb`'s positions and vertex normals, held whole (the normals sum every
-/// face around a vertex), per output vertex.
-const STREAMED_GLB_PER_VERTEX: u64 = 50;
-
-impl PeakModel {
-    /// The measured bytes per output vertex of `scheme` (the two-phase scheme is
-    /// Catmull-Clark's after level 1; the split schemes hold every level and stream
-    /// nothing).
-    pub(crate) fn of(scheme: &subd_schemes::Scheme) -> PeakModel {
-        use subd_schemes::Scheme;
-        let (per_vertex, streamed) = match scheme {
-            Scheme::CatmullClark | Scheme::TwoPhase(_) => (105, Some(70)),
-            Scheme::Bilinear => (120, Some(70)),
-            Scheme::Loop => (120, Some(90)),
-            Scheme::DooSabin => (145, None),
-            Scheme::Butterfly { .. } | Scheme::ModifiedButterfly => (190, None),
-            Scheme::Sqrt3 => (235, None),
-        };
-        PeakModel {
-            per_vertex,
-            streamed_per_vertex: streamed,
-            limit_per_vertex: if streamed.is_some() { 1150 } else { 2800 },
-        }
-    }
-
-    /// The estimated peak of refining to the level of `last` from a file of `file_bytes`,
-    /// writing `.glb` or not, with `--limit` or not.
-    pub(crate) fn peak(self, file_bytes: u64, last: LevelCounts, glb: bool, limit: bool) -> u64 {
-        let per_vertex = match self.streamed_per_vertex {
-            Some(s) if !limit => s + if glb { STREAMED_GLB_PER_VERTEX } else { 0 },
-            _ => {
-                self.per_vertex
-                    + if glb { GLB_PER_VERTEX } else { 0 }
-                    + if limit { self.limit_per_vertex } else { 0 }
-            }
-        };
-        FIXED_BYTES
-            .saturating_add(PER_INPUT_BYTE.saturating_mul(file_bytes))
-            .saturating_add(per_vertex.saturating_mul(last.vertices))
-    }
 }
 
 /// Refuses a refinement whose estimated peak is over `budget`: one line with the estimate,

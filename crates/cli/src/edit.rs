@@ -14,8 +14,8 @@ use subd_schemes::Scheme;
 
 use crate::batch::{self, Files, Job};
 use crate::failure::{bad, refuse_overwrite};
-use crate::limit::LimitSchemeArg;
 use crate::rule_args::RuleArgs;
+use crate::scheme_arg;
 use crate::{Failure, print_warnings};
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
@@ -35,8 +35,8 @@ pub(crate) struct EditArgs {
     #[arg(long, value_enum, default_value = "least-squares")]
     method: EditMethodArg,
     /// Scheme of the limit surface (the energy method needs catmull-clark).
-    #[arg(long, value_enum, default_value = "catmull-clark")]
-    scheme: LimitSchemeArg,
+    #[arg(long, value_parser = scheme_arg::parser(scheme_arg::EVALUATED), default_value = "catmull-clark")]
+    scheme: Scheme,
     /// Energy method: the seed's penalty form with this weight (relative to
     /// mean diag Q / mean diag AᵀA) instead of the exact solve.
     #[arg(long, conflicts_with = "exact")]
@@ -216,7 +216,7 @@ fn run_one(
     let file = subd_io::read_mesh(&job.input, &args.rules.read_options())?;
     print_warnings(err, &job.input, &file.warnings);
     let t_read = t_start.elapsed().as_secs_f64();
-    let scheme = args.scheme.scheme();
+    let scheme = args.scheme.clone();
     let options = args.rules.options(&file.mesh.hints);
     let topo = &file.mesh.topology;
     let x0 = &file.mesh.positions;

@@ -11,15 +11,15 @@ use subd_limit::eval::{FaceParam, LimitEvaluator};
 use subd_schemes::Scheme;
 
 use crate::failure::{bad, refuse_overwrite};
-use crate::limit::LimitSchemeArg;
 use crate::rule_args::RuleArgs;
+use crate::scheme_arg;
 use crate::{Failure, print_warnings};
 
 #[derive(Debug, Args)]
 pub(crate) struct EvalArgs {
     /// Subdivision scheme.
-    #[arg(long, value_enum)]
-    scheme: LimitSchemeArg,
+    #[arg(long, value_parser = scheme_arg::parser(scheme_arg::EVALUATED))]
+    scheme: Scheme,
     #[command(flatten)]
     rules: RuleArgs,
     /// Input mesh (.obj or .ply).
@@ -106,7 +106,7 @@ pub(crate) fn run(
     refuse_overwrite(&args.input, &args.output)?;
     let file = subd_io::read_mesh(&args.input, &args.rules.read_options())?;
     print_warnings(err, &args.input, &file.warnings);
-    let scheme = args.scheme.scheme();
+    let scheme = args.scheme.clone();
     let options = args.rules.options(&file.mesh.hints);
     let topo = &file.mesh.topology;
     let ev = LimitEvaluator::new(topo, &scheme, &options)

@@ -2,60 +2,29 @@
 
 use std::fmt::Write as _;
 use std::io::Write;
-use std::path::PathBuf;
-use std::time::Instant;
+use std::path::{Path, PathBuf};
 
-use clap::{Args, ValueEnum};
+use clap::Args;
 use serde::Serialize;
-use subd_limit::{LimitPoints, base_limit, levels_for_exact_limit, two_phase_base_limit};
+use subd_limit::{LimitPoints, LimitStencilTable, levels_for_exact_limit};
 use subd_mesh::Mesh;
 use subd_schemes::Scheme;
 
 use crate::batch::{self, Files, Job, OutputFormat};
-use crate::failure::{bad, refuse_overwrite};
+use crate::failure::bad;
 use crate::rule_args::RuleArgs;
+use crate::scheme_arg;
 use crate::vertex_data::LambdaArgs;
 use crate::{Failure, print_warnings};
 
-/// The schemes with a limit surface other than the mesh itself.
-#[derive(Debug, Clone, Copy, ValueEnum)]
-pub(crate) enum LimitSchemeArg {
-    CatmullClark,
-    Loop,
-}
-
-impl LimitSchemeArg {
-    pub(crate) fn scheme(self) -> Scheme {
-        match self {
-            LimitSchemeArg::CatmullClark => Scheme::CatmullClark,
-            LimitSchemeArg::Loop => Scheme::Loop,
-        }
-    }
-}
-
-/// Schemes of `subd limit`: those with limit masks, and the two-phase scheme.
-#[derive(Debug, Clone, Copy, ValueEnum)]
-pub(crate) enum LimitCommandScheme {
-    CatmullClark,
-    Loop,
-    /// Seed 000's two-phase scheme: formula (2) on closed quad meshes (needs --lambda or
-    /// --lambda-file).
-    TwoPhase,
-    /// Doo-Sabin: each vertex at the centroid of its vertex face one level down.
-    DooSabin,
-    /// √3: Kobbelt's limit masks (cubic B-spline along boundaries and creases).
-    Sqrt3,
-    /// Butterfly (interpolating: the vertices themselves; normals from the eigenvectors).
-    Butterfly,
-    /// Modified butterfly (interpolating, as butterfly).
-    ModifiedButterfly,
-}
-
 #[derive(Debug, Args)]
 pub(crate) struct LimitArgs {
-    /// Subdivision scheme.
-    #[arg(long, value_enum)]
-    scheme: LimitCommandScheme,
+    /// Subdivision scheme: the limit of its limit masks (Catmull-Clark, Loop), of seed 000's
+    /// formula (2) (two-phase, closed quad meshes), of each vertex's vertex face one level down
+    /// (Doo-Sabin), of Kobbelt's masks (√3), or the vertices themselves with normals from the
+    /// eigenvectors (the butterflies).
+    #[arg(long, value_parser = scheme_arg::parser(scheme_arg::WITH_LIMIT))]
+    scheme: Scheme,
     #[command(flatten)]
     lambda: LambdaArgs,
     #[command(flatten)]
@@ -105,28 +74,25 @@ fn text(limit: &LimitPoints, normals: bool) -> String {
     s
 }
 
+/// `subd limit`'s outputs: text or the input mesh with its vertices moved.
+const LIMIT: batch::Command = batch::Command {
+    name: "limit",
+    formats: &[
+        OutputFormat::Txt,
+        OutputFormat::Obj,
+        OutputFormat::Ply,
+        OutputFormat::Glb,
+    ],
+};
+
 pub(crate) fn run(
     args: &LimitArgs,
     out: &mut dyn Write,
     err: &mut dyn Write,
 ) -> Result<(), Failure> {
-    let command = batch::Command {
-        name: "limit",
-        formats: &[
-            OutputFormat::Txt,
-            OutputFormat::Obj,
-            OutputFormat::Ply,
-            OutputFormat::Glb,
-        ],
-    };
-    batch::run(
-        &args.files,
-        &command,
-        args.json,
-        out,
-        err,
-        |job, out, err| run_one(args, job, out, err),
-    )
+    LIMIT.run(&args.files, args.json, out, err, |job, out, err| {
+        run_one(args, job, out, err)
+    })
 }
 
 fn run_one(
@@ -135,154 +101,98 @@ fn run_one(
     out: &mut dyn Write,
     err: &mut dyn Write,
 ) -> Result<(), Failure> {
-    let t0 = Instant::now();
-    refuse_overwrite(&job.input, &job.output)?;
-    let is_text = job
-        .output
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("txt"));
-    if !is_text && subd_io::Format::for_output(&job.output).is_none() {
-        return Err(bad(format!(
-            "{}: unsupported output extension (expected .txt, .obj, .ply or .glb)",
-            job.output.display()
-        )));
+    let started = LIMIT.start(&job.input, &job.output)?;
+    let is_text = OutputFormat::of(&job.output) == Some(OutputFormat::Txt);
+    let scheme = scheme_arg::with_tension(&args.scheme, args.tension, "--scheme")?;
+    if args.acc.is_some() && scheme != Scheme::CatmullClark {
+        return Err(bad(
+            "--acc: ACC patches approximate catmull-clark surfaces only".into(),
+        ));
     }
-    let file = subd_io::read_mesh(&job.input, &args.rules.read_options())?;
-    print_warnings(err, &job.input, &file.warnings);
-    let options = args.rules.options(&file.mesh.hints);
-    let topo = &file.mesh.topology;
-    let (scheme, name) = match args.scheme {
-        LimitCommandScheme::CatmullClark => (Scheme::CatmullClark, "catmull-clark"),
-        LimitCommandScheme::Loop => (Scheme::Loop, "loop"),
-        LimitCommandScheme::TwoPhase => (Scheme::CatmullClark, "two-phase"),
-        _ => (Scheme::CatmullClark, "split"),
-    };
-    if args.tension.is_some() && !matches!(args.scheme, LimitCommandScheme::Butterfly) {
-        return Err(bad("--tension applies to --scheme butterfly only".into()));
-    }
-    let split = match args.scheme {
-        LimitCommandScheme::DooSabin => Some(Scheme::DooSabin),
-        LimitCommandScheme::Sqrt3 => Some(Scheme::Sqrt3),
-        LimitCommandScheme::Butterfly => Some(Scheme::Butterfly {
-            tension: crate::rule_args::butterfly_tension(args.tension)?,
-        }),
-        LimitCommandScheme::ModifiedButterfly => Some(Scheme::ModifiedButterfly),
-        _ => None,
-    };
-    if let Some(scheme) = split {
-        if args.lambda.given() {
-            return Err(bad(
-                "--lambda and --lambda-file apply to --scheme two-phase only".into(),
-            ));
-        }
-        if args.acc.is_some() {
-            return Err(bad(
-                "--acc: ACC patches approximate catmull-clark surfaces only".into(),
-            ));
-        }
-        let in_file = |e: String| bad(format!("{}: {e}", job.input.display()));
-        // One set of stencils for the positions and the texture coordinates.
-        let stencils = subd_limit::split_limit::checked_split_limit_stencils(topo, &scheme)
-            .map_err(|e| in_file(e.to_string()))?;
-        let limit = stencils
-            .limit_points(&scheme, &file.mesh.positions)
-            .map_err(|e| in_file(e.to_string()))?;
-        // Texture coordinates at their limit too, where the scheme carries them.
-        let mut uv_warnings = Vec::new();
-        let kept = match file.mesh.uv() {
-            Some(c) if !is_text => Some(
-                crate::uv::split_limit_uv(
-                    topo,
-                    (&scheme, &stencils),
-                    c,
-                    args.rules.fvar_mode(&file.mesh.hints),
-                    &mut uv_warnings,
-                )
-                .map_err(|e| bad(format!("{}: {e}", job.input.display())))?,
-            ),
-            _ => None,
-        };
-        print_warnings(err, &job.input, &uv_warnings);
-        write_limit(args, job, &limit, &file.mesh, kept.as_ref(), is_text, err)?;
-        if args.json {
-            let report = LimitReport {
-                input: job.input.display().to_string(),
-                output: job.output.display().to_string(),
-                scheme: scheme.name(),
-                vertices: topo.num_vertices(),
-                levels_refined: 0,
-                seconds: t0.elapsed().as_secs_f64(),
-                warnings: file.warnings.clone(),
-            };
-            crate::print_json(out, &report);
-        }
-        return Ok(());
-    }
-    let table = match args.scheme {
-        LimitCommandScheme::TwoPhase => {
-            let tp = args.lambda.two_phase(&job.input, topo.num_vertices())?;
-            two_phase_base_limit(topo, &tp, &options)
-        }
-        _ if args.lambda.given() => {
-            return Err(bad(
-                "--lambda and --lambda-file apply to --scheme two-phase only".into(),
-            ));
-        }
-        _ => base_limit(topo, &scheme, &options),
-    }
-    .map_err(|e| bad(format!("{}: {e}", job.input.display())))?;
-    let limit = table.apply(&file.mesh.positions);
+    let opened = started.read(&args.rules, err)?;
+    let (mesh, input) = (&opened.file.mesh, &job.input);
+    let in_file = |e: &dyn std::fmt::Display| bad(format!("{}: {e}", input.display()));
+    let topo = &mesh.topology;
+    let options = args.rules.options(&mesh.hints);
+    let scheme = scheme_arg::with_lambda(&scheme, &args.lambda, input, topo.num_vertices())?;
+    // One set of stencils for the positions and the texture coordinates.
+    let table = subd_limit::limit_stencils(topo, &scheme, &options).map_err(|e| in_file(&e))?;
+    let limit = table.apply(&mesh.positions);
     // ACC first, so that a mesh it does not cover fails before any file is written.
     let acc = match &args.acc {
-        Some(path) => {
-            if !matches!(args.scheme, LimitCommandScheme::CatmullClark) {
-                return Err(bad(format!(
-                    "{}: ACC patches approximate catmull-clark surfaces only",
-                    path.display()
-                )));
-            }
-            let patches = subd_limit::acc::acc_patches(topo, &file.mesh.positions)
-                .map_err(|e| bad(format!("{}: {e}", job.input.display())))?;
-            let json = serde_json::to_vec(&patches)
-                .map_err(|e| bad(format!("{}: {e}", path.display())))?;
-            Some((path, json))
-        }
+        Some(path) => Some((path, acc_json(path, topo, &mesh.positions, input)?)),
         None => None,
     };
-    // Texture coordinates at their limit too (two-phase: Catmull-Clark's face-varying rules,
-    // which its second phase on is).
-    let uv = match file.mesh.uv() {
+    let mut uv_warnings = Vec::new();
+    let uv = match mesh.uv() {
         Some(c) if !is_text => Some(
-            crate::uv::limit_uv(
-                topo,
-                &scheme,
-                &options,
-                c,
-                args.rules.fvar_mode(&file.mesh.hints),
-            )
-            .map_err(|e| bad(format!("{}: {e}", job.input.display())))?,
+            limit_uv(args, mesh, (&scheme, &options, &table), c, &mut uv_warnings)
+                .map_err(|e| in_file(&e))?,
         ),
         _ => None,
     };
-    write_limit(args, job, &limit, &file.mesh, uv.as_ref(), is_text, err)?;
+    print_warnings(err, input, &uv_warnings);
+    write_limit(args, job, &limit, mesh, uv.as_ref(), is_text, err)?;
     if let Some((path, json)) = acc {
         subd_io::atomic_write(path, |w| w.write_all(&json))?;
     }
     if args.json {
         let report = LimitReport {
-            input: job.input.display().to_string(),
+            input: input.display().to_string(),
             output: job.output.display().to_string(),
-            scheme: name,
+            scheme: scheme.name(),
             vertices: topo.num_vertices(),
-            levels_refined: levels_for_exact_limit(topo, &scheme)
-                .0
-                .max(usize::from(name == "two-phase")),
-            seconds: t0.elapsed().as_secs_f64(),
-            warnings: file.warnings.clone(),
+            levels_refined: levels_refined(topo, &scheme),
+            seconds: opened.elapsed(),
+            warnings: opened.file.warnings.clone(),
         };
         crate::print_json(out, &report);
     }
     Ok(())
+}
+/// The ACC patches of a Catmull-Clark mesh as JSON, for `path`.
+fn acc_json(
+    path: &Path,
+    topo: &subd_mesh::Topology,
+    positions: &[subd_mesh::DVec3],
+    input: &Path,
+) -> Result<Vec<u8>, Failure> {
+    let patches = subd_limit::acc::acc_patches(topo, positions)
+        .map_err(|e| bad(format!("{}: {e}", input.display())))?;
+    serde_json::to_vec(&patches).map_err(|e| bad(format!("{}: {e}", path.display())))
+}
+
+/// The texture coordinates at their limit too: through the positions' limit stencils
+/// (`table`) for the split schemes (warnings where they cannot carry seams), through the
+/// face-varying limit of Catmull-Clark or Loop otherwise (two-phase: Catmull-Clark's, which
+/// its second phase on is).
+fn limit_uv(
+    args: &LimitArgs,
+    mesh: &Mesh,
+    (scheme, options, table): (&Scheme, &subd_schemes::Options, &LimitStencilTable),
+    channel: &subd_mesh::fvar::FVarChannel,
+    warnings: &mut Vec<String>,
+) -> Result<crate::uv::RefinedUv, String> {
+    let mode = args.rules.fvar_mode(&mesh.hints);
+    let topo = &mesh.topology;
+    if !scheme.is_opensubdiv() {
+        crate::uv::split_limit_uv(topo, (scheme, table), channel, mode, warnings)
+    } else {
+        crate::uv::limit_uv(topo, &scheme.at_level(1), options, channel, mode)
+    }
+}
+
+/// Uniform levels the limit refines first: as semi-sharp features need to decay (and
+/// Catmull-Clark non-quads), phase 1 at least for the two-phase scheme; none for the split
+/// schemes, whose stencils look as deep as each vertex needs.
+fn levels_refined(topo: &subd_mesh::Topology, scheme: &Scheme) -> usize {
+    if !scheme.is_opensubdiv() {
+        return 0;
+    }
+    let two_phase = usize::from(scheme_arg::is_two_phase(scheme));
+    levels_for_exact_limit(topo, &scheme.at_level(1))
+        .0
+        .max(two_phase)
 }
 
 /// Writes the limit as text or as the input mesh with its vertices moved.

@@ -12,21 +12,12 @@ use subd_pia::{Method, Moving, Pia, PiaOptions, Solver, bbox_diagonal};
 use subd_schemes::Scheme;
 
 use crate::batch::{self, Files, Job};
-use crate::failure::{bad, refuse_overwrite};
+use crate::failure::bad;
 use crate::progress::Spinner;
 use crate::rule_args::RuleArgs;
+use crate::scheme_arg;
 use crate::vertex_data::{LambdaArgs, read_indices};
 use crate::{EXIT_FAILURE, Failure, print_warnings};
-
-#[derive(Debug, Clone, Copy, ValueEnum)]
-pub(crate) enum SchemeArg {
-    /// Catmull-Clark limit surface (Chen et al. 2008).
-    CatmullClark,
-    /// Loop limit surface (Cheng et al. 2009).
-    Loop,
-    /// Seed 000's two-phase scheme with shape parameter λ (needs --lambda or --lambda-file).
-    TwoPhase,
-}
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
 pub(crate) enum SolverArg {
@@ -50,8 +41,8 @@ pub(crate) enum SolverArg {
 #[derive(Debug, Args)]
 pub(crate) struct PiaArgs {
     /// Scheme whose limit surface interpolates.
-    #[arg(long, value_enum)]
-    scheme: SchemeArg,
+    #[arg(long, value_parser = scheme_arg::parser(scheme_arg::INTERPOLATED))]
+    scheme: Scheme,
     #[command(flatten)]
     lambda: LambdaArgs,
     /// Only these vertices move (a file of 0-based indices); the others keep their
@@ -113,19 +104,16 @@ struct PiaReport {
     warnings: Vec<String>,
 }
 
+/// `subd pia` writes meshes.
+const PIA: batch::Command = batch::Command {
+    name: "pia",
+    formats: batch::MESH_OUTPUTS,
+};
+
 pub(crate) fn run(args: &PiaArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<(), Failure> {
-    let command = batch::Command {
-        name: "pia",
-        formats: batch::MESH_OUTPUTS,
-    };
-    batch::run(
-        &args.files,
-        &command,
-        args.json,
-        out,
-        err,
-        |job, out, err| run_one(args, job, out, err),
-    )
+    PIA.run(&args.files, args.json, out, err, |job, out, err| {
+        run_one(args, job, out, err)
+    })
 }
 
 fn run_one(
@@ -134,39 +122,20 @@ fn run_one(
     out: &mut dyn Write,
     err: &mut dyn Write,
 ) -> Result<(), Failure> {
-    let t_start = Instant::now();
-    refuse_overwrite(&job.input, &job.output)?;
-    if subd_io::Format::for_output(&job.output).is_none() {
-        return Err(bad(format!(
-            "{}: unsupported output extension (expected .obj, .ply or .glb)",
-            job.output.display()
-        )));
-    }
+    let started = PIA.start(&job.input, &job.output)?;
     if args.tol.is_nan() || args.tol <= 0.0 {
         return Err(bad(format!(
             "--tol {}: must be a positive number",
             args.tol
         )));
     }
-    let file = subd_io::read_mesh(&job.input, &args.rules.read_options())?;
-    print_warnings(err, &job.input, &file.warnings);
-    let t_read = t_start.elapsed().as_secs_f64();
+    let opened = started.read(&args.rules, err)?;
+    let (file, t_read) = (&opened.file, opened.read_seconds);
     let topo = &file.mesh.topology;
     let nv = topo.num_vertices();
     let options = args.rules.options(&file.mesh.hints);
-    let (scheme, name) = match args.scheme {
-        SchemeArg::CatmullClark => (Scheme::CatmullClark, "catmull-clark"),
-        SchemeArg::Loop => (Scheme::Loop, "loop"),
-        SchemeArg::TwoPhase => (
-            Scheme::TwoPhase(args.lambda.two_phase(&job.input, nv)?),
-            "two-phase",
-        ),
-    };
-    if !matches!(args.scheme, SchemeArg::TwoPhase) && args.lambda.given() {
-        return Err(bad(
-            "--lambda and --lambda-file apply to --scheme two-phase only".into(),
-        ));
-    }
+    let scheme = scheme_arg::with_lambda(&args.scheme, &args.lambda, &job.input, nv)?;
+    let name = scheme.name();
     let moving = match (&args.moving, &args.fixed) {
         (Some(f), _) => Moving::Only(read_indices(f, nv, "vertex")?),
         (None, Some(f)) => Moving::AllBut(read_indices(f, nv, "vertex")?),
@@ -268,7 +237,7 @@ fn run_one(
                 solve: t_solve,
                 check: t_check,
                 write: t_write,
-                total: t_start.elapsed().as_secs_f64(),
+                total: opened.elapsed(),
             },
             warnings: file.warnings.clone(),
         };

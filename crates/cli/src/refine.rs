@@ -5,71 +5,26 @@
 use std::io::{IsTerminal, Write};
 use std::time::Instant;
 
-use clap::{Args, ValueEnum};
+use clap::Args;
 use serde::Serialize;
-use subd_limit::split_limit::SplitLimitStencils;
+use subd_limit::LimitStencilTable;
 use subd_mesh::{BoundaryInterpolation, CreaseMethod, SchemeHints, TriangleSubdivision};
-use subd_schemes::{Refinement, Scheme, TwoPhase};
+use subd_schemes::{Refinement, Scheme};
 
+use crate::Failure;
 use crate::batch::{self, Files, Job};
-use crate::budget::{Budget, PeakModel};
-use crate::failure::{bad, refuse_overwrite};
+use crate::budget::Budget;
+use crate::failure::bad;
 use crate::rule_args::RuleArgs;
+use crate::scheme_arg;
 use crate::vertex_data::LambdaArgs;
-use crate::{Failure, print_warnings};
-
-#[derive(Debug, Clone, Copy, ValueEnum)]
-pub(crate) enum SchemeArg {
-    CatmullClark,
-    Loop,
-    Bilinear,
-    /// Seed 000's two-phase modified Catmull-Clark (needs --lambda or --lambda-file).
-    TwoPhase,
-    /// Doo-Sabin's dual scheme, any polygons.
-    DooSabin,
-    /// Kobbelt's √3 scheme, triangles.
-    Sqrt3,
-    /// The interpolating butterfly scheme (Dyn, Levin, Gregory), triangles; see --tension.
-    Butterfly,
-    /// Zorin, Schröder and Sweldens' modified butterfly, triangles.
-    ModifiedButterfly,
-}
-
-impl SchemeArg {
-    /// The scheme, with the butterfly's `tension` and the two-phase scheme's `λ`.
-    pub(crate) fn scheme(self, tension: f64, two_phase: Option<TwoPhase>) -> Scheme {
-        match self {
-            SchemeArg::CatmullClark => Scheme::CatmullClark,
-            SchemeArg::TwoPhase => Scheme::TwoPhase(two_phase.unwrap_or_else(TwoPhase::unset)),
-            SchemeArg::Loop => Scheme::Loop,
-            SchemeArg::Bilinear => Scheme::Bilinear,
-            SchemeArg::DooSabin => Scheme::DooSabin,
-            SchemeArg::Sqrt3 => Scheme::Sqrt3,
-            SchemeArg::Butterfly => Scheme::Butterfly { tension },
-            SchemeArg::ModifiedButterfly => Scheme::ModifiedButterfly,
-        }
-    }
-
-    /// The name the command line uses.
-    pub(crate) fn name(self) -> &'static str {
-        match self {
-            SchemeArg::CatmullClark => "catmull-clark",
-            SchemeArg::Loop => "loop",
-            SchemeArg::Bilinear => "bilinear",
-            SchemeArg::TwoPhase => "two-phase",
-            SchemeArg::DooSabin => "doo-sabin",
-            SchemeArg::Sqrt3 => "sqrt3",
-            SchemeArg::Butterfly => "butterfly",
-            SchemeArg::ModifiedButterfly => "modified-butterfly",
-        }
-    }
-}
+use subd_schemes::peak::PeakModel;
 
 #[derive(Debug, Args)]
 pub(crate) struct RefineArgs {
-    /// Subdivision scheme.
-    #[arg(long, value_enum)]
-    scheme: SchemeArg,
+    /// Subdivision scheme (a parameter may follow a colon: butterfly:0.05, two-phase:0.6).
+    #[arg(long, value_parser = scheme_arg::parser(scheme_arg::ALL))]
+    scheme: Scheme,
     /// Number of uniform refinement levels (0 to 15; for two-phase, level 1 is phase 1).
     #[arg(long)]
     levels: usize,
@@ -140,7 +95,7 @@ struct RefineReport {
 /// positions and the texture coordinates take their limits through the same ones.
 pub(crate) struct Refined {
     refinement: Refinement,
-    last_limit: std::sync::OnceLock<Result<SplitLimitStencils, String>>,
+    last_limit: std::sync::OnceLock<Result<LimitStencilTable, String>>,
 }
 
 impl std::ops::Deref for Refined {
@@ -166,11 +121,11 @@ impl Refined {
     }
 
     /// The limit stencils of a split scheme's last level, built on first request.
-    pub(crate) fn last_limit(&self) -> Result<&SplitLimitStencils, String> {
+    pub(crate) fn last_limit(&self) -> Result<&LimitStencilTable, String> {
         self.last_limit
             .get_or_init(|| {
                 let last = self.topology(self.num_levels());
-                subd_limit::split_limit::checked_split_limit_stencils(last, self.scheme())
+                subd_limit::split_limit::split_limit_table(last, self.scheme())
                     .map_err(|e| e.to_string())
             })
             .as_ref()
@@ -193,205 +148,253 @@ impl Refined {
     }
 }
 
+/// `subd refine` writes meshes.
+const REFINE: batch::Command = batch::Command {
+    name: "refine",
+    formats: batch::MESH_OUTPUTS,
+};
+
 pub(crate) fn run(
     args: &RefineArgs,
     out: &mut dyn Write,
     err: &mut dyn Write,
 ) -> Result<(), Failure> {
-    let command = batch::Command {
-        name: "refine",
-        formats: batch::MESH_OUTPUTS,
-    };
-    batch::run(
-        &args.files,
-        &command,
-        args.json,
-        out,
-        err,
-        |job, out, err| run_one(args, job, out, err),
-    )
+    REFINE.run(&args.files, args.json, out, err, |job, out, err| {
+        run_one(args, job, out, err)
+    })
 }
 
+/// One file: open it, refine, carry the texture coordinates, write the last level (streamed
+/// where it can be), report.
 fn run_one(
     args: &RefineArgs,
     job: &Job,
     out: &mut dyn Write,
     err: &mut dyn Write,
 ) -> Result<(), Failure> {
-    let t_start = Instant::now();
-    refuse_overwrite(&job.input, &job.output)?;
-    if subd_io::Format::for_output(&job.output).is_none() {
-        return Err(bad(format!(
-            "{}: unsupported output extension (expected .obj, .ply or .glb)",
-            job.output.display()
-        )));
-    }
-    if args.tension.is_some() && !matches!(args.scheme, SchemeArg::Butterfly) {
-        return Err(bad("--tension applies to --scheme butterfly only".into()));
-    }
-    let tension = crate::rule_args::butterfly_tension(args.tension)?;
-    let mut file = subd_io::read_mesh(&job.input, &args.rules.read_options())?;
-    print_warnings(err, &job.input, &file.warnings);
-    let warned = file.warnings.len();
-    let t_read = t_start.elapsed().as_secs_f64();
-    let options = args.rules.options(&file.mesh.hints);
-    let base = &file.mesh.topology;
-    let two_phase = match args.scheme {
-        SchemeArg::TwoPhase => Some(args.lambda.two_phase(&job.input, base.num_vertices())?),
-        _ if args.lambda.given() => {
-            return Err(bad(
-                "--lambda and --lambda-file apply to --scheme two-phase only".into(),
-            ));
-        }
-        _ => None,
-    };
-    let scheme = args.scheme.scheme(tension, two_phase);
-    check_memory(args, job, &file, &scheme)?;
-
+    let (mut opened, scheme) = open(args, job, err)?;
+    let options = args.rules.options(&opened.file.mesh.hints);
     let progress = Progress::new(args.levels, args.json || job.quiet);
     let t0 = Instant::now();
-    let in_file = |e: &dyn std::fmt::Display| bad(format!("{}: {e}", job.input.display()));
+    let base = &opened.file.mesh.topology;
     let refinement =
-        Refined::new(base, scheme.clone(), &options, args.levels).map_err(|e| in_file(&e))?;
+        Refined::new(base, scheme, &options, args.levels).map_err(|e| in_file(job, &e))?;
     let input_counts = Counts {
         vertices: base.num_vertices(),
         edges: Some(base.num_edges()),
         faces: base.num_faces(),
     };
-    let fvar_mode = args.rules.fvar_mode(&file.mesh.hints);
-    let uv = crate::uv::refined_uv(
-        &refinement,
-        &file.mesh,
-        fvar_mode,
-        args.limit,
-        &mut file.warnings,
-    )
-    .map_err(|e| in_file(&e))?;
-    // PLY holds one texture coordinate per vertex: a seamed layout is left out (a refined
-    // level gives a seamless layout exactly one value per vertex).
-    let uv = match uv {
-        Some(u)
-            if subd_io::Format::for_output(&job.output) == Some(subd_io::Format::Ply)
-                && if args.levels == 0 {
-                    let t = &file.mesh.topology;
-                    !subd_io::MeshView::new(
-                        &file.mesh.positions,
-                        t.face_offsets(),
-                        t.all_face_vertices(),
-                        &[],
-                    )
-                    .and_then(|v| v.with_uv(&u.values, 2, &u.indices))
-                    .is_ok_and(|v| subd_io::ply::holds_texcoords(&v))
-                } else {
-                    u.values.len() / 2 != refinement.topology(args.levels).num_vertices()
-                } =>
-        {
-            file.warnings.push(crate::uv::ply_seam_warning(&job.output));
-            None
-        }
-        u => u,
-    };
-    print_warnings(
-        err,
-        &job.input,
-        &file.warnings[file.warnings.len().min(warned)..],
-    );
+    let fvar_mode = args.rules.fvar_mode(&opened.file.mesh.hints);
+    let uv = output_uv(args, job, &refinement, &mut opened.file, fvar_mode)?;
+    opened.print_new_warnings(&job.input, err);
     // The refinement holds its own copy of the base level: the file's is not needed again.
     if let Ok(empty) = subd_mesh::TopologyBuilder::new(0).build(&[], &[]) {
-        file.mesh.topology = empty;
+        opened.file.mesh.topology = empty;
     }
     progress.step("topology");
     let t_topology = t0.elapsed().as_secs_f64();
-    let t1 = Instant::now();
-    let osd = scheme.is_opensubdiv();
-    let mut hints = output_hints(osd, &options, &file.mesh.hints, &args.rules);
+    let osd = refinement.scheme().is_opensubdiv();
+    let mut hints = output_hints(osd, &options, &opened.file.mesh.hints, &args.rules);
     hints.fvar_interpolation = uv.as_ref().map(|_| fvar_mode);
-    let in_view = |e: subd_io::ViewError| bad(format!("{}: {e}", job.input.display()));
-    let streams = match &refinement {
-        r if osd && !args.limit && args.levels > 0 => Some(r),
-        _ => None,
+    let output = Output {
+        args,
+        job,
+        refinement: &refinement,
+        base: &opened.file.mesh.positions,
+        uv: uv.as_ref(),
+        hints,
+        progress: &progress,
     };
-    let (out_counts, t_positions, t2) = if let Some(r) = streams {
-        // The last level straight to the file, a window at a time, from the level above.
-        let above = r.points_at(&file.mesh.positions, args.levels - 1);
-        let points = crate::level_stream::Points(r.point_stream(&above).expect("levels > 0"));
-        let faces = crate::level_stream::Faces(r.face_stream().expect("levels > 0"));
-        // `.glb` normals need every position at hand.
-        let held = (subd_io::Format::for_output(&job.output) == Some(subd_io::Format::Glb))
-            .then(|| points.all());
-        progress.step("positions");
-        let t_positions = t1.elapsed().as_secs_f64();
-        let t2 = Instant::now();
-        let source = match &held {
-            Some(p) => subd_io::Points::Held(p),
-            None => subd_io::Points::Streamed(&points),
-        };
-        let tags = refinement.explicit_tags(args.levels);
-        let view = subd_io::MeshView::streamed(source, &faces, faces.0.hole_faces())
-            .and_then(|v| v.with_tags(tags.creases, tags.corners))
-            .and_then(|v| crate::uv::with_uv(v, uv.as_ref()))
-            .map_err(in_view)?;
-        let counts = write_level(job, view, hints, refinement.edges(args.levels))?;
-        (counts, t_positions, t2)
+    let written = if osd && !args.limit && args.levels > 0 {
+        output.streamed()?
     } else {
-        let mut positions = refinement.last_positions(&file.mesh.positions);
-        let normals = if args.limit {
-            let limit = output_limit(&refinement, args.levels, &options, &positions)
-                .map_err(|e| in_file(&e))?;
-            positions = limit.positions;
-            Some(limit.normals)
-        } else {
-            None
-        };
-        progress.step("positions");
-        let t_positions = t1.elapsed().as_secs_f64();
-        let t2 = Instant::now();
-        // Polygons, holes and the tags a reader cannot infer are all the file holds: they
-        // are written without building the output level's edges (most of the time and
-        // memory of a deep refinement's output).
-        let (offsets, vertices) = refinement.faces(args.levels);
-        let tags = refinement.explicit_tags(args.levels);
-        let holes = refinement.holes(args.levels);
-        let mut view = subd_io::MeshView::new(&positions, offsets, vertices, &holes)
-            .and_then(|v| v.with_tags(tags.creases, tags.corners))
-            .and_then(|v| crate::uv::with_uv(v, uv.as_ref()))
-            .map_err(in_view)?;
-        let filled;
-        if let Some(n) = &normals {
-            filled = normals_or_faces(n, &view);
-            view = view.with_normals(&filled).map_err(in_view)?;
-        }
-        let counts = write_level(job, view, hints, refinement.edges(args.levels))?;
-        (counts, t_positions, t2)
+        output.held(&options)?
     };
     progress.finish();
-    let t_write = t2.elapsed().as_secs_f64();
-
     if args.json {
         let report = RefineReport {
             input: job.input.display().to_string(),
             output: job.output.display().to_string(),
-            scheme: args.scheme.name(),
+            scheme: refinement.scheme().name(),
             levels: args.levels,
-            tension: scheme.tension(),
+            tension: refinement.scheme().tension(),
             boundary_interpolation: osd.then_some(options.boundary_interpolation),
             crease_method: osd.then_some(options.crease_method),
             triangle_subdivision: osd.then_some(options.triangle_subdivision),
             limit: args.limit,
             input_counts,
-            output_counts: out_counts,
+            output_counts: written.counts,
             seconds: Timings {
-                read: t_read,
+                read: opened.read_seconds,
                 topology: t_topology,
-                positions: t_positions,
-                write: t_write,
-                total: t_start.elapsed().as_secs_f64(),
+                positions: written.positions_seconds,
+                write: written.write_seconds,
+                total: opened.elapsed(),
             },
-            warnings: file.warnings.clone(),
+            warnings: opened.file.warnings.clone(),
         };
         crate::print_json(out, &report);
     }
     Ok(())
+}
+
+/// `e` as a message naming the input.
+fn in_file(job: &Job, e: &dyn std::fmt::Display) -> Failure {
+    bad(format!("{}: {e}", job.input.display()))
+}
+
+/// The checks before and after reading: the output, the butterfly's tension, the input
+/// itself, the two-phase scheme's `λ` and the memory budget. The file and the complete
+/// scheme.
+fn open(
+    args: &RefineArgs,
+    job: &Job,
+    err: &mut dyn Write,
+) -> Result<(crate::opening::Opened, Scheme), Failure> {
+    let started = REFINE.start(&job.input, &job.output)?;
+    let scheme = scheme_arg::with_tension(&args.scheme, args.tension, "--scheme")?;
+    let opened = started.read(&args.rules, err)?;
+    let vertices = opened.file.mesh.topology.num_vertices();
+    let scheme = scheme_arg::with_lambda(&scheme, &args.lambda, &job.input, vertices)?;
+    check_memory(args, job, &opened.file, &scheme)?;
+    Ok((opened, scheme))
+}
+
+/// The texture coordinates of the output level, if the input has them. PLY holds one per
+/// vertex: a seamed layout is left out with a warning (a refined level gives a seamless
+/// layout exactly one value per vertex).
+fn output_uv(
+    args: &RefineArgs,
+    job: &Job,
+    refinement: &Refined,
+    file: &mut subd_io::MeshFile,
+    fvar_mode: subd_mesh::fvar::FVarLinearInterpolation,
+) -> Result<Option<crate::uv::RefinedUv>, Failure> {
+    let uv = crate::uv::refined_uv(
+        refinement,
+        &file.mesh,
+        fvar_mode,
+        args.limit,
+        &mut file.warnings,
+    )
+    .map_err(|e| in_file(job, &e))?;
+    let Some(u) = uv else { return Ok(None) };
+    if subd_io::Format::for_output(&job.output) != Some(subd_io::Format::Ply) {
+        return Ok(Some(u));
+    }
+    let seamed = if args.levels == 0 {
+        let t = &file.mesh.topology;
+        !subd_io::MeshView::new(
+            &file.mesh.positions,
+            t.face_offsets(),
+            t.all_face_vertices(),
+            &[],
+        )
+        .and_then(|v| v.with_uv(&u.values, 2, &u.indices))
+        .is_ok_and(|v| subd_io::ply::holds_texcoords(&v))
+    } else {
+        u.values.len() / 2 != refinement.topology(args.levels).num_vertices()
+    };
+    if seamed {
+        file.warnings.push(crate::uv::ply_seam_warning(&job.output));
+        return Ok(None);
+    }
+    Ok(Some(u))
+}
+
+/// What writing the output level needs.
+struct Output<'a> {
+    args: &'a RefineArgs,
+    job: &'a Job,
+    refinement: &'a Refined,
+    /// The base positions.
+    base: &'a [subd_mesh::DVec3],
+    uv: Option<&'a crate::uv::RefinedUv>,
+    hints: SchemeHints,
+    progress: &'a Progress,
+}
+
+/// The output level's counts and the seconds its positions and its writing took.
+struct Written {
+    counts: Counts,
+    positions_seconds: f64,
+    write_seconds: f64,
+}
+
+impl Output<'_> {
+    fn in_view(&self, e: subd_io::ViewError) -> Failure {
+        in_file(self.job, &e)
+    }
+
+    /// The last level straight to the file, a window at a time, from the level above
+    /// (OpenSubdiv's schemes without `--limit`).
+    fn streamed(&self) -> Result<Written, Failure> {
+        let (r, levels) = (self.refinement, self.args.levels);
+        let t1 = Instant::now();
+        let above = r.points_at(self.base, levels - 1);
+        let points = crate::level_stream::Points(r.point_stream(&above).expect("levels > 0"));
+        let faces = crate::level_stream::Faces(r.face_stream().expect("levels > 0"));
+        // `.glb` normals need every position at hand.
+        let glb = subd_io::Format::for_output(&self.job.output) == Some(subd_io::Format::Glb);
+        let held = glb.then(|| points.all());
+        self.progress.step("positions");
+        let positions_seconds = t1.elapsed().as_secs_f64();
+        let t2 = Instant::now();
+        let source = match &held {
+            Some(p) => subd_io::Points::Held(p),
+            None => subd_io::Points::Streamed(&points),
+        };
+        let tags = r.explicit_tags(levels);
+        let view = subd_io::MeshView::streamed(source, &faces, faces.0.hole_faces())
+            .and_then(|v| v.with_tags(tags.creases, tags.corners))
+            .and_then(|v| crate::uv::with_uv(v, self.uv))
+            .map_err(|e| self.in_view(e))?;
+        let counts = write_level(self.job, view, self.hints, r.edges(levels))?;
+        Ok(Written {
+            counts,
+            positions_seconds,
+            write_seconds: t2.elapsed().as_secs_f64(),
+        })
+    }
+
+    /// The last level's positions computed in full (moved to the limit with `--limit`),
+    /// then written. Polygons, holes and the tags a reader cannot infer are all the file
+    /// holds: they are written without building the output level's edges (most of the time
+    /// and memory of a deep refinement's output).
+    fn held(&self, options: &subd_schemes::Options) -> Result<Written, Failure> {
+        let (r, levels) = (self.refinement, self.args.levels);
+        let t1 = Instant::now();
+        let mut positions = r.last_positions(self.base);
+        let normals = if self.args.limit {
+            let limit =
+                output_limit(r, levels, options, &positions).map_err(|e| in_file(self.job, &e))?;
+            positions = limit.positions;
+            Some(limit.normals)
+        } else {
+            None
+        };
+        self.progress.step("positions");
+        let positions_seconds = t1.elapsed().as_secs_f64();
+        let t2 = Instant::now();
+        let (offsets, vertices) = r.faces(levels);
+        let tags = r.explicit_tags(levels);
+        let holes = r.holes(levels);
+        let mut view = subd_io::MeshView::new(&positions, offsets, vertices, &holes)
+            .and_then(|v| v.with_tags(tags.creases, tags.corners))
+            .and_then(|v| crate::uv::with_uv(v, self.uv))
+            .map_err(|e| self.in_view(e))?;
+        let filled;
+        if let Some(n) = &normals {
+            filled = normals_or_faces(n, &view);
+            view = view.with_normals(&filled).map_err(|e| self.in_view(e))?;
+        }
+        let counts = write_level(self.job, view, self.hints, r.edges(levels))?;
+        Ok(Written {
+            counts,
+            positions_seconds,
+            write_seconds: t2.elapsed().as_secs_f64(),
+        })
+    }
 }
 
 /// Writes the output level with its hints; its counts for the report.
@@ -467,10 +470,7 @@ pub(crate) fn output_limit(
             .map_err(|e| e.to_string());
     }
     // A split scheme's last level: the stencils its texture coordinates share.
-    refinement
-        .last_limit()?
-        .limit_points(scheme, positions)
-        .map_err(|e| e.to_string())
+    Ok(refinement.last_limit()?.apply(positions))
 }
 
 /// `normals` where they are unit vectors; elsewhere (a split scheme's creases and corners,

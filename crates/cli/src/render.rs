@@ -8,11 +8,13 @@ use std::time::Instant;
 use clap::Args;
 use serde::Serialize;
 use subd_mesh::DVec3;
+use subd_schemes::Scheme;
 
 use crate::failure::{bad, refuse_overwrite};
 use crate::raster::{Camera, Canvas, Rgb, shade};
-use crate::refine::{Refined, SchemeArg, normals_or_faces, output_limit};
+use crate::refine::{Refined, normals_or_faces, output_limit};
 use crate::rule_args::RuleArgs;
+use crate::scheme_arg;
 use crate::{Failure, print_warnings};
 
 /// Largest picture side, in pixels.
@@ -39,8 +41,8 @@ const POINT: Rgb = [200, 20, 40];
 pub(crate) struct RenderArgs {
     /// Refine with this scheme before drawing (default: draw IN as it is; with --limit:
     /// loop for an all-triangle mesh, else catmull-clark).
-    #[arg(long, value_enum)]
-    scheme: Option<SchemeArg>,
+    #[arg(long, value_parser = scheme_arg::parser(scheme_arg::ALL))]
+    scheme: Option<Scheme>,
     /// Levels of refinement (default 3 when refining).
     #[arg(long)]
     levels: Option<usize>,
@@ -144,12 +146,20 @@ pub(crate) fn run(
             args.output.display()
         )));
     }
-    if args.tension.is_some() && !matches!(args.scheme, Some(SchemeArg::Butterfly)) {
-        return Err(bad("--tension applies to --scheme butterfly only".into()));
-    }
-    if matches!(args.scheme, Some(SchemeArg::TwoPhase)) {
+    let chosen = match &args.scheme {
+        Some(s) => Some(scheme_arg::with_tension(s, args.tension, "--scheme")?),
+        None if args.tension.is_some() => {
+            return Err(bad("--tension applies to --scheme butterfly only".into()));
+        }
+        None => None,
+    };
+    if chosen
+        .as_ref()
+        .and_then(Scheme::two_phase)
+        .is_some_and(|tp| !tp.is_set())
+    {
         return Err(bad(
-            "--scheme two-phase needs per-vertex λ: refine with `subd refine` and render its output".into(),
+            "--scheme two-phase needs its λ: two-phase:λ, or refine with `subd refine` (per-vertex λ) and render its output".into(),
         ));
     }
     let refining = args.scheme.is_some() || args.limit;
@@ -167,13 +177,11 @@ pub(crate) fn run(
         None => Vec::new(),
     };
     let base = &file.mesh.topology;
-    let scheme = args
-        .scheme
-        .unwrap_or(if (0..base.num_faces()).all(|f| base.face_size(f) == 3) {
-            SchemeArg::Loop
-        } else {
-            SchemeArg::CatmullClark
-        });
+    let scheme = chosen.unwrap_or(if (0..base.num_faces()).all(|f| base.face_size(f) == 3) {
+        Scheme::Loop
+    } else {
+        Scheme::CatmullClark
+    });
     let levels = if refining {
         args.levels.unwrap_or(3)
     } else {
@@ -181,10 +189,9 @@ pub(crate) fn run(
     };
     let in_file = |e: &dyn std::fmt::Display| bad(format!("{}: {e}", args.input.display()));
     let surface = if refining {
-        let tension = crate::rule_args::butterfly_tension(args.tension)?;
         let options = args.rules.options(&file.mesh.hints);
-        let refinement = Refined::new(base, scheme.scheme(tension, None), &options, levels)
-            .map_err(|e| in_file(&e))?;
+        let refinement =
+            Refined::new(base, scheme.clone(), &options, levels).map_err(|e| in_file(&e))?;
         let mut positions = refinement.last_positions(&file.mesh.positions);
         let limit_normals = if args.limit {
             let limit =

@@ -10,17 +10,19 @@ use serde::Serialize;
 use subd_limit::eval::LimitEvaluator;
 use subd_limit::tessellation::tessellate;
 
-use crate::failure::{bad, refuse_overwrite};
-use crate::limit::LimitSchemeArg;
+use subd_schemes::Scheme;
+
+use crate::Failure;
+use crate::failure::bad;
 use crate::refine::normals_or_faces;
 use crate::rule_args::RuleArgs;
-use crate::{Failure, print_warnings};
+use crate::scheme_arg;
 
 #[derive(Debug, Args)]
 pub(crate) struct TessellateArgs {
     /// Subdivision scheme.
-    #[arg(long, value_enum)]
-    scheme: LimitSchemeArg,
+    #[arg(long, value_parser = scheme_arg::parser(scheme_arg::EVALUATED))]
+    scheme: Scheme,
     /// Segments per base edge (even when a Catmull-Clark face is not a quad: each of its quad
     /// sub-faces takes half).
     #[arg(long)]
@@ -55,26 +57,25 @@ struct Seconds {
     write: f64,
 }
 
+/// `subd tessellate` writes meshes (one file: no batch mode).
+const TESSELLATE: crate::batch::Command = crate::batch::Command {
+    name: "tessellate",
+    formats: crate::batch::MESH_OUTPUTS,
+};
+
 pub(crate) fn run(
     args: &TessellateArgs,
     out: &mut dyn Write,
     err: &mut dyn Write,
 ) -> Result<(), Failure> {
-    let t0 = Instant::now();
-    refuse_overwrite(&args.input, &args.output)?;
-    if subd_io::Format::for_output(&args.output).is_none() {
-        return Err(bad(format!(
-            "{}: unsupported output extension (expected .obj, .ply or .glb)",
-            args.output.display()
-        )));
-    }
-    let file = subd_io::read_mesh(&args.input, &args.rules.read_options())?;
-    print_warnings(err, &args.input, &file.warnings);
-    let t_read = t0.elapsed().as_secs_f64();
+    let opened = TESSELLATE
+        .start(&args.input, &args.output)?
+        .read(&args.rules, err)?;
+    let (file, t_read) = (&opened.file, opened.read_seconds);
     let in_file = |e: &dyn std::fmt::Display| bad(format!("{}: {e}", args.input.display()));
     let t1 = Instant::now();
     let options = args.rules.options(&file.mesh.hints);
-    let scheme = args.scheme.scheme();
+    let scheme = args.scheme.clone();
     let evaluator =
         LimitEvaluator::new(&file.mesh.topology, &scheme, &options).map_err(|e| in_file(&e))?;
     let points = evaluator.prepare(&file.mesh.positions);

@@ -1,7 +1,7 @@
 //! Texture coordinates through the commands: a mesh's first face-varying channel refined
 //! with the mesh (or taken to its limit) and handed to the writers.
 
-use subd_limit::split_limit::SplitLimitStencils;
+use subd_limit::LimitStencilTable;
 use subd_mesh::DVec3;
 use subd_mesh::Topology;
 use subd_mesh::fvar::{FVarChannel, FVarLinearInterpolation};
@@ -106,7 +106,7 @@ fn split_uv(
 /// is the geometry) take the positions' limit stencils, from `stencils`.
 fn split_values_limit<'a>(
     fv: &SplitFaceVarying,
-    stencils: impl FnOnce() -> Result<&'a SplitLimitStencils, String>,
+    stencils: impl FnOnce() -> Result<&'a LimitStencilTable, String>,
     values: Vec<f64>,
 ) -> Result<Vec<f64>, String> {
     if fv.values_scheme().is_interpolating() {
@@ -116,10 +116,8 @@ fn split_values_limit<'a>(
         .chunks_exact(2)
         .map(|x| DVec3::new(x[0], x[1], 0.0))
         .collect();
-    let limit = stencils()?
-        .limit_points(fv.values_scheme(), &points)
-        .map_err(|e| e.to_string())?;
-    Ok(limit.positions.iter().flat_map(|p| [p.x, p.y]).collect())
+    let limit = stencils()?.position.apply_points(&points);
+    Ok(limit.iter().flat_map(|p| [p.x, p.y]).collect())
 }
 
 /// The limit of a base mesh's texture coordinates under a split scheme (see
@@ -127,7 +125,7 @@ fn split_values_limit<'a>(
 /// warning, where Doo-Sabin or √3 cannot carry their seams.
 pub(crate) fn split_limit_uv(
     topology: &Topology,
-    (scheme, stencils): (&Scheme, &SplitLimitStencils),
+    (scheme, stencils): (&Scheme, &LimitStencilTable),
     channel: &FVarChannel,
     mode: FVarLinearInterpolation,
     warnings: &mut Vec<String>,

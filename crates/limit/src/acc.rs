@@ -23,9 +23,9 @@
 use glam::DVec3;
 use serde::Serialize;
 use subd_mesh::Topology;
+use subd_mesh::neighbourhood::quad_ring_from;
 
 use crate::LimitError;
-use crate::patch::face_ring;
 
 /// The ACC patches of one quad face.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -87,27 +87,12 @@ impl AccPatch {
     }
 }
 
-/// The ring of interior vertex `v` starting at the edge towards `first`: (edge neighbours,
-/// face-opposite vertices), counter-clockwise. `None` unless `v` is interior and manifold
-/// with quads around it.
-fn ring_from(t: &Topology, v: usize, first: u32) -> Option<(Vec<u32>, Vec<u32>)> {
-    let f0 = *t.vertex_faces(v).first()? as usize;
-    let (mut edges, mut diags): (Vec<u32>, Vec<u32>) = face_ring::<3>(t, v, f0)?
-        .iter()
-        .map(|r| (r[0], r[1]))
-        .unzip();
-    let k = edges.iter().position(|&e| e == first)?;
-    edges.rotate_left(k);
-    diags.rotate_left(k);
-    Some((edges, diags))
-}
-
 /// The limit tangent of `v` towards its neighbour `first`, scaled as ACC scales corner
 /// tangents (equal to 3 (b₁₀ − b₀₀) of the B-spline patch at valence 4):
 /// `Σ α_i e_i + β_i f_i`, `β = 1 / (n sqrt(4 + cos²(π/n)))`, `α_i = (1/n + cos(π/n) β)
 /// cos(2πi/n)`, `β_i = β cos((2i + 1)π/n)`.
 fn corner_tangent(t: &Topology, p: &[DVec3], v: usize, first: u32) -> Option<DVec3> {
-    let (edges, diags) = ring_from(t, v, first)?;
+    let (edges, diags) = quad_ring_from(t, v, first)?;
     let n = edges.len() as f64;
     let pi = std::f64::consts::PI;
     let c = (pi / n).cos();
@@ -188,7 +173,7 @@ pub fn acc_patches(t: &Topology, p: &[DVec3]) -> Result<Vec<AccPatch>, LimitErro
         for k in 0..4 {
             let v = fv[k] as usize;
             let (edges, diags) =
-                ring_from(t, v, fv[(k + 1) % 4]).ok_or(LimitError::Unsupported {
+                quad_ring_from(t, v, fv[(k + 1) % 4]).ok_or(LimitError::Unsupported {
                     face: f,
                     reason: "a corner is not an interior vertex with quads around it",
                 })?;

@@ -9,8 +9,10 @@
 //!   against the closed forms of seed 001 §5, and used where no closed form is exact
 //!   (darts, interior valence 2).
 //! * [`LimitStencilTable`]: limit positions, tangents and normals of every vertex of a
-//!   refinement level as stencil tables; [`base_limit`] gives the exact limit of every base
-//!   vertex, refining first as far as semi-sharp creases need to decay.
+//!   refinement level as stencil tables. [`limit_stencils`] is the one entry for every
+//!   scheme: [`base_limit`] gives the exact limit of every base vertex of Catmull-Clark and
+//!   Loop, refining first as far as semi-sharp creases need to decay,
+//!   [`two_phase_base_limit`] the two-phase scheme's, [`split_limit`] the split schemes'.
 //! * [`eval`]: exact evaluation at any (face, u, v) with derivatives — bicubic B-splines and
 //!   [`stam`]'s eigenbasis for Catmull-Clark, box splines and [`loop_patch`] for Loop.
 //!   Next to irregular sharp features the evaluator refines locally, as deep as the point
@@ -179,11 +181,11 @@ pub(crate) fn first_rows(t: &StencilTable, k: usize) -> StencilTable {
     )
 }
 
-/// The exact limit of every vertex of `topology` under any `scheme`, applied to `positions`:
-/// the one limit entry. Catmull-Clark and Loop take [`base_limit`], the two-phase scheme
-/// [`two_phase_base_limit`] (its phase 1 included), the split schemes
-/// [`split_limit::checked_split_limit_stencils`] with NaN tangents and normals where none
-/// exists (√3's and the butterflies' creases and corners).
+/// The exact limit of every vertex of `topology` under any `scheme`, as stencils over its
+/// vertices: the one limit entry. Catmull-Clark and Loop take [`base_limit`], the two-phase
+/// scheme [`two_phase_base_limit`] (its phase 1 included), the split schemes
+/// [`split_limit::split_limit_table`], whose creases and corners (√3, the butterflies) have no
+/// tangents ([`LimitStencilTable::without_tangents`]: NaN tangents and normals once applied).
 ///
 /// ```
 /// use subd_mesh::{DVec3, TopologyBuilder};
@@ -196,8 +198,8 @@ pub(crate) fn first_rows(t: &StencilTable, k: usize) -> StencilTable {
 /// let p = [DVec3::X, DVec3::Y, DVec3::Z, DVec3::ONE];
 /// for name in ["loop", "sqrt3", "butterfly", "modified-butterfly"] {
 ///     let scheme: Scheme = name.parse().unwrap();
-///     let limit = subd_limit::limit_points(&tet, &scheme, &Options::default(), &p).unwrap();
-///     assert_eq!(limit.positions.len(), 4);
+///     let table = subd_limit::limit_stencils(&tet, &scheme, &Options::default()).unwrap();
+///     assert_eq!(table.num_rows(), 4);
 /// }
 /// // The butterflies interpolate: each vertex is its own limit.
 /// let b = subd_limit::limit_points(&tet, &Scheme::BUTTERFLY, &Options::default(), &p).unwrap();
@@ -207,17 +209,29 @@ pub(crate) fn first_rows(t: &StencilTable, k: usize) -> StencilTable {
 /// # Errors
 /// [`LimitError::Scheme`] for Bilinear (its limit is the mesh itself), and as the entry of
 /// the scheme's family.
+pub fn limit_stencils(
+    topology: &Topology,
+    scheme: &Scheme,
+    options: &Options,
+) -> Result<LimitStencilTable, LimitError> {
+    match scheme {
+        Scheme::TwoPhase(tp) => two_phase_base_limit(topology, tp, options),
+        s if s.is_opensubdiv() => base_limit(topology, s, options),
+        s => split_limit::split_limit_table(topology, s),
+    }
+}
+
+/// [`limit_stencils`] applied to `positions`.
+///
+/// # Errors
+/// As [`limit_stencils`].
 pub fn limit_points(
     topology: &Topology,
     scheme: &Scheme,
     options: &Options,
     positions: &[glam::DVec3],
 ) -> Result<LimitPoints, LimitError> {
-    match scheme {
-        Scheme::TwoPhase(tp) => Ok(two_phase_base_limit(topology, tp, options)?.apply(positions)),
-        s if s.is_opensubdiv() => Ok(base_limit(topology, s, options)?.apply(positions)),
-        s => split_limit::checked_split_limit_stencils(topology, s)?.limit_points(s, positions),
-    }
+    Ok(limit_stencils(topology, scheme, options)?.apply(positions))
 }
 
 /// The exact limit (position, tangents, normal) of every base vertex, as stencils over the
@@ -392,6 +406,7 @@ fn limit_through(r: &Refinement, levels: usize) -> Result<LimitStencilTable, Lim
         position: first_rows(&at.position, nv),
         tangent1: first_rows(&at.tangent1, nv),
         tangent2: first_rows(&at.tangent2, nv),
+        without_tangents: Vec::new(),
     };
     for l in (1..=levels).rev() {
         t = t.after(r.stencils(l));

@@ -16,6 +16,7 @@
 //! exact and the cut can repeat at every level.
 
 use glam::DVec3;
+use subd_mesh::neighbourhood::faces_within_two_rings;
 use subd_mesh::tags::SHARPNESS_INFINITE;
 use subd_mesh::{BoundaryInterpolation, Topology, TopologyBuilder};
 use subd_schemes::{Options, Refinement, Rule, Scheme, StencilTable};
@@ -603,7 +604,7 @@ pub(crate) fn base_limit_after(
     // vertices (a vertex keeps its index at every level, and its limit depends on the faces
     // around it only), and carry the cut vertices' stencils over `t`'s vertices along.
     let targets: Vec<u32> = (0..nv as u32).filter(|&v| affected[v as usize]).collect();
-    let mut cut = Cut::new(t, rules, &two_rings(t, &targets))?;
+    let mut cut = Cut::new(t, rules, &faces_within_two_rings(t, &targets))?;
     let mut rows = select_rows(&StencilTable::identity(nv), &cut.vertices);
     let mut targets_in_cut = positions_in(&cut.vertices, &targets);
     for _ in 0..decay {
@@ -619,7 +620,7 @@ pub(crate) fn base_limit_after(
         let next = Cut::new(
             rc.topology(1),
             rc.vertex_rules(1),
-            &two_rings(rc.topology(1), &targets_in_cut),
+            &faces_within_two_rings(rc.topology(1), &targets_in_cut),
         )?;
         rows = select_rows(&child_rows, &next.vertices);
         targets_in_cut = positions_in(&next.vertices, &targets_in_cut);
@@ -647,6 +648,7 @@ pub(crate) fn base_limit_after(
         position: merge(&direct.position, &cut_rows.position),
         tangent1: merge(&direct.tangent1, &cut_rows.tangent1),
         tangent2: merge(&direct.tangent2, &cut_rows.tangent2),
+        without_tangents: Vec::new(),
     };
     for l in (1..=pre).rev() {
         table = table.after(r.stencils(l));
@@ -656,24 +658,8 @@ pub(crate) fn base_limit_after(
         position: crate::first_rows(&table.position, base),
         tangent1: crate::first_rows(&table.tangent1, base),
         tangent2: crate::first_rows(&table.tangent2, base),
+        without_tangents: Vec::new(),
     })
-}
-
-/// Faces within two vertex-rings of the vertices `targets` of `t`, in face order.
-fn two_rings(t: &Topology, targets: &[u32]) -> Vec<u32> {
-    let mut take = vec![false; t.num_faces()];
-    for &v in targets {
-        for &g in t.vertex_faces(v as usize) {
-            for &w in t.face_vertices(g as usize) {
-                for &h in t.vertex_faces(w as usize) {
-                    take[h as usize] = true;
-                }
-            }
-        }
-    }
-    (0..t.num_faces() as u32)
-        .filter(|&f| take[f as usize])
-        .collect()
 }
 
 /// The rows `which` of `table`, in that order.

@@ -30,7 +30,9 @@ use subd_mesh::{Topology, TopologyBuilder};
 use subd_schemes::{Options, Refinement, Rule, Scheme};
 
 use crate::LimitError;
-use crate::patch::{GridPoint, SurfacePoint, face_ring};
+use subd_mesh::neighbourhood::face_ring;
+
+use crate::patch::{GridPoint, SurfacePoint};
 use crate::stam::{PerValence, Projected, SubpatchSubdivision, cached, steps_to_regular};
 use crate::table::LimitStencilTable;
 

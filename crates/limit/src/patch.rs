@@ -19,6 +19,7 @@
 
 use glam::DVec3;
 use subd_mesh::Topology;
+use subd_mesh::neighbourhood::face_ring;
 use subd_schemes::Rule;
 
 /// For n = 4: the corner-patch index of grid point (i, j) at `REGULAR_GRID[4 j + i]`.
@@ -133,34 +134,6 @@ pub fn eval_bicubic_first(grid: &[DVec3; 16], u: f64, v: f64) -> (DVec3, DVec3, 
         pv += dv[j] * r;
     }
     (p, pu, pv)
-}
-
-/// The ring of interior manifold vertex `v` starting at face `f`: for each incident face in
-/// counter-clockwise order, the face's vertices after `v` (so `[next, …, previous]`). `None`
-/// unless every face around `v` has `K + 1` vertices, `v` is interior and manifold, and `f`
-/// is incident to it.
-pub(crate) fn face_ring<const K: usize>(t: &Topology, v: usize, f: usize) -> Option<Vec<[u32; K]>> {
-    let faces = t.vertex_faces(v);
-    if t.is_boundary_vertex(v)
-        || t.is_non_manifold_vertex(v)
-        || faces.len() != t.vertex_edges(v).len()
-    {
-        return None;
-    }
-    let start = faces.iter().position(|&g| g as usize == f)?;
-    let local = t.vertex_face_local_indices(v);
-    let n = faces.len();
-    (0..n)
-        .map(|j| {
-            let i = (start + j) % n;
-            let fv = t.face_vertices(faces[i] as usize);
-            if fv.len() != K + 1 {
-                return None;
-            }
-            let c = local[i] as usize;
-            Some(std::array::from_fn(|k| fv[(c + 1 + k) % (K + 1)]))
-        })
-        .collect()
 }
 
 /// [`face_ring`] of quads: (next, opposite, previous) per face.

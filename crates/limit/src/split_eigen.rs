@@ -24,8 +24,9 @@ use std::f64::consts::TAU;
 
 use faer::{Mat, c64};
 use glam::DVec3;
+use subd_mesh::neighbourhood::{labelled_ball, ring_from};
 use subd_mesh::{Topology, TopologyBuilder};
-use subd_schemes::{Options, RefineError, Refinement, Scheme};
+use subd_schemes::{Options, RefineError, Refinement, Scheme, Split};
 
 use crate::LimitError;
 
@@ -187,41 +188,6 @@ fn disc(n: usize, rings: usize, quads: bool) -> Result<Topology, LimitError> {
         .map_err(|e| LimitError::Analysis(format!("disc of valence {n}: {e}")))
 }
 
-/// The neighbours of `v` counter-clockwise from `from` (which must be one of them).
-fn ring_from(t: &Topology, v: u32, from: u32) -> Vec<u32> {
-    let ring: Vec<u32> = t.vertex_ring(v as usize).collect();
-    let start = ring.iter().position(|&u| u == from).unwrap_or(0);
-    (0..ring.len())
-        .map(|i| ring[(start + i) % ring.len()])
-        .collect()
-}
-
-/// Breadth-first labels of the ball of radius `radius` around `seeds` (vertex, the
-/// neighbour its walk starts from), seeds first: `labels[i]` is the vertex labelled `i`.
-fn ball(t: &Topology, seeds: &[(u32, u32)], radius: usize) -> Vec<u32> {
-    let mut label = vec![u32::MAX; t.num_vertices()];
-    let mut order: Vec<u32> = Vec::new();
-    let mut queue: std::collections::VecDeque<(u32, u32, usize)> = Default::default();
-    for &(v, from) in seeds {
-        label[v as usize] = order.len() as u32;
-        order.push(v);
-        queue.push_back((v, from, 0));
-    }
-    while let Some((v, from, d)) = queue.pop_front() {
-        if d == radius {
-            continue;
-        }
-        for u in ring_from(t, v, from) {
-            if label[u as usize] == u32::MAX {
-                label[u as usize] = order.len() as u32;
-                order.push(u);
-                queue.push_back((u, v, d + 1));
-            }
-        }
-    }
-    order
-}
-
 /// A centre to analyse in a topology: its seeds for each of the `n` rotations.
 struct Centre {
     /// `seeds[t]`: the walk's seeds with the root turned `t` sectors.
@@ -271,8 +237,8 @@ fn local_matrix(
     new: &Centre,
     radius: usize,
 ) -> Option<(Mat<f64>, Vec<usize>)> {
-    let old_ball = ball(parent, &old.seeds[0], radius);
-    let new_ball = ball(child, &new.seeds[0], radius);
+    let old_ball = labelled_ball(parent, &old.seeds[0], radius);
+    let new_ball = labelled_ball(child, &new.seeds[0], radius);
     if old_ball.len() != new_ball.len() {
         return None;
     }
@@ -293,7 +259,7 @@ fn local_matrix(
         }
     }
     // The rotation: label i under the turned root is label rot[i] under the first root.
-    let turned = ball(parent, &old.seeds[1], radius);
+    let turned = labelled_ball(parent, &old.seeds[1], radius);
     let rot: Vec<usize> = turned.iter().map(|&v| label[v as usize]).collect();
     if rot.contains(&usize::MAX) {
         return None;
@@ -441,7 +407,7 @@ fn local_system(scheme: &Scheme, n: usize) -> Result<LocalSystem, LimitError> {
     let analysis = |e: RefineError| LimitError::Analysis(e.to_string());
     for radius in 1..=6 {
         let rings = 2 * radius + 4;
-        let (parent, child, stencils, old, new) = if *scheme == Scheme::DooSabin {
+        let (parent, child, stencils, old, new) = if scheme.split() == Split::Dual {
             // The n-gon: the vertex face of a valence-n vertex after one step.
             let d = disc(n, rings + 1, true)?;
             let r =
@@ -463,7 +429,7 @@ fn local_system(scheme: &Scheme, n: usize) -> Result<LocalSystem, LimitError> {
             let d = disc(n, rings, false)?;
             let first = d.vertex_ring(0).next().expect("centre has a ring");
             let old = vertex_centre(&d, 0, first);
-            if *scheme == Scheme::Sqrt3 {
+            if scheme.period() == 2 {
                 // One step turns the mesh by π/n; two steps bring it back into line. The
                 // root spoke of level 2 is the one along the root spoke of level 0: through
                 // the centroid of the level-1 face right of the level-1 root spoke, itself
@@ -529,7 +495,7 @@ impl LocalMasks {
     /// labels are (any first spoke: turning it turns the tangent masks within their plane).
     pub fn ball(t: &Topology, v: u32, radius: usize) -> Vec<u32> {
         match t.vertex_ring(v as usize).next() {
-            Some(first) => ball(t, &[(v, first)], radius),
+            Some(first) => labelled_ball(t, &[(v, first)], radius),
             None => vec![v],
         }
     }
@@ -541,7 +507,7 @@ impl LocalMasks {
 /// [`LimitError::Analysis`] for Doo-Sabin (its centres are faces), a valence out of range or
 /// a failed eigen solve.
 pub fn local_masks(scheme: &Scheme, n: usize) -> Result<LocalMasks, LimitError> {
-    if *scheme == Scheme::DooSabin {
+    if scheme.split() == Split::Dual {
         return Err(LimitError::Analysis(
             "Doo-Sabin's limit points are face centroids, not vertex masks".into(),
         ));
@@ -662,7 +628,7 @@ pub fn feature_spoke(t: &Topology, v: u32) -> Option<u32> {
 
 /// The ball of `radius` around feature vertex `v`, labelled from its feature spoke.
 pub fn feature_ball(t: &Topology, v: u32, radius: usize) -> Option<Vec<u32>> {
-    feature_spoke(t, v).map(|s| ball(t, &[(v, s)], radius))
+    feature_spoke(t, v).map(|s| labelled_ball(t, &[(v, s)], radius))
 }
 
 /// The local subdivision matrix of `v` over the ball of `radius`: the rows of the child
@@ -777,7 +743,7 @@ pub fn row_between(r: &Refinement, from: usize, to: usize, c: u32) -> Vec<(u32, 
 /// [`LimitError::Analysis`] for Doo-Sabin, a centre out of range (3 to 64 edges; 1 to 32
 /// boundary triangles), no invariant ball of radius ≤ 6, or a failed eigen solve.
 pub fn feature_masks(scheme: &Scheme, centre: FeatureCentre) -> Result<FeatureMasks, LimitError> {
-    if *scheme == Scheme::DooSabin {
+    if scheme.split() == Split::Dual {
         return Err(LimitError::Analysis(
             "Doo-Sabin's limit points are face centroids, not vertex masks".into(),
         ));
@@ -791,7 +757,7 @@ pub fn feature_masks(scheme: &Scheme, centre: FeatureCentre) -> Result<FeatureMa
             )));
         }
     };
-    let steps = if *scheme == Scheme::Sqrt3 { 2 } else { 1 };
+    let steps = scheme.period();
     let analysis = |e: RefineError| LimitError::Analysis(e.to_string());
     for radius in 1..=6 {
         let (mut fan, positions) = triangle_fan(sectors, 2 * radius + 4, closed);

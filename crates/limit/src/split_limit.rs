@@ -24,7 +24,9 @@
 //!   valence 2 has no vertex face and no limit here.
 //!
 //! Where a value is not given, [`SplitLimitStencils::position_known`] or
-//! [`SplitLimitStencils::tangents_known`] says so and the row is empty.
+//! [`SplitLimitStencils::tangents_known`] says so and the row is empty;
+//! [`split_limit_table`] gives the same rows as the [`LimitStencilTable`] every scheme's
+//! limit takes ([`crate::limit_stencils`]).
 
 use std::collections::HashMap;
 use std::f64::consts::TAU;
@@ -33,13 +35,13 @@ use glam::DVec3;
 use subd_mesh::Topology;
 use subd_schemes::StencilTable;
 use subd_schemes::split_schemes::{Features, doo_sabin};
-use subd_schemes::{Options, Refinement, Scheme};
+use subd_schemes::{Options, Refinement, Scheme, Split};
 
-use crate::LimitError;
 use crate::split_eigen::{
     FeatureCentre, FeatureMasks, LocalMasks, expand_row, feature_ball, feature_masks,
     feature_matrix, local_masks, row_between,
 };
+use crate::{LimitError, LimitStencilTable};
 
 /// The deepest level searched for a regular ball around an interior vertex.
 pub const MAX_LEVELS: usize = 4;
@@ -94,35 +96,31 @@ fn to_base(row: &Row, composed: &StencilTable) -> Row {
     expand_row(row, composed)
 }
 
-/// The stencils of `scheme`'s limit at every vertex of `base`, after the refinement's own
-/// checks of the mesh, so a mesh the scheme cannot take is refused as [`Refinement::new`]
-/// refuses it (face kind, tags, non-manifold parts), with the element named.
+/// The split family's part of the one limit entry ([`crate::limit_stencils`]): after the
+/// refinement's own checks of the mesh (so a mesh the scheme cannot take is refused as
+/// [`Refinement::new`] refuses it, the element named), the limit of every vertex of `base`
+/// as a [`LimitStencilTable`]; vertices without tangents are marked
+/// ([`LimitStencilTable::without_tangents`]).
 ///
 /// # Errors
-/// [`LimitError::Refine`] for a mesh the scheme cannot refine; as [`split_limit_stencils`].
-pub fn checked_split_limit_stencils(
+/// [`LimitError::Refine`] for a mesh the scheme cannot refine; [`LimitError::NoLimit`]
+/// naming the first vertex without a limit; as [`split_limit_stencils`].
+pub fn split_limit_table(
     base: &Topology,
     scheme: &Scheme,
-) -> Result<SplitLimitStencils, LimitError> {
+) -> Result<LimitStencilTable, LimitError> {
     Refinement::new(base, scheme.clone(), &Options::default(), 0)?;
-    split_limit_stencils(base, scheme)
+    split_limit_stencils(base, scheme)?.into_table(scheme)
 }
 
 impl SplitLimitStencils {
-    /// The limit of every vertex from `positions` (NaN normals and tangents where none is
-    /// defined: creases and corners of √3 and the butterflies); a vertex without a limit is
-    /// an error naming it.
+    /// The stencils as a [`LimitStencilTable`], every vertex with a position.
     ///
     /// # Errors
     /// [`LimitError::NoLimit`] naming the first vertex without a limit.
-    pub fn limit_points(
-        &self,
-        scheme: &Scheme,
-        positions: &[DVec3],
-    ) -> Result<crate::LimitPoints, LimitError> {
-        let points = self.evaluate(positions);
-        if let Some(v) = points.positions.iter().position(Option::is_none) {
-            let why = if *scheme == Scheme::DooSabin {
+    pub fn into_table(self, scheme: &Scheme) -> Result<LimitStencilTable, LimitError> {
+        if let Some(v) = self.position_known.iter().position(|known| !known) {
+            let why = if scheme.split() == Split::Dual {
                 "an interior vertex of valence 2 has no vertex face"
             } else {
                 "its neighbourhood never became one with a known limit mask (a dart or boundary vertex whose refined neighbourhood stays irregular)"
@@ -133,16 +131,12 @@ impl SplitLimitStencils {
                 why,
             });
         }
-        let nan = DVec3::splat(f64::NAN);
-        Ok(crate::LimitPoints {
-            positions: points.positions.into_iter().flatten().collect(),
-            tangent1: vec![nan; positions.len()],
-            tangent2: vec![nan; positions.len()],
-            normals: points
-                .normals
-                .into_iter()
-                .map(|n| n.unwrap_or(nan))
-                .collect(),
+        let [tangent1, tangent2] = self.tangents;
+        Ok(LimitStencilTable {
+            position: self.position,
+            tangent1,
+            tangent2,
+            without_tangents: self.tangents_known.iter().map(|known| !known).collect(),
         })
     }
 }
@@ -163,7 +157,7 @@ pub fn split_limit_stencils(
     };
     let mut position: Vec<Option<Row>> = vec![None; nv];
     let mut tangents: Vec<Option<[Row; 2]>> = vec![None; nv];
-    if *scheme == Scheme::DooSabin {
+    if scheme.split() == Split::Dual {
         let r = refinement(1)?;
         doo_sabin_rows(base, &r, &mut position, &mut tangents);
     } else {
@@ -265,7 +259,7 @@ fn vertex_rows(
             if (dart || boundary_curve) && !features.is_corner(vi) {
                 feature_pending.push(v);
             }
-            if *scheme == Scheme::Sqrt3 {
+            if scheme.split() == Split::Sqrt3 {
                 if features.is_corner(vi) {
                     position[vi] = Some(vec![(v, 1.0)]);
                 } else if features.is_curve_vertex(vi) {
@@ -374,7 +368,7 @@ fn feature_rows(
     if vertices.is_empty() {
         return Ok(());
     }
-    let steps = if *scheme == Scheme::Sqrt3 { 2 } else { 1 };
+    let steps = scheme.period();
     let mut masks: HashMap<FeatureCentre, Option<FeatureMasks>> = HashMap::new();
     let mut pending = vertices.to_vec();
     for level in (0..=MAX_LEVELS - steps).step_by(steps) {

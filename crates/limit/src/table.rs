@@ -22,7 +22,8 @@ pub struct LimitPoints {
     pub tangent1: Vec<DVec3>,
     /// Second tangents.
     pub tangent2: Vec<DVec3>,
-    /// `normalize(tangent1 × tangent2)`; zero where the tangents are parallel.
+    /// `normalize(tangent1 × tangent2)`; zero where the tangents are parallel, NaN where the
+    /// scheme defines no tangents ([`LimitStencilTable::without_tangents`]).
     pub normals: Vec<DVec3>,
 }
 
@@ -57,6 +58,11 @@ pub struct LimitStencilTable {
     pub tangent1: StencilTable,
     /// Second tangents.
     pub tangent2: StencilTable,
+    /// Vertices where the scheme defines no tangents (and so no normal), their tangent rows
+    /// empty: inside a crease or at a corner of √3 and the butterflies, where the classic
+    /// butterfly is not C¹. Empty when every vertex has them (Catmull-Clark, Loop, the
+    /// two-phase scheme); otherwise one flag per row.
+    pub without_tangents: Vec<bool>,
 }
 
 /// How one vertex's limit is taken.
@@ -279,6 +285,7 @@ impl LimitStencilTable {
             position: masks.table(|m| &m.position),
             tangent1: masks.table(|m| &m.tangent1),
             tangent2: masks.table(|m| &m.tangent2),
+            without_tangents: Vec::new(),
         })
     }
 
@@ -307,19 +314,32 @@ impl LimitStencilTable {
             position: first.then(&self.position),
             tangent1: first.then(&self.tangent1),
             tangent2: first.then(&self.tangent2),
+            without_tangents: self.without_tangents.clone(),
         }
     }
 
-    /// Limit positions, tangents and unit normals from the control points the rows refer to.
+    /// Whether vertex `v` has tangents (and a normal).
+    pub fn has_tangents(&self, v: usize) -> bool {
+        !self.without_tangents.get(v).copied().unwrap_or(false)
+    }
+
+    /// Limit positions, tangents and unit normals from the control points the rows refer to;
+    /// NaN tangents and normals at the vertices [`LimitStencilTable::without_tangents`] names.
     pub fn apply(&self, points: &[DVec3]) -> LimitPoints {
         let positions = self.position.apply_points(points);
-        let tangent1 = self.tangent1.apply_points(points);
-        let tangent2 = self.tangent2.apply_points(points);
-        let normals = tangent1
+        let mut tangent1 = self.tangent1.apply_points(points);
+        let mut tangent2 = self.tangent2.apply_points(points);
+        let mut normals: Vec<DVec3> = tangent1
             .iter()
             .zip(&tangent2)
             .map(|(a, b)| a.cross(*b).normalize_or_zero())
             .collect();
+        let nan = DVec3::splat(f64::NAN);
+        for (v, &without) in self.without_tangents.iter().enumerate() {
+            if without {
+                (tangent1[v], tangent2[v], normals[v]) = (nan, nan, nan);
+            }
+        }
         LimitPoints {
             positions,
             tangent1,

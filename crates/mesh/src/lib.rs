@@ -28,9 +28,12 @@
 
 pub mod analysis;
 mod build;
+pub mod cut;
 pub mod error;
 pub mod fvar;
 pub mod geometry;
+pub mod memory;
+pub mod neighbourhood;
 pub mod primitives;
 pub mod tags;
 mod topology;

@@ -14,7 +14,7 @@ use faer::{Mat, Side};
 use glam::DVec3;
 use rayon::prelude::*;
 use serde::Serialize;
-use subd_schemes::memory;
+use subd_mesh::memory;
 
 use crate::PiaError;
 use crate::checkerboard::Preconditioned;
@@ -430,7 +430,7 @@ fn cg(
     let weight: Vec<f64> = c.iter().map(|c| 1.0 / c).collect();
     // The scaled residual T r (r itself without T), the direction, its product with M̄
     // and the preconditioned residual (only with T), in one allocation: large enough for
-    // huge pages (`subd_schemes::memory`), one page fault per 2 MiB instead of per 4 KiB,
+    // huge pages (`subd_mesh::memory`), one page fault per 2 MiB instead of per 4 KiB,
     // which on a first solve took about a fifth of CG's time.
     let mut work: Vec<DVec3> = memory::zeroed(if t.is_some() { 4 * n } else { 3 * n });
     let (r, rest) = work.split_at_mut(n);

@@ -15,7 +15,8 @@ use std::sync::{Arc, OnceLock};
 
 use glam::DVec3;
 use rayon::prelude::*;
-use subd_schemes::{StencilTable, memory};
+use subd_mesh::memory;
+use subd_schemes::StencilTable;
 
 use crate::checkerboard::{self, Preconditioned};
 

@@ -63,7 +63,7 @@
 pub mod analysis;
 pub mod curve;
 mod family;
-pub mod memory;
+pub mod peak;
 mod refine;
 mod refinement;
 pub mod rules;
@@ -76,8 +76,8 @@ use subd_mesh::{BoundaryInterpolation, CreaseMethod, SchemeHints, TriangleSubdiv
 use thiserror::Error;
 
 pub use refine::{
-    FVarLevelValues, FVarValueKind, FaceStream, FaceVaryingRefinement, LevelCounts, PointStream,
-    refined_counts,
+    ChildLayout, FVarLevelValues, FVarValueKind, FaceStream, FaceVaryingRefinement, LevelCounts,
+    PointStream, refined_counts,
 };
 pub use refinement::Refinement;
 pub use rules::Rule;
@@ -241,7 +241,7 @@ pub enum RefineError {
     /// The memory for a level could not be allocated (an address-space limit, or the
     /// system's memory): the request is refused before anything is written, instead of the
     /// process aborting part-way.
-    #[error("level {level} needs about {} more memory, which cannot be allocated", memory::human_bytes(*bytes))]
+    #[error("level {level} needs about {} more memory, which cannot be allocated", subd_mesh::memory::human_bytes(*bytes))]
     OutOfMemory {
         /// The level that does not fit.
         level: usize,

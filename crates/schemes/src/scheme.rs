@@ -6,7 +6,10 @@ use std::str::FromStr;
 
 use thiserror::Error;
 
+use subd_mesh::Topology;
+
 use crate::TwoPhase;
+use crate::split_schemes::SplitStep;
 
 /// A surface subdivision scheme: OpenSubdiv's three, seed 000's two-phase scheme, and the
 /// four split schemes of seed 001 §4.
@@ -255,6 +258,72 @@ impl Scheme {
                 ..split
             },
         }
+    }
+
+    /// Bytes per output vertex at the peak of refining and writing with this scheme, held
+    /// and (OpenSubdiv's schemes) streamed from the level above: measured with
+    /// `/usr/bin/time -f %M` on the bench torus and its triangulation, levels 1–4, rounded
+    /// up (BENCHMARKS.md, "Memory estimates"; see [`crate::peak::PeakModel`]). The two-phase
+    /// scheme is Catmull-Clark's after level 1; the split schemes hold every level.
+    pub fn peak_bytes_per_vertex(&self) -> (u64, Option<u64>) {
+        match self {
+            Scheme::CatmullClark | Scheme::TwoPhase(_) => (105, Some(70)),
+            Scheme::Bilinear => (120, Some(70)),
+            Scheme::Loop => (120, Some(90)),
+            Scheme::DooSabin => (145, None),
+            Scheme::Butterfly { .. } | Scheme::ModifiedButterfly => (190, None),
+            Scheme::Sqrt3 => (235, None),
+        }
+    }
+
+    /// The scheme's parameter checked: the butterfly's tension must be finite (the
+    /// two-phase scheme's `λ` is checked where it is set, [`TwoPhase`]).
+    pub(crate) fn check_parameters(&self) -> Result<(), crate::RefineError> {
+        match *self {
+            Scheme::Butterfly { tension } if !tension.is_finite() => {
+                Err(crate::RefineError::Tension(tension))
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// The split scheme that carries face-varying values on this scheme's topology when
+    /// they interpolate linearly everywhere (`FVarLinearInterpolation::All`): the butterfly
+    /// with tension 0 (edge midpoints, old values kept) for the butterflies; Doo-Sabin and √3
+    /// carry values with their own masks, their values being a mesh of their own.
+    pub(crate) fn linear_values(&self) -> Scheme {
+        match self {
+            Scheme::Butterfly { .. } | Scheme::ModifiedButterfly => {
+                Scheme::Butterfly { tension: 0.0 }
+            }
+            s => s.clone(),
+        }
+    }
+
+    /// One step of a split scheme over `parent`, the child being level `level`: the scheme's
+    /// rule file ([`crate::split_schemes`]). `None` for OpenSubdiv's schemes and the
+    /// two-phase scheme, whose family has its own tables.
+    pub(crate) fn split_step<'a>(
+        &self,
+        parent: &'a Topology,
+        level: usize,
+    ) -> Option<Box<dyn SplitStep + 'a>> {
+        use crate::split_schemes::{butterfly, doo_sabin, sqrt3};
+        Some(match self {
+            Scheme::DooSabin => Box::new(doo_sabin::Step::new(parent)),
+            // √3 trisects boundary edges every second step.
+            Scheme::Sqrt3 => Box::new(sqrt3::Step::new(parent, level % 2 == 0)),
+            Scheme::Butterfly { tension } => Box::new(butterfly::Step::new(
+                parent,
+                butterfly::EdgeRule::Classic { tension: *tension },
+            )),
+            Scheme::ModifiedButterfly => {
+                Box::new(butterfly::Step::new(parent, butterfly::EdgeRule::Modified))
+            }
+            Scheme::CatmullClark | Scheme::Loop | Scheme::Bilinear | Scheme::TwoPhase(_) => {
+                return None;
+            }
+        })
     }
 
     /// The scheme whose rules a mesh at `level` of a refinement with this scheme follows

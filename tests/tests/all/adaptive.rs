@@ -7,8 +7,9 @@
 use std::collections::HashSet;
 
 use glam::DVec3;
-use subd_adaptive::{AdaptiveRefinement, Positions, RandomSelection, UniformCounts};
+use subd_adaptive::{AdaptiveRefinement, Positions, RandomSelection};
 use subd_limit::{LimitStencilTable, levels_for_exact_limit};
+use subd_schemes::LevelCounts;
 use subd_schemes::{Refinement, Rule};
 use subd_tests::{SurfaceShape, surface_shapes};
 
@@ -92,7 +93,7 @@ fn selecting_every_face_is_uniform_refinement() {
         )
         .unwrap();
         let mesh = a.mesh(Positions::Refined).unwrap();
-        let UniformCounts {
+        let LevelCounts {
             faces, vertices, ..
         } = a.uniform_counts(levels);
         assert_eq!(mesh.num_faces() as u64, faces, "{}", s.name);

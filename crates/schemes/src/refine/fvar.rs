@@ -643,7 +643,7 @@ impl NextValues<'_> {
     /// ([`Self::write`]).
     fn compute<V: Lanes>(&self, src: &[V]) -> Vec<V> {
         let total = self.child.num_values();
-        let mut out: Vec<V> = crate::memory::with_capacity(total);
+        let mut out: Vec<V> = subd_mesh::memory::with_capacity(total);
         self.write(src, &mut out.spare_capacity_mut()[..total]);
         #[allow(unsafe_code)]
         // SAFETY: `write` wrote every slot of `0..total` within the capacity

@@ -6,6 +6,7 @@
 mod counts;
 mod fused;
 mod fvar;
+mod layout;
 mod osd;
 mod par;
 mod rows;
@@ -16,6 +17,7 @@ pub use counts::{LevelCounts, refined_counts};
 pub(crate) use counts::{last_level_bytes, topology_bytes};
 pub use fvar::{FVarLevelValues, FVarValueKind, FaceVaryingRefinement};
 pub(crate) use fvar::{base_corner_kinds, check_channel};
+pub use layout::ChildLayout;
 pub(crate) use osd::OsdRefinement;
 pub use stream::{FaceStream, PointStream};
 
@@ -29,10 +31,10 @@ use rayon::prelude::*;
 use subd_mesh::tags::{SHARPNESS_INFINITE, is_infinite, is_semi_sharp};
 use subd_mesh::{BoundaryInterpolation, CreaseMethod, Topology, TriangleSubdivision};
 
-use crate::memory;
 use crate::rules::{self, Rule};
 use crate::stencil::{RowSink, StencilTable};
 use crate::{Options, two_phase};
+use subd_mesh::memory;
 
 /// The mask set of OpenSubdiv's family (its `Sdc::SchemeType`): which split and which
 /// vertex, edge and face masks a level takes. The two-phase scheme is Catmull-Clark with its

@@ -7,10 +7,10 @@ use std::sync::OnceLock;
 use subd_mesh::{DVec3, Topology};
 
 use super::Sdc;
-use crate::memory;
 use crate::rules::Rule;
 use crate::stencil::StencilTable;
 use crate::{ExplicitTags, MAX_LEVELS, Options, RefineError};
+use subd_mesh::memory;
 
 /// One level of a refinement.
 #[derive(Debug)]

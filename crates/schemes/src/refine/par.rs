@@ -65,7 +65,7 @@ pub(crate) fn build<T: Send + Sync + Clone + bytemuck::Zeroable>(
     start: impl Fn(usize) -> usize + Sync,
     f: impl Fn(Range<usize>, &mut [T]) + Sync,
 ) -> Vec<T> {
-    let mut out = crate::memory::zeroed(len);
+    let mut out = subd_mesh::memory::zeroed(len);
     fill(&mut out, n, start, f);
     out
 }

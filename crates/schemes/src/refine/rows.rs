@@ -6,7 +6,7 @@ use std::ops::Range;
 use glam::DVec3;
 
 use super::CHUNK;
-use crate::memory;
+use subd_mesh::memory;
 
 /// The points of one level as rows. The `middle` rows (the face points, for the schemes
 /// that have them) come from the parent level alone; every other row reads the parent level

@@ -16,7 +16,7 @@ use rayon::prelude::*;
 use subd_mesh::{Topology, TopologyParts};
 
 use super::par;
-use crate::memory;
+use subd_mesh::memory;
 
 /// Index of the half of parent edge `e` at its end `k` (0 or 1), relative to the first half.
 #[inline]

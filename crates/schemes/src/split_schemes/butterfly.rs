@@ -26,7 +26,7 @@ use std::f64::consts::TAU;
 
 use subd_mesh::{Topology, tags};
 
-use super::{ChildFaces, Features, StepError, Weights, check_size};
+use super::{ChildFaces, Features, SplitRule, StepError, Weights, check_size};
 
 /// The rule for the point of an interior edge.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -83,53 +83,6 @@ impl<'a> Step<'a> {
             features: Features::new(t),
             rule,
         }
-    }
-
-    pub(crate) fn num_rows(&self) -> usize {
-        self.t.num_vertices() + self.t.num_edges()
-    }
-
-    #[inline]
-    pub(crate) fn fill<W: Weights>(&self, r: usize, w: &mut W) {
-        let nv = self.t.num_vertices();
-        if r < nv {
-            w.add(r as u32, 1.0);
-        } else {
-            self.edge_point(r - nv, w);
-        }
-    }
-
-    /// Loop's split: triangle `(v0, v1, v2)` with edge points `E_i` of its edges
-    /// `(v_i, v_i+1)` becomes `(v0, E0, E2)`, `(E0, v1, E1)`, `(E2, E1, v2)`, `(E1, E2, E0)`;
-    /// an interior crease's two halves stay creases, corner tags stay.
-    pub(crate) fn child_faces(&self) -> Result<ChildFaces, StepError> {
-        let t = self.t;
-        let nv = t.num_vertices() as u32;
-        check_size(12 * t.num_faces() as u64)?;
-        let mut verts = Vec::with_capacity(12 * t.num_faces());
-        for f in 0..t.num_faces() {
-            let v = t.face_vertices(f);
-            let e: Vec<u32> = t.face_edges(f).iter().map(|&e| nv + e).collect();
-            verts.extend([
-                v[0], e[0], e[2], e[0], v[1], e[1], e[2], e[1], v[2], e[1], e[2], e[0],
-            ]);
-        }
-        let mut faces = ChildFaces::triangles(self.num_rows(), verts);
-        for e in 0..t.num_edges() {
-            if !t.is_boundary_edge(e) && tags::is_infinite(t.edge_sharpness(e)) {
-                let [a, b] = t.edge_vertices(e);
-                faces
-                    .creases
-                    .extend([[a, nv + e as u32], [nv + e as u32, b]]);
-            }
-        }
-        for v in 0..t.num_vertices() {
-            let s = t.vertex_sharpness(v);
-            if s > 0.0 {
-                faces.corners.push((v as u32, s));
-            }
-        }
-        Ok(faces)
     }
 
     /// The vertex across edge `pos` of triangle `f` (the edge from corner `pos` to
@@ -225,5 +178,54 @@ impl<'a> Step<'a> {
             }
         }
         self.butterfly_point(e, w, sink)
+    }
+}
+
+impl SplitRule for Step<'_> {
+    fn num_rows(&self) -> usize {
+        self.t.num_vertices() + self.t.num_edges()
+    }
+
+    #[inline]
+    fn fill<W: Weights>(&self, r: usize, w: &mut W) {
+        let nv = self.t.num_vertices();
+        if r < nv {
+            w.add(r as u32, 1.0);
+        } else {
+            self.edge_point(r - nv, w);
+        }
+    }
+
+    /// Loop's split: triangle `(v0, v1, v2)` with edge points `E_i` of its edges
+    /// `(v_i, v_i+1)` becomes `(v0, E0, E2)`, `(E0, v1, E1)`, `(E2, E1, v2)`, `(E1, E2, E0)`;
+    /// an interior crease's two halves stay creases, corner tags stay.
+    fn child_faces(&self) -> Result<ChildFaces, StepError> {
+        let t = self.t;
+        let nv = t.num_vertices() as u32;
+        check_size(12 * t.num_faces() as u64)?;
+        let mut verts = Vec::with_capacity(12 * t.num_faces());
+        for f in 0..t.num_faces() {
+            let v = t.face_vertices(f);
+            let e: Vec<u32> = t.face_edges(f).iter().map(|&e| nv + e).collect();
+            verts.extend([
+                v[0], e[0], e[2], e[0], v[1], e[1], e[2], e[1], v[2], e[1], e[2], e[0],
+            ]);
+        }
+        let mut faces = ChildFaces::triangles(self.num_rows(), verts);
+        for e in 0..t.num_edges() {
+            if !t.is_boundary_edge(e) && tags::is_infinite(t.edge_sharpness(e)) {
+                let [a, b] = t.edge_vertices(e);
+                faces
+                    .creases
+                    .extend([[a, nv + e as u32], [nv + e as u32, b]]);
+            }
+        }
+        for v in 0..t.num_vertices() {
+            let s = t.vertex_sharpness(v);
+            if s > 0.0 {
+                faces.corners.push((v as u32, s));
+            }
+        }
+        Ok(faces)
     }
 }

@@ -31,7 +31,7 @@ use std::f64::consts::TAU;
 
 use subd_mesh::Topology;
 
-use super::{ChildFaces, StepError, Weights, check_size};
+use super::{ChildFaces, SplitRule, StepError, Weights, check_size};
 
 /// Doo-Sabin weight `α_d` of corner distance `d` in an `n`-sided face.
 pub fn weight(n: usize, d: usize) -> f64 {
@@ -141,17 +141,19 @@ impl<'a> Step<'a> {
         }
     }
 
-    pub(crate) fn num_rows(&self) -> usize {
-        self.p.num_face_vertices() + self.num_chaikin
-    }
-
     /// The Chaikin point of boundary edge `e` next to its end `v`.
     fn chaikin(&self, e: u32, v: u32) -> u32 {
         self.chaikin_at[e as usize] + u32::from(self.p.edge_vertices(e as usize)[1] == v)
     }
+}
+
+impl SplitRule for Step<'_> {
+    fn num_rows(&self) -> usize {
+        self.p.num_face_vertices() + self.num_chaikin
+    }
 
     #[inline]
-    pub(crate) fn fill<W: Weights>(&self, r: usize, w: &mut W) {
+    fn fill<W: Weights>(&self, r: usize, w: &mut W) {
         let p = self.p;
         let nfv = p.num_face_vertices();
         if r < nfv {
@@ -171,7 +173,7 @@ impl<'a> Step<'a> {
         }
     }
 
-    pub(crate) fn child_faces(&self) -> Result<ChildFaces, StepError> {
+    fn child_faces(&self) -> Result<ChildFaces, StepError> {
         let p = self.p;
         let nfv = p.num_face_vertices();
         let num_boundary_vertices = (0..p.num_vertices())

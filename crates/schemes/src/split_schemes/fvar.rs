@@ -140,13 +140,10 @@ impl SplitFaceVarying {
                 }
             }
         }
-        let value_scheme = match scheme {
-            Scheme::Butterfly { .. } | Scheme::ModifiedButterfly
-                if mode == FVarLinearInterpolation::All =>
-            {
-                Scheme::Butterfly { tension: 0.0 }
-            }
-            s => s.clone(),
+        let value_scheme = if mode == FVarLinearInterpolation::All {
+            scheme.linear_values()
+        } else {
+            scheme.clone()
         };
         let values = SplitRefinement::new(&topology, &value_scheme, refinement.num_levels())?;
         Ok(SplitFaceVarying {

@@ -138,74 +138,79 @@ impl Weights for PointSum<'_> {
     }
 }
 
-/// One step of a scheme over its parent level: the child faces, and each child vertex's row.
-enum Step<'a> {
-    DooSabin(doo_sabin::Step<'a>),
-    Sqrt3(sqrt3::Step<'a>),
-    Butterfly(butterfly::Step<'a>),
+/// What a split scheme's rule file implements: one step over a parent level, with the
+/// child faces (and the tags the child keeps) and each child vertex's mask as weights of
+/// parent vertices. [`Scheme::split_step`] makes the step of a scheme at a level; the rest
+/// (levels, stencil tables, points, face-varying data, limits) is the same for every
+/// scheme.
+pub(crate) trait SplitRule: Sync {
+    /// Child vertices (rows).
+    fn num_rows(&self) -> usize;
+    /// The weights of child vertex `r`, given to `w` in a fixed order.
+    fn fill<W: Weights>(&self, r: usize, w: &mut W);
+    /// The child level's faces and tags.
+    fn child_faces(&self) -> Result<ChildFaces, StepError>;
 }
 
-impl Step<'_> {
-    fn new<'a>(p: &'a Topology, scheme: &Scheme, level: usize) -> Step<'a> {
-        match scheme {
-            Scheme::DooSabin => Step::DooSabin(doo_sabin::Step::new(p)),
-            Scheme::Sqrt3 => Step::Sqrt3(sqrt3::Step::new(p, level % 2 == 0)),
-            Scheme::Butterfly { tension } => Step::Butterfly(butterfly::Step::new(
-                p,
-                butterfly::EdgeRule::Classic { tension: *tension },
-            )),
-            Scheme::ModifiedButterfly => {
-                Step::Butterfly(butterfly::Step::new(p, butterfly::EdgeRule::Modified))
-            }
-            _ => unreachable!("the split family refines split schemes only"),
-        }
-    }
+/// A [`SplitRule`] behind a pointer: rows written to a stencil table or summed into points,
+/// one call per row.
+pub(crate) trait SplitStep: Sync {
+    /// Child vertices.
+    fn num_rows(&self) -> usize;
+    /// Row `r` into a stencil table.
+    fn row(&self, r: usize, sink: &mut RowSink);
+    /// Child point `r` from the parent points.
+    fn point(&self, r: usize, src: &[DVec3]) -> DVec3;
+    /// The child level's faces and tags.
+    fn child_faces(&self) -> Result<ChildFaces, StepError>;
+}
 
+impl<T: SplitRule> SplitStep for T {
     fn num_rows(&self) -> usize {
-        match self {
-            Step::DooSabin(s) => s.num_rows(),
-            Step::Sqrt3(s) => s.num_rows(),
-            Step::Butterfly(s) => s.num_rows(),
-        }
+        SplitRule::num_rows(self)
     }
 
     #[inline]
-    fn fill<W: Weights>(&self, r: usize, w: &mut W) {
-        match self {
-            Step::DooSabin(s) => s.fill(r, w),
-            Step::Sqrt3(s) => s.fill(r, w),
-            Step::Butterfly(s) => s.fill(r, w),
-        }
+    fn row(&self, r: usize, sink: &mut RowSink) {
+        self.fill(r, sink);
+    }
+
+    #[inline]
+    fn point(&self, r: usize, src: &[DVec3]) -> DVec3 {
+        let mut sum = PointSum {
+            src,
+            acc: DVec3::ZERO,
+        };
+        self.fill(r, &mut sum);
+        sum.acc
     }
 
     fn child_faces(&self) -> Result<ChildFaces, StepError> {
-        match self {
-            Step::DooSabin(s) => s.child_faces(),
-            Step::Sqrt3(s) => s.child_faces(),
-            Step::Butterfly(s) => s.child_faces(),
-        }
+        SplitRule::child_faces(self)
     }
+}
 
-    fn stencils(&self, num_sources: usize) -> StencilTable {
-        StencilTable::build(self.num_rows(), num_sources, |r, sink| self.fill(r, sink))
-    }
+/// One step of `scheme` over `parent`, the parent being level `level - 1`.
+fn step<'a>(parent: &'a Topology, scheme: &Scheme, level: usize) -> Box<dyn SplitStep + 'a> {
+    scheme
+        .split_step(parent, level)
+        .expect("the split family refines split schemes only")
+}
 
-    fn points(&self, src: &[DVec3]) -> Vec<DVec3> {
-        let mut out = Vec::new();
-        (0..self.num_rows())
-            .into_par_iter()
-            .with_min_len(1024)
-            .map(|r| {
-                let mut sum = PointSum {
-                    src,
-                    acc: DVec3::ZERO,
-                };
-                self.fill(r, &mut sum);
-                sum.acc
-            })
-            .collect_into_vec(&mut out);
-        out
-    }
+/// The stencils of a step: one row per child vertex over the parent's `num_sources`.
+fn step_stencils(step: &dyn SplitStep, num_sources: usize) -> StencilTable {
+    StencilTable::build(step.num_rows(), num_sources, |r, sink| step.row(r, sink))
+}
+
+/// The child points of a step, in parallel.
+fn step_points(step: &dyn SplitStep, src: &[DVec3]) -> Vec<DVec3> {
+    let mut out = Vec::new();
+    (0..step.num_rows())
+        .into_par_iter()
+        .with_min_len(1024)
+        .map(|r| step.point(r, src))
+        .collect_into_vec(&mut out);
+    out
 }
 
 /// One refined level: its faces and tags, its topology (built eagerly below the last level,
@@ -261,13 +266,13 @@ impl SplitRefinement {
             } else {
                 crate::refine::last_level_bytes(child)
             };
-            if !crate::memory::can_allocate(need) {
+            if !subd_mesh::memory::can_allocate(need) {
                 return Err(RefineError::OutOfMemory {
                     level: l,
                     bytes: need,
                 });
             }
-            let faces = Step::new(parent, scheme, l)
+            let faces = step(parent, scheme, l)
                 .child_faces()
                 .map_err(|e| e.at_level(l))?;
             let topology = OnceLock::new();
@@ -372,14 +377,14 @@ impl SplitRefinement {
     pub fn stencils(&self, level: usize) -> &StencilTable {
         self.levels[level - 1].stencils.get_or_init(|| {
             let parent = self.topology(level - 1);
-            Step::new(parent, &self.scheme, level).stencils(parent.num_vertices())
+            step_stencils(&*step(parent, &self.scheme, level), parent.num_vertices())
         })
     }
 
     /// Points of `level` from those of the level above, the masks evaluated directly, in
     /// parallel, with the same rows the tables hold.
     pub fn next_points(&self, level: usize, above: &[DVec3]) -> Vec<DVec3> {
-        Step::new(self.topology(level - 1), &self.scheme, level).points(above)
+        step_points(&*step(self.topology(level - 1), &self.scheme, level), above)
     }
 
     /// The rule of every vertex of `level`, as OpenSubdiv would name it from the level's
@@ -506,11 +511,7 @@ fn check_input(base: &Topology, scheme: &Scheme, levels: usize) -> Result<(), Re
             max: MAX_LEVELS,
         });
     }
-    if let Scheme::Butterfly { tension } = *scheme
-        && !tension.is_finite()
-    {
-        return Err(RefineError::Tension(tension));
-    }
+    scheme.check_parameters()?;
     check_faces(base, scheme)?;
     check_manifold(base, scheme)?;
     check_tags(base, scheme)

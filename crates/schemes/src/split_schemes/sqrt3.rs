@@ -30,7 +30,7 @@ use std::f64::consts::TAU;
 
 use subd_mesh::Topology;
 
-use super::{ChildFaces, Features, StepError, Weights, check_size};
+use super::{ChildFaces, Features, SplitRule, StepError, Weights, check_size};
 
 /// Kobbelt's `α_n`.
 pub fn alpha(n: usize) -> f64 {
@@ -109,10 +109,6 @@ impl<'a> Step<'a> {
         }
     }
 
-    pub(crate) fn num_rows(&self) -> usize {
-        self.num_child
-    }
-
     /// The trisection point of feature edge `e` next to its end `v`.
     fn third(&self, e: u32, v: u32) -> u32 {
         self.trisection[e as usize] + u32::from(self.p.edge_vertices(e as usize)[1] == v)
@@ -137,40 +133,6 @@ impl<'a> Step<'a> {
         }
     }
 
-    pub(crate) fn child_faces(&self) -> Result<ChildFaces, StepError> {
-        let p = self.p;
-        check_size(9 * p.num_faces() as u64 + 9 * p.num_edges() as u64)?;
-        let mut verts: Vec<u32> = Vec::with_capacity(9 * p.num_faces());
-        for e in 0..p.num_edges() {
-            let faces = p.edge_faces(e);
-            let local = p.edge_face_local_indices(e);
-            if !self.features.is_feature_edge(e) {
-                let (f0, k0) = (faces[0] as usize, local[0] as usize);
-                let fv = p.face_vertices(f0);
-                let (a, b) = (fv[k0], fv[(k0 + 1) % 3]);
-                let c0 = self.apex(f0, k0);
-                let c1 = self.apex(faces[1] as usize, local[1] as usize);
-                verts.extend([a, c1, c0, c1, b, c0]);
-                continue;
-            }
-            for (&f, &k) in faces.iter().zip(local) {
-                let fv = p.face_vertices(f as usize);
-                let k = k as usize;
-                let (a, b, x) = (fv[k], fv[(k + 1) % 3], fv[(k + 2) % 3]);
-                if self.trisect {
-                    // The middle of the fan; its two outer triangles come from the flips
-                    // of the face's other edges.
-                    verts.extend([self.third(e as u32, a), self.third(e as u32, b), x]);
-                } else {
-                    verts.extend([a, b, self.centroid_of[f as usize]]);
-                }
-            }
-        }
-        let mut faces = ChildFaces::triangles(self.num_child, verts);
-        carry_tags(p, &self.features, &self.trisection, &mut faces);
-        Ok(faces)
-    }
-
     /// `(p₋₁ + 16 near + 10 far)/27`, `p₋₁` reflected at a curve end.
     fn curve_point<W: Weights>(&self, near: u32, far: u32, e: u32, w: &mut W) {
         w.add(near, 16.0 / 27.0);
@@ -183,9 +145,38 @@ impl<'a> Step<'a> {
             }
         }
     }
+}
+
+/// Infinitely sharp creases and corner tags of the child level: a crease edge's children (the
+/// edge itself on odd steps, its three thirds on even steps) stay creases; corner tags stay
+/// on their vertices.
+fn carry_tags(p: &Topology, features: &Features, trisection: &[u32], child: &mut ChildFaces) {
+    for (e, &t) in trisection.iter().enumerate() {
+        if !features.is_feature_edge(e) || p.is_boundary_edge(e) {
+            continue;
+        }
+        let [a, b] = p.edge_vertices(e);
+        if t == u32::MAX {
+            child.creases.push([a, b]);
+        } else {
+            child.creases.extend([[a, t], [t, t + 1], [t + 1, b]]);
+        }
+    }
+    for v in 0..p.num_vertices() {
+        let s = p.vertex_sharpness(v);
+        if s > 0.0 {
+            child.corners.push((v as u32, s));
+        }
+    }
+}
+
+impl SplitRule for Step<'_> {
+    fn num_rows(&self) -> usize {
+        self.num_child
+    }
 
     #[inline]
-    pub(crate) fn fill<W: Weights>(&self, r: usize, w: &mut W) {
+    fn fill<W: Weights>(&self, r: usize, w: &mut W) {
         let p = self.p;
         let nv = p.num_vertices();
         let num_centroids = self.centroid_faces.len();
@@ -224,27 +215,38 @@ impl<'a> Step<'a> {
             }
         }
     }
-}
 
-/// Infinitely sharp creases and corner tags of the child level: a crease edge's children (the
-/// edge itself on odd steps, its three thirds on even steps) stay creases; corner tags stay
-/// on their vertices.
-fn carry_tags(p: &Topology, features: &Features, trisection: &[u32], child: &mut ChildFaces) {
-    for (e, &t) in trisection.iter().enumerate() {
-        if !features.is_feature_edge(e) || p.is_boundary_edge(e) {
-            continue;
+    fn child_faces(&self) -> Result<ChildFaces, StepError> {
+        let p = self.p;
+        check_size(9 * p.num_faces() as u64 + 9 * p.num_edges() as u64)?;
+        let mut verts: Vec<u32> = Vec::with_capacity(9 * p.num_faces());
+        for e in 0..p.num_edges() {
+            let faces = p.edge_faces(e);
+            let local = p.edge_face_local_indices(e);
+            if !self.features.is_feature_edge(e) {
+                let (f0, k0) = (faces[0] as usize, local[0] as usize);
+                let fv = p.face_vertices(f0);
+                let (a, b) = (fv[k0], fv[(k0 + 1) % 3]);
+                let c0 = self.apex(f0, k0);
+                let c1 = self.apex(faces[1] as usize, local[1] as usize);
+                verts.extend([a, c1, c0, c1, b, c0]);
+                continue;
+            }
+            for (&f, &k) in faces.iter().zip(local) {
+                let fv = p.face_vertices(f as usize);
+                let k = k as usize;
+                let (a, b, x) = (fv[k], fv[(k + 1) % 3], fv[(k + 2) % 3]);
+                if self.trisect {
+                    // The middle of the fan; its two outer triangles come from the flips
+                    // of the face's other edges.
+                    verts.extend([self.third(e as u32, a), self.third(e as u32, b), x]);
+                } else {
+                    verts.extend([a, b, self.centroid_of[f as usize]]);
+                }
+            }
         }
-        let [a, b] = p.edge_vertices(e);
-        if t == u32::MAX {
-            child.creases.push([a, b]);
-        } else {
-            child.creases.extend([[a, t], [t, t + 1], [t + 1, b]]);
-        }
-    }
-    for v in 0..p.num_vertices() {
-        let s = p.vertex_sharpness(v);
-        if s > 0.0 {
-            child.corners.push((v as u32, s));
-        }
+        let mut faces = ChildFaces::triangles(self.num_child, verts);
+        carry_tags(p, &self.features, &self.trisection, &mut faces);
+        Ok(faces)
     }
 }

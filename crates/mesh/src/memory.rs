@@ -26,9 +26,9 @@ static HUGE_PAGES: AtomicBool = AtomicBool::new(true);
 /// whole process.
 ///
 /// ```
-/// subd_schemes::memory::set_huge_pages(false);
-/// assert!(!subd_schemes::memory::huge_pages());
-/// subd_schemes::memory::set_huge_pages(true);
+/// subd_mesh::memory::set_huge_pages(false);
+/// assert!(!subd_mesh::memory::huge_pages());
+/// subd_mesh::memory::set_huge_pages(true);
 /// ```
 pub fn set_huge_pages(enabled: bool) {
     HUGE_PAGES.store(enabled, Ordering::Relaxed);
@@ -45,8 +45,8 @@ pub fn huge_pages() -> bool {
 /// abort in the middle of filling an array.
 ///
 /// ```
-/// assert!(subd_schemes::memory::can_allocate(1 << 20));
-/// assert!(!subd_schemes::memory::can_allocate(u64::MAX));
+/// assert!(subd_mesh::memory::can_allocate(1 << 20));
+/// assert!(!subd_mesh::memory::can_allocate(u64::MAX));
 /// ```
 pub fn can_allocate(bytes: u64) -> bool {
     let Ok(n) = usize::try_from(bytes) else {
@@ -58,7 +58,7 @@ pub fn can_allocate(bytes: u64) -> bool {
 /// `bytes` for people: `512 B`, `3.2 MiB`, `1.5 GiB`.
 ///
 /// ```
-/// assert_eq!(subd_schemes::memory::human_bytes(3 << 29), "1.5 GiB");
+/// assert_eq!(subd_mesh::memory::human_bytes(3 << 29), "1.5 GiB");
 /// ```
 pub fn human_bytes(bytes: u64) -> String {
     const UNITS: [&str; 5] = ["B", "KiB", "MiB", "GiB", "TiB"];
@@ -82,7 +82,7 @@ pub fn human_bytes(bytes: u64) -> String {
 /// memory it reuses from the heap before the advice could take effect, taking 4 KiB faults.
 ///
 /// ```
-/// let v: Vec<f64> = subd_schemes::memory::zeroed(1 << 20);
+/// let v: Vec<f64> = subd_mesh::memory::zeroed(1 << 20);
 /// assert!(v.len() == 1 << 20 && v.iter().all(|&x| x == 0.0));
 /// ```
 pub fn zeroed<T: bytemuck::Zeroable + Clone + Send + Sync>(len: usize) -> Vec<T> {
@@ -98,7 +98,7 @@ pub fn zeroed<T: bytemuck::Zeroable + Clone + Send + Sync>(len: usize) -> Vec<T>
 
 /// An empty vector with room for `len` elements, its memory advised to use huge pages when
 /// large; for filling with `par_extend`, which writes every element once, in place.
-pub(crate) fn with_capacity<T>(len: usize) -> Vec<T> {
+pub fn with_capacity<T>(len: usize) -> Vec<T> {
     let v: Vec<T> = Vec::with_capacity(len);
     let bytes = len.saturating_mul(std::mem::size_of::<T>());
     if huge_pages() && bytes >= HUGE_PAGE_MIN_BYTES {
@@ -116,7 +116,7 @@ pub(crate) fn with_capacity<T>(len: usize) -> Vec<T> {
 ///
 /// # Panics
 /// If `middle` does not lie within `0..len` (before anything is written).
-pub(crate) fn build_around<T, F, R>(
+pub fn build_around<T, F, R>(
     len: usize,
     middle: std::ops::Range<usize>,
     min_chunk: usize,

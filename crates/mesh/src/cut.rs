@@ -1,4 +1,5 @@
-//! A set of faces of a level as a mesh of its own, every relation kept in the level's order.
+//! A set of faces of a topology as a mesh of its own ([`cut`]), every relation kept in the
+//! source's order (adaptive refinement refines such pieces).
 //!
 //! Rebuilding a piece from its face lists would number its edges and start its vertex rings
 //! wherever the builder starts them. Masks sum their terms in ring order (and Chaikin's
@@ -7,14 +8,14 @@
 //! level: the refinement of the piece then computes its children with the same operations,
 //! bit for bit, as the refinement of the whole level.
 
-use subd_mesh::{Topology, TopologyParts};
+use crate::{Topology, TopologyParts};
 
 /// Marks an index that has no counterpart.
-pub(crate) const NONE: u32 = u32::MAX;
+pub const NONE: u32 = u32::MAX;
 
 /// Faces of a source topology cut out, with the map back to the source.
 #[derive(Debug)]
-pub(crate) struct SubMesh {
+pub struct SubMesh {
     /// The cut's topology, with the source's tags.
     pub topology: Topology,
     /// Source vertex of each cut vertex.
@@ -31,75 +32,174 @@ pub(crate) struct SubMesh {
 /// faces keeps them as the boundary fan they form when they are one run of its ring, and is
 /// flagged non-manifold otherwise (as a mesh built from the cut's face lists would have it);
 /// nothing the caller keeps reads such a vertex's ring.
-pub(crate) fn cut(src: &Topology, faces: &[u32]) -> SubMesh {
-    let mut vmap = vec![NONE; src.num_vertices()];
-    let mut emap = vec![NONE; src.num_edges()];
-    let mut fmap = vec![NONE; src.num_faces()];
-    let mut vertices = Vec::new();
-    let mut edges = Vec::new();
-    let mut face_offsets = Vec::with_capacity(faces.len() + 1);
-    face_offsets.push(0u32);
-    let mut face_vertices = Vec::new();
-    let mut face_edges = Vec::new();
-    for (i, &f) in faces.iter().enumerate() {
-        fmap[f as usize] = i as u32;
-        for (&v, &e) in src
-            .face_vertices(f as usize)
-            .iter()
-            .zip(src.face_edges(f as usize))
-        {
-            if vmap[v as usize] == NONE {
-                vmap[v as usize] = vertices.len() as u32;
-                vertices.push(v);
-            }
-            if emap[e as usize] == NONE {
-                emap[e as usize] = edges.len() as u32;
-                edges.push(e);
-            }
-            face_vertices.push(vmap[v as usize]);
-            face_edges.push(emap[e as usize]);
-        }
-        face_offsets.push(face_vertices.len() as u32);
+pub fn cut(src: &Topology, faces: &[u32]) -> SubMesh {
+    let numbering = Numbering::of(src, faces);
+    let edges = edge_relations(src, &numbering);
+    let vertices = vertex_relations(src, &numbering);
+    let (edge_sharpness, vertex_sharpness, face_holes) = cut_tags(src, faces, &numbering);
+    let Numbering {
+        vertices: cut_vertices,
+        edges: cut_edges,
+        face_offsets,
+        face_vertices,
+        face_edges,
+        ..
+    } = numbering;
+    let topology = Topology::from_parts(TopologyParts {
+        num_vertices: cut_vertices.len(),
+        face_offsets,
+        face_vertices,
+        face_edges,
+        edge_vertices: edges.vertices,
+        edge_face_offsets: edges.face_offsets,
+        edge_faces: edges.faces,
+        edge_face_local: edges.face_local,
+        vertex_face_offsets: vertices.face_offsets,
+        vertex_faces: vertices.faces,
+        vertex_face_local: vertices.face_local,
+        vertex_edge_offsets: vertices.edge_offsets,
+        vertex_edges: vertices.edges,
+        edge_boundary: edges.boundary,
+        edge_non_manifold: edges.non_manifold,
+        vertex_non_manifold: vertices.non_manifold,
+        edge_sharpness,
+        vertex_sharpness,
+        face_holes,
+    })
+    .expect("a cut of a valid topology has consistent parts");
+    SubMesh {
+        topology,
+        vertices: cut_vertices,
+        edges: cut_edges,
+        complete: vertices.complete,
     }
-    let edge_vertices: Vec<[u32; 2]> = edges
-        .iter()
-        .map(|&e| src.edge_vertices(e as usize).map(|v| vmap[v as usize]))
-        .collect();
+}
 
-    let mut edge_face_offsets = Vec::with_capacity(edges.len() + 1);
-    edge_face_offsets.push(0u32);
-    let mut edge_faces = Vec::with_capacity(face_vertices.len());
-    let mut edge_face_local = Vec::with_capacity(face_vertices.len());
-    let mut edge_boundary = Vec::with_capacity(edges.len());
-    let mut edge_non_manifold = Vec::with_capacity(edges.len());
-    for &e in &edges {
-        let start = edge_faces.len();
+/// The cut's numbering: source vertices and edges by first appearance in the cut faces, the
+/// maps from source to cut (`NONE` outside), and the cut faces' vertices and edges.
+struct Numbering {
+    vertex_map: Vec<u32>,
+    edge_map: Vec<u32>,
+    face_map: Vec<u32>,
+    vertices: Vec<u32>,
+    edges: Vec<u32>,
+    face_offsets: Vec<u32>,
+    face_vertices: Vec<u32>,
+    face_edges: Vec<u32>,
+}
+
+impl Numbering {
+    fn of(src: &Topology, faces: &[u32]) -> Numbering {
+        let mut n = Numbering {
+            vertex_map: vec![NONE; src.num_vertices()],
+            edge_map: vec![NONE; src.num_edges()],
+            face_map: vec![NONE; src.num_faces()],
+            vertices: Vec::new(),
+            edges: Vec::new(),
+            face_offsets: Vec::with_capacity(faces.len() + 1),
+            face_vertices: Vec::new(),
+            face_edges: Vec::new(),
+        };
+        n.face_offsets.push(0u32);
+        for (i, &f) in faces.iter().enumerate() {
+            n.face_map[f as usize] = i as u32;
+            for (&v, &e) in src
+                .face_vertices(f as usize)
+                .iter()
+                .zip(src.face_edges(f as usize))
+            {
+                if n.vertex_map[v as usize] == NONE {
+                    n.vertex_map[v as usize] = n.vertices.len() as u32;
+                    n.vertices.push(v);
+                }
+                if n.edge_map[e as usize] == NONE {
+                    n.edge_map[e as usize] = n.edges.len() as u32;
+                    n.edges.push(e);
+                }
+                n.face_vertices.push(n.vertex_map[v as usize]);
+                n.face_edges.push(n.edge_map[e as usize]);
+            }
+            n.face_offsets.push(n.face_vertices.len() as u32);
+        }
+        n
+    }
+}
+
+/// The cut's edge relations: ends, faces (the source's, filtered, in its order) and flags.
+struct EdgeRelations {
+    vertices: Vec<[u32; 2]>,
+    face_offsets: Vec<u32>,
+    faces: Vec<u32>,
+    face_local: Vec<u16>,
+    boundary: Vec<bool>,
+    non_manifold: Vec<bool>,
+}
+
+fn edge_relations(src: &Topology, n: &Numbering) -> EdgeRelations {
+    let ne = n.edges.len();
+    let mut r = EdgeRelations {
+        vertices: n
+            .edges
+            .iter()
+            .map(|&e| {
+                src.edge_vertices(e as usize)
+                    .map(|v| n.vertex_map[v as usize])
+            })
+            .collect(),
+        face_offsets: Vec::with_capacity(ne + 1),
+        faces: Vec::with_capacity(n.face_vertices.len()),
+        face_local: Vec::with_capacity(n.face_vertices.len()),
+        boundary: Vec::with_capacity(ne),
+        non_manifold: Vec::with_capacity(ne),
+    };
+    r.face_offsets.push(0u32);
+    for &e in &n.edges {
+        let start = r.faces.len();
         for (&g, &l) in src
             .edge_faces(e as usize)
             .iter()
             .zip(src.edge_face_local_indices(e as usize))
         {
-            if fmap[g as usize] != NONE {
-                edge_faces.push(fmap[g as usize]);
-                edge_face_local.push(l);
+            if n.face_map[g as usize] != NONE {
+                r.faces.push(n.face_map[g as usize]);
+                r.face_local.push(l);
             }
         }
-        edge_face_offsets.push(edge_faces.len() as u32);
-        edge_boundary.push(edge_faces.len() - start == 1);
-        edge_non_manifold.push(src.is_non_manifold_edge(e as usize));
+        r.face_offsets.push(r.faces.len() as u32);
+        r.boundary.push(r.faces.len() - start == 1);
+        r.non_manifold.push(src.is_non_manifold_edge(e as usize));
     }
+    r
+}
 
-    let mut vertex_face_offsets = Vec::with_capacity(vertices.len() + 1);
-    vertex_face_offsets.push(0u32);
-    let mut vertex_faces = Vec::with_capacity(face_vertices.len());
-    let mut vertex_face_local = Vec::with_capacity(face_vertices.len());
-    let mut vertex_edge_offsets = Vec::with_capacity(vertices.len() + 1);
-    vertex_edge_offsets.push(0u32);
-    let mut vertex_edges = Vec::new();
-    let mut vertex_non_manifold = Vec::with_capacity(vertices.len());
-    let mut complete = Vec::with_capacity(vertices.len());
+/// The cut's vertex relations: faces and edges (the source's ring where whole; a boundary fan
+/// where one run of it is kept; filtered and non-manifold otherwise), and which vertices
+/// kept every face.
+struct VertexRelations {
+    face_offsets: Vec<u32>,
+    faces: Vec<u32>,
+    face_local: Vec<u16>,
+    edge_offsets: Vec<u32>,
+    edges: Vec<u32>,
+    non_manifold: Vec<bool>,
+    complete: Vec<bool>,
+}
+
+fn vertex_relations(src: &Topology, n: &Numbering) -> VertexRelations {
+    let nv = n.vertices.len();
+    let mut r = VertexRelations {
+        face_offsets: Vec::with_capacity(nv + 1),
+        faces: Vec::with_capacity(n.face_vertices.len()),
+        face_local: Vec::with_capacity(n.face_vertices.len()),
+        edge_offsets: Vec::with_capacity(nv + 1),
+        edges: Vec::new(),
+        non_manifold: Vec::with_capacity(nv),
+        complete: Vec::with_capacity(nv),
+    };
+    r.face_offsets.push(0u32);
+    r.edge_offsets.push(0u32);
     let mut kept: Vec<usize> = Vec::new();
-    for &v in &vertices {
+    for &v in &n.vertices {
         let v = v as usize;
         let (vf, vl, ve) = (
             src.vertex_faces(v),
@@ -107,7 +207,7 @@ pub(crate) fn cut(src: &Topology, faces: &[u32]) -> SubMesh {
             src.vertex_edges(v),
         );
         kept.clear();
-        kept.extend((0..vf.len()).filter(|&i| fmap[vf[i] as usize] != NONE));
+        kept.extend((0..vf.len()).filter(|&i| n.face_map[vf[i] as usize] != NONE));
         let whole = kept.len() == vf.len();
         let arc = if whole || src.is_non_manifold_vertex(v) {
             None
@@ -118,40 +218,45 @@ pub(crate) fn cut(src: &Topology, faces: &[u32]) -> SubMesh {
             Some(first) => {
                 // One contiguous run of the ring: a boundary fan of the cut, starting at the
                 // run's first face (whose leaving edge is now a boundary edge).
-                let (n, ne) = (vf.len(), ve.len());
+                let (nf, ne) = (vf.len(), ve.len());
                 for j in 0..kept.len() {
-                    let i = (first + j) % n;
-                    vertex_faces.push(fmap[vf[i] as usize]);
-                    vertex_face_local.push(vl[i]);
+                    let i = (first + j) % nf;
+                    r.faces.push(n.face_map[vf[i] as usize]);
+                    r.face_local.push(vl[i]);
                 }
                 for j in 0..=kept.len() {
-                    vertex_edges.push(emap[ve[(first + j) % ne] as usize]);
+                    r.edges.push(n.edge_map[ve[(first + j) % ne] as usize]);
                 }
-                vertex_non_manifold.push(false);
+                r.non_manifold.push(false);
             }
             None => {
                 for &i in &kept {
-                    vertex_faces.push(fmap[vf[i] as usize]);
-                    vertex_face_local.push(vl[i]);
+                    r.faces.push(n.face_map[vf[i] as usize]);
+                    r.face_local.push(vl[i]);
                 }
                 for &e in ve {
-                    if emap[e as usize] != NONE {
-                        vertex_edges.push(emap[e as usize]);
+                    if n.edge_map[e as usize] != NONE {
+                        r.edges.push(n.edge_map[e as usize]);
                     }
                 }
-                vertex_non_manifold.push(src.is_non_manifold_vertex(v) || !whole);
+                r.non_manifold.push(src.is_non_manifold_vertex(v) || !whole);
             }
         }
-        vertex_face_offsets.push(vertex_faces.len() as u32);
-        vertex_edge_offsets.push(vertex_edges.len() as u32);
-        complete.push(whole);
+        r.face_offsets.push(r.faces.len() as u32);
+        r.edge_offsets.push(r.edges.len() as u32);
+        r.complete.push(whole);
     }
+    r
+}
 
+/// The source's tags on the cut's edges, vertices and faces (empty where the source has
+/// none).
+fn cut_tags(src: &Topology, faces: &[u32], n: &Numbering) -> (Vec<f32>, Vec<f32>, Vec<bool>) {
     let tags = src.tags();
     let edge_sharpness = if tags.edge_sharpness().is_empty() {
         Vec::new()
     } else {
-        edges
+        n.edges
             .iter()
             .map(|&e| src.edge_sharpness(e as usize))
             .collect()
@@ -159,7 +264,7 @@ pub(crate) fn cut(src: &Topology, faces: &[u32]) -> SubMesh {
     let vertex_sharpness = if tags.vertex_sharpness().is_empty() {
         Vec::new()
     } else {
-        vertices
+        n.vertices
             .iter()
             .map(|&v| src.vertex_sharpness(v as usize))
             .collect()
@@ -169,34 +274,7 @@ pub(crate) fn cut(src: &Topology, faces: &[u32]) -> SubMesh {
     } else {
         faces.iter().map(|&f| src.is_hole(f as usize)).collect()
     };
-    let topology = Topology::from_parts(TopologyParts {
-        num_vertices: vertices.len(),
-        face_offsets,
-        face_vertices,
-        face_edges,
-        edge_vertices,
-        edge_face_offsets,
-        edge_faces,
-        edge_face_local,
-        vertex_face_offsets,
-        vertex_faces,
-        vertex_face_local,
-        vertex_edge_offsets,
-        vertex_edges,
-        edge_boundary,
-        edge_non_manifold,
-        vertex_non_manifold,
-        edge_sharpness,
-        vertex_sharpness,
-        face_holes,
-    })
-    .expect("a cut of a valid topology has consistent parts");
-    SubMesh {
-        topology,
-        vertices,
-        edges,
-        complete,
-    }
+    (edge_sharpness, vertex_sharpness, face_holes)
 }
 
 /// The start (ring position) of the single run of consecutive ring positions `kept`
@@ -224,7 +302,7 @@ fn single_arc(kept: &[usize], n: usize, closed: bool) -> Option<usize> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use subd_mesh::TopologyBuilder;
+    use crate::TopologyBuilder;
 
     #[test]
     fn complete_vertices_keep_their_rings_in_order() {
