@@ -424,6 +424,59 @@ fn quadrature_triplets(
     Ok(())
 }
 
+/// The energy of the whole limit surface at positions `x`: `Σ_c x_cᵀ Q x_c` with `Q` over
+/// every face of the evaluator's mesh (holes carry no surface), each face's piece as
+/// [`EnergyMatrix`] assembles it. A property of the surface alone, whatever the edit method
+/// or region; with [`EnergyOptions::default`] the thin-plate energy
+/// `∬ S_uu² + 2 S_uv² + S_vv²` summed over the faces in their own parameters (the corner
+/// square of side `2^−corner_depth` left out at valence ≥ 5, as [`EnergyOptions`] says).
+/// Faces are summed in order: the same value for any thread count.
+///
+/// # Errors
+/// A face the evaluator cannot evaluate (other than holes), or `x` of the wrong length.
+///
+/// ```
+/// use subd_editing::energy::{EnergyOptions, surface_energy};
+/// use subd_limit::eval::LimitEvaluator;
+/// use subd_schemes::{Options, Scheme};
+///
+/// let mesh = subd_mesh::primitives::torus(12, 8, 2.0, 0.5);
+/// let ev = LimitEvaluator::new(&mesh.topology, &Scheme::CatmullClark, &Options::default())
+///     .unwrap();
+/// let e = surface_energy(&ev, &mesh.positions, &EnergyOptions::default()).unwrap();
+/// // Moving the surface rigidly costs nothing: the energy is the same.
+/// let moved: Vec<_> = mesh.positions.iter().map(|p| *p + subd_mesh::DVec3::X).collect();
+/// let f = surface_energy(&ev, &moved, &EnergyOptions::default()).unwrap();
+/// assert!(e > 0.0 && (e - f).abs() < 1e-9 * e);
+/// ```
+pub fn surface_energy(
+    ev: &LimitEvaluator,
+    x: &[DVec3],
+    options: &EnergyOptions,
+) -> Result<f64, EditError> {
+    let topology = ev.topology();
+    if x.len() != topology.num_vertices() {
+        return Err(EditError::Solve(format!(
+            "{} positions for {} vertices",
+            x.len(),
+            topology.num_vertices()
+        )));
+    }
+    let q0 = mat16(&bicubic_thin_plate());
+    let q1 = mat16(&bicubic_membrane());
+    let per_face: Vec<f64> = (0..topology.num_faces())
+        .into_par_iter()
+        .map(|f| {
+            let mut t = Vec::new();
+            face_triplets(ev, f, options, &q0, &q1, &mut t)?;
+            Ok(t.iter()
+                .map(|&(i, j, v)| v * x[i as usize].dot(x[j as usize]))
+                .sum::<f64>())
+        })
+        .collect::<Result<_, EditError>>()?;
+    Ok(per_face.iter().sum())
+}
+
 /// Appends a chunk's entries to `merged`; where they repeat a few vertex pairs many times
 /// (the faces around a vertex of high valence share their (2n + 8)² pairs) they are summed
 /// in a dense block over the chunk's vertices first. `local` is an all-`MAX` scratch map

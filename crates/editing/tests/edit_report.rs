@@ -1,7 +1,10 @@
 //! What an edit reports beside the positions: dependent constraints (redundant or
-//! conflicting, against cases worked out by hand).
+//! conflicting, against cases worked out by hand) and the surface's energy (against a closed
+//! form and the assembled matrix).
 
-use subd_editing::energy::EnergyOptions;
+use std::f64::consts::TAU;
+
+use subd_editing::energy::{EnergyMatrix, EnergyOptions, surface_energy};
 use subd_editing::{Axis, Constraint, Edit, Editor, Goal, Isoline, Location, Method};
 use subd_limit::eval::{FaceParam, LimitEvaluator};
 use subd_mesh::{DVec3, Mesh};
@@ -197,5 +200,49 @@ fn independent_constraints_report_no_dependencies() {
             "{method:?}: {:?}",
             e.dependencies
         );
+    }
+}
+
+/// Control points `(cos 2πi/m, sin 2πi/m, cos 2πj/n)` on an m × n torus grid: every
+/// coordinate a function of one grid direction, so the thin-plate energy is `∫ F''²` along
+/// it. A uniform cubic B-spline's F'' is linear on each span between the second
+/// differences `κ f_i` (κ = 2 cos ω − 2 for samples of cos/sin ωi), and
+/// `∫₀¹ ((1−s) a + s b)² = (a² + ab + b²)/3`, so
+/// `E = m n [κ_m² (2 + cos ω)/3 + κ_n² (2 + cos ψ)/6]` (ω = 2π/m, ψ = 2π/n).
+#[test]
+fn surface_energy_of_a_separable_torus_grid_has_its_closed_form() {
+    let (m, n) = (12u32, 8u32);
+    let mut mesh = subd_mesh::primitives::torus(m, n, 2.0, 0.5);
+    let (w, p) = (TAU / m as f64, TAU / n as f64);
+    for (k, x) in mesh.positions.iter_mut().enumerate() {
+        let (i, j) = ((k as u32 / n) as f64, (k as u32 % n) as f64);
+        *x = DVec3::new((w * i).cos(), (w * i).sin(), (p * j).cos());
+    }
+    let ev =
+        LimitEvaluator::new(&mesh.topology, &Scheme::CatmullClark, &Options::default()).unwrap();
+    let e = surface_energy(&ev, &mesh.positions, &EnergyOptions::default()).unwrap();
+    let (km, kn) = (2.0 * w.cos() - 2.0, 2.0 * p.cos() - 2.0);
+    let hand = (m * n) as f64 * (km * km * (2.0 + w.cos()) / 3.0 + kn * kn * (2.0 + p.cos()) / 6.0);
+    assert!((e - hand).abs() < 1e-12 * hand, "{e} against {hand}");
+}
+
+#[test]
+fn surface_energy_is_the_assembled_matrix_over_every_face() {
+    // Hexagons give valence-3 and (refined) valence-6 corners: corner patches and pieces.
+    let mesh = subd_mesh::primitives::torus_with_hexagons(12, 8, 4, 2.0, 0.5);
+    let ev =
+        LimitEvaluator::new(&mesh.topology, &Scheme::CatmullClark, &Options::default()).unwrap();
+    for options in [
+        EnergyOptions::default(),
+        EnergyOptions {
+            membrane: 0.3,
+            ..EnergyOptions::default()
+        },
+    ] {
+        let faces: Vec<usize> = (0..mesh.topology.num_faces()).collect();
+        let q = EnergyMatrix::new(&ev, mesh.positions.len(), &faces, &options).unwrap();
+        let want = q.energy(&mesh.positions);
+        let e = surface_energy(&ev, &mesh.positions, &options).unwrap();
+        assert!((e - want).abs() < 1e-12 * want, "{e} against {want}");
     }
 }
