@@ -8,7 +8,7 @@ use std::time::Instant;
 use clap::{Args, ValueEnum};
 use serde::Serialize;
 use subd_editing::energy::{EnergyMatrix, EnergyOptions};
-use subd_editing::{Constraint, Deformation, Editor, Method};
+use subd_editing::{Axis, Constraint, Deformation, DependentGroup, Editor, Location, Method};
 use subd_mesh::{DVec3, Mesh};
 use subd_schemes::Scheme;
 
@@ -93,6 +93,9 @@ struct EditReport {
     rank: usize,
     /// Whether the constraints were dependent or conflicting (least-squares solution).
     rank_deficient: bool,
+    /// The groups of dependent constraints: which, how many dependent rows, whether they
+    /// agree (`consistent`) and what no change can meet (`residual`).
+    dependencies: Vec<DependentGroup>,
     /// Vertices allowed to move (the constraints' support, or the energy's region).
     free_vertices: usize,
     moved_vertices: Vec<u32>,
@@ -113,6 +116,91 @@ fn kind(c: &Constraint) -> &'static str {
         Constraint::Normal { .. } => "normal",
         Constraint::Isoline { .. } => "isoline",
     }
+}
+
+/// Where a point or normal constraint is, as the constraint file says it.
+fn location(at: &Location) -> String {
+    match at {
+        Location::Vertex(v) => format!("vertex {v}"),
+        Location::Face(p) if p.sub == 0 => format!("face {} uv ({}, {})", p.face, p.u, p.v),
+        Location::Face(p) => format!("face {} sub {} uv ({}, {})", p.face, p.sub, p.u, p.v),
+    }
+}
+
+/// A constraint as the user wrote it: its index in the file, kind and place.
+fn describe(index: usize, c: &Constraint) -> String {
+    match c {
+        Constraint::Point { at, .. } => format!("{index} (point at {})", location(at)),
+        Constraint::Normal { at, .. } => format!("{index} (normal at {})", location(at)),
+        Constraint::Isoline { line, .. } => {
+            let along = match line.along {
+                Axis::U => "u",
+                Axis::V => "v",
+            };
+            format!(
+                "{index} (isoline from face {} along {along} at {})",
+                line.face, line.at
+            )
+        }
+    }
+}
+
+/// "constraint 2 (…)", "constraints 0 (…) and 1 (…)", "constraints 0 (…), 1 (…) and 3 (…)".
+fn name_constraints(indices: &[usize], constraints: &[Constraint]) -> String {
+    let names: Vec<String> = indices
+        .iter()
+        .map(|&i| describe(i, &constraints[i]))
+        .collect();
+    match names.as_slice() {
+        [one] => format!("constraint {one}"),
+        [init @ .., last] => format!("constraints {} and {last}", init.join(", ")),
+        [] => "no constraint".into(),
+    }
+}
+
+/// One warning per dependent group: redundant when its targets agree, else conflicting
+/// with what the least-squares compromise leaves unmet. A rank deficiency the groups do not
+/// explain (a solver's test looser than theirs) gets one line of its own.
+fn dependency_warnings(
+    constraints: &[Constraint],
+    groups: &[DependentGroup],
+    rank: usize,
+    rows: usize,
+) -> Vec<String> {
+    let mut lines: Vec<String> = groups
+        .iter()
+        .map(|g| {
+            let names = name_constraints(&g.constraints, constraints);
+            let single = g.constraints.len() == 1;
+            if g.consistent {
+                format!(
+                    "{names} {} redundant: {} dependent but consistent, every one met",
+                    if single { "is" } else { "are" },
+                    if single {
+                        "its rows are"
+                    } else {
+                        "their rows are"
+                    },
+                )
+            } else {
+                format!(
+                    "{names} conflict{}: no surface meets {} ({} dependent rows); the \
+                     least-squares compromise leaves {:.4e} unmet",
+                    if single { "s with itself" } else { "" },
+                    if single { "all its rows" } else { "them all" },
+                    g.dependent_rows,
+                    g.residual
+                )
+            }
+        })
+        .collect();
+    if groups.is_empty() && rank < rows {
+        lines.push(format!(
+            "the constraint rows are dependent (rank {rank} of {rows} rows): the \
+             least-squares solution"
+        ));
+    }
+    lines
 }
 
 fn read_text(path: &Path) -> Result<String, Failure> {
@@ -243,6 +331,16 @@ fn run_one(
         .filter(|(c, _)| !matches!(c, Constraint::Normal { .. }))
         .map(|(_, r)| r / diag)
         .fold(0.0, f64::max);
+    print_warnings(
+        err,
+        &args.constraints,
+        &dependency_warnings(
+            &constraints,
+            &edit.dependencies,
+            editor.rank,
+            editor.rows().rows.len(),
+        ),
+    );
     let (before, after, disp) = if scheme == Scheme::CatmullClark {
         let q = match editor.energy.take() {
             Some(q) => q,
@@ -296,6 +394,7 @@ fn run_one(
             rows: editor.rows().rows.len(),
             rank: editor.rank,
             rank_deficient: editor.rank_deficient,
+            dependencies: edit.dependencies.clone(),
             free_vertices: editor.free_vertices().len(),
             moved_vertices: edit.moved.clone(),
             residuals: constraints

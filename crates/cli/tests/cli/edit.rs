@@ -41,6 +41,14 @@ fn edit_meets_constraints_and_reports_json() {
         }
         assert_eq!(j["constraints"], 4);
         assert!(j["energy_after"].as_f64().is_some());
+        // The iso-line ends at the infinitely sharp crease: its last control point is the
+        // extrapolation 2 c₃ − c₂, and its displacements (…, 0.1, 0.05, 0) agree with that.
+        assert_eq!(j["dependencies"][0]["constraints"], serde_json::json!([3]));
+        assert!(
+            err.contains("constraint 3 (isoline from face 60 along u at 0.5) is redundant")
+                && !err.contains("conflict"),
+            "{err}"
+        );
         let moved = j["moved_vertices"].as_array().unwrap().len();
         assert!(moved > 0 && moved <= j["free_vertices"].as_u64().unwrap() as usize);
         assert!(out.exists());
@@ -173,5 +181,97 @@ fn deform_moves_constraint_points_and_keeps_the_rest() {
         if !inside {
             assert_eq!(p, q);
         }
+    }
+}
+
+/// Runs `subd edit` with `constraints` (JSON text) on `input`; (exit code, JSON report,
+/// stderr).
+fn edit_json(
+    s: &Scratch,
+    tag: &str,
+    input: &Path,
+    constraints: &str,
+    extra: &[&str],
+) -> (i32, serde_json::Value, String) {
+    let c = s.file(&format!("{tag}.json"), constraints.as_bytes());
+    let out = s.0.join(format!("{tag}.obj"));
+    let mut args = vec!["edit", "--constraints", c.to_str().unwrap()];
+    args.extend(extra);
+    args.extend([input.to_str().unwrap(), out.to_str().unwrap(), "--json"]);
+    let (code, stdout, err) = subd(&args);
+    let j = serde_json::from_str(&stdout).unwrap_or(serde_json::Value::Null);
+    (code, j, err)
+}
+
+fn torus_creased() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/meshes/torus_creased.obj")
+}
+
+#[test]
+fn edit_warns_naming_conflicting_constraints_with_their_residual() {
+    let s = Scratch::new("edit-conflict");
+    // Two displacements of vertex 8's limit point, 0.25 and 0.05 along z: the z rows ask
+    // two values of one, and (−1, 1)/√2 · r = 0.2/√2 is what no change can meet.
+    let text = r#"{"constraints": [
+      {"kind": "point", "vertex": 8, "displacement": [0, 0, 0.25]},
+      {"kind": "point", "face": 40, "uv": [0.5, 0.5], "displacement": [0, 0, -0.15]},
+      {"kind": "point", "vertex": 8, "displacement": [0, 0, 0.05]}
+    ]}"#;
+    let hand = 0.2 / 2f64.sqrt();
+    for method in ["least-squares", "energy"] {
+        let (code, j, err) = edit_json(&s, method, &torus_creased(), text, &["--method", method]);
+        assert_eq!(code, 0, "{err}");
+        let c = s.0.join(format!("{method}.json"));
+        let want = format!(
+            "subd: warning: {}: constraints 0 (point at vertex 8) and 2 (point at vertex 8) \
+             conflict: no surface meets them all (3 dependent rows); the least-squares \
+             compromise leaves {hand:.4e} unmet",
+            c.display()
+        );
+        assert_eq!(err.trim_end(), want, "{method}");
+        assert_eq!(j["rank_deficient"], true);
+        let groups = j["dependencies"].as_array().unwrap();
+        assert_eq!(groups.len(), 1, "{j}");
+        assert_eq!(groups[0]["constraints"], serde_json::json!([0, 2]));
+        assert_eq!(groups[0]["consistent"], false);
+        assert!((groups[0]["residual"].as_f64().unwrap() - hand).abs() < 1e-12);
+        // Measured afresh: the compromise (0.15) misses each request by 0.1.
+        let r = &j["residuals"];
+        for k in [0, 2] {
+            assert!(
+                (r[k]["residual"].as_f64().unwrap() - 0.1).abs() < 1e-9,
+                "{r}"
+            );
+        }
+    }
+}
+
+#[test]
+fn edit_notes_redundant_constraints_as_dependent_not_conflicting() {
+    let s = Scratch::new("edit-redundant");
+    let text = r#"{"constraints": [
+      {"kind": "point", "vertex": 8, "displacement": [0, 0, 0.25]},
+      {"kind": "point", "face": 40, "uv": [0.5, 0.5], "displacement": [0, 0, -0.15]},
+      {"kind": "point", "vertex": 8, "displacement": [0, 0, 0.25]}
+    ]}"#;
+    for method in ["least-squares", "energy"] {
+        let (code, j, err) = edit_json(&s, method, &torus_creased(), text, &["--method", method]);
+        assert_eq!(code, 0, "{err}");
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(
+            err.starts_with("subd: warning: ")
+                && err.contains(
+                    "constraints 0 (point at vertex 8) and 2 (point at vertex 8) are \
+                     redundant: their rows are dependent but consistent"
+                )
+                && !err.contains("conflict"),
+            "{err}"
+        );
+        let groups = j["dependencies"].as_array().unwrap();
+        assert_eq!(groups.len(), 1, "{j}");
+        assert_eq!(groups[0]["constraints"], serde_json::json!([0, 2]));
+        assert_eq!(groups[0]["consistent"], true);
+        assert!(groups[0]["residual"].as_f64().unwrap() < 1e-12, "{j}");
+        assert!(j["max_residual_relative"].as_f64().unwrap() < 1e-10, "{j}");
     }
 }
