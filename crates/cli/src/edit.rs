@@ -7,7 +7,7 @@ use std::time::Instant;
 
 use clap::{Args, ValueEnum};
 use serde::Serialize;
-use subd_editing::energy::{EnergyMatrix, EnergyOptions};
+use subd_editing::energy::{EnergyMatrix, EnergyOptions, surface_energy};
 use subd_editing::{Axis, Constraint, Deformation, DependentGroup, Editor, Location, Method};
 use subd_mesh::{DVec3, Mesh};
 use subd_schemes::Scheme;
@@ -102,10 +102,14 @@ struct EditReport {
     residuals: Vec<ConstraintReport>,
     /// The largest point residual over the bounding-box diagonal.
     max_residual_relative: f64,
-    /// Thin-plate energy of the limit surface over the faces the edit can change, before and
-    /// after (Catmull-Clark), and of the displacement.
+    /// Thin-plate energy `∬ S_uu² + 2 S_uv² + S_vv²` of the whole limit surface (every face
+    /// but holes, in each face's parameters; `subd_editing::energy::surface_energy`), before
+    /// and after (Catmull-Clark): the same definition for every method, with no membrane
+    /// term whatever `--membrane` says.
     energy_before: Option<f64>,
     energy_after: Option<f64>,
+    /// The energy of the displacement over the faces the free vertices touch, with the
+    /// energy method's membrane term (what that method minimises).
     displacement_energy: Option<f64>,
     seconds: EditSeconds,
 }
@@ -356,11 +360,11 @@ fn run_one(
             .zip(x0)
             .map(|(a, b)| *a - *b)
             .collect();
-        (
-            Some(q.energy(x0)),
-            Some(q.energy(&edit.positions)),
-            Some(q.energy(&d)),
-        )
+        // One definition for every method: the whole surface's thin-plate energy.
+        let thin_plate = EnergyOptions::default();
+        let before = surface_energy(&ev, x0, &thin_plate).map_err(named)?;
+        let after = surface_energy(&ev, &edit.positions, &thin_plate).map_err(named)?;
+        (Some(before), Some(after), Some(q.energy(&d)))
     } else {
         (None, None, None)
     };
