@@ -7,7 +7,7 @@ use std::time::Instant;
 
 use clap::{Args, ValueEnum};
 use serde::Serialize;
-use subd_editing::energy::{EnergyMatrix, EnergyOptions, surface_energy};
+use subd_editing::energy::{EnergyMatrix, EnergyOptions, surface_energy_before_after};
 use subd_editing::{Axis, Constraint, Deformation, DependentGroup, Editor, Location, Method};
 use subd_mesh::{DVec3, Mesh};
 use subd_schemes::Scheme;
@@ -362,8 +362,8 @@ fn run_one(
             .collect();
         // One definition for every method: the whole surface's thin-plate energy.
         let thin_plate = EnergyOptions::default();
-        let before = surface_energy(&ev, x0, &thin_plate).map_err(named)?;
-        let after = surface_energy(&ev, &edit.positions, &thin_plate).map_err(named)?;
+        let (before, after) =
+            surface_energy_before_after(&ev, x0, &edit.positions, &thin_plate).map_err(named)?;
         (Some(before), Some(after), Some(q.energy(&d)))
     } else {
         (None, None, None)

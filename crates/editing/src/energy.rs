@@ -45,6 +45,7 @@ use subd_limit::eval::{FaceParam, LimitEvaluator};
 use subd_limit::patch::bspline_basis;
 use subd_limit::stam::CornerPatchMatrices;
 use subd_limit::{FacePatch, PatchForm};
+use subd_mesh::Topology;
 
 use crate::EditError;
 
@@ -454,27 +455,94 @@ pub fn surface_energy(
     x: &[DVec3],
     options: &EnergyOptions,
 ) -> Result<f64, EditError> {
+    check_length(ev, x)?;
+    let all: Vec<usize> = (0..ev.topology().num_faces()).collect();
+    Ok(face_energies(ev, x, &all, options)?.iter().sum())
+}
+
+/// [`surface_energy`] of `before` and of `after` (an edit of it), bit for bit, with only the
+/// faces whose patches reach a vertex that moved evaluated twice.
+///
+/// # Errors
+/// As [`surface_energy`].
+pub fn surface_energy_before_after(
+    ev: &LimitEvaluator,
+    before: &[DVec3],
+    after: &[DVec3],
+    options: &EnergyOptions,
+) -> Result<(f64, f64), EditError> {
+    check_length(ev, before)?;
+    check_length(ev, after)?;
     let topology = ev.topology();
-    if x.len() != topology.num_vertices() {
+    let all: Vec<usize> = (0..topology.num_faces()).collect();
+    let mut per_face = face_energies(ev, before, &all, options)?;
+    let energy_before = per_face.iter().sum();
+    let moved: Vec<u32> = (0..before.len() as u32)
+        .filter(|&v| before[v as usize] != after[v as usize])
+        .collect();
+    let changed = faces_reaching(topology, &moved);
+    for (&f, e) in changed
+        .iter()
+        .zip(face_energies(ev, after, &changed, options)?)
+    {
+        per_face[f] = e;
+    }
+    // The same faces summed in the same order as a fresh evaluation of `after`.
+    Ok((energy_before, per_face.iter().sum()))
+}
+
+fn check_length(ev: &LimitEvaluator, x: &[DVec3]) -> Result<(), EditError> {
+    let n = ev.topology().num_vertices();
+    if x.len() != n {
         return Err(EditError::Solve(format!(
-            "{} positions for {} vertices",
-            x.len(),
-            topology.num_vertices()
+            "{} positions for {n} vertices",
+            x.len()
         )));
     }
+    Ok(())
+}
+
+/// The energies `Σ_c x_cᵀ Q_f x_c` of `faces` (in parallel; each face's value depends on
+/// that face alone).
+fn face_energies(
+    ev: &LimitEvaluator,
+    x: &[DVec3],
+    faces: &[usize],
+    options: &EnergyOptions,
+) -> Result<Vec<f64>, EditError> {
     let q0 = mat16(&bicubic_thin_plate());
     let q1 = mat16(&bicubic_membrane());
-    let per_face: Vec<f64> = (0..topology.num_faces())
-        .into_par_iter()
-        .map(|f| {
+    faces
+        .par_iter()
+        .map(|&f| {
             let mut t = Vec::new();
             face_triplets(ev, f, options, &q0, &q1, &mut t)?;
             Ok(t.iter()
                 .map(|&(i, j, v)| v * x[i as usize].dot(x[j as usize]))
                 .sum::<f64>())
         })
-        .collect::<Result<_, EditError>>()?;
-    Ok(per_face.iter().sum())
+        .collect()
+}
+
+/// The faces whose limit patches depend on one of `vertices`, ascending: a Catmull-Clark
+/// patch depends on the vertices of the faces around its corners, so these are the faces
+/// sharing a vertex with a face around one of `vertices`.
+fn faces_reaching(topology: &Topology, vertices: &[u32]) -> Vec<usize> {
+    let mut near = vec![false; topology.num_vertices()];
+    for &v in vertices {
+        for &f in topology.vertex_faces(v as usize) {
+            for &w in topology.face_vertices(f as usize) {
+                near[w as usize] = true;
+            }
+        }
+    }
+    let mut hit = vec![false; topology.num_faces()];
+    for w in (0..near.len()).filter(|&w| near[w]) {
+        for &f in topology.vertex_faces(w) {
+            hit[f as usize] = true;
+        }
+    }
+    (0..hit.len()).filter(|&f| hit[f]).collect()
 }
 
 /// Appends a chunk's entries to `merged`; where they repeat a few vertex pairs many times

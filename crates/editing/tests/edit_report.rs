@@ -4,7 +4,9 @@
 
 use std::f64::consts::TAU;
 
-use subd_editing::energy::{EnergyMatrix, EnergyOptions, surface_energy};
+use subd_editing::energy::{
+    EnergyMatrix, EnergyOptions, surface_energy, surface_energy_before_after,
+};
 use subd_editing::{Axis, Constraint, Edit, Editor, Goal, Isoline, Location, Method};
 use subd_limit::eval::{FaceParam, LimitEvaluator};
 use subd_mesh::{DVec3, Mesh};
@@ -245,4 +247,20 @@ fn surface_energy_is_the_assembled_matrix_over_every_face() {
         let e = surface_energy(&ev, &mesh.positions, &options).unwrap();
         assert!((e - want).abs() < 1e-12 * want, "{e} against {want}");
     }
+}
+
+#[test]
+fn surface_energy_before_after_is_two_fresh_evaluations_bit_for_bit() {
+    let mesh = subd_mesh::primitives::torus_with_hexagons(12, 8, 4, 2.0, 0.5);
+    let ev =
+        LimitEvaluator::new(&mesh.topology, &Scheme::CatmullClark, &Options::default()).unwrap();
+    let options = EnergyOptions::default();
+    // Vertex 0 is a hexagon's corner; 33 a regular vertex elsewhere.
+    let mut after = mesh.positions.clone();
+    after[0] += DVec3::new(0.0, 0.1, 0.2);
+    after[33] += DVec3::new(-0.1, 0.0, 0.05);
+    let (b, a) = surface_energy_before_after(&ev, &mesh.positions, &after, &options).unwrap();
+    assert_eq!(b, surface_energy(&ev, &mesh.positions, &options).unwrap());
+    assert_eq!(a, surface_energy(&ev, &after, &options).unwrap());
+    assert!(a != b);
 }
