@@ -8,7 +8,10 @@ use std::time::Instant;
 use clap::{Args, ValueEnum};
 use serde::Serialize;
 use subd_editing::energy::{EnergyMatrix, EnergyOptions, surface_energy_before_after};
-use subd_editing::{Axis, Constraint, Deformation, DependentGroup, Editor, Location, Method};
+use subd_editing::{
+    Axis, Constraint, Deformation, DependentGroup, EditError, Editor, Location, Method,
+};
+use subd_limit::eval::LimitEvaluator;
 use subd_mesh::{DVec3, Mesh};
 use subd_schemes::Scheme;
 
@@ -287,6 +290,94 @@ pub(crate) fn run(
     )
 }
 
+/// The constraints of `path`, at least one.
+fn read_constraints(path: &Path) -> Result<Vec<Constraint>, Failure> {
+    let constraints = subd_editing::spec::parse_constraints(&read_text(path)?)
+        .map_err(|e| bad(format!("{}: {e}", path.display())))?;
+    if constraints.is_empty() {
+        return Err(bad(format!("{}: no constraints", path.display())));
+    }
+    Ok(constraints)
+}
+
+/// The largest residual of a point or iso-line over the bounding-box diagonal of `x0`.
+fn largest_relative_distance(constraints: &[Constraint], res: &[f64], x0: &[DVec3]) -> f64 {
+    let diag = subd_pia::bbox_diagonal(x0).max(f64::MIN_POSITIVE);
+    constraints
+        .iter()
+        .zip(res)
+        .filter(|(c, _)| !matches!(c, Constraint::Normal { .. }))
+        .map(|(_, r)| r / diag)
+        .fold(0.0, f64::max)
+}
+
+fn residual_reports(constraints: &[Constraint], res: &[f64]) -> Vec<ConstraintReport> {
+    constraints
+        .iter()
+        .zip(res)
+        .enumerate()
+        .map(|(i, (c, &r))| ConstraintReport {
+            constraint: i,
+            kind: kind(c),
+            residual: r,
+        })
+        .collect()
+}
+
+/// The energies `subd edit --json` reports (Catmull-Clark).
+struct Energies {
+    /// The thin-plate energy of the whole limit surface before the edit: one definition
+    /// for every method ([`surface_energy_before_after`]).
+    before: f64,
+    /// The same after.
+    after: f64,
+    /// The displacement's energy over the faces the free vertices touch (the method's own
+    /// energy, membrane included, where it assembled one).
+    displacement: f64,
+}
+
+fn energies(
+    ev: &LimitEvaluator,
+    editor: &mut Editor,
+    x0: &[DVec3],
+    x1: &[DVec3],
+) -> Result<Energies, EditError> {
+    let topo = ev.topology();
+    let q = match editor.energy.take() {
+        Some(q) => q,
+        None => {
+            let faces = subd_editing::solve::faces_touching(topo, editor.free_vertices());
+            EnergyMatrix::new(ev, topo.num_vertices(), &faces, &EnergyOptions::default())?
+        }
+    };
+    let d: Vec<DVec3> = x1.iter().zip(x0).map(|(a, b)| *a - *b).collect();
+    let (before, after) = surface_energy_before_after(ev, x0, x1, &EnergyOptions::default())?;
+    Ok(Energies {
+        before,
+        after,
+        displacement: q.energy(&d),
+    })
+}
+
+/// Writes IN's topology, tags and texture coordinates with the edited control vertices.
+fn write_edited(
+    job: &Job,
+    file: &subd_io::MeshFile,
+    positions: &[DVec3],
+    err: &mut dyn Write,
+) -> Result<(), Failure> {
+    let mut mesh = Mesh::new(file.mesh.topology.clone(), positions.to_vec())
+        .map_err(|e| bad(format!("{}: {e}", job.input.display())))?;
+    mesh.hints = file.mesh.hints;
+    // The edit moves control points only: texture coordinates stay as given.
+    mesh.fvar = file.mesh.fvar.clone();
+    let mut dropped = Vec::new();
+    crate::uv::fit_ply(&mut mesh, &job.output, &mut dropped);
+    print_warnings(err, &job.input, &dropped);
+    subd_io::write_mesh(&job.output, &mesh, &subd_io::WriteOptions::default())?;
+    Ok(())
+}
+
 fn run_one(
     args: &EditArgs,
     job: &Job,
@@ -297,14 +388,7 @@ fn run_one(
     refuse_overwrite(&job.input, &job.output)?;
     check_output_format(&job.output)?;
     let method = method(args)?;
-    let constraints = subd_editing::spec::parse_constraints(&read_text(&args.constraints)?)
-        .map_err(|e| bad(format!("{}: {e}", args.constraints.display())))?;
-    if constraints.is_empty() {
-        return Err(bad(format!(
-            "{}: no constraints",
-            args.constraints.display()
-        )));
-    }
+    let constraints = read_constraints(&args.constraints)?;
     let file = subd_io::read_mesh(&job.input, &args.rules.read_options())?;
     print_warnings(err, &job.input, &file.warnings);
     let t_read = t_start.elapsed().as_secs_f64();
@@ -328,13 +412,7 @@ fn run_one(
         .map_err(|e| bad(format!("{}: {e}", job.input.display())))?;
     let res = subd_editing::check::residuals(&ev, topo, &scheme, &constraints, x0, &edit.positions)
         .map_err(named)?;
-    let diag = subd_pia::bbox_diagonal(x0).max(f64::MIN_POSITIVE);
-    let max_rel = constraints
-        .iter()
-        .zip(&res)
-        .filter(|(c, _)| !matches!(c, Constraint::Normal { .. }))
-        .map(|(_, r)| r / diag)
-        .fold(0.0, f64::max);
+    let max_rel = largest_relative_distance(&constraints, &res, x0);
     print_warnings(
         err,
         &args.constraints,
@@ -345,41 +423,14 @@ fn run_one(
             editor.rows().rows.len(),
         ),
     );
-    let (before, after, disp) = if scheme == Scheme::CatmullClark {
-        let q = match editor.energy.take() {
-            Some(q) => q,
-            None => {
-                let faces = subd_editing::solve::faces_touching(topo, editor.free_vertices());
-                EnergyMatrix::new(&ev, topo.num_vertices(), &faces, &EnergyOptions::default())
-                    .map_err(named)?
-            }
-        };
-        let d: Vec<DVec3> = edit
-            .positions
-            .iter()
-            .zip(x0)
-            .map(|(a, b)| *a - *b)
-            .collect();
-        // One definition for every method: the whole surface's thin-plate energy.
-        let thin_plate = EnergyOptions::default();
-        let (before, after) =
-            surface_energy_before_after(&ev, x0, &edit.positions, &thin_plate).map_err(named)?;
-        (Some(before), Some(after), Some(q.energy(&d)))
-    } else {
-        (None, None, None)
-    };
+    let energies = (scheme == Scheme::CatmullClark)
+        .then(|| energies(&ev, &mut editor, x0, &edit.positions))
+        .transpose()
+        .map_err(named)?;
     let t_check = t_check.elapsed().as_secs_f64();
 
     let t_write = Instant::now();
-    let mut mesh = Mesh::new(topo.clone(), edit.positions.clone())
-        .map_err(|e| bad(format!("{}: {e}", job.input.display())))?;
-    mesh.hints = file.mesh.hints;
-    // The edit moves control points only: texture coordinates stay as given.
-    mesh.fvar = file.mesh.fvar.clone();
-    let mut dropped = Vec::new();
-    crate::uv::fit_ply(&mut mesh, &job.output, &mut dropped);
-    print_warnings(err, &job.input, &dropped);
-    subd_io::write_mesh(&job.output, &mesh, &subd_io::WriteOptions::default())?;
+    write_edited(job, &file, &edit.positions, err)?;
     let t_write = t_write.elapsed().as_secs_f64();
 
     if args.json {
@@ -401,20 +452,11 @@ fn run_one(
             dependencies: edit.dependencies.clone(),
             free_vertices: editor.free_vertices().len(),
             moved_vertices: edit.moved.clone(),
-            residuals: constraints
-                .iter()
-                .zip(&res)
-                .enumerate()
-                .map(|(i, (c, &r))| ConstraintReport {
-                    constraint: i,
-                    kind: kind(c),
-                    residual: r,
-                })
-                .collect(),
+            residuals: residual_reports(&constraints, &res),
             max_residual_relative: max_rel,
-            energy_before: before,
-            energy_after: after,
-            displacement_energy: disp,
+            energy_before: energies.as_ref().map(|e| e.before),
+            energy_after: energies.as_ref().map(|e| e.after),
+            displacement_energy: energies.as_ref().map(|e| e.displacement),
             seconds: EditSeconds {
                 read: t_read,
                 constraints: t.constraints,
