@@ -7,8 +7,11 @@ use std::time::Instant;
 
 use clap::{Args, ValueEnum};
 use serde::Serialize;
-use subd_editing::energy::{EnergyMatrix, EnergyOptions};
-use subd_editing::{Constraint, Deformation, Editor, Method};
+use subd_editing::energy::{EnergyMatrix, EnergyOptions, surface_energy_before_after};
+use subd_editing::{
+    Axis, Constraint, Deformation, DependentGroup, EditError, Editor, Location, Method,
+};
+use subd_limit::eval::LimitEvaluator;
 use subd_mesh::{DVec3, Mesh};
 use subd_schemes::Scheme;
 
@@ -93,16 +96,23 @@ struct EditReport {
     rank: usize,
     /// Whether the constraints were dependent or conflicting (least-squares solution).
     rank_deficient: bool,
+    /// The groups of dependent constraints: which, how many dependent rows, whether they
+    /// agree (`consistent`) and what no change can meet (`residual`).
+    dependencies: Vec<DependentGroup>,
     /// Vertices allowed to move (the constraints' support, or the energy's region).
     free_vertices: usize,
     moved_vertices: Vec<u32>,
     residuals: Vec<ConstraintReport>,
     /// The largest point residual over the bounding-box diagonal.
     max_residual_relative: f64,
-    /// Thin-plate energy of the limit surface over the faces the edit can change, before and
-    /// after (Catmull-Clark), and of the displacement.
+    /// Thin-plate energy `∬ S_uu² + 2 S_uv² + S_vv²` of the whole limit surface (every face
+    /// but holes, in each face's parameters; `subd_editing::energy::surface_energy`), before
+    /// and after (Catmull-Clark): the same definition for every method, with no membrane
+    /// term whatever `--membrane` says.
     energy_before: Option<f64>,
     energy_after: Option<f64>,
+    /// The energy of the displacement over the faces the free vertices touch, with the
+    /// energy method's membrane term (what that method minimises).
     displacement_energy: Option<f64>,
     seconds: EditSeconds,
 }
@@ -113,6 +123,91 @@ fn kind(c: &Constraint) -> &'static str {
         Constraint::Normal { .. } => "normal",
         Constraint::Isoline { .. } => "isoline",
     }
+}
+
+/// Where a point or normal constraint is, as the constraint file says it.
+fn location(at: &Location) -> String {
+    match at {
+        Location::Vertex(v) => format!("vertex {v}"),
+        Location::Face(p) if p.sub == 0 => format!("face {} uv ({}, {})", p.face, p.u, p.v),
+        Location::Face(p) => format!("face {} sub {} uv ({}, {})", p.face, p.sub, p.u, p.v),
+    }
+}
+
+/// A constraint as the user wrote it: its index in the file, kind and place.
+fn describe(index: usize, c: &Constraint) -> String {
+    match c {
+        Constraint::Point { at, .. } => format!("{index} (point at {})", location(at)),
+        Constraint::Normal { at, .. } => format!("{index} (normal at {})", location(at)),
+        Constraint::Isoline { line, .. } => {
+            let along = match line.along {
+                Axis::U => "u",
+                Axis::V => "v",
+            };
+            format!(
+                "{index} (isoline from face {} along {along} at {})",
+                line.face, line.at
+            )
+        }
+    }
+}
+
+/// "constraint 2 (…)", "constraints 0 (…) and 1 (…)", "constraints 0 (…), 1 (…) and 3 (…)".
+fn name_constraints(indices: &[usize], constraints: &[Constraint]) -> String {
+    let names: Vec<String> = indices
+        .iter()
+        .map(|&i| describe(i, &constraints[i]))
+        .collect();
+    match names.as_slice() {
+        [one] => format!("constraint {one}"),
+        [init @ .., last] => format!("constraints {} and {last}", init.join(", ")),
+        [] => "no constraint".into(),
+    }
+}
+
+/// One warning per dependent group: redundant when its targets agree, else conflicting
+/// with what the least-squares compromise leaves unmet. A rank deficiency the groups do not
+/// explain (a solver's test looser than theirs) gets one line of its own.
+fn dependency_warnings(
+    constraints: &[Constraint],
+    groups: &[DependentGroup],
+    rank: usize,
+    rows: usize,
+) -> Vec<String> {
+    let mut lines: Vec<String> = groups
+        .iter()
+        .map(|g| {
+            let names = name_constraints(&g.constraints, constraints);
+            let single = g.constraints.len() == 1;
+            if g.consistent {
+                format!(
+                    "{names} {} redundant: {} dependent but consistent, every one met",
+                    if single { "is" } else { "are" },
+                    if single {
+                        "its rows are"
+                    } else {
+                        "their rows are"
+                    },
+                )
+            } else {
+                format!(
+                    "{names} conflict{}: no surface meets {} ({} dependent rows); the \
+                     least-squares compromise leaves {:.4e} unmet",
+                    if single { "s with itself" } else { "" },
+                    if single { "all its rows" } else { "them all" },
+                    g.dependent_rows,
+                    g.residual
+                )
+            }
+        })
+        .collect();
+    if groups.is_empty() && rank < rows {
+        lines.push(format!(
+            "the constraint rows are dependent (rank {rank} of {rows} rows): the \
+             least-squares solution"
+        ));
+    }
+    lines
 }
 
 fn read_text(path: &Path) -> Result<String, Failure> {
@@ -195,6 +290,94 @@ pub(crate) fn run(
     )
 }
 
+/// The constraints of `path`, at least one.
+fn read_constraints(path: &Path) -> Result<Vec<Constraint>, Failure> {
+    let constraints = subd_editing::spec::parse_constraints(&read_text(path)?)
+        .map_err(|e| bad(format!("{}: {e}", path.display())))?;
+    if constraints.is_empty() {
+        return Err(bad(format!("{}: no constraints", path.display())));
+    }
+    Ok(constraints)
+}
+
+/// The largest residual of a point or iso-line over the bounding-box diagonal of `x0`.
+fn largest_relative_distance(constraints: &[Constraint], res: &[f64], x0: &[DVec3]) -> f64 {
+    let diag = subd_pia::bbox_diagonal(x0).max(f64::MIN_POSITIVE);
+    constraints
+        .iter()
+        .zip(res)
+        .filter(|(c, _)| !matches!(c, Constraint::Normal { .. }))
+        .map(|(_, r)| r / diag)
+        .fold(0.0, f64::max)
+}
+
+fn residual_reports(constraints: &[Constraint], res: &[f64]) -> Vec<ConstraintReport> {
+    constraints
+        .iter()
+        .zip(res)
+        .enumerate()
+        .map(|(i, (c, &r))| ConstraintReport {
+            constraint: i,
+            kind: kind(c),
+            residual: r,
+        })
+        .collect()
+}
+
+/// The energies `subd edit --json` reports (Catmull-Clark).
+struct Energies {
+    /// The thin-plate energy of the whole limit surface before the edit: one definition
+    /// for every method ([`surface_energy_before_after`]).
+    before: f64,
+    /// The same after.
+    after: f64,
+    /// The displacement's energy over the faces the free vertices touch (the method's own
+    /// energy, membrane included, where it assembled one).
+    displacement: f64,
+}
+
+fn energies(
+    ev: &LimitEvaluator,
+    editor: &mut Editor,
+    x0: &[DVec3],
+    x1: &[DVec3],
+) -> Result<Energies, EditError> {
+    let topo = ev.topology();
+    let q = match editor.energy.take() {
+        Some(q) => q,
+        None => {
+            let faces = subd_editing::solve::faces_touching(topo, editor.free_vertices());
+            EnergyMatrix::new(ev, topo.num_vertices(), &faces, &EnergyOptions::default())?
+        }
+    };
+    let d: Vec<DVec3> = x1.iter().zip(x0).map(|(a, b)| *a - *b).collect();
+    let (before, after) = surface_energy_before_after(ev, x0, x1, &EnergyOptions::default())?;
+    Ok(Energies {
+        before,
+        after,
+        displacement: q.energy(&d),
+    })
+}
+
+/// Writes IN's topology, tags and texture coordinates with the edited control vertices.
+fn write_edited(
+    job: &Job,
+    file: &subd_io::MeshFile,
+    positions: &[DVec3],
+    err: &mut dyn Write,
+) -> Result<(), Failure> {
+    let mut mesh = Mesh::new(file.mesh.topology.clone(), positions.to_vec())
+        .map_err(|e| bad(format!("{}: {e}", job.input.display())))?;
+    mesh.hints = file.mesh.hints;
+    // The edit moves control points only: texture coordinates stay as given.
+    mesh.fvar = file.mesh.fvar.clone();
+    let mut dropped = Vec::new();
+    crate::uv::fit_ply(&mut mesh, &job.output, &mut dropped);
+    print_warnings(err, &job.input, &dropped);
+    subd_io::write_mesh(&job.output, &mesh, &subd_io::WriteOptions::default())?;
+    Ok(())
+}
+
 fn run_one(
     args: &EditArgs,
     job: &Job,
@@ -205,14 +388,7 @@ fn run_one(
     refuse_overwrite(&job.input, &job.output)?;
     check_output_format(&job.output)?;
     let method = method(args)?;
-    let constraints = subd_editing::spec::parse_constraints(&read_text(&args.constraints)?)
-        .map_err(|e| bad(format!("{}: {e}", args.constraints.display())))?;
-    if constraints.is_empty() {
-        return Err(bad(format!(
-            "{}: no constraints",
-            args.constraints.display()
-        )));
-    }
+    let constraints = read_constraints(&args.constraints)?;
     let file = subd_io::read_mesh(&job.input, &args.rules.read_options())?;
     print_warnings(err, &job.input, &file.warnings);
     let t_read = t_start.elapsed().as_secs_f64();
@@ -236,48 +412,25 @@ fn run_one(
         .map_err(|e| bad(format!("{}: {e}", job.input.display())))?;
     let res = subd_editing::check::residuals(&ev, topo, &scheme, &constraints, x0, &edit.positions)
         .map_err(named)?;
-    let diag = subd_pia::bbox_diagonal(x0).max(f64::MIN_POSITIVE);
-    let max_rel = constraints
-        .iter()
-        .zip(&res)
-        .filter(|(c, _)| !matches!(c, Constraint::Normal { .. }))
-        .map(|(_, r)| r / diag)
-        .fold(0.0, f64::max);
-    let (before, after, disp) = if scheme == Scheme::CatmullClark {
-        let q = match editor.energy.take() {
-            Some(q) => q,
-            None => {
-                let faces = subd_editing::solve::faces_touching(topo, editor.free_vertices());
-                EnergyMatrix::new(&ev, topo.num_vertices(), &faces, &EnergyOptions::default())
-                    .map_err(named)?
-            }
-        };
-        let d: Vec<DVec3> = edit
-            .positions
-            .iter()
-            .zip(x0)
-            .map(|(a, b)| *a - *b)
-            .collect();
-        (
-            Some(q.energy(x0)),
-            Some(q.energy(&edit.positions)),
-            Some(q.energy(&d)),
-        )
-    } else {
-        (None, None, None)
-    };
+    let max_rel = largest_relative_distance(&constraints, &res, x0);
+    print_warnings(
+        err,
+        &args.constraints,
+        &dependency_warnings(
+            &constraints,
+            &edit.dependencies,
+            editor.rank,
+            editor.rows().rows.len(),
+        ),
+    );
+    let energies = (scheme == Scheme::CatmullClark)
+        .then(|| energies(&ev, &mut editor, x0, &edit.positions))
+        .transpose()
+        .map_err(named)?;
     let t_check = t_check.elapsed().as_secs_f64();
 
     let t_write = Instant::now();
-    let mut mesh = Mesh::new(topo.clone(), edit.positions.clone())
-        .map_err(|e| bad(format!("{}: {e}", job.input.display())))?;
-    mesh.hints = file.mesh.hints;
-    // The edit moves control points only: texture coordinates stay as given.
-    mesh.fvar = file.mesh.fvar.clone();
-    let mut dropped = Vec::new();
-    crate::uv::fit_ply(&mut mesh, &job.output, &mut dropped);
-    print_warnings(err, &job.input, &dropped);
-    subd_io::write_mesh(&job.output, &mesh, &subd_io::WriteOptions::default())?;
+    write_edited(job, &file, &edit.positions, err)?;
     let t_write = t_write.elapsed().as_secs_f64();
 
     if args.json {
@@ -296,22 +449,14 @@ fn run_one(
             rows: editor.rows().rows.len(),
             rank: editor.rank,
             rank_deficient: editor.rank_deficient,
+            dependencies: edit.dependencies.clone(),
             free_vertices: editor.free_vertices().len(),
             moved_vertices: edit.moved.clone(),
-            residuals: constraints
-                .iter()
-                .zip(&res)
-                .enumerate()
-                .map(|(i, (c, &r))| ConstraintReport {
-                    constraint: i,
-                    kind: kind(c),
-                    residual: r,
-                })
-                .collect(),
+            residuals: residual_reports(&constraints, &res),
             max_residual_relative: max_rel,
-            energy_before: before,
-            energy_after: after,
-            displacement_energy: disp,
+            energy_before: energies.as_ref().map(|e| e.before),
+            energy_after: energies.as_ref().map(|e| e.after),
+            displacement_energy: energies.as_ref().map(|e| e.displacement),
             seconds: EditSeconds {
                 read: t_read,
                 constraints: t.constraints,

@@ -106,6 +106,28 @@ impl Row {
             Coupling::Along(d) => w * d[c],
         }
     }
+
+    /// The dot product of the two rows' coefficient vectors (an entry of `A Aᵀ`).
+    pub fn dot(&self, other: &Row) -> f64 {
+        let (a, b) = (self, other);
+        let (mut i, mut j, mut s) = (0, 0, 0.0);
+        while i < a.entries.len() && j < b.entries.len() {
+            let (va, wa) = a.entries[i];
+            let (vb, wb) = b.entries[j];
+            match va.cmp(&vb) {
+                std::cmp::Ordering::Less => i += 1,
+                std::cmp::Ordering::Greater => j += 1,
+                std::cmp::Ordering::Equal => {
+                    for c in 0..3 {
+                        s += a.coefficient(wa, c) * b.coefficient(wb, c);
+                    }
+                    i += 1;
+                    j += 1;
+                }
+            }
+        }
+        s
+    }
 }
 
 /// What a row asks of the positions: a value, or a change of its current value.

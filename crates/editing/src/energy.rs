@@ -45,6 +45,7 @@ use subd_limit::eval::{FaceParam, LimitEvaluator};
 use subd_limit::patch::bspline_basis;
 use subd_limit::stam::CornerPatchMatrices;
 use subd_limit::{FacePatch, PatchForm};
+use subd_mesh::Topology;
 
 use crate::EditError;
 
@@ -422,6 +423,126 @@ fn quadrature_triplets(
         }
     }
     Ok(())
+}
+
+/// The energy of the whole limit surface at positions `x`: `Σ_c x_cᵀ Q x_c` with `Q` over
+/// every face of the evaluator's mesh (holes carry no surface), each face's piece as
+/// [`EnergyMatrix`] assembles it. A property of the surface alone, whatever the edit method
+/// or region; with [`EnergyOptions::default`] the thin-plate energy
+/// `∬ S_uu² + 2 S_uv² + S_vv²` summed over the faces in their own parameters (the corner
+/// square of side `2^−corner_depth` left out at valence ≥ 5, as [`EnergyOptions`] says).
+/// Faces are summed in order: the same value for any thread count.
+///
+/// # Errors
+/// A face the evaluator cannot evaluate (other than holes), or `x` of the wrong length.
+///
+/// ```
+/// use subd_editing::energy::{EnergyOptions, surface_energy};
+/// use subd_limit::eval::LimitEvaluator;
+/// use subd_schemes::{Options, Scheme};
+///
+/// let mesh = subd_mesh::primitives::torus(12, 8, 2.0, 0.5);
+/// let ev = LimitEvaluator::new(&mesh.topology, &Scheme::CatmullClark, &Options::default())
+///     .unwrap();
+/// let e = surface_energy(&ev, &mesh.positions, &EnergyOptions::default()).unwrap();
+/// // Moving the surface rigidly costs nothing: the energy is the same.
+/// let moved: Vec<_> = mesh.positions.iter().map(|p| *p + subd_mesh::DVec3::X).collect();
+/// let f = surface_energy(&ev, &moved, &EnergyOptions::default()).unwrap();
+/// assert!(e > 0.0 && (e - f).abs() < 1e-9 * e);
+/// ```
+pub fn surface_energy(
+    ev: &LimitEvaluator,
+    x: &[DVec3],
+    options: &EnergyOptions,
+) -> Result<f64, EditError> {
+    check_length(ev, x)?;
+    let all: Vec<usize> = (0..ev.topology().num_faces()).collect();
+    Ok(face_energies(ev, x, &all, options)?.iter().sum())
+}
+
+/// [`surface_energy`] of `before` and of `after` (an edit of it), bit for bit, with only the
+/// faces whose patches reach a vertex that moved evaluated twice.
+///
+/// # Errors
+/// As [`surface_energy`].
+pub fn surface_energy_before_after(
+    ev: &LimitEvaluator,
+    before: &[DVec3],
+    after: &[DVec3],
+    options: &EnergyOptions,
+) -> Result<(f64, f64), EditError> {
+    check_length(ev, before)?;
+    check_length(ev, after)?;
+    let topology = ev.topology();
+    let all: Vec<usize> = (0..topology.num_faces()).collect();
+    let mut per_face = face_energies(ev, before, &all, options)?;
+    let energy_before = per_face.iter().sum();
+    let moved: Vec<u32> = (0..before.len() as u32)
+        .filter(|&v| before[v as usize] != after[v as usize])
+        .collect();
+    let changed = faces_reaching(topology, &moved);
+    for (&f, e) in changed
+        .iter()
+        .zip(face_energies(ev, after, &changed, options)?)
+    {
+        per_face[f] = e;
+    }
+    // The same faces summed in the same order as a fresh evaluation of `after`.
+    Ok((energy_before, per_face.iter().sum()))
+}
+
+fn check_length(ev: &LimitEvaluator, x: &[DVec3]) -> Result<(), EditError> {
+    let n = ev.topology().num_vertices();
+    if x.len() != n {
+        return Err(EditError::Solve(format!(
+            "{} positions for {n} vertices",
+            x.len()
+        )));
+    }
+    Ok(())
+}
+
+/// The energies `Σ_c x_cᵀ Q_f x_c` of `faces` (in parallel; each face's value depends on
+/// that face alone).
+fn face_energies(
+    ev: &LimitEvaluator,
+    x: &[DVec3],
+    faces: &[usize],
+    options: &EnergyOptions,
+) -> Result<Vec<f64>, EditError> {
+    let q0 = mat16(&bicubic_thin_plate());
+    let q1 = mat16(&bicubic_membrane());
+    faces
+        .par_iter()
+        .map(|&f| {
+            let mut t = Vec::new();
+            face_triplets(ev, f, options, &q0, &q1, &mut t)?;
+            Ok(t.iter()
+                .map(|&(i, j, v)| v * x[i as usize].dot(x[j as usize]))
+                .sum::<f64>())
+        })
+        .collect()
+}
+
+/// The faces whose limit patches depend on one of `vertices`, ascending: a Catmull-Clark
+/// patch depends on the vertices of the faces around its corners, so these are the faces
+/// sharing a vertex with a face around one of `vertices`.
+fn faces_reaching(topology: &Topology, vertices: &[u32]) -> Vec<usize> {
+    let mut near = vec![false; topology.num_vertices()];
+    for &v in vertices {
+        for &f in topology.vertex_faces(v as usize) {
+            for &w in topology.face_vertices(f as usize) {
+                near[w as usize] = true;
+            }
+        }
+    }
+    let mut hit = vec![false; topology.num_faces()];
+    for w in (0..near.len()).filter(|&w| near[w]) {
+        for &f in topology.vertex_faces(w) {
+            hit[f as usize] = true;
+        }
+    }
+    (0..hit.len()).filter(|&f| hit[f]).collect()
 }
 
 /// Appends a chunk's entries to `merged`; where they repeat a few vertex pairs many times

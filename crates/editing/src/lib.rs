@@ -16,8 +16,10 @@
 //!   penalty.
 //!
 //! An [`Editor`] factors once per set of constraint locations; [`Editor::solve`] with new
-//! targets only substitutes. [`deform`] moves points by radial blends around constraint
-//! points (Borrel & Moreau's Scodef), for a mesh of any level.
+//! targets only substitutes. Constraints whose rows are dependent are named in
+//! [`Edit::dependencies`]: redundant when their targets agree, conflicting when not.
+//! [`deform`] moves points by radial blends around constraint points (Borrel & Moreau's
+//! Scodef), for a mesh of any level.
 //!
 //! ```
 //! use subd_editing::{Constraint, Editor, Goal, Location, Method};
@@ -48,6 +50,7 @@
 pub mod check;
 pub mod constraint;
 pub mod deform;
+pub mod dependency;
 pub mod energy;
 pub mod isoline;
 pub mod solve;
@@ -55,6 +58,7 @@ pub mod spec;
 
 pub use constraint::{Constraint, ConstraintRows, Coupling, Goal, Location, Row};
 pub use deform::{DeformConstraint, Deformation};
+pub use dependency::DependentGroup;
 pub use energy::{EnergyMatrix, EnergyOptions};
 pub use isoline::{Axis, Isoline};
 pub use solve::{Edit, Editor, Method, Timings};

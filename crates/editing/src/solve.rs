@@ -16,6 +16,10 @@
 //!   `(Q + λ AᵀA) ΔX = λ Aᵀ r`. `Q` gets `1e-12` of its largest diagonal added: that keeps it
 //!   definite when no vertex of a component is fixed (a translation costs no energy; with
 //!   the term the smallest such move is taken) and changes nothing else measurably.
+//!
+//! Where the rows are dependent (and always for the penalty form, which cannot tell), the
+//! [`crate::dependency`] analysis groups them by constraint; each solve reports the groups
+//! with whether their targets agree ([`Edit::dependencies`]).
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -30,6 +34,7 @@ use subd_schemes::{Options, Scheme};
 
 use crate::EditError;
 use crate::constraint::{Constraint, ConstraintRows, Row};
+use crate::dependency::{Dependencies, DependentGroup};
 use crate::energy::{EnergyMatrix, EnergyOptions};
 
 /// Rows up to which `A Aᵀ` is factored densely.
@@ -74,6 +79,10 @@ pub struct Edit {
     pub positions: Vec<DVec3>,
     /// Vertices that moved, ascending.
     pub moved: Vec<u32>,
+    /// Constraints whose rows are dependent (empty when the rows are independent): each
+    /// group redundant (its targets agree, every row met) or conflicting (no change meets
+    /// them all; the least-squares compromise and what it leaves unmet).
+    pub dependencies: Vec<DependentGroup>,
 }
 
 /// An edit prepared for one set of constraint locations: the rows factored once, so that
@@ -115,9 +124,14 @@ pub struct Editor {
     pre: Option<Mat<f64>>,
     /// Whether the map solves the rows exactly (not the penalty form).
     exact: bool,
-    /// Whether the rows were dependent or conflicting (pseudo-inverse used).
+    /// The dependent rows, grouped by constraint.
+    dependencies: Dependencies,
+    /// Whether the rows were dependent or conflicting (the exact methods then use a
+    /// pseudo-inverse: the least-squares solution). Which constraints, and whether they
+    /// agree, is in [`Edit::dependencies`].
     pub rank_deficient: bool,
-    /// The rank found (rows when full).
+    /// The rank found (rows when full; for the penalty form, the rows less the dependent
+    /// rows [`Dependencies`] finds).
     pub rank: usize,
     /// The energy matrix, when the method assembled one.
     pub energy: Option<EnergyMatrix>,
@@ -178,52 +192,29 @@ impl Editor {
             constraints: t0.elapsed().as_secs_f64(),
             ..Timings::default()
         };
-        let support = rows.support();
-        let (free, (map, pre, rank), energy) = match method {
-            Method::LeastSquares => {
-                let t1 = Instant::now();
-                let m = min_norm_map(&rows.rows, &support)?;
-                timings.factor = t1.elapsed().as_secs_f64();
-                (support, m, None)
-            }
+        let (free, (map, pre, rank), energy) =
+            solution_map(&ev, topology, scheme, &rows, method, &mut timings)?;
+        let exact = !matches!(
+            method,
             Method::Energy {
-                penalty,
-                region_rings,
-                energy,
-            } => {
-                if *scheme != Scheme::CatmullClark {
-                    return Err(EditError::EnergyScheme);
-                }
-                let t1 = Instant::now();
-                let free = region(topology, &support, region_rings);
-                let faces = faces_touching(topology, &free);
-                let q = EnergyMatrix::new(&ev, topology.num_vertices(), &faces, &energy)?;
-                timings.assemble = t1.elapsed().as_secs_f64();
-                let t2 = Instant::now();
-                // With vertices fixed around the region Q is definite and its Cholesky
-                // Schur complement is accurate and the faster; with every vertex free Q is
-                // singular up to the regularisation and the KKT system is solved instead.
-                let bounded = free.len() < topology.num_vertices();
-                let m = match penalty {
-                    None if bounded => schur_map(&rows.rows, &free, &q)?,
-                    None => match independent(&rows.rows, &support)
-                        .then(|| kkt_map(&rows.rows, &free, &q))
-                        .transpose()?
-                        .flatten()
-                    {
-                        Some(map) => (map, None, rows.rows.len()),
-                        None => schur_map(&rows.rows, &free, &q)?,
-                    },
-                    Some(lambda) => (
-                        penalty_map(&rows.rows, &free, &q, lambda)?,
-                        None,
-                        rows.rows.len(),
-                    ),
-                };
-                timings.factor = t2.elapsed().as_secs_f64();
-                (free, m, Some(q))
+                penalty: Some(_),
+                ..
             }
+        );
+        // The exact solves find the rank and the dependent rows only where it falls short;
+        // the penalty form never looks, so its rows are always examined.
+        let t_deps = Instant::now();
+        let dependencies = if rank < rows.rows.len() || !exact {
+            Dependencies::new(&rows.rows)
+        } else {
+            Dependencies::default()
         };
+        let rank = if exact {
+            rank
+        } else {
+            rows.rows.len() - dependencies.dependent_rows()
+        };
+        timings.factor += t_deps.elapsed().as_secs_f64();
         Ok(Editor {
             topology: topology.clone(),
             scheme: scheme.clone(),
@@ -236,13 +227,8 @@ impl Editor {
             free,
             map,
             pre,
-            exact: !matches!(
-                method,
-                Method::Energy {
-                    penalty: Some(_),
-                    ..
-                }
-            ),
+            exact,
+            dependencies,
             energy,
             timings,
         })
@@ -281,7 +267,9 @@ impl Editor {
         }
         let goals = ConstraintRows::new(&self.ev, &self.topology, &self.scheme, constraints)?;
         let r = goals.residual(&self.base);
-        Ok(self.apply(&r))
+        let mut edit = self.apply(&r);
+        edit.dependencies = self.dependencies.report(&self.rows.rows, &r, &self.base);
+        Ok(edit)
     }
 
     /// [`Editor::solve`] timed: the substitution's seconds go into [`Editor::timings`].
@@ -335,7 +323,11 @@ impl Editor {
                 moved.push(v);
             }
         }
-        Edit { positions, moved }
+        Edit {
+            positions,
+            moved,
+            dependencies: Vec::new(),
+        }
     }
 
     /// The changes of the free vertices' coordinates for right-hand side `r`.
@@ -372,6 +364,60 @@ impl Editor {
             _ => None,
         }
     }
+}
+
+/// The vertices that may move, the solution map and the energy matrix (energy method) for
+/// `method`, with the seconds of assembly and factorisation in `timings`.
+fn solution_map(
+    ev: &LimitEvaluator,
+    topology: &Topology,
+    scheme: &Scheme,
+    constraint_rows: &ConstraintRows,
+    method: Method,
+    timings: &mut Timings,
+) -> Result<(Vec<u32>, SolutionMap, Option<EnergyMatrix>), EditError> {
+    let support = constraint_rows.support();
+    let rows = &constraint_rows.rows;
+    let (penalty, region_rings, energy) = match method {
+        Method::LeastSquares => {
+            let t1 = Instant::now();
+            let m = min_norm_map(rows, &support)?;
+            timings.factor = t1.elapsed().as_secs_f64();
+            return Ok((support, m, None));
+        }
+        Method::Energy {
+            penalty,
+            region_rings,
+            energy,
+        } => (penalty, region_rings, energy),
+    };
+    if *scheme != Scheme::CatmullClark {
+        return Err(EditError::EnergyScheme);
+    }
+    let t1 = Instant::now();
+    let free = region(topology, &support, region_rings);
+    let faces = faces_touching(topology, &free);
+    let q = EnergyMatrix::new(ev, topology.num_vertices(), &faces, &energy)?;
+    timings.assemble = t1.elapsed().as_secs_f64();
+    let t2 = Instant::now();
+    // With vertices fixed around the region Q is definite and its Cholesky Schur complement
+    // is accurate and the faster; with every vertex free Q is singular up to the
+    // regularisation and the KKT system is solved instead.
+    let bounded = free.len() < topology.num_vertices();
+    let m = match penalty {
+        None if bounded => schur_map(rows, &free, &q)?,
+        None => match independent(rows, &support)
+            .then(|| kkt_map(rows, &free, &q))
+            .transpose()?
+            .flatten()
+        {
+            Some(map) => (map, None, rows.len()),
+            None => schur_map(rows, &free, &q)?,
+        },
+        Some(lambda) => (penalty_map(rows, &free, &q, lambda)?, None, rows.len()),
+    };
+    timings.factor = t2.elapsed().as_secs_f64();
+    Ok((free, m, Some(q)))
 }
 
 fn same_location(a: &Constraint, b: &Constraint) -> bool {
@@ -510,7 +556,7 @@ fn min_norm_map(rows: &[Row], free: &[u32]) -> Result<SolutionMap, EditError> {
         let mut t = Vec::new();
         for j in 0..c {
             for k in 0..c {
-                let d = row_dot(&rows[j], &rows[k]);
+                let d = rows[j].dot(&rows[k]);
                 if d != 0.0 {
                     t.push(Triplet::new(j, k, d));
                 }
@@ -539,26 +585,6 @@ fn min_norm_map(rows: &[Row], free: &[u32]) -> Result<SolutionMap, EditError> {
     let top = (0..s.nrows()).map(|i| s[i]).fold(0.0, f64::max);
     let rank = (0..s.nrows()).filter(|&i| s[i] > 1e-12 * top).count();
     Ok((svd.pseudoinverse(), None, rank))
-}
-
-fn row_dot(a: &Row, b: &Row) -> f64 {
-    let (mut i, mut j, mut s) = (0, 0, 0.0);
-    while i < a.entries.len() && j < b.entries.len() {
-        let (va, wa) = a.entries[i];
-        let (vb, wb) = b.entries[j];
-        match va.cmp(&vb) {
-            std::cmp::Ordering::Less => i += 1,
-            std::cmp::Ordering::Greater => j += 1,
-            std::cmp::Ordering::Equal => {
-                for c in 0..3 {
-                    s += a.coefficient(wa, c) * b.coefficient(wb, c);
-                }
-                i += 1;
-                j += 1;
-            }
-        }
-    }
-    s
 }
 
 /// `Q` restricted to the free vertices (scalar, per coordinate), with the regularising
