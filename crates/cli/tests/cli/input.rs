@@ -344,3 +344,34 @@ fn a_gltf_exported_with_split_seams_refines_to_a_closed_mesh() {
         "a sphere"
     );
 }
+
+/// A `.glb` that subd wrote from a mesh with UV seams reads back with no warning: welding
+/// only joins the copies the writer split at the seams.
+#[test]
+fn subds_own_glb_with_uv_seams_reads_back_without_warnings() {
+    let s = Scratch::new("glb-seams");
+    // A cube whose every face is a UV island of its own: twelve seam edges.
+    let cube = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n\
+        vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n\
+        f 1/1 4/2 3/3 2/4\nf 5/1 6/2 7/3 8/4\nf 1/1 2/2 6/3 5/4\n\
+        f 2/1 3/2 7/3 6/4\nf 3/1 4/2 8/3 7/4\nf 4/1 1/2 5/3 8/4\n";
+    let input = s.file("cube.obj", cube.as_bytes());
+    let glb = s.0.join("cube.glb");
+    let (code, _, err) = subd(&[
+        "refine",
+        "--scheme",
+        "catmull-clark",
+        "--levels",
+        "1",
+        input.to_str().unwrap(),
+        glb.to_str().unwrap(),
+    ]);
+    assert_eq!((code, err.as_str()), (0, ""));
+    let (code, out, err) = subd(&["info", glb.to_str().unwrap(), "--json"]);
+    assert_eq!((code, err.as_str()), (0, ""));
+    let report: serde_json::Value = serde_json::from_str(&out).unwrap();
+    // Closed again: the refined cube's 26 vertices, 24 quads fanned into 48 triangles.
+    assert_eq!(report["vertices"], 26);
+    assert_eq!(report["faces"], 48);
+    assert_eq!(report["boundary_edges"], 0);
+}
