@@ -497,3 +497,10 @@ pub fn creased_torus(m: u32, n: u32) -> (Topology, Vec<subd_mesh::DVec3>) {
         .collect();
     (t, positions)
 }
+
+/// The workspace README's "Use it as a library" examples, run as doctests here: this crate
+/// depends on every library crate they use and, unlike the published crates, sits beside
+/// the `examples/` meshes they read.
+#[cfg(doctest)]
+#[doc = include_str!("../../README.md")]
+struct WorkspaceReadmeDoctests;

@@ -186,7 +186,7 @@ where
             quiet: false,
             concurrent: 1,
         };
-        return one(&job, out, err);
+        return crate::refusal_alone(err, |err| one(&job, out, err));
     };
     if let Some(f) = files.format
         && !command.formats.contains(&f)
@@ -247,7 +247,10 @@ where
             let job = &jobs[outcome.index];
             bar.finished(outcome.index);
             bar.suspend(|| {
-                let _ = err.write_all(&outcome.stderr);
+                // A refused input's stderr (its reading warnings) gives way to the refusal.
+                if !matches!(&outcome.failure, Some(f) if f.code == EXIT_BAD_INPUT) {
+                    let _ = err.write_all(&outcome.stderr);
+                }
                 if let Some(f) = &outcome.failure {
                     let _ = writeln!(err, "subd: {}", f.message);
                 }

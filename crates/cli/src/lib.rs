@@ -126,6 +126,21 @@ pub(crate) fn print_warnings(err: &mut dyn Write, path: &std::path::Path, warnin
     }
 }
 
+/// Runs one input's work with its stderr held back: written out once the work is done, or
+/// dropped when the input is refused (exit 2), so that the refusal is its one line rather
+/// than the last of the warnings about the same problem gathered while reading it.
+pub(crate) fn refusal_alone(
+    err: &mut dyn Write,
+    work: impl FnOnce(&mut dyn Write) -> Result<(), Failure>,
+) -> Result<(), Failure> {
+    let mut held = Vec::new();
+    let result = work(&mut held);
+    if !matches!(&result, Err(f) if f.code == EXIT_BAD_INPUT) {
+        let _ = err.write_all(&held);
+    }
+    result
+}
+
 /// Runs `subd` with `args` (the first item is the program name). Returns the exit code.
 pub fn run<I, T>(args: I, out: &mut dyn Write, err: &mut dyn Write) -> i32
 where
@@ -149,18 +164,19 @@ where
             return code;
         }
     };
+    // The commands that take several inputs hold each one's stderr in `batch::run`.
     let result = match cli.command {
-        Command::Info(a) => info::run(&a, out, err),
+        Command::Info(a) => refusal_alone(err, |err| info::run(&a, out, err)),
         Command::Refine(a) => refine::run(&a, out, err),
         Command::Limit(a) => limit::run(&a, out, err),
-        Command::Eval(a) => eval::run(&a, out, err),
-        Command::Tessellate(a) => tessellate::run(&a, out, err),
+        Command::Eval(a) => refusal_alone(err, |err| eval::run(&a, out, err)),
+        Command::Tessellate(a) => refusal_alone(err, |err| tessellate::run(&a, out, err)),
         Command::Pia(a) => pia::run(&a, out, err),
         Command::Adaptive(a) => adaptive::run(&a, out, err),
         Command::Edit(a) => edit::run(&a, out, err),
         Command::Deform(a) => edit::run_deform(&a, out, err),
-        Command::Render(a) => render::run(&a, out, err),
-        Command::Curve(a) => curve::run(&a, out, err),
+        Command::Render(a) => refusal_alone(err, |err| render::run(&a, out, err)),
+        Command::Curve(a) => refusal_alone(err, |err| curve::run(&a, out, err)),
         Command::Analyze(a) => analyze::run(&a, out),
     };
     match result {
@@ -175,9 +191,3 @@ where
 #[cfg(doctest)]
 #[doc = include_str!("../README.md")]
 struct ReadmeDoctests;
-
-/// The workspace README's "Use it as a library" examples (this crate depends on every
-/// library crate they use).
-#[cfg(doctest)]
-#[doc = include_str!("../../../README.md")]
-struct WorkspaceReadmeDoctests;

@@ -63,6 +63,10 @@ pub use energy::{EnergyMatrix, EnergyOptions};
 pub use isoline::{Axis, Isoline};
 pub use solve::{Edit, Editor, Method, Timings};
 
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;
+
 use thiserror::Error;
 
 /// What can go wrong.

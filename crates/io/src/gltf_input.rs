@@ -13,11 +13,20 @@
 //! keeps its glTF vertex's value (v flipped back to OBJ's bottom-left origin), so vertices
 //! welded across a UV seam keep the seam as a face-varying discontinuity. Other sets are
 //! dropped with a warning, and so is `TEXCOORD_0` unless every primitive has it.
+//!
+//! Welding warns only when it joins vertices that are not copies of one vertex split at a
+//! seam. Seam copies, as subd's own `.glb` writer makes them, share their position and their
+//! `NORMAL` and differ in `TEXCOORD_0` only (or not even there: values of two UV islands
+//! may coincide), so glTF vertices at one position with the same normal are taken as one
+//! vertex. Vertices with different normals (a hard edge, a face's own corners, two surfaces
+//! meeting at an angle) or without normals were distinct, or cannot be told apart from
+//! distinct ones; welding them is reported. Coincident distinct vertices with equal normals
+//! (a crack in a flat region) look exactly like seam copies and are welded silently.
 
 use std::collections::HashMap;
 use std::path::Path;
 
-use glam::DMat4;
+use glam::{DMat3, DMat4};
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::Mode;
 use subd_mesh::fvar::FVarChannel;
@@ -181,6 +190,10 @@ struct TriangleSoup {
     missing_uv: bool,
     /// Texture coordinate sets beyond the first, which are not read.
     dropped_uv_sets: usize,
+    /// Each glTF vertex's `NORMAL` in world space as bits (`None` where its primitive has
+    /// none), parallel to `positions`: compared only, to tell seam copies from distinct
+    /// vertices when welding ([`distinct_merged`]).
+    normals: Vec<Option<[u64; 3]>>,
 }
 
 impl TriangleSoup {
@@ -244,6 +257,7 @@ impl TriangleSoup {
             let count = self.positions.len() - first as usize;
             self.read_texcoords(&primitive, &reader, count, buffers)
                 .map_err(|m| at(&m))?;
+            self.read_normals(&primitive, &reader, count, transform, buffers);
             let indices: Vec<u32> = match reader.read_indices() {
                 Some(i) => i.into_u32().collect(),
                 None => (0..count as u32).collect(),
@@ -307,6 +321,36 @@ impl TriangleSoup {
         Ok(())
     }
 
+    /// Appends the primitive's `NORMAL`s (`count` vertices) moved into world space by
+    /// `transform`'s inverse transpose, as bits with −0 made +0. A primitive without a
+    /// readable `NORMAL` accessor gives `None`s: normals are dropped from the mesh anyway,
+    /// so an unusable accessor is no reason to refuse the file.
+    fn read_normals<'a, 's, F>(
+        &mut self,
+        primitive: &gltf::Primitive<'a>,
+        reader: &gltf::mesh::Reader<'a, 's, F>,
+        count: usize,
+        transform: DMat4,
+        buffers: &[Vec<u8>],
+    ) where
+        F: Clone + Fn(gltf::Buffer<'a>) -> Option<&'s [u8]>,
+    {
+        let usable = primitive.get(&gltf::Semantic::Normals).is_some_and(|a| {
+            a.count() == count
+                && check_accessor(&a, &[DataType::F32], Dimensions::Vec3, buffers).is_ok()
+        });
+        let start = self.normals.len();
+        if usable && let Some(normals) = reader.read_normals() {
+            let to_world = DMat3::from_mat4(transform).inverse().transpose();
+            self.normals.extend(normals.map(|n| {
+                let n = to_world * DVec3::new(n[0].into(), n[1].into(), n[2].into());
+                Some((n + DVec3::ZERO).to_array().map(f64::to_bits))
+            }));
+        }
+        // A primitive whose normals were not read has none.
+        self.normals.resize(start + count, None);
+    }
+
     fn into_mesh_file(mut self, options: &ReadOptions) -> Result<MeshFile, ReadError> {
         let read = self.positions.len();
         let (remap, positions) = weld(&self.positions, options.weld_tolerance.unwrap_or(0.0));
@@ -324,9 +368,11 @@ impl TriangleSoup {
             face_vertices.extend([a, b, c]);
             uv_indices.extend(t);
         }
-        if read != positions.len() {
+        let distinct = distinct_merged(&remap, positions.len(), &self.normals);
+        if distinct > 0 {
             self.warnings.push(format!(
-                "{read} glTF vertices welded by position into {}",
+                "{read} glTF vertices welded by position into {}, {distinct} of them into a \
+                 vertex they were distinct from (another normal, or none to tell)",
                 positions.len()
             ));
         }
@@ -474,6 +520,32 @@ fn corners(mode: Mode, indices: &[u32]) -> Vec<[u32; 3]> {
     }
 }
 
+/// How many glTF vertices welding merged into a vertex they were distinct from, rather
+/// than into a copy of themselves split at a seam.
+///
+/// `remap` gives each glTF vertex its welded vertex (`kept` of them) and `normals` its
+/// normal's bits. Within one welded vertex, the glTF vertices with one normal are the seam
+/// copies of one vertex (a writer splitting at UV seams copies the normal with the
+/// position); each further normal is a further vertex, and so is every glTF vertex without
+/// a normal, since nothing tells what it was split from.
+fn distinct_merged(remap: &[u32], kept: usize, normals: &[Option<[u64; 3]>]) -> usize {
+    if remap.len() == kept {
+        return 0;
+    }
+    let mut vertices = std::collections::HashSet::new();
+    let mut without_normal = 0;
+    for (&w, normal) in remap.iter().zip(normals) {
+        match normal {
+            Some(n) => {
+                vertices.insert((w, *n));
+            }
+            None => without_normal += 1,
+        }
+    }
+    // Every welded vertex has at least one glTF vertex: at least `kept` distinct ones.
+    vertices.len() + without_normal - kept
+}
+
 /// Merges vertices at the same position (`tolerance` 0: bit-equal coordinates, with −0 and
 /// +0 equal) or within `tolerance` of an earlier kept vertex. Returns each input vertex's
 /// new index and the kept positions, in first-seen order.
@@ -553,6 +625,18 @@ mod tests {
         let (remap, kept) = weld(&p, 1e-3);
         assert_eq!(remap, vec![0, 0, 1, 0]);
         assert_eq!(kept, vec![p[0], p[2]]);
+    }
+
+    #[test]
+    fn seam_copies_are_not_counted_as_distinct_vertices() {
+        let (n, m) = (Some([1, 2, 3]), Some([4, 5, 6]));
+        // Welded vertex 0: three seam copies (one normal). Welded vertex 1: two normals.
+        // Welded vertex 2: two glTF vertices without normals.
+        let remap = [0, 0, 0, 1, 1, 2, 2];
+        let normals = [n, n, n, n, m, None, None];
+        assert_eq!(distinct_merged(&remap, 3, &normals), 2);
+        // Nothing merged.
+        assert_eq!(distinct_merged(&[0, 1], 2, &[None, None]), 0);
     }
 
     #[test]

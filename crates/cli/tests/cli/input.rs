@@ -344,3 +344,107 @@ fn a_gltf_exported_with_split_seams_refines_to_a_closed_mesh() {
         "a sphere"
     );
 }
+
+/// A `.glb` that subd wrote from a mesh with UV seams reads back with no warning: welding
+/// only joins the copies the writer split at the seams.
+#[test]
+fn subds_own_glb_with_uv_seams_reads_back_without_warnings() {
+    let s = Scratch::new("glb-seams");
+    // A cube whose every face is a UV island of its own: twelve seam edges.
+    let cube = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n\
+        vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n\
+        f 1/1 4/2 3/3 2/4\nf 5/1 6/2 7/3 8/4\nf 1/1 2/2 6/3 5/4\n\
+        f 2/1 3/2 7/3 6/4\nf 3/1 4/2 8/3 7/4\nf 4/1 1/2 5/3 8/4\n";
+    let input = s.file("cube.obj", cube.as_bytes());
+    let glb = s.0.join("cube.glb");
+    let (code, _, err) = subd(&[
+        "refine",
+        "--scheme",
+        "catmull-clark",
+        "--levels",
+        "1",
+        input.to_str().unwrap(),
+        glb.to_str().unwrap(),
+    ]);
+    assert_eq!((code, err.as_str()), (0, ""));
+    let (code, out, err) = subd(&["info", glb.to_str().unwrap(), "--json"]);
+    assert_eq!((code, err.as_str()), (0, ""));
+    let report: serde_json::Value = serde_json::from_str(&out).unwrap();
+    // Closed again: the refined cube's 26 vertices, 24 quads fanned into 48 triangles.
+    assert_eq!(report["vertices"], 26);
+    assert_eq!(report["faces"], 48);
+    assert_eq!(report["boundary_edges"], 0);
+}
+
+/// An input refused for inconsistent orientation prints its refusal alone: one line, exit 2,
+/// without the "treated as non-manifold" warnings read before it, whether the reader
+/// refuses it or (accepted with the flag) the scheme does; in batch mode too, where the
+/// other inputs keep their warnings. An input that is not refused keeps its warnings.
+#[test]
+fn a_refused_input_prints_the_refusal_alone() {
+    let s = Scratch::new("refusal-alone");
+    let vertices = "v 0 0 1\nv 1 0 0\nv 0 1 0\nv -1 0 0\nv 0 -1 0\nv 0 0 -1\n";
+    // An octahedron with two faces turned over: six edges used twice the same way.
+    let flipped = format!(
+        "{vertices}f 1 3 2\nf 1 3 4\nf 1 4 5\nf 1 5 2\nf 6 3 2\nf 6 3 4\nf 6 5 4\nf 6 2 5\n"
+    );
+    // The octahedron as it should be, with a line the reader warns about.
+    let warned = format!(
+        "{vertices}f 1 2 3\nf 1 3 4\nf 1 4 5\nf 1 5 2\nf 6 3 2\nf 6 4 3\nf 6 5 4\nf 6 2 5\nfrob 1\n"
+    );
+    let input = s.file("flipped.obj", flipped.as_bytes());
+    let good = s.file("warned.obj", warned.as_bytes());
+    let output = s.0.join("out.obj");
+    let (input, output) = (input.to_str().unwrap(), output.to_str().unwrap());
+    let refine = |scheme: &str, accept: bool| {
+        let mut args = vec!["refine", "--scheme", scheme, "--levels", "1"];
+        if accept {
+            args.push("--accept-inconsistent-orientation");
+        }
+        subd(&[&args[..], &[input, output]].concat())
+    };
+    for (scheme, accept, expect) in [
+        (
+            "loop",
+            false,
+            "in the same direction (inconsistent orientation)",
+        ),
+        (
+            "sqrt3",
+            true,
+            "is non-manifold; the sqrt3 scheme needs a manifold mesh",
+        ),
+    ] {
+        let (code, _, err) = refine(scheme, accept);
+        assert_eq!(code, 2, "{scheme}: {err}");
+        assert_eq!(err.lines().count(), 1, "{scheme}: {err}");
+        assert!(err.starts_with(&format!("subd: {input}")), "{err}");
+        assert!(err.contains(expect), "{scheme}: {err}");
+    }
+    // Accepted by a scheme that takes non-manifold edges, the warnings are printed.
+    let (code, _, err) = refine("loop", true);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(err.matches("treated as non-manifold").count(), 6, "{err}");
+    // In batch mode the refused input's refusal stands alone; the other input warns.
+    let dir = s.0.join("batch");
+    let (code, _, err) = subd(&[
+        "refine",
+        "--scheme",
+        "sqrt3",
+        "--levels",
+        "1",
+        "--accept-inconsistent-orientation",
+        "--out-dir",
+        dir.to_str().unwrap(),
+        input,
+        good.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(!err.contains("treated as non-manifold"), "{err}");
+    assert_eq!(err.matches("needs a manifold mesh").count(), 1, "{err}");
+    assert!(
+        err.contains("unknown OBJ statement \"frob\" ignored"),
+        "{err}"
+    );
+    assert!(dir.join("warned.obj").exists());
+}

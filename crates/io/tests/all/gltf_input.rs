@@ -352,3 +352,58 @@ fn a_gltf_with_an_external_buffer_reads_it_beside_the_document() {
     assert!(e.to_string().contains("cube data.bin"), "{e}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A unit cube whose six faces are UV islands of their own (the unit square), as an OBJ
+/// with `vt` lines: all twelve edges are UV seams.
+const SEAMED_CUBE_OBJ: &str = "\
+v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n\
+vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n\
+f 1/1 4/2 3/3 2/4\nf 5/1 6/2 7/3 8/4\nf 1/1 2/2 6/3 5/4\n\
+f 2/1 3/2 7/3 6/4\nf 3/1 4/2 8/3 7/4\nf 4/1 1/2 5/3 8/4\n";
+
+/// `obj` read, written as `.glb` by subd, and read back.
+fn through_glb(obj: &str) -> subd_io::MeshFile {
+    use subd_io::{WriteOptions, encode_mesh};
+    let file = parse_mesh(obj.as_bytes(), Format::Obj, &ReadOptions::default()).unwrap();
+    let mut glb = Vec::new();
+    encode_mesh(&mut glb, &file.mesh, Format::Glb, &WriteOptions::default()).unwrap();
+    parse_mesh(&glb, Format::Glb, &ReadOptions::default()).unwrap()
+}
+
+#[test]
+fn subds_own_seam_split_glb_welds_back_without_a_warning() {
+    let back = through_glb(SEAMED_CUBE_OBJ);
+    assert!(back.warnings.is_empty(), "{:?}", back.warnings);
+    // The writer split the 8 corners at the seams; welding restored them, seams kept.
+    let topo = &back.mesh.topology;
+    assert_eq!((topo.num_vertices(), topo.num_faces()), (8, 12));
+    assert!((0..topo.num_edges()).all(|e| topo.edge_faces(e).len() == 2));
+    let uv = back.mesh.uv().expect("TEXCOORD_0 read back");
+    let seams = subd_mesh::fvar::FVarSeams::of(topo, uv);
+    assert_eq!(seams.num_seam_edges(), 12);
+}
+
+#[test]
+fn welding_coincident_distinct_vertices_still_warns() {
+    // An L of unit squares: the first flat, the second and third standing on its edge
+    // x = 1. The second has its own copies (vertices 7 and 8) of the corners it shares
+    // with the first, whose normals differ from theirs (an edge, not a seam), which the
+    // writer keeps as distinct glTF vertices. The third shares vertices 5 and 6 with the
+    // second but maps them elsewhere: a real UV seam, split by the writer.
+    let obj = "\
+v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 1 0 1\nv 1 1 1\nv 1 0 0\nv 1 1 0\nv 1 0 2\nv 1 1 2\n\
+vt 0 0\nvt 0.5 0\nvt 0.5 1\nvt 0 1\nvt 1 0\nvt 1 1\n\
+f 1/1 2/2 3/3 4/4\nf 8/3 7/2 5/5 6/6\nf 6/4 5/1 9/2 10/3\n";
+    let back = through_glb(obj);
+    // 12 glTF vertices (the 10 and the seam copies of 5 and 6) weld into 8; of the four
+    // merges only the two along the fold joined distinct vertices (six triangles, 13 edges).
+    let topo = &back.mesh.topology;
+    assert_eq!((topo.num_vertices(), topo.num_edges()), (8, 13));
+    assert_eq!(
+        back.warnings,
+        [
+            "12 glTF vertices welded by position into 8, 2 of them into a vertex they were \
+          distinct from (another normal, or none to tell)"
+        ]
+    );
+}
