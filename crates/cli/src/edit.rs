@@ -16,7 +16,7 @@ use subd_mesh::{DVec3, Mesh};
 use subd_schemes::Scheme;
 
 use crate::batch::{self, Files, Job};
-use crate::failure::{bad, refuse_overwrite};
+use crate::failure::bad;
 use crate::rule_args::RuleArgs;
 use crate::scheme_arg;
 use crate::{Failure, print_warnings};
@@ -225,16 +225,6 @@ fn region_rings(text: &str) -> Result<Option<usize>, Failure> {
     })
 }
 
-fn check_output_format(output: &Path) -> Result<(), Failure> {
-    if subd_io::Format::for_output(output).is_none() {
-        return Err(bad(format!(
-            "{}: unsupported output extension (expected .obj, .ply or .glb)",
-            output.display()
-        )));
-    }
-    Ok(())
-}
-
 /// The method the arguments ask for.
 fn method(args: &EditArgs) -> Result<Method, Failure> {
     let energy_only = args.penalty.is_some() || args.exact || args.membrane != 0.0;
@@ -276,19 +266,22 @@ pub(crate) fn run(
     out: &mut dyn Write,
     err: &mut dyn Write,
 ) -> Result<(), Failure> {
-    let command = batch::Command {
-        name: "edit",
-        formats: batch::MESH_OUTPUTS,
-    };
-    batch::run(
-        &args.files,
-        &command,
-        args.json,
-        out,
-        err,
-        |job, out, err| run_one(args, job, out, err),
-    )
+    EDIT.run(&args.files, args.json, out, err, |job, out, err| {
+        run_one(args, job, out, err)
+    })
 }
+
+/// `subd edit` writes meshes.
+const EDIT: batch::Command = batch::Command {
+    name: "edit",
+    formats: batch::MESH_OUTPUTS,
+};
+
+/// `subd deform` writes meshes.
+const DEFORM: batch::Command = batch::Command {
+    name: "deform",
+    formats: batch::MESH_OUTPUTS,
+};
 
 /// The constraints of `path`, at least one.
 fn read_constraints(path: &Path) -> Result<Vec<Constraint>, Failure> {
@@ -384,14 +377,11 @@ fn run_one(
     out: &mut dyn Write,
     err: &mut dyn Write,
 ) -> Result<(), Failure> {
-    let t_start = Instant::now();
-    refuse_overwrite(&job.input, &job.output)?;
-    check_output_format(&job.output)?;
+    let started = EDIT.start(&job.input, &job.output)?;
     let method = method(args)?;
     let constraints = read_constraints(&args.constraints)?;
-    let file = subd_io::read_mesh(&job.input, &args.rules.read_options())?;
-    print_warnings(err, &job.input, &file.warnings);
-    let t_read = t_start.elapsed().as_secs_f64();
+    let opened = started.read(&args.rules, err)?;
+    let (file, t_read) = (&opened.file, opened.read_seconds);
     let scheme = args.scheme.clone();
     let options = args.rules.options(&file.mesh.hints);
     let topo = &file.mesh.topology;
@@ -465,7 +455,7 @@ fn run_one(
                 solve: t.solve,
                 check: t_check,
                 write: t_write,
-                total: t_start.elapsed().as_secs_f64(),
+                total: opened.elapsed(),
             },
         };
         crate::print_json(out, &report);
@@ -502,18 +492,9 @@ pub(crate) fn run_deform(
     out: &mut dyn Write,
     err: &mut dyn Write,
 ) -> Result<(), Failure> {
-    let command = batch::Command {
-        name: "deform",
-        formats: batch::MESH_OUTPUTS,
-    };
-    batch::run(
-        &args.files,
-        &command,
-        args.json,
-        out,
-        err,
-        |job, out, err| run_deform_one(args, job, out, err),
-    )
+    DEFORM.run(&args.files, args.json, out, err, |job, out, err| {
+        run_deform_one(args, job, out, err)
+    })
 }
 
 fn run_deform_one(
@@ -522,16 +503,14 @@ fn run_deform_one(
     out: &mut dyn Write,
     err: &mut dyn Write,
 ) -> Result<(), Failure> {
-    let t0 = Instant::now();
-    refuse_overwrite(&job.input, &job.output)?;
-    check_output_format(&job.output)?;
+    let started = DEFORM.start(&job.input, &job.output)?;
     let cs = subd_editing::spec::parse_deformation(&read_text(&args.constraints)?)
         .map_err(|e| bad(format!("{}: {e}", args.constraints.display())))?;
     let d =
         Deformation::new(&cs).map_err(|e| bad(format!("{}: {e}", args.constraints.display())))?;
-    let file = subd_io::read_mesh(&job.input, &subd_io::ReadOptions::default())?;
-    print_warnings(err, &job.input, &file.warnings);
-    let mut mesh = file.mesh;
+    let opened = started.read_with(&subd_io::ReadOptions::default(), err)?;
+    let started = opened.started;
+    let mut mesh = opened.file.mesh;
     let moved = d.apply(&mut mesh.positions);
     let max_err = cs
         .iter()
@@ -551,7 +530,7 @@ fn run_deform_one(
                 constraints: cs.len(),
                 moved,
                 max_constraint_error: max_err,
-                seconds: t0.elapsed().as_secs_f64(),
+                seconds: started.elapsed().as_secs_f64(),
             },
         );
     }

@@ -81,7 +81,16 @@ pub(crate) struct Opened {
 impl Started {
     /// Reads the input with the rule arguments' read options and prints its warnings.
     pub(crate) fn read(self, rules: &RuleArgs, err: &mut dyn Write) -> Result<Opened, Failure> {
-        let file = subd_io::read_mesh(&self.input, &rules.read_options())?;
+        self.read_with(&rules.read_options(), err)
+    }
+
+    /// Reads the input with `options` and prints its warnings.
+    pub(crate) fn read_with(
+        self,
+        options: &subd_io::ReadOptions,
+        err: &mut dyn Write,
+    ) -> Result<Opened, Failure> {
+        let file = subd_io::read_mesh(&self.input, options)?;
         print_warnings(err, &self.input, &file.warnings);
         Ok(Opened {
             printed: file.warnings.len(),

@@ -30,6 +30,7 @@ use faer::{Mat, Side};
 use glam::DVec3;
 use subd_limit::eval::LimitEvaluator;
 use subd_mesh::Topology;
+use subd_mesh::neighbourhood;
 use subd_schemes::{Options, Scheme};
 
 use crate::EditError;
@@ -437,50 +438,22 @@ fn same_location(a: &Constraint, b: &Constraint) -> bool {
     }
 }
 
-/// Vertices within `rings` vertex-rings (through faces) of `seed` (`None`: all).
+/// Vertices within `rings` vertex-rings (through faces) of `seed` (`None`: all), ascending
+/// ([`subd_mesh::neighbourhood::vertices_within_rings`]).
 pub fn region(topology: &Topology, seed: &[u32], rings: Option<usize>) -> Vec<u32> {
-    let Some(rings) = rings else {
-        return (0..topology.num_vertices() as u32).collect();
-    };
-    let mut inside = vec![false; topology.num_vertices()];
-    let mut frontier: Vec<u32> = seed.to_vec();
-    for &v in seed {
-        inside[v as usize] = true;
+    match rings {
+        Some(rings) => neighbourhood::vertices_within_rings(topology, seed, rings),
+        None => (0..topology.num_vertices() as u32).collect(),
     }
-    for _ in 0..rings {
-        let mut next = Vec::new();
-        for &v in &frontier {
-            for &f in topology.vertex_faces(v as usize) {
-                for &w in topology.face_vertices(f as usize) {
-                    if !inside[w as usize] {
-                        inside[w as usize] = true;
-                        next.push(w);
-                    }
-                }
-            }
-        }
-        frontier = next;
-    }
-    (0..topology.num_vertices() as u32)
-        .filter(|&v| inside[v as usize])
-        .collect()
 }
 
 /// Faces with a vertex in `vertices` (ascending): the faces an edit of those vertices
-/// can change.
+/// can change ([`subd_mesh::neighbourhood::faces_touching`]).
 pub fn faces_touching(topology: &Topology, vertices: &[u32]) -> Vec<usize> {
-    let mut f: Vec<usize> = vertices
-        .iter()
-        .flat_map(|&v| {
-            topology
-                .vertex_faces(v as usize)
-                .iter()
-                .map(|&f| f as usize)
-        })
-        .collect();
-    f.sort_unstable();
-    f.dedup();
-    f
+    neighbourhood::faces_touching(topology, vertices)
+        .into_iter()
+        .map(|f| f as usize)
+        .collect()
 }
 
 /// The non-zero coefficients of row `r` as (unknown `3 i + coordinate`, coefficient),
