@@ -173,21 +173,55 @@ where
     F: Fn(&Job, &mut dyn Write, &mut dyn Write) -> Result<(), Failure> + Sync,
 {
     let Some(dir) = &files.out_dir else {
-        let [input, output] = &files.paths[..] else {
-            return Err(bad(format!(
-                "{}: expected IN OUT, or inputs with --out-dir DIR ({} paths given)",
-                command.name,
-                files.paths.len()
-            )));
-        };
-        let job = Job {
-            input: input.clone(),
-            output: output.clone(),
-            quiet: false,
-            concurrent: 1,
-        };
-        return crate::refusal_alone(err, |err| one(&job, out, err));
+        return run_single(files, command, out, err, &one);
     };
+    let jobs = prepare(files, dir, command)?;
+    let t0 = Instant::now();
+    let bar = FilesBar::new(&jobs, json);
+    let mut report = Report {
+        jobs: &jobs,
+        json,
+        out,
+        err,
+        bar: &bar,
+        failed: 0,
+    };
+    run_jobs(&jobs, &one, &bar, |outcome| report.outcome(outcome));
+    bar.finish();
+    let failed = report.failed;
+    summarize(command, jobs.len(), failed, t0, json, out, err)
+}
+
+/// The single `IN OUT` form: one job, its stderr held until it ends (a refusal alone).
+fn run_single<F>(
+    files: &Files,
+    command: &Command,
+    out: &mut dyn Write,
+    err: &mut dyn Write,
+    one: &F,
+) -> Result<(), Failure>
+where
+    F: Fn(&Job, &mut dyn Write, &mut dyn Write) -> Result<(), Failure> + Sync,
+{
+    let [input, output] = &files.paths[..] else {
+        return Err(bad(format!(
+            "{}: expected IN OUT, or inputs with --out-dir DIR ({} paths given)",
+            command.name,
+            files.paths.len()
+        )));
+    };
+    let job = Job {
+        input: input.clone(),
+        output: output.clone(),
+        quiet: false,
+        concurrent: 1,
+    };
+    crate::refusal_alone(err, |err| one(&job, out, err))
+}
+
+/// The jobs of a batch into `dir`, after the format check, each knowing how many run at
+/// once; the directory created.
+fn prepare(files: &Files, dir: &Path, command: &Command) -> Result<Vec<Job>, Failure> {
     if let Some(f) = files.format
         && !command.formats.contains(&f)
     {
@@ -212,16 +246,22 @@ where
     for job in &mut jobs {
         job.concurrent = workers;
     }
+    Ok(jobs)
+}
 
-    let t0 = Instant::now();
-    let bar = FilesBar::new(&jobs, json);
+/// Runs the jobs on their workers, each job's streams captured, and hands each outcome to
+/// `done` on this thread as it completes.
+fn run_jobs<F>(jobs: &[Job], one: &F, bar: &FilesBar, mut done: impl FnMut(Outcome))
+where
+    F: Fn(&Job, &mut dyn Write, &mut dyn Write) -> Result<(), Failure> + Sync,
+{
+    let workers = jobs.first().map_or(1, |j| j.concurrent);
     let next = AtomicUsize::new(0);
     let (tx, rx) = mpsc::channel::<Outcome>();
-    let mut failed = 0;
     std::thread::scope(|scope| {
         for _ in 0..workers {
             let tx = tx.clone();
-            let (jobs, next, one, bar) = (&jobs, &next, &one, &bar);
+            let next = &next;
             scope.spawn(move || {
                 loop {
                     let index = next.fetch_add(1, Ordering::Relaxed);
@@ -242,47 +282,77 @@ where
             });
         }
         drop(tx);
-        // Streams are written here only, whole file at a time, so lines never interleave.
         for outcome in rx {
-            let job = &jobs[outcome.index];
-            bar.finished(outcome.index);
-            bar.suspend(|| {
-                // A refused input's stderr (its reading warnings) gives way to the refusal.
-                if !matches!(&outcome.failure, Some(f) if f.code == EXIT_BAD_INPUT) {
-                    let _ = err.write_all(&outcome.stderr);
-                }
-                if let Some(f) = &outcome.failure {
-                    let _ = writeln!(err, "subd: {}", f.message);
-                }
-            });
-            if json && jobs.len() > 1 {
-                let _ = out.write_all(&with_index(&outcome.stdout, outcome.index));
-            } else {
-                let _ = out.write_all(&outcome.stdout);
-            }
-            if let Some(f) = outcome.failure {
-                failed += 1;
-                if json {
-                    crate::print_json(
-                        out,
-                        &FileError {
-                            index: (jobs.len() > 1).then_some(outcome.index),
-                            input: job.input.display().to_string(),
-                            output: job.output.display().to_string(),
-                            error: &f.message,
-                            code: f.code,
-                        },
-                    );
-                }
-            }
+            done(outcome);
         }
     });
-    bar.finish();
+}
 
+/// Writes the batch's outcomes as they come: streams are written here only, a whole file
+/// at a time, so lines never interleave.
+struct Report<'a> {
+    jobs: &'a [Job],
+    json: bool,
+    out: &'a mut dyn Write,
+    err: &'a mut dyn Write,
+    bar: &'a FilesBar,
+    failed: usize,
+}
+
+impl Report<'_> {
+    fn outcome(&mut self, outcome: Outcome) {
+        let job = &self.jobs[outcome.index];
+        let many = self.jobs.len() > 1;
+        self.bar.finished(outcome.index);
+        let err = &mut *self.err;
+        self.bar.suspend(|| {
+            // A refused input's stderr (its reading warnings) gives way to the refusal.
+            if !matches!(&outcome.failure, Some(f) if f.code == EXIT_BAD_INPUT) {
+                let _ = err.write_all(&outcome.stderr);
+            }
+            if let Some(f) = &outcome.failure {
+                let _ = writeln!(err, "subd: {}", f.message);
+            }
+        });
+        if self.json && many {
+            let _ = self
+                .out
+                .write_all(&with_index(&outcome.stdout, outcome.index));
+        } else {
+            let _ = self.out.write_all(&outcome.stdout);
+        }
+        if let Some(f) = outcome.failure {
+            self.failed += 1;
+            if self.json {
+                crate::print_json(
+                    self.out,
+                    &FileError {
+                        index: many.then_some(outcome.index),
+                        input: job.input.display().to_string(),
+                        output: job.output.display().to_string(),
+                        error: &f.message,
+                        code: f.code,
+                    },
+                );
+            }
+        }
+    }
+}
+
+/// The summary line (and JSON line); a failure if any file failed.
+fn summarize(
+    command: &Command,
+    files: usize,
+    failed: usize,
+    t0: Instant,
+    json: bool,
+    out: &mut dyn Write,
+    err: &mut dyn Write,
+) -> Result<(), Failure> {
     let summary = Summary {
         command: command.name,
-        files: jobs.len(),
-        succeeded: jobs.len() - failed,
+        files,
+        succeeded: files - failed,
         failed,
         seconds: t0.elapsed().as_secs_f64(),
     };

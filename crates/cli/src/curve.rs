@@ -195,6 +195,57 @@ pub(crate) fn run(
     err: &mut dyn Write,
 ) -> Result<(), Failure> {
     let t0 = Instant::now();
+    let ext = check_arguments(args)?;
+    let name = args.scheme.name();
+    let file = read_points(&args.input)?;
+    let (points, normals, normals_estimated) = match args.scheme {
+        CurveSchemeArg::CircleFourPoint | CurveSchemeArg::CircleTernary => {
+            let (points, normals, estimated) = subdivide_circle_average(args, &file, err)?;
+            (points, Some(normals), estimated)
+        }
+        _ => {
+            let points = linear_scheme(args)
+                .subdivide(&file.points, args.closed, args.levels)
+                .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
+            (points, None, false)
+        }
+    };
+    let body = if ext == "svg" {
+        svg(
+            &file.points,
+            &points,
+            normals.as_deref(),
+            args.closed,
+            name,
+            args.levels,
+        )
+    } else {
+        let sep = if ext == "csv" { "," } else { " " };
+        text(&points, normals.as_deref(), file.columns == 3, sep)
+    };
+    subd_io::atomic_write(&args.output, |w| w.write_all(body.as_bytes()))?;
+    if args.json {
+        crate::print_json(
+            out,
+            &CurveReport {
+                input: args.input.display().to_string(),
+                output: args.output.display().to_string(),
+                scheme: name,
+                levels: args.levels,
+                closed: args.closed,
+                input_points: file.points.len(),
+                output_points: points.len(),
+                normals_estimated,
+                seconds: t0.elapsed().as_secs_f64(),
+            },
+        );
+    }
+    Ok(())
+}
+
+/// Checks the output (not the input; `.txt`, `.csv` or `.svg`, returned in lower case) and
+/// refuses parameters the scheme does not take, rather than ignoring them.
+fn check_arguments(args: &CurveArgs) -> Result<String, Failure> {
     refuse_overwrite(&args.input, &args.output)?;
     let ext = args
         .output
@@ -209,8 +260,6 @@ pub(crate) fn run(
         )));
     }
     let scheme = args.scheme;
-    let name = scheme.name();
-    // Parameters a scheme does not take are refused, not ignored.
     let takes = |flag: &str| match flag {
         "omega" => matches!(
             scheme,
@@ -234,130 +283,115 @@ pub(crate) fn run(
         ("alpha0", args.alpha0.is_some()),
     ] {
         if given && !takes(flag) {
-            return Err(bad(format!("--{flag} does not apply to --scheme {name}")));
+            return Err(bad(format!(
+                "--{flag} does not apply to --scheme {}",
+                scheme.name()
+            )));
         }
     }
-    let file = read_points(&args.input)?;
-    let omega = args.omega.unwrap_or(
+    Ok(ext)
+}
+
+/// `--omega`, or the scheme's default: 1/4 for the ternary schemes, 1/16 for the rest.
+fn omega(args: &CurveArgs) -> f64 {
+    args.omega.unwrap_or(
         if matches!(
-            scheme,
+            args.scheme,
             CurveSchemeArg::Ternary3pt | CurveSchemeArg::CircleTernary
         ) {
             0.25
         } else {
             1.0 / 16.0
         },
-    );
-    let mu = args.mu.unwrap_or(0.0);
-    let at_input =
-        |e: subd_schemes::curve::CurveError| bad(format!("{}: {e}", args.input.display()));
-    let mut normals_estimated = false;
-    let (points, normals): (Vec<DVec3>, Option<Vec<DVec2>>) = match scheme {
-        CurveSchemeArg::CircleFourPoint | CurveSchemeArg::CircleTernary => {
-            if file.columns == 3 {
-                return Err(bad(format!(
-                    "{}: the circle-average schemes work on planar points (`x y` or `x y nx ny`), not `x y z`",
-                    args.input.display()
-                )));
-            }
-            let normals = match &file.normals {
-                Some(n) => n.clone(),
-                None => {
-                    normals_estimated = true;
-                    let _ = writeln!(
-                        err,
-                        "subd: warning: {}: no normals given; estimated from the polygon",
-                        args.input.display()
-                    );
-                    estimate_normals(&file.points, args.closed)
-                }
-            };
-            let pn: Vec<PointNormal> = file
-                .points
-                .iter()
-                .zip(&normals)
-                .map(|(p, n)| PointNormal {
-                    p: p.truncate(),
-                    n: *n,
-                })
-                .collect();
-            let cs = if scheme == CurveSchemeArg::CircleFourPoint {
-                CircleScheme::FourPoint { omega, mu }
-            } else {
-                CircleScheme::Ternary { omega }
-            };
-            let r = cs
-                .subdivide(&pn, args.closed, args.levels)
-                .map_err(at_input)?;
-            (
-                r.iter().map(|q| q.p.extend(0.0)).collect(),
-                Some(r.iter().map(|q| q.n).collect()),
-            )
-        }
-        _ => {
-            let cs = match scheme {
-                CurveSchemeArg::Chaikin => CurveScheme::Chaikin,
-                CurveSchemeArg::Bspline => CurveScheme::BSpline {
-                    order: args.order.unwrap_or(4),
-                },
-                CurveSchemeArg::FourPoint => CurveScheme::FourPoint { omega },
-                CurveSchemeArg::FourPoint2p => CurveScheme::FourPoint2 { omega, mu },
-                CurveSchemeArg::Ternary3pt => CurveScheme::Ternary3 { omega },
-                CurveSchemeArg::Tension => CurveScheme::Tension {
-                    alpha0: args.alpha0.unwrap_or(1.0),
-                },
-                CurveSchemeArg::CirclePreserving => CurveScheme::CirclePreserving,
-                _ => CurveScheme::Variational,
-            };
-            let r = cs
-                .subdivide(&file.points, args.closed, args.levels)
-                .map_err(at_input)?;
-            (r, None)
-        }
-    };
-    let three_d = file.columns == 3;
-    let body = if ext == "svg" {
-        svg(
-            &file.points,
-            &points,
-            normals.as_deref(),
-            args.closed,
-            name,
-            args.levels,
-        )
-    } else {
-        let sep = if ext == "csv" { "," } else { " " };
-        let mut s = String::with_capacity(points.len() * 48);
-        for (i, p) in points.iter().enumerate() {
-            let _ = write!(s, "{}{sep}{}", p.x, p.y);
-            if three_d {
-                let _ = write!(s, "{sep}{}", p.z);
-            }
-            if let Some(n) = &normals {
-                let _ = write!(s, "{sep}{}{sep}{}", n[i].x, n[i].y);
-            }
-            s.push('\n');
-        }
-        s
-    };
-    subd_io::atomic_write(&args.output, |w| w.write_all(body.as_bytes()))?;
-    if args.json {
-        crate::print_json(
-            out,
-            &CurveReport {
-                input: args.input.display().to_string(),
-                output: args.output.display().to_string(),
-                scheme: name,
-                levels: args.levels,
-                closed: args.closed,
-                input_points: file.points.len(),
-                output_points: points.len(),
-                normals_estimated,
-                seconds: t0.elapsed().as_secs_f64(),
-            },
-        );
+    )
+}
+
+/// The linear scheme the arguments name, with its parameters.
+fn linear_scheme(args: &CurveArgs) -> CurveScheme {
+    let (omega, mu) = (omega(args), args.mu.unwrap_or(0.0));
+    match args.scheme {
+        CurveSchemeArg::Chaikin => CurveScheme::Chaikin,
+        CurveSchemeArg::Bspline => CurveScheme::BSpline {
+            order: args.order.unwrap_or(4),
+        },
+        CurveSchemeArg::FourPoint => CurveScheme::FourPoint { omega },
+        CurveSchemeArg::FourPoint2p => CurveScheme::FourPoint2 { omega, mu },
+        CurveSchemeArg::Ternary3pt => CurveScheme::Ternary3 { omega },
+        CurveSchemeArg::Tension => CurveScheme::Tension {
+            alpha0: args.alpha0.unwrap_or(1.0),
+        },
+        CurveSchemeArg::CirclePreserving => CurveScheme::CirclePreserving,
+        _ => CurveScheme::Variational,
     }
-    Ok(())
+}
+
+/// Seed 004's circle-average schemes on planar points with normals (estimated from the
+/// polygon, with a warning, when the file has none): points, normals and whether they were
+/// estimated.
+fn subdivide_circle_average(
+    args: &CurveArgs,
+    file: &PointFile,
+    err: &mut dyn Write,
+) -> Result<(Vec<DVec3>, Vec<DVec2>, bool), Failure> {
+    if file.columns == 3 {
+        return Err(bad(format!(
+            "{}: the circle-average schemes work on planar points (`x y` or `x y nx ny`), not `x y z`",
+            args.input.display()
+        )));
+    }
+    let (normals, estimated) = match &file.normals {
+        Some(n) => (n.clone(), false),
+        None => {
+            let _ = writeln!(
+                err,
+                "subd: warning: {}: no normals given; estimated from the polygon",
+                args.input.display()
+            );
+            (estimate_normals(&file.points, args.closed), true)
+        }
+    };
+    let pn: Vec<PointNormal> = file
+        .points
+        .iter()
+        .zip(&normals)
+        .map(|(p, n)| PointNormal {
+            p: p.truncate(),
+            n: *n,
+        })
+        .collect();
+    let omega = omega(args);
+    let cs = if args.scheme == CurveSchemeArg::CircleFourPoint {
+        CircleScheme::FourPoint {
+            omega,
+            mu: args.mu.unwrap_or(0.0),
+        }
+    } else {
+        CircleScheme::Ternary { omega }
+    };
+    let r = cs
+        .subdivide(&pn, args.closed, args.levels)
+        .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
+    Ok((
+        r.iter().map(|q| q.p.extend(0.0)).collect(),
+        r.iter().map(|q| q.n).collect(),
+        estimated,
+    ))
+}
+
+/// One line per point: `x y` (`z` for 3D input), then the normal where there is one.
+fn text(points: &[DVec3], normals: Option<&[DVec2]>, three_d: bool, sep: &str) -> String {
+    let mut s = String::with_capacity(points.len() * 48);
+    for (i, p) in points.iter().enumerate() {
+        let _ = write!(s, "{}{sep}{}", p.x, p.y);
+        if three_d {
+            let _ = write!(s, "{sep}{}", p.z);
+        }
+        if let Some(n) = normals {
+            let _ = write!(s, "{sep}{}{sep}{}", n[i].x, n[i].y);
+        }
+        s.push('\n');
+    }
+    s
 }
 
 /// An SVG figure (x, y; z dropped): the control polygon in grey with its points, the result

@@ -29,6 +29,7 @@ mod pia;
 mod progress;
 mod raster;
 mod refine;
+mod refined;
 mod render;
 mod rule_args;
 mod scheme_arg;

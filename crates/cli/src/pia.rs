@@ -136,19 +136,8 @@ fn run_one(
     let options = args.rules.options(&file.mesh.hints);
     let scheme = scheme_arg::with_lambda(&args.scheme, &args.lambda, &job.input, nv)?;
     let name = scheme.name();
-    let moving = match (&args.moving, &args.fixed) {
-        (Some(f), _) => Moving::Only(read_indices(f, nv, "vertex")?),
-        (None, Some(f)) => Moving::AllBut(read_indices(f, nv, "vertex")?),
-        (None, None) => Moving::All,
-    };
-    let solver = match args.solver {
-        SolverArg::Auto => Solver::Auto,
-        SolverArg::Iterate => Solver::Iterate,
-        SolverArg::Weighted => Solver::Weighted,
-        SolverArg::Cg => Solver::Cg,
-        SolverArg::Chebyshev => Solver::Chebyshev,
-        SolverArg::Direct => Solver::Direct,
-    };
+    let moving = moving_vertices(args, nv)?;
+    let solver = args.solver.solver();
     let at_input = |e: subd_pia::PiaError| bad(format!("{}: {e}", job.input.display()));
 
     let spinner = Spinner::new(args.json || job.quiet, "limit stencils");
@@ -171,49 +160,20 @@ fn run_one(
     // written positions, not the solver's own residual.
     spinner.message("checking");
     let t2 = Instant::now();
-    let check = match &scheme {
-        Scheme::TwoPhase(tp) => subd_limit::two_phase_base_limit_positions(topo, tp, &options),
-        s => subd_limit::base_limit_positions(topo, s, &options),
-    }
-    .map_err(|e| at_input(e.into()))?;
-    let limit = check.apply_points(&result.points);
-    let flags = moving.flags(nv).map_err(at_input)?;
-    let max_error = (0..nv)
-        .filter(|&v| flags[v])
-        .map(|v| (limit[v] - file.mesh.positions[v]).length())
-        .fold(0.0, f64::max);
-    let diagonal = bbox_diagonal(&file.mesh.positions);
-    let relative = if diagonal > 0.0 {
-        max_error / diagonal
-    } else {
-        max_error
+    let fitted = Fitted {
+        mesh: &file.mesh,
+        points: &result.points,
+        moving: &moving,
     };
+    let (max_error, relative) = fitted.max_error(&scheme, &options).map_err(at_input)?;
     let t_check = t2.elapsed().as_secs_f64();
     spinner.finish();
     if !result.converged || relative.is_nan() || relative > args.tol * (1.0 + 1e-6) {
-        return Err(Failure {
-            code: EXIT_FAILURE,
-            message: format!(
-                "{}: {name} interpolation did not reach --tol {} in {} iterations ({:?}): max error {:e} of the diagonal; no output written (raise --max-iter or try another --solver)",
-                job.input.display(),
-                args.tol,
-                result.iterations,
-                result.method,
-                relative
-            ),
-        });
+        return Err(not_converged(args, job, name, &result, relative));
     }
 
     let t3 = Instant::now();
-    let mut mesh = Mesh::new(topo.clone(), result.points.clone())
-        .map_err(|e| bad(format!("{}: {e}", job.input.display())))?;
-    mesh.hints = file.mesh.hints;
-    // The fitted mesh keeps the input's topology, so its texture coordinates stay as given.
-    mesh.fvar = file.mesh.fvar.clone();
-    let mut dropped = Vec::new();
-    crate::uv::fit_ply(&mut mesh, &job.output, &mut dropped);
-    print_warnings(err, &job.input, &dropped);
-    subd_io::write_mesh(&job.output, &mesh, &subd_io::WriteOptions::default())?;
+    fitted.write(job, err)?;
     let t_write = t3.elapsed().as_secs_f64();
 
     if args.json {
@@ -244,4 +204,100 @@ fn run_one(
         crate::print_json(out, &report);
     }
     Ok(())
+}
+
+/// The vertices that move: `--moving`, all but `--fixed`, or all.
+fn moving_vertices(args: &PiaArgs, nv: usize) -> Result<Moving, Failure> {
+    Ok(match (&args.moving, &args.fixed) {
+        (Some(f), _) => Moving::Only(read_indices(f, nv, "vertex")?),
+        (None, Some(f)) => Moving::AllBut(read_indices(f, nv, "vertex")?),
+        (None, None) => Moving::All,
+    })
+}
+
+/// The failure of an interpolation that did not reach `--tol`: nothing is written.
+fn not_converged(
+    args: &PiaArgs,
+    job: &Job,
+    name: &str,
+    result: &subd_pia::PiaResult,
+    relative: f64,
+) -> Failure {
+    Failure {
+        code: EXIT_FAILURE,
+        message: format!(
+            "{}: {name} interpolation did not reach --tol {} in {} iterations ({:?}): max error {:e} of the diagonal; no output written (raise --max-iter or try another --solver)",
+            job.input.display(),
+            args.tol,
+            result.iterations,
+            result.method,
+            relative
+        ),
+    }
+}
+
+impl SolverArg {
+    /// The library's solver.
+    fn solver(self) -> Solver {
+        match self {
+            SolverArg::Auto => Solver::Auto,
+            SolverArg::Iterate => Solver::Iterate,
+            SolverArg::Weighted => Solver::Weighted,
+            SolverArg::Cg => Solver::Cg,
+            SolverArg::Chebyshev => Solver::Chebyshev,
+            SolverArg::Direct => Solver::Direct,
+        }
+    }
+}
+
+/// The input and its fitted control points.
+struct Fitted<'a> {
+    mesh: &'a Mesh,
+    points: &'a [subd_mesh::DVec3],
+    moving: &'a Moving,
+}
+
+impl Fitted<'_> {
+    /// The largest distance of a moving vertex's limit from its input position, absolute and
+    /// over the bounding-box diagonal: measured with a limit table built afresh and applied
+    /// to the written positions, not the solver's own residual.
+    fn max_error(
+        &self,
+        scheme: &Scheme,
+        options: &subd_schemes::Options,
+    ) -> Result<(f64, f64), subd_pia::PiaError> {
+        let topo = &self.mesh.topology;
+        let nv = topo.num_vertices();
+        let check = match scheme {
+            Scheme::TwoPhase(tp) => subd_limit::two_phase_base_limit_positions(topo, tp, options),
+            s => subd_limit::base_limit_positions(topo, s, options),
+        }?;
+        let limit = check.apply_points(self.points);
+        let flags = self.moving.flags(nv)?;
+        let max_error = (0..nv)
+            .filter(|&v| flags[v])
+            .map(|v| (limit[v] - self.mesh.positions[v]).length())
+            .fold(0.0, f64::max);
+        let diagonal = bbox_diagonal(&self.mesh.positions);
+        let relative = if diagonal > 0.0 {
+            max_error / diagonal
+        } else {
+            max_error
+        };
+        Ok((max_error, relative))
+    }
+
+    /// Writes the fitted mesh: the input's topology, hints and texture coordinates (the
+    /// topology is kept, so the coordinates stay as given) with the fitted points.
+    fn write(&self, job: &Job, err: &mut dyn Write) -> Result<(), Failure> {
+        let mut mesh = Mesh::new(self.mesh.topology.clone(), self.points.to_vec())
+            .map_err(|e| bad(format!("{}: {e}", job.input.display())))?;
+        mesh.hints = self.mesh.hints;
+        mesh.fvar = self.mesh.fvar.clone();
+        let mut dropped = Vec::new();
+        crate::uv::fit_ply(&mut mesh, &job.output, &mut dropped);
+        print_warnings(err, &job.input, &dropped);
+        subd_io::write_mesh(&job.output, &mesh, &subd_io::WriteOptions::default())?;
+        Ok(())
+    }
 }

@@ -12,7 +12,7 @@ use subd_schemes::Scheme;
 
 use crate::failure::{bad, refuse_overwrite};
 use crate::raster::{Camera, Canvas, Rgb, shade};
-use crate::refine::{Refined, normals_or_faces, output_limit};
+use crate::refined::{Refined, normals_or_faces, output_limit};
 use crate::rule_args::RuleArgs;
 use crate::scheme_arg;
 use crate::{Failure, print_warnings};
@@ -135,6 +135,70 @@ pub(crate) fn run(
     err: &mut dyn Write,
 ) -> Result<(), Failure> {
     let t0 = Instant::now();
+    let chosen = check_arguments(args)?;
+    let refining = args.scheme.is_some() || args.limit;
+    let file = subd_io::read_mesh(&args.input, &args.rules.read_options())?;
+    print_warnings(err, &args.input, &file.warnings);
+    let points = match &args.points {
+        Some(p) => {
+            let f = subd_io::read_mesh(p, &args.rules.read_options())?;
+            print_warnings(err, p, &f.warnings);
+            f.mesh.positions
+        }
+        None => Vec::new(),
+    };
+    let base = &file.mesh.topology;
+    let scheme = chosen.unwrap_or(if (0..base.num_faces()).all(|f| base.face_size(f) == 3) {
+        Scheme::Loop
+    } else {
+        Scheme::CatmullClark
+    });
+    let levels = if refining {
+        args.levels.unwrap_or(3)
+    } else {
+        0
+    };
+    let surface = if refining {
+        refined_surface(args, &file, &scheme, levels)
+    } else {
+        let holes = base.tags().holes().to_vec();
+        let levels = file.face_levels.as_deref();
+        surface(
+            base.face_offsets().to_vec(),
+            base.all_face_vertices().to_vec(),
+            holes,
+            file.mesh.positions.clone(),
+            None,
+            levels,
+        )
+    }
+    .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
+    let png = draw(args, &surface, &file.mesh, &points)
+        .png()
+        .map_err(|e| bad(format!("{}: cannot encode PNG: {e}", args.output.display())))?;
+    subd_io::atomic_write(&args.output, |w| w.write_all(&png))?;
+    if args.json {
+        let report = RenderReport {
+            input: args.input.display().to_string(),
+            output: args.output.display().to_string(),
+            width: args.size.0,
+            height: args.size.1,
+            scheme: refining.then(|| scheme.name()),
+            levels,
+            limit: args.limit,
+            faces: surface.offsets.len() - 1,
+            vertices: surface.positions.len(),
+            coloured_by_level: !refining && file.face_levels.is_some(),
+            seconds: t0.elapsed().as_secs_f64(),
+        };
+        crate::print_json(out, &report);
+    }
+    Ok(())
+}
+
+/// What can be checked before reading: the output, the scheme (with its tension; the
+/// two-phase scheme needs its one `λ` in its name here) and `--levels`.
+fn check_arguments(args: &RenderArgs) -> Result<Option<Scheme>, Failure> {
     refuse_overwrite(&args.input, &args.output)?;
     if !args
         .output
@@ -162,117 +226,70 @@ pub(crate) fn run(
             "--scheme two-phase needs its λ: two-phase:λ, or refine with `subd refine` (per-vertex λ) and render its output".into(),
         ));
     }
-    let refining = args.scheme.is_some() || args.limit;
-    if args.levels.is_some() && !refining {
+    if args.levels.is_some() && args.scheme.is_none() && !args.limit {
         return Err(bad("--levels needs --scheme or --limit".into()));
     }
-    let file = subd_io::read_mesh(&args.input, &args.rules.read_options())?;
-    print_warnings(err, &args.input, &file.warnings);
-    let points = match &args.points {
-        Some(p) => {
-            let f = subd_io::read_mesh(p, &args.rules.read_options())?;
-            print_warnings(err, p, &f.warnings);
-            f.mesh.positions
-        }
-        None => Vec::new(),
-    };
-    let base = &file.mesh.topology;
-    let scheme = chosen.unwrap_or(if (0..base.num_faces()).all(|f| base.face_size(f) == 3) {
-        Scheme::Loop
-    } else {
-        Scheme::CatmullClark
-    });
-    let levels = if refining {
-        args.levels.unwrap_or(3)
-    } else {
-        0
-    };
-    let in_file = |e: &dyn std::fmt::Display| bad(format!("{}: {e}", args.input.display()));
-    let surface = if refining {
-        let options = args.rules.options(&file.mesh.hints);
-        let refinement =
-            Refined::new(base, scheme.clone(), &options, levels).map_err(|e| in_file(&e))?;
-        let mut positions = refinement.last_positions(&file.mesh.positions);
-        let limit_normals = if args.limit {
-            let limit =
-                output_limit(&refinement, levels, &options, &positions).map_err(|e| in_file(&e))?;
-            positions = limit.positions;
-            Some(limit.normals)
-        } else {
-            None
-        };
-        let (offsets, vertices) = refinement.faces(levels);
-        let holes = refinement.holes(levels).into_owned();
-        surface(
-            offsets.to_vec(),
-            vertices.to_vec(),
-            holes,
-            positions,
-            limit_normals,
-            None,
-        )
-    } else {
-        let holes = base.tags().holes().to_vec();
-        let levels = file.face_levels.as_deref();
-        surface(
-            base.face_offsets().to_vec(),
-            base.all_face_vertices().to_vec(),
-            holes,
-            file.mesh.positions.clone(),
-            None,
-            levels,
-        )
-    }
-    .map_err(|e| in_file(&e))?;
+    Ok(chosen)
+}
 
+/// The refined surface to draw: `levels` levels of `scheme`, at the limit with `--limit`.
+fn refined_surface(
+    args: &RenderArgs,
+    file: &subd_io::MeshFile,
+    scheme: &Scheme,
+    levels: usize,
+) -> Result<Surface, String> {
+    let options = args.rules.options(&file.mesh.hints);
+    let refinement = Refined::new(&file.mesh.topology, scheme.clone(), &options, levels)?;
+    let mut positions = refinement.last_positions(&file.mesh.positions);
+    let limit_normals = if args.limit {
+        let limit = output_limit(&refinement, levels, &options, &positions)?;
+        positions = limit.positions;
+        Some(limit.normals)
+    } else {
+        None
+    };
+    let (offsets, vertices) = refinement.faces(levels);
+    let holes = refinement.holes(levels).into_owned();
+    surface(
+        offsets.to_vec(),
+        vertices.to_vec(),
+        holes,
+        positions,
+        limit_normals,
+        None,
+    )
+}
+
+/// The picture: the surface, the cage (`--cage`) and the points (`--points`), framed to hold
+/// all of them.
+fn draw(args: &RenderArgs, surface: &Surface, cage: &subd_mesh::Mesh, points: &[DVec3]) -> Canvas {
     let (width, height) = args.size;
     let mut drawn: Vec<DVec3> = surface.positions.clone();
     if args.cage {
-        drawn.extend_from_slice(&file.mesh.positions);
+        drawn.extend_from_slice(&cage.positions);
     }
-    drawn.extend_from_slice(&points);
+    drawn.extend_from_slice(points);
     let (centre, radius) = bounding_sphere(&drawn);
     let camera = Camera::new(centre, radius, args.view.0, args.view.1, width, height);
     let mut canvas = Canvas::new(width, height);
-    draw_surface(&mut canvas, &camera, &surface, args.wireframe, radius);
+    draw_surface(&mut canvas, &camera, surface, args.wireframe, radius);
     let bias = 0.02 * radius;
     if args.cage {
+        let base = &cage.topology;
         for e in 0..base.num_edges() {
             let [a, b] = base.edge_vertices(e);
-            let (a, b) = (
-                file.mesh.positions[a as usize],
-                file.mesh.positions[b as usize],
-            );
+            let (a, b) = (cage.positions[a as usize], cage.positions[b as usize]);
             canvas.line(camera.project(a), camera.project(b), CAGE, 2, bias, 0.25);
         }
-        for &p in &file.mesh.positions {
+        for &p in &cage.positions {
             canvas.dot(camera.project(p), 2.5, CAGE, bias, 0.25);
         }
     }
-    for &p in &points {
+    for &p in points {
         canvas.dot(camera.project(p), 3.5, POINT, bias, 0.3);
     }
-    let png = canvas
-        .png()
-        .map_err(|e| bad(format!("{}: cannot encode PNG: {e}", args.output.display())))?;
-    subd_io::atomic_write(&args.output, |w| w.write_all(&png))?;
-    if args.json {
-        let report = RenderReport {
-            input: args.input.display().to_string(),
-            output: args.output.display().to_string(),
-            width,
-            height,
-            scheme: refining.then(|| scheme.name()),
-            levels,
-            limit: args.limit,
-            faces: surface.offsets.len() - 1,
-            vertices: surface.positions.len(),
-            coloured_by_level: !refining && file.face_levels.is_some(),
-            seconds: t0.elapsed().as_secs_f64(),
-        };
-        crate::print_json(out, &report);
-    }
-    Ok(())
+    canvas
 }
 
 /// The surface with unit normals (the limit's where given and defined, else the faces'

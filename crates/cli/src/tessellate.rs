@@ -14,7 +14,7 @@ use subd_schemes::Scheme;
 
 use crate::Failure;
 use crate::failure::bad;
-use crate::refine::normals_or_faces;
+use crate::refined::normals_or_faces;
 use crate::rule_args::RuleArgs;
 use crate::scheme_arg;
 

@@ -29,7 +29,7 @@ pub(crate) struct RefinedUv {
 /// `limit`), interpolated by `mode`; `None` when the mesh has none, or, with a warning, when
 /// a split scheme cannot carry their seams.
 pub(crate) fn refined_uv(
-    refinement: &crate::refine::Refined,
+    refinement: &crate::refined::Refined,
     mesh: &subd_mesh::Mesh,
     mode: FVarLinearInterpolation,
     limit: bool,
@@ -38,19 +38,26 @@ pub(crate) fn refined_uv(
     let Some(channel) = mesh.uv() else {
         return Ok(None);
     };
-    if !refinement.scheme().is_opensubdiv() {
-        return split_uv(refinement, channel, mode, limit, warnings);
-    }
     let r: &Refinement = refinement;
-    let fr =
-        subd_schemes::FaceVaryingRefinement::new(r, channel, mode).map_err(|e| e.to_string())?;
+    let fv = match r.face_varying(channel, mode) {
+        Ok(fv) => fv,
+        Err(e @ SplitFVarError::Seam { .. }) => {
+            warnings.push(format!("texture coordinates left out: {e}"));
+            return Ok(None);
+        }
+        Err(e) => return Err(e.to_string()),
+    };
     let level = r.num_levels();
-    let values = fr
-        .refine_values(r, channel.values(), 2)
+    let values = fv
+        .refine_values(channel.values(), 2)
         .pop()
         .expect("level 0 at least");
-    let indices = fr.face_values(level);
+    let indices = fv.face_values(level);
     if !limit {
+        return Ok(Some(RefinedUv { values, indices }));
+    }
+    if let Some(split) = fv.split() {
+        let values = split_values_limit(split, || refinement.last_limit(), values)?;
         return Ok(Some(RefinedUv { values, indices }));
     }
     // The exact limit of the output level's values, as the positions take theirs.
@@ -66,39 +73,6 @@ pub(crate) fn refined_uv(
         mode,
     )
     .map(Some)
-}
-
-/// A split scheme's refined texture coordinates ([`SplitFaceVarying`]); `None` with a warning
-/// for seams that Doo-Sabin or √3 cannot carry.
-fn split_uv(
-    r: &crate::refine::Refined,
-    channel: &FVarChannel,
-    mode: FVarLinearInterpolation,
-    limit: bool,
-    warnings: &mut Vec<String>,
-) -> Result<Option<RefinedUv>, String> {
-    let fv = match SplitFaceVarying::new(r, channel, mode) {
-        Ok(fv) => fv,
-        Err(e @ SplitFVarError::Seam { .. }) => {
-            warnings.push(format!("texture coordinates left out: {e}"));
-            return Ok(None);
-        }
-        Err(e) => return Err(e.to_string()),
-    };
-    let level = r.num_levels();
-    let values = fv
-        .refine_values(channel.values(), 2)
-        .pop()
-        .expect("level 0 at least");
-    let values = if limit {
-        split_values_limit(&fv, || r.last_limit(), values)?
-    } else {
-        values
-    };
-    Ok(Some(RefinedUv {
-        values,
-        indices: fv.face_values(level),
-    }))
 }
 
 /// The limit of the values of `fv`'s output level: the butterflies interpolate, so each

@@ -62,6 +62,7 @@
 
 pub mod analysis;
 pub mod curve;
+mod face_varying;
 mod family;
 pub mod peak;
 mod refine;
@@ -75,6 +76,7 @@ pub mod two_phase;
 use subd_mesh::{BoundaryInterpolation, CreaseMethod, SchemeHints, TriangleSubdivision};
 use thiserror::Error;
 
+pub use face_varying::FaceVarying;
 pub use refine::{
     ChildLayout, FVarLevelValues, FVarValueKind, FaceStream, FaceVaryingRefinement, LevelCounts,
     PointStream, refined_counts,
