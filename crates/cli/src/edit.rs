@@ -420,7 +420,7 @@ fn run_one(
     let t_check = t_check.elapsed().as_secs_f64();
 
     let t_write = Instant::now();
-    write_edited(job, &file, &edit.positions, err)?;
+    write_edited(job, file, &edit.positions, err)?;
     let t_write = t_write.elapsed().as_secs_f64();
 
     if args.json {

@@ -38,7 +38,7 @@ pub struct FaceVarying<'r> {
 #[derive(Debug)]
 enum Family {
     OpenSubdiv(FaceVaryingRefinement),
-    Split(SplitFaceVarying),
+    Split(Box<SplitFaceVarying>),
 }
 
 impl Refinement {
@@ -56,7 +56,7 @@ impl Refinement {
         let family = if self.scheme().is_opensubdiv() {
             Family::OpenSubdiv(FaceVaryingRefinement::new(self, channel, mode)?)
         } else {
-            Family::Split(SplitFaceVarying::new(self, channel, mode)?)
+            Family::Split(Box::new(SplitFaceVarying::new(self, channel, mode)?))
         };
         Ok(FaceVarying {
             refinement: self,
