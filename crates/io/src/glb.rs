@@ -185,14 +185,49 @@ fn write_arrays(
     normals: &[DVec3],
     texcoords: Option<&[[f32; 2]]>,
 ) -> std::io::Result<()> {
-    let nv = mesh.num_vertices();
-    let num_indices = 3 * mesh.num_fan_triangles();
+    let layout = BinLayout::new(mesh, texcoords.is_some());
+    let root = document(mesh, normals, &layout)?;
+    let json_bytes = json::serialize::to_vec(&root).map_err(std::io::Error::other)?;
+    write_container_start(w, json_bytes, layout.bin_len)?;
+    write_bin_chunk(w, mesh, normals, texcoords)
+}
 
-    // Every element is 4 bytes, so the BIN chunk needs no padding.
-    let vec3_len = nv * 12;
-    let uv_len = if texcoords.is_some() { nv * 8 } else { 0 };
-    let bin_len = 2 * vec3_len + uv_len + num_indices * 4;
+/// Where each array lies in the BIN chunk: positions, normals, texture coordinates (when
+/// present), indices, one after the other.
+struct BinLayout {
+    has_texcoords: bool,
+    num_vertices: usize,
+    num_indices: usize,
+    vec3_len: usize,
+    uv_len: usize,
+    bin_len: usize,
+}
 
+impl BinLayout {
+    fn new(mesh: &MeshView<'_>, has_texcoords: bool) -> BinLayout {
+        let nv = mesh.num_vertices();
+        let num_indices = 3 * mesh.num_fan_triangles();
+        // Every element is 4 bytes, so the BIN chunk needs no padding.
+        let vec3_len = nv * 12;
+        let uv_len = if has_texcoords { nv * 8 } else { 0 };
+        BinLayout {
+            has_texcoords,
+            num_vertices: nv,
+            num_indices,
+            vec3_len,
+            uv_len,
+            bin_len: 2 * vec3_len + uv_len + num_indices * 4,
+        }
+    }
+}
+
+/// The glTF JSON document: one buffer, its views and accessors, one mesh with one
+/// primitive, one node, one scene (pushed in this order, which fixes their indices).
+fn document(
+    mesh: &MeshView<'_>,
+    normals: &[DVec3],
+    layout: &BinLayout,
+) -> std::io::Result<json::Root> {
     let mut root = json::Root {
         asset: json::Asset {
             generator: Some(format!("subd {}", env!("CARGO_PKG_VERSION"))),
@@ -201,69 +236,28 @@ fn write_arrays(
         ..Default::default()
     };
     let buffer = root.push(json::Buffer {
-        byte_length: USize64::from(bin_len),
+        byte_length: USize64::from(layout.bin_len),
         extensions: Default::default(),
         extras: Default::default(),
         uri: None,
     });
-    let view = |root: &mut json::Root, offset: usize, len: usize, target: json::buffer::Target| {
-        root.push(json::buffer::View {
-            buffer,
-            byte_length: USize64::from(len),
-            byte_offset: Some(USize64::from(offset)),
-            byte_stride: None,
-            extensions: Default::default(),
-            extras: Default::default(),
-            target: Some(Valid(target)),
-        })
-    };
-    let pos_view = view(&mut root, 0, vec3_len, json::buffer::Target::ArrayBuffer);
-    let nrm_view = view(
+    let (vec3_len, uv_len) = (layout.vec3_len, layout.uv_len);
+    let array = json::buffer::Target::ArrayBuffer;
+    let pos_view = push_view(&mut root, buffer, 0, vec3_len, array);
+    let nrm_view = push_view(&mut root, buffer, vec3_len, vec3_len, array);
+    let uv_view = layout
+        .has_texcoords
+        .then(|| push_view(&mut root, buffer, 2 * vec3_len, uv_len, array));
+    let idx_view = push_view(
         &mut root,
-        vec3_len,
-        vec3_len,
-        json::buffer::Target::ArrayBuffer,
-    );
-    let uv_view = texcoords.is_some().then(|| {
-        view(
-            &mut root,
-            2 * vec3_len,
-            uv_len,
-            json::buffer::Target::ArrayBuffer,
-        )
-    });
-    let idx_view = view(
-        &mut root,
+        buffer,
         2 * vec3_len + uv_len,
-        num_indices * 4,
+        layout.num_indices * 4,
         json::buffer::Target::ElementArrayBuffer,
     );
-    let accessor = |root: &mut json::Root,
-                    view: json::Index<json::buffer::View>,
-                    count: usize,
-                    ct: json::accessor::ComponentType,
-                    ty: json::accessor::Type,
-                    minmax: Option<(json::Value, json::Value)>| {
-        let (min, max) = match minmax {
-            Some((a, b)) => (Some(a), Some(b)),
-            None => (None, None),
-        };
-        root.push(json::Accessor {
-            buffer_view: Some(view),
-            byte_offset: Some(USize64(0)),
-            count: USize64::from(count),
-            component_type: Valid(json::accessor::GenericComponentType(ct)),
-            extensions: Default::default(),
-            extras: Default::default(),
-            type_: Valid(ty),
-            min,
-            max,
-            normalized: false,
-            sparse: None,
-        })
-    };
     use json::accessor::{ComponentType as C, Type as T};
-    let pos_acc = accessor(
+    let nv = layout.num_vertices;
+    let pos_acc = push_accessor(
         &mut root,
         pos_view,
         nv,
@@ -271,9 +265,16 @@ fn write_arrays(
         T::Vec3,
         Some(bounds(mesh)?),
     );
-    let nrm_acc = accessor(&mut root, nrm_view, normals.len(), C::F32, T::Vec3, None);
-    let uv_acc = uv_view.map(|v| accessor(&mut root, v, nv, C::F32, T::Vec2, None));
-    let idx_acc = accessor(&mut root, idx_view, num_indices, C::U32, T::Scalar, None);
+    let nrm_acc = push_accessor(&mut root, nrm_view, normals.len(), C::F32, T::Vec3, None);
+    let uv_acc = uv_view.map(|v| push_accessor(&mut root, v, nv, C::F32, T::Vec2, None));
+    let idx_acc = push_accessor(
+        &mut root,
+        idx_view,
+        layout.num_indices,
+        C::U32,
+        T::Scalar,
+        None,
+    );
     let mut attributes: std::collections::BTreeMap<_, _> = [
         (Valid(json::mesh::Semantic::Positions), pos_acc),
         (Valid(json::mesh::Semantic::Normals), nrm_acc),
@@ -283,11 +284,72 @@ fn write_arrays(
     if let Some(a) = uv_acc {
         attributes.insert(Valid(json::mesh::Semantic::TexCoords(0)), a);
     }
+    push_scene(&mut root, attributes, idx_acc);
+    Ok(root)
+}
+
+/// A view of `len` bytes of `buffer` from `offset`.
+fn push_view(
+    root: &mut json::Root,
+    buffer: json::Index<json::Buffer>,
+    offset: usize,
+    len: usize,
+    target: json::buffer::Target,
+) -> json::Index<json::buffer::View> {
+    root.push(json::buffer::View {
+        buffer,
+        byte_length: USize64::from(len),
+        byte_offset: Some(USize64::from(offset)),
+        byte_stride: None,
+        extensions: Default::default(),
+        extras: Default::default(),
+        target: Some(Valid(target)),
+    })
+}
+
+/// An accessor of `count` elements over a whole view, with bounds when given.
+fn push_accessor(
+    root: &mut json::Root,
+    view: json::Index<json::buffer::View>,
+    count: usize,
+    ct: json::accessor::ComponentType,
+    ty: json::accessor::Type,
+    minmax: Option<(json::Value, json::Value)>,
+) -> json::Index<json::Accessor> {
+    let (min, max) = match minmax {
+        Some((a, b)) => (Some(a), Some(b)),
+        None => (None, None),
+    };
+    root.push(json::Accessor {
+        buffer_view: Some(view),
+        byte_offset: Some(USize64(0)),
+        count: USize64::from(count),
+        component_type: Valid(json::accessor::GenericComponentType(ct)),
+        extensions: Default::default(),
+        extras: Default::default(),
+        type_: Valid(ty),
+        min,
+        max,
+        normalized: false,
+        sparse: None,
+    })
+}
+
+/// One triangle primitive with these attributes and indices, in a mesh, a node and the
+/// default scene.
+fn push_scene(
+    root: &mut json::Root,
+    attributes: std::collections::BTreeMap<
+        json::validation::Checked<json::mesh::Semantic>,
+        json::Index<json::Accessor>,
+    >,
+    indices: json::Index<json::Accessor>,
+) {
     let primitive = json::mesh::Primitive {
         attributes,
         extensions: Default::default(),
         extras: Default::default(),
-        indices: Some(idx_acc),
+        indices: Some(indices),
         material: None,
         mode: Valid(json::mesh::Mode::Triangles),
         targets: None,
@@ -308,17 +370,23 @@ fn write_arrays(
         nodes: vec![node],
     });
     root.scene = Some(scene);
+}
 
-    let json_bytes = json::serialize::to_vec(&root).map_err(std::io::Error::other)?;
+/// The GLB header, the JSON chunk, and the header of the BIN chunk of `bin_len` bytes.
+///
+/// The GLB container (glTF 2.0 §4.4: a 12-byte header, then chunks of length, type and
+/// data) is framed here rather than by `gltf::binary::Glb`, which wants the whole BIN chunk
+/// as one slice: a copy of every array, hundreds of megabytes for a deep refinement.
+fn write_container_start(
+    w: &mut dyn Write,
+    json_bytes: Vec<u8>,
+    bin_len: usize,
+) -> std::io::Result<()> {
     // GLB chunks are 4-byte aligned: JSON is padded with spaces, BIN with zeros.
     let mut json_padded = json_bytes;
     while json_padded.len() % 4 != 0 {
         json_padded.push(b' ');
     }
-    // The GLB container (glTF 2.0 §4.4: a 12-byte header, then chunks of length, type and
-    // data) is framed here rather than by `gltf::binary::Glb`, which wants the whole BIN
-    // chunk as one slice: a copy of every array, hundreds of megabytes for a deep
-    // refinement.
     let total = 12 + 8 + json_padded.len() + 8 + bin_len;
     let total = u32::try_from(total)
         .map_err(|_| std::io::Error::other("the mesh is too large for a .glb file (4 GiB)"))?;
@@ -329,10 +397,19 @@ fn write_arrays(
     w.write_all(b"JSON")?;
     w.write_all(&json_padded)?;
     w.write_all(&(bin_len as u32).to_le_bytes())?;
-    w.write_all(b"BIN\0")?;
+    w.write_all(b"BIN\0")
+}
+
+/// The BIN chunk's data, in the order of [`BinLayout`], encoded by all threads.
+fn write_bin_chunk(
+    w: &mut dyn Write,
+    mesh: &MeshView<'_>,
+    normals: &[DVec3],
+    texcoords: Option<&[[f32; 2]]>,
+) -> std::io::Result<()> {
     write_windows(
         w,
-        nv,
+        mesh.num_vertices(),
         |r| mesh.point_window(r),
         |points, i, b| {
             for c in to_f32(&points.get(i)) {

@@ -493,6 +493,18 @@ fn tag_index(tag: &TagLine, what: &str, i: i64) -> Result<u64, ReadError> {
     })
 }
 
+/// An error of a malformed tag line.
+fn tag_error(tag: &TagLine, msg: &str) -> ReadError {
+    ReadError::line(tag.line, format!("{} tag: {msg}", tag.name))
+}
+
+/// A topology's refusal of a tag, at the tag's line.
+fn topology_error(tag: &TagLine, e: subd_mesh::TopologyError) -> ReadError {
+    ReadError::line(tag.line, e.to_string())
+}
+
+/// Applies one tag line: sharpness and holes to `topo`, scheme options to `hints`; tags
+/// that change nothing are kept verbatim in `extra`, with a warning.
 fn apply_tag(
     tag: &TagLine,
     topo: &mut subd_mesh::Topology,
@@ -500,48 +512,97 @@ fn apply_tag(
     warnings: &mut Vec<String>,
     extra: &mut Vec<String>,
 ) -> Result<(), ReadError> {
-    let at = |e: subd_mesh::TopologyError| ReadError::line(tag.line, e.to_string());
-    let bad = |msg: &str| ReadError::line(tag.line, format!("{} tag: {msg}", tag.name));
     match tag.name.as_str() {
-        "crease" => {
-            let n = tag.ints.len();
-            if n < 2 || !(tag.floats.len() == 1 || tag.floats.len() == n - 1) {
-                return Err(bad(
-                    "expected n >= 2 vertices and 1 or n-1 sharpness values",
-                ));
-            }
-            for i in 0..n - 1 {
-                let a = tag_index(tag, "vertex", tag.ints[i])?;
-                let b = tag_index(tag, "vertex", tag.ints[i + 1])?;
-                let s = tag.floats[i.min(tag.floats.len() - 1)];
-                if topo.set_crease(a, b, s).map_err(at)?.is_none() {
-                    warnings.push(format!(
-                        "line {}: crease tag names edge ({a}, {b}), which is not an edge of the mesh; ignored",
-                        tag.line
-                    ));
-                }
-            }
+        "crease" => return apply_crease(tag, topo, warnings),
+        "corner" => return apply_corner(tag, topo),
+        "hole" => return apply_hole(tag, topo),
+        "interpolateboundary"
+        | "creasemethod"
+        | "smoothtriangles"
+        | "facevaryinginterpolateboundary" => return apply_hint(tag, hints),
+        "vertexedit" | "edgeedit" | "faceedit" => {
+            warnings.push(format!(
+                "line {}: hierarchical edit tag {:?} is not supported (OpenSubdiv's Far ignores it too); kept but not applied",
+                tag.line, tag.name
+            ));
         }
-        "corner" => {
-            let n = tag.ints.len();
-            if n < 1 || !(tag.floats.len() == 1 || tag.floats.len() == n) {
-                return Err(bad("expected n >= 1 vertices and 1 or n sharpness values"));
-            }
-            for i in 0..n {
-                let v = tag_index(tag, "vertex", tag.ints[i])?;
-                topo.set_corner(v, tag.floats[i.min(tag.floats.len() - 1)])
-                    .map_err(at)?;
-            }
+        other => {
+            warnings.push(format!(
+                "line {}: tag {other:?} does not affect vertex positions; kept but not applied",
+                tag.line
+            ));
         }
-        "hole" => {
-            if tag.ints.is_empty() {
-                return Err(bad("expected at least one face index"));
-            }
-            for &f in &tag.ints {
-                topo.set_hole_checked(tag_index(tag, "face", f)?)
-                    .map_err(at)?;
-            }
+    }
+    extra.push(tag.raw.clone());
+    Ok(())
+}
+
+/// `t crease n 1|n-1 v0 .. vn-1 s..`: sharpness on the edges of a vertex chain; a pair that
+/// is not an edge is ignored with a warning.
+fn apply_crease(
+    tag: &TagLine,
+    topo: &mut subd_mesh::Topology,
+    warnings: &mut Vec<String>,
+) -> Result<(), ReadError> {
+    let n = tag.ints.len();
+    if n < 2 || !(tag.floats.len() == 1 || tag.floats.len() == n - 1) {
+        return Err(tag_error(
+            tag,
+            "expected n >= 2 vertices and 1 or n-1 sharpness values",
+        ));
+    }
+    for i in 0..n - 1 {
+        let a = tag_index(tag, "vertex", tag.ints[i])?;
+        let b = tag_index(tag, "vertex", tag.ints[i + 1])?;
+        let s = tag.floats[i.min(tag.floats.len() - 1)];
+        if topo
+            .set_crease(a, b, s)
+            .map_err(|e| topology_error(tag, e))?
+            .is_none()
+        {
+            warnings.push(format!(
+                "line {}: crease tag names edge ({a}, {b}), which is not an edge of the mesh; ignored",
+                tag.line
+            ));
         }
+    }
+    Ok(())
+}
+
+/// `t corner n 1|n v.. s..`: vertex sharpness.
+fn apply_corner(tag: &TagLine, topo: &mut subd_mesh::Topology) -> Result<(), ReadError> {
+    let n = tag.ints.len();
+    if n < 1 || !(tag.floats.len() == 1 || tag.floats.len() == n) {
+        return Err(tag_error(
+            tag,
+            "expected n >= 1 vertices and 1 or n sharpness values",
+        ));
+    }
+    for i in 0..n {
+        let v = tag_index(tag, "vertex", tag.ints[i])?;
+        topo.set_corner(v, tag.floats[i.min(tag.floats.len() - 1)])
+            .map_err(|e| topology_error(tag, e))?;
+    }
+    Ok(())
+}
+
+/// `t hole n 0 f..`: faces made holes.
+fn apply_hole(tag: &TagLine, topo: &mut subd_mesh::Topology) -> Result<(), ReadError> {
+    if tag.ints.is_empty() {
+        return Err(tag_error(tag, "expected at least one face index"));
+    }
+    for &f in &tag.ints {
+        topo.set_hole_checked(tag_index(tag, "face", f)?)
+            .map_err(|e| topology_error(tag, e))?;
+    }
+    Ok(())
+}
+
+/// The tags that choose scheme options: boundary and face-varying interpolation, crease
+/// method, triangle rule.
+fn apply_hint(tag: &TagLine, hints: &mut SchemeHints) -> Result<(), ReadError> {
+    let bad = |msg: &str| tag_error(tag, msg);
+    match tag.name.as_str() {
         "interpolateboundary" => {
             let k = match tag.ints.as_slice() {
                 [k] => *k,
@@ -572,7 +633,8 @@ fn apply_tag(
                 _ => return Err(bad("expected one string: catmark or smooth")),
             });
         }
-        "facevaryinginterpolateboundary" => {
+        // "facevaryinginterpolateboundary", the last of the tags `apply_tag` sends here.
+        _ => {
             let k = match tag.ints.as_slice() {
                 [k] => *k,
                 _ => return Err(bad("expected one integer (0 none ... 5 all)")),
@@ -583,20 +645,6 @@ fn apply_tag(
                         "unknown value {k} (0 none, 1 corners-only, 2 corners-plus1, 3 corners-plus2, 4 boundaries, 5 all)"
                     ))
                 })?);
-        }
-        "vertexedit" | "edgeedit" | "faceedit" => {
-            warnings.push(format!(
-                "line {}: hierarchical edit tag {:?} is not supported (OpenSubdiv's Far ignores it too); kept but not applied",
-                tag.line, tag.name
-            ));
-            extra.push(tag.raw.clone());
-        }
-        other => {
-            warnings.push(format!(
-                "line {}: tag {other:?} does not affect vertex positions; kept but not applied",
-                tag.line
-            ));
-            extra.push(tag.raw.clone());
         }
     }
     Ok(())

@@ -403,35 +403,89 @@ struct PlyData {
 
 /// Reads every element instance of the body (see the module docs for the roles).
 fn read_elements(header: &Header, body: &mut Body<'_>) -> Result<PlyData, ReadError> {
-    let mut positions: Vec<DVec3> = Vec::new();
-    let mut face_sizes: Vec<u32> = Vec::new();
-    let mut face_vertices: Vec<u32> = Vec::new();
-    let mut face_levels: Vec<u8> = Vec::new();
-    let mut creases: Vec<(f64, f64, f64, Option<usize>)> = Vec::new();
-    let mut corners: Vec<(f64, f64, Option<usize>)> = Vec::new();
-    let mut holes: Vec<(f64, Option<usize>)> = Vec::new();
-    let mut have_vertex = false;
-    let mut have_face = false;
-    let mut values: Vec<f64> = Vec::new();
-    let mut list: Vec<f64> = Vec::new();
-    // Per-vertex texture coordinates, when the vertex element has them.
-    let mut texcoords: Vec<f64> = Vec::new();
-    let mut uv_props: Option<[usize; 2]> = None;
+    let mut r = ElementReader {
+        d: PlyData {
+            positions: Vec::new(),
+            texcoords: None,
+            face_sizes: Vec::new(),
+            face_vertices: Vec::new(),
+            face_levels: Vec::new(),
+            creases: Vec::new(),
+            corners: Vec::new(),
+            holes: Vec::new(),
+            have_vertex: false,
+            have_face: false,
+        },
+        texcoords: Vec::new(),
+        uv_props: None,
+        values: Vec::new(),
+        list: Vec::new(),
+    };
     for el in &header.elements {
+        let role = r.role_of(el)?;
+        check_instance_count(el, body)?;
+        match role {
+            Some(Role::Vertex(_)) => r.d.positions.reserve(el.count),
+            Some(Role::Face { .. }) => r.d.face_sizes.reserve(el.count),
+            _ => {}
+        }
+        for k in 0..el.count {
+            r.read_values(el, k, role, body)?;
+            r.keep_instance(k, role, body)?;
+        }
+    }
+    let mut d = r.d;
+    d.texcoords = r.uv_props.map(|_| r.texcoords);
+    Ok(d)
+}
+
+/// What an element's instances give, with the positions of the properties that give it.
+#[derive(Debug, Clone, Copy)]
+enum Role {
+    /// x, y, z.
+    Vertex([usize; 3]),
+    /// The vertex index list, and `level` (as `subd adaptive` writes it; `usize::MAX`:
+    /// absent).
+    Face { list: usize, level: usize },
+    /// v0, v1, sharpness.
+    Crease([usize; 3]),
+    /// vertex, sharpness.
+    Corner([usize; 2]),
+    /// face.
+    Hole(usize),
+}
+
+/// The state of [`read_elements`]: the data so far, the vertex texture coordinates, and the
+/// values of the instance being read (reused, never allocated per instance).
+struct ElementReader {
+    d: PlyData,
+    texcoords: Vec<f64>,
+    /// The `u v` properties of the vertex element, when it has them.
+    uv_props: Option<[usize; 2]>,
+    /// The instance's values, one per property (NaN for a list).
+    values: Vec<f64>,
+    /// The face's vertex indices.
+    list: Vec<f64>,
+}
+
+impl ElementReader {
+    /// The role of `el`; an element of another name, or one lacking a property its name
+    /// needs, has none (but vertex and face elements must have theirs).
+    fn role_of(&mut self, el: &Element) -> Result<Option<Role>, ReadError> {
         let find = |n: &str| el.props.iter().position(|p| p.name() == n);
-        let role = match el.name.as_str() {
+        Ok(match el.name.as_str() {
             "vertex" => {
-                have_vertex = true;
+                self.d.have_vertex = true;
                 let (Some(x), Some(y), Some(z)) = (find("x"), find("y"), find("z")) else {
                     return Err(ReadError::general(
                         "vertex element lacks an x, y or z property",
                     ));
                 };
-                uv_props = texcoord_properties(&el.props);
-                Some(("vertex", [x, y, z]))
+                self.uv_props = texcoord_properties(&el.props);
+                Some(Role::Vertex([x, y, z]))
             }
             "face" => {
-                have_face = true;
+                self.d.have_face = true;
                 let Some(i) = find("vertex_indices").or_else(|| find("vertex_index")) else {
                     return Err(ReadError::general(
                         "face element has no vertex_indices list",
@@ -442,145 +496,168 @@ fn read_elements(header: &Header, body: &mut Body<'_>) -> Result<PlyData, ReadEr
                         "face vertex_indices is not a list property",
                     ));
                 }
-                // `level`, as `subd adaptive` writes it; usize::MAX: absent.
-                Some(("face", [i, find("level").unwrap_or(usize::MAX), 0]))
+                let level = find("level").unwrap_or(usize::MAX);
+                Some(Role::Face { list: i, level })
             }
             "crease" => match (find("v0"), find("v1"), find("sharpness")) {
-                (Some(a), Some(b), Some(s)) => Some(("crease", [a, b, s])),
+                (Some(a), Some(b), Some(s)) => Some(Role::Crease([a, b, s])),
                 _ => None,
             },
             "corner" => match (find("vertex"), find("sharpness")) {
-                (Some(a), Some(s)) => Some(("corner", [a, s, 0])),
+                (Some(a), Some(s)) => Some(Role::Corner([a, s])),
                 _ => None,
             },
-            "hole" => find("face").map(|a| ("hole", [a, 0, 0])),
+            "hole" => find("face").map(Role::Hole),
             _ => None,
-        };
-        // An instance with at least one property takes at least one byte, so a count beyond
-        // the remaining bytes is malformed. Checking it up front keeps a forged header from
-        // driving allocation or a long loop (found by fuzzing: `element crease 01569664312`
-        // with no properties spun for billions of empty iterations).
-        if el.count > 0 && el.props.is_empty() {
-            return Err(ReadError::general(format!(
-                "element {} declares {} instances but has no properties",
-                el.name, el.count
-            )));
-        }
-        if el.count > body.remaining_bytes() {
-            return Err(ReadError::general(format!(
-                "element {} declares {} instances but only {} bytes of data remain",
-                el.name,
-                el.count,
-                body.remaining_bytes()
-            )));
-        }
-        let reserve = el.count;
-        match role {
-            Some(("vertex", _)) => positions.reserve(reserve),
-            Some(("face", _)) => face_sizes.reserve(reserve),
-            _ => {}
-        }
-        for k in 0..el.count {
-            values.clear();
-            list.clear();
-            for (pi, prop) in el.props.iter().enumerate() {
-                let what = || format!("{} {k} property {}", el.name, prop.name());
-                match prop {
-                    Property::Scalar(_, ty) => values.push(body.read(*ty, &what)?),
-                    Property::List(_, cty, ity) => {
-                        let n = body.read(*cty, &what)?;
-                        if n < 0.0 {
-                            return Err(err_at(body, format!("{}: negative list length", what())));
-                        }
-                        let n = n as usize;
-                        if n > body.remaining_bytes() {
-                            return Err(err_at(
-                                body,
-                                format!("{}: list length {n} exceeds the file", what()),
-                            ));
-                        }
-                        let keep = matches!(role, Some(("face", [i, _, _])) if i == pi);
-                        for _ in 0..n {
-                            let v = body.read(*ity, &what)?;
-                            if keep {
-                                list.push(v);
-                            }
-                        }
-                        values.push(f64::NAN);
-                    }
-                }
-            }
-            // The line of the instance's last value: where a text instance lives.
-            let line = body.line();
-            match role {
-                Some(("vertex", [x, y, z])) => {
-                    let p = DVec3::new(values[x], values[y], values[z]);
-                    if !p.is_finite() {
-                        return Err(err_at(
-                            body,
-                            format!("vertex {k} has a non-finite coordinate"),
-                        ));
-                    }
-                    positions.push(p);
-                    if let Some([u, v]) = uv_props {
-                        if !(values[u].is_finite() && values[v].is_finite()) {
-                            return Err(err_at(
-                                body,
-                                format!("vertex {k} has a non-finite texture coordinate"),
-                            ));
-                        }
-                        texcoords.extend([values[u], values[v]]);
-                    }
-                }
-                Some(("face", [_, level, _])) => {
-                    if level != usize::MAX {
-                        let l = values[level];
-                        if !(0.0..=255.0).contains(&l) || l.fract() != 0.0 {
-                            return Err(err_at(body, format!("face {k} has invalid level {l}")));
-                        }
-                        face_levels.push(l as u8);
-                    }
-                    if list.len() < 3 {
-                        return Err(err_at(
-                            body,
-                            format!(
-                                "face {k} has {} vertices; a face needs at least 3",
-                                list.len()
-                            ),
-                        ));
-                    }
-                    for &v in &list {
-                        if v < 0.0 || v.fract() != 0.0 || v >= u32::MAX as f64 {
-                            return Err(err_at(
-                                body,
-                                format!("face {k} has invalid vertex index {v}"),
-                            ));
-                        }
-                        face_vertices.push(v as u32);
-                    }
-                    face_sizes.push(list.len() as u32);
-                }
-                Some(("crease", [a, b, s])) => {
-                    creases.push((values[a], values[b], values[s], line))
-                }
-                Some(("corner", [a, s, _])) => corners.push((values[a], values[s], line)),
-                Some(("hole", [a, _, _])) => holes.push((values[a], line)),
-                _ => {}
-            }
-        }
+        })
     }
-    Ok(PlyData {
-        positions,
-        texcoords: uv_props.map(|_| texcoords),
-        face_sizes,
-        face_vertices,
-        face_levels,
-        creases,
-        corners,
-        holes,
-        have_vertex,
-        have_face,
-    })
+
+    /// Reads instance `k` of `el` into `values` (and a face's index list into `list`; other
+    /// lists are read past).
+    fn read_values(
+        &mut self,
+        el: &Element,
+        k: usize,
+        role: Option<Role>,
+        body: &mut Body<'_>,
+    ) -> Result<(), ReadError> {
+        self.values.clear();
+        self.list.clear();
+        for (pi, prop) in el.props.iter().enumerate() {
+            let what = || format!("{} {k} property {}", el.name, prop.name());
+            match prop {
+                Property::Scalar(_, ty) => self.values.push(body.read(*ty, &what)?),
+                Property::List(_, cty, ity) => {
+                    let n = body.read(*cty, &what)?;
+                    if n < 0.0 {
+                        return Err(err_at(body, format!("{}: negative list length", what())));
+                    }
+                    let n = n as usize;
+                    if n > body.remaining_bytes() {
+                        return Err(err_at(
+                            body,
+                            format!("{}: list length {n} exceeds the file", what()),
+                        ));
+                    }
+                    let keep = matches!(role, Some(Role::Face { list, .. }) if list == pi);
+                    for _ in 0..n {
+                        let v = body.read(*ity, &what)?;
+                        if keep {
+                            self.list.push(v);
+                        }
+                    }
+                    self.values.push(f64::NAN);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Keeps what instance `k`, just read, gives in its role.
+    fn keep_instance(
+        &mut self,
+        k: usize,
+        role: Option<Role>,
+        body: &Body<'_>,
+    ) -> Result<(), ReadError> {
+        // The line of the instance's last value: where a text instance lives.
+        let line = body.line();
+        let values = &self.values;
+        match role {
+            Some(Role::Vertex(xyz)) => self.keep_vertex(k, xyz, body)?,
+            Some(Role::Face { level, .. }) => self.keep_face(k, level, body)?,
+            Some(Role::Crease([a, b, s])) => {
+                self.d.creases.push((values[a], values[b], values[s], line))
+            }
+            Some(Role::Corner([a, s])) => self.d.corners.push((values[a], values[s], line)),
+            Some(Role::Hole(a)) => self.d.holes.push((values[a], line)),
+            None => {}
+        }
+        Ok(())
+    }
+
+    /// Keeps vertex `k`'s position and texture coordinates, which must be finite.
+    fn keep_vertex(
+        &mut self,
+        k: usize,
+        [x, y, z]: [usize; 3],
+        body: &Body<'_>,
+    ) -> Result<(), ReadError> {
+        let values = &self.values;
+        let p = DVec3::new(values[x], values[y], values[z]);
+        if !p.is_finite() {
+            return Err(err_at(
+                body,
+                format!("vertex {k} has a non-finite coordinate"),
+            ));
+        }
+        self.d.positions.push(p);
+        if let Some([u, v]) = self.uv_props {
+            if !(values[u].is_finite() && values[v].is_finite()) {
+                return Err(err_at(
+                    body,
+                    format!("vertex {k} has a non-finite texture coordinate"),
+                ));
+            }
+            self.texcoords.extend([values[u], values[v]]);
+        }
+        Ok(())
+    }
+
+    /// Keeps face `k`'s level (when `level` is a property) and its vertex indices, which
+    /// must be at least 3 valid `u32` indices.
+    fn keep_face(&mut self, k: usize, level: usize, body: &Body<'_>) -> Result<(), ReadError> {
+        if level != usize::MAX {
+            let l = self.values[level];
+            if !(0.0..=255.0).contains(&l) || l.fract() != 0.0 {
+                return Err(err_at(body, format!("face {k} has invalid level {l}")));
+            }
+            self.d.face_levels.push(l as u8);
+        }
+        let list = &self.list;
+        if list.len() < 3 {
+            return Err(err_at(
+                body,
+                format!(
+                    "face {k} has {} vertices; a face needs at least 3",
+                    list.len()
+                ),
+            ));
+        }
+        for &v in list {
+            if v < 0.0 || v.fract() != 0.0 || v >= u32::MAX as f64 {
+                return Err(err_at(
+                    body,
+                    format!("face {k} has invalid vertex index {v}"),
+                ));
+            }
+            self.d.face_vertices.push(v as u32);
+        }
+        self.d.face_sizes.push(list.len() as u32);
+        Ok(())
+    }
+}
+
+/// Refuses instance counts a body cannot hold. An instance with at least one property takes
+/// at least one byte, so a count beyond the remaining bytes is malformed. Checking it up
+/// front keeps a forged header from driving allocation or a long loop (found by fuzzing:
+/// `element crease 01569664312` with no properties spun for billions of empty iterations).
+fn check_instance_count(el: &Element, body: &Body<'_>) -> Result<(), ReadError> {
+    if el.count > 0 && el.props.is_empty() {
+        return Err(ReadError::general(format!(
+            "element {} declares {} instances but has no properties",
+            el.name, el.count
+        )));
+    }
+    if el.count > body.remaining_bytes() {
+        return Err(ReadError::general(format!(
+            "element {} declares {} instances but only {} bytes of data remain",
+            el.name,
+            el.count,
+            body.remaining_bytes()
+        )));
+    }
+    Ok(())
 }
 
 /// Checks that there are faces and that every face names an existing vertex.
@@ -723,17 +800,210 @@ pub fn write_ply(
     mesh: &MeshView<'_>,
     encoding: PlyEncoding,
 ) -> std::io::Result<()> {
-    let nv = mesh.num_vertices();
-    let (creases, corners) = (mesh.creases(), mesh.corners());
-    let holes = mesh.hole_faces();
-    let uv = per_vertex_uv(mesh)?;
-    let nf = mesh.num_faces();
-    let wide_lists = mesh.max_face_size() > 255;
-    let index_ty = if nv > i32::MAX as usize {
-        "uint"
-    } else {
-        "int"
-    };
+    let out = PlyOutput::of(mesh)?;
+    write_header_start(w, mesh, encoding)?;
+    out.write_element_declarations(w)?;
+    match encoding {
+        PlyEncoding::Ascii => out.write_ascii_body(w),
+        PlyEncoding::BinaryLittleEndian => out.write_binary_body(w),
+    }
+}
+
+/// What a PLY output holds besides positions and faces, and how it stores it.
+struct PlyOutput<'a> {
+    mesh: &'a MeshView<'a>,
+    normals: Option<&'a [DVec3]>,
+    /// One texture coordinate per vertex, when the mesh has them (and no seams).
+    uv: Option<Vec<[f64; 2]>>,
+    levels: Option<&'a [u8]>,
+    creases: &'a [([u32; 2], f32)],
+    corners: &'a [(u32, f32)],
+    holes: Vec<usize>,
+    /// Face sizes need a `uint` count (binary): a face has more than 255 vertices.
+    wide_lists: bool,
+    /// `int`, or `uint` for vertex indices beyond `i32`.
+    index_ty: &'static str,
+}
+
+impl<'a> PlyOutput<'a> {
+    fn of(mesh: &'a MeshView<'a>) -> std::io::Result<PlyOutput<'a>> {
+        let holes = mesh.hole_faces();
+        let uv = per_vertex_uv(mesh)?;
+        Ok(PlyOutput {
+            mesh,
+            normals: mesh.normals(),
+            uv,
+            levels: mesh.face_levels(),
+            creases: mesh.creases(),
+            corners: mesh.corners(),
+            holes,
+            wide_lists: mesh.max_face_size() > 255,
+            index_ty: if mesh.num_vertices() > i32::MAX as usize {
+                "uint"
+            } else {
+                "int"
+            },
+        })
+    }
+
+    /// The header from the elements on: vertex, face and tag elements, `end_header`.
+    fn write_element_declarations(&self, w: &mut dyn Write) -> std::io::Result<()> {
+        let index_ty = self.index_ty;
+        writeln!(w, "element vertex {}", self.mesh.num_vertices())?;
+        for c in ["x", "y", "z"] {
+            writeln!(w, "property double {c}")?;
+        }
+        if self.normals.is_some() {
+            for c in ["nx", "ny", "nz"] {
+                writeln!(w, "property double {c}")?;
+            }
+        }
+        if self.uv.is_some() {
+            writeln!(w, "property double u\nproperty double v")?;
+        }
+        writeln!(w, "element face {}", self.mesh.num_faces())?;
+        writeln!(
+            w,
+            "property list {} {index_ty} vertex_indices",
+            if self.wide_lists { "uint" } else { "uchar" }
+        )?;
+        if self.levels.is_some() {
+            writeln!(w, "property uchar level")?;
+        }
+        if !self.creases.is_empty() {
+            writeln!(w, "element crease {}", self.creases.len())?;
+            writeln!(
+                w,
+                "property {index_ty} v0\nproperty {index_ty} v1\nproperty float sharpness"
+            )?;
+        }
+        if !self.corners.is_empty() {
+            writeln!(w, "element corner {}", self.corners.len())?;
+            writeln!(w, "property {index_ty} vertex\nproperty float sharpness")?;
+        }
+        if !self.holes.is_empty() {
+            writeln!(w, "element hole {}", self.holes.len())?;
+            writeln!(w, "property int face")?;
+        }
+        writeln!(w, "end_header")
+    }
+
+    fn write_ascii_body(&self, w: &mut dyn Write) -> std::io::Result<()> {
+        let mesh = self.mesh;
+        let (normals, uv, levels) = (self.normals, &self.uv, self.levels);
+        write_windows(
+            w,
+            mesh.num_vertices(),
+            |r| mesh.point_window(r),
+            |points, i, b| {
+                let p = points.get(i);
+                let _ = write!(b, "{} {} {}", p.x, p.y, p.z);
+                if let Some(n) = normals {
+                    let n = n[i];
+                    let _ = write!(b, " {} {} {}", n.x, n.y, n.z);
+                }
+                if let Some(uv) = uv {
+                    let _ = write!(b, " {} {}", uv[i][0], uv[i][1]);
+                }
+                b.push(b'\n');
+            },
+        )?;
+        write_windows(
+            w,
+            mesh.num_faces(),
+            |r| mesh.face_window(r),
+            |faces, f, b| {
+                let fv = faces.face(f);
+                let _ = write!(b, "{}", fv.len());
+                for &v in fv {
+                    let _ = write!(b, " {v}");
+                }
+                if let Some(l) = levels {
+                    let _ = write!(b, " {}", l[f]);
+                }
+                b.push(b'\n');
+            },
+        )?;
+        for &([a, b], s) in self.creases {
+            writeln!(w, "{a} {b} {s}")?;
+        }
+        for &(v, s) in self.corners {
+            writeln!(w, "{v} {s}")?;
+        }
+        for &f in &self.holes {
+            writeln!(w, "{f}")?;
+        }
+        Ok(())
+    }
+
+    fn write_binary_body(&self, w: &mut dyn Write) -> std::io::Result<()> {
+        let mesh = self.mesh;
+        let (normals, uv, levels) = (self.normals, &self.uv, self.levels);
+        write_windows(
+            w,
+            mesh.num_vertices(),
+            |r| mesh.point_window(r),
+            |points, i, b| {
+                for c in points.get(i).to_array() {
+                    b.extend_from_slice(&c.to_le_bytes());
+                }
+                if let Some(n) = normals {
+                    for c in n[i].to_array() {
+                        b.extend_from_slice(&c.to_le_bytes());
+                    }
+                }
+                if let Some(uv) = uv {
+                    for c in uv[i] {
+                        b.extend_from_slice(&c.to_le_bytes());
+                    }
+                }
+            },
+        )?;
+        let wide_lists = self.wide_lists;
+        write_windows(
+            w,
+            mesh.num_faces(),
+            |r| mesh.face_window(r),
+            |faces, f, b| {
+                let fv = faces.face(f);
+                if wide_lists {
+                    b.extend_from_slice(&(fv.len() as u32).to_le_bytes());
+                } else {
+                    b.push(fv.len() as u8);
+                }
+                for &v in fv {
+                    b.extend_from_slice(&v.to_le_bytes());
+                }
+                if let Some(l) = levels {
+                    b.push(l[f]);
+                }
+            },
+        )?;
+        // The tag elements are few: encoded in one buffer, written at once.
+        let mut buf: Vec<u8> = Vec::new();
+        for &([a, b], s) in self.creases {
+            buf.extend_from_slice(&a.to_le_bytes());
+            buf.extend_from_slice(&b.to_le_bytes());
+            buf.extend_from_slice(&s.to_le_bytes());
+        }
+        for &(v, s) in self.corners {
+            buf.extend_from_slice(&v.to_le_bytes());
+            buf.extend_from_slice(&s.to_le_bytes());
+        }
+        for &f in &self.holes {
+            buf.extend_from_slice(&(f as u32).to_le_bytes());
+        }
+        w.write_all(&buf)
+    }
+}
+
+/// The header up to the elements: magic, format, and the comments that carry the mesh's
+/// scheme hints.
+fn write_header_start(
+    w: &mut dyn Write,
+    mesh: &MeshView<'_>,
+    encoding: PlyEncoding,
+) -> std::io::Result<()> {
     writeln!(w, "ply")?;
     writeln!(
         w,
@@ -769,128 +1039,6 @@ pub fn write_ply(
             "catmark"
         };
         writeln!(w, "comment subd smoothtriangles {s}")?;
-    }
-    writeln!(w, "element vertex {nv}")?;
-    for c in ["x", "y", "z"] {
-        writeln!(w, "property double {c}")?;
-    }
-    let normals = mesh.normals();
-    if normals.is_some() {
-        for c in ["nx", "ny", "nz"] {
-            writeln!(w, "property double {c}")?;
-        }
-    }
-    if uv.is_some() {
-        writeln!(w, "property double u\nproperty double v")?;
-    }
-    writeln!(w, "element face {nf}")?;
-    writeln!(
-        w,
-        "property list {} {index_ty} vertex_indices",
-        if wide_lists { "uint" } else { "uchar" }
-    )?;
-    let levels = mesh.face_levels();
-    if levels.is_some() {
-        writeln!(w, "property uchar level")?;
-    }
-    if !creases.is_empty() {
-        writeln!(w, "element crease {}", creases.len())?;
-        writeln!(
-            w,
-            "property {index_ty} v0\nproperty {index_ty} v1\nproperty float sharpness"
-        )?;
-    }
-    if !corners.is_empty() {
-        writeln!(w, "element corner {}", corners.len())?;
-        writeln!(w, "property {index_ty} vertex\nproperty float sharpness")?;
-    }
-    if !holes.is_empty() {
-        writeln!(w, "element hole {}", holes.len())?;
-        writeln!(w, "property int face")?;
-    }
-    writeln!(w, "end_header")?;
-    let points = |r| mesh.point_window(r);
-    let faces = |r| mesh.face_window(r);
-    match encoding {
-        PlyEncoding::Ascii => {
-            write_windows(w, nv, points, |points, i, b| {
-                let p = points.get(i);
-                let _ = write!(b, "{} {} {}", p.x, p.y, p.z);
-                if let Some(n) = normals {
-                    let n = n[i];
-                    let _ = write!(b, " {} {} {}", n.x, n.y, n.z);
-                }
-                if let Some(uv) = &uv {
-                    let _ = write!(b, " {} {}", uv[i][0], uv[i][1]);
-                }
-                b.push(b'\n');
-            })?;
-            write_windows(w, nf, faces, |faces, f, b| {
-                let fv = faces.face(f);
-                let _ = write!(b, "{}", fv.len());
-                for &v in fv {
-                    let _ = write!(b, " {v}");
-                }
-                if let Some(l) = levels {
-                    let _ = write!(b, " {}", l[f]);
-                }
-                b.push(b'\n');
-            })?;
-            for &([a, b], s) in creases {
-                writeln!(w, "{a} {b} {s}")?;
-            }
-            for &(v, s) in corners {
-                writeln!(w, "{v} {s}")?;
-            }
-            for &f in &holes {
-                writeln!(w, "{f}")?;
-            }
-        }
-        PlyEncoding::BinaryLittleEndian => {
-            write_windows(w, nv, points, |points, i, b| {
-                for c in points.get(i).to_array() {
-                    b.extend_from_slice(&c.to_le_bytes());
-                }
-                if let Some(n) = normals {
-                    for c in n[i].to_array() {
-                        b.extend_from_slice(&c.to_le_bytes());
-                    }
-                }
-                if let Some(uv) = &uv {
-                    for c in uv[i] {
-                        b.extend_from_slice(&c.to_le_bytes());
-                    }
-                }
-            })?;
-            write_windows(w, nf, faces, |faces, f, b| {
-                let fv = faces.face(f);
-                if wide_lists {
-                    b.extend_from_slice(&(fv.len() as u32).to_le_bytes());
-                } else {
-                    b.push(fv.len() as u8);
-                }
-                for &v in fv {
-                    b.extend_from_slice(&v.to_le_bytes());
-                }
-                if let Some(l) = levels {
-                    b.push(l[f]);
-                }
-            })?;
-            let mut buf: Vec<u8> = Vec::new();
-            for &([a, b], s) in creases {
-                buf.extend_from_slice(&a.to_le_bytes());
-                buf.extend_from_slice(&b.to_le_bytes());
-                buf.extend_from_slice(&s.to_le_bytes());
-            }
-            for &(v, s) in corners {
-                buf.extend_from_slice(&v.to_le_bytes());
-                buf.extend_from_slice(&s.to_le_bytes());
-            }
-            for &f in &holes {
-                buf.extend_from_slice(&(f as u32).to_le_bytes());
-            }
-            w.write_all(&buf)?;
-        }
     }
     Ok(())
 }

@@ -1,5 +1,6 @@
 //! Building a [`Topology`] from face-vertex lists in O(V + E + F).
 
+use crate::csr::{RowSlots, group_by_key, offsets_of_keys};
 use crate::error::{BuildWarning, TopologyError};
 use crate::tags::Tags;
 use crate::topology::MAX_FACE_SIZE;
@@ -60,60 +61,139 @@ impl TopologyBuilder {
         face_vertices: &[u32],
     ) -> Result<(Topology, Vec<BuildWarning>), TopologyError> {
         let nv = self.num_vertices;
-        if nv >= NONE as usize {
-            return Err(TopologyError::TooLarge {
-                what: "vertex",
-                count: nv,
-            });
-        }
-        if face_vertices.len() >= NONE as usize || face_sizes.len() >= NONE as usize {
-            return Err(TopologyError::TooLarge {
-                what: "face-vertex",
-                count: face_vertices.len(),
-            });
-        }
+        check_index_range(nv, face_sizes, face_vertices)?;
+        let face_offsets = checked_face_offsets(face_sizes, face_vertices.len())?;
+        let faces = FaceLoops {
+            offsets: &face_offsets,
+            vertices: face_vertices,
+        };
         let mut warnings = Vec::new();
-
-        // Face offsets and index validation.
-        let mut face_offsets = Vec::with_capacity(face_sizes.len() + 1);
-        face_offsets.push(0u32);
-        let mut total: usize = 0;
-        for (f, &n) in face_sizes.iter().enumerate() {
-            if n < 3 {
-                return Err(TopologyError::FaceTooSmall {
-                    face: f,
-                    size: n as usize,
-                });
-            }
-            if n as usize > MAX_FACE_SIZE {
-                return Err(TopologyError::FaceTooLarge {
-                    face: f,
-                    size: n as usize,
-                    max: MAX_FACE_SIZE,
-                });
-            }
-            total += n as usize;
-            if total > face_vertices.len() {
-                return Err(TopologyError::FaceVertexCountMismatch {
-                    expected: face_sizes.iter().map(|&s| s as usize).sum(),
-                    actual: face_vertices.len(),
-                });
-            }
-            face_offsets.push(total as u32);
-        }
-        if total != face_vertices.len() {
-            return Err(TopologyError::FaceVertexCountMismatch {
-                expected: total,
-                actual: face_vertices.len(),
-            });
-        }
-        let nf = face_sizes.len();
         // `stamp[v]` remembers the last face (or bucket) that touched `v`; it replaces a hash
         // set so that repeated-vertex detection and edge matching stay linear.
         let mut stamp = vec![NONE; nv];
-        for f in 0..nf {
-            let fv = &face_vertices[face_offsets[f] as usize..face_offsets[f + 1] as usize];
-            for (corner, &v) in fv.iter().enumerate() {
+        faces.check_vertices(nv, &mut stamp, &mut warnings)?;
+        let half_face = faces.half_faces();
+        let first_half = faces.first_halves(nv, &half_face, &mut stamp);
+        let numbering = EdgeNumbering::number(
+            &faces,
+            &half_face,
+            &first_half,
+            self.accept_inconsistent_orientation,
+            &mut warnings,
+        )?;
+        drop(first_half);
+        drop(half_face);
+        let topo = assemble(
+            nv,
+            face_offsets,
+            face_vertices.to_vec(),
+            numbering.face_edges,
+            numbering.edge_vertices,
+            numbering.edge_flags,
+        );
+        Ok((topo, warnings))
+    }
+}
+
+/// Refuses counts that do not fit the `u32` indices (with `NONE` kept free).
+fn check_index_range(
+    nv: usize,
+    face_sizes: &[u32],
+    face_vertices: &[u32],
+) -> Result<(), TopologyError> {
+    if nv >= NONE as usize {
+        return Err(TopologyError::TooLarge {
+            what: "vertex",
+            count: nv,
+        });
+    }
+    if face_vertices.len() >= NONE as usize || face_sizes.len() >= NONE as usize {
+        return Err(TopologyError::TooLarge {
+            what: "face-vertex",
+            count: face_vertices.len(),
+        });
+    }
+    Ok(())
+}
+
+/// Face offsets from face sizes, refusing faces too small or too large and sizes that do not
+/// add up to the `num_face_vertices` given.
+fn checked_face_offsets(
+    face_sizes: &[u32],
+    num_face_vertices: usize,
+) -> Result<Vec<u32>, TopologyError> {
+    let mut face_offsets = Vec::with_capacity(face_sizes.len() + 1);
+    face_offsets.push(0u32);
+    let mut total: usize = 0;
+    for (f, &n) in face_sizes.iter().enumerate() {
+        if n < 3 {
+            return Err(TopologyError::FaceTooSmall {
+                face: f,
+                size: n as usize,
+            });
+        }
+        if n as usize > MAX_FACE_SIZE {
+            return Err(TopologyError::FaceTooLarge {
+                face: f,
+                size: n as usize,
+                max: MAX_FACE_SIZE,
+            });
+        }
+        total += n as usize;
+        if total > num_face_vertices {
+            return Err(TopologyError::FaceVertexCountMismatch {
+                expected: face_sizes.iter().map(|&s| s as usize).sum(),
+                actual: num_face_vertices,
+            });
+        }
+        face_offsets.push(total as u32);
+    }
+    if total != num_face_vertices {
+        return Err(TopologyError::FaceVertexCountMismatch {
+            expected: total,
+            actual: num_face_vertices,
+        });
+    }
+    Ok(face_offsets)
+}
+
+/// The faces as closed loops of face-vertices ("half-edges": face-vertex `h` starts the
+/// half-edge to the next vertex of its face).
+struct FaceLoops<'a> {
+    offsets: &'a [u32],
+    vertices: &'a [u32],
+}
+
+impl FaceLoops<'_> {
+    fn num_faces(&self) -> usize {
+        self.offsets.len() - 1
+    }
+
+    fn range(&self, f: usize) -> std::ops::Range<usize> {
+        self.offsets[f] as usize..self.offsets[f + 1] as usize
+    }
+
+    /// The vertices at the two ends of half-edge `h` of face `f`.
+    #[inline]
+    fn ends(&self, f: usize, h: usize) -> (u32, u32) {
+        let end = self.offsets[f + 1] as usize;
+        let next = if h + 1 == end {
+            self.offsets[f] as usize
+        } else {
+            h + 1
+        };
+        (self.vertices[h], self.vertices[next])
+    }
+
+    /// Refuses vertex indices out of range; warns about faces that repeat a vertex.
+    fn check_vertices(
+        &self,
+        nv: usize,
+        stamp: &mut [u32],
+        warnings: &mut Vec<BuildWarning>,
+    ) -> Result<(), TopologyError> {
+        for f in 0..self.num_faces() {
+            for (corner, &v) in self.vertices[self.range(f)].iter().enumerate() {
                 if v as usize >= nv {
                     return Err(TopologyError::VertexIndexOutOfRange {
                         face: f,
@@ -128,55 +208,35 @@ impl TopologyBuilder {
                 stamp[v as usize] = f as u32;
             }
         }
+        Ok(())
+    }
 
-        let nh = face_vertices.len();
-        let next_in_face = |f: usize, h: usize| -> usize {
-            let end = face_offsets[f + 1] as usize;
-            if h + 1 == end {
-                face_offsets[f] as usize
-            } else {
-                h + 1
-            }
-        };
+    /// The face of every half-edge.
+    fn half_faces(&self) -> Vec<u32> {
+        let mut half_face = vec![0u32; self.vertices.len()];
+        for f in 0..self.num_faces() {
+            half_face[self.range(f)].fill(f as u32);
+        }
+        half_face
+    }
 
-        // Pass 1: for every non-degenerate half-edge, the first half-edge (in face order)
-        // joining the same unordered vertex pair. Half-edges are bucketed by their smaller
-        // vertex with a stable counting sort, then matched on the larger vertex.
-        let mut bucket_offsets = vec![0u32; nv + 1];
-        let mut half_face = vec![0u32; nh];
-        for f in 0..nf {
-            for h in face_offsets[f] as usize..face_offsets[f + 1] as usize {
-                half_face[h] = f as u32;
-                let (a, b) = (face_vertices[h], face_vertices[next_in_face(f, h)]);
-                if a != b {
-                    bucket_offsets[a.min(b) as usize + 1] += 1;
-                }
-            }
-        }
-        for i in 0..nv {
-            bucket_offsets[i + 1] += bucket_offsets[i];
-        }
-        let mut bucket = vec![0u32; bucket_offsets[nv] as usize];
-        {
-            let mut fill = bucket_offsets.clone();
-            for h in 0..nh {
-                let f = half_face[h] as usize;
-                let (a, b) = (face_vertices[h], face_vertices[next_in_face(f, h)]);
-                if a != b {
-                    let slot = &mut fill[a.min(b) as usize];
-                    bucket[*slot as usize] = h as u32;
-                    *slot += 1;
-                }
-            }
-        }
-        let mut first_half = vec![NONE; nh];
+    /// Pass 1 of the build: for every non-degenerate half-edge, the first half-edge (in face
+    /// order) joining the same unordered vertex pair. Half-edges are bucketed by their
+    /// smaller vertex with a stable counting sort, then matched on the larger vertex
+    /// (`stamp` is scratch space of one entry per vertex).
+    fn first_halves(&self, nv: usize, half_face: &[u32], stamp: &mut [u32]) -> Vec<u32> {
+        let non_degenerate_by_smaller_end = (0..self.vertices.len()).filter_map(|h| {
+            let (a, b) = self.ends(half_face[h] as usize, h);
+            (a != b).then_some((a.min(b), h as u32))
+        });
+        let buckets = group_by_key(nv, non_degenerate_by_smaller_end);
+        let mut first_half = vec![NONE; self.vertices.len()];
         stamp.fill(NONE);
         let mut first_of = vec![0u32; nv];
         for a in 0..nv {
-            for &h in &bucket[bucket_offsets[a] as usize..bucket_offsets[a + 1] as usize] {
+            for &h in buckets.row(a) {
                 let h = h as usize;
-                let f = half_face[h] as usize;
-                let (x, y) = (face_vertices[h], face_vertices[next_in_face(f, h)]);
+                let (x, y) = self.ends(half_face[h] as usize, h);
                 let b = x.max(y) as usize;
                 if stamp[b] != a as u32 {
                     stamp[b] = a as u32;
@@ -185,78 +245,101 @@ impl TopologyBuilder {
                 first_half[h] = first_of[b];
             }
         }
-        drop(bucket);
-        drop(bucket_offsets);
-        drop(first_of);
+        first_half
+    }
+}
 
-        // Pass 2: number the edges by first appearance, following OpenSubdiv's rules for
-        // non-manifold cases (Vtr::Level::completeTopologyFromFaceVertices).
-        let mut face_edges = vec![0u32; nh];
-        let mut edge_vertices: Vec<[u32; 2]> = Vec::with_capacity(nh / 2 + 16);
-        let mut edge_face_count: Vec<u32> = Vec::with_capacity(nh / 2 + 16);
-        let mut edge_last_face: Vec<u32> = Vec::with_capacity(nh / 2 + 16);
-        let mut edge_flags: Vec<u8> = Vec::with_capacity(nh / 2 + 16);
+/// Pass 2 of the build: the edges numbered by first appearance, following OpenSubdiv's rules
+/// for non-manifold cases (Vtr::Level::completeTopologyFromFaceVertices).
+struct EdgeNumbering {
+    face_edges: Vec<u32>,
+    edge_vertices: Vec<[u32; 2]>,
+    edge_flags: Vec<u8>,
+    edge_face_count: Vec<u32>,
+    edge_last_face: Vec<u32>,
+}
+
+impl EdgeNumbering {
+    fn number(
+        faces: &FaceLoops<'_>,
+        half_face: &[u32],
+        first_half: &[u32],
+        accept_inconsistent_orientation: bool,
+        warnings: &mut Vec<BuildWarning>,
+    ) -> Result<EdgeNumbering, TopologyError> {
+        let nh = faces.vertices.len();
+        let mut n = EdgeNumbering {
+            face_edges: vec![0u32; nh],
+            edge_vertices: Vec::with_capacity(nh / 2 + 16),
+            edge_flags: Vec::with_capacity(nh / 2 + 16),
+            edge_face_count: Vec::with_capacity(nh / 2 + 16),
+            edge_last_face: Vec::with_capacity(nh / 2 + 16),
+        };
         for h in 0..nh {
             let f = half_face[h];
-            let (v0, v1) = (face_vertices[h], face_vertices[next_in_face(f as usize, h)]);
+            let (v0, v1) = faces.ends(f as usize, h);
             let mut edge = NONE;
             let mut new_flags = 0u8;
             if v0 == v1 {
                 new_flags = EDGE_NON_MANIFOLD | EDGE_DEGENERATE;
             } else if first_half[h] != h as u32 {
-                let e = face_edges[first_half[h] as usize] as usize;
-                if edge_last_face[e] == f {
+                let e = n.face_edges[first_half[h] as usize] as usize;
+                if n.edge_last_face[e] == f {
                     // The pair occurs twice in this face: a new, non-manifold instance.
-                    edge_flags[e] |= EDGE_NON_MANIFOLD;
+                    n.edge_flags[e] |= EDGE_NON_MANIFOLD;
                     new_flags = EDGE_NON_MANIFOLD;
                 } else {
-                    if edge_face_count[e] > 1 {
-                        edge_flags[e] |= EDGE_NON_MANIFOLD;
-                    } else if v0 == edge_vertices[e][0] {
-                        let first_face = edge_last_face[e] as usize;
-                        if !self.accept_inconsistent_orientation {
-                            return Err(TopologyError::InconsistentOrientation {
-                                first_face,
-                                second_face: f as usize,
-                                v0,
-                                v1,
-                            });
-                        }
-                        warnings.push(BuildWarning::InconsistentOrientation {
-                            first_face,
-                            second_face: f as usize,
-                            v0,
-                            v1,
-                        });
-                        edge_flags[e] |= EDGE_NON_MANIFOLD;
-                    }
-                    edge_face_count[e] += 1;
-                    edge_last_face[e] = f;
+                    n.add_face(e, f, v0, v1, accept_inconsistent_orientation, warnings)?;
                     edge = e as u32;
                 }
             }
             if edge == NONE {
-                edge = edge_vertices.len() as u32;
-                edge_vertices.push([v0, v1]);
-                edge_face_count.push(1);
-                edge_last_face.push(f);
-                edge_flags.push(new_flags);
+                edge = n.edge_vertices.len() as u32;
+                n.edge_vertices.push([v0, v1]);
+                n.edge_face_count.push(1);
+                n.edge_last_face.push(f);
+                n.edge_flags.push(new_flags);
             }
-            face_edges[h] = edge;
+            n.face_edges[h] = edge;
         }
-        drop(first_half);
-        drop(edge_last_face);
-        drop(edge_face_count);
-        drop(half_face);
-        let topo = assemble(
-            nv,
-            face_offsets,
-            face_vertices.to_vec(),
-            face_edges,
-            edge_vertices,
-            edge_flags,
-        );
-        Ok((topo, warnings))
+        Ok(n)
+    }
+
+    /// Adds face `f`, traversing `v0 -> v1`, to edge `e` that an earlier face already has:
+    /// a third face makes it non-manifold, and so does a second face in the same direction
+    /// (an orientation conflict, refused unless accepted).
+    fn add_face(
+        &mut self,
+        e: usize,
+        f: u32,
+        v0: u32,
+        v1: u32,
+        accept_inconsistent_orientation: bool,
+        warnings: &mut Vec<BuildWarning>,
+    ) -> Result<(), TopologyError> {
+        if self.edge_face_count[e] > 1 {
+            self.edge_flags[e] |= EDGE_NON_MANIFOLD;
+        } else if v0 == self.edge_vertices[e][0] {
+            let first_face = self.edge_last_face[e] as usize;
+            if !accept_inconsistent_orientation {
+                return Err(TopologyError::InconsistentOrientation {
+                    first_face,
+                    second_face: f as usize,
+                    v0,
+                    v1,
+                });
+            }
+            warnings.push(BuildWarning::InconsistentOrientation {
+                first_face,
+                second_face: f as usize,
+                v0,
+                v1,
+            });
+            self.edge_flags[e] |= EDGE_NON_MANIFOLD;
+        }
+        self.edge_face_count[e] += 1;
+        self.edge_last_face[e] = f;
+        Ok(())
     }
 }
 
@@ -385,92 +468,94 @@ pub(crate) fn assemble(
     mut edge_flags: Vec<u8>,
 ) -> Topology {
     let nf = face_offsets.len() - 1;
-    let nh = face_vertices.len();
     let ne = edge_vertices.len();
-    let mut half_face = vec![0u32; nh];
-    for f in 0..nf {
-        half_face[face_offsets[f] as usize..face_offsets[f + 1] as usize].fill(f as u32);
-    }
-    let mut edge_face_count = vec![0u32; ne];
-    for &e in &face_edges {
-        edge_face_count[e as usize] += 1;
-    }
-    for (e, &c) in edge_face_count.iter().enumerate() {
-        if c > 2 {
-            edge_flags[e] |= EDGE_NON_MANIFOLD;
-        }
-    }
-
-    // Edge -> faces, in face order, with the edge's position in each face.
-    let mut edge_face_offsets = Vec::with_capacity(ne + 1);
-    edge_face_offsets.push(0u32);
-    let mut acc = 0u32;
-    for &c in &edge_face_count {
-        acc += c;
-        edge_face_offsets.push(acc);
-    }
-    let mut edge_faces = vec![0u32; nh];
-    let mut edge_face_local = vec![0u16; nh];
-    {
-        let mut fill = edge_face_offsets.clone();
-        for h in 0..nh {
-            let f = half_face[h];
-            let e = face_edges[h] as usize;
-            let slot = fill[e] as usize;
-            edge_faces[slot] = f;
-            edge_face_local[slot] = (h - face_offsets[f as usize] as usize) as u16;
-            fill[e] += 1;
-        }
-    }
-    for (e, &c) in edge_face_count.iter().enumerate() {
-        if c == 1 {
-            edge_flags[e] |= EDGE_BOUNDARY;
-        }
-    }
-
-    // Vertex -> faces (face order for now, with the corner index).
-    let mut vertex_face_offsets = vec![0u32; nv + 1];
-    for &v in &face_vertices {
-        vertex_face_offsets[v as usize + 1] += 1;
-    }
-    for i in 0..nv {
-        vertex_face_offsets[i + 1] += vertex_face_offsets[i];
-    }
-    let mut vertex_faces = vec![0u32; nh];
-    let mut vertex_face_local = vec![0u16; nh];
-    {
-        let mut fill = vertex_face_offsets.clone();
-        for h in 0..nh {
-            let v = face_vertices[h] as usize;
-            let f = half_face[h];
-            let slot = fill[v] as usize;
-            vertex_faces[slot] = f;
-            vertex_face_local[slot] = (h - face_offsets[f as usize] as usize) as u16;
-            fill[v] += 1;
-        }
-    }
-
+    let faces = FaceLoops {
+        offsets: &face_offsets,
+        vertices: &face_vertices,
+    };
+    let half_face = faces.half_faces();
+    // Edge -> faces and vertex -> faces, in face order (vertex fans are ordered below), with
+    // the edge's or vertex's position in each face.
+    let (edge_face_offsets, edge_faces, edge_face_local) =
+        faces_by_key(ne, &face_edges, &half_face, &face_offsets);
+    flag_edges_by_face_count(&edge_face_offsets, &mut edge_flags);
+    let (vertex_face_offsets, vertex_faces, vertex_face_local) =
+        faces_by_key(nv, &face_vertices, &half_face, &face_offsets);
+    drop(half_face);
     // Vertex -> edges in creation order (a degenerate edge appears twice at its vertex).
-    let mut vertex_edge_offsets = vec![0u32; nv + 1];
-    for &[a, b] in &edge_vertices {
-        vertex_edge_offsets[a as usize + 1] += 1;
-        vertex_edge_offsets[b as usize + 1] += 1;
+    let vertex_edges = group_by_key(
+        nv,
+        (0..ne as u32).flat_map(|e| {
+            let [a, b] = edge_vertices[e as usize];
+            [(a, e), (b, e)]
+        }),
+    );
+    let vertex_flags = vertex_flags(nv, &edge_vertices, &edge_flags, &vertex_face_offsets);
+    let mut topo = Topology {
+        num_vertices: nv as u32,
+        face_offsets,
+        face_vertices,
+        face_edges,
+        edge_vertices,
+        edge_face_offsets,
+        edge_faces,
+        edge_face_local,
+        vertex_face_offsets,
+        vertex_faces,
+        vertex_face_local,
+        vertex_edge_offsets: vertex_edges.offsets,
+        vertex_edges: vertex_edges.values,
+        edge_flags,
+        vertex_flags,
+        tags: Tags::new(nv, ne, nf),
+    };
+    topo.order_vertex_fans();
+    topo
+}
+
+/// The faces of each of `num_rows` keys, where face-vertex `h` belongs to row `keys[h]`
+/// (its edge or its vertex), in face order: offsets, faces, and the face-vertex's position
+/// in its face.
+fn faces_by_key(
+    num_rows: usize,
+    keys: &[u32],
+    half_face: &[u32],
+    face_offsets: &[u32],
+) -> (Vec<u32>, Vec<u32>, Vec<u16>) {
+    let offsets = offsets_of_keys(num_rows, keys.iter().copied());
+    let mut faces = vec![0u32; keys.len()];
+    let mut local = vec![0u16; keys.len()];
+    let mut slots = RowSlots::new(&offsets);
+    for (h, &key) in keys.iter().enumerate() {
+        let f = half_face[h];
+        let slot = slots.take(key as usize);
+        faces[slot] = f;
+        local[slot] = (h - face_offsets[f as usize] as usize) as u16;
     }
-    for i in 0..nv {
-        vertex_edge_offsets[i + 1] += vertex_edge_offsets[i];
-    }
-    let mut vertex_edges = vec![0u32; vertex_edge_offsets[nv] as usize];
-    {
-        let mut fill = vertex_edge_offsets.clone();
-        for (e, &[a, b]) in edge_vertices.iter().enumerate() {
-            for v in [a, b] {
-                vertex_edges[fill[v as usize] as usize] = e as u32;
-                fill[v as usize] += 1;
-            }
+    (offsets, faces, local)
+}
+
+/// Flags edges with one face as boundary and edges with more than two as non-manifold.
+fn flag_edges_by_face_count(edge_face_offsets: &[u32], edge_flags: &mut [u8]) {
+    for (e, fl) in edge_flags.iter_mut().enumerate() {
+        let count = edge_face_offsets[e + 1] - edge_face_offsets[e];
+        if count > 2 {
+            *fl |= EDGE_NON_MANIFOLD;
+        }
+        if count == 1 {
+            *fl |= EDGE_BOUNDARY;
         }
     }
+}
 
-    // Vertex flags.
+/// Vertex flags: boundary and non-manifold from the vertex's edges, isolated when no face
+/// uses it.
+fn vertex_flags(
+    nv: usize,
+    edge_vertices: &[[u32; 2]],
+    edge_flags: &[u8],
+    vertex_face_offsets: &[u32],
+) -> Vec<u8> {
     let mut vertex_flags = vec![0u8; nv];
     for (e, &[a, b]) in edge_vertices.iter().enumerate() {
         let fl = edge_flags[e];
@@ -489,27 +574,7 @@ pub(crate) fn assemble(
             vertex_flags[v] |= VERTEX_ISOLATED;
         }
     }
-
-    let mut topo = Topology {
-        num_vertices: nv as u32,
-        face_offsets,
-        face_vertices,
-        face_edges,
-        edge_vertices,
-        edge_face_offsets,
-        edge_faces,
-        edge_face_local,
-        vertex_face_offsets,
-        vertex_faces,
-        vertex_face_local,
-        vertex_edge_offsets,
-        vertex_edges,
-        edge_flags,
-        vertex_flags,
-        tags: Tags::new(nv, ne, nf),
-    };
-    topo.order_vertex_fans();
-    topo
+    vertex_flags
 }
 
 impl Topology {
