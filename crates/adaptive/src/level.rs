@@ -184,144 +184,20 @@ impl SparseLevel {
     ) -> Result<SparseLevel, AdaptiveError> {
         self.vertex_child.fill(NONE);
         self.edge_child.fill(NONE);
-        let t = &self.topology;
-        let nf = t.num_faces();
-        // The piece: every face sharing a vertex with a refined face.
-        let mut touched = vec![false; t.num_vertices()];
-        for f in (0..nf).filter(|&f| self.refined[f]) {
-            for &v in t.face_vertices(f) {
-                touched[v as usize] = true;
-            }
-        }
-        let piece_faces: Vec<u32> = (0..nf as u32)
-            .filter(|&f| {
-                t.face_vertices(f as usize)
-                    .iter()
-                    .any(|&v| touched[v as usize])
-            })
-            .collect();
+        let piece_faces = self.refined_piece();
         let (cut, rules, points) = self.piece(&piece_faces);
-        let (pnv, pnf, pnh) = (
-            cut.topology.num_vertices(),
-            cut.topology.num_faces(),
-            cut.topology.num_face_vertices(),
-        );
-        let piece_offsets = cut.topology.face_offsets().to_vec();
-        let r = Refinement::from_prepared(cut.topology, rules, scheme.clone(), options, 1)?;
+        let (piece, piece_topology) = Piece::new(cut, piece_faces, *scheme == Scheme::Loop);
+        let r = Refinement::from_prepared(piece_topology, rules, scheme.clone(), options, 1)?;
         let child_points = r.refine_points(&points).pop().expect("one level");
-        let c = r.topology(1);
         let child_rules = r.vertex_rules(1);
-        let loop_scheme = *scheme == Scheme::Loop;
-        let edge_point_base = if loop_scheme { pnv } else { pnv + pnf };
-        let half_base = if loop_scheme { 3 * pnf } else { pnh };
-
-        // The kept child faces: children of refined faces, in parent order.
-        let mut kept = Vec::new();
-        let mut kept_parent = Vec::new();
-        let mut kept_k = Vec::new();
-        for (pi, &f) in piece_faces.iter().enumerate() {
-            if !self.refined[f as usize] {
-                continue;
-            }
-            let children = if loop_scheme {
-                4 * pi..4 * pi + 4
-            } else {
-                piece_offsets[pi] as usize..piece_offsets[pi + 1] as usize
-            };
-            for (k, cf) in children.enumerate() {
-                kept.push(cf as u32);
-                kept_parent.push((pi as u32, f));
-                kept_k.push(k);
-            }
-        }
-        let next = submesh::cut(c, &kept);
-
-        // Vertices: uniform index, ring size in the uniform level, origin.
-        let nv = next.vertices.len();
-        let mut vertex_key = Vec::with_capacity(nv);
-        let mut vertex_full = Vec::with_capacity(nv);
-        let mut vertex_origin = Vec::with_capacity(nv);
-        for (i, &cv) in next.vertices.iter().enumerate() {
-            let cv = cv as usize;
-            if cv < pnv {
-                let v = cut.vertices[cv];
-                vertex_key.push(self.vertex_key[v as usize]);
-                vertex_full.push(self.vertex_full[v as usize]);
-                vertex_origin.push(Origin::Vertex(v));
-                self.vertex_child[v as usize] = i as u32;
-            } else if cv < edge_point_base {
-                let f = piece_faces[cv - pnv];
-                vertex_key.push(uniform.face_point(level - 1, self.face_key[f as usize]));
-                vertex_full.push(self.topology.face_size(f as usize) as u32);
-                vertex_origin.push(Origin::Face(f));
-            } else {
-                let e = cut.edges[cv - edge_point_base];
-                vertex_key.push(uniform.edge_point(level - 1, self.edge_key[e as usize]));
-                vertex_full.push(uniform.edge_point_faces(self.edge_full[e as usize]));
-                vertex_origin.push(Origin::Edge(e));
-                self.edge_child[e as usize] = i as u32;
-            }
-        }
-        // Edges: interior edges of a piece face, or halves of a piece edge.
-        let mut edge_key = Vec::with_capacity(next.edges.len());
-        let mut edge_full = Vec::with_capacity(next.edges.len());
-        for &ce in &next.edges {
-            let ce = ce as usize;
-            if ce < half_base {
-                let (pi, j) = if loop_scheme {
-                    (ce / 3, ce % 3)
-                } else {
-                    let pi = piece_offsets.partition_point(|&o| o as usize <= ce) - 1;
-                    (pi, ce - piece_offsets[pi] as usize)
-                };
-                let f = piece_faces[pi] as usize;
-                edge_key.push(uniform.interior_edge(level - 1, self.face_key[f], j));
-                edge_full.push(2);
-            } else {
-                let h = ce - half_base;
-                let e = cut.edges[h / 2] as usize;
-                edge_key.push(uniform.half_edge(level - 1, self.edge_key[e], (h % 2) as u32));
-                edge_full.push(self.edge_full[e]);
-            }
-        }
-        // Faces: uniform index and parameter domain.
-        let mut face_key = Vec::with_capacity(kept.len());
-        let mut face_parent = Vec::with_capacity(kept.len());
-        let mut base_face = Vec::with_capacity(kept.len());
-        let mut sub_face = Vec::with_capacity(kept.len());
-        let mut corner_params = Vec::with_capacity(4 * kept.len());
-        for (&(_, f), &k) in kept_parent.iter().zip(&kept_k) {
-            let f = f as usize;
-            face_key.push(uniform.child_face(level - 1, self.face_key[f], k));
-            face_parent.push(f as u32);
-            base_face.push(self.base_face[f]);
-            let d = self.params(f);
-            if loop_scheme {
-                sub_face.push(0);
-                let m = |a: usize, b: usize| mid(d[a], d[b]);
-                corner_params.extend(match k {
-                    0 => [d[0], m(0, 1), m(2, 0)],
-                    1 => [m(0, 1), d[1], m(1, 2)],
-                    2 => [m(2, 0), m(1, 2), d[2]],
-                    _ => [m(1, 2), m(2, 0), m(0, 1)],
-                });
-            } else if self.sub_face[f] == WHOLE_FACE {
-                // Sub-face k of a base face that is not a quad: its own unit square.
-                sub_face.push(k as u16);
-                corner_params.extend([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]);
-            } else {
-                sub_face.push(self.sub_face[f]);
-                let centre = [
-                    0.25 * (d[0][0] + d[1][0] + d[2][0] + d[3][0]),
-                    0.25 * (d[0][1] + d[1][1] + d[2][1] + d[3][1]),
-                ];
-                // Child k of a quad is (V_k, E_k, F, E_{k-1}) rotated to put V_k at corner k.
-                let (prev, next_k) = ((k + 3) % 4, (k + 1) % 4);
-                let around = [d[k], mid(d[k], d[next_k]), centre, mid(d[prev], d[k])];
-                corner_params.extend((0..4).map(|i| around[(i + 4 - k) % 4]));
-            }
-        }
-        let child = SparseLevel {
+        let kept = self.kept_children(&piece);
+        let next = submesh::cut(r.topology(1), &kept.faces);
+        // The children's uniform indices are those of this level's elements' children.
+        let parent_level = level - 1;
+        let vertices = self.child_vertices(&piece, &next, uniform, parent_level);
+        let (edge_key, edge_full) = self.child_edges(&piece, &next, uniform, parent_level);
+        let faces = self.child_faces(&kept, uniform, parent_level, piece.loop_scheme);
+        Ok(SparseLevel {
             rules: next
                 .vertices
                 .iter()
@@ -332,23 +208,269 @@ impl SparseLevel {
                 .iter()
                 .map(|&v| child_points[v as usize])
                 .collect(),
-            face_key,
+            face_key: faces.face_key,
             edge_key,
-            vertex_key,
+            vertex_key: vertices.vertex_key,
             edge_full,
-            vertex_full,
-            vertex_origin,
-            face_parent,
-            base_face,
-            sub_face,
-            corner_params,
-            refined: vec![false; kept.len()],
-            vertex_child: vec![NONE; nv],
+            vertex_full: vertices.vertex_full,
+            vertex_origin: vertices.vertex_origin,
+            face_parent: faces.face_parent,
+            base_face: faces.base_face,
+            sub_face: faces.sub_face,
+            corner_params: faces.corner_params,
+            refined: vec![false; kept.faces.len()],
+            vertex_child: vec![NONE; next.vertices.len()],
             edge_child: vec![NONE; next.edges.len()],
             topology: next.topology,
-        };
-        Ok(child)
+        })
     }
+
+    /// The piece that is refined: every face sharing a vertex with a refined face, in face
+    /// order.
+    fn refined_piece(&self) -> Vec<u32> {
+        let t = &self.topology;
+        let nf = t.num_faces();
+        let mut touched = vec![false; t.num_vertices()];
+        for f in (0..nf).filter(|&f| self.refined[f]) {
+            for &v in t.face_vertices(f) {
+                touched[v as usize] = true;
+            }
+        }
+        (0..nf as u32)
+            .filter(|&f| {
+                t.face_vertices(f as usize)
+                    .iter()
+                    .any(|&v| touched[v as usize])
+            })
+            .collect()
+    }
+
+    /// The kept child faces: children of refined faces, in parent order (indices in the
+    /// refined piece's child level), with their parent face and child index.
+    fn kept_children(&self, piece: &Piece) -> KeptChildren {
+        let mut kept = KeptChildren {
+            faces: Vec::new(),
+            parent: Vec::new(),
+            k: Vec::new(),
+        };
+        for (pi, &f) in piece.faces.iter().enumerate() {
+            if !self.refined[f as usize] {
+                continue;
+            }
+            let children = if piece.loop_scheme {
+                4 * pi..4 * pi + 4
+            } else {
+                piece.face_offsets[pi] as usize..piece.face_offsets[pi + 1] as usize
+            };
+            for (k, cf) in children.enumerate() {
+                kept.faces.push(cf as u32);
+                kept.parent.push(f);
+                kept.k.push(k);
+            }
+        }
+        kept
+    }
+
+    /// The next level's vertices (uniform index, ring size in the uniform level, origin);
+    /// records the children of this level's vertices and edges.
+    fn child_vertices(
+        &mut self,
+        piece: &Piece,
+        next: &submesh::SubMesh,
+        uniform: &ChildLayout,
+        parent_level: usize,
+    ) -> ChildVertices {
+        let nv = next.vertices.len();
+        let mut out = ChildVertices {
+            vertex_key: Vec::with_capacity(nv),
+            vertex_full: Vec::with_capacity(nv),
+            vertex_origin: Vec::with_capacity(nv),
+        };
+        for (i, &cv) in next.vertices.iter().enumerate() {
+            let cv = cv as usize;
+            if cv < piece.num_vertices {
+                let v = piece.vertices[cv];
+                out.vertex_key.push(self.vertex_key[v as usize]);
+                out.vertex_full.push(self.vertex_full[v as usize]);
+                out.vertex_origin.push(Origin::Vertex(v));
+                self.vertex_child[v as usize] = i as u32;
+            } else if cv < piece.edge_point_base {
+                let f = piece.faces[cv - piece.num_vertices];
+                let key = uniform.face_point(parent_level, self.face_key[f as usize]);
+                out.vertex_key.push(key);
+                out.vertex_full
+                    .push(self.topology.face_size(f as usize) as u32);
+                out.vertex_origin.push(Origin::Face(f));
+            } else {
+                let e = piece.edges[cv - piece.edge_point_base];
+                let key = uniform.edge_point(parent_level, self.edge_key[e as usize]);
+                out.vertex_key.push(key);
+                out.vertex_full
+                    .push(uniform.edge_point_faces(self.edge_full[e as usize]));
+                out.vertex_origin.push(Origin::Edge(e));
+                self.edge_child[e as usize] = i as u32;
+            }
+        }
+        out
+    }
+
+    /// The next level's edges (uniform index, faces in the uniform level): interior edges
+    /// of a piece face, or halves of a piece edge.
+    fn child_edges(
+        &self,
+        piece: &Piece,
+        next: &submesh::SubMesh,
+        uniform: &ChildLayout,
+        parent_level: usize,
+    ) -> (Vec<u64>, Vec<u32>) {
+        let mut edge_key = Vec::with_capacity(next.edges.len());
+        let mut edge_full = Vec::with_capacity(next.edges.len());
+        for &ce in &next.edges {
+            let ce = ce as usize;
+            if ce < piece.half_base {
+                let (pi, j) = if piece.loop_scheme {
+                    (ce / 3, ce % 3)
+                } else {
+                    let pi = piece.face_offsets.partition_point(|&o| o as usize <= ce) - 1;
+                    (pi, ce - piece.face_offsets[pi] as usize)
+                };
+                let f = piece.faces[pi] as usize;
+                edge_key.push(uniform.interior_edge(parent_level, self.face_key[f], j));
+                edge_full.push(2);
+            } else {
+                let h = ce - piece.half_base;
+                let e = piece.edges[h / 2] as usize;
+                edge_key.push(uniform.half_edge(parent_level, self.edge_key[e], (h % 2) as u32));
+                edge_full.push(self.edge_full[e]);
+            }
+        }
+        (edge_key, edge_full)
+    }
+
+    /// The next level's faces: uniform index, parent, base face and parameter domain.
+    fn child_faces(
+        &self,
+        kept: &KeptChildren,
+        uniform: &ChildLayout,
+        parent_level: usize,
+        loop_scheme: bool,
+    ) -> ChildFaces {
+        let n = kept.faces.len();
+        let mut out = ChildFaces {
+            face_key: Vec::with_capacity(n),
+            face_parent: Vec::with_capacity(n),
+            base_face: Vec::with_capacity(n),
+            sub_face: Vec::with_capacity(n),
+            corner_params: Vec::with_capacity(4 * n),
+        };
+        for (&f, &k) in kept.parent.iter().zip(&kept.k) {
+            let f = f as usize;
+            out.face_key
+                .push(uniform.child_face(parent_level, self.face_key[f], k));
+            out.face_parent.push(f as u32);
+            out.base_face.push(self.base_face[f]);
+            let d = self.params(f);
+            if loop_scheme {
+                out.sub_face.push(0);
+                out.corner_params.extend(loop_child_params(d, k));
+            } else if self.sub_face[f] == WHOLE_FACE {
+                // Sub-face k of a base face that is not a quad: its own unit square.
+                out.sub_face.push(k as u16);
+                out.corner_params
+                    .extend([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]);
+            } else {
+                out.sub_face.push(self.sub_face[f]);
+                out.corner_params.extend(quad_child_params(d, k));
+            }
+        }
+        out
+    }
+}
+
+/// The refined piece of a level, and where its refinement puts each kind of child vertex
+/// and edge.
+struct Piece {
+    /// The piece's faces, vertices and edges, as the level's.
+    faces: Vec<u32>,
+    vertices: Vec<u32>,
+    edges: Vec<u32>,
+    /// The piece's face offsets (its quad split's children of face `i` start at offset `i`).
+    face_offsets: Vec<u32>,
+    loop_scheme: bool,
+    /// The piece's vertex count: its vertices' children come first.
+    num_vertices: usize,
+    /// The first edge-point child.
+    edge_point_base: usize,
+    /// The first child edge that is a half of a piece edge.
+    half_base: usize,
+}
+
+impl Piece {
+    /// The piece cut as `cut` from the level's `faces`; returns its topology apart, to be
+    /// refined.
+    fn new(cut: submesh::SubMesh, faces: Vec<u32>, loop_scheme: bool) -> (Piece, Topology) {
+        let t = cut.topology;
+        let (pnv, pnf, pnh) = (t.num_vertices(), t.num_faces(), t.num_face_vertices());
+        let piece = Piece {
+            faces,
+            vertices: cut.vertices,
+            edges: cut.edges,
+            face_offsets: t.face_offsets().to_vec(),
+            loop_scheme,
+            num_vertices: pnv,
+            edge_point_base: if loop_scheme { pnv } else { pnv + pnf },
+            half_base: if loop_scheme { 3 * pnf } else { pnh },
+        };
+        (piece, t)
+    }
+}
+
+/// The kept child faces of a refined piece (indices in its child level), each with its
+/// parent face in the level and its index among the parent's children.
+struct KeptChildren {
+    faces: Vec<u32>,
+    parent: Vec<u32>,
+    k: Vec<usize>,
+}
+
+/// The next level's per-vertex arrays.
+struct ChildVertices {
+    vertex_key: Vec<u64>,
+    vertex_full: Vec<u32>,
+    vertex_origin: Vec<Origin>,
+}
+
+/// The next level's per-face arrays.
+struct ChildFaces {
+    face_key: Vec<u64>,
+    face_parent: Vec<u32>,
+    base_face: Vec<u32>,
+    sub_face: Vec<u16>,
+    corner_params: Vec<[f64; 2]>,
+}
+
+/// Corner parameters of child `k` of a Loop triangle with corner parameters `d`, in the
+/// triangle split's child order.
+fn loop_child_params(d: &[[f64; 2]], k: usize) -> [[f64; 2]; 3] {
+    let m = |a: usize, b: usize| mid(d[a], d[b]);
+    match k {
+        0 => [d[0], m(0, 1), m(2, 0)],
+        1 => [m(0, 1), d[1], m(1, 2)],
+        2 => [m(2, 0), m(1, 2), d[2]],
+        _ => [m(1, 2), m(2, 0), m(0, 1)],
+    }
+}
+
+/// Corner parameters of child `k` of a quad with corner parameters `d`.
+fn quad_child_params(d: &[[f64; 2]], k: usize) -> [[f64; 2]; 4] {
+    let centre = [
+        0.25 * (d[0][0] + d[1][0] + d[2][0] + d[3][0]),
+        0.25 * (d[0][1] + d[1][1] + d[2][1] + d[3][1]),
+    ];
+    // Child k of a quad is (V_k, E_k, F, E_{k-1}) rotated to put V_k at corner k.
+    let (prev, next_k) = ((k + 3) % 4, (k + 1) % 4);
+    let around = [d[k], mid(d[k], d[next_k]), centre, mid(d[prev], d[k])];
+    [0, 1, 2, 3].map(|i| around[(i + 4 - k) % 4])
 }
 
 fn mid(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {

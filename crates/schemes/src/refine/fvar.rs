@@ -19,7 +19,7 @@ use subd_mesh::tags::{is_infinite, is_semi_sharp};
 use rayon::prelude::*;
 
 use super::Sdc;
-use super::{Lanes, Layout, MaskSink, OsdRefinement, Points, half_sharpness, nm_vertex};
+use super::{Lanes, MaskSink, OsdRefinement, Points, half_sharpness, nm_vertex};
 use crate::Refinement;
 use crate::rules;
 use crate::stencil::{RowSink, StencilTable};
@@ -123,6 +123,11 @@ impl ChannelLevel {
 
     fn count(&self, v: usize) -> usize {
         (self.value_offsets[v + 1] - self.value_offsets[v]) as usize
+    }
+
+    /// Whether vertex `v`'s values are mismatched (all or none of them are).
+    fn is_mismatched(&self, v: usize) -> bool {
+        self.tags[self.offset(v)].mismatch
     }
 
     /// The source index (into the values a stencil reads) of per-vertex value `slot`.
@@ -980,91 +985,182 @@ pub(crate) fn check_channel(base: &Topology, channel: &FVarChannel) -> Result<()
 /// Per-vertex classification of the base level (`FVarLevel::completeTopologyFromFaceValues`,
 /// §2.2–2.3).
 fn base_level(t: &Topology, indices: &[u32], flags: ModeFlags) -> ChannelLevel {
-    let (nv, ne) = (t.num_vertices(), t.num_edges());
-    let fo = t.face_offsets();
-    let value_at = |f: u32, k: u16| indices[fo[f as usize] as usize + k as usize];
-    let mut edge_mismatch = vec![false; ne];
-    let mut edge_linear = vec![false; ne];
-    let mut mismatched = vec![false; nv];
-    // Per vertex-face, the sibling of the corner; per vertex, its distinct values.
-    let vfo = t.vertex_face_offsets();
-    let mut siblings = vec![0u16; vfo[nv] as usize];
-    let mut distinct_offsets = Vec::with_capacity(nv + 1);
-    let mut distinct: Vec<u32> = Vec::new();
-    let mut vals: Vec<u32> = Vec::new();
+    let mut scan = BaseScan::new(t, indices, flags);
     // First pass (§2.2), in vertex order: "not yet mismatched" depends on it.
-    for v in 0..nv {
-        let (faces, local, edges) = (
-            t.vertex_faces(v),
-            t.vertex_face_local_indices(v),
-            t.vertex_edges(v),
+    for v in 0..t.num_vertices() {
+        scan.scan_vertex(v);
+    }
+    scan.distinct_offsets.push(scan.distinct.len() as u32);
+    // Second pass (§2.3): the tags of each value of a mismatched vertex.
+    let (tags, ends) = scan.classify_values();
+    let face_values = scan.corner_values();
+    ChannelLevel {
+        value_offsets: scan.distinct_offsets,
+        face_values,
+        user: Some(scan.distinct),
+        tags,
+        ends,
+        edge_mismatch: scan.edge_mismatch,
+        edge_linear: scan.edge_linear,
+        geometric: Vec::new(),
+    }
+}
+
+/// The base level's classification while its first pass walks the vertices: what the
+/// vertices walked so far marked (a later vertex reads its ends' marks) and found.
+struct BaseScan<'a> {
+    t: &'a Topology,
+    /// The caller's value index of every face-vertex.
+    indices: &'a [u32],
+    flags: ModeFlags,
+    edge_mismatch: Vec<bool>,
+    edge_linear: Vec<bool>,
+    mismatched: Vec<bool>,
+    /// Per vertex-face, the sibling of the corner.
+    siblings: Vec<u16>,
+    /// Per vertex, where its distinct values start in `distinct`.
+    distinct_offsets: Vec<u32>,
+    distinct: Vec<u32>,
+    /// The values around the vertex being scanned, in its face order (reused).
+    vals: Vec<u32>,
+}
+
+impl<'a> BaseScan<'a> {
+    fn new(t: &'a Topology, indices: &'a [u32], flags: ModeFlags) -> BaseScan<'a> {
+        let (nv, ne) = (t.num_vertices(), t.num_edges());
+        BaseScan {
+            t,
+            indices,
+            flags,
+            edge_mismatch: vec![false; ne],
+            edge_linear: vec![false; ne],
+            mismatched: vec![false; nv],
+            siblings: vec![0u16; t.vertex_face_offsets()[nv] as usize],
+            distinct_offsets: Vec::with_capacity(nv + 1),
+            distinct: Vec::new(),
+            vals: Vec::new(),
+        }
+    }
+
+    /// The value of corner `k` of face `f`.
+    fn value_at(&self, f: u32, k: u16) -> u32 {
+        self.indices[self.t.face_offsets()[f as usize] as usize + k as usize]
+    }
+
+    /// The first pass at vertex `v`: its discontinuous edges, whether it is mismatched, the
+    /// siblings of its corners.
+    fn scan_vertex(&mut self, v: usize) {
+        let t = self.t;
+        let faces = t.vertex_faces(v);
+        let (indices, fo) = (self.indices, t.face_offsets());
+        self.vals.clear();
+        self.vals.extend(
+            faces
+                .iter()
+                .zip(t.vertex_face_local_indices(v))
+                .map(|(&f, &k)| indices[fo[f as usize] as usize + k as usize]),
         );
-        vals.clear();
-        vals.extend(faces.iter().zip(local).map(|(&f, &k)| value_at(f, k)));
-        let nf = faces.len();
         let manifold = !nm_vertex(t, v);
-        let boundary = t.is_boundary_vertex(v);
-        let mut mark = |e: usize, mismatched: &mut [bool]| {
-            edge_mismatch[e] = true;
-            edge_linear[e] = flags.linear_boundaries;
-            let [a, b] = t.edge_vertices(e);
-            mismatched[a as usize] = true;
-            mismatched[b as usize] = true;
-        };
         if manifold {
-            for i in usize::from(boundary)..nf {
-                let prev = if i == 0 { nf - 1 } else { i - 1 };
-                if vals[i] != vals[prev] {
-                    mark(edges[i] as usize, &mut mismatched);
-                }
-            }
-        } else if nf > 0 {
-            for &e in edges {
-                let e = e as usize;
-                let ef = t.edge_faces(e);
-                if ef.len() < 2 {
-                    continue;
-                }
-                let at_v = |j: usize| {
-                    let f = ef[j];
-                    let l = t.edge_face_local_indices(e)[j];
-                    let fv = t.face_vertices(f as usize);
-                    let k = if fv[l as usize] as usize == v {
-                        l
-                    } else {
-                        ((l as usize + 1) % fv.len()) as u16
-                    };
-                    value_at(f, k)
-                };
-                if (1..ef.len()).any(|j| at_v(j) != at_v(0)) {
-                    mark(e, &mut mismatched);
-                }
+            self.mark_manifold_seams(v);
+        } else if !faces.is_empty() {
+            self.mark_non_manifold_seams(v);
+        }
+        if t.is_boundary_vertex(v) && !self.mismatched[v] {
+            self.sharpen_boundary_vertex(v, manifold);
+        }
+        let values = self.assign_siblings(v);
+        if !manifold && values > 1 {
+            self.mismatched[v] = true;
+        }
+    }
+
+    /// Edge `e` is discontinuous: it and both its ends are mismatched.
+    fn mark_seam(&mut self, e: usize) {
+        self.edge_mismatch[e] = true;
+        self.edge_linear[e] = self.flags.linear_boundaries;
+        let [a, b] = self.t.edge_vertices(e);
+        self.mismatched[a as usize] = true;
+        self.mismatched[b as usize] = true;
+    }
+
+    /// Around manifold vertex `v`, an edge between two faces whose corners differ is a seam
+    /// (the leading boundary edge has no face before it).
+    fn mark_manifold_seams(&mut self, v: usize) {
+        let t = self.t;
+        let edges = t.vertex_edges(v);
+        let nf = self.vals.len();
+        let first = usize::from(t.is_boundary_vertex(v));
+        // Edge i lies between faces i - 1 and i (cyclically).
+        for (i, &e) in edges.iter().enumerate().take(nf).skip(first) {
+            let prev = if i == 0 { nf - 1 } else { i - 1 };
+            if self.vals[i] != self.vals[prev] {
+                self.mark_seam(e as usize);
             }
         }
-        if boundary && !mismatched[v] {
-            if flags.linear_boundaries && nf > 0 {
-                mismatched[v] = true;
-                if manifold {
-                    edge_linear[edges[0] as usize] = true;
-                    edge_linear[edges[edges.len() - 1] as usize] = true;
+    }
+
+    /// Around non-manifold vertex `v` (faces not in order), an edge is a seam when its faces
+    /// disagree on the value at `v`.
+    fn mark_non_manifold_seams(&mut self, v: usize) {
+        let t = self.t;
+        for &e in t.vertex_edges(v) {
+            let e = e as usize;
+            let ef = t.edge_faces(e);
+            if ef.len() < 2 {
+                continue;
+            }
+            let at_v = |j: usize| {
+                let f = ef[j];
+                let l = t.edge_face_local_indices(e)[j];
+                let fv = t.face_vertices(f as usize);
+                let k = if fv[l as usize] as usize == v {
+                    l
                 } else {
-                    for &e in edges {
-                        if t.is_boundary_edge(e as usize) {
-                            edge_linear[e as usize] = true;
-                        }
+                    ((l as usize + 1) % fv.len()) as u16
+                };
+                self.value_at(f, k)
+            };
+            if (1..ef.len()).any(|j| at_v(j) != at_v(0)) {
+                self.mark_seam(e);
+            }
+        }
+    }
+
+    /// A boundary vertex without a seam is still mismatched when the mode keeps the
+    /// boundaries linear (its boundary edges with it) or sharpens a smooth corner.
+    fn sharpen_boundary_vertex(&mut self, v: usize, manifold: bool) {
+        let t = self.t;
+        let (nf, edges) = (self.vals.len(), t.vertex_edges(v));
+        if self.flags.linear_boundaries && nf > 0 {
+            self.mismatched[v] = true;
+            if manifold {
+                self.edge_linear[edges[0] as usize] = true;
+                self.edge_linear[edges[edges.len() - 1] as usize] = true;
+            } else {
+                for &e in edges {
+                    if t.is_boundary_edge(e as usize) {
+                        self.edge_linear[e as usize] = true;
                     }
                 }
-            } else if nf == 1 && flags.smooth_corners_sharp {
-                mismatched[v] = true;
             }
+        } else if nf == 1 && self.flags.smooth_corners_sharp {
+            self.mismatched[v] = true;
         }
-        // Siblings: the k-th distinct value met walking the faces, with OpenSubdiv's
-        // shortcut (`completeTopologyFromFaceValues`): while exactly two values are known, a
-        // change of value is looked up against the first only, so A B A B gives siblings
-        // 0 1 0 2 (three values, the last two both B).
+    }
+
+    /// The siblings of `v`'s corners and its distinct values; returns how many.
+    ///
+    /// Siblings: the k-th distinct value met walking the faces, with OpenSubdiv's shortcut
+    /// (`completeTopologyFromFaceValues`): while exactly two values are known, a change of
+    /// value is looked up against the first only, so A B A B gives siblings 0 1 0 2 (three
+    /// values, the last two both B).
+    fn assign_siblings(&mut self, v: usize) -> usize {
+        let vfo = self.t.vertex_face_offsets();
+        let (vals, distinct) = (&self.vals, &mut self.distinct);
         let first = distinct.len();
-        distinct_offsets.push(first as u32);
-        let sib = &mut siblings[vfo[v] as usize..vfo[v + 1] as usize];
+        self.distinct_offsets.push(first as u32);
+        let sib = &mut self.siblings[vfo[v] as usize..vfo[v + 1] as usize];
         for (i, &x) in vals.iter().enumerate() {
             let known = &distinct[first..];
             let k = if i > 0 && x == vals[i - 1] {
@@ -1082,61 +1178,65 @@ fn base_level(t: &Topology, indices: &[u32], flags: ModeFlags) -> ChannelLevel {
             };
             sib[i] = k as u16;
         }
-        if nf == 0 {
+        if vals.is_empty() {
             // A vertex without faces still has one value, value 0.
             distinct.push(0);
         }
-        if !manifold && distinct.len() - first > 1 {
-            mismatched[v] = true;
-        }
+        distinct.len() - first
     }
-    distinct_offsets.push(distinct.len() as u32);
-    // Second pass (§2.3): the tags of each value of a mismatched vertex.
-    let num = distinct.len();
-    let mut tags = vec![ValueTag::default(); num];
-    let mut ends = vec![[0u16; 2]; num];
-    for v in 0..nv {
-        if !mismatched[v] {
-            continue;
+
+    /// The tags and crease ends of every value (§2.3); those of a matched vertex stay
+    /// default.
+    fn classify_values(&self) -> (Vec<ValueTag>, Vec<[u16; 2]>) {
+        let t = self.t;
+        let vfo = t.vertex_face_offsets();
+        let num = self.distinct.len();
+        let mut tags = vec![ValueTag::default(); num];
+        let mut ends = vec![[0u16; 2]; num];
+        for v in 0..t.num_vertices() {
+            if !self.mismatched[v] {
+                continue;
+            }
+            let o = self.distinct_offsets[v] as usize;
+            let n = self.distinct_offsets[v + 1] as usize - o;
+            let vertex = MismatchedVertex {
+                t,
+                v,
+                n,
+                sib: &self.siblings[vfo[v] as usize..vfo[v + 1] as usize],
+                edge_mismatch: &self.edge_mismatch,
+                nonmanifold: nm_vertex(t, v),
+                boundary: t.is_boundary_vertex(v),
+            };
+            classify_vertex(
+                &vertex,
+                self.flags,
+                &mut tags[o..o + n],
+                &mut ends[o..o + n],
+            );
         }
-        let o = distinct_offsets[v] as usize;
-        let n = distinct_offsets[v + 1] as usize - o;
-        let sib = &siblings[vfo[v] as usize..vfo[v + 1] as usize];
-        classify_vertex(
-            t,
-            v,
-            n,
-            sib,
-            &edge_mismatch,
-            flags,
-            &mut tags[o..o + n],
-            &mut ends[o..o + n],
-        );
+        (tags, ends)
     }
-    // Each corner names its vertex's sibling (not a search by value: two siblings can
-    // share a value, see above).
-    let mut face_values = vec![0u32; t.num_face_vertices()];
-    for v in 0..nv {
-        let o = distinct_offsets[v];
-        let range = vfo[v] as usize..vfo[v + 1] as usize;
-        for ((&f, &k), &s) in t
-            .vertex_faces(v)
-            .iter()
-            .zip(t.vertex_face_local_indices(v))
-            .zip(&siblings[range])
-        {
-            face_values[fo[f as usize] as usize + k as usize] = o + s as u32;
+
+    /// The value of every face-vertex. Each corner names its vertex's sibling (not a search
+    /// by value: two siblings can share a value, see [`BaseScan::assign_siblings`]).
+    fn corner_values(&self) -> Vec<u32> {
+        let t = self.t;
+        let (fo, vfo) = (t.face_offsets(), t.vertex_face_offsets());
+        let mut face_values = vec![0u32; t.num_face_vertices()];
+        for v in 0..t.num_vertices() {
+            let o = self.distinct_offsets[v];
+            let range = vfo[v] as usize..vfo[v + 1] as usize;
+            for ((&f, &k), &s) in t
+                .vertex_faces(v)
+                .iter()
+                .zip(t.vertex_face_local_indices(v))
+                .zip(&self.siblings[range])
+            {
+                face_values[fo[f as usize] as usize + k as usize] = o + s as u32;
+            }
         }
-    }
-    ChannelLevel {
-        value_offsets: distinct_offsets,
-        face_values,
-        user: Some(distinct),
-        tags,
-        ends,
-        edge_mismatch,
-        edge_linear,
-        geometric: Vec::new(),
+        face_values
     }
 }
 
@@ -1150,51 +1250,56 @@ struct Span {
     inf: u16,
 }
 
-/// Tags and crease ends of the `n` values of mismatched vertex `v` (`sib`: the sibling of
-/// each of its faces): `gatherValueSpans` and the per-value decisions of §2.3.
-#[allow(clippy::too_many_arguments)]
-fn classify_vertex(
-    t: &Topology,
+/// A mismatched vertex of the base level, as its values are classified.
+struct MismatchedVertex<'a> {
+    t: &'a Topology,
     v: usize,
+    /// Number of distinct values.
     n: usize,
-    sib: &[u16],
-    edge_mismatch: &[bool],
-    flags: ModeFlags,
-    tags: &mut [ValueTag],
-    ends: &mut [[u16; 2]],
-) {
-    let edges = t.vertex_edges(v);
-    let nf = sib.len();
-    let vs = t.vertex_sharpness(v);
-    let nonmanifold = nm_vertex(t, v);
-    let boundary = t.is_boundary_vertex(v);
-    let mut all_corners = flags.linear_boundaries
-        || is_infinite(vs)
-        || nonmanifold
-        || (flags.dependent_sharpness && n > 2)
-        || (flags.sharpen_darts && n == 1 && !boundary);
-    let mut spans = vec![Span::default(); n];
-    let classify_edge = |span: &mut Span, e: u32| {
+    /// The sibling of each of its faces.
+    sib: &'a [u16],
+    edge_mismatch: &'a [bool],
+    nonmanifold: bool,
+    boundary: bool,
+}
+
+impl MismatchedVertex<'_> {
+    /// `gatherValueSpans`: the span of each value around the vertex.
+    fn spans(&self) -> Vec<Span> {
+        let mut spans = vec![Span::default(); self.n];
+        if self.nonmanifold {
+            for s in &mut spans {
+                s.discts = 1;
+            }
+        } else if self.n == 1 && !self.boundary {
+            self.single_value_span(&mut spans[0]);
+        } else if !self.sib.is_empty() {
+            self.sibling_spans(&mut spans);
+        }
+        spans
+    }
+
+    /// Counts continuous edge `e` inside `span` by its sharpness; a discontinuous one as a
+    /// discontinuity.
+    fn count_edge(&self, span: &mut Span, e: u32) {
         let e = e as usize;
-        if edge_mismatch[e] {
+        if self.edge_mismatch[e] {
             span.discts += 1;
-        } else if is_infinite(t.edge_sharpness(e)) {
+        } else if is_infinite(self.t.edge_sharpness(e)) {
             span.inf += 1;
-        } else if is_semi_sharp(t.edge_sharpness(e)) {
+        } else if is_semi_sharp(self.t.edge_sharpness(e)) {
             span.semi += 1;
         }
-    };
-    if nonmanifold {
-        for s in &mut spans {
-            s.discts = 1;
-        }
-    } else if n == 1 && !boundary {
-        let s = &mut spans[0];
-        s.size = nf as u16;
+    }
+
+    /// The one value of an interior vertex: all its faces, starting after its one
+    /// discontinuous edge.
+    fn single_value_span(&self, s: &mut Span) {
+        s.size = self.sib.len() as u16;
         let mut seen = false;
-        for (i, &e) in edges.iter().enumerate() {
-            if !edge_mismatch[e as usize] {
-                classify_edge(s, e);
+        for (i, &e) in self.t.vertex_edges(self.v).iter().enumerate() {
+            if !self.edge_mismatch[e as usize] {
+                self.count_edge(s, e);
             } else if seen {
                 // A second discontinuous edge: the one value is split in two (disjoint).
                 s.discts = 1;
@@ -1204,16 +1309,22 @@ fn classify_vertex(
                 s.start = i as u16;
             }
         }
-    } else if nf > 0 {
+    }
+
+    /// Several values (or a boundary): each value's span is its run of faces; a value met
+    /// again after another counts a discontinuity, except the run wrapping around face 0.
+    fn sibling_spans(&self, spans: &mut [Span]) {
+        let (sib, nf) = (self.sib, self.sib.len());
+        let edges = self.t.vertex_edges(self.v);
         spans[0].size = 1;
-        let wraps = !boundary && sib[nf - 1] == 0;
+        let wraps = !self.boundary && sib[nf - 1] == 0;
         if wraps {
-            classify_edge(&mut spans[0], edges[0]);
+            self.count_edge(&mut spans[0], edges[0]);
         }
         for i in 1..nf {
             let k = sib[i] as usize;
             if sib[i] == sib[i - 1] {
-                classify_edge(&mut spans[k], edges[i]);
+                self.count_edge(&mut spans[k], edges[i]);
             } else {
                 if spans[k].size > 0 {
                     spans[k].discts += 1;
@@ -1226,6 +1337,24 @@ fn classify_vertex(
             spans[0].discts -= 1;
         }
     }
+}
+
+/// Tags and crease ends of the values of mismatched vertex `m`: `gatherValueSpans` and the
+/// per-value decisions of §2.3.
+fn classify_vertex(
+    m: &MismatchedVertex<'_>,
+    flags: ModeFlags,
+    tags: &mut [ValueTag],
+    ends: &mut [[u16; 2]],
+) {
+    let (n, nf) = (m.n, m.sib.len());
+    let vs = m.t.vertex_sharpness(m.v);
+    let mut all_corners = flags.linear_boundaries
+        || is_infinite(vs)
+        || m.nonmanifold
+        || (flags.dependent_sharpness && n > 2)
+        || (flags.sharpen_darts && n == 1 && !m.boundary);
+    let spans = m.spans();
     let mut dependent = false;
     if flags.dependent_sharpness && n == 2 && !all_corners {
         let (a, b) = (spans[0], spans[1]);
@@ -1252,34 +1381,58 @@ fn classify_vertex(
                 tag.crease = true;
             }
             if flags.smooth_boundaries() {
-                let (start, size) = (s.start as i64, s.size as i64);
-                let end = if k == 0 && start != 0 {
-                    start + size - 1 - nf as i64
-                } else {
-                    start + size - 1
-                };
-                ends[k] = [s.start, end as u16];
+                ends[k] = span_ends(s, k, nf);
             }
         }
         tags[k] = tag;
     }
 }
 
+/// First and last local face of span `s` of value `k` among `nf` faces: the first value's
+/// span, when it starts past face 0, wraps around the last face and ends before its start.
+fn span_ends(s: &Span, k: usize, nf: usize) -> [u16; 2] {
+    let (start, size) = (s.start as i64, s.size as i64);
+    let end = if k == 0 && start != 0 {
+        start + size - 1 - nf as i64
+    } else {
+        start + size - 1
+    };
+    [s.start, end as u16]
+}
+
 /// The channel at the child level of `step` (§3): value counts, face values, edge and value
 /// tags, crease ends, semi-sharp decay.
 fn child_level(step: &super::Step<'_>, parent: &ChannelLevel, flags: ModeFlags) -> ChannelLevel {
-    let p = step.parent;
-    let l: Layout = step.layout;
-    let (nv, nf, ne) = (p.num_vertices(), p.num_faces(), p.num_edges());
-    let ncv = l.num_child_vertices;
     let quads = step.scheme != Sdc::Loop;
-    // Counts by child vertex, in child vertex order.
-    let mut offsets = Vec::with_capacity(ncv + 1);
+    let offsets = child_value_offsets(step, parent, quads);
+    let face_values = child_face_values(step, parent, &offsets, quads);
+    let (edge_mismatch, edge_linear) = child_edge_tags(step, parent);
+    let (mut tags, ends) = child_value_tags(step, parent, &offsets, flags, quads);
+    if flags.smooth_boundaries() {
+        reclassify_semi_sharp(step, parent, &offsets, flags, &mut tags);
+    }
+    ChannelLevel {
+        value_offsets: offsets,
+        face_values,
+        user: None,
+        tags,
+        ends,
+        edge_mismatch,
+        edge_linear,
+        geometric: Vec::new(),
+    }
+}
+
+/// Where each child vertex's values start, in child vertex order: a mismatched vertex's
+/// child keeps its values, a face child has one, a seam edge's child one per face.
+fn child_value_offsets(step: &super::Step<'_>, parent: &ChannelLevel, quads: bool) -> Vec<u32> {
+    let p = step.parent;
+    let (nv, nf, ne) = (p.num_vertices(), p.num_faces(), p.num_edges());
+    let mut offsets = Vec::with_capacity(step.layout.num_child_vertices + 1);
     let mut total = 0u32;
-    let vertex_mismatched = |v: usize| parent.tags[parent.offset(v)].mismatch;
     for v in 0..nv {
         offsets.push(total);
-        total += if vertex_mismatched(v) {
+        total += if parent.is_mismatched(v) {
             parent.count(v) as u32
         } else {
             1
@@ -1300,12 +1453,21 @@ fn child_level(step: &super::Step<'_>, parent: &ChannelLevel, flags: ModeFlags) 
         };
     }
     offsets.push(total);
-    let num = total as usize;
-    // Face values from the parent faces' corners.
+    offsets
+}
+
+/// The child faces' values from the parent faces' corners, in the split's child order.
+fn child_face_values(
+    step: &super::Step<'_>,
+    parent: &ChannelLevel,
+    offsets: &[u32],
+    quads: bool,
+) -> Vec<u32> {
+    let (p, l) = (step.parent, step.layout);
     let vertex_value = |f: usize, k: usize| {
         let v = p.face_vertices(f)[k] as usize;
         let c = offsets[v];
-        if vertex_mismatched(v) {
+        if parent.is_mismatched(v) {
             c + (parent.corner_slot(p, f, k) - parent.offset(v)) as u32
         } else {
             c
@@ -1327,7 +1489,7 @@ fn child_level(step: &super::Step<'_>, parent: &ChannelLevel, flags: ModeFlags) 
         }
     };
     let mut face_values = Vec::with_capacity(4 * p.num_face_vertices());
-    for f in 0..nf {
+    for f in 0..p.num_faces() {
         let n = p.face_size(f);
         if quads {
             let fc = offsets[l.face_vertex_base as usize + f];
@@ -1350,22 +1512,44 @@ fn child_level(step: &super::Step<'_>, parent: &ChannelLevel, flags: ModeFlags) 
             face_values.extend([v0, e0, e2, e0, v1, e1, e2, e1, v2, e1, e2, e0]);
         }
     }
-    // Edge tags: face-interior edges continuous, halves copy their parent.
-    let nce = l.half_edge_base as usize + 2 * ne;
+    face_values
+}
+
+/// Child edge tags (mismatch, linear): face-interior edges continuous, halves copy their
+/// parent.
+fn child_edge_tags(step: &super::Step<'_>, parent: &ChannelLevel) -> (Vec<bool>, Vec<bool>) {
+    let ne = step.parent.num_edges();
+    let hb = step.layout.half_edge_base as usize;
+    let nce = hb + 2 * ne;
     let mut edge_mismatch = vec![false; nce];
     let mut edge_linear = vec![false; nce];
     for e in 0..ne {
         for h in [0, 1] {
-            let c = l.half_edge_base as usize + 2 * e + h;
+            let c = hb + 2 * e + h;
             edge_mismatch[c] = parent.edge_mismatch[e];
             edge_linear[c] = parent.edge_linear[e];
         }
     }
-    // Value tags and crease ends.
+    (edge_mismatch, edge_linear)
+}
+
+/// Child value tags and crease ends (before semi-sharp decay): a mismatched vertex's child
+/// copies its values', a seam or linear edge's child values are creases (or corners when
+/// the boundaries are linear), spanning the child faces of their parent face.
+fn child_value_tags(
+    step: &super::Step<'_>,
+    parent: &ChannelLevel,
+    offsets: &[u32],
+    flags: ModeFlags,
+    quads: bool,
+) -> (Vec<ValueTag>, Vec<[u16; 2]>) {
+    let (p, l) = (step.parent, step.layout);
+    let (nv, ne) = (p.num_vertices(), p.num_edges());
+    let num = *offsets.last().unwrap_or(&0) as usize;
     let mut tags = vec![ValueTag::default(); num];
     let mut ends = vec![[0u16; 2]; num];
     for (v, &co) in offsets[..nv].iter().enumerate() {
-        if vertex_mismatched(v) {
+        if parent.is_mismatched(v) {
             let (po, co, n) = (parent.offset(v), co as usize, parent.count(v));
             tags[co..co + n].copy_from_slice(&parent.tags[po..po + n]);
             ends[co..co + n].copy_from_slice(&parent.ends[po..po + n]);
@@ -1388,19 +1572,7 @@ fn child_level(step: &super::Step<'_>, parent: &ChannelLevel, flags: ModeFlags) 
             }
         }
     }
-    if flags.smooth_boundaries() {
-        reclassify_semi_sharp(step, parent, &offsets, flags, &mut tags);
-    }
-    ChannelLevel {
-        value_offsets: offsets,
-        face_values,
-        user: None,
-        tags,
-        ends,
-        edge_mismatch,
-        edge_linear,
-        geometric: Vec::new(),
-    }
+    (tags, ends)
 }
 
 /// Semi-sharp values whose features decayed become creases (`reclassifySemisharpValues`,

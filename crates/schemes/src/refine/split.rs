@@ -664,181 +664,18 @@ fn quad_vertex_edges(p: &Topology) -> (Vec<u32>, Vec<u32>) {
 /// the tags). The caller checks that every face is a triangle. Filled in parallel blocks like the quad split.
 pub(crate) fn tri_split(p: &Topology) -> TopologyParts {
     let (nv, nf, ne) = (p.num_vertices(), p.num_faces(), p.num_edges());
-    let pefo = p.edge_face_offsets();
-    let pvfo = p.vertex_face_offsets();
-    let pveo = p.vertex_edge_offsets();
-    let edge_point = |e: usize| (nv + e) as u32;
-    let hb = 3 * nf as u32;
     let (face_offsets, face_vertices) = tri_faces(p);
     let face_edges = per_face(nf, |f| tri_child_edges(p, f));
-
-    let mut edge_vertices = memory::zeroed::<[u32; 2]>(3 * nf + 2 * ne);
-    {
-        let (interior, halves) = edge_vertices.split_at_mut(3 * nf);
-        par::fill(
-            interior,
-            nf,
-            |f| 3 * f,
-            |r, out| {
-                for (o, f) in r.enumerate() {
-                    let e = p.face_edges(f);
-                    let (e0, e1, e2) = (
-                        edge_point(e[0] as usize),
-                        edge_point(e[1] as usize),
-                        edge_point(e[2] as usize),
-                    );
-                    out[3 * o..3 * o + 3].copy_from_slice(&[[e0, e2], [e1, e0], [e2, e1]]);
-                }
-            },
-        );
-        half_edge_vertices(p, nv, halves);
-    }
-
-    let total_ef = 6 * nf + 2 * pefo[ne] as usize;
-    let edge_face_offsets = child_edge_face_offsets(p, 3 * nf);
-    let mut edge_faces = memory::zeroed(total_ef);
-    let mut edge_face_local = memory::zeroed(total_ef);
-    {
-        let (fa, fb) = edge_faces.split_at_mut(6 * nf);
-        let (la, lb) = edge_face_local.split_at_mut(6 * nf);
-        par::fill_pair(
-            fa,
-            la,
-            nf,
-            |f| 6 * f,
-            |r, faces, local| {
-                for (o, f) in r.enumerate() {
-                    let f = f as u32;
-                    for j in 0..3u32 {
-                        let k = 6 * o + 2 * j as usize;
-                        faces[k..k + 2].copy_from_slice(&[4 * f + j, 4 * f + 3]);
-                        local[k..k + 2].fill(((j + 1) % 3) as u16);
-                    }
-                }
-            },
-        );
-        par::fill_pair(
-            fb,
-            lb,
-            ne,
-            |e| 2 * pefo[e] as usize,
-            |r, faces, local| {
-                let mut i = 0;
-                for e in r {
-                    let ev = p.edge_vertices(e);
-                    let degenerate = ev[0] == ev[1];
-                    for k in 0..2usize {
-                        for (&pf, &l) in p.edge_faces(e).iter().zip(p.edge_face_local_indices(e)) {
-                            let c = if degenerate {
-                                k as u32
-                            } else {
-                                u32::from(p.face_vertices(pf as usize)[l as usize] != ev[k])
-                            };
-                            faces[i] = 4 * pf + (l as u32 + c) % 3;
-                            local[i] = l;
-                            i += 1;
-                        }
-                    }
-                }
-            },
-        );
-    }
-
-    let nvf = pvfo[nv] as usize;
-    let total_vf = nvf + 3 * pefo[ne] as usize;
-    let vertex_face_offsets =
-        child_vertex_offsets(pvfo, 0, ne, |_| 0, |e| nvf + 3 * pefo[e] as usize);
-    let mut vertex_faces = memory::zeroed(total_vf);
-    let mut vertex_face_local = memory::zeroed(total_vf);
-    {
-        let (fa, fb) = vertex_faces.split_at_mut(nvf);
-        let (la, lb) = vertex_face_local.split_at_mut(nvf);
-        par::fill_pair(
-            fa,
-            la,
-            nv,
-            |v| pvfo[v] as usize,
-            |r, faces, local| {
-                let mut i = 0;
-                for v in r {
-                    for (&pf, &c) in p.vertex_faces(v).iter().zip(p.vertex_face_local_indices(v)) {
-                        faces[i] = 4 * pf + c as u32;
-                        local[i] = c;
-                        i += 1;
-                    }
-                }
-            },
-        );
-        par::fill_pair(
-            fb,
-            lb,
-            ne,
-            |e| 3 * pefo[e] as usize,
-            |r, faces, local| {
-                let mut i = 0;
-                for e in r {
-                    for (&pf, &l) in p.edge_faces(e).iter().zip(p.edge_face_local_indices(e)) {
-                        let l32 = l as u32;
-                        faces[i..i + 3].copy_from_slice(&[
-                            4 * pf + (l32 + 1) % 3,
-                            4 * pf + 3,
-                            4 * pf + l32,
-                        ]);
-                        local[i..i + 3].copy_from_slice(&[l, (l + 2) % 3, (l + 1) % 3]);
-                        i += 3;
-                    }
-                }
-            },
-        );
-    }
-
-    let nve = pveo[nv] as usize;
-    let total_ve = nve + 2 * pefo[ne] as usize + 2 * ne;
-    let vertex_edge_offsets =
-        child_vertex_offsets(pveo, 0, ne, |_| 0, |e| nve + 2 * pefo[e] as usize + 2 * e);
-    let mut vertex_edges = memory::zeroed(total_ve);
-    {
-        let (a, b) = vertex_edges.split_at_mut(nve);
-        vertex_child_edges(p, hb, a);
-        par::fill(
-            b,
-            ne,
-            |e| 2 * pefo[e] as usize + 2 * e,
-            |r, out| {
-                let mut i = 0;
-                for e in r {
-                    let ev = p.edge_vertices(e);
-                    let ef = p.edge_faces(e);
-                    let el = p.edge_face_local_indices(e);
-                    let (pf, l) = (ef[0], el[0] as u32);
-                    let rev = u32::from(
-                        ev[0] != ev[1] && p.face_vertices(pf as usize)[l as usize] != ev[0],
-                    );
-                    out[i..i + 4].copy_from_slice(&[
-                        hb + half(e as u32, 1 - rev),
-                        3 * pf + (l + 1) % 3,
-                        3 * pf + l,
-                        hb + half(e as u32, rev),
-                    ]);
-                    i += 4;
-                    for (&pf, &l) in ef.iter().zip(el).skip(1) {
-                        let l = l as u32;
-                        out[i..i + 2].copy_from_slice(&[3 * pf + (l + 1) % 3, 3 * pf + l]);
-                        i += 2;
-                    }
-                }
-            },
-        );
-    }
-
+    let (edge_face_offsets, edge_faces, edge_face_local) = tri_edge_faces(p);
+    let (vertex_face_offsets, vertex_faces, vertex_face_local) = tri_vertex_faces(p);
+    let (vertex_edge_offsets, vertex_edges) = tri_vertex_edges(p);
     let (edge_boundary, edge_non_manifold, vertex_non_manifold) = inherited_flags(p, 3 * nf, 0);
-
     TopologyParts {
         num_vertices: nv + ne,
         face_offsets,
         face_vertices,
         face_edges,
-        edge_vertices,
+        edge_vertices: tri_edge_vertices(p),
         edge_face_offsets,
         edge_faces,
         edge_face_local,
@@ -852,4 +689,186 @@ pub(crate) fn tri_split(p: &Topology) -> TopologyParts {
         vertex_non_manifold,
         ..TopologyParts::default()
     }
+}
+
+/// The triangle split's child edges' vertices: the three edges of each parent face's middle
+/// triangle, `(E0, E2)`, `(E1, E0)`, `(E2, E1)`, then H(e, k) = (E, V_{e.v[k]}).
+fn tri_edge_vertices(p: &Topology) -> Vec<[u32; 2]> {
+    let (nv, nf, ne) = (p.num_vertices(), p.num_faces(), p.num_edges());
+    let edge_point = |e: usize| (nv + e) as u32;
+    let mut edge_vertices = memory::zeroed::<[u32; 2]>(3 * nf + 2 * ne);
+    let (interior, halves) = edge_vertices.split_at_mut(3 * nf);
+    par::fill(
+        interior,
+        nf,
+        |f| 3 * f,
+        |r, out| {
+            for (o, f) in r.enumerate() {
+                let e = p.face_edges(f);
+                let (e0, e1, e2) = (
+                    edge_point(e[0] as usize),
+                    edge_point(e[1] as usize),
+                    edge_point(e[2] as usize),
+                );
+                out[3 * o..3 * o + 3].copy_from_slice(&[[e0, e2], [e1, e0], [e2, e1]]);
+            }
+        },
+    );
+    half_edge_vertices(p, nv, halves);
+    edge_vertices
+}
+
+/// The triangle split's edge -> faces (offsets, faces, local indices): each interior edge
+/// borders its corner triangle and the middle one; each half as many faces as its parent.
+fn tri_edge_faces(p: &Topology) -> (Vec<u32>, Vec<u32>, Vec<u16>) {
+    let (nf, ne) = (p.num_faces(), p.num_edges());
+    let pefo = p.edge_face_offsets();
+    let total_ef = 6 * nf + 2 * pefo[ne] as usize;
+    let edge_face_offsets = child_edge_face_offsets(p, 3 * nf);
+    let mut edge_faces = memory::zeroed(total_ef);
+    let mut edge_face_local = memory::zeroed(total_ef);
+    let (fa, fb) = edge_faces.split_at_mut(6 * nf);
+    let (la, lb) = edge_face_local.split_at_mut(6 * nf);
+    par::fill_pair(
+        fa,
+        la,
+        nf,
+        |f| 6 * f,
+        |r, faces, local| {
+            for (o, f) in r.enumerate() {
+                let f = f as u32;
+                for j in 0..3u32 {
+                    let k = 6 * o + 2 * j as usize;
+                    faces[k..k + 2].copy_from_slice(&[4 * f + j, 4 * f + 3]);
+                    local[k..k + 2].fill(((j + 1) % 3) as u16);
+                }
+            }
+        },
+    );
+    par::fill_pair(
+        fb,
+        lb,
+        ne,
+        |e| 2 * pefo[e] as usize,
+        |r, faces, local| {
+            let mut i = 0;
+            for e in r {
+                let ev = p.edge_vertices(e);
+                let degenerate = ev[0] == ev[1];
+                for k in 0..2usize {
+                    for (&pf, &l) in p.edge_faces(e).iter().zip(p.edge_face_local_indices(e)) {
+                        let c = if degenerate {
+                            k as u32
+                        } else {
+                            u32::from(p.face_vertices(pf as usize)[l as usize] != ev[k])
+                        };
+                        faces[i] = 4 * pf + (l as u32 + c) % 3;
+                        local[i] = l;
+                        i += 1;
+                    }
+                }
+            }
+        },
+    );
+    (edge_face_offsets, edge_faces, edge_face_local)
+}
+
+/// The triangle split's vertex -> faces (offsets, faces, local indices): V_v (as the
+/// parent), then E_e (three per parent face: two corner triangles and the middle one).
+fn tri_vertex_faces(p: &Topology) -> (Vec<u32>, Vec<u32>, Vec<u16>) {
+    let (nv, ne) = (p.num_vertices(), p.num_edges());
+    let pefo = p.edge_face_offsets();
+    let pvfo = p.vertex_face_offsets();
+    let nvf = pvfo[nv] as usize;
+    let total_vf = nvf + 3 * pefo[ne] as usize;
+    let vertex_face_offsets =
+        child_vertex_offsets(pvfo, 0, ne, |_| 0, |e| nvf + 3 * pefo[e] as usize);
+    let mut vertex_faces = memory::zeroed(total_vf);
+    let mut vertex_face_local = memory::zeroed(total_vf);
+    let (fa, fb) = vertex_faces.split_at_mut(nvf);
+    let (la, lb) = vertex_face_local.split_at_mut(nvf);
+    par::fill_pair(
+        fa,
+        la,
+        nv,
+        |v| pvfo[v] as usize,
+        |r, faces, local| {
+            let mut i = 0;
+            for v in r {
+                for (&pf, &c) in p.vertex_faces(v).iter().zip(p.vertex_face_local_indices(v)) {
+                    faces[i] = 4 * pf + c as u32;
+                    local[i] = c;
+                    i += 1;
+                }
+            }
+        },
+    );
+    par::fill_pair(
+        fb,
+        lb,
+        ne,
+        |e| 3 * pefo[e] as usize,
+        |r, faces, local| {
+            let mut i = 0;
+            for e in r {
+                for (&pf, &l) in p.edge_faces(e).iter().zip(p.edge_face_local_indices(e)) {
+                    let l32 = l as u32;
+                    faces[i..i + 3].copy_from_slice(&[
+                        4 * pf + (l32 + 1) % 3,
+                        4 * pf + 3,
+                        4 * pf + l32,
+                    ]);
+                    local[i..i + 3].copy_from_slice(&[l, (l + 2) % 3, (l + 1) % 3]);
+                    i += 3;
+                }
+            }
+        },
+    );
+    (vertex_face_offsets, vertex_faces, vertex_face_local)
+}
+
+/// The triangle split's vertex -> edges (offsets, edges): V_v takes the half of each parent
+/// edge at it; E_e its two halves around the first face's two interior edges, then two
+/// interior edges per further face (OpenSubdiv's order).
+fn tri_vertex_edges(p: &Topology) -> (Vec<u32>, Vec<u32>) {
+    let (nv, nf, ne) = (p.num_vertices(), p.num_faces(), p.num_edges());
+    let pefo = p.edge_face_offsets();
+    let pveo = p.vertex_edge_offsets();
+    let hb = 3 * nf as u32;
+    let nve = pveo[nv] as usize;
+    let total_ve = nve + 2 * pefo[ne] as usize + 2 * ne;
+    let vertex_edge_offsets =
+        child_vertex_offsets(pveo, 0, ne, |_| 0, |e| nve + 2 * pefo[e] as usize + 2 * e);
+    let mut vertex_edges = memory::zeroed(total_ve);
+    let (a, b) = vertex_edges.split_at_mut(nve);
+    vertex_child_edges(p, hb, a);
+    par::fill(
+        b,
+        ne,
+        |e| 2 * pefo[e] as usize + 2 * e,
+        |r, out| {
+            let mut i = 0;
+            for e in r {
+                let ev = p.edge_vertices(e);
+                let ef = p.edge_faces(e);
+                let el = p.edge_face_local_indices(e);
+                let (pf, l) = (ef[0], el[0] as u32);
+                let rev =
+                    u32::from(ev[0] != ev[1] && p.face_vertices(pf as usize)[l as usize] != ev[0]);
+                out[i..i + 4].copy_from_slice(&[
+                    hb + half(e as u32, 1 - rev),
+                    3 * pf + (l + 1) % 3,
+                    3 * pf + l,
+                    hb + half(e as u32, rev),
+                ]);
+                i += 4;
+                for (&pf, &l) in ef.iter().zip(el).skip(1) {
+                    let l = l as u32;
+                    out[i..i + 2].copy_from_slice(&[3 * pf + (l + 1) % 3, 3 * pf + l]);
+                    i += 2;
+                }
+            }
+        },
+    );
+    (vertex_edge_offsets, vertex_edges)
 }
