@@ -9,6 +9,8 @@ use subd_schemes::{Options, Refinement, Scheme};
 use rayon::prelude::*;
 
 use crate::osd;
+use crate::refined_limits::RefinedLimits;
+pub use crate::row::Row;
 
 /// Tolerance on max |Δ| / bounding-box diagonal.
 const TOLERANCE: f64 = 1e-12;
@@ -23,41 +25,6 @@ const NORMAL_TOLERANCE: f64 = 1e-10;
 const EVAL_NORMAL_TOLERANCE: f64 = 1e-9;
 /// Limit checks refine at most this many face-vertices deep.
 const MAX_LIMIT_FACE_VERTICES: usize = 8_000_000;
-
-/// Outcome of one check of one mesh at one level.
-pub struct Row {
-    pub mesh: String,
-    /// "refine" (positions of the refined level) or "limit" (PrimvarRefiner::Limit there).
-    pub check: &'static str,
-    pub level: usize,
-    pub vertices: usize,
-    pub error: f64,
-    /// Max difference of unit normals (limit checks only).
-    pub normal_error: Option<f64>,
-    /// Vertices left out of the limit check because OpenSubdiv is not exact there, with the
-    /// largest |Δ|/diag seen at them.
-    pub excluded: Option<(usize, f64)>,
-    /// Something the row wants said when it passes.
-    pub note: Option<String>,
-    pub problem: Option<String>,
-}
-
-impl Row {
-    /// A row not decided yet: infinite error, nothing found.
-    pub(crate) fn pending(mesh: &str, check: &'static str, level: usize) -> Row {
-        Row {
-            mesh: mesh.to_string(),
-            check,
-            level,
-            vertices: 0,
-            error: f64::INFINITY,
-            normal_error: None,
-            excluded: None,
-            note: None,
-            problem: None,
-        }
-    }
-}
 
 /// Levels to check: up to 3, fewer where the mesh would grow past [`MAX_VERTICES`].
 pub(crate) fn levels_for(topo: &Topology, scheme: &Scheme) -> usize {
@@ -857,70 +824,6 @@ fn compare_eval(
         ));
     }
     row
-}
-
-/// Uniform refinement past semi-sharp decay (at least 4 levels) and the exact limits of its
-/// vertices: the independent reference used where OpenSubdiv's patch evaluation is not exact.
-pub(crate) struct RefinedLimits {
-    refinement: Refinement,
-    level: usize,
-    limits: subd_limit::LimitPoints,
-}
-
-impl RefinedLimits {
-    /// `None` where the mesh would be too large to refine that far here.
-    pub(crate) fn new(
-        topo: &Topology,
-        positions: &[DVec3],
-        scheme: &Scheme,
-        options: &Options,
-    ) -> Option<RefinedLimits> {
-        let level = subd_limit::levels_for_exact_limit(topo, scheme).0.max(4);
-        if topo.num_face_vertices() << (2 * level) > 1 << 23 {
-            return None;
-        }
-        let refinement = Refinement::new(topo, scheme.clone(), options, level).ok()?;
-        let table = subd_limit::LimitStencilTable::at_level(&refinement, level).ok()?;
-        let limits = table.apply(&refinement.refine_points(positions)[level]);
-        Some(RefinedLimits {
-            refinement,
-            level,
-            limits,
-        })
-    }
-
-    /// The limit of the refined vertex at dyadic parameter (u, v) of base face `f` (a quad
-    /// for Catmull-Clark, a triangle for Loop); `None` off the refined vertices.
-    pub(crate) fn at(&self, f: usize, u: f64, v: f64) -> Option<DVec3> {
-        subd_limit::eval::dyadic_vertex(&self.refinement, self.level, f, u, v)
-            .map(|vtx| self.limits.positions[vtx])
-    }
-
-    /// Whether subd's evaluation of ptex face `(f, sub)` equals the limit of the refined
-    /// vertices at dyadic parameters, to 1e-12 of the diagonal (quads and Loop triangles).
-    fn agrees(
-        &self,
-        ev: &subd_limit::eval::LimitEvaluator,
-        pts: &subd_limit::eval::PatchPoints,
-        (f, sub): (usize, usize),
-        diag: f64,
-    ) -> bool {
-        use subd_limit::eval::{FaceParam, dyadic_vertex};
-        let params = [
-            (0.5, 0.5),
-            (0.25, 0.25),
-            (0.125, 0.1875),
-            (0.5, 0.25),
-            (0.0625, 0.375),
-        ];
-        params.iter().all(|&(u, v)| {
-            let Some(vtx) = dyadic_vertex(&self.refinement, self.level, f, u, v) else {
-                return false;
-            };
-            ev.evaluate(pts, FaceParam { face: f, sub, u, v })
-                .is_ok_and(|p| (p.position - self.limits.positions[vtx]).length() <= 1e-12 * diag)
-        })
-    }
 }
 
 /// Limit positions, tangents and normals of every vertex of level N against OpenSubdiv's

@@ -19,6 +19,8 @@ mod geom_ref;
 mod osd;
 mod pia_bench;
 mod random_mesh;
+mod refined_limits;
+mod row;
 mod split_bench;
 mod tess_bench;
 mod tess_conformance;

@@ -11,8 +11,8 @@ use subd_limit::tessellation::tessellate;
 use subd_mesh::{DVec3, Topology, TopologyBuilder};
 use subd_schemes::{Options, Scheme};
 
-use crate::conformance::Row;
 use crate::osd;
+use crate::row::Row;
 
 /// The rate compared (even, so Catmull-Clark non-quads are covered too).
 pub const RATE: usize = 4;
@@ -155,7 +155,7 @@ pub fn compare(
     // there.
     let mut bfr_off = (0usize, 0.0f64);
     let refined = (!disputed.is_empty())
-        .then(|| crate::conformance::RefinedLimits::new(topo, positions, scheme, options))
+        .then(|| crate::refined_limits::RefinedLimits::new(topo, positions, scheme, options))
         .flatten();
     let refinement_agrees = |at: &FaceParam, p: DVec3| {
         let quad_or_tri = at.sub == 0 && (*scheme == Scheme::Loop || topo.face_size(at.face) == 4);

@@ -11,12 +11,14 @@
 use glam::DVec3;
 use subd_limit::PointStencil;
 use subd_limit::eval::{FaceParam, LimitEvaluator};
-use subd_limit::point_stencil::{DU, DV, POSITION};
+use subd_limit::point_stencil::{ControlRow, DU, DV, POSITION};
 use subd_mesh::Topology;
 use subd_schemes::Scheme;
 
 use crate::EditError;
-use crate::isoline::{Isoline, strip_rows};
+use crate::isoline::{
+    Isoline, SAMPLES_PER_FACE, along_rows, bspline_point, control_triple, is_regular, strip,
+};
 
 /// Where on the limit surface.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -256,6 +258,72 @@ fn check_goal(g: &Goal) -> Result<Goal, String> {
         return Err("the target is not finite".into());
     }
     Ok(*g)
+}
+
+/// The rows (over base vertices, one position each) and goals of an iso-line constraint:
+/// the curve's control points on a regular strip, samples otherwise.
+pub(crate) fn strip_rows(
+    ev: &LimitEvaluator,
+    topology: &Topology,
+    line: &Isoline,
+    goals: &[Goal],
+) -> Result<Vec<(ControlRow, Goal)>, String> {
+    let faces = strip(topology, line)?;
+    let m = faces.len();
+    if goals.len() != m + 3 {
+        return Err(format!(
+            "an iso-line over {m} faces needs {} control points, not {}",
+            m + 3,
+            goals.len()
+        ));
+    }
+    let mut out = Vec::new();
+    if is_regular(ev, &faces) {
+        for (j, f) in faces.iter().enumerate() {
+            let [c0, c1, c2] = control_triple(&along_rows(ev, f, 0.0)?);
+            if j == 0 {
+                out.push((c0, goals[0]));
+                out.push((c1, goals[1]));
+            }
+            out.push((c2, goals[j + 2]));
+        }
+        let [_, _, last] = control_triple(&along_rows(ev, &faces[m - 1], 1.0)?);
+        out.push((last, goals[m + 2]));
+        return Ok(out);
+    }
+    // Sampled: each sample's goal is the target curve (or the displacement curve) there.
+    let all_positions = goals.iter().all(|g| matches!(g, Goal::Position(_)));
+    let all_changes = goals.iter().all(|g| matches!(g, Goal::Displacement(_)));
+    if !all_positions && !all_changes {
+        return Err("an iso-line's control points are all targets or all displacements".into());
+    }
+    let cps: Vec<DVec3> = goals
+        .iter()
+        .map(|g| match g {
+            Goal::Position(p) | Goal::Displacement(p) => *p,
+        })
+        .collect();
+    for (j, f) in faces.iter().enumerate() {
+        for k in 0..SAMPLES_PER_FACE {
+            let s = (k as f64 + 0.5) / SAMPLES_PER_FACE as f64;
+            let st = ev.stencil(f.param(s)).map_err(|e| e.to_string())?;
+            let p = bspline_point(&cps, j as f64 + s);
+            let goal = if all_positions {
+                Goal::Position(p)
+            } else {
+                Goal::Displacement(p)
+            };
+            out.push((
+                st.indices
+                    .iter()
+                    .copied()
+                    .zip(st.weights[POSITION].iter().copied())
+                    .collect(),
+                goal,
+            ));
+        }
+    }
+    Ok(out)
 }
 
 /// The parameter of a base vertex as a corner of its first face.

@@ -16,11 +16,8 @@
 use glam::DVec3;
 use subd_limit::PatchForm;
 use subd_limit::eval::{FaceParam, LimitEvaluator};
-use subd_limit::point_stencil::ControlRow;
 use subd_limit::point_stencil::{DU, DV, POSITION};
 use subd_mesh::Topology;
-
-use crate::constraint::Goal;
 
 /// Which parameter a line runs along.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -219,9 +216,9 @@ pub fn is_regular(ev: &LimitEvaluator, strip: &[StripFace]) -> bool {
 }
 
 /// Position, first and second derivative along the line at `s` of one strip face, as rows.
-type AlongRows = [Vec<(u32, f64)>; 3];
+pub(crate) type AlongRows = [Vec<(u32, f64)>; 3];
 
-fn along_rows(ev: &LimitEvaluator, f: &StripFace, s: f64) -> Result<AlongRows, String> {
+pub(crate) fn along_rows(ev: &LimitEvaluator, f: &StripFace, s: f64) -> Result<AlongRows, String> {
     let st = ev.stencil(f.param(s)).map_err(|e| e.to_string())?;
     let (d1, d2) = match f.along {
         Axis::U => (DU, 3),
@@ -240,77 +237,11 @@ fn along_rows(ev: &LimitEvaluator, f: &StripFace, s: f64) -> Result<AlongRows, S
 
 /// The three curve control points `(c₀, c₁, c₂)` from position and derivatives at the start
 /// of a segment.
-fn control_triple(r: &AlongRows) -> [Vec<(u32, f64)>; 3] {
+pub(crate) fn control_triple(r: &AlongRows) -> [Vec<(u32, f64)>; 3] {
     let c1 = combine(&[(&r[0], 1.0), (&r[2], -1.0 / 6.0)]);
     let c0 = combine(&[(&c1, 1.0), (&r[1], -1.0), (&r[2], 0.5)]);
     let c2 = combine(&[(&c1, 1.0), (&r[1], 1.0), (&r[2], 0.5)]);
     [c0, c1, c2]
-}
-
-/// The rows (over base vertices, one position each) and goals of an iso-line constraint:
-/// the curve's control points on a regular strip, samples otherwise.
-pub(crate) fn strip_rows(
-    ev: &LimitEvaluator,
-    topology: &Topology,
-    line: &Isoline,
-    goals: &[Goal],
-) -> Result<Vec<(ControlRow, Goal)>, String> {
-    let faces = strip(topology, line)?;
-    let m = faces.len();
-    if goals.len() != m + 3 {
-        return Err(format!(
-            "an iso-line over {m} faces needs {} control points, not {}",
-            m + 3,
-            goals.len()
-        ));
-    }
-    let mut out = Vec::new();
-    if is_regular(ev, &faces) {
-        for (j, f) in faces.iter().enumerate() {
-            let [c0, c1, c2] = control_triple(&along_rows(ev, f, 0.0)?);
-            if j == 0 {
-                out.push((c0, goals[0]));
-                out.push((c1, goals[1]));
-            }
-            out.push((c2, goals[j + 2]));
-        }
-        let [_, _, last] = control_triple(&along_rows(ev, &faces[m - 1], 1.0)?);
-        out.push((last, goals[m + 2]));
-        return Ok(out);
-    }
-    // Sampled: each sample's goal is the target curve (or the displacement curve) there.
-    let all_positions = goals.iter().all(|g| matches!(g, Goal::Position(_)));
-    let all_changes = goals.iter().all(|g| matches!(g, Goal::Displacement(_)));
-    if !all_positions && !all_changes {
-        return Err("an iso-line's control points are all targets or all displacements".into());
-    }
-    let cps: Vec<DVec3> = goals
-        .iter()
-        .map(|g| match g {
-            Goal::Position(p) | Goal::Displacement(p) => *p,
-        })
-        .collect();
-    for (j, f) in faces.iter().enumerate() {
-        for k in 0..SAMPLES_PER_FACE {
-            let s = (k as f64 + 0.5) / SAMPLES_PER_FACE as f64;
-            let st = ev.stencil(f.param(s)).map_err(|e| e.to_string())?;
-            let p = bspline_point(&cps, j as f64 + s);
-            let goal = if all_positions {
-                Goal::Position(p)
-            } else {
-                Goal::Displacement(p)
-            };
-            out.push((
-                st.indices
-                    .iter()
-                    .copied()
-                    .zip(st.weights[POSITION].iter().copied())
-                    .collect(),
-                goal,
-            ));
-        }
-    }
-    Ok(out)
 }
 
 /// The current control points of a line over a regular strip (`None` when the strip is not

@@ -43,6 +43,7 @@
 //! ```
 
 pub mod acc;
+mod child_param;
 pub mod eigen;
 pub mod eval;
 pub mod fvar;
@@ -51,11 +52,13 @@ pub mod local;
 pub mod loop_patch;
 pub mod masks;
 pub mod patch;
+mod piece;
 pub mod point_stencil;
 mod smooth_closed;
 pub mod split_eigen;
 pub mod split_limit;
 pub mod stam;
+mod support;
 mod table;
 pub mod tessellation;
 mod two_phase_closed;

@@ -343,10 +343,10 @@ fn corner_limit<P>(
 /// parameters there and the scale of the parameter map.
 fn child_at(t: &Topology, scheme: &Scheme, f: usize, u: f64, v: f64) -> (usize, f64, f64, f64) {
     if *scheme == Scheme::Loop {
-        let (j, s, tt, k) = crate::eval::tri_child(u, v.min(1.0 - u));
+        let (j, s, tt, k) = crate::child_param::tri_child(u, v.min(1.0 - u));
         (4 * f + j, s, tt, k)
     } else {
-        let (j, s, tt) = crate::eval::quadrant(u, v);
+        let (j, s, tt) = crate::child_param::quadrant(u, v);
         (t.face_offsets()[f] as usize + j, s, tt, 2.0)
     }
 }
@@ -400,9 +400,9 @@ pub(crate) fn stencil(
         let nb = ending.piece();
         // The final piece's weights over its own support, one unit-vector evaluation per
         // three vertices, then carried back to the sources through the weights.
-        let support = crate::point_stencil::face_support(&nb.topology, nb.face);
+        let support = crate::support::face_support(&nb.topology, nb.face);
         let mut buf = Vec::new();
-        let local = crate::point_stencil::linear_weights(
+        let local = crate::support::linear_weights(
             &mut buf,
             nb.topology.num_vertices(),
             &support,
@@ -449,7 +449,7 @@ impl<P> Ending<P> {
     /// face the descent started from in errors).
     fn value(&self, pts: &[DVec3], scheme: &Scheme, f: usize) -> Result<SurfacePoint, LimitError> {
         match self {
-            Ending::Patch { nb, u, v, scale } => crate::eval::direct_evaluation(
+            Ending::Patch { nb, u, v, scale } => crate::piece::direct_evaluation(
                 &nb.topology,
                 &nb.rules,
                 pts,
@@ -492,7 +492,7 @@ fn descend<P: Carried>(
     for depth in 0..MAX_LOCAL_LEVELS {
         let r = nb.refine(scheme, &options, 1)?;
         let (t0, rules0) = (r.topology(0), r.vertex_rules(0));
-        if crate::eval::is_direct(t0, rules0, nb.face, scheme)? {
+        if crate::piece::is_direct(t0, rules0, nb.face, scheme)? {
             return Ok(Ending::Patch { nb, u, v, scale });
         }
         // At a corner: once the other corners are refined away (two levels) and nothing

@@ -34,8 +34,8 @@
 use rayon::prelude::*;
 use subd_mesh::Topology;
 
-use crate::solvers::ritz_extremes;
-use crate::system::{CHUNK, Matrix, RowBlock};
+use crate::matrix::{CHUNK, Matrix, RowBlock};
+use crate::ritz::ritz_extremes;
 
 /// Lanczos steps for the spectral interval of `K`: its spectrum is a narrow interval
 /// (condition about 16/9 on regular regions), whose ends the Ritz values find in a few steps.

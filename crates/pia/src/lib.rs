@@ -44,6 +44,8 @@
 //! ```
 
 pub mod checkerboard;
+mod matrix;
+mod ritz;
 mod solvers;
 mod system;
 

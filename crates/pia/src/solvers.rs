@@ -18,7 +18,9 @@ use subd_mesh::memory;
 
 use crate::PiaError;
 use crate::checkerboard::Preconditioned;
-use crate::system::{CHUNK, Matrix, ReducedSystem, dot, finite_or_inf, max_norm, safe_div};
+use crate::matrix::{CHUNK, Matrix};
+use crate::ritz::ritz_extremes;
+use crate::system::{ReducedSystem, dot, finite_or_inf, max_norm, safe_div};
 
 /// Which solver to run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
@@ -768,26 +770,4 @@ pub(crate) fn extreme_eigenvalues(s: &ReducedSystem) -> (f64, f64) {
     }
     let lo = (hi - mu).max(1e-3 * hi);
     (lo, hi)
-}
-
-/// Smallest and largest eigenvalue of the Lanczos tridiagonal matrix (diagonal `alphas`,
-/// off-diagonal `betas`), when the smallest is positive.
-pub(crate) fn ritz_extremes(alphas: &[f64], betas: &[f64]) -> Option<(f64, f64)> {
-    let m = alphas.len();
-    let t = Mat::<f64>::from_fn(m, m, |i, j| {
-        if i == j {
-            alphas[i]
-        } else if i == j + 1 {
-            betas[j]
-        } else if j == i + 1 {
-            betas[i]
-        } else {
-            0.0
-        }
-    });
-    let ev = t.self_adjoint_eigenvalues(Side::Lower).ok()?;
-    match (ev.first(), ev.last()) {
-        (Some(&lo), Some(&hi)) if lo > 0.0 => Some((lo, hi)),
-        _ => None,
-    }
 }

@@ -16,6 +16,7 @@ use std::fmt::Debug;
 use glam::DVec3;
 use subd_mesh::Topology;
 
+use crate::refine::OsdRefinement;
 use crate::rules::Rule;
 use crate::stencil::StencilTable;
 use crate::{ExplicitTags, FaceStream, PointStream};
@@ -55,7 +56,59 @@ pub(crate) trait Family: Debug + Send + Sync {
     fn point_stream<'a>(&'a self, above: &'a [DVec3]) -> Option<PointStream<'a>>;
     /// OpenSubdiv's family, for what only it has (face-varying modes, vertex rules of
     /// prepared levels).
-    fn as_opensubdiv(&self) -> Option<&crate::refine::OsdRefinement> {
+    fn as_opensubdiv(&self) -> Option<&OsdRefinement> {
         None
+    }
+}
+
+/// OpenSubdiv's family: the trait forwarded to [`OsdRefinement`]'s own methods.
+impl Family for OsdRefinement {
+    fn num_levels(&self) -> usize {
+        OsdRefinement::num_levels(self)
+    }
+    fn num_vertices(&self, level: usize) -> usize {
+        OsdRefinement::num_vertices(self, level)
+    }
+    fn num_edges(&self, level: usize) -> Option<usize> {
+        Some(OsdRefinement::num_edges(self, level))
+    }
+    fn faces(&self, level: usize) -> (&[u32], &[u32]) {
+        OsdRefinement::faces(self, level)
+    }
+    fn holes(&self, level: usize) -> std::borrow::Cow<'_, [bool]> {
+        std::borrow::Cow::Borrowed(OsdRefinement::holes(self, level))
+    }
+    fn has_sharpness(&self, level: usize) -> bool {
+        OsdRefinement::has_sharpness(self, level)
+    }
+    fn explicit_tags(&self, level: usize) -> ExplicitTags {
+        OsdRefinement::explicit_tags(self, level)
+    }
+    fn topology(&self, level: usize) -> &Topology {
+        OsdRefinement::topology(self, level)
+    }
+    fn has_topology(&self, level: usize) -> bool {
+        OsdRefinement::has_topology(self, level)
+    }
+    fn into_topology(self: Box<Self>, level: usize) -> Topology {
+        OsdRefinement::into_topology(*self, level)
+    }
+    fn vertex_rules(&self, level: usize) -> &[Rule] {
+        OsdRefinement::vertex_rules(self, level)
+    }
+    fn stencils(&self, level: usize) -> &StencilTable {
+        OsdRefinement::stencils(self, level)
+    }
+    fn next_points(&self, level: usize, above: &[DVec3]) -> Vec<DVec3> {
+        OsdRefinement::next_points(self, level, above)
+    }
+    fn face_stream(&self) -> Option<FaceStream<'_>> {
+        OsdRefinement::face_stream(self)
+    }
+    fn point_stream<'a>(&'a self, above: &'a [DVec3]) -> Option<PointStream<'a>> {
+        OsdRefinement::point_stream(self, above)
+    }
+    fn as_opensubdiv(&self) -> Option<&OsdRefinement> {
+        Some(self)
     }
 }
