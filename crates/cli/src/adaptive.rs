@@ -28,7 +28,7 @@ const DEFAULT_LEVELS: usize = 4;
 #[derive(Debug, Args)]
 pub(crate) struct AdaptiveArgs {
     /// Subdivision scheme.
-    #[arg(long, value_parser = scheme_arg::parser(scheme_arg::EVALUATED))]
+    #[arg(long, value_parser = scheme_arg::parser(scheme_arg::evaluated))]
     scheme: Scheme,
     /// Seed 002's flatness: refine every face that is not dead, a vertex being dead when the
     /// largest angle between its faces' normals is below DEG degrees.

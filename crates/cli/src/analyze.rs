@@ -45,7 +45,7 @@ pub(crate) struct AnalyzeArgs {
     max_levels: usize,
     /// Instead of a mask: the eigenvalue test of this surface scheme's local subdivision
     /// matrix at an interior vertex of valence --valence.
-    #[arg(long, value_parser = scheme_arg::parser(scheme_arg::ANALYSED), requires = "valence")]
+    #[arg(long, value_parser = scheme_arg::parser(scheme_arg::analysed), requires = "valence")]
     surface: Option<Scheme>,
     /// Valence for --surface (the number of sides of the centre face for doo-sabin).
     #[arg(long)]

@@ -38,7 +38,7 @@ pub(crate) struct EditArgs {
     #[arg(long, value_enum, default_value = "least-squares")]
     method: EditMethodArg,
     /// Scheme of the limit surface (the energy method needs catmull-clark).
-    #[arg(long, value_parser = scheme_arg::parser(scheme_arg::EVALUATED), default_value = "catmull-clark")]
+    #[arg(long, value_parser = scheme_arg::parser(scheme_arg::evaluated), default_value = "catmull-clark")]
     scheme: Scheme,
     /// Energy method: the seed's penalty form with this weight (relative to
     /// mean diag Q / mean diag AᵀA) instead of the exact solve.

@@ -18,7 +18,7 @@ use crate::{Failure, print_warnings};
 #[derive(Debug, Args)]
 pub(crate) struct EvalArgs {
     /// Subdivision scheme.
-    #[arg(long, value_parser = scheme_arg::parser(scheme_arg::EVALUATED))]
+    #[arg(long, value_parser = scheme_arg::parser(scheme_arg::evaluated))]
     scheme: Scheme,
     #[command(flatten)]
     rules: RuleArgs,

@@ -23,7 +23,7 @@ pub(crate) struct LimitArgs {
     /// formula (2) (two-phase, closed quad meshes), of each vertex's vertex face one level down
     /// (Doo-Sabin), of Kobbelt's masks (√3), or the vertices themselves with normals from the
     /// eigenvectors (the butterflies).
-    #[arg(long, value_parser = scheme_arg::parser(scheme_arg::WITH_LIMIT))]
+    #[arg(long, value_parser = scheme_arg::parser(scheme_arg::with_limit))]
     scheme: Scheme,
     #[command(flatten)]
     lambda: LambdaArgs,

@@ -41,7 +41,7 @@ pub(crate) enum SolverArg {
 #[derive(Debug, Args)]
 pub(crate) struct PiaArgs {
     /// Scheme whose limit surface interpolates.
-    #[arg(long, value_parser = scheme_arg::parser(scheme_arg::INTERPOLATED))]
+    #[arg(long, value_parser = scheme_arg::parser(scheme_arg::interpolated))]
     scheme: Scheme,
     #[command(flatten)]
     lambda: LambdaArgs,

@@ -15,7 +15,7 @@ use crate::Failure;
 use crate::batch::{self, Files, Job};
 use crate::budget::Budget;
 use crate::failure::bad;
-use crate::refined::{Refined, normals_or_faces, output_limit};
+use crate::refined::{RefinementWithLimit, normals_or_faces, output_limit};
 use crate::rule_args::RuleArgs;
 use crate::scheme_arg;
 use crate::vertex_data::LambdaArgs;
@@ -23,7 +23,7 @@ use crate::vertex_data::LambdaArgs;
 #[derive(Debug, Args)]
 pub(crate) struct RefineArgs {
     /// Subdivision scheme (a parameter may follow a colon: butterfly:0.05, two-phase:0.6).
-    #[arg(long, value_parser = scheme_arg::parser(scheme_arg::ALL))]
+    #[arg(long, value_parser = scheme_arg::parser(scheme_arg::all))]
     scheme: Scheme,
     /// Number of uniform refinement levels (0 to 15; for two-phase, level 1 is phase 1).
     #[arg(long)]
@@ -120,8 +120,8 @@ fn run_one(
     let progress = Progress::new(args.levels, args.json || job.quiet);
     let t0 = Instant::now();
     let base = &opened.file.mesh.topology;
-    let refinement =
-        Refined::new(base, scheme, &options, args.levels).map_err(|e| in_file(job, &e))?;
+    let refinement = RefinementWithLimit::new(base, scheme, &options, args.levels)
+        .map_err(|e| in_file(job, &e))?;
     let input_counts = Counts {
         vertices: base.num_vertices(),
         edges: Some(base.num_edges()),
@@ -209,7 +209,7 @@ fn open(
 fn output_uv(
     args: &RefineArgs,
     job: &Job,
-    refinement: &Refined,
+    refinement: &RefinementWithLimit,
     file: &mut subd_io::MeshFile,
     fvar_mode: subd_mesh::fvar::FVarLinearInterpolation,
 ) -> Result<Option<crate::uv::RefinedUv>, Failure> {
@@ -249,7 +249,7 @@ fn output_uv(
 struct Output<'a> {
     args: &'a RefineArgs,
     job: &'a Job,
-    refinement: &'a Refined,
+    refinement: &'a RefinementWithLimit,
     /// The base positions.
     base: &'a [subd_mesh::DVec3],
     uv: Option<&'a crate::uv::RefinedUv>,

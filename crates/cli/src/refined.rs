@@ -1,33 +1,34 @@
-//! A refinement as the commands hold it: [`Refined`] (the library's `Refinement`, and the
-//! limit stencils of a split scheme's last level once asked for), the exact limit of its
-//! output level, and the normals a writer gets where the limit defines none.
+//! A refinement as the commands hold it: [`RefinementWithLimit`] (the library's
+//! `Refinement`, and the limit stencils of a split scheme's last level once asked for), the
+//! exact limit of its output level, and the normals a writer gets where the limit defines
+//! none.
 
 use subd_limit::LimitStencilTable;
 use subd_schemes::{Refinement, Scheme};
 
 /// A refinement, and the limit stencils of a split scheme's last level once asked for: the
 /// positions and the texture coordinates take their limits through the same ones.
-pub(crate) struct Refined {
+pub(crate) struct RefinementWithLimit {
     refinement: Refinement,
     last_limit: std::sync::OnceLock<Result<LimitStencilTable, String>>,
 }
 
-impl std::ops::Deref for Refined {
+impl std::ops::Deref for RefinementWithLimit {
     type Target = Refinement;
     fn deref(&self) -> &Refinement {
         &self.refinement
     }
 }
 
-impl Refined {
+impl RefinementWithLimit {
     /// Refines `base` with `scheme`; the error names the element.
     pub(crate) fn new(
         base: &subd_mesh::Topology,
         scheme: Scheme,
         options: &subd_schemes::Options,
         levels: usize,
-    ) -> Result<Refined, String> {
-        Ok(Refined {
+    ) -> Result<RefinementWithLimit, String> {
+        Ok(RefinementWithLimit {
             refinement: Refinement::new(base, scheme, options, levels)
                 .map_err(|e| e.to_string())?,
             last_limit: std::sync::OnceLock::new(),
@@ -65,7 +66,7 @@ impl Refined {
 /// The exact limit (positions and normals) of the vertices of the output level, from the
 /// limit masks of that level's own topology: what Blender calls "use limit surface".
 pub(crate) fn output_limit(
-    refinement: &Refined,
+    refinement: &RefinementWithLimit,
     level: usize,
     options: &subd_schemes::Options,
     positions: &[subd_mesh::DVec3],

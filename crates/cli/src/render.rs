@@ -12,7 +12,7 @@ use subd_schemes::Scheme;
 
 use crate::failure::{bad, refuse_overwrite};
 use crate::raster::{Camera, Canvas, Rgb, shade};
-use crate::refined::{Refined, normals_or_faces, output_limit};
+use crate::refined::{RefinementWithLimit, normals_or_faces, output_limit};
 use crate::rule_args::RuleArgs;
 use crate::scheme_arg;
 use crate::{Failure, print_warnings};
@@ -41,7 +41,7 @@ const POINT: Rgb = [200, 20, 40];
 pub(crate) struct RenderArgs {
     /// Refine with this scheme before drawing (default: draw IN as it is; with --limit:
     /// loop for an all-triangle mesh, else catmull-clark).
-    #[arg(long, value_parser = scheme_arg::parser(scheme_arg::ALL))]
+    #[arg(long, value_parser = scheme_arg::parser(scheme_arg::all))]
     scheme: Option<Scheme>,
     /// Levels of refinement (default 3 when refining).
     #[arg(long)]
@@ -240,7 +240,8 @@ fn refined_surface(
     levels: usize,
 ) -> Result<Surface, String> {
     let options = args.rules.options(&file.mesh.hints);
-    let refinement = Refined::new(&file.mesh.topology, scheme.clone(), &options, levels)?;
+    let refinement =
+        RefinementWithLimit::new(&file.mesh.topology, scheme.clone(), &options, levels)?;
     let mut positions = refinement.last_positions(&file.mesh.positions);
     let limit_normals = if args.limit {
         let limit = output_limit(&refinement, levels, &options, &positions)?;

@@ -15,41 +15,48 @@ use crate::failure::bad;
 use crate::vertex_data::LambdaArgs;
 
 /// Every surface scheme (`refine`, `render`).
-pub(crate) const ALL: &[&str] = &Scheme::NAMES;
-/// Schemes with a limit surface other than the mesh itself (`limit`).
-pub(crate) const WITH_LIMIT: &[&str] = &[
-    "catmull-clark",
-    "loop",
-    "two-phase",
-    "doo-sabin",
-    "sqrt3",
-    "butterfly",
-    "modified-butterfly",
-];
+pub(crate) fn all(_: &Scheme) -> bool {
+    true
+}
+
+/// Schemes with a limit surface other than the mesh itself (`limit`): all but Bilinear.
+pub(crate) fn with_limit(s: &Scheme) -> bool {
+    *s != Scheme::Bilinear
+}
+
 /// Schemes whose limit is evaluated exactly at any (face, u, v) (`eval`, `tessellate`,
 /// `edit`, `deform`, `adaptive`).
-pub(crate) const EVALUATED: &[&str] = &["catmull-clark", "loop"];
-/// Schemes whose limit surface interpolates (`pia`).
-pub(crate) const INTERPOLATED: &[&str] = &["catmull-clark", "loop", "two-phase"];
-/// Schemes with a local subdivision matrix at a valence (`analyze --surface`).
-pub(crate) const ANALYSED: &[&str] = &[
-    "catmull-clark",
-    "loop",
-    "doo-sabin",
-    "sqrt3",
-    "butterfly",
-    "modified-butterfly",
-];
+pub(crate) fn evaluated(s: &Scheme) -> bool {
+    matches!(s, Scheme::CatmullClark | Scheme::Loop)
+}
 
-/// A clap value parser giving a [`Scheme`], accepting the names in `accepted`.
-pub(crate) fn parser(accepted: &'static [&'static str]) -> SchemeParser {
-    SchemeParser { accepted }
+/// Schemes whose limit surface interpolates through PIA (`pia`).
+pub(crate) fn interpolated(s: &Scheme) -> bool {
+    matches!(s, Scheme::CatmullClark | Scheme::Loop | Scheme::TwoPhase(_))
+}
+
+/// Schemes with a local subdivision matrix at a valence (`analyze --surface`): all with a
+/// limit but the two-phase scheme, whose λ varies per vertex.
+pub(crate) fn analysed(s: &Scheme) -> bool {
+    with_limit(s) && !matches!(s, Scheme::TwoPhase(_))
+}
+
+/// A clap value parser giving a [`Scheme`], accepting the schemes `accepts` takes (every
+/// name of [`Scheme::NAMES`] it is true for).
+pub(crate) fn parser(accepts: fn(&Scheme) -> bool) -> SchemeParser {
+    SchemeParser {
+        accepted: Scheme::NAMES
+            .iter()
+            .filter_map(|name| name.parse::<Scheme>().ok())
+            .filter(accepts)
+            .collect(),
+    }
 }
 
 /// See [`parser`].
 #[derive(Clone)]
 pub(crate) struct SchemeParser {
-    accepted: &'static [&'static str],
+    accepted: Vec<Scheme>,
 }
 
 impl TypedValueParser for SchemeParser {
@@ -88,27 +95,8 @@ impl SchemeParser {
     fn possible_values_list(&self) -> Vec<PossibleValue> {
         self.accepted
             .iter()
-            .map(|&name| PossibleValue::new(name).help(help(name)))
+            .map(|s| PossibleValue::new(s.name()).help(s.summary()))
             .collect()
-    }
-}
-
-/// One line on each scheme for `--help`.
-fn help(name: &str) -> &'static str {
-    match name {
-        "catmull-clark" => "Catmull-Clark (OpenSubdiv's), any polygons",
-        "loop" => "Loop (OpenSubdiv's), triangles",
-        "bilinear" => "Bilinear (OpenSubdiv's), any polygons",
-        "two-phase" => {
-            "Seed 000's two-phase modified Catmull-Clark, quads (needs --lambda or --lambda-file, or two-phase:λ)"
-        }
-        "doo-sabin" => "Doo-Sabin's dual scheme, any polygons",
-        "sqrt3" => "Kobbelt's √3 scheme, triangles",
-        "butterfly" => {
-            "The interpolating butterfly (Dyn, Levin, Gregory), triangles; tension w by --tension or butterfly:w (default 1/16)"
-        }
-        "modified-butterfly" => "Zorin, Schröder and Sweldens' modified butterfly, triangles",
-        _ => "",
     }
 }
 
@@ -161,7 +149,7 @@ pub(crate) fn is_two_phase(scheme: &Scheme) -> bool {
 mod tests {
     use super::*;
 
-    fn parse(accepted: &'static [&'static str], text: &str) -> Result<Scheme, String> {
+    fn parse(accepted: fn(&Scheme) -> bool, text: &str) -> Result<Scheme, String> {
         let cmd = clap::Command::new("t");
         parser(accepted)
             .parse_ref(&cmd, None, OsStr::new(text))
@@ -170,15 +158,15 @@ mod tests {
 
     #[test]
     fn names_and_parameters_parse_to_the_library_scheme() {
-        assert_eq!(parse(ALL, "sqrt3").unwrap(), Scheme::Sqrt3);
+        assert_eq!(parse(all, "sqrt3").unwrap(), Scheme::Sqrt3);
         assert_eq!(
-            parse(ALL, "butterfly:0.05").unwrap(),
+            parse(all, "butterfly:0.05").unwrap(),
             Scheme::Butterfly { tension: 0.05 }
         );
-        let two_phase = parse(INTERPOLATED, "two-phase:0.6").unwrap();
+        let two_phase = parse(interpolated, "two-phase:0.6").unwrap();
         assert_eq!(two_phase.two_phase().unwrap().uniform_lambda(), Some(0.6));
         assert!(
-            !parse(INTERPOLATED, "two-phase")
+            !parse(interpolated, "two-phase")
                 .unwrap()
                 .two_phase()
                 .unwrap()
@@ -188,25 +176,52 @@ mod tests {
 
     #[test]
     fn names_outside_the_command_and_bad_parameters_are_refused() {
-        let e = parse(EVALUATED, "sqrt3").unwrap_err();
+        let e = parse(evaluated, "sqrt3").unwrap_err();
         assert!(
             e.contains("'sqrt3'") && e.contains("catmull-clark, loop"),
             "{e}"
         );
-        let e = parse(ALL, "butterfly:x").unwrap_err();
+        let e = parse(all, "butterfly:x").unwrap_err();
         assert!(
             e.contains("butterfly:x") && e.contains("not a finite number"),
             "{e}"
         );
-        let e = parse(ALL, "loop:2").unwrap_err();
+        let e = parse(all, "loop:2").unwrap_err();
         assert!(e.contains("takes no parameter"), "{e}");
-        // Every accepted list names schemes the library knows.
-        for list in [ALL, WITH_LIMIT, EVALUATED, INTERPOLATED, ANALYSED] {
-            for name in list {
-                assert!(name.parse::<Scheme>().is_ok(), "{name}");
-                assert!(!help(name).is_empty(), "{name}");
-            }
-        }
+        // Each command's list, in the library's order.
+        let names = |accepts| {
+            parser(accepts)
+                .accepted
+                .iter()
+                .map(Scheme::name)
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(names(all), Scheme::NAMES);
+        assert_eq!(
+            names(with_limit),
+            [
+                "catmull-clark",
+                "loop",
+                "two-phase",
+                "doo-sabin",
+                "sqrt3",
+                "butterfly",
+                "modified-butterfly"
+            ]
+        );
+        assert_eq!(
+            names(analysed),
+            [
+                "catmull-clark",
+                "loop",
+                "doo-sabin",
+                "sqrt3",
+                "butterfly",
+                "modified-butterfly"
+            ]
+        );
+        assert_eq!(names(evaluated), ["catmull-clark", "loop"]);
+        assert_eq!(names(interpolated), ["catmull-clark", "loop", "two-phase"]);
     }
 
     #[test]

@@ -21,7 +21,7 @@ use crate::scheme_arg;
 #[derive(Debug, Args)]
 pub(crate) struct TessellateArgs {
     /// Subdivision scheme.
-    #[arg(long, value_parser = scheme_arg::parser(scheme_arg::EVALUATED))]
+    #[arg(long, value_parser = scheme_arg::parser(scheme_arg::evaluated))]
     scheme: Scheme,
     /// Segments per base edge (even when a Catmull-Clark face is not a quad: each of its quad
     /// sub-faces takes half).

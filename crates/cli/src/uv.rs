@@ -29,7 +29,7 @@ pub(crate) struct RefinedUv {
 /// `limit`), interpolated by `mode`; `None` when the mesh has none, or, with a warning, when
 /// a split scheme cannot carry their seams.
 pub(crate) fn refined_uv(
-    refinement: &crate::refined::Refined,
+    refinement: &crate::refined::RefinementWithLimit,
     mesh: &subd_mesh::Mesh,
     mode: FVarLinearInterpolation,
     limit: bool,

@@ -24,12 +24,18 @@
 //!
 //! # What a scheme implements
 //!
-//! A scheme is a split plus masks. Behind [`Refinement`] each family implements one trait
-//! (the level's child faces and tags, the mask of every child vertex, the level's topology
-//! on request); a split scheme is one rule file in [`split_schemes`] (its step: child faces
-//! and a row of weights per child vertex) plus its [`Scheme`] variant, whose methods state
-//! the facts callers need ([`Scheme::input_faces`], [`Scheme::split`], [`Scheme::period`],
-//! [`Scheme::is_interpolating`], [`Scheme::tags`], [`Scheme::regular_valence`]).
+//! A scheme is a split plus masks. Behind [`Refinement`] each family implements one
+//! crate-private trait (`Family`: the level's faces and tags, the topology on request, the
+//! stencils between levels, direct evaluation of points). A split scheme is one rule file in
+//! [`split_schemes`] implementing its `SplitRule` (for one step over a parent level: the
+//! child faces with the tags they keep, and a row of weights over parent vertices for each
+//! child vertex) plus its [`Scheme`] variant: `Scheme::split_step` makes the step, and the
+//! variant's methods state the facts every caller needs ([`Scheme::input_faces`],
+//! [`Scheme::split`], [`Scheme::period`], [`Scheme::is_interpolating`], [`Scheme::tags`],
+//! [`Scheme::regular_valence`], [`Scheme::peak_bytes_per_vertex`]). Levels, stencil tables,
+//! points, face-varying channels ([`Refinement::face_varying`]), counts
+//! ([`refined_counts`]) and the memory estimate ([`peak::PeakModel`]) then work for it
+//! unchanged; its limit masks go in `subd-limit`.
 //!
 //! # Ordering (OpenSubdiv's default uniform order)
 //!

@@ -260,6 +260,26 @@ impl Scheme {
         }
     }
 
+    /// One line on the scheme: who it is by, the faces it takes, and its parameter.
+    pub fn summary(&self) -> &'static str {
+        match self {
+            Scheme::CatmullClark => "Catmull-Clark (OpenSubdiv's), any polygons",
+            Scheme::Loop => "Loop (OpenSubdiv's), triangles",
+            Scheme::Bilinear => "Bilinear (OpenSubdiv's), any polygons",
+            Scheme::TwoPhase(_) => {
+                "Seed 000's two-phase modified Catmull-Clark, quads; shape parameter λ (two-phase:λ)"
+            }
+            Scheme::DooSabin => "Doo-Sabin's dual scheme, any polygons",
+            Scheme::Sqrt3 => "Kobbelt's √3 scheme, triangles",
+            Scheme::Butterfly { .. } => {
+                "The interpolating butterfly (Dyn, Levin, Gregory), triangles; tension w (butterfly:w, default 1/16)"
+            }
+            Scheme::ModifiedButterfly => {
+                "Zorin, Schröder and Sweldens' modified butterfly, triangles"
+            }
+        }
+    }
+
     /// Bytes per output vertex at the peak of refining and writing with this scheme, held
     /// and (OpenSubdiv's schemes) streamed from the level above: measured with
     /// `/usr/bin/time -f %M` on the bench torus and its triangulation, levels 1–4, rounded
