@@ -135,7 +135,10 @@ impl AdaptiveRefinement {
         } else {
             criteria.to_vec()
         };
-        let mut uniform = ChildLayout::new(base, scheme, max_level);
+        let mut uniform =
+            ChildLayout::new(base, scheme, max_level).ok_or_else(|| AdaptiveError::Scheme {
+                scheme: scheme.to_string(),
+            })?;
         let mut levels = vec![SparseLevel::base(base, points, scheme, options)?];
         let mut requests: Vec<HashSet<u64>> = vec![HashSet::new(); max_level];
         let mut level_builds = 1;

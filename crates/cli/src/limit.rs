@@ -189,7 +189,7 @@ fn levels_refined(topo: &subd_mesh::Topology, scheme: &Scheme) -> usize {
     if !scheme.is_opensubdiv() {
         return 0;
     }
-    let two_phase = usize::from(scheme_arg::is_two_phase(scheme));
+    let two_phase = usize::from(scheme.two_phase().is_some());
     levels_for_exact_limit(topo, &scheme.at_level(1))
         .0
         .max(two_phase)

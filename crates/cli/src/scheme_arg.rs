@@ -140,11 +140,6 @@ pub(crate) fn with_lambda(
     }
 }
 
-/// Whether `scheme` is the two-phase scheme, with or without its `λ`.
-pub(crate) fn is_two_phase(scheme: &Scheme) -> bool {
-    matches!(scheme, Scheme::TwoPhase(_))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -318,11 +318,6 @@ impl LimitStencilTable {
         }
     }
 
-    /// Whether vertex `v` has tangents (and a normal).
-    pub fn has_tangents(&self, v: usize) -> bool {
-        !self.without_tangents.get(v).copied().unwrap_or(false)
-    }
-
     /// Limit positions, tangents and unit normals from the control points the rows refer to;
     /// NaN tangents and normals at the vertices [`LimitStencilTable::without_tangents`] names.
     pub fn apply(&self, points: &[DVec3]) -> LimitPoints {

@@ -20,21 +20,15 @@ pub struct ChildLayout {
 }
 
 impl ChildLayout {
-    /// The layout of `levels` uniform levels of `base` under `scheme`.
-    ///
-    /// # Panics
-    /// For a scheme whose split is neither [`Split::Quad`] nor [`Split::Triangle`].
-    pub fn new(base: &Topology, scheme: &Scheme, levels: usize) -> ChildLayout {
+    /// The layout of `levels` uniform levels of `base` under `scheme`; `None` for a scheme
+    /// whose split is neither [`Split::Quad`] nor [`Split::Triangle`] (Doo-Sabin, √3).
+    pub fn new(base: &Topology, scheme: &Scheme, levels: usize) -> Option<ChildLayout> {
         let split = scheme.split();
-        assert!(
-            matches!(split, Split::Quad | Split::Triangle),
-            "ChildLayout: the {scheme} scheme's children are not numbered as OpenSubdiv's"
-        );
-        ChildLayout {
+        matches!(split, Split::Quad | Split::Triangle).then(|| ChildLayout {
             split,
             counts: refined_counts(base, scheme, levels),
             base_offsets: base.face_offsets().to_vec(),
-        }
+        })
     }
 
     /// Counts of uniform level `level`.
@@ -114,7 +108,7 @@ mod tests {
             .build(&[4, 3, 3, 3, 3], &fv)
             .unwrap();
         let r = Refinement::new(&t, Scheme::CatmullClark, &Options::default(), 3).unwrap();
-        let u = ChildLayout::new(&t, &Scheme::CatmullClark, 3);
+        let u = ChildLayout::new(&t, &Scheme::CatmullClark, 3).unwrap();
         for l in 0..=3 {
             let c = u.counts(l);
             let tl = r.topology(l);
@@ -127,7 +121,8 @@ mod tests {
             .build(&[3; 4], &[0, 1, 2, 0, 3, 1, 1, 3, 2, 2, 3, 0])
             .unwrap();
         let r = Refinement::new(&tri, Scheme::Loop, &Options::default(), 3).unwrap();
-        let u = ChildLayout::new(&tri, &Scheme::Loop, 3);
+        let u = ChildLayout::new(&tri, &Scheme::Loop, 3).unwrap();
+        assert!(ChildLayout::new(&tri, &Scheme::Sqrt3, 1).is_none());
         for l in 0..=3 {
             let tl = r.topology(l);
             assert_eq!(u.counts(l).edges, tl.num_edges() as u64);
