@@ -329,7 +329,8 @@ impl Output<'_> {
         let filled;
         if let Some(n) = &normals {
             filled = normals_or_faces(n, &view);
-            view = view.with_normals(&filled).map_err(|e| self.in_view(e))?;
+            let n = filled.as_deref().unwrap_or(n);
+            view = view.with_normals(n).map_err(|e| self.in_view(e))?;
         }
         let counts = write_level(self.job, view, self.hints, r.edges(levels))?;
         Ok(Written {

@@ -73,8 +73,14 @@ pub(crate) fn output_limit(
 ) -> Result<subd_limit::LimitPoints, String> {
     let scheme = &refinement.scheme().at_level(level);
     if scheme.is_opensubdiv() || level < refinement.num_levels() {
-        return subd_limit::limit_points(refinement.topology(level), scheme, options, positions)
-            .map_err(|e| e.to_string());
+        return subd_limit::level_limit_points(
+            refinement,
+            level,
+            options,
+            positions,
+            subd_limit::Tangents::Dropped,
+        )
+        .map_err(|e| e.to_string());
     }
     // A split scheme's last level: the stencils its texture coordinates share.
     Ok(refinement.last_limit()?.apply(positions))
@@ -82,20 +88,27 @@ pub(crate) fn output_limit(
 
 /// `normals` where they are unit vectors; elsewhere (a split scheme's creases and corners,
 /// parallel tangents) the area-weighted normal of the output faces, as `.glb` shading uses.
+/// `None` when every normal is a unit vector already (the face normals are not computed).
 pub(crate) fn normals_or_faces(
     normals: &[subd_mesh::DVec3],
     view: &subd_io::MeshView<'_>,
-) -> Vec<subd_mesh::DVec3> {
+) -> Option<Vec<subd_mesh::DVec3>> {
+    let is_unit = |n: &subd_mesh::DVec3| n.is_finite() && n.length_squared() > 0.5;
+    if normals.iter().all(is_unit) {
+        return None;
+    }
     let from_faces = subd_io::glb::vertex_normals(view);
-    normals
-        .iter()
-        .zip(from_faces)
-        .map(|(n, f)| {
-            if n.is_finite() && n.length_squared() > 0.5 {
-                *n
-            } else {
-                f.try_normalize().unwrap_or(subd_mesh::DVec3::Z)
-            }
-        })
-        .collect()
+    Some(
+        normals
+            .iter()
+            .zip(from_faces)
+            .map(|(n, f)| {
+                if is_unit(n) {
+                    *n
+                } else {
+                    f.try_normalize().unwrap_or(subd_mesh::DVec3::Z)
+                }
+            })
+            .collect(),
+    )
 }

@@ -305,8 +305,8 @@ fn surface(
 ) -> Result<Surface, String> {
     let view = subd_io::MeshView::new(&positions, &offsets, &vertices, &holes)
         .map_err(|e| e.to_string())?;
-    let normals = match &limit_normals {
-        Some(n) => normals_or_faces(n, &view),
+    let normals = match limit_normals {
+        Some(n) => normals_or_faces(&n, &view).unwrap_or(n),
         None => subd_io::glb::vertex_normals(&view)
             .into_iter()
             .map(|n| n.try_normalize().unwrap_or(DVec3::Z))

@@ -88,7 +88,8 @@ pub(crate) fn run(
     let view = subd_io::MeshView::new(&t.positions, &t.face_offsets, &t.face_vertices, &holes)
         .map_err(|e| in_file(&e))?;
     let normals = normals_or_faces(&t.normals, &view);
-    let view = view.with_normals(&normals).map_err(|e| in_file(&e))?;
+    let normals = normals.as_deref().unwrap_or(&t.normals);
+    let view = view.with_normals(normals).map_err(|e| in_file(&e))?;
     subd_io::write_view(&args.output, &view, &subd_io::WriteOptions::default())?;
     if args.json {
         let report = TessellateReport {

@@ -43,6 +43,7 @@
 //! ```
 
 pub mod acc;
+mod child_limit;
 mod child_param;
 pub mod eigen;
 pub mod eval;
@@ -235,6 +236,81 @@ pub fn limit_points(
     positions: &[glam::DVec3],
 ) -> Result<LimitPoints, LimitError> {
     Ok(limit_stencils(topology, scheme, options)?.apply(positions))
+}
+
+/// The exact limit (positions, tangents, normals) of every vertex of `level` of
+/// `refinement`, from `points`, that level's points: what `refine --limit` writes. Where
+/// no semi-sharp feature is left at that level (and, for Catmull-Clark, every face is a
+/// quad), each vertex's limit mask is applied straight to its ring in one parallel pass,
+/// without stencil tables: the closed forms for smooth, crease and corner vertices, the
+/// eigen analysis for darts and interior valence-2 vertices. The values are those of
+/// [`limit_points`] of the level's topology, bit for bit. Elsewhere (semi-sharp features
+/// left to decay, the two-phase scheme's level 0, a split scheme) it is [`limit_points`] of
+/// that topology.
+///
+/// ```
+/// use subd_mesh::{DVec3, TopologyBuilder};
+/// use subd_schemes::{Options, Refinement, Scheme};
+/// use subd_limit::Tangents;
+///
+/// let faces = [0, 1, 3, 2, 2, 3, 5, 4, 4, 5, 7, 6, 6, 7, 1, 0, 1, 7, 5, 3, 6, 0, 2, 4];
+/// let cube = TopologyBuilder::new(8).build(&[4; 6], &faces).unwrap();
+/// let base: Vec<DVec3> = (0..8)
+///     .map(|i| DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64))
+///     .collect();
+/// let o = Options::default();
+/// let r = Refinement::new(&cube, Scheme::CatmullClark, &o, 2).unwrap();
+/// let points = r.points_at(&base, 2);
+/// let direct = subd_limit::level_limit_points(&r, 2, &o, &points, Tangents::Kept).unwrap();
+/// let via_table =
+///     subd_limit::limit_points(r.topology(2), &Scheme::CatmullClark, &o, &points).unwrap();
+/// for v in 0..points.len() {
+///     assert!((direct.positions[v] - via_table.positions[v]).length() < 1e-15);
+///     assert!((direct.normals[v] - via_table.normals[v]).length() < 1e-14);
+/// }
+/// ```
+///
+/// # Errors
+/// As [`limit_points`].
+///
+/// # Panics
+/// If `points` does not hold one point per vertex of `level`.
+pub fn level_limit_points(
+    refinement: &Refinement,
+    level: usize,
+    options: &Options,
+    points: &[glam::DVec3],
+    tangents: Tangents,
+) -> Result<LimitPoints, LimitError> {
+    if child_limit::applies(refinement, level) {
+        return child_limit::child_level_limit(refinement, level, points, tangents);
+    }
+    let scheme = refinement.scheme().at_level(level);
+    let topology = refinement.topology(level);
+    // The two-phase scheme's level 0 (phase 1 still to come) takes its own entry; a
+    // non-manifold vertex its rules from the level's own tags.
+    let with_masks = matches!(scheme, Scheme::CatmullClark | Scheme::Loop);
+    if with_masks
+        && levels_for_exact_limit(topology, &scheme).0 == 0
+        && (0..topology.num_vertices()).all(|v| !topology.is_non_manifold_vertex(v))
+    {
+        return Ok(table::LevelMasks::new(refinement, level)?.apply(points, tangents));
+    }
+    let mut limit = limit_points(topology, &scheme, options, points)?;
+    if tangents == Tangents::Dropped {
+        (limit.tangent1, limit.tangent2) = (Vec::new(), Vec::new());
+    }
+    Ok(limit)
+}
+
+/// Whether [`level_limit_points`] keeps the limit tangents or only the positions and the
+/// normals (half the memory written, all a mesh file takes).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Tangents {
+    /// `tangent1` and `tangent2` filled.
+    Kept,
+    /// `tangent1` and `tangent2` left empty.
+    Dropped,
 }
 
 /// The exact limit (position, tangents, normal) of every base vertex, as stencils over the

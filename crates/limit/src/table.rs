@@ -9,9 +9,9 @@ use subd_mesh::Topology;
 use subd_mesh::tags::is_infinite;
 use subd_schemes::{Refinement, RowSink, Rule, Scheme, StencilTable, rules};
 
-use crate::LimitError;
 use crate::eigen::{RingFeature, ring_limit_mask};
 use crate::masks::{self, LimitMask, RingMask};
+use crate::{LimitError, Tangents};
 
 /// Limit position, tangents and unit normals of a set of vertices.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -224,6 +224,20 @@ impl<'a> LevelMasks<'a> {
         &self.library[self.mask[v] as usize]
     }
 
+    /// The limit points of every vertex of the level from that level's `points`: each mask
+    /// applied straight to the ring, without building a table, in parallel chunks. The sums
+    /// are those of [`StencilTable::apply_points`] over [`LevelMasks::table`]'s rows, term
+    /// for term, so the values are the same bit for bit.
+    pub(crate) fn apply(&self, points: &[DVec3], tangents: Tangents) -> LimitPoints {
+        let t = self.topology;
+        assert_eq!(points.len(), t.num_vertices(), "one point per vertex");
+        let with_faces = self.library.iter().any(|m| !m.position.faces.is_empty());
+        limit_by_vertex(t.num_vertices(), tangents, |ring, v| {
+            ring.gather(t, v, with_faces);
+            ring.limit(self.of(v), points)
+        })
+    }
+
     /// The table of one of the masks (`which` picks position or a tangent).
     fn table(&self, which: impl Fn(&LimitMask) -> &RingMask + Sync) -> StencilTable {
         let t = self.topology;
@@ -341,6 +355,177 @@ impl LimitStencilTable {
             tangent2,
             normals,
         }
+    }
+}
+
+/// Vertices per parallel job of [`limit_by_vertex`].
+const APPLY_CHUNK: usize = 4096;
+
+/// The limit points of `n` vertices, vertex `v`'s (position, tangents, normal) given by
+/// `limit(ring, v)` with a scratch [`Ring`], filled in parallel chunks straight into the
+/// arrays (their zeroed pages first touched by the thread that fills them); the tangent
+/// arrays left empty when `tangents` drops them.
+pub(crate) fn limit_by_vertex(
+    n: usize,
+    tangents: Tangents,
+    limit: impl Fn(&mut Ring, usize) -> [DVec3; 4] + Sync,
+) -> LimitPoints {
+    let kept = if tangents == Tangents::Kept { n } else { 0 };
+    let mut out = LimitPoints {
+        positions: subd_mesh::memory::zeroed(n),
+        tangent1: subd_mesh::memory::zeroed(kept),
+        tangent2: subd_mesh::memory::zeroed(kept),
+        normals: subd_mesh::memory::zeroed(n),
+    };
+    let fill = |chunk: usize, p: &mut [DVec3], normal: &mut [DVec3], mut t: TangentChunks| {
+        let mut ring = Ring::default();
+        for k in 0..p.len() {
+            let [pk, t1, t2, nk] = limit(&mut ring, chunk * APPLY_CHUNK + k);
+            (p[k], normal[k]) = (pk, nk);
+            if let Some((a, b)) = &mut t {
+                (a[k], b[k]) = (t1, t2);
+            }
+        }
+    };
+    let points = out
+        .positions
+        .par_chunks_mut(APPLY_CHUNK)
+        .zip(out.normals.par_chunks_mut(APPLY_CHUNK))
+        .enumerate();
+    if kept > 0 {
+        let t = out
+            .tangent1
+            .par_chunks_mut(APPLY_CHUNK)
+            .zip(out.tangent2.par_chunks_mut(APPLY_CHUNK));
+        points
+            .zip(t)
+            .for_each(|((c, (p, nm)), (a, b))| fill(c, p, nm, Some((a, b))));
+    } else {
+        points.for_each(|(c, (p, nm))| fill(c, p, nm, None));
+    }
+    out
+}
+
+/// One chunk of both tangent arrays, where they are kept.
+type TangentChunks<'a> = Option<(&'a mut [DVec3], &'a mut [DVec3])>;
+
+/// The points one vertex's ring masks read, in [`emit`]'s order (the face terms' opposite
+/// corners, the edges' far ends, the vertex), gathered once for its three masks.
+#[derive(Default)]
+pub(crate) struct Ring {
+    indices: Vec<u32>,
+    num_faces: usize,
+    num_edges: usize,
+    /// Whether a point occurs twice (a small closed mesh): its stencil row then merges the
+    /// terms, and [`Ring::apply`] sums as that row does.
+    repeats: bool,
+}
+
+impl Ring {
+    /// The ring of vertex `v` of `t` (without the face terms when no mask has any).
+    fn gather(&mut self, t: &Topology, v: usize, with_faces: bool) {
+        let faces = with_faces.then(|| {
+            let local = t.vertex_face_local_indices(v);
+            t.vertex_faces(v).iter().zip(local).map(|(&f, &k)| {
+                let corners = t.face_vertices(f as usize);
+                corners[(k as usize + 2) % corners.len()]
+            })
+        });
+        let edges = t
+            .vertex_edges(v)
+            .iter()
+            .map(|&e| t.edge_other_vertex(e as usize, v as u32));
+        self.set(faces.into_iter().flatten(), edges, v as u32);
+    }
+
+    /// A ring given by its points: the face terms' opposite corners, the edges' far ends,
+    /// the centre.
+    pub(crate) fn set(
+        &mut self,
+        faces: impl IntoIterator<Item = u32>,
+        edges: impl IntoIterator<Item = u32>,
+        centre: u32,
+    ) {
+        self.indices.clear();
+        self.indices.extend(faces);
+        self.num_faces = self.indices.len();
+        self.indices.extend(edges);
+        self.num_edges = self.indices.len() - self.num_faces;
+        self.indices.push(centre);
+        let ix = &self.indices;
+        self.repeats = (1..ix.len()).any(|i| ix[..i].contains(&ix[i]));
+    }
+
+    /// The three masks of `m` applied to `points`: position, tangents, unit normal.
+    pub(crate) fn limit(&self, m: &LimitMask, points: &[DVec3]) -> [DVec3; 4] {
+        let [p, t1, t2] = if self.repeats {
+            [&m.position, &m.tangent1, &m.tangent2].map(|r| self.apply(r, points))
+        } else {
+            self.apply_three(m, points)
+        };
+        [p, t1, t2, t1.cross(t2).normalize_or_zero()]
+    }
+
+    /// [`Ring::apply`] of the three masks in one pass over the ring (each point read once;
+    /// each sum in the same order as alone), for a ring without repeated points.
+    fn apply_three(&self, m: &LimitMask, points: &[DVec3]) -> [DVec3; 3] {
+        let masks = [&m.position, &m.tangent1, &m.tangent2];
+        let (nf, ne) = (self.num_faces, self.num_edges);
+        let mut acc = [DVec3::ZERO; 3];
+        let mut add = |i: u32, w: [f64; 3]| {
+            let p = points[i as usize];
+            for (a, w) in acc.iter_mut().zip(w) {
+                *a += w * p;
+            }
+        };
+        let at = |w: &[f64], k: usize| w.get(k).copied().unwrap_or(0.0);
+        for (k, &i) in self.indices[..nf].iter().enumerate() {
+            add(i, masks.map(|r| at(&r.faces, k)));
+        }
+        for (k, &i) in self.indices[nf..nf + ne].iter().enumerate() {
+            add(i, masks.map(|r| at(&r.edges, k)));
+        }
+        add(self.indices[nf + ne], masks.map(|r| r.vertex));
+        acc
+    }
+
+    /// Mask `m` applied to `points`. A term of weight zero, which the row leaves out, adds
+    /// a signed zero to a sum that started at +0: no change for finite points.
+    fn apply(&self, m: &RingMask, points: &[DVec3]) -> DVec3 {
+        if self.repeats {
+            // As `RowSink` merges: nonzero terms, per point in order of first appearance.
+            let mut merged: Vec<(u32, f64)> = Vec::with_capacity(self.indices.len());
+            for (i, w) in self.terms(m).filter(|&(_, w)| w != 0.0) {
+                match merged.iter_mut().find(|(j, _)| *j == i) {
+                    Some((_, sum)) => *sum += w,
+                    None => merged.push((i, w)),
+                }
+            }
+            return merged
+                .iter()
+                .fold(DVec3::ZERO, |acc, &(i, w)| acc + w * points[i as usize]);
+        }
+        let mut acc = DVec3::ZERO;
+        for (i, w) in self.terms(m) {
+            acc += w * points[i as usize];
+        }
+        acc
+    }
+
+    /// (point, weight) in order; weights past a mask's end are zero.
+    fn terms<'a>(&'a self, m: &'a RingMask) -> impl Iterator<Item = (u32, f64)> + 'a {
+        let (nf, ne) = (self.num_faces, self.num_edges);
+        let weight = |w: &[f64], i: usize| w.get(i).copied().unwrap_or(0.0);
+        self.indices.iter().enumerate().map(move |(k, &i)| {
+            let w = if k < nf {
+                weight(&m.faces, k)
+            } else if k < nf + ne {
+                weight(&m.edges, k - nf)
+            } else {
+                m.vertex
+            };
+            (i, w)
+        })
     }
 }
 

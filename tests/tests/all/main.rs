@@ -7,6 +7,7 @@ mod curves;
 mod editing;
 mod front_door;
 mod fvar_eval;
+mod level_limit;
 mod limit_eval;
 mod limit_shapes;
 mod osd_meshes;
