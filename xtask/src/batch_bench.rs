@@ -24,7 +24,7 @@ struct Corpus {
 }
 
 /// Builds `subd` in release mode and returns its path.
-fn subd_binary() -> Result<PathBuf, String> {
+pub(crate) fn subd_binary() -> Result<PathBuf, String> {
     run(cargo().args(["build", "--release", "-p", "subd-cli"]))?;
     let target = std::env::var_os("CARGO_TARGET_DIR")
         .map(PathBuf::from)

@@ -21,6 +21,7 @@ mod pia_bench;
 mod random_mesh;
 mod refined_limits;
 mod row;
+mod scaling_bench;
 mod split_bench;
 mod tess_bench;
 mod tess_conformance;
@@ -112,6 +113,14 @@ enum Task {
         /// InterpolateFaceVarying).
         #[arg(long)]
         fvar_only: bool,
+        /// Only the scaling table: every path of the `subd` binary (refine with each kind of
+        /// scheme, --limit, UVs, tessellate, adaptive), each phase at 1, 2 and all threads,
+        /// OpenSubdiv on one thread beside it.
+        #[arg(long)]
+        scaling: bool,
+        /// The thread counts of --scaling (default 1, 2 and every CPU), e.g. 1,2,4,8,16.
+        #[arg(long, value_delimiter = ',')]
+        threads: Vec<usize>,
     },
     /// (internal) One subd split-scheme measurement for `bench`, in its own process.
     #[command(hide = true)]
@@ -285,6 +294,8 @@ fn main() -> ExitCode {
             batch_only,
             tess_only,
             fvar_only,
+            scaling,
+            threads,
         } => {
             let refinement = || {
                 bench::run(
@@ -301,7 +312,10 @@ fn main() -> ExitCode {
             let batch = || batch_bench::run_batch(rounds.max(1), &shapes);
             let tess = || tess_bench::run(repeats);
             let fvar = || fvar_bench::run(levels, repeats, rounds.max(1));
-            if fvar_only {
+            if scaling {
+                ensure_system_packages(REFERENCE_PACKAGES)
+                    .and_then(|_| scaling_bench::run(repeats, &threads))
+            } else if fvar_only {
                 ensure_system_packages(REFERENCE_PACKAGES).and_then(|_| fvar())
             } else if tess_only {
                 ensure_system_packages(REFERENCE_PACKAGES).and_then(|_| tess())
