@@ -1,12 +1,25 @@
 //! Building a [`Topology`] from face-vertex lists in O(V + E + F).
 
-use crate::csr::{RowSlots, group_by_key, offsets_of_keys};
+use std::sync::atomic::{AtomicU32, Ordering};
+
+use rayon::prelude::*;
+
+use crate::csr::{Csr, exclusive_prefix_sum, par_group_indices};
 use crate::error::{BuildWarning, TopologyError};
+use crate::memory;
 use crate::tags::Tags;
 use crate::topology::MAX_FACE_SIZE;
 use crate::topology::*;
 
+#[cfg(test)]
+mod reference;
+#[cfg(test)]
+mod tests;
+
 const NONE: u32 = u32::MAX;
+/// Faces, vertices or half-edges per parallel task: large enough that a task's bookkeeping
+/// is negligible, small enough that two threads share the work evenly.
+const BLOCK: usize = 1 << 12;
 
 /// Builds a [`Topology`] from face sizes and face-vertex indices (OpenSubdiv's
 /// `numVertsPerFace` / `vertIndicesPerFace` form).
@@ -55,6 +68,9 @@ impl TopologyBuilder {
 
     /// Builds the topology and returns the warnings about accepted oddities (faces that
     /// repeat a vertex, accepted orientation conflicts).
+    ///
+    /// The build runs on rayon's current thread pool; its result, warnings and errors do not
+    /// depend on the number of threads (an error is the first in face order).
     pub fn build_with_warnings(
         &self,
         face_sizes: &[u32],
@@ -63,34 +79,34 @@ impl TopologyBuilder {
         let nv = self.num_vertices;
         check_index_range(nv, face_sizes, face_vertices)?;
         let face_offsets = checked_face_offsets(face_sizes, face_vertices.len())?;
+        let half_face = half_faces(&face_offsets, face_vertices.len());
         let faces = FaceLoops {
             offsets: &face_offsets,
             vertices: face_vertices,
+            half_face: &half_face,
         };
-        let mut warnings = Vec::new();
-        // `stamp[v]` remembers the last face (or bucket) that touched `v`; it replaces a hash
-        // set so that repeated-vertex detection and edge matching stay linear.
-        let mut stamp = vec![NONE; nv];
-        faces.check_vertices(nv, &mut stamp, &mut warnings)?;
-        let half_face = faces.half_faces();
-        let first_half = faces.first_halves(nv, &half_face, &mut stamp);
-        let numbering = EdgeNumbering::number(
+        faces.check_vertex_range(nv)?;
+        let mut warnings = faces.repeated_vertex_warnings();
+        // Half-edges by their first vertex: the vertex-face relation, and where edge matching
+        // finds each vertex's half-edges.
+        let corners = par_group_indices(nv, face_vertices.len(), |h| face_vertices[h]);
+        let pairs = faces.match_pairs(&corners);
+        report_conflicts(
             &faces,
-            &half_face,
-            &first_half,
+            pairs.conflicts,
             self.accept_inconsistent_orientation,
             &mut warnings,
         )?;
-        drop(first_half);
-        drop(half_face);
-        let topo = assemble(
-            nv,
-            face_offsets,
-            face_vertices.to_vec(),
-            numbering.face_edges,
-            numbering.edge_vertices,
-            numbering.edge_flags,
-        );
+        let numbered = faces.number_edges(pairs.link, &pairs.non_manifold);
+        let relations = Relations {
+            face_offsets: &face_offsets,
+            face_vertices: par_copy(face_vertices),
+            half_face: &half_face,
+            face_edges: numbered.face_edges,
+            edge_vertices: numbered.edge_vertices,
+            edge_flags: numbered.edge_flags,
+        };
+        let topo = relations.assemble(nv, corners);
         Ok((topo, warnings))
     }
 }
@@ -157,11 +173,65 @@ fn checked_face_offsets(
     Ok(face_offsets)
 }
 
+/// The face of every half-edge, filled face block by face block in parallel.
+fn half_faces(face_offsets: &[u32], num_half_edges: usize) -> Vec<u32> {
+    let nf = face_offsets.len() - 1;
+    let mut half_face: Vec<u32> = memory::zeroed(num_half_edges);
+    let block_starts = (0..nf.div_ceil(BLOCK)).map(|b| face_offsets[b * BLOCK] as usize);
+    split_at_starts(&mut half_face, block_starts)
+        .into_par_iter()
+        .enumerate()
+        .for_each(|(b, out)| {
+            let first = b * BLOCK;
+            let base = face_offsets[first] as usize;
+            for f in first..(first + BLOCK).min(nf) {
+                let r = face_offsets[f] as usize - base..face_offsets[f + 1] as usize - base;
+                out[r].fill(f as u32);
+            }
+        });
+    half_face
+}
+
+/// Splits `data` into consecutive pieces starting at `starts` (increasing, the first 0), the
+/// last piece running to the end; for parallel tasks that each own a contiguous range.
+fn split_at_starts<T>(mut data: &mut [T], starts: impl Iterator<Item = usize>) -> Vec<&mut [T]> {
+    let mut pieces = Vec::new();
+    let mut at = 0;
+    for next in starts.skip(1) {
+        let (piece, rest) = data.split_at_mut(next - at);
+        pieces.push(piece);
+        (data, at) = (rest, next);
+    }
+    pieces.push(data);
+    pieces
+}
+
 /// The faces as closed loops of face-vertices ("half-edges": face-vertex `h` starts the
 /// half-edge to the next vertex of its face).
 struct FaceLoops<'a> {
     offsets: &'a [u32],
     vertices: &'a [u32],
+    half_face: &'a [u32],
+}
+
+/// The result of matching half-edges into pairs (see [`FaceLoops::match_pairs`]).
+struct Pairs {
+    /// Per half-edge: itself when it starts an edge, else the half-edge that started its
+    /// edge.
+    link: Vec<u32>,
+    /// Half-edges starting an edge that is non-manifold.
+    non_manifold: Vec<u32>,
+    /// Second faces using an edge in its first face's direction: (half-edge, first face).
+    conflicts: Vec<(u32, u32)>,
+}
+
+/// What matching finds in a block of vertices besides the links.
+#[derive(Default)]
+struct Oddities {
+    /// Half-edges starting an edge that is non-manifold.
+    non_manifold: Vec<u32>,
+    /// Orientation conflicts: (half-edge, first face of its edge).
+    conflicts: Vec<(u32, u32)>,
 }
 
 impl FaceLoops<'_> {
@@ -169,178 +239,288 @@ impl FaceLoops<'_> {
         self.offsets.len() - 1
     }
 
-    fn range(&self, f: usize) -> std::ops::Range<usize> {
-        self.offsets[f] as usize..self.offsets[f + 1] as usize
-    }
-
-    /// The vertices at the two ends of half-edge `h` of face `f`.
+    /// The half-edges before and after half-edge `h` in its face.
     #[inline]
-    fn ends(&self, f: usize, h: usize) -> (u32, u32) {
-        let end = self.offsets[f + 1] as usize;
-        let next = if h + 1 == end {
-            self.offsets[f] as usize
-        } else {
-            h + 1
+    fn prev_next(&self, h: usize) -> (usize, usize) {
+        let f = self.half_face[h] as usize;
+        let (start, end) = (self.offsets[f] as usize, self.offsets[f + 1] as usize);
+        let prev = if h == start { end - 1 } else { h - 1 };
+        let next = if h + 1 == end { start } else { h + 1 };
+        (prev, next)
+    }
+
+    /// The vertices at the two ends of half-edge `h`.
+    #[inline]
+    fn ends(&self, h: usize) -> (u32, u32) {
+        (self.vertices[h], self.vertices[self.prev_next(h).1])
+    }
+
+    /// Refuses the first vertex index, in face order, that is out of range.
+    fn check_vertex_range(&self, nv: usize) -> Result<(), TopologyError> {
+        let bad = |&v: &u32| v as usize >= nv;
+        // Blocks first: a per-element parallel search costs more than the scan itself.
+        let Some(b) = self
+            .vertices
+            .par_chunks(BLOCK)
+            .position_first(|block| block.iter().any(bad))
+        else {
+            return Ok(());
         };
-        (self.vertices[h], self.vertices[next])
+        let h = block(b, self.vertices.len())
+            .find(|&h| bad(&self.vertices[h]))
+            .unwrap_or(0);
+        let face = self.half_face[h] as usize;
+        Err(TopologyError::VertexIndexOutOfRange {
+            face,
+            corner: h - self.offsets[face] as usize,
+            index: self.vertices[h] as u64,
+            num_vertices: nv,
+        })
     }
 
-    /// Refuses vertex indices out of range; warns about faces that repeat a vertex.
-    fn check_vertices(
-        &self,
-        nv: usize,
-        stamp: &mut [u32],
-        warnings: &mut Vec<BuildWarning>,
-    ) -> Result<(), TopologyError> {
-        for f in 0..self.num_faces() {
-            for (corner, &v) in self.vertices[self.range(f)].iter().enumerate() {
-                if v as usize >= nv {
-                    return Err(TopologyError::VertexIndexOutOfRange {
-                        face: f,
-                        corner,
-                        index: v as u64,
-                        num_vertices: nv,
-                    });
+    /// A warning for every corner whose vertex occurs earlier in the same face, in face
+    /// order.
+    fn repeated_vertex_warnings(&self) -> Vec<BuildWarning> {
+        let face =
+            |f: usize| &self.vertices[self.offsets[f] as usize..self.offsets[f + 1] as usize];
+        // Such faces are rare: find them in parallel, then list their repeats.
+        let faces: Vec<usize> = (0..self.num_faces())
+            .into_par_iter()
+            .with_min_len(BLOCK)
+            .filter(|&f| has_repeat(face(f)))
+            .collect();
+        let warning = |f: usize, c: usize| BuildWarning::RepeatedVertex {
+            face: f,
+            vertex: face(f)[c],
+        };
+        faces
+            .into_iter()
+            .flat_map(|f| {
+                repeated_corners(face(f))
+                    .into_iter()
+                    .map(move |c| warning(f, c))
+            })
+            .collect()
+    }
+
+    /// Pass 1 of the build: groups the non-degenerate half-edges by unordered vertex pair
+    /// and decides, pair by pair, which half-edges start an edge. Each pair is found at its
+    /// smaller vertex, among the half-edges leaving it and (one before those in their faces)
+    /// entering it, so vertices are matched independently, in parallel.
+    fn match_pairs(&self, corners: &Csr<u32>) -> Pairs {
+        let link = memory::atomic_u32s(self.vertices.len(), |h| h as u32);
+        let nv = corners.num_rows();
+        let found: Vec<Oddities> = (0..nv.div_ceil(BLOCK))
+            .into_par_iter()
+            .map(|b| {
+                let mut found = Oddities::default();
+                let mut pairs: Vec<(u32, u32)> = Vec::new();
+                for a in b * BLOCK..((b + 1) * BLOCK).min(nv) {
+                    self.pairs_at(a as u32, corners.row(a), &mut pairs);
+                    for group in pairs.chunk_by(|x, y| x.0 == y.0) {
+                        self.resolve_pair(group, &link, &mut found);
+                    }
                 }
-                if stamp[v as usize] == f as u32 {
-                    warnings.push(BuildWarning::RepeatedVertex { face: f, vertex: v });
-                }
-                stamp[v as usize] = f as u32;
+                found
+            })
+            .collect();
+        let mut conflicts: Vec<(u32, u32)> =
+            found.iter().flat_map(|o| o.conflicts.clone()).collect();
+        conflicts.sort_unstable();
+        Pairs {
+            link: memory::into_u32s(link),
+            non_manifold: found.into_iter().flat_map(|o| o.non_manifold).collect(),
+            conflicts,
+        }
+    }
+
+    /// The half-edges whose smaller vertex is `a`, as (larger vertex, half-edge), sorted:
+    /// each pair's half-edges together, in face order. `leaving` lists the half-edges that
+    /// leave `a`.
+    fn pairs_at(&self, a: u32, leaving: &[u32], pairs: &mut Vec<(u32, u32)>) {
+        pairs.clear();
+        for &h in leaving {
+            let (prev, next) = self.prev_next(h as usize);
+            let b = self.vertices[next];
+            if b > a {
+                pairs.push((b, h));
+            }
+            let c = self.vertices[prev];
+            if c > a {
+                pairs.push((c, prev as u32));
             }
         }
-        Ok(())
+        pairs.sort_unstable();
     }
 
-    /// The face of every half-edge.
-    fn half_faces(&self) -> Vec<u32> {
-        let mut half_face = vec![0u32; self.vertices.len()];
-        for f in 0..self.num_faces() {
-            half_face[self.range(f)].fill(f as u32);
-        }
-        half_face
-    }
-
-    /// Pass 1 of the build: for every non-degenerate half-edge, the first half-edge (in face
-    /// order) joining the same unordered vertex pair. Half-edges are bucketed by their
-    /// smaller vertex with a stable counting sort, then matched on the larger vertex
-    /// (`stamp` is scratch space of one entry per vertex).
-    fn first_halves(&self, nv: usize, half_face: &[u32], stamp: &mut [u32]) -> Vec<u32> {
-        let non_degenerate_by_smaller_end = (0..self.vertices.len()).filter_map(|h| {
-            let (a, b) = self.ends(half_face[h] as usize, h);
-            (a != b).then_some((a.min(b), h as u32))
-        });
-        let buckets = group_by_key(nv, non_degenerate_by_smaller_end);
-        let mut first_half = vec![NONE; self.vertices.len()];
-        stamp.fill(NONE);
-        let mut first_of = vec![0u32; nv];
-        for a in 0..nv {
-            for &h in buckets.row(a) {
-                let h = h as usize;
-                let (x, y) = self.ends(half_face[h] as usize, h);
-                let b = x.max(y) as usize;
-                if stamp[b] != a as u32 {
-                    stamp[b] = a as u32;
-                    first_of[b] = h as u32;
+    /// Decides which half-edges of one vertex pair (`group`, in face order) start an edge,
+    /// following the serial rules: the first does; a later one in the same face as the one
+    /// before it is a repeat in that face and starts a new, non-manifold instance; any other
+    /// joins the first one's edge, which a second joining face makes non-manifold, and so
+    /// does a first joining face in the same direction (an orientation conflict).
+    fn resolve_pair(&self, group: &[(u32, u32)], link: &[AtomicU32], found: &mut Oddities) {
+        let first = group[0].1;
+        let first_face = self.half_face[first as usize];
+        let mut prev_face = first_face;
+        let mut joined = 0;
+        let mut bad = false;
+        for &(_, h) in &group[1..] {
+            let face = self.half_face[h as usize];
+            if face == prev_face {
+                found.non_manifold.push(h);
+                bad = true;
+            } else {
+                link[h as usize].store(first, Ordering::Relaxed);
+                joined += 1;
+                let same_direction = self.vertices[h as usize] == self.vertices[first as usize];
+                if joined == 1 && same_direction {
+                    found.conflicts.push((h, first_face));
                 }
-                first_half[h] = first_of[b];
+                bad |= joined > 1 || same_direction;
             }
+            prev_face = face;
         }
-        first_half
+        if bad {
+            found.non_manifold.push(first);
+        }
+    }
+
+    /// Pass 2 of the build: numbers the half-edges that start an edge in face order (an
+    /// exclusive prefix sum over blocks of half-edges) and gives every half-edge its edge.
+    fn number_edges(&self, mut link: Vec<u32>, non_manifold: &[u32]) -> NumberedEdges {
+        let starts_edge = |h: usize| link[h] == h as u32;
+        let blocks = link.len().div_ceil(BLOCK);
+        let counts: Vec<u32> = (0..blocks)
+            .into_par_iter()
+            .map(|b| block(b, link.len()).filter(|&h| starts_edge(h)).count() as u32)
+            .collect();
+        let first_edge = exclusive_prefix_sum(&counts);
+        let ne = counts.iter().sum::<u32>() as usize;
+        let mut edge_of: Vec<u32> = memory::zeroed(link.len());
+        let mut edge_vertices: Vec<[u32; 2]> = memory::zeroed(ne);
+        let pieces = split_at_starts(&mut edge_vertices, first_edge.iter().map(|&e| e as usize));
+        edge_of
+            .par_chunks_mut(BLOCK)
+            .zip(pieces)
+            .zip(&first_edge)
+            .enumerate()
+            .for_each(|(b, ((edge_of, ev), &first))| {
+                let mut next = first;
+                for (i, h) in block(b, link.len()).enumerate() {
+                    if starts_edge(h) {
+                        let (v0, v1) = self.ends(h);
+                        ev[(next - first) as usize] = [v0, v1];
+                        edge_of[i] = next;
+                        next += 1;
+                    }
+                }
+            });
+        let mut edge_flags: Vec<u8> = memory::with_capacity(ne);
+        edge_flags.par_extend(edge_vertices.par_iter().map(|&[a, b]| {
+            if a == b {
+                EDGE_NON_MANIFOLD | EDGE_DEGENERATE
+            } else {
+                0
+            }
+        }));
+        for &h in non_manifold {
+            edge_flags[edge_of[h as usize] as usize] |= EDGE_NON_MANIFOLD;
+        }
+        link.par_iter_mut()
+            .with_min_len(BLOCK)
+            .for_each(|l| *l = edge_of[*l as usize]);
+        NumberedEdges {
+            face_edges: link,
+            edge_vertices,
+            edge_flags,
+        }
     }
 }
 
-/// Pass 2 of the build: the edges numbered by first appearance, following OpenSubdiv's rules
-/// for non-manifold cases (Vtr::Level::completeTopologyFromFaceVertices).
-struct EdgeNumbering {
+/// A copy of `values`, made by all threads.
+fn par_copy(values: &[u32]) -> Vec<u32> {
+    let mut copy = memory::with_capacity(values.len());
+    copy.par_extend(values.par_iter().copied());
+    copy
+}
+
+/// The half-edges of block `b` of `n`.
+fn block(b: usize, n: usize) -> std::ops::Range<usize> {
+    b * BLOCK..((b + 1) * BLOCK).min(n)
+}
+
+/// Whether a vertex occurs twice in `face`.
+fn has_repeat(face: &[u32]) -> bool {
+    match *face {
+        [a, b, c] => a == b || b == c || a == c,
+        [a, b, c, d] => a == b || a == c || a == d || b == c || b == d || c == d,
+        _ => !repeated_corners(face).is_empty(),
+    }
+}
+
+/// The corners of `face` whose vertex occurs at an earlier corner, in order.
+fn repeated_corners(face: &[u32]) -> Vec<usize> {
+    // Faces are mostly small: comparing all pairs is faster than sorting there.
+    if face.len() <= 32 {
+        return (1..face.len())
+            .filter(|&c| face[..c].contains(&face[c]))
+            .collect();
+    }
+    let mut sorted: Vec<(u32, usize)> = face.iter().copied().zip(0..).collect();
+    sorted.sort_unstable();
+    let mut repeated: Vec<usize> = sorted
+        .windows(2)
+        .filter(|w| w[0].0 == w[1].0)
+        .map(|w| w[1].1)
+        .collect();
+    repeated.sort_unstable();
+    repeated
+}
+
+/// Refuses the first orientation conflict in face order, or warns about all of them when
+/// they are accepted.
+fn report_conflicts(
+    faces: &FaceLoops<'_>,
+    conflicts: Vec<(u32, u32)>,
+    accept: bool,
+    warnings: &mut Vec<BuildWarning>,
+) -> Result<(), TopologyError> {
+    let describe = |(h, first_face): (u32, u32)| {
+        let (v0, v1) = faces.ends(h as usize);
+        (
+            first_face as usize,
+            faces.half_face[h as usize] as usize,
+            v0,
+            v1,
+        )
+    };
+    if let (false, Some(&first)) = (accept, conflicts.first()) {
+        let (first_face, second_face, v0, v1) = describe(first);
+        return Err(TopologyError::InconsistentOrientation {
+            first_face,
+            second_face,
+            v0,
+            v1,
+        });
+    }
+    warnings.extend(conflicts.into_iter().map(|c| {
+        let (first_face, second_face, v0, v1) = describe(c);
+        BuildWarning::InconsistentOrientation {
+            first_face,
+            second_face,
+            v0,
+            v1,
+        }
+    }));
+    Ok(())
+}
+
+/// Edges numbered by first appearance: each half-edge's edge, each edge's vertices (in its
+/// first face's direction) and its non-manifold and degenerate flags.
+struct NumberedEdges {
     face_edges: Vec<u32>,
     edge_vertices: Vec<[u32; 2]>,
     edge_flags: Vec<u8>,
-    edge_face_count: Vec<u32>,
-    edge_last_face: Vec<u32>,
-}
-
-impl EdgeNumbering {
-    fn number(
-        faces: &FaceLoops<'_>,
-        half_face: &[u32],
-        first_half: &[u32],
-        accept_inconsistent_orientation: bool,
-        warnings: &mut Vec<BuildWarning>,
-    ) -> Result<EdgeNumbering, TopologyError> {
-        let nh = faces.vertices.len();
-        let mut n = EdgeNumbering {
-            face_edges: vec![0u32; nh],
-            edge_vertices: Vec::with_capacity(nh / 2 + 16),
-            edge_flags: Vec::with_capacity(nh / 2 + 16),
-            edge_face_count: Vec::with_capacity(nh / 2 + 16),
-            edge_last_face: Vec::with_capacity(nh / 2 + 16),
-        };
-        for h in 0..nh {
-            let f = half_face[h];
-            let (v0, v1) = faces.ends(f as usize, h);
-            let mut edge = NONE;
-            let mut new_flags = 0u8;
-            if v0 == v1 {
-                new_flags = EDGE_NON_MANIFOLD | EDGE_DEGENERATE;
-            } else if first_half[h] != h as u32 {
-                let e = n.face_edges[first_half[h] as usize] as usize;
-                if n.edge_last_face[e] == f {
-                    // The pair occurs twice in this face: a new, non-manifold instance.
-                    n.edge_flags[e] |= EDGE_NON_MANIFOLD;
-                    new_flags = EDGE_NON_MANIFOLD;
-                } else {
-                    n.add_face(e, f, v0, v1, accept_inconsistent_orientation, warnings)?;
-                    edge = e as u32;
-                }
-            }
-            if edge == NONE {
-                edge = n.edge_vertices.len() as u32;
-                n.edge_vertices.push([v0, v1]);
-                n.edge_face_count.push(1);
-                n.edge_last_face.push(f);
-                n.edge_flags.push(new_flags);
-            }
-            n.face_edges[h] = edge;
-        }
-        Ok(n)
-    }
-
-    /// Adds face `f`, traversing `v0 -> v1`, to edge `e` that an earlier face already has:
-    /// a third face makes it non-manifold, and so does a second face in the same direction
-    /// (an orientation conflict, refused unless accepted).
-    fn add_face(
-        &mut self,
-        e: usize,
-        f: u32,
-        v0: u32,
-        v1: u32,
-        accept_inconsistent_orientation: bool,
-        warnings: &mut Vec<BuildWarning>,
-    ) -> Result<(), TopologyError> {
-        if self.edge_face_count[e] > 1 {
-            self.edge_flags[e] |= EDGE_NON_MANIFOLD;
-        } else if v0 == self.edge_vertices[e][0] {
-            let first_face = self.edge_last_face[e] as usize;
-            if !accept_inconsistent_orientation {
-                return Err(TopologyError::InconsistentOrientation {
-                    first_face,
-                    second_face: f as usize,
-                    v0,
-                    v1,
-                });
-            }
-            warnings.push(BuildWarning::InconsistentOrientation {
-                first_face,
-                second_face: f as usize,
-                v0,
-                v1,
-            });
-            self.edge_flags[e] |= EDGE_NON_MANIFOLD;
-        }
-        self.edge_face_count[e] += 1;
-        self.edge_last_face[e] = f;
-        Ok(())
-    }
 }
 
 impl Topology {
@@ -444,161 +624,211 @@ impl Topology {
                 *fl |= EDGE_NON_MANIFOLD;
             }
         }
-        Ok(assemble(
-            num_vertices,
-            face_offsets,
+        let half_face = half_faces(&face_offsets, face_vertices.len());
+        let corners = par_group_indices(num_vertices, face_vertices.len(), |h| face_vertices[h]);
+        let relations = Relations {
+            face_offsets: &face_offsets,
             face_vertices,
+            half_face: &half_face,
             face_edges,
             edge_vertices,
             edge_flags,
-        ))
+        };
+        let topo = relations.assemble(num_vertices, corners);
+        Ok(topo)
     }
 }
 
-/// Completes a topology from face-vertices, face-edges and numbered edges: edge-faces,
-/// vertex-faces, vertex-edges (ordered), boundary/non-manifold/isolated flags. `edge_flags`
-/// carries non-manifold and degenerate flags already known; boundary flags and edges with
-/// more than two faces are added here.
-pub(crate) fn assemble(
-    nv: usize,
-    face_offsets: Vec<u32>,
+/// The relations a topology is completed from: face-vertices, face-edges and numbered edges
+/// with the non-manifold and degenerate flags already known, and the face of each
+/// face-vertex.
+struct Relations<'a> {
+    face_offsets: &'a [u32],
     face_vertices: Vec<u32>,
+    half_face: &'a [u32],
     face_edges: Vec<u32>,
     edge_vertices: Vec<[u32; 2]>,
-    mut edge_flags: Vec<u8>,
-) -> Topology {
-    let nf = face_offsets.len() - 1;
-    let ne = edge_vertices.len();
-    let faces = FaceLoops {
-        offsets: &face_offsets,
-        vertices: &face_vertices,
-    };
-    let half_face = faces.half_faces();
-    // Edge -> faces and vertex -> faces, in face order (vertex fans are ordered below), with
-    // the edge's or vertex's position in each face.
-    let (edge_face_offsets, edge_faces, edge_face_local) =
-        faces_by_key(ne, &face_edges, &half_face, &face_offsets);
-    flag_edges_by_face_count(&edge_face_offsets, &mut edge_flags);
-    let (vertex_face_offsets, vertex_faces, vertex_face_local) =
-        faces_by_key(nv, &face_vertices, &half_face, &face_offsets);
-    drop(half_face);
-    // Vertex -> edges in creation order (a degenerate edge appears twice at its vertex).
-    let vertex_edges = group_by_key(
-        nv,
-        (0..ne as u32).flat_map(|e| {
-            let [a, b] = edge_vertices[e as usize];
-            [(a, e), (b, e)]
-        }),
-    );
-    let vertex_flags = vertex_flags(nv, &edge_vertices, &edge_flags, &vertex_face_offsets);
-    let mut topo = Topology {
-        num_vertices: nv as u32,
-        face_offsets,
-        face_vertices,
-        face_edges,
-        edge_vertices,
-        edge_face_offsets,
-        edge_faces,
-        edge_face_local,
-        vertex_face_offsets,
-        vertex_faces,
-        vertex_face_local,
-        vertex_edge_offsets: vertex_edges.offsets,
-        vertex_edges: vertex_edges.values,
-        edge_flags,
-        vertex_flags,
-        tags: Tags::new(nv, ne, nf),
-    };
-    topo.order_vertex_fans();
-    topo
+    edge_flags: Vec<u8>,
 }
 
-/// The faces of each of `num_rows` keys, where face-vertex `h` belongs to row `keys[h]`
-/// (its edge or its vertex), in face order: offsets, faces, and the face-vertex's position
-/// in its face.
-fn faces_by_key(
-    num_rows: usize,
-    keys: &[u32],
-    half_face: &[u32],
-    face_offsets: &[u32],
-) -> (Vec<u32>, Vec<u32>, Vec<u16>) {
-    let offsets = offsets_of_keys(num_rows, keys.iter().copied());
-    let mut faces = vec![0u32; keys.len()];
-    let mut local = vec![0u16; keys.len()];
-    let mut slots = RowSlots::new(&offsets);
-    for (h, &key) in keys.iter().enumerate() {
-        let f = half_face[h];
-        let slot = slots.take(key as usize);
-        faces[slot] = f;
-        local[slot] = (h - face_offsets[f as usize] as usize) as u16;
+impl Relations<'_> {
+    /// Completes the topology: edge-faces, vertex-faces (from `corners`, the face-vertices
+    /// grouped by vertex), vertex-edges (ordered), boundary/non-manifold/isolated flags.
+    /// Boundary flags and edges with more than two faces are added here.
+    fn assemble(self, nv: usize, corners: Csr<u32>) -> Topology {
+        let nf = self.face_offsets.len() - 1;
+        let ne = self.edge_vertices.len();
+        let by_edge = par_group_indices(ne, self.face_edges.len(), |h| self.face_edges[h]);
+        let (edge_faces, edge_face_local) = self.faces_and_corners(&by_edge.values);
+        let (vertex_faces, vertex_face_local) = self.faces_and_corners(&corners.values);
+        drop(corners.values);
+        let mut edge_flags = self.edge_flags;
+        flag_edges_by_face_count(&by_edge.offsets, &mut edge_flags);
+        // Vertex -> edges in creation order (a degenerate edge appears twice at its vertex).
+        let edge_ends: &[u32] = bytemuck::cast_slice(&self.edge_vertices);
+        let mut vertex_edges = par_group_indices(nv, edge_ends.len(), |i| edge_ends[i]);
+        vertex_edges.values.par_iter_mut().for_each(|i| *i /= 2);
+        let vertex_flags = vertex_flags(&vertex_edges, &edge_flags, &corners.offsets);
+        let mut topo = Topology {
+            num_vertices: nv as u32,
+            face_offsets: par_copy(self.face_offsets),
+            face_vertices: self.face_vertices,
+            face_edges: self.face_edges,
+            edge_vertices: self.edge_vertices,
+            edge_face_offsets: by_edge.offsets,
+            edge_faces,
+            edge_face_local,
+            vertex_face_offsets: corners.offsets,
+            vertex_faces,
+            vertex_face_local,
+            vertex_edge_offsets: vertex_edges.offsets,
+            vertex_edges: vertex_edges.values,
+            edge_flags,
+            vertex_flags,
+            tags: Tags::new(nv, ne, nf),
+        };
+        topo.order_vertex_fans();
+        topo
     }
-    (offsets, faces, local)
+
+    /// The face of each face-vertex in `corners`, and its position in that face.
+    fn faces_and_corners(&self, corners: &[u32]) -> (Vec<u32>, Vec<u16>) {
+        let mut faces: Vec<u32> = memory::with_capacity(corners.len());
+        faces.par_extend(corners.par_iter().map(|&h| self.half_face[h as usize]));
+        let mut local: Vec<u16> = memory::with_capacity(corners.len());
+        local.par_extend(
+            corners
+                .par_iter()
+                .zip(&faces)
+                .map(|(&h, &f)| (h - self.face_offsets[f as usize]) as u16),
+        );
+        (faces, local)
+    }
 }
 
 /// Flags edges with one face as boundary and edges with more than two as non-manifold.
 fn flag_edges_by_face_count(edge_face_offsets: &[u32], edge_flags: &mut [u8]) {
-    for (e, fl) in edge_flags.iter_mut().enumerate() {
-        let count = edge_face_offsets[e + 1] - edge_face_offsets[e];
-        if count > 2 {
-            *fl |= EDGE_NON_MANIFOLD;
-        }
-        if count == 1 {
-            *fl |= EDGE_BOUNDARY;
-        }
-    }
+    edge_flags
+        .par_iter_mut()
+        .with_min_len(BLOCK)
+        .enumerate()
+        .for_each(|(e, fl)| {
+            let count = edge_face_offsets[e + 1] - edge_face_offsets[e];
+            if count > 2 {
+                *fl |= EDGE_NON_MANIFOLD;
+            }
+            if count == 1 {
+                *fl |= EDGE_BOUNDARY;
+            }
+        });
 }
 
 /// Vertex flags: boundary and non-manifold from the vertex's edges, isolated when no face
 /// uses it.
 fn vertex_flags(
-    nv: usize,
-    edge_vertices: &[[u32; 2]],
+    vertex_edges: &Csr<u32>,
     edge_flags: &[u8],
     vertex_face_offsets: &[u32],
 ) -> Vec<u8> {
-    let mut vertex_flags = vec![0u8; nv];
-    for (e, &[a, b]) in edge_vertices.iter().enumerate() {
-        let fl = edge_flags[e];
-        let mut vf = 0;
-        if fl & EDGE_BOUNDARY != 0 {
-            vf |= VERTEX_BOUNDARY;
-        }
-        if fl & EDGE_NON_MANIFOLD != 0 {
-            vf |= VERTEX_NON_MANIFOLD;
-        }
-        vertex_flags[a as usize] |= vf;
-        vertex_flags[b as usize] |= vf;
-    }
-    for v in 0..nv {
-        if vertex_face_offsets[v] == vertex_face_offsets[v + 1] {
-            vertex_flags[v] |= VERTEX_ISOLATED;
-        }
-    }
-    vertex_flags
+    (0..vertex_edges.num_rows())
+        .into_par_iter()
+        .with_min_len(BLOCK)
+        .map(|v| {
+            let mut vf = 0;
+            for &e in vertex_edges.row(v) {
+                let fl = edge_flags[e as usize];
+                if fl & EDGE_BOUNDARY != 0 {
+                    vf |= VERTEX_BOUNDARY;
+                }
+                if fl & EDGE_NON_MANIFOLD != 0 {
+                    vf |= VERTEX_NON_MANIFOLD;
+                }
+            }
+            if vertex_face_offsets[v] == vertex_face_offsets[v + 1] {
+                vf |= VERTEX_ISOLATED;
+            }
+            vf
+        })
+        .collect()
+}
+
+/// A block of vertices' part of the vertex relations, which ordering its fans rewrites.
+struct FanBlock<'a> {
+    first: usize,
+    faces: &'a mut [u32],
+    local: &'a mut [u16],
+    edges: &'a mut [u32],
+    flags: &'a mut [u8],
 }
 
 impl Topology {
     /// Orders the faces and edges around every vertex counter-clockwise; a vertex whose
     /// neighbourhood is not a single fan is flagged non-manifold and keeps face order.
+    /// Vertices are independent, so blocks of them are ordered in parallel.
     fn order_vertex_fans(&mut self) {
-        let mut faces: Vec<(u32, u16)> = Vec::new();
-        let mut edges: Vec<u32> = Vec::new();
-        for v in 0..self.num_vertices() {
-            if self.vertex_flags[v] & (VERTEX_NON_MANIFOLD | VERTEX_ISOLATED) != 0 {
+        let mut faces = std::mem::take(&mut self.vertex_faces);
+        let mut local = std::mem::take(&mut self.vertex_face_local);
+        let mut edges = std::mem::take(&mut self.vertex_edges);
+        let mut flags = std::mem::take(&mut self.vertex_flags);
+        let nv = self.num_vertices();
+        let firsts = || (0..nv.div_ceil(BLOCK)).map(|b| b * BLOCK);
+        let at = |offsets: &[u32]| {
+            firsts()
+                .map(move |v| offsets[v] as usize)
+                .collect::<Vec<_>>()
+        };
+        let (face_starts, edge_starts) =
+            (at(&self.vertex_face_offsets), at(&self.vertex_edge_offsets));
+        let blocks: Vec<FanBlock<'_>> = split_at_starts(&mut faces, face_starts.iter().copied())
+            .into_iter()
+            .zip(split_at_starts(&mut local, face_starts.iter().copied()))
+            .zip(split_at_starts(&mut edges, edge_starts.iter().copied()))
+            .zip(split_at_starts(&mut flags, firsts()))
+            .zip(firsts())
+            .map(|((((faces, local), edges), flags), first)| FanBlock {
+                first,
+                faces,
+                local,
+                edges,
+                flags,
+            })
+            .collect();
+        let this = &*self;
+        blocks
+            .into_par_iter()
+            .for_each(|block| this.order_fans_of(block));
+        self.vertex_faces = faces;
+        self.vertex_face_local = local;
+        self.vertex_edges = edges;
+        self.vertex_flags = flags;
+    }
+
+    /// [`Self::order_vertex_fans`] for one block of vertices.
+    fn order_fans_of(&self, block: FanBlock<'_>) {
+        let (mut fan_faces, mut fan_edges) = (Vec::new(), Vec::new());
+        let face_base = self.vertex_face_offsets[block.first] as usize;
+        let edge_base = self.vertex_edge_offsets[block.first] as usize;
+        for (i, flags) in block.flags.iter_mut().enumerate() {
+            if *flags & (VERTEX_NON_MANIFOLD | VERTEX_ISOLATED) != 0 {
                 continue;
             }
-            if self.walk_fan(v, &mut faces, &mut edges) {
-                let fr =
-                    self.vertex_face_offsets[v] as usize..self.vertex_face_offsets[v + 1] as usize;
-                for (slot, &(f, c)) in fr.zip(faces.iter()) {
-                    self.vertex_faces[slot] = f;
-                    self.vertex_face_local[slot] = c;
+            let v = block.first + i;
+            let fr = self.vertex_face_offsets[v] as usize - face_base
+                ..self.vertex_face_offsets[v + 1] as usize - face_base;
+            let er = self.vertex_edge_offsets[v] as usize - edge_base
+                ..self.vertex_edge_offsets[v + 1] as usize - edge_base;
+            let around = (&block.faces[fr.clone()], &block.edges[er.clone()]);
+            if self.walk_fan(v, around, &mut fan_faces, &mut fan_edges) {
+                for ((f, c), &(g, d)) in block.faces[fr.clone()]
+                    .iter_mut()
+                    .zip(&mut block.local[fr])
+                    .zip(&fan_faces)
+                {
+                    (*f, *c) = (g, d);
                 }
-                let er =
-                    self.vertex_edge_offsets[v] as usize..self.vertex_edge_offsets[v + 1] as usize;
-                self.vertex_edges[er].copy_from_slice(&edges);
+                block.edges[er].copy_from_slice(&fan_edges);
             } else {
-                self.vertex_flags[v] |= VERTEX_NON_MANIFOLD;
+                *flags |= VERTEX_NON_MANIFOLD;
             }
         }
     }
@@ -607,11 +837,16 @@ impl Topology {
     /// boundary edge that leaves `v` in its face. Returns `false` when the faces and edges
     /// around `v` do not form a single fan. Mirrors the conditions of OpenSubdiv's
     /// `Vtr::Level::orderVertexFacesAndEdges` so the same vertices come out non-manifold.
-    fn walk_fan(&self, v: usize, faces: &mut Vec<(u32, u16)>, edges: &mut Vec<u32>) -> bool {
+    /// `around` holds the faces and edges of `v` in face order.
+    fn walk_fan(
+        &self,
+        v: usize,
+        (vf, ve): (&[u32], &[u32]),
+        faces: &mut Vec<(u32, u16)>,
+        edges: &mut Vec<u32>,
+    ) -> bool {
         faces.clear();
         edges.clear();
-        let vf = self.vertex_faces(v);
-        let ve = self.vertex_edges(v);
         let (nf, ne) = (vf.len(), ve.len());
         if nf == 0 || ne < 2 || ne > nf + 1 {
             return false;

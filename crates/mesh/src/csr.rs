@@ -7,6 +7,8 @@
 //! linear in rows + entries and allocates the offsets, one cursor array and the values, never
 //! anything per entry. [`offsets_of_keys`] and [`RowSlots`] are the two steps for callers that
 //! scatter into several parallel arrays at once; [`group_by_key`] does both for one array.
+//! [`par_group_indices`] is the same sort run by all threads, for the large arrays of a
+//! topology build; its result does not depend on the number of threads.
 //!
 //! ```
 //! use subd_mesh::csr::group_by_key;
@@ -16,6 +18,12 @@
 //! assert_eq!(rows.row(0), ['b', 'd']);
 //! assert_eq!(rows.row(2), ['a', 'c', 'e']);
 //! ```
+
+use std::sync::atomic::Ordering;
+
+use rayon::prelude::*;
+
+use crate::memory;
 
 /// Row offsets (`num_rows + 1` of them, starting at 0) for entries whose rows are `keys`:
 /// row `r` will occupy `offsets[r]..offsets[r + 1]`. Every key must be below `num_rows`, and
@@ -93,6 +101,125 @@ pub fn group_by_key<T: Copy + Default>(
     Csr { offsets, values }
 }
 
+/// Entries below which a parallel sort uses a single chunk (and so runs on one thread).
+const MIN_ENTRIES_PER_CHUNK: usize = 1 << 15;
+/// Most chunks a parallel sort counts separately: each holds one count per row.
+const MAX_CHUNKS: usize = 8;
+/// Rows per task when the per-chunk counts are turned into cursors.
+const ROWS_PER_TASK: usize = 1 << 14;
+
+/// [`group_by_key`] of the indices `0..n`, index `i` in row `key(i)`, run in parallel: each
+/// chunk of the indices counts its rows, the counts become one cursor per row and chunk
+/// (rows in order, and within a row the chunks in order), then all chunks scatter at once.
+/// Each row lists its indices in increasing order, the stable order, so the result is that
+/// of the serial sort whatever the number of threads.
+///
+/// ```
+/// use subd_mesh::csr::par_group_indices;
+/// let keys = [2u32, 0, 2, 0, 2];
+/// let rows = par_group_indices(3, keys.len(), |i| keys[i]);
+/// assert_eq!(rows.offsets, [0, 2, 2, 5]);
+/// assert_eq!(rows.row(2), [0, 2, 4]);
+/// ```
+///
+/// # Panics
+/// If a key is not below `num_rows` or `n` does not fit a `u32`.
+pub fn par_group_indices(num_rows: usize, n: usize, key: impl Fn(usize) -> u32 + Sync) -> Csr<u32> {
+    assert!(n < u32::MAX as usize, "too many entries for u32 indices");
+    let chunks = index_chunks(n);
+    let mut cursors: Vec<Vec<u32>> = chunks
+        .par_iter()
+        .map(|r| {
+            let mut counts = vec![0u32; num_rows];
+            for i in r.clone() {
+                counts[key(i) as usize] += 1;
+            }
+            counts
+        })
+        .collect();
+    let offsets = cursors_from_counts(num_rows, n, &mut cursors);
+    // Chunks write to disjoint slots; atomics let them share the array without locks
+    // (relaxed stores compile to plain stores).
+    let values = memory::atomic_u32s(n, |_| 0);
+    chunks
+        .par_iter()
+        .zip(cursors.par_iter_mut())
+        .for_each(|(r, next)| {
+            for i in r.clone() {
+                let k = key(i) as usize;
+                values[next[k] as usize].store(i as u32, Ordering::Relaxed);
+                next[k] += 1;
+            }
+        });
+    Csr {
+        offsets,
+        values: memory::into_u32s(values),
+    }
+}
+
+/// Splits `0..n` into chunks for a parallel sort: one per thread (at most [`MAX_CHUNKS`]),
+/// fewer for small `n`.
+fn index_chunks(n: usize) -> Vec<std::ops::Range<usize>> {
+    let count = (n / MIN_ENTRIES_PER_CHUNK).clamp(1, rayon::current_num_threads().min(MAX_CHUNKS));
+    let size = n.div_ceil(count).max(1);
+    (0..count)
+        .map(|c| (c * size).min(n)..((c + 1) * size).min(n))
+        .collect()
+}
+
+/// Turns per-chunk row counts into per-chunk cursors (the slot of each chunk's first entry
+/// in each row) and returns the row offsets; `n` is the number of entries.
+fn cursors_from_counts(num_rows: usize, n: usize, counts: &mut [Vec<u32>]) -> Vec<u32> {
+    let totals: Vec<u32> = (0..num_rows.div_ceil(ROWS_PER_TASK))
+        .into_par_iter()
+        .map(|t| {
+            let rows = t * ROWS_PER_TASK..((t + 1) * ROWS_PER_TASK).min(num_rows);
+            counts
+                .iter()
+                .map(|c| c[rows.clone()].iter().sum::<u32>())
+                .sum()
+        })
+        .collect();
+    let starts = exclusive_prefix_sum(&totals);
+    // Each task takes its rows of every chunk's counts.
+    let mut tasks: Vec<Vec<&mut [u32]>> = totals.iter().map(|_| Vec::new()).collect();
+    for c in counts.iter_mut() {
+        for (task, rows) in tasks.iter_mut().zip(c.chunks_mut(ROWS_PER_TASK)) {
+            task.push(rows);
+        }
+    }
+    let mut offsets = vec![0u32; num_rows + 1];
+    offsets[..num_rows]
+        .par_chunks_mut(ROWS_PER_TASK)
+        .zip(tasks)
+        .zip(starts)
+        .for_each(|((offsets, mut counts), mut next)| {
+            for (r, offset) in offsets.iter_mut().enumerate() {
+                *offset = next;
+                for c in counts.iter_mut() {
+                    let count = c[r];
+                    c[r] = next;
+                    next += count;
+                }
+            }
+        });
+    offsets[num_rows] = n as u32;
+    offsets
+}
+
+/// The exclusive prefix sums of `counts`: element `i` is the sum of `counts[..i]`.
+pub(crate) fn exclusive_prefix_sum(counts: &[u32]) -> Vec<u32> {
+    let mut sum = 0;
+    counts
+        .iter()
+        .map(|&c| {
+            let start = sum;
+            sum += c;
+            start
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -133,6 +260,28 @@ mod tests {
                 let got = group_by_key(num_rows, entries.iter().copied());
                 assert_eq!(got, naive(num_rows, &entries), "{num_rows} rows, {len}");
                 assert_eq!(got.num_rows(), num_rows);
+            }
+        }
+    }
+
+    #[test]
+    fn parallel_sort_matches_the_serial_one_in_any_pool() {
+        let mut seed = 11;
+        for (num_rows, len) in [(0usize, 0usize), (1, 5), (7, 100_000), (50_000, 200_000)] {
+            let keys: Vec<u32> = (0..len)
+                .map(|_| lcg(&mut seed) % num_rows.max(1) as u32)
+                .collect();
+            let want = group_by_key(num_rows, keys.iter().copied().zip(0u32..));
+            for threads in [1, 2, 4] {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .unwrap();
+                let got = pool.install(|| par_group_indices(num_rows, len, |i| keys[i]));
+                assert_eq!(
+                    got, want,
+                    "{num_rows} rows, {len} entries, {threads} threads"
+                );
             }
         }
     }

@@ -13,7 +13,7 @@
 //! (`/sys/kernel/mm/transparent_hugepage/enabled` = `never`). It is a no-op on other systems.
 //! [`set_huge_pages`] turns it off for the whole process.
 
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 
 use rayon::iter::ParallelExtend;
 
@@ -166,6 +166,30 @@ where
     v
 }
 
+/// A vector of `len` atomics, element `i` set to `init(i)` in parallel: an array that
+/// parallel tasks fill at scattered, disjoint places (relaxed stores compile to plain ones).
+/// Large ones get the huge-page advice.
+pub(crate) fn atomic_u32s(len: usize, init: impl Fn(usize) -> u32 + Sync) -> Vec<AtomicU32> {
+    use rayon::prelude::*;
+    let mut v = with_capacity(len);
+    v.par_extend((0..len).into_par_iter().map(|i| AtomicU32::new(init(i))));
+    v
+}
+
+/// The values of `atomics`, in place: no copy, no pass over the array.
+pub(crate) fn into_u32s(atomics: Vec<AtomicU32>) -> Vec<u32> {
+    let mut atomics = std::mem::ManuallyDrop::new(atomics);
+    let (ptr, len, capacity) = (atomics.as_mut_ptr(), atomics.len(), atomics.capacity());
+    #[allow(unsafe_code)]
+    // SAFETY: `AtomicU32` has the size, alignment and bit validity of `u32` (its documented
+    // guarantee), so the allocation, its length and capacity describe a valid `Vec<u32>`
+    // with the same layout; the original vector is not dropped (`ManuallyDrop`), so the
+    // allocation has exactly one owner.
+    unsafe {
+        Vec::from_raw_parts(ptr.cast::<u32>(), len, capacity)
+    }
+}
+
 /// Advises the kernel to back the 2 MiB-aligned interior of `[start, start + bytes)` with
 /// huge pages.
 #[cfg(target_os = "linux")]
@@ -223,6 +247,20 @@ mod tests {
                 let want = if middle.contains(&i) { 3 * i } else { 5 * i };
                 assert_eq!(x, want as u64);
             }
+        }
+    }
+
+    #[test]
+    fn atomics_become_their_values() {
+        for len in [0usize, 3, HUGE_PAGE_MIN_BYTES / 4 + 7] {
+            let a = atomic_u32s(len, |i| i as u32 * 7);
+            if let Some(x) = a.last() {
+                x.store(1, Ordering::Relaxed);
+            }
+            let v = into_u32s(a);
+            assert_eq!(v.len(), len);
+            let want = |i: usize| if i + 1 == len { 1 } else { i as u32 * 7 };
+            assert!(v.iter().enumerate().all(|(i, &x)| x == want(i)));
         }
     }
 
