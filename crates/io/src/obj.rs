@@ -33,6 +33,8 @@ use crate::records::{write_records, write_windows};
 use crate::view::MeshView;
 use crate::{MeshFile, ReadOptions};
 
+mod chunks;
+
 /// One `t` line.
 struct TagLine {
     line: usize,
@@ -69,7 +71,21 @@ struct ObjStatements {
 
 /// Parses OBJ text. Errors carry the 1-based line number.
 pub fn parse_obj(bytes: &[u8], options: &ReadOptions) -> Result<MeshFile, ReadError> {
-    let mut st = read_statements(bytes)?;
+    parse_obj_in_chunks(bytes, options, chunks::CHUNK_BYTES)
+}
+
+/// [`parse_obj`] with the statements read in parallel chunks of about `chunk_bytes`; input
+/// the chunks refuse is read again serially, so that the first error in file order is the
+/// one reported, worded as the serial reader words it.
+fn parse_obj_in_chunks(
+    bytes: &[u8],
+    options: &ReadOptions,
+    chunk_bytes: usize,
+) -> Result<MeshFile, ReadError> {
+    let mut st = match chunks::read_statements(bytes, chunk_bytes) {
+        Ok(st) => st,
+        Err(chunks::Failed) => read_statements(bytes)?,
+    };
     check_face_indices(&st)?;
     let (mut topology, orientation_conflicts) = build_topology(&mut st, options)?;
     let mut hints = SchemeHints::default();

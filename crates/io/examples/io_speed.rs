@@ -1,0 +1,69 @@
+//! Read and write throughput of one mesh file, for comparing builds:
+//!
+//! ```text
+//! cargo run --release -p subd-io --example io_speed -- read FILE [REPEATS]
+//! cargo run --release -p subd-io --example io_speed -- write FILE OUT [REPEATS]
+//! ```
+//!
+//! `read` times [`subd_io::read_mesh`] (and, apart, the topology build it includes);
+//! `write` reads FILE once, then times [`subd_io::write_mesh`] to OUT (format by extension,
+//! PLY binary). Each line: seconds and MB/s (10^6 bytes of the file read or written).
+//! Threads: `RAYON_NUM_THREADS`.
+
+use std::path::Path;
+use std::time::Instant;
+
+use subd_io::{ReadOptions, WriteOptions, read_mesh, write_mesh};
+use subd_mesh::TopologyBuilder;
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let repeats = |k: usize| args.get(k).and_then(|s| s.parse().ok()).unwrap_or(1usize);
+    match args.first().map(String::as_str) {
+        Some("read") if args.len() >= 2 => read(Path::new(&args[1]), repeats(2)),
+        Some("write") if args.len() >= 3 => {
+            write(Path::new(&args[1]), Path::new(&args[2]), repeats(3))
+        }
+        _ => Err("usage: io_speed read FILE [REPEATS] | write FILE OUT [REPEATS]".into()),
+    }
+}
+
+fn mb_per_s(bytes: u64, seconds: f64) -> f64 {
+    bytes as f64 / seconds / 1e6
+}
+
+fn read(path: &Path, repeats: usize) -> Result<(), Box<dyn std::error::Error>> {
+    let bytes = std::fs::metadata(path)?.len();
+    for _ in 0..repeats {
+        let t = Instant::now();
+        let file = read_mesh(path, &ReadOptions::default())?;
+        let total = t.elapsed().as_secs_f64();
+        let topo = &file.mesh.topology;
+        let sizes: Vec<u32> = topo.face_sizes().collect();
+        let t = Instant::now();
+        TopologyBuilder::new(file.mesh.positions.len()).build(&sizes, topo.all_face_vertices())?;
+        let build = t.elapsed().as_secs_f64();
+        println!(
+            "read {total:.3} s {:.1} MB/s; topology build {build:.3} s; rest {:.3} s {:.1} MB/s",
+            mb_per_s(bytes, total),
+            total - build,
+            mb_per_s(bytes, total - build)
+        );
+    }
+    Ok(())
+}
+
+fn write(path: &Path, out: &Path, repeats: usize) -> Result<(), Box<dyn std::error::Error>> {
+    let file = read_mesh(path, &ReadOptions::default())?;
+    for _ in 0..repeats {
+        let t = Instant::now();
+        write_mesh(out, &file.mesh, &WriteOptions::default())?;
+        let s = t.elapsed().as_secs_f64();
+        let bytes = std::fs::metadata(out)?.len();
+        println!(
+            "write {s:.3} s {:.1} MB/s ({bytes} bytes)",
+            mb_per_s(bytes, s)
+        );
+    }
+    Ok(())
+}
