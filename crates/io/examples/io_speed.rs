@@ -3,17 +3,18 @@
 //! ```text
 //! cargo run --release -p subd-io --example io_speed -- read FILE [REPEATS]
 //! cargo run --release -p subd-io --example io_speed -- write FILE OUT [REPEATS]
+//! cargo run --release -p subd-io --example io_speed -- encode FILE obj|ply [REPEATS]
 //! ```
 //!
 //! `read` times [`subd_io::read_mesh`] (and, apart, the topology build it includes);
 //! `write` reads FILE once, then times [`subd_io::write_mesh`] to OUT (format by extension,
-//! PLY binary). Each line: seconds and MB/s (10^6 bytes of the file read or written).
+//! PLY binary); `encode` times [`subd_io::encode_mesh`] into a sink (no file). Each line: seconds and MB/s (10^6 bytes of the file read or written).
 //! Threads: `RAYON_NUM_THREADS`.
 
 use std::path::Path;
 use std::time::Instant;
 
-use subd_io::{ReadOptions, WriteOptions, read_mesh, write_mesh};
+use subd_io::{Format, ReadOptions, WriteOptions, encode_mesh, read_mesh, write_mesh};
 use subd_mesh::TopologyBuilder;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -24,7 +25,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         Some("write") if args.len() >= 3 => {
             write(Path::new(&args[1]), Path::new(&args[2]), repeats(3))
         }
-        _ => Err("usage: io_speed read FILE [REPEATS] | write FILE OUT [REPEATS]".into()),
+        Some("encode") if args.len() >= 3 => encode(Path::new(&args[1]), &args[2], repeats(3)),
+        _ => Err(
+            "usage: io_speed read FILE [REPEATS] | write FILE OUT [REPEATS] | encode FILE obj|ply [REPEATS]"
+                .into(),
+        ),
     }
 }
 
@@ -63,6 +68,40 @@ fn write(path: &Path, out: &Path, repeats: usize) -> Result<(), Box<dyn std::err
         println!(
             "write {s:.3} s {:.1} MB/s ({bytes} bytes)",
             mb_per_s(bytes, s)
+        );
+    }
+    Ok(())
+}
+
+/// Counts the bytes written to it.
+struct Counter(u64);
+
+impl std::io::Write for Counter {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.0 += buf.len() as u64;
+        Ok(buf.len())
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+fn encode(path: &Path, format: &str, repeats: usize) -> Result<(), Box<dyn std::error::Error>> {
+    let format = match format {
+        "obj" => Format::Obj,
+        "ply" => Format::Ply,
+        _ => return Err("encode: obj or ply".into()),
+    };
+    let file = read_mesh(path, &ReadOptions::default())?;
+    for _ in 0..repeats {
+        let mut sink = Counter(0);
+        let t = Instant::now();
+        encode_mesh(&mut sink, &file.mesh, format, &WriteOptions::default())?;
+        let s = t.elapsed().as_secs_f64();
+        println!(
+            "encode {s:.3} s {:.1} MB/s ({} bytes)",
+            mb_per_s(sink.0, s),
+            sink.0
         );
     }
     Ok(())

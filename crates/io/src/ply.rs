@@ -23,6 +23,7 @@ use subd_mesh::{
 
 use crate::error::ReadError;
 use crate::records::{for_each_windowed, write_windows};
+use crate::text::{push_f64s, push_u64};
 use crate::view::MeshView;
 use crate::{MeshFile, ReadOptions};
 
@@ -896,14 +897,14 @@ impl<'a> PlyOutput<'a> {
             mesh.num_vertices(),
             |r| mesh.point_window(r),
             |points, i, b| {
-                let p = points.get(i);
-                let _ = write!(b, "{} {} {}", p.x, p.y, p.z);
+                push_f64s(b, &points.get(i).to_array());
                 if let Some(n) = normals {
-                    let n = n[i];
-                    let _ = write!(b, " {} {} {}", n.x, n.y, n.z);
+                    b.push(b' ');
+                    push_f64s(b, &n[i].to_array());
                 }
                 if let Some(uv) = uv {
-                    let _ = write!(b, " {} {}", uv[i][0], uv[i][1]);
+                    b.push(b' ');
+                    push_f64s(b, &uv[i]);
                 }
                 b.push(b'\n');
             },
@@ -914,12 +915,14 @@ impl<'a> PlyOutput<'a> {
             |r| mesh.face_window(r),
             |faces, f, b| {
                 let fv = faces.face(f);
-                let _ = write!(b, "{}", fv.len());
+                push_u64(b, fv.len() as u64);
                 for &v in fv {
-                    let _ = write!(b, " {v}");
+                    b.push(b' ');
+                    push_u64(b, v.into());
                 }
                 if let Some(l) = levels {
-                    let _ = write!(b, " {}", l[f]);
+                    b.push(b' ');
+                    push_u64(b, l[f].into());
                 }
                 b.push(b'\n');
             },
