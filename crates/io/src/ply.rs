@@ -27,6 +27,8 @@ use crate::text::{push_f64s, push_u64};
 use crate::view::MeshView;
 use crate::{MeshFile, ReadOptions};
 
+mod binary;
+
 /// PLY encoding to write.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum PlyEncoding {
@@ -175,24 +177,33 @@ impl Body<'_> {
                         what()
                     )));
                 }
-                let mut b = [0u8; 8];
-                b[..n].copy_from_slice(&data[*pos..*pos + n]);
-                if *big_endian {
-                    b[..n].reverse();
-                }
+                let v = scalar_value(&data[*pos..*pos + n], ty, *big_endian);
                 *pos += n;
-                Ok(match ty {
-                    Scalar::I8 => b[0] as i8 as f64,
-                    Scalar::U8 => b[0] as f64,
-                    Scalar::I16 => i16::from_le_bytes([b[0], b[1]]) as f64,
-                    Scalar::U16 => u16::from_le_bytes([b[0], b[1]]) as f64,
-                    Scalar::I32 => i32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
-                    Scalar::U32 => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
-                    Scalar::F32 => f32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
-                    Scalar::F64 => f64::from_le_bytes(b),
-                })
+                Ok(v)
             }
         }
+    }
+}
+
+/// The value of a binary scalar of type `ty` at the start of `bytes` (which holds at
+/// least `ty.size()` of them).
+#[inline]
+fn scalar_value(bytes: &[u8], ty: Scalar, big_endian: bool) -> f64 {
+    let n = ty.size();
+    let mut b = [0u8; 8];
+    b[..n].copy_from_slice(&bytes[..n]);
+    if big_endian {
+        b[..n].reverse();
+    }
+    match ty {
+        Scalar::I8 => b[0] as i8 as f64,
+        Scalar::U8 => b[0] as f64,
+        Scalar::I16 => i16::from_le_bytes([b[0], b[1]]) as f64,
+        Scalar::U16 => u16::from_le_bytes([b[0], b[1]]) as f64,
+        Scalar::I32 => i32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+        Scalar::U32 => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+        Scalar::F32 => f32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+        Scalar::F64 => f64::from_le_bytes(b),
     }
 }
 
@@ -429,6 +440,9 @@ fn read_elements(header: &Header, body: &mut Body<'_>) -> Result<PlyData, ReadEr
             Some(Role::Vertex(_)) => r.d.positions.reserve(el.count),
             Some(Role::Face { .. }) => r.d.face_sizes.reserve(el.count),
             _ => {}
+        }
+        if binary::read_element(&mut r, el, role, body) {
+            continue;
         }
         for k in 0..el.count {
             r.read_values(el, k, role, body)?;
