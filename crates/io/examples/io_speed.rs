@@ -8,7 +8,8 @@
 //!
 //! `read` times [`subd_io::read_mesh`] (and, apart, the topology build it includes);
 //! `write` reads FILE once, then times [`subd_io::write_mesh`] to OUT (format by extension,
-//! PLY binary); `encode` times [`subd_io::encode_mesh`] into a sink (no file). Each line: seconds and MB/s (10^6 bytes of the file read or written).
+//! PLY binary, a new file each time); `encode` times [`subd_io::encode_mesh`] into a sink
+//! (no file). Each line: seconds and MB/s (10^6 bytes of the file read or written).
 //! Threads: `RAYON_NUM_THREADS`.
 
 use std::path::Path;
@@ -61,6 +62,9 @@ fn read(path: &Path, repeats: usize) -> Result<(), Box<dyn std::error::Error>> {
 fn write(path: &Path, out: &Path, repeats: usize) -> Result<(), Box<dyn std::error::Error>> {
     let file = read_mesh(path, &ReadOptions::default())?;
     for _ in 0..repeats {
+        // Each write makes a new file (replacing one costs the file system more: freeing
+        // the old one's pages, and ext4 starts writing back a file renamed over another).
+        let _ = std::fs::remove_file(out);
         let t = Instant::now();
         write_mesh(out, &file.mesh, &WriteOptions::default())?;
         let s = t.elapsed().as_secs_f64();

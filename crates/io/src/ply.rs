@@ -824,6 +824,9 @@ pub fn write_ply(
     }
 }
 
+/// Bytes per write of data that needs no encoding (as `dd bs=8M` writes).
+const RAW_BLOCK: usize = 8 << 20;
+
 /// What a PLY output holds besides positions and faces, and how it stores it.
 struct PlyOutput<'a> {
     mesh: &'a MeshView<'a>,
@@ -953,13 +956,13 @@ impl<'a> PlyOutput<'a> {
         Ok(())
     }
 
-    fn write_binary_body(&self, w: &mut dyn Write) -> std::io::Result<()> {
-        let mesh = self.mesh;
-        let (normals, uv, levels) = (self.normals, &self.uv, self.levels);
+    /// Vertex records (position, normal, uv) encoded by all threads.
+    fn write_binary_vertices(&self, w: &mut dyn Write) -> std::io::Result<()> {
+        let (normals, uv) = (self.normals, &self.uv);
         write_windows(
             w,
-            mesh.num_vertices(),
-            |r| mesh.point_window(r),
+            self.mesh.num_vertices(),
+            |r| self.mesh.point_window(r),
             |points, i, b| {
                 for c in points.get(i).to_array() {
                     b.extend_from_slice(&c.to_le_bytes());
@@ -975,7 +978,24 @@ impl<'a> PlyOutput<'a> {
                     }
                 }
             },
-        )?;
+        )
+    }
+
+    fn write_binary_body(&self, w: &mut dyn Write) -> std::io::Result<()> {
+        let mesh = self.mesh;
+        let (normals, uv, levels) = (self.normals, &self.uv, self.levels);
+        // Held positions alone are their own little-endian records: no encoding at all.
+        let raw = match (mesh.positions(), normals, uv) {
+            (Some(points), None, None) if cfg!(target_endian = "little") => Some(points),
+            _ => None,
+        };
+        if let Some(points) = raw {
+            for block in bytemuck::cast_slice::<DVec3, u8>(points).chunks(RAW_BLOCK) {
+                w.write_all(block)?;
+            }
+        } else {
+            self.write_binary_vertices(w)?;
+        }
         let wide_lists = self.wide_lists;
         write_windows(
             w,

@@ -167,3 +167,39 @@ fn output_is_the_same_on_one_thread() {
         assert!(one == encode());
     }
 }
+
+/// Binary PLY bodies, positions alone (written straight from memory) and with normals
+/// (encoded record by record), against the serial encoding.
+#[test]
+fn binary_ply_records_are_the_serial_encoders_bytes() {
+    let m = random(300_000, 37);
+    for with_normals in [false, true] {
+        let mut view = MeshView::new(&m.positions, &m.offsets, &m.vertices, &[]).unwrap();
+        if with_normals {
+            view = view.with_normals(&m.normals).unwrap();
+        }
+        let mut out = Vec::new();
+        encode_view(&mut out, &view, Format::Ply, &WriteOptions::default()).unwrap();
+        let mut expected = Vec::new();
+        for (i, p) in m.positions.iter().enumerate() {
+            let normal = with_normals.then(|| m.normals[i].to_array());
+            for c in p.to_array().iter().chain(normal.iter().flatten()) {
+                expected.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+        for f in 0..m.offsets.len() - 1 {
+            let face = &m.vertices[m.offsets[f] as usize..m.offsets[f + 1] as usize];
+            expected.push(face.len() as u8);
+            for v in face {
+                expected.extend_from_slice(&v.to_le_bytes());
+            }
+        }
+        let header_end = b"end_header\n";
+        let body = out
+            .windows(header_end.len())
+            .position(|w| w == header_end)
+            .unwrap()
+            + header_end.len();
+        assert!(out[body..] == expected[..], "normals: {with_normals}");
+    }
+}
