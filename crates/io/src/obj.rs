@@ -72,7 +72,7 @@ struct ObjStatements {
 
 /// Parses OBJ text. Errors carry the 1-based line number.
 pub fn parse_obj(bytes: &[u8], options: &ReadOptions) -> Result<MeshFile, ReadError> {
-    parse_obj_in_chunks(bytes, options, chunks::CHUNK_BYTES)
+    parse_obj_in_chunks(bytes, options, chunks::chunk_bytes())
 }
 
 /// [`parse_obj`] with the statements read in parallel chunks of about `chunk_bytes`; input

@@ -15,7 +15,17 @@ use super::{ObjStatements, TagLine, is_statement_name, parse_tag};
 
 /// Bytes per chunk: large enough that joining costs little, small enough that two threads
 /// share a file of a few megabytes.
-pub(super) const CHUNK_BYTES: usize = 1 << 20;
+const CHUNK_BYTES: usize = 1 << 20;
+
+/// Bytes per chunk for the pool this runs in: one chunk on one thread, whose arrays are
+/// then the file's without a copy (the chunks give the same statements, however cut).
+pub(super) fn chunk_bytes() -> usize {
+    if rayon::current_num_threads() > 1 {
+        CHUNK_BYTES
+    } else {
+        usize::MAX
+    }
+}
 
 /// A chunk failed to read; the serial reader says why.
 pub(super) struct Failed;
@@ -58,7 +68,7 @@ fn chunk_ranges(bytes: &[u8], chunk_bytes: usize) -> Vec<std::ops::Range<usize>>
     let mut start = 0;
     while start < len {
         // Search for a line end from the chunk's nominal last byte on.
-        let mut from = (start + chunk_bytes.max(1)).min(len) - 1;
+        let mut from = start.saturating_add(chunk_bytes.max(1)).min(len) - 1;
         let end = loop {
             let Some(p) = bytes[from..].iter().position(|&b| b == b'\n') else {
                 break len;
@@ -226,18 +236,15 @@ fn coordinates<'a, const N: usize>(
 
 /// Joins the chunks in file order, fixing up line numbers and relative indices.
 fn join(chunks: Vec<Chunk>) -> Result<ObjStatements, Failed> {
+    let total = |f: fn(&ObjStatements) -> usize| chunks.iter().map(|c| f(&c.st)).sum::<usize>();
+    let totals = Totals {
+        positions: total(|s| s.positions.len()),
+        texcoords: total(|s| s.texcoords.len()),
+        faces: total(|s| s.face_sizes.len()),
+        face_vertices: total(|s| s.face_vertices.len()),
+        face_texcoords: total(|s| s.face_texcoords.len()),
+    };
     let mut st = ObjStatements::default();
-    let total = |f: fn(&Chunk) -> usize| chunks.iter().map(f).sum::<usize>();
-    st.positions.reserve_exact(total(|c| c.st.positions.len()));
-    st.texcoords.reserve_exact(total(|c| c.st.texcoords.len()));
-    st.face_sizes
-        .reserve_exact(total(|c| c.st.face_sizes.len()));
-    st.face_lines
-        .reserve_exact(total(|c| c.st.face_lines.len()));
-    st.face_vertices
-        .reserve_exact(total(|c| c.st.face_vertices.len()));
-    st.face_texcoords
-        .reserve_exact(total(|c| c.st.face_texcoords.len()));
     let mut first_line = 0usize;
     for mut c in chunks {
         resolve(
@@ -250,7 +257,7 @@ fn join(chunks: Vec<Chunk>) -> Result<ObjStatements, Failed> {
             &c.relative_texcoords,
             st.texcoords.len(),
         )?;
-        append(&mut st, c.st, first_line);
+        append(&mut st, c.st, first_line, &totals);
         if let Some((line, name)) = c.unknown.filter(|_| st.warnings.is_empty()) {
             st.warnings.push(format!(
                 "line {}: unknown OBJ statement {name:?} ignored",
@@ -260,6 +267,26 @@ fn join(chunks: Vec<Chunk>) -> Result<ObjStatements, Failed> {
         first_line += c.lines;
     }
     Ok(st)
+}
+
+/// The lengths of the joined arrays.
+struct Totals {
+    positions: usize,
+    texcoords: usize,
+    faces: usize,
+    face_vertices: usize,
+    face_texcoords: usize,
+}
+
+/// Appends `src` to `dst`, which has room for `total` after the first call. The first
+/// non-empty chunk's array becomes `dst` (a file read as one chunk is never copied).
+fn extend<T>(dst: &mut Vec<T>, src: &mut Vec<T>, total: usize) {
+    if dst.is_empty() {
+        std::mem::swap(dst, src);
+        dst.reserve_exact(total - dst.len());
+    } else {
+        dst.append(src);
+    }
 }
 
 /// Resolves a chunk's relative indices now that `before` elements precede it.
@@ -275,16 +302,26 @@ fn resolve(indices: &mut [u32], relative: &[(usize, i64)], before: usize) -> Res
 }
 
 /// Appends a chunk's statements whose lines start after `first_line`.
-fn append(st: &mut ObjStatements, mut c: ObjStatements, first_line: usize) {
-    st.positions.append(&mut c.positions);
-    st.texcoords.append(&mut c.texcoords);
-    st.face_sizes.append(&mut c.face_sizes);
-    st.face_vertices.append(&mut c.face_vertices);
-    st.face_texcoords.append(&mut c.face_texcoords);
+fn append(st: &mut ObjStatements, mut c: ObjStatements, first_line: usize, totals: &Totals) {
     // Lines are kept as `u32` the way the serial reader keeps them (wrapping alike).
     let base = first_line as u32;
-    st.face_lines
-        .extend(c.face_lines.iter().map(|&l| l.wrapping_add(base)));
+    c.face_lines
+        .iter_mut()
+        .for_each(|l| *l = l.wrapping_add(base));
+    extend(&mut st.positions, &mut c.positions, totals.positions);
+    extend(&mut st.texcoords, &mut c.texcoords, totals.texcoords);
+    extend(&mut st.face_sizes, &mut c.face_sizes, totals.faces);
+    extend(&mut st.face_lines, &mut c.face_lines, totals.faces);
+    extend(
+        &mut st.face_vertices,
+        &mut c.face_vertices,
+        totals.face_vertices,
+    );
+    extend(
+        &mut st.face_texcoords,
+        &mut c.face_texcoords,
+        totals.face_texcoords,
+    );
     st.faces_with_texcoords += c.faces_with_texcoords;
     if st.first_face_without_texcoords.is_none() {
         st.first_face_without_texcoords = c.first_face_without_texcoords.map(|l| first_line + l);
@@ -413,7 +450,7 @@ mod tests {
         for seed in 1..=12u64 {
             let text = generated(seed * 7919, 400);
             let serial = read_serially(text.as_bytes()).unwrap();
-            for chunk in [1, 5, 17, 64, 500, 1 << 20] {
+            for chunk in [1, 5, 17, 64, 500, 1 << 20, usize::MAX] {
                 let parallel = read_statements(text.as_bytes(), chunk)
                     .unwrap_or_else(|_| panic!("seed {seed}, chunk {chunk} refused"));
                 assert_same(&parallel, &serial);
