@@ -27,7 +27,10 @@ pub mod gltf_input;
 pub mod obj;
 pub mod ply;
 mod records;
+mod text;
 pub mod view;
+#[cfg(test)]
+mod write_reference_tests;
 
 use std::io::Write;
 use std::path::Path;

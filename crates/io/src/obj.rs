@@ -30,8 +30,11 @@ use subd_mesh::{
 
 use crate::error::ReadError;
 use crate::records::{write_records, write_windows};
+use crate::text::{push_f64s, push_u64};
 use crate::view::MeshView;
 use crate::{MeshFile, ReadOptions};
+
+mod chunks;
 
 /// One `t` line.
 struct TagLine {
@@ -69,7 +72,21 @@ struct ObjStatements {
 
 /// Parses OBJ text. Errors carry the 1-based line number.
 pub fn parse_obj(bytes: &[u8], options: &ReadOptions) -> Result<MeshFile, ReadError> {
-    let mut st = read_statements(bytes)?;
+    parse_obj_in_chunks(bytes, options, chunks::chunk_bytes())
+}
+
+/// [`parse_obj`] with the statements read in parallel chunks of about `chunk_bytes`; input
+/// the chunks refuse is read again serially, so that the first error in file order is the
+/// one reported, worded as the serial reader words it.
+fn parse_obj_in_chunks(
+    bytes: &[u8],
+    options: &ReadOptions,
+    chunk_bytes: usize,
+) -> Result<MeshFile, ReadError> {
+    let mut st = match chunks::read_statements(bytes, chunk_bytes) {
+        Ok(st) => st,
+        Err(chunks::Failed) => read_statements(bytes)?,
+    };
     check_face_indices(&st)?;
     let (mut topology, orientation_conflicts) = build_topology(&mut st, options)?;
     let mut hints = SchemeHints::default();
@@ -670,23 +687,16 @@ pub fn write_obj(
         w,
         mesh.num_vertices(),
         |r| mesh.point_window(r),
-        |points, i, b| {
-            let p = points.get(i);
-            let _ = writeln!(b, "v {} {} {}", p.x, p.y, p.z);
-        },
+        |points, i, b| push_numbers_line(b, b"v", &points.get(i).to_array()),
     )?;
     if let Some(normals) = mesh.normals() {
         write_records(w, normals.len(), |i, b| {
-            let n = normals[i];
-            let _ = writeln!(b, "vn {} {} {}", n.x, n.y, n.z);
+            push_numbers_line(b, b"vn", &normals[i].to_array())
         })?;
     }
     let uv = mesh.uv();
     if let Some(uv) = uv {
-        write_records(w, uv.len(), |i, b| {
-            let [u, v] = uv.uv(i);
-            let _ = writeln!(b, "vt {u} {v}");
-        })?;
+        write_records(w, uv.len(), |i, b| push_numbers_line(b, b"vt", &uv.uv(i)))?;
     }
     let with_normals = mesh.normals().is_some();
     write_windows(
@@ -698,14 +708,20 @@ pub fn write_obj(
             let first = faces.first_corner(f);
             for (k, &v) in faces.face(f).iter().enumerate() {
                 let v = v as u64 + 1;
-                let _ = match (uv, with_normals) {
-                    (Some(uv), true) => {
-                        write!(b, " {v}/{}/{v}", uv.indices()[first + k] as u64 + 1)
+                b.push(b' ');
+                push_u64(b, v);
+                match uv {
+                    Some(uv) => {
+                        b.push(b'/');
+                        push_u64(b, uv.indices()[first + k] as u64 + 1);
                     }
-                    (Some(uv), false) => write!(b, " {v}/{}", uv.indices()[first + k] as u64 + 1),
-                    (None, true) => write!(b, " {v}//{v}"),
-                    (None, false) => write!(b, " {v}"),
-                };
+                    None if with_normals => b.push(b'/'),
+                    None => continue,
+                }
+                if with_normals {
+                    b.push(b'/');
+                    push_u64(b, v);
+                }
             }
             b.push(b'\n');
         },
@@ -715,6 +731,14 @@ pub fn write_obj(
         writeln!(w, "{t}")?;
     }
     Ok(())
+}
+
+/// A line `keyword x y ..` of shortest round-trip numbers.
+fn push_numbers_line(b: &mut Vec<u8>, keyword: &[u8], values: &[f64]) {
+    b.extend_from_slice(keyword);
+    b.push(b' ');
+    push_f64s(b, values);
+    b.push(b'\n');
 }
 
 fn write_tags(w: &mut dyn Write, mesh: &MeshView<'_>) -> std::io::Result<()> {

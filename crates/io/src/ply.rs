@@ -23,8 +23,11 @@ use subd_mesh::{
 
 use crate::error::ReadError;
 use crate::records::{for_each_windowed, write_windows};
+use crate::text::{push_f64s, push_u64};
 use crate::view::MeshView;
 use crate::{MeshFile, ReadOptions};
+
+mod binary;
 
 /// PLY encoding to write.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -174,24 +177,33 @@ impl Body<'_> {
                         what()
                     )));
                 }
-                let mut b = [0u8; 8];
-                b[..n].copy_from_slice(&data[*pos..*pos + n]);
-                if *big_endian {
-                    b[..n].reverse();
-                }
+                let v = scalar_value(&data[*pos..*pos + n], ty, *big_endian);
                 *pos += n;
-                Ok(match ty {
-                    Scalar::I8 => b[0] as i8 as f64,
-                    Scalar::U8 => b[0] as f64,
-                    Scalar::I16 => i16::from_le_bytes([b[0], b[1]]) as f64,
-                    Scalar::U16 => u16::from_le_bytes([b[0], b[1]]) as f64,
-                    Scalar::I32 => i32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
-                    Scalar::U32 => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
-                    Scalar::F32 => f32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
-                    Scalar::F64 => f64::from_le_bytes(b),
-                })
+                Ok(v)
             }
         }
+    }
+}
+
+/// The value of a binary scalar of type `ty` at the start of `bytes` (which holds at
+/// least `ty.size()` of them).
+#[inline]
+fn scalar_value(bytes: &[u8], ty: Scalar, big_endian: bool) -> f64 {
+    let n = ty.size();
+    let mut b = [0u8; 8];
+    b[..n].copy_from_slice(&bytes[..n]);
+    if big_endian {
+        b[..n].reverse();
+    }
+    match ty {
+        Scalar::I8 => b[0] as i8 as f64,
+        Scalar::U8 => b[0] as f64,
+        Scalar::I16 => i16::from_le_bytes([b[0], b[1]]) as f64,
+        Scalar::U16 => u16::from_le_bytes([b[0], b[1]]) as f64,
+        Scalar::I32 => i32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+        Scalar::U32 => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+        Scalar::F32 => f32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+        Scalar::F64 => f64::from_le_bytes(b),
     }
 }
 
@@ -428,6 +440,9 @@ fn read_elements(header: &Header, body: &mut Body<'_>) -> Result<PlyData, ReadEr
             Some(Role::Vertex(_)) => r.d.positions.reserve(el.count),
             Some(Role::Face { .. }) => r.d.face_sizes.reserve(el.count),
             _ => {}
+        }
+        if binary::read_element(&mut r, el, role, body) {
+            continue;
         }
         for k in 0..el.count {
             r.read_values(el, k, role, body)?;
@@ -809,6 +824,9 @@ pub fn write_ply(
     }
 }
 
+/// Bytes per write of data that needs no encoding (as `dd bs=8M` writes).
+const RAW_BLOCK: usize = 8 << 20;
+
 /// What a PLY output holds besides positions and faces, and how it stores it.
 struct PlyOutput<'a> {
     mesh: &'a MeshView<'a>,
@@ -896,14 +914,14 @@ impl<'a> PlyOutput<'a> {
             mesh.num_vertices(),
             |r| mesh.point_window(r),
             |points, i, b| {
-                let p = points.get(i);
-                let _ = write!(b, "{} {} {}", p.x, p.y, p.z);
+                push_f64s(b, &points.get(i).to_array());
                 if let Some(n) = normals {
-                    let n = n[i];
-                    let _ = write!(b, " {} {} {}", n.x, n.y, n.z);
+                    b.push(b' ');
+                    push_f64s(b, &n[i].to_array());
                 }
                 if let Some(uv) = uv {
-                    let _ = write!(b, " {} {}", uv[i][0], uv[i][1]);
+                    b.push(b' ');
+                    push_f64s(b, &uv[i]);
                 }
                 b.push(b'\n');
             },
@@ -914,12 +932,14 @@ impl<'a> PlyOutput<'a> {
             |r| mesh.face_window(r),
             |faces, f, b| {
                 let fv = faces.face(f);
-                let _ = write!(b, "{}", fv.len());
+                push_u64(b, fv.len() as u64);
                 for &v in fv {
-                    let _ = write!(b, " {v}");
+                    b.push(b' ');
+                    push_u64(b, v.into());
                 }
                 if let Some(l) = levels {
-                    let _ = write!(b, " {}", l[f]);
+                    b.push(b' ');
+                    push_u64(b, l[f].into());
                 }
                 b.push(b'\n');
             },
@@ -936,13 +956,13 @@ impl<'a> PlyOutput<'a> {
         Ok(())
     }
 
-    fn write_binary_body(&self, w: &mut dyn Write) -> std::io::Result<()> {
-        let mesh = self.mesh;
-        let (normals, uv, levels) = (self.normals, &self.uv, self.levels);
+    /// Vertex records (position, normal, uv) encoded by all threads.
+    fn write_binary_vertices(&self, w: &mut dyn Write) -> std::io::Result<()> {
+        let (normals, uv) = (self.normals, &self.uv);
         write_windows(
             w,
-            mesh.num_vertices(),
-            |r| mesh.point_window(r),
+            self.mesh.num_vertices(),
+            |r| self.mesh.point_window(r),
             |points, i, b| {
                 for c in points.get(i).to_array() {
                     b.extend_from_slice(&c.to_le_bytes());
@@ -958,7 +978,24 @@ impl<'a> PlyOutput<'a> {
                     }
                 }
             },
-        )?;
+        )
+    }
+
+    fn write_binary_body(&self, w: &mut dyn Write) -> std::io::Result<()> {
+        let mesh = self.mesh;
+        let (normals, uv, levels) = (self.normals, &self.uv, self.levels);
+        // Held positions alone are their own little-endian records: no encoding at all.
+        let raw = match (mesh.positions(), normals, uv) {
+            (Some(points), None, None) if cfg!(target_endian = "little") => Some(points),
+            _ => None,
+        };
+        if let Some(points) = raw {
+            for block in bytemuck::cast_slice::<DVec3, u8>(points).chunks(RAW_BLOCK) {
+                w.write_all(block)?;
+            }
+        } else {
+            self.write_binary_vertices(w)?;
+        }
         let wide_lists = self.wide_lists;
         write_windows(
             w,

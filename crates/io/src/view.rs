@@ -13,6 +13,7 @@
 use std::borrow::Cow;
 use std::ops::Range;
 
+use rayon::prelude::*;
 use subd_mesh::{DVec3, Mesh, SchemeHints};
 use thiserror::Error;
 
@@ -562,11 +563,15 @@ impl<'a> MeshView<'a> {
     /// a corner tag for every vertex with sharpness above zero (in edge and vertex order).
     pub fn from_mesh(mesh: &'a Mesh) -> MeshView<'a> {
         let topo = &mesh.topology;
+        // Every edge and vertex is looked at (millions in a refined mesh): by all threads,
+        // collected in order.
         let creases = (0..topo.num_edges())
+            .into_par_iter()
             .filter(|&e| topo.edge_sharpness(e) > 0.0)
             .map(|e| (topo.edge_vertices(e), topo.edge_sharpness(e)))
             .collect();
         let corners = (0..topo.num_vertices())
+            .into_par_iter()
             .filter(|&v| topo.vertex_sharpness(v) > 0.0)
             .map(|v| (v as u32, topo.vertex_sharpness(v)))
             .collect();
