@@ -4,7 +4,7 @@
 //! OpenSubdiv shape, Catmull-Clark and Loop, levels 1 to 3.
 
 use glam::DVec3;
-use subd_limit::{Tangents, level_limit_points, limit_points};
+use subd_limit::{Tangents, level_limit_points, levels_for_exact_limit, limit_points};
 use subd_schemes::Refinement;
 use subd_tests::surface_shapes;
 
@@ -25,7 +25,10 @@ fn level_limit_equals_the_tables_of_the_level() {
 
     for s in surface_shapes() {
         let levels = 3;
-        if s.mesh.topology.num_face_vertices() << (2 * levels) > 2_000_000 {
+        // Semi-sharp features still decaying at level 3 take `limit_points` itself at every
+        // level: nothing to compare (and their reference refines deepest).
+        let (decay, _) = levels_for_exact_limit(&s.mesh.topology, &s.scheme);
+        if decay > levels || s.mesh.topology.num_face_vertices() << (2 * levels) > 400_000 {
             continue;
         }
         let r = Refinement::new(&s.mesh.topology, s.scheme.clone(), &s.options, levels).unwrap();
