@@ -33,6 +33,8 @@ use std::f64::consts::TAU;
 
 use glam::DVec3;
 use subd_mesh::Topology;
+use subd_mesh::cut::{NONE, cut};
+use subd_mesh::neighbourhood::{faces_touching, vertices_within_rings};
 use subd_schemes::StencilTable;
 use subd_schemes::split_schemes::{Features, doo_sabin};
 use subd_schemes::{Options, Refinement, Scheme, Split};
@@ -141,7 +143,8 @@ impl SplitLimitStencils {
     }
 }
 
-/// The stencils of `scheme`'s limit at every vertex of `base`.
+/// The stencils of `scheme`'s limit at every vertex of `base`, the levels below the base
+/// refined only around the vertices that need them ([`Neighbourhoods::Local`]).
 ///
 /// # Errors
 /// [`LimitError::Analysis`] when `base` is not a mesh `scheme` refines (see
@@ -150,18 +153,40 @@ pub fn split_limit_stencils(
     base: &Topology,
     scheme: &Scheme,
 ) -> Result<SplitLimitStencils, LimitError> {
+    split_limit_stencils_in(base, scheme, Neighbourhoods::Local)
+}
+
+/// How the levels below the base are refined where a vertex's masks apply only further down.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Neighbourhoods {
+    /// Pieces cut around the vertices still waiting for a level ([`subd_mesh::cut`]), wide
+    /// enough that the piece's refinement agrees with the whole mesh's where the masks read
+    /// it; the whole mesh when a piece cannot be refined (a pinched cut).
+    #[default]
+    Local,
+    /// The whole mesh every time: the reference the pieces are checked against.
+    Whole,
+}
+
+/// [`split_limit_stencils`], with the levels below the base refined as `how` says.
+///
+/// # Errors
+/// As [`split_limit_stencils`].
+pub fn split_limit_stencils_in(
+    base: &Topology,
+    scheme: &Scheme,
+    how: Neighbourhoods,
+) -> Result<SplitLimitStencils, LimitError> {
     let nv = base.num_vertices();
-    let refinement = |levels| {
-        Refinement::new(base, scheme.clone(), &Options::default(), levels)
-            .map_err(|e| LimitError::Analysis(e.to_string()))
-    };
+    let refiner = Refiner { base, scheme, how };
+    let refinement = |levels| refiner.whole(levels).map(|r| r.r);
     let mut position: Vec<Option<Row>> = vec![None; nv];
     let mut tangents: Vec<Option<[Row; 2]>> = vec![None; nv];
     if scheme.split() == Split::Dual {
         let r = refinement(1)?;
         doo_sabin_rows(base, &r, &mut position, &mut tangents);
     } else {
-        vertex_rows(base, scheme, &refinement, &mut position, &mut tangents)?;
+        vertex_rows(base, scheme, &refiner, &mut position, &mut tangents)?;
     }
     let table = |rows: Vec<Row>| {
         StencilTable::build(nv, nv, |v, sink| {
@@ -232,12 +257,119 @@ fn regular_ball(t: &Topology, features: &Features, v: u32, ball: &[u32], expecte
         })
 }
 
+/// A refinement the masks of some base vertices are read from: of the whole base, or of a
+/// piece cut around them.
+struct Refined {
+    r: Refinement,
+    /// The stencils from each level used back to level 0, composed once.
+    composed: std::cell::RefCell<HashMap<usize, StencilTable>>,
+    /// For a piece: the piece vertex of each base vertex ([`NONE`] outside) and the base vertex
+    /// of each piece vertex. Vertices keep their index at every level of the √3 and butterfly
+    /// splits, so these serve every level.
+    piece: Option<(Vec<u32>, Vec<u32>)>,
+}
+
+impl Refined {
+    /// The refinement's vertex of base vertex `v`.
+    fn vertex(&self, v: u32) -> u32 {
+        match &self.piece {
+            None => v,
+            Some((of_base, _)) => of_base[v as usize],
+        }
+    }
+
+    /// A row over the vertices of the refinement's `level` as a row over the base vertices.
+    fn base_row(&self, row: Row, level: usize) -> Row {
+        let row = if level == 0 {
+            row
+        } else {
+            let mut composed = self.composed.borrow_mut();
+            let table = composed
+                .entry(level)
+                .or_insert_with(|| self.r.composed(level));
+            to_base(&row, table)
+        };
+        match &self.piece {
+            None => row,
+            Some((_, to_base)) => row
+                .into_iter()
+                .map(|(u, w)| (to_base[u as usize], w))
+                .collect(),
+        }
+    }
+}
+
+/// Makes the refinements the masks are read from, as [`Neighbourhoods`] says.
+struct Refiner<'a> {
+    base: &'a Topology,
+    scheme: &'a Scheme,
+    how: Neighbourhoods,
+}
+
+impl Refiner<'_> {
+    /// The whole base refined `levels` times.
+    fn whole(&self, levels: usize) -> Result<Refined, LimitError> {
+        let r = Refinement::new(self.base, self.scheme.clone(), &Options::default(), levels)
+            .map_err(|e| LimitError::Analysis(e.to_string()))?;
+        Ok(Refined {
+            r,
+            composed: Default::default(),
+            piece: None,
+        })
+    }
+
+    /// A refinement `levels` deep that agrees with the whole base's on balls of `radius`
+    /// (rings of level `levels`) around `vertices`.
+    ///
+    /// A ring of a finer level lies inside the ring of the base it came from, and one step
+    /// reads its parent within two rings (the butterflies' wings) plus one for the features
+    /// and splits a rule sees; so a piece of the faces within `radius + 3·levels + 2` base
+    /// rings of `vertices` refines, on those balls, exactly as the whole base does.
+    fn around(
+        &self,
+        vertices: &[u32],
+        levels: usize,
+        radius: usize,
+    ) -> Result<Refined, LimitError> {
+        if self.how == Neighbourhoods::Whole || levels == 0 {
+            return self.whole(levels);
+        }
+        let rings = radius + 3 * levels + 2;
+        let faces = faces_touching(
+            self.base,
+            &vertices_within_rings(self.base, vertices, rings),
+        );
+        if faces.len() == self.base.num_faces() {
+            return self.whole(levels);
+        }
+        let sub = cut(self.base, &faces);
+        // A cut can pinch a vertex between two runs of faces, which the schemes refuse.
+        let Ok(r) = Refinement::new(
+            &sub.topology,
+            self.scheme.clone(),
+            &Options::default(),
+            levels,
+        ) else {
+            return self.whole(levels);
+        };
+        let mut of_base = vec![NONE; self.base.num_vertices()];
+        for (i, &v) in sub.vertices.iter().enumerate() {
+            of_base[v as usize] = i as u32;
+        }
+        Ok(Refined {
+            r,
+            composed: Default::default(),
+            piece: Some((of_base, sub.vertices)),
+        })
+    }
+}
+
 /// √3 and the butterflies: features by their curve rules, interior vertices by their masks
 /// at the first level with a regular ball.
 fn vertex_rows(
     base: &Topology,
     scheme: &Scheme,
-    refinement: &dyn Fn(usize) -> Result<Refinement, LimitError>,
+    refiner: &Refiner<'_>,
     position: &mut [Option<Row>],
     tangents: &mut [Option<[Row; 2]>],
 ) -> Result<(), LimitError> {
@@ -263,7 +395,7 @@ fn vertex_rows(
                 if features.is_corner(vi) {
                     position[vi] = Some(vec![(v, 1.0)]);
                 } else if features.is_curve_vertex(vi) {
-                    position[vi] = Some(sqrt3_curve_limit(base, &features, v, refinement)?);
+                    position[vi] = Some(sqrt3_curve_limit(base, &features, v, refiner)?);
                 }
                 // A dart (one crease edge ending inside the surface): no mask here.
             }
@@ -271,29 +403,46 @@ fn vertex_rows(
         }
         pending.push(v);
     }
+    interior_rows(base, scheme, refiner, pending, position, tangents)?;
+    feature_rows(scheme, refiner, &feature_pending, position, tangents)
+}
+
+/// Interior vertices: the masks of their valence at the first level (0 to [`MAX_LEVELS`])
+/// where their ball is regular, each level refined around the vertices still pending.
+fn interior_rows(
+    base: &Topology,
+    scheme: &Scheme,
+    refiner: &Refiner<'_>,
+    mut pending: Vec<u32>,
+    position: &mut [Option<Row>],
+    tangents: &mut [Option<[Row; 2]>],
+) -> Result<(), LimitError> {
     let mut masks: HashMap<usize, (LocalMasks, usize)> = HashMap::new();
+    pending.retain(|&v| (3..=64).contains(&base.valence(v as usize)));
+    for &v in &pending {
+        let n = base.valence(v as usize);
+        if let std::collections::hash_map::Entry::Vacant(e) = masks.entry(n) {
+            let m = local_masks(scheme, n)?;
+            let size = m.limit.len();
+            e.insert((m, size));
+        }
+    }
     let mut level = 0;
-    let mut refined: Option<Refinement> = None;
     while !pending.is_empty() && level <= MAX_LEVELS {
-        let (t, composed) = match &refined {
-            None => (base, None),
-            Some(r) => (r.topology(level), Some(r.composed(level))),
-        };
+        let radius = pending
+            .iter()
+            .map(|&v| masks[&base.valence(v as usize)].0.radius)
+            .max()
+            .unwrap_or(0);
+        let refined = refiner.around(&pending, level, radius)?;
+        let t = refined.r.topology(level);
         let features = Features::new(t);
         let mut still = Vec::new();
         for &v in &pending {
-            let n = base.valence(v as usize);
-            if !(3..=64).contains(&n) {
-                continue;
-            }
-            if let std::collections::hash_map::Entry::Vacant(e) = masks.entry(n) {
-                let m = local_masks(scheme, n)?;
-                let size = m.limit.len();
-                e.insert((m, size));
-            }
-            let (m, size) = &masks[&n];
-            let ball = LocalMasks::ball(t, v, m.radius);
-            if !regular_ball(t, &features, v, &ball, *size) {
+            let (m, size) = &masks[&base.valence(v as usize)];
+            let lv = refined.vertex(v);
+            let ball = LocalMasks::ball(t, lv, m.radius);
+            if !regular_ball(t, &features, lv, &ball, *size) {
                 still.push(v);
                 continue;
             }
@@ -304,10 +453,7 @@ fn vertex_rows(
                     .filter(|(_, w)| **w != 0.0)
                     .map(|(&u, &w)| (u, w))
                     .collect();
-                match &composed {
-                    None => r,
-                    Some(c) => to_base(&r, c),
-                }
+                refined.base_row(r, level)
             };
             if !scheme.is_interpolating() {
                 position[v as usize] = Some(row(&m.limit));
@@ -318,11 +464,8 @@ fn vertex_rows(
         }
         pending = still;
         level += 1;
-        if !pending.is_empty() && level <= MAX_LEVELS {
-            refined = Some(refinement(level)?);
-        }
     }
-    feature_rows(scheme, refinement, &feature_pending, position, tangents)
+    Ok(())
 }
 
 /// √3's limit of a vertex inside a boundary or crease curve: `(p₋₁ + 4p + p₁)/6` of its
@@ -334,9 +477,9 @@ fn sqrt3_curve_limit(
     base: &Topology,
     features: &Features,
     v: u32,
-    refinement: &dyn Fn(usize) -> Result<Refinement, LimitError>,
+    refiner: &Refiner<'_>,
 ) -> Result<Row, LimitError> {
-    let curve = |t: &Topology, f: &Features| -> Row {
+    let curve = |t: &Topology, f: &Features, v: u32| -> Row {
         let [e0, e1] = f.curve_edges(v as usize);
         vec![
             (t.edge_other_vertex(e0 as usize, v), 1.0 / 6.0),
@@ -344,14 +487,15 @@ fn sqrt3_curve_limit(
             (t.edge_other_vertex(e1 as usize, v), 1.0 / 6.0),
         ]
     };
-    let row = curve(base, features);
+    let row = curve(base, features, v);
     let is_dart = |u: u32| features.degree(u as usize) == 1 && !base.is_boundary_vertex(u as usize);
     if !row.iter().any(|&(u, _)| u != v && is_dart(u)) {
         return Ok(row);
     }
-    let r = refinement(2)?;
-    let t2 = r.topology(2);
-    Ok(to_base(&curve(t2, &Features::new(t2)), &r.composed(2)))
+    let refined = refiner.around(&[v], 2, 1)?;
+    let t2 = refined.r.topology(2);
+    let row = curve(t2, &Features::new(t2), refined.vertex(v));
+    Ok(refined.base_row(row, 2))
 }
 
 /// Darts and boundary vertices: the masks of the synthetic feature centre of the same kind
@@ -360,7 +504,7 @@ fn sqrt3_curve_limit(
 /// matrix covers an odd and an even step, so only even levels are tried there.
 fn feature_rows(
     scheme: &Scheme,
-    refinement: &dyn Fn(usize) -> Result<Refinement, LimitError>,
+    refiner: &Refiner<'_>,
     vertices: &[u32],
     position: &mut [Option<Row>],
     tangents: &mut [Option<[Row; 2]>],
@@ -372,28 +516,29 @@ fn feature_rows(
     let mut masks: HashMap<FeatureCentre, Option<FeatureMasks>> = HashMap::new();
     let mut pending = vertices.to_vec();
     for level in (0..=MAX_LEVELS - steps).step_by(steps) {
-        // Refined only as deep as this level needs (most vertices are settled at level 0).
-        let r = refinement(level + steps)?;
+        // Refined only as deep as this level needs, only around the vertices still pending
+        // (most vertices are settled at level 0).
+        let refined = refiner.around(&pending, level + steps, FEATURE_RADIUS)?;
+        let r = &refined.r;
         let (parent, child) = (r.topology(level), r.topology(level + steps));
-        let composed = (level > 0).then(|| r.composed(level));
-        let rows = |c: u32| row_between(&r, level, level + steps, c);
+        let rows = |c: u32| row_between(r, level, level + steps, c);
         let mut still = Vec::new();
         for &v in &pending {
-            let vi = v as usize;
-            let centre = if parent.is_boundary_vertex(vi) {
+            let lv = refined.vertex(v);
+            let centre = if parent.is_boundary_vertex(lv as usize) {
                 FeatureCentre::Boundary {
-                    faces: parent.vertex_faces(vi).len(),
+                    faces: parent.vertex_faces(lv as usize).len(),
                 }
             } else {
                 FeatureCentre::Dart {
-                    valence: parent.valence(vi),
+                    valence: parent.valence(lv as usize),
                 }
             };
             let m = masks
                 .entry(centre)
                 .or_insert_with(|| feature_masks(scheme, centre).ok());
             let Some(m) = m else { continue };
-            let Some(local) = feature_matrix(parent, child, &rows, v, m.radius) else {
+            let Some(local) = feature_matrix(parent, child, &rows, lv, m.radius) else {
                 still.push(v);
                 continue;
             };
@@ -405,7 +550,7 @@ fn feature_rows(
                 still.push(v);
                 continue;
             }
-            let ball = feature_ball(parent, v, m.radius).expect("a feature vertex");
+            let ball = feature_ball(parent, lv, m.radius).expect("a feature vertex");
             let row = |w: &[f64]| -> Row {
                 let r: Row = ball
                     .iter()
@@ -413,16 +558,13 @@ fn feature_rows(
                     .filter(|(_, w)| w.abs() > 1e-15)
                     .map(|(&u, &w)| (u, w))
                     .collect();
-                match &composed {
-                    None => r,
-                    Some(c) => to_base(&r, c),
-                }
+                refined.base_row(r, level)
             };
-            if position[vi].is_none() {
-                position[vi] = Some(row(&m.limit));
+            if position[v as usize].is_none() {
+                position[v as usize] = Some(row(&m.limit));
             }
             if let Some([a, b]) = &m.tangents {
-                tangents[vi] = Some([row(a), row(b)]);
+                tangents[v as usize] = Some([row(a), row(b)]);
             }
         }
         pending = still;
@@ -432,3 +574,6 @@ fn feature_rows(
     }
     Ok(())
 }
+
+/// The largest ball radius [`feature_masks`] reads (its search stops at 6).
+const FEATURE_RADIUS: usize = 6;

@@ -22,7 +22,7 @@
 //! assert_eq!(vertices_within_rings(&t, &[0], 1), vec![0, 1, 4, 5]);
 //! ```
 
-use std::collections::VecDeque;
+use std::collections::{HashSet, VecDeque};
 
 use crate::Topology;
 
@@ -41,11 +41,13 @@ pub fn ring_from(t: &Topology, v: u32, from: u32) -> Vec<u32> {
 /// vertex labelled `i`. A vertex's neighbours are labelled counter-clockwise from the
 /// vertex it was reached from, so two balls of the same shape get the same labels.
 pub fn labelled_ball(t: &Topology, seeds: &[(u32, u32)], radius: usize) -> Vec<u32> {
-    let mut label = vec![u32::MAX; t.num_vertices()];
+    // A set, not a per-vertex array: balls are small and taken around many vertices of
+    // large meshes, where clearing an array the size of the mesh each time dominates.
+    let mut labelled: HashSet<u32> = HashSet::new();
     let mut order: Vec<u32> = Vec::new();
     let mut queue: VecDeque<(u32, u32, usize)> = VecDeque::new();
     for &(v, from) in seeds {
-        label[v as usize] = order.len() as u32;
+        labelled.insert(v);
         order.push(v);
         queue.push_back((v, from, 0));
     }
@@ -54,8 +56,7 @@ pub fn labelled_ball(t: &Topology, seeds: &[(u32, u32)], radius: usize) -> Vec<u
             continue;
         }
         for u in ring_from(t, v, from) {
-            if label[u as usize] == u32::MAX {
-                label[u as usize] = order.len() as u32;
+            if labelled.insert(u) {
                 order.push(u);
                 queue.push_back((u, v, d + 1));
             }

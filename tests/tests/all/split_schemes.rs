@@ -551,3 +551,42 @@ fn normals_of_a_flat_grid_are_the_plane_normal() {
         assert!(boundary > 10, "{scheme:?}: {boundary} boundary normals");
     }
 }
+
+/// The limits of √3 and the butterflies read off pieces cut around the vertices that need
+/// deeper levels are those read off the whole mesh refined that deep, bit for bit: on every
+/// OpenSubdiv shape the scheme refines, at the base and one level down (where the pieces
+/// are smaller than the mesh).
+#[test]
+fn split_limits_of_local_pieces_match_the_whole_mesh() {
+    use subd_limit::split_limit::{Neighbourhoods, split_limit_stencils_in};
+    let mut compared = 0;
+    for path in subd_tests::osd_meshes() {
+        let Ok(file) = subd_io::read_mesh(&path, &subd_io::ReadOptions::default()) else {
+            continue;
+        };
+        for scheme in [Scheme::Sqrt3, Scheme::BUTTERFLY, Scheme::ModifiedButterfly] {
+            let (t, p) = (&file.mesh.topology, &file.mesh.positions);
+            let Ok(r) = Refinement::new(t, scheme.clone(), &Options::default(), 1) else {
+                continue;
+            };
+            let p1 = r.refine_points(p).pop().unwrap();
+            for (t, p) in [(t, p), (r.topology(1), &p1)] {
+                let whole = split_limit_stencils_in(t, &scheme, Neighbourhoods::Whole);
+                let local = split_limit_stencils_in(t, &scheme, Neighbourhoods::Local);
+                let (Ok(whole), Ok(local)) = (whole, local) else {
+                    panic!("{} {scheme:?}: one path failed", path.display());
+                };
+                assert_eq!(whole.position_known, local.position_known);
+                assert_eq!(whole.tangents_known, local.tangents_known);
+                assert_eq!(
+                    whole.evaluate(p),
+                    local.evaluate(p),
+                    "{} {scheme:?}",
+                    path.display()
+                );
+                compared += 1;
+            }
+        }
+    }
+    assert!(compared > 50, "only {compared} meshes compared");
+}
