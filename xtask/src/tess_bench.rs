@@ -2,15 +2,15 @@
 //! `tessellate` against OpenSubdiv's `Bfr::RefinerSurfaceFactory` + `Bfr::Tessellation`, on
 //! the bench torus (Catmull-Clark) and its triangulation (Loop).
 //!
-//! Both sides do the same work per run: set up (subd: the evaluator and its patch points;
-//! Bfr: the factory), then every face's samples with positions and first derivatives. Bfr's
-//! time is measured inside its harness (the topology refiner it starts from is not timed);
-//! subd's in this process, on one thread (`tessellate` is serial).
+//! Both sides do the same work per run: set up (subd: the refinement or the evaluator,
+//! inside `tessellate_mesh`; Bfr: the factory), then every face's samples with positions
+//! and normals (Bfr: first derivatives). Bfr's time is measured inside its harness (the
+//! topology refiner it starts from is not timed); subd's in this process, on 1 thread (the
+//! ratio to Bfr's one thread) and on 2 (the speed-up).
 
 use std::time::Instant;
 
-use subd_limit::eval::LimitEvaluator;
-use subd_limit::tessellation::tessellate;
+use subd_limit::tessellation::tessellate_mesh;
 use subd_schemes::{Options, Scheme};
 
 use crate::bench::{json_number, median, quad_bench_mesh, tri_bench_mesh};
@@ -20,11 +20,11 @@ use crate::osd;
 pub fn run(repeats: usize) -> Result<(), String> {
     let exe = osd::build_harness()?;
     println!(
-        "uniform limit tessellation: subd tessellate (1 thread) vs OpenSubdiv 3.5 Bfr (approximation level 10); medians of {repeats} runs"
+        "uniform limit tessellation: subd tessellate_mesh (1 and 2 threads) vs OpenSubdiv 3.5 Bfr (approximation level 10); medians of {repeats} runs"
     );
     println!(
-        "{:<14} {:>7} {:>5} {:>10} {:>10} {:>10} {:>12} {:>7}",
-        "scheme", "faces", "rate", "samples", "bfr s", "subd s", "(setup s)", "ratio"
+        "{:<14} {:>7} {:>5} {:>10} {:>10} {:>10} {:>10} {:>7} {:>7}",
+        "scheme", "faces", "rate", "samples", "bfr s", "subd 1t s", "subd 2t s", "ratio", "1t/2t"
     );
     for (scheme, mesh) in [
         (Scheme::CatmullClark, quad_bench_mesh()),
@@ -40,30 +40,35 @@ pub fn run(repeats: usize) -> Result<(), String> {
             )?;
             let line = String::from_utf8_lossy(&out);
             let bfr = json_number(&line, "seconds").ok_or("Bfr bench: no seconds")?;
-            let mut times = Vec::new();
-            let mut setups = Vec::new();
             let mut samples = 0;
-            for _ in 0..repeats {
-                let t = Instant::now();
-                let ev = LimitEvaluator::new(&mesh.topology, &scheme, &options)
+            let mut time_on = |threads: usize| -> Result<f64, String> {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
                     .map_err(|e| e.to_string())?;
-                let pts = ev.prepare(&mesh.positions);
-                setups.push(t.elapsed().as_secs_f64());
-                let tess = tessellate(&ev, &pts, rate).map_err(|e| e.to_string())?;
-                times.push(t.elapsed().as_secs_f64());
-                samples = tess.positions.len();
-            }
-            let ours = median(times);
+                let mut times = Vec::new();
+                for _ in 0..repeats {
+                    let t = Instant::now();
+                    let tess = pool.install(|| {
+                        tessellate_mesh(&mesh.topology, &scheme, &options, &mesh.positions, rate)
+                    });
+                    times.push(t.elapsed().as_secs_f64());
+                    samples = tess.map_err(|e| e.to_string())?.positions.len();
+                }
+                Ok(median(times))
+            };
+            let (one, two) = (time_on(1)?, time_on(2)?);
             println!(
-                "{:<14} {:>7} {:>5} {:>10} {:>10.3} {:>10.3} {:>12.3} {:>7.2}",
+                "{:<14} {:>7} {:>5} {:>10} {:>10.3} {:>10.3} {:>10.3} {:>7.2} {:>7.2}",
                 format!("{scheme:?}"),
                 mesh.topology.num_faces(),
                 rate,
                 samples,
                 bfr,
-                ours,
-                median(setups),
-                ours / bfr
+                one,
+                two,
+                one / bfr,
+                one / two
             );
         }
     }

@@ -7,8 +7,7 @@ use std::time::Instant;
 
 use clap::Args;
 use serde::Serialize;
-use subd_limit::eval::LimitEvaluator;
-use subd_limit::tessellation::tessellate;
+use subd_limit::tessellation::tessellate_mesh;
 
 use subd_schemes::Scheme;
 
@@ -76,12 +75,13 @@ pub(crate) fn run(
     let t1 = Instant::now();
     let options = args.rules.options(&file.mesh.hints);
     let scheme = args.scheme.clone();
-    let evaluator =
-        LimitEvaluator::new(&file.mesh.topology, &scheme, &options).map_err(|e| in_file(&e))?;
-    let points = evaluator.prepare(&file.mesh.positions);
     let t_setup = t1.elapsed().as_secs_f64();
     let t2 = Instant::now();
-    let t = tessellate(&evaluator, &points, args.rate).map_err(|e| in_file(&e))?;
+    // Refinement and the last level's limit masks at a rate that is a power of two, the
+    // evaluator (set up inside, so counted here) at others.
+    let (topology, positions) = (&file.mesh.topology, &file.mesh.positions);
+    let t = tessellate_mesh(topology, &scheme, &options, positions, args.rate)
+        .map_err(|e| in_file(&e))?;
     let t_evaluate = t2.elapsed().as_secs_f64();
     let t3 = Instant::now();
     let holes = vec![false; t.face_offsets.len() - 1];

@@ -61,6 +61,7 @@ pub mod split_limit;
 pub mod stam;
 mod support;
 mod table;
+mod tess_refined;
 pub mod tessellation;
 mod two_phase_closed;
 

@@ -21,7 +21,8 @@
 
 use glam::DVec3;
 use rayon::prelude::*;
-use subd_schemes::Scheme;
+use subd_mesh::Topology;
+use subd_schemes::{Options, Scheme};
 
 use crate::LimitError;
 use crate::eval::{FaceParam, LimitEvaluator, PatchPoints};
@@ -105,13 +106,88 @@ pub fn tessellate(
     rate: usize,
 ) -> Result<Tessellation, LimitError> {
     let topo = evaluator.topology();
-    let catmark = evaluator.scheme == Scheme::CatmullClark;
-    if rate == 0 || rate > MAX_RATE {
+    let loop_scheme = evaluator.scheme == Scheme::Loop;
+    check_rate(topo, loop_scheme, rate)?;
+    let Numbered {
+        params, mut out, ..
+    } = number_samples(topo, loop_scheme, rate as u32);
+    let evaluated: Result<Vec<(DVec3, DVec3)>, LimitError> = params
+        .par_iter()
+        .map(|&at| evaluator.evaluate_position_normal(points, at))
+        .collect();
+    let evaluated = match evaluated {
+        Ok(values) => values,
+        Err(any) => {
+            // The first failing sample's error, not whichever a thread met first.
+            let first = params
+                .iter()
+                .find_map(|&at| evaluator.evaluate_position_normal(points, at).err());
+            return Err(first.unwrap_or(any));
+        }
+    };
+    (out.positions, out.normals) = evaluated.into_iter().unzip();
+    out.params = params;
+    Ok(out)
+}
+
+/// Tessellates the limit surface of `positions` on `topology` at `rate`, as [`tessellate`]
+/// does with an evaluator of the mesh: the same samples, faces and grids, the same values to
+/// rounding. A rate that is a power of two on a manifold Catmull-Clark or Loop mesh takes
+/// uniform refinement instead, its samples being the vertices of the refined level: the
+/// limit masks of that level ([`crate::level_limit_points`]), one pass over its vertices,
+/// in place of one patch evaluation per sample (positions agree with the evaluator's to
+/// ~1e-15 of the mesh's size, normals to ~1e-12). Other rates build a [`LimitEvaluator`].
+///
+/// ```
+/// use subd_limit::tessellation::tessellate_mesh;
+/// use subd_mesh::{DVec3, TopologyBuilder};
+/// use subd_schemes::{Options, Scheme};
+///
+/// let faces = [0, 1, 3, 2, 2, 3, 5, 4, 4, 5, 7, 6, 6, 7, 1, 0, 1, 7, 5, 3, 6, 0, 2, 4];
+/// let cube = TopologyBuilder::new(8).build(&[4; 6], &faces).unwrap();
+/// let p: Vec<DVec3> = (0..8)
+///     .map(|i| DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64))
+///     .collect();
+/// let t = tessellate_mesh(&cube, &Scheme::CatmullClark, &Options::default(), &p, 8).unwrap();
+/// assert_eq!(t.face_offsets.len() - 1, 6 * 64);
+/// assert_eq!(t.positions.len(), 6 * 64 + 2);
+/// ```
+///
+/// # Errors
+/// As [`tessellate`], and [`LimitError::Param`] when `positions` does not hold one point
+/// per vertex of `topology`.
+pub fn tessellate_mesh(
+    topology: &Topology,
+    scheme: &Scheme,
+    options: &Options,
+    positions: &[DVec3],
+    rate: usize,
+) -> Result<Tessellation, LimitError> {
+    if positions.len() != topology.num_vertices() {
         return Err(LimitError::Param(format!(
-            "rate {rate}: expected 1 to {MAX_RATE}"
+            "{} positions for {} vertices",
+            positions.len(),
+            topology.num_vertices()
         )));
     }
-    if catmark && rate % 2 == 1 {
+    check_range(rate)?;
+    if let Some(levels) = crate::tess_refined::depth(topology, scheme, rate) {
+        return crate::tess_refined::tessellate_refined(
+            topology, scheme, options, positions, levels,
+        );
+    }
+    let evaluator = LimitEvaluator::new(topology, scheme, options)?;
+    tessellate(&evaluator, &evaluator.prepare(positions), rate)
+}
+
+/// Checks `rate`: 1 to [`MAX_RATE`], even where a Catmull-Clark face is not a quad.
+pub(crate) fn check_rate(
+    topo: &Topology,
+    loop_scheme: bool,
+    rate: usize,
+) -> Result<(), LimitError> {
+    check_range(rate)?;
+    if !loop_scheme && rate % 2 == 1 {
         if let Some(f) = (0..topo.num_faces()).find(|&f| topo.face_size(f) != 4 && !topo.is_hole(f))
         {
             return Err(LimitError::Param(format!(
@@ -119,9 +195,35 @@ pub fn tessellate(
             )));
         }
     }
+    Ok(())
+}
+
+/// Checks that `rate` is 1 to [`MAX_RATE`].
+fn check_range(rate: usize) -> Result<(), LimitError> {
+    if rate == 0 || rate > MAX_RATE {
+        return Err(LimitError::Param(format!(
+            "rate {rate}: expected 1 to {MAX_RATE}"
+        )));
+    }
+    Ok(())
+}
+
+/// The samples of a tessellation before evaluation.
+pub(crate) struct Numbered {
+    /// The parameter of each sample.
+    pub params: Vec<FaceParam>,
+    /// The output faces and grids over the samples (positions and normals left empty).
+    pub out: Tessellation,
+    /// Each base vertex's sample (`u32::MAX` where no face reaches it).
+    pub vertex_sample: Vec<u32>,
+}
+
+/// Numbers the samples of every face that is not a hole (see the module docs).
+pub(crate) fn number_samples(topo: &Topology, loop_scheme: bool, rate: u32) -> Numbered {
     let mut t = Builder {
-        evaluator,
-        rate: rate as u32,
+        topo,
+        loop_scheme,
+        rate,
         vertex_index: vec![UNSET; topo.num_vertices()],
         edge_first: vec![UNSET; topo.num_edges()],
         params: Vec::new(),
@@ -140,55 +242,27 @@ pub fn tessellate(
             continue;
         }
         let n = topo.face_size(f);
-        if !catmark {
+        if loop_scheme {
             t.triangle(f);
         } else if n == 4 {
             t.quad(f);
         } else {
-            // The centre and the n spokes (midpoint of a side to the centre) belong to
-            // this face alone.
-            let m = t.rate / 2;
-            let centre = t.new_sample(FaceParam {
-                face: f,
-                sub: 0,
-                u: 1.0,
-                v: 1.0,
-            });
-            let spokes = t.params.len() as u32;
-            for side in 0..n {
-                for k in 1..m {
-                    // On sub-face `side`, the spoke of side `side` is its line u = 1.
-                    let v = f64::from(k) / f64::from(m);
-                    t.new_sample(FaceParam {
-                        face: f,
-                        sub: side,
-                        u: 1.0,
-                        v,
-                    });
-                }
-            }
-            for sub in 0..n {
-                t.sub_face(f, sub, centre, spokes);
-            }
+            t.polygon(f);
         }
     }
-    let Builder {
-        params, mut out, ..
-    } = t;
-    let evaluated: Result<Vec<(DVec3, DVec3)>, LimitError> = params
-        .par_iter()
-        .map(|&at| evaluator.evaluate_position_normal(points, at))
-        .collect();
-    (out.positions, out.normals) = evaluated?.into_iter().unzip();
-    out.params = params;
-    Ok(out)
+    Numbered {
+        params: t.params,
+        out: t.out,
+        vertex_sample: t.vertex_index,
+    }
 }
 
 /// Not numbered yet.
 const UNSET: u32 = u32::MAX;
 
 struct Builder<'a> {
-    evaluator: &'a LimitEvaluator,
+    topo: &'a Topology,
+    loop_scheme: bool,
     rate: u32,
     /// Each base vertex's sample, once numbered.
     vertex_index: Vec<u32>,
@@ -200,6 +274,35 @@ struct Builder<'a> {
 }
 
 impl Builder<'_> {
+    /// A Catmull-Clark face that is not a quad: its centre and its n spokes (midpoint of a
+    /// side to the centre) belong to it alone, then its n quad sub-faces.
+    fn polygon(&mut self, f: usize) {
+        let n = self.topo.face_size(f);
+        let m = self.rate / 2;
+        let centre = self.new_sample(FaceParam {
+            face: f,
+            sub: 0,
+            u: 1.0,
+            v: 1.0,
+        });
+        let spokes = self.params.len() as u32;
+        for side in 0..n {
+            for k in 1..m {
+                // On sub-face `side`, the spoke of side `side` is its line u = 1.
+                let v = f64::from(k) / f64::from(m);
+                self.new_sample(FaceParam {
+                    face: f,
+                    sub: side,
+                    u: 1.0,
+                    v,
+                });
+            }
+        }
+        for sub in 0..n {
+            self.sub_face(f, sub, centre, spokes);
+        }
+    }
+
     fn new_sample(&mut self, at: FaceParam) -> u32 {
         self.params.push(at);
         self.params.len() as u32 - 1
@@ -208,7 +311,7 @@ impl Builder<'_> {
     /// The sample at step `t` of `rate` along the face's side `side` (from corner `side` to
     /// `side + 1`), numbered with this face's parameter if no face reached it before.
     fn on_side(&mut self, face: usize, side: usize, t: u32) -> u32 {
-        let topo = self.evaluator.topology();
+        let topo = self.topo;
         let fv = topo.face_vertices(face);
         let n = fv.len();
         let (a, b) = (fv[side], fv[(side + 1) % n]);
@@ -253,14 +356,14 @@ impl Builder<'_> {
     /// coordinates (so a sample has the same bits whichever way it is reached).
     fn side_param(&self, face: usize, side: usize, t: u32) -> FaceParam {
         let n = self.rate;
-        let size = self.evaluator.topology().face_size(face);
+        let size = self.topo.face_size(face);
         let param = |sub: usize, i: u32, j: u32, m: u32| FaceParam {
             face,
             sub,
             u: f64::from(i) / f64::from(m),
             v: f64::from(j) / f64::from(m),
         };
-        if self.evaluator.scheme == Scheme::Loop {
+        if self.loop_scheme {
             return match side {
                 0 => param(0, t, 0, n),
                 1 => param(0, n - t, t, n),
@@ -332,7 +435,7 @@ impl Builder<'_> {
     /// the side's midpoint inwards).
     fn sub_face(&mut self, face: usize, sub: usize, centre: u32, spokes: u32) {
         let m = self.rate / 2;
-        let sides = self.evaluator.topology().face_size(face);
+        let sides = self.topo.face_size(face);
         let prev = (sub + sides - 1) % sides;
         let spoke = |side: usize, k: u32| spokes + side as u32 * (m - 1) + k - 1;
         let mut grid = vec![0u32; ((m + 1) * (m + 1)) as usize];

@@ -21,3 +21,4 @@ mod refined_topology;
 mod split_fvar;
 mod split_schemes;
 mod streamed_output;
+mod tessellation;

@@ -70,3 +70,48 @@ fn tessellate_is_watertight_and_checks_its_rate() {
         assert!(!out.exists());
     }
 }
+
+/// A rate that is a power of two takes uniform refinement and the last level's limit masks:
+/// the file holds the evaluator's samples (`tessellate`, one patch per sample), in its order.
+#[test]
+fn tessellate_at_a_power_of_two_writes_the_evaluated_samples() {
+    use subd_limit::eval::LimitEvaluator;
+    use subd_limit::tessellation::tessellate;
+    let s = Scratch::new("tessellate_pow2");
+    for (scheme_arg, scheme, shape) in [
+        (
+            "catmull-clark",
+            subd_schemes::Scheme::CatmullClark,
+            "catmark_pyramid.obj",
+        ),
+        ("loop", subd_schemes::Scheme::Loop, "loop_icosahedron.obj"),
+    ] {
+        let input = meshes().join(shape);
+        let out = s.0.join(format!("{shape}.obj"));
+        let (code, _, err) = subd(&[
+            "tessellate",
+            "--scheme",
+            scheme_arg,
+            "--rate",
+            "4",
+            input.to_str().unwrap(),
+            out.to_str().unwrap(),
+        ]);
+        assert_eq!(code, 0, "{shape}: {err}");
+        let base = subd_io::read_mesh(&input, &subd_io::ReadOptions::default()).unwrap();
+        let options = subd_schemes::Options::from_hints(&base.mesh.hints);
+        let ev = LimitEvaluator::new(&base.mesh.topology, &scheme, &options).unwrap();
+        let reference = tessellate(&ev, &ev.prepare(&base.mesh.positions), 4).unwrap();
+        let written = subd_io::read_mesh(&out, &subd_io::ReadOptions::default()).unwrap();
+        let (p, t) = (&written.mesh.positions, &written.mesh.topology);
+        assert_eq!(p.len(), reference.positions.len(), "{shape}");
+        assert_eq!(
+            t.all_face_vertices(),
+            &reference.face_vertices[..],
+            "{shape}"
+        );
+        for (a, b) in p.iter().zip(&reference.positions) {
+            assert!((*a - *b).length() < 1e-9, "{shape}: {a} vs {b}");
+        }
+    }
+}
