@@ -60,8 +60,8 @@ use subd_schemes::RefineError;
 use thiserror::Error;
 
 pub use criteria::{
-    Criterion, DihedralAngle, EveryFace, FaceSelection, Flatness, GaussianCurvature, LevelView,
-    LimitDistance, LimitSurface, RandomSelection,
+    Criterion, DihedralAngle, EveryFace, FaceSelection, Flatness, GaussianCurvature, Judgement,
+    LevelView, LimitDistance, LimitSurface, RandomSelection,
 };
 pub use fvar::AdaptiveFVar;
 pub use hierarchy::{AdaptiveRefinement, Positions};
@@ -306,10 +306,22 @@ impl AdaptiveMesh {
     /// # Errors
     /// As [`LimitSurface::position`].
     pub fn max_limit_distance(&self, surface: &LimitSurface) -> Result<f64, AdaptiveError> {
+        self.max_limit_distance_of(surface, |_| true)
+    }
+
+    /// [`Self::max_limit_distance`] over the faces `f` with `faces(f)` only (0 for none).
+    ///
+    /// # Errors
+    /// As [`LimitSurface::position`].
+    pub fn max_limit_distance_of(
+        &self,
+        surface: &LimitSurface,
+        faces: impl Fn(usize) -> bool + Sync,
+    ) -> Result<f64, AdaptiveError> {
         use rayon::prelude::*;
         (0..self.num_faces())
             .into_par_iter()
-            .filter(|&f| !self.holes[f])
+            .filter(|&f| !self.holes[f] && faces(f))
             .map(|f| self.face_distance(surface, f))
             .try_reduce(|| 0.0, |a, b| Ok(a.max(b)))
     }
