@@ -312,7 +312,7 @@ impl AdaptiveMesh {
 
     /// The smallest angle of any face that is not a hole, in degrees.
     pub fn min_angle_degrees(&self) -> f64 {
-        (0..self.num_faces())
+        let cos = (0..self.num_faces())
             .into_par_iter()
             .filter(|&f| !self.holes[f])
             .map(|f| {
@@ -321,10 +321,14 @@ impl AdaptiveMesh {
                     .iter()
                     .map(|&v| self.positions[v as usize])
                     .collect();
-                conform::min_angle(&p)
+                conform::max_corner_cos(&p)
             })
-            .reduce(|| f64::INFINITY, f64::min)
-            .to_degrees()
+            .reduce(|| f64::NEG_INFINITY, f64::max);
+        if cos == f64::NEG_INFINITY {
+            return f64::INFINITY; // no face
+        }
+        // acos decreases: one acos for the whole mesh instead of one per corner.
+        cos.acos().to_degrees()
     }
 
     /// The largest sampled distance of any face that is not a hole to the limit surface,
