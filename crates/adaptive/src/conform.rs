@@ -134,6 +134,19 @@ pub(crate) fn min_angle(p: &[DVec3]) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
+/// The largest cosine of an interior angle of a polygon (clamped to `[-1, 1]`): the cosine of
+/// [`min_angle`], without an `acos` per corner.
+pub(crate) fn max_corner_cos(p: &[DVec3]) -> f64 {
+    let n = p.len();
+    (0..n)
+        .map(|i| {
+            let a = (p[(i + n - 1) % n] - p[i]).normalize_or_zero();
+            let b = (p[(i + 1) % n] - p[i]).normalize_or_zero();
+            a.dot(b).clamp(-1.0, 1.0)
+        })
+        .fold(f64::NEG_INFINITY, f64::max)
+}
+
 /// A leaf of the hierarchy and its boundary points.
 struct Leaf {
     level: usize,

@@ -86,6 +86,29 @@ pub trait Criterion: Send + Sync {
     fn reject(&self, mesh: &AdaptiveMesh) -> Result<Vec<bool>, AdaptiveError> {
         Ok(vec![false; mesh.num_faces()])
     }
+
+    /// [`Self::reject`], with the largest error measured on the way where the criterion
+    /// measures one (the hierarchy keeps it for the final mesh,
+    /// [`crate::AdaptiveRefinement::final_errors`]). The default measures none.
+    ///
+    /// # Errors
+    /// As [`Self::select`].
+    fn judge(&self, mesh: &AdaptiveMesh) -> Result<Judgement, AdaptiveError> {
+        Ok(Judgement {
+            rejected: self.reject(mesh)?,
+            worst: None,
+        })
+    }
+}
+
+/// What [`Criterion::judge`] finds on a conforming mesh.
+#[derive(Clone, Debug, Default)]
+pub struct Judgement {
+    /// The faces rejected: their leaves are refined.
+    pub rejected: Vec<bool>,
+    /// The largest error measured over the faces judged (`None` for a criterion that
+    /// measures none).
+    pub worst: Option<f64>,
 }
 
 /// Checks an angle threshold in degrees and returns it in radians.
@@ -611,6 +634,18 @@ impl LimitDistance {
     pub fn surface(&self) -> &LimitSurface {
         &self.surface
     }
+
+    /// The tolerance (absolute).
+    pub fn tolerance(&self) -> f64 {
+        self.tolerance
+    }
+
+    /// Whether [`Criterion::judge`] measures face `f` of the conforming mesh: every face
+    /// that is not a hole, except, with limit corners, a leaf that is not a transition face
+    /// (measured as the criterion saw it; its corners cannot have moved on).
+    pub fn judged(&self, mesh: &AdaptiveMesh, f: usize) -> bool {
+        !(mesh.holes[f] || (self.limit_corners && !mesh.transition[f]))
+    }
 }
 
 impl Criterion for LimitDistance {
@@ -664,17 +699,27 @@ impl Criterion for LimitDistance {
     }
 
     fn reject(&self, mesh: &AdaptiveMesh) -> Result<Vec<bool>, AdaptiveError> {
-        (0..mesh.num_faces())
+        Ok(self.judge(mesh)?.rejected)
+    }
+
+    /// Measures every face that is not a hole, except, with limit corners, the leaves that
+    /// are not transition faces: the criterion measured those as it saw them at their level
+    /// (see [`LimitDistance::judged`]). The worst is the largest distance measured.
+    fn judge(&self, mesh: &AdaptiveMesh) -> Result<Judgement, AdaptiveError> {
+        let distances: Vec<f64> = (0..mesh.num_faces())
             .into_par_iter()
             .map(|f| {
-                // With limit corners a leaf is measured as the criterion saw it; otherwise
-                // its corners may have moved on to finer levels.
-                if mesh.holes[f] || (self.limit_corners && !mesh.transition[f]) {
-                    return Ok(false);
+                if !self.judged(mesh, f) {
+                    return Ok(0.0);
                 }
-                Ok(mesh.face_distance(&self.surface, f)? > self.tolerance)
+                mesh.face_distance(&self.surface, f)
             })
-            .collect()
+            .collect::<Result<_, AdaptiveError>>()?;
+        let worst = distances.iter().copied().fold(0.0, f64::max);
+        Ok(Judgement {
+            rejected: distances.iter().map(|&d| d > self.tolerance).collect(),
+            worst: Some(worst),
+        })
     }
 }
 

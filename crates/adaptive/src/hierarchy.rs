@@ -28,7 +28,7 @@ use subd_schemes::{Options, Scheme};
 
 use crate::criteria::{Criterion, EveryFace, LevelView};
 use crate::level::SparseLevel;
-use crate::{AdaptiveError, MAX_LEVELS};
+use crate::{AdaptiveError, AdaptiveMesh, MAX_LEVELS};
 use subd_mesh::cut::NONE;
 use subd_schemes::{ChildLayout, LevelCounts};
 
@@ -62,6 +62,11 @@ pub struct AdaptiveRefinement {
     pub(crate) levels: Vec<SparseLevel>,
     pub(crate) uniform: ChildLayout,
     level_builds: usize,
+    /// The last conforming mesh the criteria judged (the final one), kept for
+    /// [`Self::take_mesh`].
+    judged: Option<(Positions, AdaptiveMesh)>,
+    /// The largest error each criterion measured on it.
+    final_errors: Vec<Option<f64>>,
 }
 
 /// Which positions the conforming mesh gets.
@@ -174,20 +179,28 @@ impl AdaptiveRefinement {
                 levels,
                 uniform,
                 level_builds,
+                judged: None,
+                final_errors: vec![None; criteria.len()],
             };
             let mut restart = None;
-            for c in &criteria {
+            for (i, c) in criteria.iter().enumerate() {
                 let Some(positions) = c.output_positions() else {
                     continue;
                 };
-                let mesh = h.mesh(positions)?;
-                for (f, rejected) in c.reject(&mesh)?.into_iter().enumerate() {
+                let mesh = match h.judged.take() {
+                    Some((p, mesh)) if p == positions => mesh,
+                    _ => h.mesh(positions)?,
+                };
+                let judgement = c.judge(&mesh)?;
+                h.final_errors[i] = judgement.worst;
+                for (f, rejected) in judgement.rejected.into_iter().enumerate() {
                     let level = mesh.face_levels[f] as usize;
                     if rejected && level < max_level && requests[level].insert(mesh.face_uniform[f])
                     {
                         restart = Some(restart.map_or(level, |r: usize| r.min(level)));
                     }
                 }
+                h.judged = Some((positions, mesh));
             }
             let Some(r) = restart else {
                 return Ok(h);
@@ -226,6 +239,25 @@ impl AdaptiveRefinement {
     /// Element counts of uniform refinement at `level` (up to the level cap).
     pub fn uniform_counts(&self, level: usize) -> LevelCounts {
         self.uniform.counts(level)
+    }
+
+    /// The conforming mesh with vertices at `positions`: the one the criteria judged last
+    /// when it has those positions (taken, not built again), otherwise [`Self::mesh`].
+    ///
+    /// # Errors
+    /// As [`Self::mesh`].
+    pub fn take_mesh(&mut self, positions: Positions) -> Result<AdaptiveMesh, AdaptiveError> {
+        match self.judged.take() {
+            Some((p, mesh)) if p == positions => Ok(mesh),
+            _ => self.mesh(positions),
+        }
+    }
+
+    /// The largest error each criterion (in the order given) measured on the final
+    /// conforming mesh ([`Criterion::judge`]); `None` for one that measures none (one `None`
+    /// with no criterion given: every face is refined).
+    pub fn final_errors(&self) -> &[Option<f64>] {
+        &self.final_errors
     }
 
     /// How many times a level was built, rebuilds after the closure reached back included.

@@ -53,6 +53,7 @@ mod level;
 mod limit;
 
 use glam::DVec3;
+use rayon::prelude::*;
 use serde::Serialize;
 use subd_limit::LimitError;
 use subd_mesh::TopologyBuilder;
@@ -60,8 +61,8 @@ use subd_schemes::RefineError;
 use thiserror::Error;
 
 pub use criteria::{
-    Criterion, DihedralAngle, EveryFace, FaceSelection, Flatness, GaussianCurvature, LevelView,
-    LimitDistance, LimitSurface, RandomSelection,
+    Criterion, DihedralAngle, EveryFace, FaceSelection, Flatness, GaussianCurvature, Judgement,
+    LevelView, LimitDistance, LimitSurface, RandomSelection,
 };
 pub use fvar::AdaptiveFVar;
 pub use hierarchy::{AdaptiveRefinement, Positions};
@@ -233,14 +234,52 @@ impl AdaptiveMesh {
                 };
             }
         };
-        // Each uniform edge (or piece of one) must be used by as many face sides as it has
-        // faces in uniform refinement: one side short is a crack or a hanging vertex. Counted
-        // per origin, not per vertex pair, since uniform refinement itself can have two edges
-        // between the same two vertices (two faces on the same three vertices, refined).
-        let mut uses: std::collections::HashMap<(u8, u64), (u32, u32)> =
-            std::collections::HashMap::new();
-        let mut diagonals: std::collections::HashMap<(u32, u32), u32> =
-            std::collections::HashMap::new();
+        let mut report = Conformity {
+            mismatched_edges: self.mismatched_edges(),
+            ..Conformity::default()
+        };
+        // Sums and maxima: the same whatever the thread count.
+        let (boundary, nonmanifold, edge_spread) = (0..topo.num_edges())
+            .into_par_iter()
+            .map(|e| {
+                let levels = topo
+                    .edge_faces(e)
+                    .iter()
+                    .map(|&f| self.face_levels[f as usize]);
+                (
+                    usize::from(topo.is_boundary_edge(e)),
+                    usize::from(topo.is_non_manifold_edge(e)),
+                    spread(levels),
+                )
+            })
+            .reduce(|| (0, 0, 0), |a, b| (a.0 + b.0, a.1 + b.1, a.2.max(b.2)));
+        report.boundary_edges = boundary;
+        report.nonmanifold_edges = nonmanifold;
+        report.max_level_difference_edge = edge_spread;
+        report.max_level_difference_vertex = (0..topo.num_vertices())
+            .into_par_iter()
+            .map(|v| {
+                let levels = topo
+                    .vertex_faces(v)
+                    .iter()
+                    .map(|&f| self.face_levels[f as usize]);
+                spread(levels)
+            })
+            .max()
+            .unwrap_or(0);
+        report.conforming = report.mismatched_edges == 0;
+        report
+    }
+
+    /// Uniform edges (or pieces of one) used by another number of face sides than the faces
+    /// they have in uniform refinement — one side short is a crack or a hanging vertex — and
+    /// transition diagonals not used twice. Counted per origin, not per vertex pair, since
+    /// uniform refinement itself can have two edges between the same two vertices (two
+    /// faces on the same three vertices, refined). Sorted runs rather than hashing: the
+    /// count does not depend on the order.
+    fn mismatched_edges(&self) -> usize {
+        let mut uses: Vec<(u8, u64, u32)> = Vec::with_capacity(self.edge_origins.len());
+        let mut diagonals: Vec<(u32, u32)> = Vec::new();
         for f in 0..self.num_faces() {
             let fv = self.face(f);
             let first = self.face_offsets[f] as usize;
@@ -250,43 +289,31 @@ impl AdaptiveMesh {
                         level,
                         index,
                         faces,
-                    } => uses.entry((level, index)).or_insert((0, faces)).0 += 1,
+                    } => uses.push((level, index, faces)),
                     EdgeOrigin::Diagonal => {
                         let (a, b) = (fv[i], fv[(i + 1) % fv.len()]);
-                        *diagonals.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+                        diagonals.push((a.min(b), a.max(b)));
                     }
                 }
             }
         }
-        let mut report = Conformity {
-            mismatched_edges: uses.values().filter(|(n, want)| n != want).count()
-                + diagonals.values().filter(|&&n| n % 2 != 0).count(),
-            ..Conformity::default()
-        };
-        for e in 0..topo.num_edges() {
-            report.boundary_edges += usize::from(topo.is_boundary_edge(e));
-            report.nonmanifold_edges += usize::from(topo.is_non_manifold_edge(e));
-            let levels = topo
-                .edge_faces(e)
-                .iter()
-                .map(|&f| self.face_levels[f as usize]);
-            report.max_level_difference_edge = report.max_level_difference_edge.max(spread(levels));
-        }
-        for v in 0..topo.num_vertices() {
-            let levels = topo
-                .vertex_faces(v)
-                .iter()
-                .map(|&f| self.face_levels[f as usize]);
-            report.max_level_difference_vertex =
-                report.max_level_difference_vertex.max(spread(levels));
-        }
-        report.conforming = report.mismatched_edges == 0;
-        report
+        uses.par_sort_unstable();
+        diagonals.par_sort_unstable();
+        let uses_off = uses
+            .chunk_by(|a, b| (a.0, a.1) == (b.0, b.1))
+            .filter(|run| run.len() != run[0].2 as usize)
+            .count();
+        let diagonals_off = diagonals
+            .chunk_by(|a, b| a == b)
+            .filter(|run| run.len() % 2 != 0)
+            .count();
+        uses_off + diagonals_off
     }
 
     /// The smallest angle of any face that is not a hole, in degrees.
     pub fn min_angle_degrees(&self) -> f64 {
-        (0..self.num_faces())
+        let cos = (0..self.num_faces())
+            .into_par_iter()
             .filter(|&f| !self.holes[f])
             .map(|f| {
                 let p: Vec<DVec3> = self
@@ -294,10 +321,14 @@ impl AdaptiveMesh {
                     .iter()
                     .map(|&v| self.positions[v as usize])
                     .collect();
-                conform::min_angle(&p)
+                conform::max_corner_cos(&p)
             })
-            .fold(f64::INFINITY, f64::min)
-            .to_degrees()
+            .reduce(|| f64::NEG_INFINITY, f64::max);
+        if cos == f64::NEG_INFINITY {
+            return f64::INFINITY; // no face
+        }
+        // acos decreases: one acos for the whole mesh instead of one per corner.
+        cos.acos().to_degrees()
     }
 
     /// The largest sampled distance of any face that is not a hole to the limit surface,
@@ -306,10 +337,21 @@ impl AdaptiveMesh {
     /// # Errors
     /// As [`LimitSurface::position`].
     pub fn max_limit_distance(&self, surface: &LimitSurface) -> Result<f64, AdaptiveError> {
-        use rayon::prelude::*;
+        self.max_limit_distance_of(surface, |_| true)
+    }
+
+    /// [`Self::max_limit_distance`] over the faces `f` with `faces(f)` only (0 for none).
+    ///
+    /// # Errors
+    /// As [`LimitSurface::position`].
+    pub fn max_limit_distance_of(
+        &self,
+        surface: &LimitSurface,
+        faces: impl Fn(usize) -> bool + Sync,
+    ) -> Result<f64, AdaptiveError> {
         (0..self.num_faces())
             .into_par_iter()
-            .filter(|&f| !self.holes[f])
+            .filter(|&f| !self.holes[f] && faces(f))
             .map(|f| self.face_distance(surface, f))
             .try_reduce(|| 0.0, |a, b| Ok(a.max(b)))
     }

@@ -61,9 +61,15 @@ pub(crate) struct AdaptiveArgs {
     rules: RuleArgs,
     #[command(flatten)]
     files: Files,
-    /// Print a JSON report on stdout.
+    /// Print a JSON report on stdout. Its sampled distance to the limit comes with
+    /// --max-distance (measured for the criterion anyway) or --report-distance; otherwise
+    /// `max_distance_to_limit` and `max_distance_to_limit_relative` are null.
     #[arg(long)]
     json: bool,
+    /// With --json, measure the largest sampled distance to the limit surface without a
+    /// --max-distance criterion (a limit evaluation at 7–9 points per output face).
+    #[arg(long)]
+    report_distance: bool,
 }
 
 #[derive(Serialize)]
@@ -114,6 +120,9 @@ struct AdaptiveReport {
     /// evaluator does not cover the mesh.
     max_distance_to_limit: Option<f64>,
     max_distance_to_limit_relative: Option<f64>,
+    /// Whether every face is within --max-distance (`null` without it); `false` when the
+    /// level cap stopped the refinement short.
+    tolerance_met: Option<bool>,
     bbox_diagonal: f64,
     seconds: Timings,
     warnings: Vec<String>,
@@ -260,7 +269,7 @@ fn run_one(
 
     let spinner = Spinner::new(args.json || job.quiet, "refining");
     let t0 = Instant::now();
-    let hierarchy = AdaptiveRefinement::with_progress(
+    let mut hierarchy = AdaptiveRefinement::with_progress(
         base,
         &mesh.positions,
         &scheme,
@@ -278,7 +287,8 @@ fn run_one(
     } else {
         Positions::Refined
     };
-    let result = hierarchy.mesh(positions).map_err(input_err)?;
+    // The distance criterion judged this very mesh: taken, not built again.
+    let result = hierarchy.take_mesh(positions).map_err(input_err)?;
     let t_mesh = t1.elapsed().as_secs_f64();
 
     let t2 = Instant::now();
@@ -286,18 +296,18 @@ fn run_one(
     let own;
     let surface = match &selection.distance {
         Some(d) => Some(d.surface()),
-        None if args.json || mesh.uv().is_some() => {
+        None if (args.json && args.report_distance) || mesh.uv().is_some() => {
             own = LimitSurface::new(base, &mesh.positions, &scheme, &options);
             own.as_ref().ok()
         }
         None => None,
     };
-    let measured = if args.json {
-        spinner.message("measuring");
-        Some(measure(&result, surface))
-    } else {
-        None
-    };
+    spinner.message("measuring");
+    let check = check_distance(args, &selection, &hierarchy, &result, surface, levels);
+    if let Some(warning) = check.warning(args, levels, diagonal) {
+        print_warnings(err, &job.input, &[warning]);
+    }
+    let measured = args.json.then(|| measure(&result));
     let t_report = t2.elapsed().as_secs_f64();
 
     spinner.message("texture coordinates");
@@ -327,10 +337,85 @@ fn run_one(
             diagonal,
             warnings: &file.warnings,
         };
-        let report = context.report(&hierarchy, &result, measured, seconds);
+        let report = context.report(&hierarchy, &result, (measured, check), seconds);
         crate::print_json(out, &report);
     }
     Ok(())
+}
+
+/// The largest sampled distance of the output to the limit surface (for the report), and
+/// whether it meets --max-distance.
+struct DistanceCheck {
+    /// For the report (with --json).
+    distance: Option<f64>,
+    /// What the tolerance was checked with.
+    worst: Option<f64>,
+    met: Option<bool>,
+}
+
+impl DistanceCheck {
+    /// The warning that the level cap stopped --max-distance short, naming the level that
+    /// would meet it by the distance's ~4× fall per level (Loop and Catmull-Clark converge
+    /// quadratically in the edge length, which halves per level).
+    fn warning(&self, args: &AdaptiveArgs, levels: usize, diagonal: f64) -> Option<String> {
+        let (Some(false), Some(tolerance)) = (self.met, args.max_distance) else {
+            return None;
+        };
+        let worst = self.worst? / diagonal;
+        let more = (worst / tolerance).log(4.0).ceil().max(1.0) as usize;
+        Some(format!(
+            "--max-distance {tolerance:e} not met: --levels {levels} stopped the refinement \
+             at a sampled distance of {worst:.3e} × the diagonal; about level {} would meet \
+             it (the distance falls ~4× per level)",
+            levels + more
+        ))
+    }
+}
+
+/// Measures the output's distance to the limit where it is asked for: with --max-distance
+/// from what the criterion measured on this mesh (reused, not measured again), with
+/// --report-distance and --json here; `None` otherwise.
+fn check_distance(
+    args: &AdaptiveArgs,
+    selection: &Selection,
+    hierarchy: &AdaptiveRefinement,
+    result: &AdaptiveMesh,
+    surface: Option<&LimitSurface>,
+    levels: usize,
+) -> DistanceCheck {
+    let Some(criterion) = &selection.distance else {
+        let wanted = args.json && args.report_distance;
+        let distance = surface
+            .filter(|_| wanted)
+            .and_then(|s| result.max_limit_distance(s).ok());
+        return DistanceCheck {
+            distance,
+            worst: None,
+            met: None,
+        };
+    };
+    // The distance criterion is the last one (Selection::criteria).
+    let judged = hierarchy.final_errors().last().copied().flatten();
+    // With --limit the criterion left the leaves to its level-by-level selection, which
+    // cleared those below the cap: the cap's leaves decide the tolerance, all of them the
+    // report's distance.
+    let leaves = |all: bool| {
+        result
+            .max_limit_distance_of(criterion.surface(), |f| {
+                !criterion.judged(result, f) && (all || result.face_levels[f] as usize == levels)
+            })
+            .ok()
+    };
+    let worst = if args.limit {
+        judged.zip(leaves(args.json)).map(|(a, b)| a.max(b))
+    } else {
+        judged
+    };
+    DistanceCheck {
+        distance: worst.filter(|_| args.json),
+        worst,
+        met: worst.map(|w| w <= criterion.tolerance()),
+    }
 }
 
 /// What the JSON report says besides the hierarchy and the mesh.
@@ -349,7 +434,7 @@ impl ReportContext<'_> {
         &self,
         hierarchy: &AdaptiveRefinement,
         result: &AdaptiveMesh,
-        (conformity, min_angle, distance): (Conformity, f64, Option<f64>),
+        ((conformity, min_angle), check): ((Conformity, f64), DistanceCheck),
         seconds: Timings,
     ) -> AdaptiveReport {
         let (args, job, base, options) = (self.args, self.job, self.base, self.options);
@@ -387,8 +472,9 @@ impl ReportContext<'_> {
             level_builds: hierarchy.level_builds(),
             conformity,
             min_angle_degrees: min_angle,
-            max_distance_to_limit: distance,
-            max_distance_to_limit_relative: distance.map(|d| d / self.diagonal),
+            max_distance_to_limit: check.distance,
+            max_distance_to_limit_relative: check.distance.map(|d| d / self.diagonal),
+            tolerance_met: check.met,
             bbox_diagonal: self.diagonal,
             seconds,
             warnings: self.warnings.to_vec(),
@@ -396,13 +482,9 @@ impl ReportContext<'_> {
     }
 }
 
-/// Conformity, smallest angle and largest sampled distance to the limit (`None` where the
-/// exact evaluator does not cover the mesh).
-fn measure(mesh: &AdaptiveMesh, surface: Option<&LimitSurface>) -> (Conformity, f64, Option<f64>) {
-    let conformity = mesh.conformity();
-    let min_angle = mesh.min_angle_degrees();
-    let distance = surface.and_then(|s| mesh.max_limit_distance(s).ok());
-    (conformity, min_angle, distance)
+/// The report's cheap measures: conformity and smallest angle.
+fn measure(mesh: &AdaptiveMesh) -> (Conformity, f64) {
+    (mesh.conformity(), mesh.min_angle_degrees())
 }
 
 /// The input's texture coordinates on the adaptive mesh: their exact limit at every corner's

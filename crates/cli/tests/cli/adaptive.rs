@@ -207,3 +207,58 @@ fn adaptive_bad_input_exits_2_without_output() {
     assert_eq!(code, 2);
     assert!(err.contains("would overwrite the input"), "{err}");
 }
+
+#[test]
+fn adaptive_says_when_the_level_cap_stops_the_distance_short() {
+    let s = Scratch::new("adaptive-tolerance");
+    let input =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/meshes/torus_creased.obj");
+    let out = s.0.join("torus.obj");
+    let run = |extra: &[&str]| {
+        let mut args = vec!["adaptive", "--scheme", "catmull-clark"];
+        args.extend_from_slice(extra);
+        args.extend_from_slice(&[input.to_str().unwrap(), out.to_str().unwrap(), "--json"]);
+        let (code, stdout, err) = subd(&args);
+        assert_eq!(code, 0, "{extra:?}: {err}");
+        let j: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+        (j, err)
+    };
+    for limit in [&[][..], &["--limit"][..]] {
+        // One level cannot reach 1e-4: a warning names a deeper level, the JSON says so.
+        let (j, err) = run(&[&["--max-distance", "1e-4", "--levels", "1"][..], limit].concat());
+        assert_eq!(j["tolerance_met"], false, "{limit:?}");
+        let d = j["max_distance_to_limit_relative"].as_f64().unwrap();
+        assert!(d > 1e-4, "{limit:?}: {d}");
+        let warning: Vec<&str> = err.lines().filter(|l| l.contains("not met")).collect();
+        assert_eq!(warning.len(), 1, "{limit:?}: {err}");
+        assert!(warning[0].starts_with("subd: warning: "), "{err}");
+        assert!(warning[0].contains("--levels 1"), "{err}");
+        let level: usize = warning[0]
+            .split("about level ")
+            .nth(1)
+            .and_then(|r| r.split_whitespace().next())
+            .and_then(|n| n.parse().ok())
+            .unwrap_or_else(|| panic!("no level in {err}"));
+        // By the ~4× fall per level the estimate claims.
+        let want = 1 + (d / 1e-4).log(4.0).ceil() as usize;
+        assert_eq!(level, want, "{err}");
+        assert!(level > 1, "{err}");
+
+        // Enough levels: met, no warning.
+        let (j, err) = run(&[&["--max-distance", "2e-3", "--levels", "4"][..], limit].concat());
+        assert_eq!(j["tolerance_met"], true, "{limit:?}");
+        assert!(j["max_distance_to_limit_relative"].as_f64().unwrap() <= 2e-3);
+        assert!(!err.contains("not met"), "{err}");
+    }
+    // No distance criterion: the distance is measured only on request.
+    let (j, _) = run(&["--flatness", "20", "--levels", "2"]);
+    assert!(j["max_distance_to_limit"].is_null() && j["tolerance_met"].is_null());
+    assert!(
+        j.as_object()
+            .unwrap()
+            .contains_key("max_distance_to_limit_relative")
+    );
+    let (j, _) = run(&["--flatness", "20", "--levels", "2", "--report-distance"]);
+    assert!(j["max_distance_to_limit_relative"].as_f64().unwrap() > 0.0);
+    assert!(j["tolerance_met"].is_null());
+}
