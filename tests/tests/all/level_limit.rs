@@ -9,11 +9,7 @@ use subd_schemes::Refinement;
 use subd_tests::surface_shapes;
 
 fn diagonal(p: &[DVec3]) -> f64 {
-    let (lo, hi) = p.iter().fold(
-        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-        |(a, b), &q| (a.min(q), b.max(q)),
-    );
-    (hi - lo).length().max(1e-300)
+    subd_pia::bbox_diagonal(p).max(1e-300)
 }
 
 /// Positions agree to 2e-15 of the bounding box (a few units in the last place) and unit normals to 1e-13 (the sums run in

@@ -9,11 +9,7 @@ use subd_limit::tessellation::{tessellate, tessellate_mesh};
 use subd_tests::surface_shapes;
 
 fn diagonal(p: &[DVec3]) -> f64 {
-    let (lo, hi) = p.iter().fold(
-        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-        |(a, b), &q| (a.min(q), b.max(q)),
-    );
-    (hi - lo).length().max(1e-300)
+    subd_pia::bbox_diagonal(p).max(1e-300)
 }
 
 /// The same samples (parameters), faces and grids. Positions within 2.5e-14 of the bounding
