@@ -123,33 +123,69 @@ pub(crate) fn child_level_limit(
     points: &[DVec3],
     tangents: Tangents,
 ) -> Result<LimitPoints, LimitError> {
-    let scheme = refinement.scheme().at_level(level);
-    let t = refinement.topology(level - 1);
-    let parents = LevelMasks::new(refinement, level - 1)?;
-    let loop_scheme = scheme == Scheme::Loop;
-    let (nv, nf) = (t.num_vertices() as u32, t.num_faces() as u32);
-    let at = Numbering {
-        first_face: nv,
-        first_edge: if loop_scheme { nv } else { nv + nf },
-    };
-    let children = ChildMasks::new(&scheme, t);
-    let n = at.first_edge as usize + t.num_edges();
-    assert_eq!(points.len(), n, "one point per vertex of the level");
-    Ok(limit_by_vertex(n, tangents, |ring, v| {
-        let v32 = v as u32;
+    let children = ChildLimit::new(refinement, level)?;
+    assert_eq!(
+        points.len(),
+        children.num_vertices(),
+        "one point per vertex of the level"
+    );
+    Ok(limit_by_vertex(points.len(), tangents, |ring, v| {
+        children.limit(ring, v, points)
+    }))
+}
+
+/// The limit masks of the vertices of a level, one vertex at a time, read off the level
+/// above ([`applies`] must hold): for callers that visit the vertices in an order of their
+/// own, as tessellation does.
+pub(crate) struct ChildLimit<'a> {
+    above: &'a Topology,
+    parents: LevelMasks<'a>,
+    children: ChildMasks,
+    at: Numbering,
+    loop_scheme: bool,
+}
+
+impl<'a> ChildLimit<'a> {
+    pub(crate) fn new(refinement: &'a Refinement, level: usize) -> Result<Self, LimitError> {
+        let scheme = refinement.scheme().at_level(level);
+        let above = refinement.topology(level - 1);
+        let loop_scheme = scheme == Scheme::Loop;
+        let (nv, nf) = (above.num_vertices() as u32, above.num_faces() as u32);
+        Ok(ChildLimit {
+            above,
+            parents: LevelMasks::new(refinement, level - 1)?,
+            children: ChildMasks::new(&scheme, above),
+            at: Numbering {
+                first_face: nv,
+                first_edge: if loop_scheme { nv } else { nv + nf },
+            },
+            loop_scheme,
+        })
+    }
+
+    /// Vertices of the level.
+    pub(crate) fn num_vertices(&self) -> usize {
+        self.at.first_edge as usize + self.above.num_edges()
+    }
+
+    /// Vertex `v`'s (position, tangents, normal) from the level's `points`, with a scratch
+    /// [`Ring`].
+    pub(crate) fn limit(&self, ring: &mut Ring, v: usize, points: &[DVec3]) -> [DVec3; 4] {
+        let (t, at) = (self.above, &self.at);
+        let (v32, nv) = (v as u32, t.num_vertices() as u32);
         if v32 < nv {
-            vertex_child(t, &at, loop_scheme, v, ring);
-            ring.limit(parents.of(v), points)
+            vertex_child(t, at, self.loop_scheme, v, ring);
+            ring.limit(self.parents.of(v), points)
         } else if v32 < at.first_edge {
             let f = (v32 - nv) as usize;
-            face_child(t, &at, f, ring);
-            ring.limit(&children.face[t.face_size(f)], points)
+            face_child(t, at, f, ring);
+            ring.limit(&self.children.face[t.face_size(f)], points)
         } else {
             let e = (v32 - at.first_edge) as usize;
-            let mask = edge_child(t, &at, &children, loop_scheme, e, ring);
+            let mask = edge_child(t, at, &self.children, self.loop_scheme, e, ring);
             ring.limit(mask, points)
         }
-    }))
+    }
 }
 
 /// The ring of vertex `v`'s child: its parent's ring with every edge and face replaced by

@@ -15,7 +15,9 @@ use rayon::prelude::*;
 use subd_mesh::Topology;
 use subd_schemes::{Options, Refinement, Rule, Scheme};
 
+use crate::child_limit::{self, ChildLimit};
 use crate::eval::{FaceParam, LimitEvaluator};
+use crate::table::limit_by_vertex;
 use crate::tessellation::{Numbered, Tessellation, check_rate, number_samples};
 use crate::{LimitError, Tangents, level_limit_points};
 
@@ -58,17 +60,9 @@ pub(crate) fn tessellate_refined(
         vertex_sample,
     } = number_samples(r.topology(0), loop_scheme, 1 << levels);
     let points = r.points_at(positions, levels);
-    let limit = level_limit_points(&r, levels, options, &points, Tangents::Dropped)?;
-    drop(points);
     let finder = VertexFinder::new(&r, levels);
-    (out.positions, out.normals) = params
-        .par_iter()
-        .map(|at| {
-            let v = finder.vertex(at) as usize;
-            (limit.positions[v], limit.normals[v])
-        })
-        .unzip();
-    drop(limit);
+    (out.positions, out.normals) = sample_limits(&r, levels, options, &points, &params, &finder)?;
+    drop(points);
     let evaluated: Vec<usize> = (0..r.topology(0).num_vertices())
         .filter(|&v| vertex_sample[v] != u32::MAX && !masks_match_patches(&r, v))
         .map(|v| vertex_sample[v] as usize)
@@ -83,6 +77,35 @@ pub(crate) fn tessellate_refined(
     }
     out.params = params;
     Ok(out)
+}
+
+/// The limit position and normal of every sample: its vertex's at level `levels`. Where the
+/// level's masks can be read off the level above, each sample's vertex is evaluated in
+/// sample order straight into the outputs; otherwise the level's limits are computed and
+/// gathered.
+fn sample_limits(
+    r: &Refinement,
+    levels: usize,
+    options: &Options,
+    points: &[DVec3],
+    params: &[FaceParam],
+    finder: &VertexFinder,
+) -> Result<(Vec<DVec3>, Vec<DVec3>), LimitError> {
+    if child_limit::applies(r, levels) {
+        let children = ChildLimit::new(r, levels)?;
+        let limit = limit_by_vertex(params.len(), Tangents::Dropped, |ring, s| {
+            children.limit(ring, finder.vertex(&params[s]) as usize, points)
+        });
+        return Ok((limit.positions, limit.normals));
+    }
+    let limit = level_limit_points(r, levels, options, points, Tangents::Dropped)?;
+    Ok(params
+        .par_iter()
+        .map(|at| {
+            let v = finder.vertex(at) as usize;
+            (limit.positions[v], limit.normals[v])
+        })
+        .unzip())
 }
 
 /// Whether the limit masks of base vertex `v`, carried to any level, give the normal the

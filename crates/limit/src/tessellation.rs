@@ -220,22 +220,26 @@ pub(crate) struct Numbered {
 
 /// Numbers the samples of every face that is not a hole (see the module docs).
 pub(crate) fn number_samples(topo: &Topology, loop_scheme: bool, rate: u32) -> Numbered {
+    let sizes = GridSizes::of(topo, loop_scheme, rate);
+    let mut face_offsets = Vec::with_capacity(sizes.faces + 1);
+    face_offsets.push(0);
     let mut t = Builder {
         topo,
         loop_scheme,
         rate,
         vertex_index: vec![UNSET; topo.num_vertices()],
         edge_first: vec![UNSET; topo.num_edges()],
-        params: Vec::new(),
+        params: Vec::with_capacity(sizes.grid_vertices),
         out: Tessellation {
             positions: Vec::new(),
             normals: Vec::new(),
             params: Vec::new(),
-            face_offsets: vec![0],
-            face_vertices: Vec::new(),
-            grids: Vec::new(),
-            grid_vertices: Vec::new(),
+            face_offsets,
+            face_vertices: Vec::with_capacity(sizes.face_vertices),
+            grids: Vec::with_capacity(sizes.grids),
+            grid_vertices: Vec::with_capacity(sizes.grid_vertices),
         },
+        grid: Vec::new(),
     };
     for f in 0..topo.num_faces() {
         if topo.is_hole(f) {
@@ -260,6 +264,46 @@ pub(crate) fn number_samples(topo: &Topology, loop_scheme: bool, rate: u32) -> N
 /// Not numbered yet.
 const UNSET: u32 = u32::MAX;
 
+/// The sizes of a tessellation's arrays, counted before they are filled so that each is
+/// allocated once (a grow-by-doubling copy of the samples' parameters cost as much as
+/// numbering them). The samples are fewer than the grids' entries, which count shared ones
+/// once per grid: an upper bound whose unused tail is never touched.
+struct GridSizes {
+    grids: usize,
+    grid_vertices: usize,
+    faces: usize,
+    face_vertices: usize,
+}
+
+impl GridSizes {
+    fn of(topo: &Topology, loop_scheme: bool, rate: u32) -> GridSizes {
+        let n = rate as usize;
+        let mut s = GridSizes {
+            grids: 0,
+            grid_vertices: 0,
+            faces: 0,
+            face_vertices: 0,
+        };
+        for f in (0..topo.num_faces()).filter(|&f| !topo.is_hole(f)) {
+            let size = topo.face_size(f);
+            if loop_scheme {
+                s.grids += 1;
+                s.grid_vertices += (n + 1) * (n + 2) / 2;
+                s.faces += n * n;
+                s.face_vertices += 3 * n * n;
+            } else {
+                // A quad is one grid of n segments; another polygon `size` grids of n / 2.
+                let (grids, m) = if size == 4 { (1, n) } else { (size, n / 2) };
+                s.grids += grids;
+                s.grid_vertices += grids * (m + 1) * (m + 1);
+                s.faces += grids * m * m;
+                s.face_vertices += 4 * grids * m * m;
+            }
+        }
+        s
+    }
+}
+
 struct Builder<'a> {
     topo: &'a Topology,
     loop_scheme: bool,
@@ -271,6 +315,8 @@ struct Builder<'a> {
     /// The parameter each sample is evaluated at, by sample index.
     params: Vec<FaceParam>,
     out: Tessellation,
+    /// The grid being numbered (scratch, reused face to face).
+    grid: Vec<u32>,
 }
 
 impl Builder<'_> {
@@ -301,6 +347,14 @@ impl Builder<'_> {
         for sub in 0..n {
             self.sub_face(f, sub, centre, spokes);
         }
+    }
+
+    /// The scratch grid, `len` entries long, taken out of `self` while it is filled.
+    fn scratch_grid(&mut self, len: usize) -> Vec<u32> {
+        let mut grid = std::mem::take(&mut self.grid);
+        grid.clear();
+        grid.resize(len, 0);
+        grid
     }
 
     fn new_sample(&mut self, at: FaceParam) -> u32 {
@@ -398,7 +452,7 @@ impl Builder<'_> {
     /// A quad: corners 0, 1, 2, 3 at (0,0), (1,0), (1,1), (0,1).
     fn quad(&mut self, face: usize) {
         let n = self.rate;
-        let mut grid = vec![0u32; ((n + 1) * (n + 1)) as usize];
+        let mut grid = self.scratch_grid(((n + 1) * (n + 1)) as usize);
         for j in 0..=n {
             for i in 0..=n {
                 grid[(j * (n + 1) + i) as usize] = match (i, j) {
@@ -417,6 +471,7 @@ impl Builder<'_> {
         }
         self.record(face, 0, n, &grid);
         self.grid_quads(&grid, n);
+        self.grid = grid;
     }
 
     fn record(&mut self, face: usize, sub: usize, segments: u32, grid: &[u32]) {
@@ -438,7 +493,7 @@ impl Builder<'_> {
         let sides = self.topo.face_size(face);
         let prev = (sub + sides - 1) % sides;
         let spoke = |side: usize, k: u32| spokes + side as u32 * (m - 1) + k - 1;
-        let mut grid = vec![0u32; ((m + 1) * (m + 1)) as usize];
+        let mut grid = self.scratch_grid(((m + 1) * (m + 1)) as usize);
         for j in 0..=m {
             for i in 0..=m {
                 grid[(j * (m + 1) + i) as usize] = match (i, j) {
@@ -458,6 +513,7 @@ impl Builder<'_> {
         }
         self.record(face, sub, m, &grid);
         self.grid_quads(&grid, m);
+        self.grid = grid;
     }
 
     fn grid_quads(&mut self, grid: &[u32], n: u32) {
@@ -473,7 +529,7 @@ impl Builder<'_> {
     fn triangle(&mut self, face: usize) {
         let n = self.rate;
         let row = |j: u32| (j * (2 * n + 3 - j) / 2) as usize;
-        let mut grid = vec![0u32; row(n + 1)];
+        let mut grid = self.scratch_grid(row(n + 1));
         for j in 0..=n {
             for i in 0..=(n - j) {
                 grid[row(j) + i as usize] = match (i, j) {
@@ -499,6 +555,7 @@ impl Builder<'_> {
                 }
             }
         }
+        self.grid = grid;
     }
 }
 
