@@ -55,6 +55,7 @@ pub mod masks;
 pub mod patch;
 mod piece;
 pub mod point_stencil;
+mod sample_numbering;
 mod smooth_closed;
 pub mod split_eigen;
 pub mod split_limit;

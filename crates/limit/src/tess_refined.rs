@@ -17,8 +17,9 @@ use subd_schemes::{Options, Refinement, Rule, Scheme};
 
 use crate::child_limit::{self, ChildLimit};
 use crate::eval::{FaceParam, LimitEvaluator};
+use crate::sample_numbering::number_samples;
 use crate::table::limit_by_vertex;
-use crate::tessellation::{Numbered, Tessellation, check_rate, number_samples};
+use crate::tessellation::{Numbered, Tessellation, check_rate};
 use crate::{LimitError, Tangents, level_limit_points};
 
 /// The refinement depth k of a rate 2^k that this path tessellates: Catmull-Clark or Loop
