@@ -243,17 +243,35 @@ impl LimitEvaluator {
         points: &PatchPoints,
         at: FaceParam,
     ) -> Result<(DVec3, DVec3), LimitError> {
+        self.evaluate_position_normal_in(points, at, &mut GatheredPatch::default())
+    }
+
+    /// [`Self::evaluate_position_normal`] with the control points of a regular face kept in
+    /// `patch` for the next sample of the same face: a tessellation evaluates its samples
+    /// face by face, and gathering them was a third of a regular sample's work. The same
+    /// points in the same sums, so the same bits.
+    pub(crate) fn evaluate_position_normal_in(
+        &self,
+        points: &PatchPoints,
+        at: FaceParam,
+        patch: &mut GatheredPatch,
+    ) -> Result<(DVec3, DVec3), LimitError> {
         match &self.base_pieces[at.face] {
             Piece::Regular(grid) => {
                 self.check(&at)?;
-                let g: [DVec3; 16] = std::array::from_fn(|i| points.base[grid[i] as usize]);
-                let (p, du, dv) = crate::patch::eval_bicubic_first(&g, at.u, at.v);
+                let g = patch.of(at.face, || grid.map(|i| points.base[i as usize]));
+                let (p, du, dv) = crate::patch::eval_bicubic_first(g, at.u, at.v);
                 return Ok((p, du.cross(dv).normalize_or_zero()));
             }
             Piece::LoopRegular(cp) if cp.len() == 12 => {
                 self.check(&at)?;
-                let c: [DVec3; 12] = std::array::from_fn(|i| points.base[cp[i] as usize]);
-                let (p, du, dv) = box_spline()?.evaluate_first(&c, at.u, at.v);
+                let g = patch.of(at.face, || {
+                    std::array::from_fn(|i| {
+                        cp.get(i).map_or(DVec3::ZERO, |&c| points.base[c as usize])
+                    })
+                });
+                let c: &[DVec3; 12] = g[..12].try_into().expect("12 of 16");
+                let (p, du, dv) = box_spline()?.evaluate_first(c, at.u, at.v);
                 return Ok((p, du.cross(dv).normalize_or_zero()));
             }
             _ => {}
@@ -267,6 +285,33 @@ impl LimitEvaluator {
         let r = self.refined.as_ref().expect("refined when a face needs it");
         let (p, scale) = descend(r, 2, *at);
         (p.face, p.u, p.v, scale)
+    }
+}
+
+/// The control points of the regular face evaluated last (16 for a bicubic patch, the first
+/// 12 for a box spline).
+pub(crate) struct GatheredPatch {
+    face: usize,
+    points: [DVec3; 16],
+}
+
+impl Default for GatheredPatch {
+    fn default() -> Self {
+        GatheredPatch {
+            face: usize::MAX,
+            points: [DVec3::ZERO; 16],
+        }
+    }
+}
+
+impl GatheredPatch {
+    /// The points of `face`, gathered by `gather` unless they are the ones kept.
+    fn of(&mut self, face: usize, gather: impl FnOnce() -> [DVec3; 16]) -> &[DVec3; 16] {
+        if self.face != face {
+            self.points = gather();
+            self.face = face;
+        }
+        &self.points
     }
 }
 

@@ -26,7 +26,7 @@ use subd_mesh::Topology;
 use subd_schemes::{Options, Scheme};
 
 use crate::LimitError;
-use crate::eval::{FaceParam, LimitEvaluator, PatchPoints};
+use crate::eval::{FaceParam, GatheredPatch, LimitEvaluator, PatchPoints};
 use crate::sample_numbering::number_samples;
 
 /// The largest rate accepted.
@@ -113,23 +113,46 @@ pub fn tessellate(
     let Numbered {
         params, mut out, ..
     } = number_samples(topo, loop_scheme, rate as u32);
-    let evaluated: Result<Vec<(DVec3, DVec3)>, LimitError> = params
-        .par_iter()
-        .map(|&at| evaluator.evaluate_position_normal(points, at))
-        .collect();
-    let evaluated = match evaluated {
-        Ok(values) => values,
-        Err(any) => {
-            // The first failing sample's error, not whichever a thread met first.
-            let first = params
-                .iter()
-                .find_map(|&at| evaluator.evaluate_position_normal(points, at).err());
-            return Err(first.unwrap_or(any));
-        }
-    };
-    (out.positions, out.normals) = evaluated.into_iter().unzip();
+    (out.positions, out.normals) = evaluate_samples(evaluator, points, &params)?;
     out.params = params;
     Ok(out)
+}
+
+/// Samples per parallel job of [`evaluate_samples`]: many faces' worth, so that a face's
+/// run of samples is rarely split.
+const SAMPLE_CHUNK: usize = 4096;
+
+/// The position and normal at every sample, in parallel chunks, each keeping the control
+/// points of the face it evaluated last (a face's own samples are numbered together).
+fn evaluate_samples(
+    evaluator: &LimitEvaluator,
+    points: &PatchPoints,
+    params: &[FaceParam],
+) -> Result<(Vec<DVec3>, Vec<DVec3>), LimitError> {
+    let mut positions = subd_mesh::memory::zeroed::<DVec3>(params.len());
+    let mut normals = subd_mesh::memory::zeroed::<DVec3>(params.len());
+    let failed = positions
+        .par_chunks_mut(SAMPLE_CHUNK)
+        .zip(normals.par_chunks_mut(SAMPLE_CHUNK))
+        .zip(params.par_chunks(SAMPLE_CHUNK))
+        .any(|((p, n), at)| {
+            let mut patch = GatheredPatch::default();
+            for k in 0..at.len() {
+                match evaluator.evaluate_position_normal_in(points, at[k], &mut patch) {
+                    Ok(value) => (p[k], n[k]) = value,
+                    Err(_) => return true,
+                }
+            }
+            false
+        });
+    if failed {
+        // The first failing sample's error, not whichever a thread met first.
+        let first = params
+            .iter()
+            .find_map(|&at| evaluator.evaluate_position_normal(points, at).err());
+        return Err(first.expect("a sample failed"));
+    }
+    Ok((positions, normals))
 }
 
 /// Tessellates the limit surface of `positions` on `topology` at `rate`, as [`tessellate`]
