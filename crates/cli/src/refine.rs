@@ -15,7 +15,7 @@ use crate::Failure;
 use crate::batch::{self, Files, Job};
 use crate::budget::Budget;
 use crate::failure::bad;
-use crate::refined::{RefinementWithLimit, normals_or_faces, output_limit};
+use crate::refined::{RefinementWithLimit, all_unit, normals_or_faces, output_limit};
 use crate::rule_args::RuleArgs;
 use crate::scheme_arg;
 use crate::vertex_data::LambdaArgs;
@@ -319,6 +319,15 @@ impl Output<'_> {
         self.progress.step("positions");
         let positions_seconds = t1.elapsed().as_secs_f64();
         let t2 = Instant::now();
+        if let Some(n) = normals.as_deref().filter(|n| all_unit(n)) {
+            if let Some(counts) = self.with_streamed_faces(&positions, n)? {
+                return Ok(Written {
+                    counts,
+                    positions_seconds,
+                    write_seconds: t2.elapsed().as_secs_f64(),
+                });
+            }
+        }
         let (offsets, vertices) = r.faces(levels);
         let tags = r.explicit_tags(levels);
         let holes = r.holes(levels);
@@ -338,6 +347,35 @@ impl Output<'_> {
             positions_seconds,
             write_seconds: t2.elapsed().as_secs_f64(),
         })
+    }
+}
+
+impl Output<'_> {
+    /// Held positions and normals with the faces streamed as [`Self::streamed`] streams
+    /// them (OpenSubdiv's schemes, `--limit`): the faces of a deep level, its largest array,
+    /// are never held. `None` where the faces cannot be streamed (level 0, a split scheme).
+    fn with_streamed_faces(
+        &self,
+        positions: &[subd_mesh::DVec3],
+        normals: &[subd_mesh::DVec3],
+    ) -> Result<Option<Counts>, Failure> {
+        let (r, levels) = (self.refinement, self.args.levels);
+        let last = levels > 0 && levels == r.num_levels();
+        let Some(stream) = r.face_stream().filter(|_| last) else {
+            return Ok(None);
+        };
+        let faces = crate::level_stream::Faces(stream);
+        let tags = r.explicit_tags(levels);
+        let view = subd_io::MeshView::streamed(
+            subd_io::Points::Held(positions),
+            &faces,
+            faces.0.hole_faces(),
+        )
+        .and_then(|v| v.with_tags(tags.creases, tags.corners))
+        .and_then(|v| crate::uv::with_uv(v, self.uv))
+        .and_then(|v| v.with_normals(normals))
+        .map_err(|e| self.in_view(e))?;
+        write_level(self.job, view, self.hints, r.edges(levels)).map(Some)
     }
 }
 

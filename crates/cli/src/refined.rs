@@ -86,6 +86,13 @@ pub(crate) fn output_limit(
     Ok(refinement.last_limit()?.apply(positions))
 }
 
+/// Whether every normal is a unit vector (the limit defines every tangent plane).
+pub(crate) fn all_unit(normals: &[subd_mesh::DVec3]) -> bool {
+    normals
+        .iter()
+        .all(|n| n.is_finite() && n.length_squared() > 0.5)
+}
+
 /// `normals` where they are unit vectors; elsewhere (a split scheme's creases and corners,
 /// parallel tangents) the area-weighted normal of the output faces, as `.glb` shading uses.
 /// `None` when every normal is a unit vector already (the face normals are not computed).
@@ -93,10 +100,10 @@ pub(crate) fn normals_or_faces(
     normals: &[subd_mesh::DVec3],
     view: &subd_io::MeshView<'_>,
 ) -> Option<Vec<subd_mesh::DVec3>> {
-    let is_unit = |n: &subd_mesh::DVec3| n.is_finite() && n.length_squared() > 0.5;
-    if normals.iter().all(is_unit) {
+    if all_unit(normals) {
         return None;
     }
+    let is_unit = |n: &subd_mesh::DVec3| n.is_finite() && n.length_squared() > 0.5;
     let from_faces = subd_io::glb::vertex_normals(view);
     Some(
         normals
