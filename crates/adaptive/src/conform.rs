@@ -265,8 +265,17 @@ impl AdaptiveRefinement {
             corners: &corner_ids,
             edge_points: &edge_ids,
         };
+        // Sized for the leaves as they are (transition patterns add a little): growing by
+        // doubling copied these arrays over and over.
         out.face_offsets.reserve(leaves.len());
         out.face_vertices.reserve(corner_ids.len());
+        out.edge_origins.reserve(corner_ids.len());
+        out.corner_params.reserve(corner_ids.len());
+        out.face_levels.reserve(leaves.len());
+        out.face_uniform.reserve(leaves.len());
+        out.holes.reserve(leaves.len());
+        out.transition.reserve(leaves.len());
+        out.face_domains.reserve(leaves.len());
         for leaf in &leaves {
             self.emit(leaf, &ids, &mut out);
         }

@@ -146,16 +146,23 @@ impl AdaptiveRefinement {
             })?;
         let mut levels = vec![SparseLevel::base(base, points, scheme, options)?];
         let mut requests: Vec<HashSet<u64>> = vec![HashSet::new(); max_level];
+        // The criteria's selection of each level built, kept while the level is: when the
+        // closure returns to a level, only its requests changed.
+        let mut picked: Vec<Vec<bool>> = Vec::new();
         let mut level_builds = 1;
         let mut l = 0;
         loop {
             while l < max_level {
-                let sel = decide(&levels[l], l, &criteria, &requests[l], scheme)?;
+                if picked.len() <= l {
+                    picked.push(select(&levels[l], l, &criteria)?);
+                }
+                let sel = decide(&levels[l], &picked[l], &requests[l], scheme);
                 if l > 0 {
                     let before = requests[l - 1].len();
                     request_support(&levels[l - 1], &levels[l], &sel, &mut requests[l - 1]);
                     if requests[l - 1].len() > before {
                         levels.truncate(l);
+                        picked.truncate(l);
                         l -= 1;
                         continue;
                     }
@@ -206,6 +213,7 @@ impl AdaptiveRefinement {
                 return Ok(h);
             };
             h.levels.truncate(r + 1);
+            picked.truncate(r + 1);
             (levels, uniform, level_builds) = (h.levels, h.uniform, h.level_builds);
             l = r;
         }
@@ -296,14 +304,11 @@ impl AdaptiveRefinement {
     }
 }
 
-/// The faces of level `l` to refine: the criteria's union, the faces requested by finer
-/// levels, and the red-green closure; none at the level cap.
-fn decide(
+/// The faces of level `l` the criteria select (their union).
+fn select(
     level: &SparseLevel,
     l: usize,
     criteria: &[&dyn Criterion],
-    requests: &HashSet<u64>,
-    scheme: &Scheme,
 ) -> Result<Vec<bool>, AdaptiveError> {
     let mut sel = vec![false; level.num_faces()];
     let view = LevelView {
@@ -313,6 +318,18 @@ fn decide(
     for c in criteria {
         c.select(&view, &mut sel)?;
     }
+    Ok(sel)
+}
+
+/// The faces of a level to refine: the criteria's selection `picked`, the faces requested by
+/// finer levels, and the red-green closure.
+fn decide(
+    level: &SparseLevel,
+    picked: &[bool],
+    requests: &HashSet<u64>,
+    scheme: &Scheme,
+) -> Vec<bool> {
+    let mut sel = picked.to_vec();
     if !requests.is_empty() {
         for (s, k) in sel.iter_mut().zip(&level.face_key) {
             if requests.contains(k) {
@@ -321,7 +338,7 @@ fn decide(
         }
     }
     red_green(&level.topology, &mut sel, scheme);
-    Ok(sel)
+    sel
 }
 
 /// Whether a face left unrefined with `split` edges split by finer neighbours has no

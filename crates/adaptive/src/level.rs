@@ -182,8 +182,6 @@ impl SparseLevel {
         options: &Options,
         uniform: &ChildLayout,
     ) -> Result<SparseLevel, AdaptiveError> {
-        self.vertex_child.fill(NONE);
-        self.edge_child.fill(NONE);
         let piece_faces = self.refined_piece();
         let (cut, rules, points) = self.piece(&piece_faces);
         let (piece, piece_topology) = Piece::new(cut, piece_faces, *scheme == Scheme::Loop);
@@ -194,20 +192,34 @@ impl SparseLevel {
         let next = submesh::cut(r.topology(1), &kept.faces);
         // The children's uniform indices are those of this level's elements' children.
         let parent_level = level - 1;
-        let vertices = self.child_vertices(&piece, &next, uniform, parent_level);
-        let (edge_key, edge_full) = self.child_edges(&piece, &next, uniform, parent_level);
-        let faces = self.child_faces(&kept, uniform, parent_level, piece.loop_scheme);
+        // Each reads this level and the cuts only: built side by side.
+        let this = &*self;
+        let ((vertices, (edge_key, edge_full)), (faces, (rules, points))) = rayon::join(
+            || {
+                rayon::join(
+                    || this.child_vertices(&piece, &next, uniform, parent_level),
+                    || this.child_edges(&piece, &next, uniform, parent_level),
+                )
+            },
+            || {
+                rayon::join(
+                    || this.child_faces(&kept, uniform, parent_level, piece.loop_scheme),
+                    || {
+                        let vs = &next.vertices;
+                        let rules: Vec<Rule> =
+                            vs.iter().map(|&v| child_rules[v as usize]).collect();
+                        let points: Vec<DVec3> =
+                            vs.iter().map(|&v| child_points[v as usize]).collect();
+                        (rules, points)
+                    },
+                )
+            },
+        );
+        self.vertex_child = vertices.vertex_child;
+        self.edge_child = vertices.edge_child;
         Ok(SparseLevel {
-            rules: next
-                .vertices
-                .iter()
-                .map(|&v| child_rules[v as usize])
-                .collect(),
-            points: next
-                .vertices
-                .iter()
-                .map(|&v| child_points[v as usize])
-                .collect(),
+            rules,
+            points,
             face_key: faces.face_key,
             edge_key,
             vertex_key: vertices.vertex_key,
@@ -271,10 +283,10 @@ impl SparseLevel {
         kept
     }
 
-    /// The next level's vertices (uniform index, ring size in the uniform level, origin);
-    /// records the children of this level's vertices and edges.
+    /// The next level's vertices (uniform index, ring size in the uniform level, origin),
+    /// and the children of this level's vertices and edges.
     fn child_vertices(
-        &mut self,
+        &self,
         piece: &Piece,
         next: &submesh::SubMesh,
         uniform: &ChildLayout,
@@ -285,6 +297,8 @@ impl SparseLevel {
             vertex_key: Vec::with_capacity(nv),
             vertex_full: Vec::with_capacity(nv),
             vertex_origin: Vec::with_capacity(nv),
+            vertex_child: vec![NONE; self.topology.num_vertices()],
+            edge_child: vec![NONE; self.topology.num_edges()],
         };
         for (i, &cv) in next.vertices.iter().enumerate() {
             let cv = cv as usize;
@@ -293,7 +307,7 @@ impl SparseLevel {
                 out.vertex_key.push(self.vertex_key[v as usize]);
                 out.vertex_full.push(self.vertex_full[v as usize]);
                 out.vertex_origin.push(Origin::Vertex(v));
-                self.vertex_child[v as usize] = i as u32;
+                out.vertex_child[v as usize] = i as u32;
             } else if cv < piece.edge_point_base {
                 let f = piece.faces[cv - piece.num_vertices];
                 let key = uniform.face_point(parent_level, self.face_key[f as usize]);
@@ -308,7 +322,7 @@ impl SparseLevel {
                 out.vertex_full
                     .push(uniform.edge_point_faces(self.edge_full[e as usize]));
                 out.vertex_origin.push(Origin::Edge(e));
-                self.edge_child[e as usize] = i as u32;
+                out.edge_child[e as usize] = i as u32;
             }
         }
         out
@@ -433,11 +447,13 @@ struct KeptChildren {
     k: Vec<usize>,
 }
 
-/// The next level's per-vertex arrays.
+/// The next level's per-vertex arrays, and where this level's vertices and edges went.
 struct ChildVertices {
     vertex_key: Vec<u64>,
     vertex_full: Vec<u32>,
     vertex_origin: Vec<Origin>,
+    vertex_child: Vec<u32>,
+    edge_child: Vec<u32>,
 }
 
 /// The next level's per-face arrays.
