@@ -24,7 +24,7 @@
 
 use std::f64::consts::TAU;
 
-use subd_mesh::{Topology, tags};
+use subd_mesh::{Topology, TopologyParts, tags};
 
 use super::{ChildFaces, Features, SplitRule, StepError, Weights, check_size};
 
@@ -227,5 +227,12 @@ impl SplitRule for Step<'_> {
             }
         }
         Ok(faces)
+    }
+
+    /// Loop's split is OpenSubdiv's triangle split: the relations come in closed form from
+    /// the parent's ([`crate::refine::split::tri_split`], the faces of
+    /// [`Self::child_faces`]).
+    fn derived_topology(&self) -> Option<TopologyParts> {
+        Some(crate::refine::split::tri_split(self.t))
     }
 }

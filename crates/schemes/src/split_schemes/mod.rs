@@ -21,7 +21,12 @@
 //! Doo-Sabin and √3 where it has none: [`SplitFaceVarying`].
 //!
 //! Every level is a new [`Topology`]; rows of the stencil tables are built in parallel and do
-//! not depend on the number of threads.
+//! not depend on the number of threads. A level's topology is derived from the level above
+//! in closed form, in parallel, where the rule has a derivation
+//! ([`SplitRule::derived_topology`]: the butterflies) and built from its faces by
+//! [`TopologyBuilder`] otherwise;
+//! both give the same topology, relation for relation (the derived one is put in the
+//! builder's order by [`subd_mesh::canonical::builder_order`]).
 //!
 //! ```
 //! use subd_mesh::{DVec3, TopologyBuilder};
@@ -47,7 +52,7 @@ use std::sync::OnceLock;
 
 use glam::DVec3;
 use rayon::prelude::*;
-use subd_mesh::{Topology, TopologyBuilder, TopologyError, tags};
+use subd_mesh::{Topology, TopologyBuilder, TopologyError, TopologyParts, tags};
 
 use crate::rules::Rule;
 use crate::{MAX_LEVELS, RefineError, RowSink, Scheme, StencilTable};
@@ -97,9 +102,28 @@ impl ChildFaces {
         ChildFaces::untagged(num_vertices, offsets, vertices)
     }
 
-    fn build(&self) -> Result<Topology, TopologyError> {
+    /// The topology of these faces by [`TopologyBuilder`]: the reference the derived
+    /// topologies ([`SplitRule::derived_topology`]) are put in the order of.
+    pub(crate) fn build(&self) -> Result<Topology, TopologyError> {
         let sizes: Vec<u32> = self.offsets.windows(2).map(|w| w[1] - w[0]).collect();
-        let mut t = TopologyBuilder::new(self.num_vertices).build(&sizes, &self.vertices)?;
+        let t = TopologyBuilder::new(self.num_vertices).build(&sizes, &self.vertices)?;
+        Ok(self.tagged(t))
+    }
+
+    /// The topology of these faces from relations a rule derived from the parent (`parts`,
+    /// whose faces are these), put in the builder's order: what [`Self::build`] gives,
+    /// without its search. Without `parts`, [`Self::build`].
+    fn build_from(&self, parts: Option<TopologyParts>) -> Result<Topology, TopologyError> {
+        let Some(parts) = parts else {
+            return self.build();
+        };
+        debug_assert!(parts.face_offsets == self.offsets && parts.face_vertices == self.vertices);
+        let t = Topology::from_parts(subd_mesh::canonical::builder_order(parts))?;
+        Ok(self.tagged(t))
+    }
+
+    /// `t` with the creases and corners of these faces.
+    fn tagged(&self, mut t: Topology) -> Topology {
         for &[a, b] in &self.creases {
             if let Some(e) = t.find_edge(a, b) {
                 t.set_edge_sharpness(e as usize, tags::SHARPNESS_INFINITE);
@@ -108,7 +132,7 @@ impl ChildFaces {
         for &(v, s) in &self.corners {
             t.set_vertex_sharpness(v as usize, s);
         }
-        Ok(t)
+        t
     }
 }
 
@@ -150,6 +174,13 @@ pub(crate) trait SplitRule: Sync {
     fn fill<W: Weights>(&self, r: usize, w: &mut W);
     /// The child level's faces and tags.
     fn child_faces(&self) -> Result<ChildFaces, StepError>;
+    /// The child level's relations derived from the parent's (the faces of
+    /// [`Self::child_faces`], edges and rings in any order
+    /// [`subd_mesh::canonical::builder_order`] takes), or `None` where the rule has no such
+    /// derivation and the child is built from its faces.
+    fn derived_topology(&self) -> Option<TopologyParts> {
+        None
+    }
 }
 
 /// A [`SplitRule`] behind a pointer: rows written to a stencil table or summed into points,
@@ -163,6 +194,8 @@ pub(crate) trait SplitStep: Sync {
     fn point(&self, r: usize, src: &[DVec3]) -> DVec3;
     /// The child level's faces and tags.
     fn child_faces(&self) -> Result<ChildFaces, StepError>;
+    /// The child level's topology, the faces being `faces` (from [`Self::child_faces`]).
+    fn child_topology(&self, faces: &ChildFaces) -> Result<Topology, TopologyError>;
 }
 
 impl<T: SplitRule> SplitStep for T {
@@ -187,6 +220,10 @@ impl<T: SplitRule> SplitStep for T {
 
     fn child_faces(&self) -> Result<ChildFaces, StepError> {
         SplitRule::child_faces(self)
+    }
+
+    fn child_topology(&self, faces: &ChildFaces) -> Result<Topology, TopologyError> {
+        faces.build_from(self.derived_topology())
     }
 }
 
@@ -272,16 +309,16 @@ impl SplitRefinement {
                     bytes: need,
                 });
             }
-            let faces = step(parent, scheme, l)
-                .child_faces()
-                .map_err(|e| e.at_level(l))?;
+            let step = step(parent, scheme, l);
+            let faces = step.child_faces().map_err(|e| e.at_level(l))?;
             let topology = OnceLock::new();
             if l < levels {
-                let t = faces
-                    .build()
+                let t = step
+                    .child_topology(&faces)
                     .map_err(|e| StepError::Topology(e).at_level(l))?;
                 let _ = topology.set(t);
             }
+            drop(step);
             out.push(SplitLevel {
                 faces,
                 topology,
@@ -366,7 +403,9 @@ impl SplitRefinement {
                 lv.topology.get_or_init(|| {
                     // The faces were derived from a valid manifold parent; building them is
                     // what the levels above the last already did without fail.
-                    lv.faces.build().expect("a refined level is a valid mesh")
+                    step(self.topology(l - 1), &self.scheme, l)
+                        .child_topology(&lv.faces)
+                        .expect("a refined level is a valid mesh")
                 })
             }
         }
@@ -602,3 +641,4 @@ fn check_size(face_vertices: u64) -> Result<(), StepError> {
         Ok(())
     }
 }
+
