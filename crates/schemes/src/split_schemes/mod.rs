@@ -23,8 +23,8 @@
 //! Every level is a new [`Topology`]; rows of the stencil tables are built in parallel and do
 //! not depend on the number of threads. A level's topology is derived from the level above
 //! in closed form, in parallel, where the rule has a derivation
-//! ([`SplitRule::derived_topology`]: the butterflies) and built from its faces by
-//! [`TopologyBuilder`] otherwise;
+//! ([`SplitRule::derived_topology`]: the butterflies always, √3 and Doo-Sabin over closed
+//! levels without feature edges) and built from its faces by [`TopologyBuilder`] otherwise;
 //! both give the same topology, relation for relation (the derived one is put in the
 //! builder's order by [`subd_mesh::canonical::builder_order`]).
 //!
@@ -44,9 +44,11 @@
 
 pub mod butterfly;
 pub mod doo_sabin;
+mod doo_sabin_split;
 mod features;
 pub mod fvar;
 pub mod sqrt3;
+mod sqrt3_split;
 
 use std::sync::OnceLock;
 
@@ -642,3 +644,56 @@ fn check_size(face_vertices: u64) -> Result<(), StepError> {
     }
 }
 
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A closed torus of quads, and its quads split along a diagonal.
+    fn closed_meshes() -> (Topology, Topology) {
+        let quads = subd_mesh::primitives::torus(7, 5, 3.0, 1.0).topology;
+        let tris: Vec<u32> = quads
+            .all_face_vertices()
+            .chunks(4)
+            .flat_map(|q| [q[0], q[1], q[2], q[0], q[2], q[3]])
+            .collect();
+        let sizes = vec![3; tris.len() / 3];
+        let tris = TopologyBuilder::new(quads.num_vertices())
+            .build(&sizes, &tris)
+            .unwrap();
+        (quads, tris)
+    }
+
+    /// Checks that `rule` derives the child of `parent` and that the derived topology is the
+    /// builder's; returns the child.
+    fn derived_is_built(rule: &impl SplitRule, what: &str) -> Topology {
+        let faces = rule.child_faces().unwrap();
+        let parts = rule.derived_topology();
+        assert!(parts.is_some(), "{what}: no closed form");
+        let derived = faces.build_from(parts).unwrap();
+        assert!(
+            derived == faces.build().unwrap(),
+            "{what}: not the builder's"
+        );
+        derived
+    }
+
+    /// On closed meshes every split scheme takes its closed form, three levels deep (√3's
+    /// trisecting steps included), and gets the builder's topology.
+    #[test]
+    fn closed_forms_apply_on_closed_meshes_and_give_the_builders() {
+        let (quads, tris) = closed_meshes();
+        let mut t = quads;
+        for l in 1..=3 {
+            t = derived_is_built(&doo_sabin::Step::new(&t), &format!("doo-sabin {l}"));
+        }
+        let mut t = tris.clone();
+        for l in 1..=3 {
+            t = derived_is_built(&sqrt3::Step::new(&t, l % 2 == 0), &format!("sqrt3 {l}"));
+        }
+        let mut t = tris;
+        for l in 1..=3 {
+            let rule = butterfly::Step::new(&t, butterfly::EdgeRule::Modified);
+            t = derived_is_built(&rule, &format!("butterfly {l}"));
+        }
+    }
+}
