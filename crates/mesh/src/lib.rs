@@ -28,6 +28,7 @@
 
 pub mod analysis;
 mod build;
+pub mod canonical;
 pub mod csr;
 pub mod cut;
 pub mod error;

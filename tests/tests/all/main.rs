@@ -20,5 +20,6 @@ mod proptest_topology;
 mod refined_topology;
 mod split_fvar;
 mod split_schemes;
+mod split_topology;
 mod streamed_output;
 mod tessellation;

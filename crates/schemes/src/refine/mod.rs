@@ -8,9 +8,9 @@ mod fused;
 mod fvar;
 mod layout;
 mod osd;
-mod par;
+pub(crate) mod par;
 mod rows;
-mod split;
+pub(crate) mod split;
 mod stream;
 
 pub use counts::{LevelCounts, refined_counts};

@@ -211,7 +211,7 @@ pub(super) fn tri_child_edges(p: &Topology, f: usize) -> [u32; 12] {
 }
 
 /// Offsets of `faces` faces of `size` vertices each.
-pub(super) fn uniform_offsets(faces: usize, size: u32) -> Vec<u32> {
+pub(crate) fn uniform_offsets(faces: usize, size: u32) -> Vec<u32> {
     let mut out = memory::with_capacity(faces + 1);
     out.par_extend(
         (0..faces + 1)

@@ -24,7 +24,8 @@
 
 use std::f64::consts::TAU;
 
-use subd_mesh::{Topology, tags};
+use rayon::prelude::*;
+use subd_mesh::{Topology, TopologyParts, tags};
 
 use super::{ChildFaces, Features, SplitRule, StepError, Weights, check_size};
 
@@ -203,29 +204,31 @@ impl SplitRule for Step<'_> {
         let t = self.t;
         let nv = t.num_vertices() as u32;
         check_size(12 * t.num_faces() as u64)?;
-        let mut verts = Vec::with_capacity(12 * t.num_faces());
-        for f in 0..t.num_faces() {
-            let v = t.face_vertices(f);
-            let e: Vec<u32> = t.face_edges(f).iter().map(|&e| nv + e).collect();
-            verts.extend([
-                v[0], e[0], e[2], e[0], v[1], e[1], e[2], e[1], v[2], e[1], e[2], e[0],
-            ]);
-        }
-        let mut faces = ChildFaces::triangles(self.num_rows(), verts);
-        for e in 0..t.num_edges() {
-            if !t.is_boundary_edge(e) && tags::is_infinite(t.edge_sharpness(e)) {
+        // The same faces as OpenSubdiv's triangle split, written in parallel.
+        let (offsets, verts) = crate::refine::split::tri_faces(t);
+        let mut faces = ChildFaces::untagged(self.num_rows(), offsets, verts);
+        faces.creases = (0..t.num_edges())
+            .into_par_iter()
+            .with_min_len(4096)
+            .filter(|&e| !t.is_boundary_edge(e) && tags::is_infinite(t.edge_sharpness(e)))
+            .flat_map_iter(|e| {
                 let [a, b] = t.edge_vertices(e);
-                faces
-                    .creases
-                    .extend([[a, nv + e as u32], [nv + e as u32, b]]);
-            }
-        }
-        for v in 0..t.num_vertices() {
-            let s = t.vertex_sharpness(v);
-            if s > 0.0 {
-                faces.corners.push((v as u32, s));
-            }
-        }
+                [[a, nv + e as u32], [nv + e as u32, b]]
+            })
+            .collect();
+        faces.corners = (0..t.num_vertices())
+            .into_par_iter()
+            .with_min_len(4096)
+            .filter(|&v| t.vertex_sharpness(v) > 0.0)
+            .map(|v| (v as u32, t.vertex_sharpness(v)))
+            .collect();
         Ok(faces)
+    }
+
+    /// Loop's split is OpenSubdiv's triangle split: the relations come in closed form from
+    /// the parent's ([`crate::refine::split::tri_split`], the faces of
+    /// [`Self::child_faces`]).
+    fn derived_topology(&self) -> Option<TopologyParts> {
+        Some(crate::refine::split::tri_split(self.t))
     }
 }

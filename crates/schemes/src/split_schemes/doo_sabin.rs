@@ -29,7 +29,7 @@
 
 use std::f64::consts::TAU;
 
-use subd_mesh::Topology;
+use subd_mesh::{Topology, TopologyParts};
 
 use super::{ChildFaces, SplitRule, StepError, Weights, check_size};
 
@@ -124,10 +124,18 @@ pub(crate) struct Step<'a> {
 impl<'a> Step<'a> {
     pub(crate) fn new(p: &'a Topology) -> Step<'a> {
         let (chaikin_at, num_chaikin) = boundary_points(p, p.num_face_vertices() as u32);
-        let mut face_of = Vec::with_capacity(p.num_face_vertices());
-        for f in 0..p.num_faces() {
-            face_of.extend(std::iter::repeat_n(f as u32, p.face_size(f)));
-        }
+        let face_of = crate::refine::par::build(
+            p.num_face_vertices(),
+            p.num_faces(),
+            |f| p.face_offsets()[f] as usize,
+            |r, out: &mut [u32]| {
+                let base = p.face_offsets()[r.start] as usize;
+                for f in r {
+                    let o = p.face_offsets()[f] as usize - base;
+                    out[o..o + p.face_size(f)].fill(f as u32);
+                }
+            },
+        );
         let boundary_edges = (0..p.num_edges() as u32)
             .filter(|&e| chaikin_at[e as usize] != u32::MAX)
             .collect();
@@ -176,6 +184,12 @@ impl SplitRule for Step<'_> {
     fn child_faces(&self) -> Result<ChildFaces, StepError> {
         let p = self.p;
         let nfv = p.num_face_vertices();
+        if super::doo_sabin_split::applies(p) {
+            // The same faces, written in parallel.
+            check_size(2 * nfv as u64 + 4 * p.num_edges() as u64)?;
+            let (offsets, verts) = super::doo_sabin_split::face_lists(p);
+            return Ok(ChildFaces::untagged(self.num_rows(), offsets, verts));
+        }
         let num_boundary_vertices = (0..p.num_vertices())
             .filter(|&v| p.is_boundary_vertex(v))
             .count();
@@ -238,5 +252,11 @@ impl SplitRule for Step<'_> {
             }
         }
         Ok(ChildFaces::from_sizes(self.num_rows(), &sizes, verts))
+    }
+
+    /// In closed form on a closed parent ([`super::doo_sabin_split`]); other levels are
+    /// built from their faces.
+    fn derived_topology(&self) -> Option<TopologyParts> {
+        super::doo_sabin_split::applies(self.p).then(|| super::doo_sabin_split::split(self.p))
     }
 }

@@ -1,6 +1,7 @@
 //! Feature curves of a level: boundary edges and infinitely sharp creases, along which √3 and
 //! the butterflies apply their curve rules.
 
+use rayon::prelude::*;
 use subd_mesh::{Topology, tags};
 
 /// Which edges are feature edges (boundary, or an infinitely sharp crease) and how the feature
@@ -17,24 +18,28 @@ impl Features {
     /// The features of `t`: boundary edges, infinitely sharp edges; a vertex is a corner when
     /// it has a corner tag or three or more feature edges.
     pub fn new(t: &Topology) -> Features {
+        // Per edge, then per vertex from its edges: both in parallel.
         let edge: Vec<bool> = (0..t.num_edges())
+            .into_par_iter()
+            .with_min_len(4096)
             .map(|e| t.is_boundary_edge(e) || tags::is_infinite(t.edge_sharpness(e)))
             .collect();
-        let mut at_vertex = vec![([u32::MAX; 2], 0u8); t.num_vertices()];
-        let mut corner = vec![false; t.num_vertices()];
-        for v in 0..t.num_vertices() {
-            let mut slot = ([u32::MAX; 2], 0u8);
-            for &e in t.vertex_edges(v) {
-                if edge[e as usize] {
-                    if (slot.1 as usize) < 2 {
-                        slot.0[slot.1 as usize] = e;
+        let (at_vertex, corner): (Vec<([u32; 2], u8)>, Vec<bool>) = (0..t.num_vertices())
+            .into_par_iter()
+            .with_min_len(4096)
+            .map(|v| {
+                let mut slot = ([u32::MAX; 2], 0u8);
+                for &e in t.vertex_edges(v) {
+                    if edge[e as usize] {
+                        if (slot.1 as usize) < 2 {
+                            slot.0[slot.1 as usize] = e;
+                        }
+                        slot.1 = slot.1.saturating_add(1);
                     }
-                    slot.1 = slot.1.saturating_add(1);
                 }
-            }
-            corner[v] = slot.1 >= 3 || t.vertex_sharpness(v) > 0.0;
-            at_vertex[v] = slot;
-        }
+                (slot, slot.1 >= 3 || t.vertex_sharpness(v) > 0.0)
+            })
+            .unzip();
         Features {
             edge,
             at_vertex,

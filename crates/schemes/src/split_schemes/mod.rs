@@ -21,7 +21,12 @@
 //! Doo-Sabin and √3 where it has none: [`SplitFaceVarying`].
 //!
 //! Every level is a new [`Topology`]; rows of the stencil tables are built in parallel and do
-//! not depend on the number of threads.
+//! not depend on the number of threads. A level's topology is derived from the level above
+//! in closed form, in parallel, where the rule has a derivation
+//! ([`SplitRule::derived_topology`]: the butterflies always, √3 and Doo-Sabin over closed
+//! levels without feature edges) and built from its faces by [`TopologyBuilder`] otherwise;
+//! both give the same topology, relation for relation (the derived one is put in the
+//! builder's order by [`subd_mesh::canonical::builder_order`]).
 //!
 //! ```
 //! use subd_mesh::{DVec3, TopologyBuilder};
@@ -39,15 +44,17 @@
 
 pub mod butterfly;
 pub mod doo_sabin;
+mod doo_sabin_split;
 mod features;
 pub mod fvar;
 pub mod sqrt3;
+mod sqrt3_split;
 
 use std::sync::OnceLock;
 
 use glam::DVec3;
 use rayon::prelude::*;
-use subd_mesh::{Topology, TopologyBuilder, TopologyError, tags};
+use subd_mesh::{Topology, TopologyBuilder, TopologyError, TopologyParts, tags};
 
 use crate::rules::Rule;
 use crate::{MAX_LEVELS, RefineError, RowSink, Scheme, StencilTable};
@@ -97,9 +104,28 @@ impl ChildFaces {
         ChildFaces::untagged(num_vertices, offsets, vertices)
     }
 
-    fn build(&self) -> Result<Topology, TopologyError> {
+    /// The topology of these faces by [`TopologyBuilder`]: the reference the derived
+    /// topologies ([`SplitRule::derived_topology`]) are put in the order of.
+    pub(crate) fn build(&self) -> Result<Topology, TopologyError> {
         let sizes: Vec<u32> = self.offsets.windows(2).map(|w| w[1] - w[0]).collect();
-        let mut t = TopologyBuilder::new(self.num_vertices).build(&sizes, &self.vertices)?;
+        let t = TopologyBuilder::new(self.num_vertices).build(&sizes, &self.vertices)?;
+        Ok(self.tagged(t))
+    }
+
+    /// The topology of these faces from relations a rule derived from the parent (`parts`,
+    /// whose faces are these), put in the builder's order: what [`Self::build`] gives,
+    /// without its search. Without `parts`, [`Self::build`].
+    fn build_from(&self, parts: Option<TopologyParts>) -> Result<Topology, TopologyError> {
+        let Some(parts) = parts else {
+            return self.build();
+        };
+        debug_assert!(parts.face_offsets == self.offsets && parts.face_vertices == self.vertices);
+        let t = Topology::from_parts(subd_mesh::canonical::builder_order(parts))?;
+        Ok(self.tagged(t))
+    }
+
+    /// `t` with the creases and corners of these faces.
+    fn tagged(&self, mut t: Topology) -> Topology {
         for &[a, b] in &self.creases {
             if let Some(e) = t.find_edge(a, b) {
                 t.set_edge_sharpness(e as usize, tags::SHARPNESS_INFINITE);
@@ -108,7 +134,7 @@ impl ChildFaces {
         for &(v, s) in &self.corners {
             t.set_vertex_sharpness(v as usize, s);
         }
-        Ok(t)
+        t
     }
 }
 
@@ -150,6 +176,13 @@ pub(crate) trait SplitRule: Sync {
     fn fill<W: Weights>(&self, r: usize, w: &mut W);
     /// The child level's faces and tags.
     fn child_faces(&self) -> Result<ChildFaces, StepError>;
+    /// The child level's relations derived from the parent's (the faces of
+    /// [`Self::child_faces`], edges and rings in any order
+    /// [`subd_mesh::canonical::builder_order`] takes), or `None` where the rule has no such
+    /// derivation and the child is built from its faces.
+    fn derived_topology(&self) -> Option<TopologyParts> {
+        None
+    }
 }
 
 /// A [`SplitRule`] behind a pointer: rows written to a stencil table or summed into points,
@@ -163,6 +196,8 @@ pub(crate) trait SplitStep: Sync {
     fn point(&self, r: usize, src: &[DVec3]) -> DVec3;
     /// The child level's faces and tags.
     fn child_faces(&self) -> Result<ChildFaces, StepError>;
+    /// The child level's topology, the faces being `faces` (from [`Self::child_faces`]).
+    fn child_topology(&self, faces: &ChildFaces) -> Result<Topology, TopologyError>;
 }
 
 impl<T: SplitRule> SplitStep for T {
@@ -187,6 +222,10 @@ impl<T: SplitRule> SplitStep for T {
 
     fn child_faces(&self) -> Result<ChildFaces, StepError> {
         SplitRule::child_faces(self)
+    }
+
+    fn child_topology(&self, faces: &ChildFaces) -> Result<Topology, TopologyError> {
+        faces.build_from(self.derived_topology())
     }
 }
 
@@ -272,16 +311,16 @@ impl SplitRefinement {
                     bytes: need,
                 });
             }
-            let faces = step(parent, scheme, l)
-                .child_faces()
-                .map_err(|e| e.at_level(l))?;
+            let step = step(parent, scheme, l);
+            let faces = step.child_faces().map_err(|e| e.at_level(l))?;
             let topology = OnceLock::new();
             if l < levels {
-                let t = faces
-                    .build()
+                let t = step
+                    .child_topology(&faces)
                     .map_err(|e| StepError::Topology(e).at_level(l))?;
                 let _ = topology.set(t);
             }
+            drop(step);
             out.push(SplitLevel {
                 faces,
                 topology,
@@ -366,7 +405,9 @@ impl SplitRefinement {
                 lv.topology.get_or_init(|| {
                     // The faces were derived from a valid manifold parent; building them is
                     // what the levels above the last already did without fail.
-                    lv.faces.build().expect("a refined level is a valid mesh")
+                    step(self.topology(l - 1), &self.scheme, l)
+                        .child_topology(&lv.faces)
+                        .expect("a refined level is a valid mesh")
                 })
             }
         }
@@ -600,5 +641,59 @@ fn check_size(face_vertices: u64) -> Result<(), StepError> {
         Err(StepError::TooLarge)
     } else {
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A closed torus of quads, and its quads split along a diagonal.
+    fn closed_meshes() -> (Topology, Topology) {
+        let quads = subd_mesh::primitives::torus(7, 5, 3.0, 1.0).topology;
+        let tris: Vec<u32> = quads
+            .all_face_vertices()
+            .chunks(4)
+            .flat_map(|q| [q[0], q[1], q[2], q[0], q[2], q[3]])
+            .collect();
+        let sizes = vec![3; tris.len() / 3];
+        let tris = TopologyBuilder::new(quads.num_vertices())
+            .build(&sizes, &tris)
+            .unwrap();
+        (quads, tris)
+    }
+
+    /// Checks that `rule` derives the child of `parent` and that the derived topology is the
+    /// builder's; returns the child.
+    fn derived_is_built(rule: &impl SplitRule, what: &str) -> Topology {
+        let faces = rule.child_faces().unwrap();
+        let parts = rule.derived_topology();
+        assert!(parts.is_some(), "{what}: no closed form");
+        let derived = faces.build_from(parts).unwrap();
+        assert!(
+            derived == faces.build().unwrap(),
+            "{what}: not the builder's"
+        );
+        derived
+    }
+
+    /// On closed meshes every split scheme takes its closed form, three levels deep (√3's
+    /// trisecting steps included), and gets the builder's topology.
+    #[test]
+    fn closed_forms_apply_on_closed_meshes_and_give_the_builders() {
+        let (quads, tris) = closed_meshes();
+        let mut t = quads;
+        for l in 1..=3 {
+            t = derived_is_built(&doo_sabin::Step::new(&t), &format!("doo-sabin {l}"));
+        }
+        let mut t = tris.clone();
+        for l in 1..=3 {
+            t = derived_is_built(&sqrt3::Step::new(&t, l % 2 == 0), &format!("sqrt3 {l}"));
+        }
+        let mut t = tris;
+        for l in 1..=3 {
+            let rule = butterfly::Step::new(&t, butterfly::EdgeRule::Modified);
+            t = derived_is_built(&rule, &format!("butterfly {l}"));
+        }
     }
 }

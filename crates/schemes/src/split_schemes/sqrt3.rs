@@ -28,7 +28,7 @@
 
 use std::f64::consts::TAU;
 
-use subd_mesh::Topology;
+use subd_mesh::{Topology, TopologyParts};
 
 use super::{ChildFaces, Features, SplitRule, StepError, Weights, check_size};
 
@@ -219,6 +219,13 @@ impl SplitRule for Step<'_> {
     fn child_faces(&self) -> Result<ChildFaces, StepError> {
         let p = self.p;
         check_size(9 * p.num_faces() as u64 + 9 * p.num_edges() as u64)?;
+        if super::sqrt3_split::applies(p, &self.features) {
+            // The same faces, written in parallel; no tag but corners to carry.
+            let verts = super::sqrt3_split::face_vertices(p);
+            let mut faces = ChildFaces::triangles(self.num_child, verts);
+            carry_tags(p, &self.features, &self.trisection, &mut faces);
+            return Ok(faces);
+        }
         let mut verts: Vec<u32> = Vec::with_capacity(9 * p.num_faces());
         for e in 0..p.num_edges() {
             let faces = p.edge_faces(e);
@@ -248,5 +255,12 @@ impl SplitRule for Step<'_> {
         let mut faces = ChildFaces::triangles(self.num_child, verts);
         carry_tags(p, &self.features, &self.trisection, &mut faces);
         Ok(faces)
+    }
+
+    /// In closed form where every edge is flipped ([`super::sqrt3_split`]); other levels are
+    /// built from their faces.
+    fn derived_topology(&self) -> Option<TopologyParts> {
+        super::sqrt3_split::applies(self.p, &self.features)
+            .then(|| super::sqrt3_split::split(self.p))
     }
 }
