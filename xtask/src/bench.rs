@@ -44,6 +44,32 @@ pub fn split_quads(q: &Mesh) -> Mesh {
     Mesh::new(topo, q.positions.clone()).expect("finite")
 }
 
+/// The quad bench mesh with every face whose centre lies in a band around the x axis or
+/// on the negative x side removed (two boundary loops): refinement on it takes the general
+/// path (boundaries), not the closed smooth one.
+pub fn open_quad_bench_mesh() -> Result<Mesh, String> {
+    let quads = quad_bench_mesh();
+    let t = &quads.topology;
+    let mut sizes = Vec::new();
+    let mut corners = Vec::new();
+    for f in 0..t.num_faces() {
+        let fv = t.face_vertices(f);
+        let centre = fv
+            .iter()
+            .map(|&v| quads.positions[v as usize])
+            .sum::<subd_mesh::DVec3>()
+            / fv.len() as f64;
+        if centre.y.abs() > 0.6 || centre.x < 0.0 {
+            sizes.push(fv.len() as u32);
+            corners.extend_from_slice(fv);
+        }
+    }
+    let topo = TopologyBuilder::new(t.num_vertices())
+        .build(&sizes, &corners)
+        .map_err(|e| e.to_string())?;
+    Mesh::new(topo, quads.positions.clone()).map_err(|e| e.to_string())
+}
+
 pub(crate) fn peak_rss_bytes() -> u64 {
     std::fs::read_to_string("/proc/self/status")
         .ok()
@@ -53,6 +79,20 @@ pub(crate) fn peak_rss_bytes() -> u64 {
                 .and_then(|l| l.split_whitespace().nth(1)?.parse::<u64>().ok())
         })
         .map_or(0, |kb| kb * 1024)
+}
+
+/// CPU time (user + system, all threads) this process has used so far: beside wall time on
+/// a shared machine, where other work stretches the wall clock but not this.
+#[allow(unsafe_code)]
+pub(crate) fn cpu_seconds() -> f64 {
+    // SAFETY: `getrusage` only writes the `rusage` it is given.
+    let mut u: libc::rusage = unsafe { std::mem::zeroed() };
+    // SAFETY: a valid pointer to a `rusage`; RUSAGE_SELF is always a valid target.
+    if unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut u) } != 0 {
+        return 0.0;
+    }
+    let t = |v: libc::timeval| v.tv_sec as f64 + v.tv_usec as f64 * 1e-6;
+    t(u.ru_utime) + t(u.ru_stime)
 }
 
 pub(crate) fn median(mut v: Vec<f64>) -> f64 {
@@ -84,9 +124,11 @@ pub fn run_subd(
         .map(|f| base.face_size(f) as u32)
         .collect();
     let (mut total, mut refine, mut points) = (Vec::new(), Vec::new(), Vec::new());
+    let mut cpu = Vec::new();
     let mut check = 0.0;
     for _ in 0..repeats {
         pool.install(|| {
+            let c0 = cpu_seconds();
             let t0 = Instant::now();
             let topo = TopologyBuilder::new(base.num_vertices())
                 .build(&sizes, base.all_face_vertices())
@@ -96,6 +138,7 @@ pub fn run_subd(
             let t1 = Instant::now();
             let p = r.refine_points(pos);
             let t2 = Instant::now();
+            cpu.push(cpu_seconds() - c0);
             check += p[levels].len() as f64;
             refine.push((t1 - t0).as_secs_f64());
             points.push((t2 - t1).as_secs_f64());
@@ -103,10 +146,11 @@ pub fn run_subd(
         });
     }
     println!(
-        "{{\"seconds\": {:.9}, \"topology_seconds\": {:.9}, \"primvar_seconds\": {:.9}, \"peak_rss_bytes\": {}, \"vertices\": {}}}",
+        "{{\"seconds\": {:.9}, \"topology_seconds\": {:.9}, \"primvar_seconds\": {:.9}, \"cpu_seconds\": {:.9}, \"peak_rss_bytes\": {}, \"vertices\": {}}}",
         median(total),
         median(refine),
         median(points),
+        median(cpu),
         peak_rss_bytes(),
         check / repeats as f64
     );
@@ -144,13 +188,16 @@ fn measure(cmd: &mut Command, huge_pages: bool) -> Result<Measure, String> {
 /// the same transparent-huge-page malloc setting; `advice` is subd's own huge-page advice
 /// for its large arrays (on by default in the library). Each level is measured in `rounds`
 /// back-to-back rounds of OpenSubdiv, subd on one thread and subd on all threads; the table
-/// shows medians over rounds, and each ratio is the median of the rounds' ratios.
+/// shows medians over rounds, and each ratio is the median of the rounds' ratios. With
+/// `open` the meshes are the open ones ([`open_quad_bench_mesh`], triangulated for Loop),
+/// which take the general path.
 pub fn run(
     levels: usize,
     repeats: usize,
     rounds: usize,
     huge_pages: bool,
     advice: bool,
+    open: bool,
 ) -> Result<(), String> {
     let exe = osd::build_harness()?;
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/xtask/bench");
@@ -169,6 +216,11 @@ pub fn run(
         "subd's huge-page advice for its large arrays: {}",
         if advice { "on (default)" } else { "off" }
     );
+    if open {
+        println!(
+            "meshes: the bench tori with a band of faces removed (boundaries: the general path)"
+        );
+    }
     println!(
         "{:<8} {:>8} {:>5} {:>10} {:>10} {:>10} {:>7} {:>10} {:>7} {:>9} {:>9}",
         "scheme",
@@ -183,16 +235,28 @@ pub fn run(
         "osd MB",
         "subd MB"
     );
-    for (scheme, mesh) in [
-        (Scheme::CatmullClark, quad_bench_mesh()),
-        (Scheme::Loop, tri_bench_mesh()),
-    ] {
+    let meshes = if open {
+        let quads = open_quad_bench_mesh()?;
+        let tris = split_quads(&quads);
+        [(Scheme::CatmullClark, quads), (Scheme::Loop, tris)]
+    } else {
+        [
+            (Scheme::CatmullClark, quad_bench_mesh()),
+            (Scheme::Loop, tri_bench_mesh()),
+        ]
+    };
+    for (scheme, mesh) in meshes {
         let name = if scheme == Scheme::Loop {
             "loop"
         } else {
             "catmark"
         };
-        let path = dir.join(format!("{name}.obj"));
+        let file = if open {
+            format!("{name}_open")
+        } else {
+            name.to_string()
+        };
+        let path = dir.join(format!("{file}.obj"));
         subd_io::write_mesh(&path, &mesh, &subd_io::WriteOptions::default())
             .map_err(|e| e.to_string())?;
         for level in 1..=levels {
@@ -203,7 +267,7 @@ pub fn run(
                 &Options::default(),
                 level as u32,
             );
-            let input_path = dir.join(format!("{name}_{level}.bin"));
+            let input_path = dir.join(format!("{file}_{level}.bin"));
             std::fs::write(&input_path, &input).map_err(|e| e.to_string())?;
             let osd = || {
                 measure(

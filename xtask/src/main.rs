@@ -84,6 +84,10 @@ enum Task {
         /// Only the refinement benchmark.
         #[arg(long)]
         refine_only: bool,
+        /// The refinement benchmark on open meshes (the bench torus with a band of faces
+        /// removed: boundaries, so the general path) instead of the closed tori.
+        #[arg(long)]
+        open: bool,
         /// Only the evaluation benchmark.
         #[arg(long)]
         eval_only: bool,
@@ -286,6 +290,7 @@ fn main() -> ExitCode {
             huge_pages,
             no_huge_page_advice,
             refine_only,
+            open,
             eval_only,
             pia_only,
             adaptive_only,
@@ -304,6 +309,7 @@ fn main() -> ExitCode {
                     rounds.max(1),
                     huge_pages,
                     !no_huge_page_advice,
+                    open,
                 )
             };
             let split = || split_bench::run(levels, repeats, rounds.max(1));

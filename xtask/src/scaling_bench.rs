@@ -13,11 +13,11 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+use subd_mesh::Mesh;
 use subd_mesh::fvar::FVarLinearInterpolation;
-use subd_mesh::{Mesh, TopologyBuilder};
 use subd_schemes::{Options, Scheme};
 
-use crate::bench::{json_number, median, quad_bench_mesh, split_quads};
+use crate::bench::{json_number, median, open_quad_bench_mesh, quad_bench_mesh, split_quads};
 use crate::osd;
 
 /// One command line of the table.
@@ -52,36 +52,11 @@ struct Inputs {
     uv_path: PathBuf,
 }
 
-/// The bench torus with every face whose centre lies in a band around the x axis removed
-/// (two boundary loops), triangulated: Loop on it takes the general path.
-fn open_mesh(quads: &Mesh) -> Result<Mesh, String> {
-    let t = &quads.topology;
-    let mut sizes = Vec::new();
-    let mut corners = Vec::new();
-    for f in 0..t.num_faces() {
-        let fv = t.face_vertices(f);
-        let centre = fv
-            .iter()
-            .map(|&v| quads.positions[v as usize])
-            .sum::<subd_mesh::DVec3>()
-            / fv.len() as f64;
-        if centre.y.abs() > 0.6 || centre.x < 0.0 {
-            sizes.push(fv.len() as u32);
-            corners.extend_from_slice(fv);
-        }
-    }
-    let topo = TopologyBuilder::new(t.num_vertices())
-        .build(&sizes, &corners)
-        .map_err(|e| e.to_string())?;
-    let open = Mesh::new(topo, quads.positions.clone()).map_err(|e| e.to_string())?;
-    Ok(split_quads(&open))
-}
-
 impl Inputs {
     fn write(dir: &Path) -> Result<Inputs, String> {
         let quads = quad_bench_mesh();
         let triangles = split_quads(&quads);
-        let open = open_mesh(&quads)?;
+        let open = split_quads(&open_quad_bench_mesh()?);
         let mut with_uv = quads.clone();
         with_uv.fvar = vec![crate::fvar_bench::torus_uv(&quads)];
         let path = |name: &str| dir.join(name);
