@@ -445,7 +445,10 @@ fn split_lengths<T>(mut v: &mut [T], lengths: impl Iterator<Item = usize>) -> Ve
 fn assign(grid: &Grid, numbers: &Numbers, starts: &[Counts]) -> Vec<FaceParam> {
     let total = starts.last().map_or(0, |c| c.samples);
     let unset = param(0, 0, 0, 0, 1);
-    let mut params: Vec<FaceParam> = (0..total).into_par_iter().map(|_| unset).collect();
+    // Huge pages where large: a rate-8 tessellation's parameters are ~200 MB, and 4 KiB
+    // page faults on them cost as much as numbering them.
+    let mut params = subd_mesh::memory::with_capacity::<FaceParam>(total);
+    params.par_extend(rayon::iter::repeat_n(unset, total));
     let lengths = starts.windows(2).map(|w| w[1].samples - w[0].samples);
     split_lengths(&mut params, lengths)
         .into_par_iter()
@@ -508,11 +511,18 @@ fn emit(grid: &Grid, numbers: &Numbers, starts: &[Counts], total: Counts) -> Tes
         positions: Vec::new(),
         normals: Vec::new(),
         params: Vec::new(),
-        face_offsets: (0..=num_faces as u32).map(|k| k * corners as u32).collect(),
+        face_offsets: face_offsets(num_faces, corners as u32),
         face_vertices,
         grids,
         grid_vertices,
     }
+}
+
+/// The offsets of `num_faces` faces of `corners` corners each.
+fn face_offsets(num_faces: usize, corners: u32) -> Vec<u32> {
+    let mut offsets = subd_mesh::memory::with_capacity::<u32>(num_faces + 1);
+    offsets.par_extend((0..=num_faces as u32).into_par_iter().map(|k| k * corners));
+    offsets
 }
 
 /// Pass 1's sink: numbers the chunk's samples from `next` and writes their parameters.
