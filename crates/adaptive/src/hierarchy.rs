@@ -120,20 +120,7 @@ impl AdaptiveRefinement {
         max_level: usize,
         progress: &mut dyn FnMut(usize, usize),
     ) -> Result<Self, AdaptiveError> {
-        if !matches!(
-            scheme,
-            Scheme::CatmullClark | Scheme::Loop | Scheme::Bilinear
-        ) {
-            return Err(AdaptiveError::Scheme {
-                scheme: scheme.to_string(),
-            });
-        }
-        if max_level > MAX_LEVELS {
-            return Err(AdaptiveError::TooManyLevels {
-                levels: max_level,
-                max: MAX_LEVELS,
-            });
-        }
+        check_arguments(scheme, max_level)?;
         let every = EveryFace;
         let criteria: Vec<&dyn Criterion> = if criteria.is_empty() {
             vec![&every]
@@ -189,27 +176,7 @@ impl AdaptiveRefinement {
                 judged: None,
                 final_errors: vec![None; criteria.len()],
             };
-            let mut restart = None;
-            for (i, c) in criteria.iter().enumerate() {
-                let Some(positions) = c.output_positions() else {
-                    continue;
-                };
-                let mesh = match h.judged.take() {
-                    Some((p, mesh)) if p == positions => mesh,
-                    _ => h.mesh(positions)?,
-                };
-                let judgement = c.judge(&mesh)?;
-                h.final_errors[i] = judgement.worst;
-                for (f, rejected) in judgement.rejected.into_iter().enumerate() {
-                    let level = mesh.face_levels[f] as usize;
-                    if rejected && level < max_level && requests[level].insert(mesh.face_uniform[f])
-                    {
-                        restart = Some(restart.map_or(level, |r: usize| r.min(level)));
-                    }
-                }
-                h.judged = Some((positions, mesh));
-            }
-            let Some(r) = restart else {
+            let Some(r) = h.judge_output(&criteria, &mut requests, max_level)? else {
                 return Ok(h);
             };
             h.levels.truncate(r + 1);
@@ -217,6 +184,37 @@ impl AdaptiveRefinement {
             (levels, uniform, level_builds) = (h.levels, h.uniform, h.level_builds);
             l = r;
         }
+    }
+
+    /// Lets the criteria that judge the conforming mesh judge it: the leaves of the faces
+    /// they reject are requested for refinement. The coarsest level that got a new request,
+    /// where the hierarchy must be rebuilt from; `None` when every criterion is met.
+    fn judge_output(
+        &mut self,
+        criteria: &[&dyn Criterion],
+        requests: &mut [HashSet<u64>],
+        max_level: usize,
+    ) -> Result<Option<usize>, AdaptiveError> {
+        let mut restart = None;
+        for (i, c) in criteria.iter().enumerate() {
+            let Some(positions) = c.output_positions() else {
+                continue;
+            };
+            let mesh = match self.judged.take() {
+                Some((p, mesh)) if p == positions => mesh,
+                _ => self.mesh(positions)?,
+            };
+            let judgement = c.judge(&mesh)?;
+            self.final_errors[i] = judgement.worst;
+            for (f, rejected) in judgement.rejected.into_iter().enumerate() {
+                let level = mesh.face_levels[f] as usize;
+                if rejected && level < max_level && requests[level].insert(mesh.face_uniform[f]) {
+                    restart = Some(restart.map_or(level, |r: usize| r.min(level)));
+                }
+            }
+            self.judged = Some((positions, mesh));
+        }
+        Ok(restart)
     }
 
     /// The scheme.
@@ -401,4 +399,23 @@ fn request_support(up: &SparseLevel, level: &SparseLevel, sel: &[bool], out: &mu
             }
         }
     }
+}
+
+/// The schemes adaptive refinement covers, and the level cap.
+fn check_arguments(scheme: &Scheme, max_level: usize) -> Result<(), AdaptiveError> {
+    if !matches!(
+        scheme,
+        Scheme::CatmullClark | Scheme::Loop | Scheme::Bilinear
+    ) {
+        return Err(AdaptiveError::Scheme {
+            scheme: scheme.to_string(),
+        });
+    }
+    if max_level > MAX_LEVELS {
+        return Err(AdaptiveError::TooManyLevels {
+            levels: max_level,
+            max: MAX_LEVELS,
+        });
+    }
+    Ok(())
 }

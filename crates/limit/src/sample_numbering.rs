@@ -363,8 +363,7 @@ pub(crate) fn number_samples(topo: &Topology, loop_scheme: bool, rate: u32) -> N
         edge_first: &edge_first,
     };
     let params = assign(&grid, &numbers, &starts);
-    let mut out = emit(&grid, &numbers, &starts, total);
-    out.params = Vec::new();
+    let out = emit(&grid, &numbers, &starts, total);
     Numbered {
         params,
         out,
