@@ -222,11 +222,12 @@ impl AdaptiveMesh {
     /// differences across edges and vertices.
     pub fn conformity(&self) -> Conformity {
         let sizes: Vec<u32> = self.face_offsets.windows(2).map(|w| w[1] - w[0]).collect();
-        let topo = match TopologyBuilder::new(self.positions.len())
+        // The edges alone: the vertex rings a full build would order are not needed here.
+        let edges = match TopologyBuilder::new(self.positions.len())
             .accept_inconsistent_orientation(true)
-            .build(&sizes, &self.face_vertices)
+            .edges(&sizes, &self.face_vertices)
         {
-            Ok(t) => t,
+            Ok(edges) => edges,
             Err(_) => {
                 return Conformity {
                     mismatched_edges: usize::MAX,
@@ -238,37 +239,36 @@ impl AdaptiveMesh {
             mismatched_edges: self.mismatched_edges(),
             ..Conformity::default()
         };
-        // Sums and maxima: the same whatever the thread count.
-        let (boundary, nonmanifold, edge_spread) = (0..topo.num_edges())
-            .into_par_iter()
-            .map(|e| {
-                let levels = topo
-                    .edge_faces(e)
-                    .iter()
-                    .map(|&f| self.face_levels[f as usize]);
-                (
-                    usize::from(topo.is_boundary_edge(e)),
-                    usize::from(topo.is_non_manifold_edge(e)),
-                    spread(levels),
-                )
-            })
-            .reduce(|| (0, 0, 0), |a, b| (a.0 + b.0, a.1 + b.1, a.2.max(b.2)));
-        report.boundary_edges = boundary;
-        report.nonmanifold_edges = nonmanifold;
-        report.max_level_difference_edge = edge_spread;
-        report.max_level_difference_vertex = (0..topo.num_vertices())
-            .into_par_iter()
-            .map(|v| {
-                let levels = topo
-                    .vertex_faces(v)
-                    .iter()
-                    .map(|&f| self.face_levels[f as usize]);
-                spread(levels)
-            })
-            .max()
-            .unwrap_or(0);
+        let ne = edges.num_edges();
+        report.boundary_edges = (0..ne).filter(|&e| edges.is_boundary_edge(e)).count();
+        report.nonmanifold_edges = (0..ne).filter(|&e| edges.is_non_manifold_edge(e)).count();
+        report.max_level_difference_edge = self.level_spread(edges.face_edges(), ne);
+        report.max_level_difference_vertex =
+            self.level_spread(&self.face_vertices, self.positions.len());
         report.conforming = report.mismatched_edges == 0;
         report
+    }
+
+    /// The largest difference between the levels of two faces that share an element, each
+    /// face-vertex naming the element (of `count`) it puts its face at.
+    fn level_spread(&self, element_of_corner: &[u32], count: usize) -> u8 {
+        let mut lowest = vec![u8::MAX; count];
+        let mut highest = vec![0u8; count];
+        for f in 0..self.num_faces() {
+            let level = self.face_levels[f];
+            let corners = self.face_offsets[f] as usize..self.face_offsets[f + 1] as usize;
+            for &x in &element_of_corner[corners] {
+                lowest[x as usize] = lowest[x as usize].min(level);
+                highest[x as usize] = highest[x as usize].max(level);
+            }
+        }
+        // An element no face uses has lowest > highest: no spread.
+        lowest
+            .iter()
+            .zip(&highest)
+            .map(|(&lo, &hi)| hi.saturating_sub(lo))
+            .max()
+            .unwrap_or(0)
     }
 
     /// Uniform edges (or pieces of one) used by another number of face sides than the faces
@@ -316,12 +316,20 @@ impl AdaptiveMesh {
             .into_par_iter()
             .filter(|&f| !self.holes[f])
             .map(|f| {
-                let p: Vec<DVec3> = self
-                    .face(f)
-                    .iter()
-                    .map(|&v| self.positions[v as usize])
-                    .collect();
-                conform::max_corner_cos(&p)
+                let face = self.face(f);
+                // Faces here are triangles and quads but for whole n-gons of the base.
+                let mut small = [DVec3::ZERO; 4];
+                let large: Vec<DVec3>;
+                let p = if face.len() <= small.len() {
+                    for (q, &v) in small.iter_mut().zip(face) {
+                        *q = self.positions[v as usize];
+                    }
+                    &small[..face.len()]
+                } else {
+                    large = face.iter().map(|&v| self.positions[v as usize]).collect();
+                    &large
+                };
+                conform::max_corner_cos(p)
             })
             .reduce(|| f64::NEG_INFINITY, f64::max);
         if cos == f64::NEG_INFINITY {
@@ -373,11 +381,6 @@ impl AdaptiveMesh {
             surface.face_distance(face as usize, sub as usize, &p, &self.corner_params[range])
         }
     }
-}
-
-fn spread(levels: impl Iterator<Item = u8>) -> u8 {
-    let (lo, hi) = levels.fold((u8::MAX, 0u8), |(lo, hi), l| (lo.min(l), hi.max(l)));
-    hi.saturating_sub(lo)
 }
 
 #[cfg(doctest)]

@@ -77,27 +77,16 @@ impl TopologyBuilder {
         face_vertices: &[u32],
     ) -> Result<(Topology, Vec<BuildWarning>), TopologyError> {
         let nv = self.num_vertices;
-        check_index_range(nv, face_sizes, face_vertices)?;
-        let face_offsets = checked_face_offsets(face_sizes, face_vertices.len())?;
-        let half_face = half_faces(&face_offsets, face_vertices.len());
+        let (face_offsets, half_face) = self.face_loops(face_sizes, face_vertices)?;
         let faces = FaceLoops {
             offsets: &face_offsets,
             vertices: face_vertices,
             half_face: &half_face,
         };
-        faces.check_vertex_range(nv)?;
-        let mut warnings = faces.repeated_vertex_warnings();
         // Half-edges by their first vertex: the vertex-face relation, and where edge matching
         // finds each vertex's half-edges.
         let corners = par_group_indices(nv, face_vertices.len(), |h| face_vertices[h]);
-        let pairs = faces.match_pairs(&corners);
-        report_conflicts(
-            &faces,
-            pairs.conflicts,
-            self.accept_inconsistent_orientation,
-            &mut warnings,
-        )?;
-        let numbered = faces.number_edges(pairs.link, &pairs.non_manifold);
+        let (numbered, warnings) = self.numbered_edges(&faces, &corners)?;
         let relations = Relations {
             face_offsets: &face_offsets,
             face_vertices: par_copy(face_vertices),
@@ -108,6 +97,123 @@ impl TopologyBuilder {
         };
         let topo = relations.assemble(nv, corners);
         Ok((topo, warnings))
+    }
+
+    /// The edges of the mesh alone, numbered and flagged as [`Self::build`] numbers and
+    /// flags them, without the vertex rings and the other relations: for measures over
+    /// edges (boundary and non-manifold counts, what meets at an edge) at a fraction of a
+    /// build's cost.
+    ///
+    /// ```
+    /// use subd_mesh::TopologyBuilder;
+    /// // Two quads sharing an edge: 7 edges, 6 of them on the boundary.
+    /// let edges = TopologyBuilder::new(6)
+    ///     .edges(&[4, 4], &[0, 1, 4, 3, 1, 2, 5, 4])
+    ///     .unwrap();
+    /// assert_eq!(edges.num_edges(), 7);
+    /// assert_eq!((0..7).filter(|&e| edges.is_boundary_edge(e)).count(), 6);
+    /// ```
+    ///
+    /// # Errors
+    /// As [`Self::build`].
+    pub fn edges(
+        &self,
+        face_sizes: &[u32],
+        face_vertices: &[u32],
+    ) -> Result<FaceEdges, TopologyError> {
+        let nv = self.num_vertices;
+        let (face_offsets, half_face) = self.face_loops(face_sizes, face_vertices)?;
+        let faces = FaceLoops {
+            offsets: &face_offsets,
+            vertices: face_vertices,
+            half_face: &half_face,
+        };
+        let corners = par_group_indices(nv, face_vertices.len(), |h| face_vertices[h]);
+        let (numbered, _) = self.numbered_edges(&faces, &corners)?;
+        drop(corners);
+        let mut face_counts = vec![0u32; numbered.edge_vertices.len()];
+        for &e in &numbered.face_edges {
+            face_counts[e as usize] += 1;
+        }
+        let mut edge_flags = numbered.edge_flags;
+        for (fl, &count) in edge_flags.iter_mut().zip(&face_counts) {
+            *fl |= edge_flags_by_face_count(count);
+        }
+        Ok(FaceEdges {
+            face_edges: numbered.face_edges,
+            edge_flags,
+        })
+    }
+
+    /// Checks the index ranges and face sizes; the face offsets and each half-edge's face.
+    fn face_loops(
+        &self,
+        face_sizes: &[u32],
+        face_vertices: &[u32],
+    ) -> Result<(Vec<u32>, Vec<u32>), TopologyError> {
+        check_index_range(self.num_vertices, face_sizes, face_vertices)?;
+        let face_offsets = checked_face_offsets(face_sizes, face_vertices.len())?;
+        let half_face = half_faces(&face_offsets, face_vertices.len());
+        FaceLoops {
+            offsets: &face_offsets,
+            vertices: face_vertices,
+            half_face: &half_face,
+        }
+        .check_vertex_range(self.num_vertices)?;
+        Ok((face_offsets, half_face))
+    }
+
+    /// Matches the half-edges into edges and numbers them (passes 1 and 2); the warnings
+    /// about accepted oddities, or the first orientation conflict when they are refused.
+    fn numbered_edges(
+        &self,
+        faces: &FaceLoops,
+        corners: &Csr<u32>,
+    ) -> Result<(NumberedEdges, Vec<BuildWarning>), TopologyError> {
+        let mut warnings = faces.repeated_vertex_warnings();
+        let pairs = faces.match_pairs(corners);
+        report_conflicts(
+            faces,
+            pairs.conflicts,
+            self.accept_inconsistent_orientation,
+            &mut warnings,
+        )?;
+        Ok((
+            faces.number_edges(pairs.link, &pairs.non_manifold),
+            warnings,
+        ))
+    }
+}
+
+/// The edges of a face list ([`TopologyBuilder::edges`]): each face-vertex's edge (the one
+/// leaving it along its face) and each edge's flags, as in the [`Topology`] built from the
+/// same lists.
+#[derive(Debug, Clone)]
+pub struct FaceEdges {
+    face_edges: Vec<u32>,
+    edge_flags: Vec<u8>,
+}
+
+impl FaceEdges {
+    /// Number of edges.
+    pub fn num_edges(&self) -> usize {
+        self.edge_flags.len()
+    }
+
+    /// The edge of every face-vertex, in face-vertex order ([`Topology::face_edges`] of
+    /// every face, one after the other).
+    pub fn face_edges(&self) -> &[u32] {
+        &self.face_edges
+    }
+
+    /// As [`Topology::is_boundary_edge`].
+    pub fn is_boundary_edge(&self, e: usize) -> bool {
+        self.edge_flags[e] & EDGE_BOUNDARY != 0
+    }
+
+    /// As [`Topology::is_non_manifold_edge`].
+    pub fn is_non_manifold_edge(&self, e: usize) -> bool {
+        self.edge_flags[e] & EDGE_NON_MANIFOLD != 0
     }
 }
 
@@ -713,14 +819,18 @@ fn flag_edges_by_face_count(edge_face_offsets: &[u32], edge_flags: &mut [u8]) {
         .with_min_len(BLOCK)
         .enumerate()
         .for_each(|(e, fl)| {
-            let count = edge_face_offsets[e + 1] - edge_face_offsets[e];
-            if count > 2 {
-                *fl |= EDGE_NON_MANIFOLD;
-            }
-            if count == 1 {
-                *fl |= EDGE_BOUNDARY;
-            }
+            *fl |= edge_flags_by_face_count(edge_face_offsets[e + 1] - edge_face_offsets[e]);
         });
+}
+
+/// The flags an edge gets from its number of faces: boundary with one, non-manifold with
+/// more than two.
+fn edge_flags_by_face_count(count: u32) -> u8 {
+    match count {
+        1 => EDGE_BOUNDARY,
+        0 | 2 => 0,
+        _ => EDGE_NON_MANIFOLD,
+    }
 }
 
 /// Vertex flags: boundary and non-manifold from the vertex's edges, isolated when no face

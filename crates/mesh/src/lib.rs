@@ -41,7 +41,7 @@ pub mod tags;
 mod topology;
 
 pub use analysis::{Component, TopologySummary};
-pub use build::TopologyBuilder;
+pub use build::{FaceEdges, TopologyBuilder};
 pub use error::{BuildWarning, TopologyError};
 pub use geometry::{Mesh, bounding_box, validate_positions};
 pub use glam::DVec3;

@@ -36,6 +36,17 @@ fn check_exact(s: &SurfaceShape, a: &AdaptiveRefinement, uniform: &[Vec<DVec3>])
     }
     let mesh = a.mesh(Positions::Refined).unwrap();
     let c = mesh.conformity();
+    assert_eq!(
+        edge_measures(&mesh),
+        (
+            c.boundary_edges,
+            c.nonmanifold_edges,
+            c.max_level_difference_edge,
+            c.max_level_difference_vertex
+        ),
+        "{}",
+        s.name
+    );
     assert!(c.conforming, "{}: {c:?}", s.name);
     assert!(c.max_level_difference_vertex <= 1, "{}: {c:?}", s.name);
     assert!(c.max_level_difference_edge <= 1, "{}: {c:?}", s.name);
@@ -51,6 +62,31 @@ fn check_exact(s: &SurfaceShape, a: &AdaptiveRefinement, uniform: &[Vec<DVec3>])
             s.name
         );
     }
+}
+
+/// Boundary and non-manifold edges and the largest level differences across edges and
+/// vertices, read from the output's full topology (the report computes them from its edges
+/// alone).
+fn edge_measures(mesh: &subd_adaptive::AdaptiveMesh) -> (usize, usize, u8, u8) {
+    let sizes: Vec<u32> = mesh.face_offsets.windows(2).map(|w| w[1] - w[0]).collect();
+    let t = subd_mesh::TopologyBuilder::new(mesh.positions.len())
+        .accept_inconsistent_orientation(true)
+        .build(&sizes, &mesh.face_vertices)
+        .unwrap();
+    let spread = |faces: &[u32]| {
+        let levels = faces.iter().map(|&f| mesh.face_levels[f as usize]);
+        levels.clone().max().unwrap_or(0) - levels.min().unwrap_or(0)
+    };
+    let edges = 0..t.num_edges();
+    (
+        edges.clone().filter(|&e| t.is_boundary_edge(e)).count(),
+        edges.clone().filter(|&e| t.is_non_manifold_edge(e)).count(),
+        edges.map(|e| spread(t.edge_faces(e))).max().unwrap_or(0),
+        (0..t.num_vertices())
+            .map(|v| spread(t.vertex_faces(v)))
+            .max()
+            .unwrap_or(0),
+    )
 }
 
 #[test]

@@ -199,8 +199,36 @@ fn check_same(input: &Input, accept: bool, what: &str) -> Built {
             }
             _ => assert_eq!(got, want, "{what}, {threads} threads"),
         }
+        let edges = pool.install(|| {
+            TopologyBuilder::new(input.nv)
+                .accept_inconsistent_orientation(accept)
+                .edges(&input.sizes, &input.vertices)
+        });
+        check_edges(&edges, &want, &format!("{what}, {threads} threads: edges"));
     }
     want
+}
+
+/// The edge census against the serial build's edges and flags, or its error.
+fn check_edges(got: &Result<FaceEdges, TopologyError>, want: &Built, what: &str) {
+    match (got, want) {
+        (Ok(edges), Ok((topo, _))) => {
+            let face_edges: Vec<u32> = (0..topo.num_faces())
+                .flat_map(|f| topo.face_edges(f).iter().copied())
+                .collect();
+            assert_eq!(edges.face_edges(), face_edges, "{what}");
+            assert_eq!(edges.num_edges(), topo.num_edges(), "{what}");
+            for e in 0..topo.num_edges() {
+                assert_eq!(
+                    (edges.is_boundary_edge(e), edges.is_non_manifold_edge(e)),
+                    (topo.is_boundary_edge(e), topo.is_non_manifold_edge(e)),
+                    "{what}: edge {e}"
+                );
+            }
+        }
+        (Err(g), Err(w)) => assert_eq!(g, w, "{what}"),
+        _ => panic!("{what}: one refused, the other not"),
+    }
 }
 
 #[test]
