@@ -45,6 +45,7 @@
 pub mod acc;
 mod child_limit;
 mod child_param;
+mod composed_rows;
 pub mod eigen;
 pub mod eval;
 pub mod fvar;

@@ -32,13 +32,15 @@ use std::collections::HashMap;
 use std::f64::consts::TAU;
 
 use glam::DVec3;
+use rayon::prelude::*;
 use subd_mesh::Topology;
 use subd_mesh::cut::{NONE, cut};
-use subd_mesh::neighbourhood::{faces_touching, vertices_within_rings};
+use subd_mesh::neighbourhood::{faces_touching, vertices_within_rings, without_pinches};
 use subd_schemes::StencilTable;
 use subd_schemes::split_schemes::{Features, doo_sabin};
 use subd_schemes::{Options, Refinement, Scheme, Split};
 
+use crate::composed_rows::{ComposedRows, Row};
 use crate::split_eigen::{
     FeatureCentre, FeatureMasks, LocalMasks, expand_row, feature_ball, feature_masks,
     feature_matrix, local_masks, row_between,
@@ -89,9 +91,6 @@ impl SplitLimitStencils {
         }
     }
 }
-
-/// A row under construction: weights over some level's vertices.
-type Row = Vec<(u32, f64)>;
 
 /// Rows over level-`l` vertices carried back to the base through `composed` (`l ≥ 1`).
 fn to_base(row: &Row, composed: &StencilTable) -> Row {
@@ -261,8 +260,6 @@ fn regular_ball(t: &Topology, features: &Features, v: u32, ball: &[u32], expecte
 /// piece cut around them.
 struct Refined {
     r: Refinement,
-    /// The stencils from each level used back to level 0, composed once.
-    composed: std::cell::RefCell<HashMap<usize, StencilTable>>,
     /// For a piece: the piece vertex of each base vertex ([`NONE`] outside) and the base vertex
     /// of each piece vertex. Vertices keep their index at every level of the √3 and butterfly
     /// splits, so these serve every level.
@@ -279,15 +276,11 @@ impl Refined {
     }
 
     /// A row over the vertices of the refinement's `level` as a row over the base vertices.
-    fn base_row(&self, row: Row, level: usize) -> Row {
+    fn base_row(&self, row: Row, level: usize, composed: &mut ComposedRows) -> Row {
         let row = if level == 0 {
             row
         } else {
-            let mut composed = self.composed.borrow_mut();
-            let table = composed
-                .entry(level)
-                .or_insert_with(|| self.r.composed(level));
-            to_base(&row, table)
+            composed.over_level_zero(&row, level)
         };
         match &self.piece {
             None => row,
@@ -311,11 +304,7 @@ impl Refiner<'_> {
     fn whole(&self, levels: usize) -> Result<Refined, LimitError> {
         let r = Refinement::new(self.base, self.scheme.clone(), &Options::default(), levels)
             .map_err(|e| LimitError::Analysis(e.to_string()))?;
-        Ok(Refined {
-            r,
-            composed: Default::default(),
-            piece: None,
-        })
+        Ok(Refined { r, piece: None })
     }
 
     /// A refinement `levels` deep that agrees with the whole base's on balls of `radius`
@@ -324,20 +313,55 @@ impl Refiner<'_> {
     /// A ring of a finer level lies inside the ring of the base it came from, and one step
     /// reads its parent within two rings (the butterflies' wings) plus one for the features
     /// and splits a rule sees; so a piece of the faces within `radius + 3·levels + 2` base
-    /// rings of `vertices` refines, on those balls, exactly as the whole base does.
+    /// rings of `vertices` refines, on those balls, exactly as the whole base does. That
+    /// holds for a ball read at any level down to `levels`.
     fn around(
         &self,
         vertices: &[u32],
         levels: usize,
         radius: usize,
     ) -> Result<Refined, LimitError> {
+        self.piece(vertices, levels, radius + 3 * levels + 2)
+    }
+
+    /// [`Self::around`] for balls read at level `levels` only, in a piece as small as the
+    /// split allows. The butterflies' split halves distances: an old vertex `d` rings from
+    /// `v` is `2d` rings away one level down, and an edge point within `r` rings has both
+    /// ends within `⌊(r + 1)/2⌋` rings of the level above (each child edge changes the sum of
+    /// the ends' distances by at most one). Its stencil reads the rings of those ends (the
+    /// wings lie across their edges), so a level is exact within `C` rings when the level
+    /// above is within `⌊(C + 1)/2⌋ + 1`; one more ring per level is kept as a margin, and
+    /// `radius + 1` at the last level, so the ball's own vertices have whole rings. √3's
+    /// split does not halve distances so simply: it keeps [`Self::around`]'s count.
+    fn around_last_level(
+        &self,
+        vertices: &[u32],
+        levels: usize,
+        radius: usize,
+    ) -> Result<Refined, LimitError> {
+        if self.scheme.split() != Split::Triangle {
+            return self.around(vertices, levels, radius);
+        }
+        let mut rings = radius + 1;
+        for _ in 0..levels {
+            rings = rings.div_ceil(2) + 2;
+        }
+        self.piece(vertices, levels, rings)
+    }
+
+    /// The faces touching the vertices within `rings` base rings of `vertices`, refined
+    /// `levels` deep; the whole base where that is every face, or where the piece cannot be
+    /// refined.
+    fn piece(&self, vertices: &[u32], levels: usize, rings: usize) -> Result<Refined, LimitError> {
         if self.how == Neighbourhoods::Whole || levels == 0 {
             return self.whole(levels);
         }
-        let rings = radius + 3 * levels + 2;
-        let faces = faces_touching(
+        let faces = without_pinches(
             self.base,
-            &vertices_within_rings(self.base, vertices, rings),
+            &faces_touching(
+                self.base,
+                &vertices_within_rings(self.base, vertices, rings),
+            ),
         );
         if faces.len() == self.base.num_faces() {
             return self.whole(levels);
@@ -358,7 +382,6 @@ impl Refiner<'_> {
         }
         Ok(Refined {
             r,
-            composed: Default::default(),
             piece: Some((of_base, sub.vertices)),
         })
     }
@@ -434,32 +457,52 @@ fn interior_rows(
             .map(|&v| masks[&base.valence(v as usize)].0.radius)
             .max()
             .unwrap_or(0);
-        let refined = refiner.around(&pending, level, radius)?;
+        let refined = refiner.around_last_level(&pending, level, radius)?;
         let t = refined.r.topology(level);
         let features = Features::new(t);
-        let mut still = Vec::new();
-        for &v in &pending {
+        let masks = &masks;
+        // The vertex's rows, or `None` while its ball is not regular yet.
+        let rows_of = |v: u32, composed: &mut ComposedRows| {
             let (m, size) = &masks[&base.valence(v as usize)];
             let lv = refined.vertex(v);
             let ball = LocalMasks::ball(t, lv, m.radius);
             if !regular_ball(t, &features, lv, &ball, *size) {
-                still.push(v);
-                continue;
+                return None;
             }
-            let row = |w: &[f64]| -> Row {
+            let mut row = |w: &[f64]| -> Row {
                 let r: Row = ball
                     .iter()
                     .zip(w)
                     .filter(|(_, w)| **w != 0.0)
                     .map(|(&u, &w)| (u, w))
                     .collect();
-                refined.base_row(r, level)
+                refined.base_row(r, level, composed)
             };
-            if !scheme.is_interpolating() {
-                position[v as usize] = Some(row(&m.limit));
-            }
-            if let Some([a, b]) = &m.tangents {
-                tangents[v as usize] = Some([row(a), row(b)]);
+            let limit = (!scheme.is_interpolating()).then(|| row(&m.limit));
+            let tangent_rows = m.tangents.as_ref().map(|[a, b]| [row(a), row(b)]);
+            Some((limit, tangent_rows))
+        };
+        // Vertices in chunks, each composing the rows it reads (a row two chunks read is
+        // composed twice, the same way): the rows do not depend on the chunks.
+        let found: Vec<Vec<_>> = pending
+            .par_chunks(ROWS_CHUNK)
+            .map(|chunk| {
+                let mut composed = ComposedRows::new(&refined.r);
+                chunk.iter().map(|&v| rows_of(v, &mut composed)).collect()
+            })
+            .collect();
+        let mut still = Vec::new();
+        for (&v, rows) in pending.iter().zip(found.into_iter().flatten()) {
+            match rows {
+                None => still.push(v),
+                Some((limit, tangent_rows)) => {
+                    if limit.is_some() {
+                        position[v as usize] = limit;
+                    }
+                    if tangent_rows.is_some() {
+                        tangents[v as usize] = tangent_rows;
+                    }
+                }
             }
         }
         pending = still;
@@ -467,6 +510,9 @@ fn interior_rows(
     }
     Ok(())
 }
+
+/// Pending vertices per parallel task of [`interior_rows`].
+const ROWS_CHUNK: usize = 2048;
 
 /// √3's limit of a vertex inside a boundary or crease curve: `(p₋₁ + 4p + p₁)/6` of its
 /// curve neighbours. The mask is invariant under every step as long as those neighbours do
@@ -495,7 +541,7 @@ fn sqrt3_curve_limit(
     let refined = refiner.around(&[v], 2, 1)?;
     let t2 = refined.r.topology(2);
     let row = curve(t2, &Features::new(t2), refined.vertex(v));
-    Ok(refined.base_row(row, 2))
+    Ok(refined.base_row(row, 2, &mut ComposedRows::new(&refined.r)))
 }
 
 /// Darts and boundary vertices: the masks of the synthetic feature centre of the same kind
@@ -519,6 +565,7 @@ fn feature_rows(
         // Refined only as deep as this level needs, only around the vertices still pending
         // (most vertices are settled at level 0).
         let refined = refiner.around(&pending, level + steps, FEATURE_RADIUS)?;
+        let mut composed = ComposedRows::new(&refined.r);
         let r = &refined.r;
         let (parent, child) = (r.topology(level), r.topology(level + steps));
         let rows = |c: u32| row_between(r, level, level + steps, c);
@@ -551,14 +598,14 @@ fn feature_rows(
                 continue;
             }
             let ball = feature_ball(parent, lv, m.radius).expect("a feature vertex");
-            let row = |w: &[f64]| -> Row {
+            let mut row = |w: &[f64]| -> Row {
                 let r: Row = ball
                     .iter()
                     .zip(w)
                     .filter(|(_, w)| w.abs() > 1e-15)
                     .map(|(&u, &w)| (u, w))
                     .collect();
-                refined.base_row(r, level)
+                refined.base_row(r, level, &mut composed)
             };
             if position[v as usize].is_none() {
                 position[v as usize] = Some(row(&m.limit));

@@ -29,11 +29,17 @@ use crate::Topology;
 /// The edge neighbours of `v` counter-clockwise, starting at `from` (the first neighbour
 /// when `from` is not one of them).
 pub fn ring_from(t: &Topology, v: u32, from: u32) -> Vec<u32> {
-    let ring: Vec<u32> = t.vertex_ring(v as usize).collect();
+    let mut ring = Vec::new();
+    ring_from_into(t, v, from, &mut ring);
+    ring
+}
+
+/// [`ring_from`] into `ring` (cleared first).
+fn ring_from_into(t: &Topology, v: u32, from: u32, ring: &mut Vec<u32>) {
+    ring.clear();
+    ring.extend(t.vertex_ring(v as usize));
     let start = ring.iter().position(|&u| u == from).unwrap_or(0);
-    (0..ring.len())
-        .map(|i| ring[(start + i) % ring.len()])
-        .collect()
+    ring.rotate_left(start);
 }
 
 /// Breadth-first labels of the ball of radius `radius` (in edges) around `seeds`, each a
@@ -41,13 +47,15 @@ pub fn ring_from(t: &Topology, v: u32, from: u32) -> Vec<u32> {
 /// vertex labelled `i`. A vertex's neighbours are labelled counter-clockwise from the
 /// vertex it was reached from, so two balls of the same shape get the same labels.
 pub fn labelled_ball(t: &Topology, seeds: &[(u32, u32)], radius: usize) -> Vec<u32> {
-    // A set, not a per-vertex array: balls are small and taken around many vertices of
-    // large meshes, where clearing an array the size of the mesh each time dominates.
-    let mut labelled: HashSet<u32> = HashSet::new();
+    // Not a per-vertex array: balls are small and taken around many vertices of large
+    // meshes, where clearing an array the size of the mesh each time dominates. The labels
+    // themselves are searched while there are few of them, a set kept past that.
+    const SEARCHED: usize = 48;
+    let mut labelled: Option<HashSet<u32>> = None;
     let mut order: Vec<u32> = Vec::new();
     let mut queue: VecDeque<(u32, u32, usize)> = VecDeque::new();
+    let mut ring = Vec::new();
     for &(v, from) in seeds {
-        labelled.insert(v);
         order.push(v);
         queue.push_back((v, from, 0));
     }
@@ -55,8 +63,16 @@ pub fn labelled_ball(t: &Topology, seeds: &[(u32, u32)], radius: usize) -> Vec<u
         if d == radius {
             continue;
         }
-        for u in ring_from(t, v, from) {
-            if labelled.insert(u) {
+        ring_from_into(t, v, from, &mut ring);
+        for &u in &ring {
+            let new = if labelled.is_none() && order.len() < SEARCHED {
+                !order.contains(&u)
+            } else {
+                labelled
+                    .get_or_insert_with(|| order.iter().copied().collect())
+                    .insert(u)
+            };
+            if new {
                 order.push(u);
                 queue.push_back((u, v, d + 1));
             }
@@ -145,6 +161,59 @@ pub fn faces_touching(t: &Topology, vertices: &[u32]) -> Vec<u32> {
     (0..t.num_faces() as u32)
         .filter(|&f| take[f as usize])
         .collect()
+}
+
+/// `faces` (ascending) grown until no vertex they touch is pinched, ascending. A vertex is
+/// pinched when the faces around it that are in make more than one run of its fan: cut
+/// out, it would be non-manifold, which a refinement of the piece refuses. A pinched vertex
+/// (and a non-manifold one missing faces) gets all its faces, which may pinch others.
+pub fn without_pinches(t: &Topology, faces: &[u32]) -> Vec<u32> {
+    let mut taken = vec![false; t.num_faces()];
+    let mut check: Vec<u32> = Vec::new();
+    for &f in faces {
+        taken[f as usize] = true;
+        check.extend_from_slice(t.face_vertices(f as usize));
+    }
+    while let Some(v) = check.pop() {
+        let around = t.vertex_faces(v as usize);
+        if !is_pinched(t, v as usize, around, &taken) {
+            continue;
+        }
+        for &f in around {
+            if !taken[f as usize] {
+                taken[f as usize] = true;
+                check.extend_from_slice(t.face_vertices(f as usize));
+            }
+        }
+    }
+    (0..t.num_faces() as u32)
+        .filter(|&f| taken[f as usize])
+        .collect()
+}
+
+/// Whether the taken faces of `around` (vertex `v`'s faces, in fan order where `v` is
+/// manifold) are neither all of them nor one run of the fan (cyclic for an interior vertex).
+fn is_pinched(t: &Topology, v: usize, around: &[u32], taken: &[bool]) -> bool {
+    let is_in = |i: usize| taken[around[i] as usize];
+    let count = (0..around.len()).filter(|&i| is_in(i)).count();
+    if count == around.len() {
+        return false;
+    }
+    if t.is_non_manifold_vertex(v) {
+        return true;
+    }
+    let cyclic = !t.is_boundary_vertex(v);
+    let starts = (0..around.len())
+        .filter(|&i| {
+            let before = match i {
+                0 if cyclic => is_in(around.len() - 1),
+                0 => false,
+                _ => is_in(i - 1),
+            };
+            is_in(i) && !before
+        })
+        .count();
+    starts > 1
 }
 
 /// Faces within two rings of `targets` (the faces touching [`vertices_within_rings`] of

@@ -552,6 +552,72 @@ fn normals_of_a_flat_grid_are_the_plane_normal() {
     }
 }
 
+/// A `n × n` grid of squares, each cut along a diagonal chosen by a fixed pseudo-random
+/// sequence, lifted onto a wavy height field: valences 2 to 8 everywhere, a boundary, and
+/// wide enough that the pieces cut around vertices are much smaller than the mesh.
+fn irregular_grid(n: u32) -> (Topology, Vec<DVec3>) {
+    let id = |i: u32, j: u32| j * (n + 1) + i;
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut faces = Vec::new();
+    for j in 0..n {
+        for i in 0..n {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+            if state.is_multiple_of(3) {
+                faces.extend([a, b, d, b, c, d]);
+            } else {
+                faces.extend([a, b, c, a, c, d]);
+            }
+        }
+    }
+    let nv = ((n + 1) * (n + 1)) as usize;
+    let t = subd_mesh::TopologyBuilder::new(nv)
+        .build(&vec![3; faces.len() / 3], &faces)
+        .unwrap();
+    let p = (0..nv as u32)
+        .map(|v| {
+            let (x, y) = (f64::from(v % (n + 1)), f64::from(v / (n + 1)));
+            DVec3::new(x, y, (0.7 * x).sin() + (0.45 * y).cos())
+        })
+        .collect();
+    (t, p)
+}
+
+/// [`split_limits_of_local_pieces_match_the_whole_mesh`] where the pieces are far smaller
+/// than the mesh (the OpenSubdiv shapes are mostly refined whole): an irregular grid with a
+/// boundary, at the base and one level down.
+#[test]
+fn split_limits_of_small_pieces_match_the_whole_mesh() {
+    use subd_limit::split_limit::{Neighbourhoods, split_limit_stencils_in};
+    let (t, p) = irregular_grid(40);
+    for scheme in [Scheme::Sqrt3, Scheme::BUTTERFLY, Scheme::ModifiedButterfly] {
+        let r = Refinement::new(&t, scheme.clone(), &Options::default(), 1).unwrap();
+        let p1 = r.refine_points(&p).pop().unwrap();
+        for (level, (t, p)) in [(&t, &p), (r.topology(1), &p1)].into_iter().enumerate() {
+            let whole = split_limit_stencils_in(t, &scheme, Neighbourhoods::Whole).unwrap();
+            let local = split_limit_stencils_in(t, &scheme, Neighbourhoods::Local).unwrap();
+            assert_eq!(
+                whole.position_known, local.position_known,
+                "{scheme:?} {level}"
+            );
+            assert_eq!(
+                whole.tangents_known, local.tangents_known,
+                "{scheme:?} {level}"
+            );
+            let (w, l) = (whole.evaluate(p), local.evaluate(p));
+            assert_eq!(w, l, "{scheme:?} level {level}");
+            // Most interior vertices have a normal: the comparison is not of empty rows.
+            let normals = w.normals.iter().filter(|n| n.is_some()).count();
+            assert!(
+                normals * 2 > t.num_vertices(),
+                "{scheme:?} {level}: {normals}"
+            );
+        }
+    }
+}
+
 /// The limits of √3 and the butterflies read off pieces cut around the vertices that need
 /// deeper levels are those read off the whole mesh refined that deep, bit for bit: on every
 /// OpenSubdiv shape the scheme refines, at the base and one level down (where the pieces
