@@ -47,8 +47,33 @@ impl<'r> ComposedRows<'r> {
         for &(v, _) in row {
             self.compose(level, v);
         }
-        let rows = &self.rows[level - 1];
-        crate::split_eigen::expand_row_with(row, |v| rows[&v].iter().copied())
+        // `expand_row`'s sums (each starting at 0.0), merged through the stamps rather than
+        // a hash map.
+        let current = self.next_stamp();
+        let (stamp, pos) = (&mut self.stamp, &mut self.pos);
+        let mut out: Row = Vec::new();
+        for &(v, w) in row {
+            for &(s, b) in &self.rows[level - 1][&v] {
+                let i = s as usize;
+                if stamp[i] != current {
+                    stamp[i] = current;
+                    pos[i] = out.len() as u32;
+                    out.push((s, 0.0));
+                }
+                out[pos[i] as usize].1 += w * b;
+            }
+        }
+        out
+    }
+
+    /// A stamp no entry holds yet (on wrapping round, the stamps are cleared once).
+    fn next_stamp(&mut self) -> u32 {
+        self.current = self.current.wrapping_add(1);
+        if self.current == u32::MAX {
+            self.stamp.fill(u32::MAX);
+            self.current = 0;
+        }
+        self.current
     }
 
     /// Composes (once) the row of vertex `v` of `level`, and first those of the vertices of
@@ -70,14 +95,9 @@ impl<'r> ComposedRows<'r> {
     /// `Σ a · (composed row of m)` over the stencil `(sources, weights)` of a vertex of
     /// `level`, merged as `then`'s row sink merges (level 1 reads the identity).
     fn sum(&mut self, level: usize, sources: &[u32], weights: &[f64]) -> Row {
-        // A fresh stamp per row; on wrapping round, the stamps are cleared once.
-        self.current = self.current.wrapping_add(1);
-        if self.current == u32::MAX {
-            self.stamp.fill(u32::MAX);
-            self.current = 0;
-        }
+        let current = self.next_stamp();
         let mut out: Row = Vec::new();
-        let (stamp, pos, current) = (&mut self.stamp, &mut self.pos, self.current);
+        let (stamp, pos) = (&mut self.stamp, &mut self.pos);
         let mut add = |s: u32, w: f64| {
             let i = s as usize;
             if stamp[i] == current {

@@ -714,22 +714,11 @@ fn triangle_fan(sectors: usize, rings: usize, closed: bool) -> (Topology, Vec<DV
 /// A sparse row over a table's rows, re-expressed over the table's sources (entries in
 /// order of first appearance).
 pub fn expand_row(row: &[(u32, f64)], table: &subd_schemes::StencilTable) -> Vec<(u32, f64)> {
-    expand_row_with(row, |v| {
-        let (idx, wts) = table.row(v as usize);
-        idx.iter().copied().zip(wts.iter().copied())
-    })
-}
-
-/// [`expand_row`] with the rows read through `source_row` (row `v` as `(source, weight)`
-/// pairs).
-pub(crate) fn expand_row_with<I: Iterator<Item = (u32, f64)>>(
-    row: &[(u32, f64)],
-    mut source_row: impl FnMut(u32) -> I,
-) -> Vec<(u32, f64)> {
     let mut acc: std::collections::HashMap<u32, f64> = Default::default();
     let mut order = Vec::new();
     for &(v, w) in row {
-        for (s, b) in source_row(v) {
+        let (idx, wts) = table.row(v as usize);
+        for (&s, &b) in idx.iter().zip(wts) {
             *acc.entry(s).or_insert_with(|| {
                 order.push(s);
                 0.0
