@@ -76,26 +76,22 @@ impl TopologyBuilder {
         face_sizes: &[u32],
         face_vertices: &[u32],
     ) -> Result<(Topology, Vec<BuildWarning>), TopologyError> {
-        let nv = self.num_vertices;
-        let (face_offsets, half_face) = self.face_loops(face_sizes, face_vertices)?;
-        let faces = FaceLoops {
-            offsets: &face_offsets,
-            vertices: face_vertices,
-            half_face: &half_face,
-        };
-        // Half-edges by their first vertex: the vertex-face relation, and where edge matching
-        // finds each vertex's half-edges.
-        let corners = par_group_indices(nv, face_vertices.len(), |h| face_vertices[h]);
-        let (numbered, warnings) = self.numbered_edges(&faces, &corners)?;
+        let Numbered {
+            face_offsets,
+            half_face,
+            corners,
+            edges,
+            warnings,
+        } = self.numbered(face_sizes, face_vertices)?;
         let relations = Relations {
             face_offsets: &face_offsets,
             face_vertices: par_copy(face_vertices),
             half_face: &half_face,
-            face_edges: numbered.face_edges,
-            edge_vertices: numbered.edge_vertices,
-            edge_flags: numbered.edge_flags,
+            face_edges: edges.face_edges,
+            edge_vertices: edges.edge_vertices,
+            edge_flags: edges.edge_flags,
         };
-        let topo = relations.assemble(nv, corners);
+        let topo = relations.assemble(self.num_vertices, corners);
         Ok((topo, warnings))
     }
 
@@ -121,16 +117,7 @@ impl TopologyBuilder {
         face_sizes: &[u32],
         face_vertices: &[u32],
     ) -> Result<FaceEdges, TopologyError> {
-        let nv = self.num_vertices;
-        let (face_offsets, half_face) = self.face_loops(face_sizes, face_vertices)?;
-        let faces = FaceLoops {
-            offsets: &face_offsets,
-            vertices: face_vertices,
-            half_face: &half_face,
-        };
-        let corners = par_group_indices(nv, face_vertices.len(), |h| face_vertices[h]);
-        let (numbered, _) = self.numbered_edges(&faces, &corners)?;
-        drop(corners);
+        let numbered = self.numbered(face_sizes, face_vertices)?.edges;
         let mut face_counts = vec![0u32; numbered.edge_vertices.len()];
         for &e in &numbered.face_edges {
             face_counts[e as usize] += 1;
@@ -145,44 +132,54 @@ impl TopologyBuilder {
         })
     }
 
-    /// Checks the index ranges and face sizes; the face offsets and each half-edge's face.
-    fn face_loops(
+    /// Passes 1 and 2 of a build, after checking the index ranges and face sizes: the face
+    /// offsets, each half-edge's face, the half-edges grouped by first vertex, and the
+    /// matched and numbered edges, with the warnings about accepted oddities (or the first
+    /// orientation conflict when they are refused).
+    fn numbered(
         &self,
         face_sizes: &[u32],
         face_vertices: &[u32],
-    ) -> Result<(Vec<u32>, Vec<u32>), TopologyError> {
-        check_index_range(self.num_vertices, face_sizes, face_vertices)?;
+    ) -> Result<Numbered, TopologyError> {
+        let nv = self.num_vertices;
+        check_index_range(nv, face_sizes, face_vertices)?;
         let face_offsets = checked_face_offsets(face_sizes, face_vertices.len())?;
         let half_face = half_faces(&face_offsets, face_vertices.len());
-        FaceLoops {
+        let faces = FaceLoops {
             offsets: &face_offsets,
             vertices: face_vertices,
             half_face: &half_face,
-        }
-        .check_vertex_range(self.num_vertices)?;
-        Ok((face_offsets, half_face))
-    }
-
-    /// Matches the half-edges into edges and numbers them (passes 1 and 2); the warnings
-    /// about accepted oddities, or the first orientation conflict when they are refused.
-    fn numbered_edges(
-        &self,
-        faces: &FaceLoops,
-        corners: &Csr<u32>,
-    ) -> Result<(NumberedEdges, Vec<BuildWarning>), TopologyError> {
+        };
+        faces.check_vertex_range(nv)?;
         let mut warnings = faces.repeated_vertex_warnings();
-        let pairs = faces.match_pairs(corners);
+        // Half-edges by their first vertex: the vertex-face relation, and where edge matching
+        // finds each vertex's half-edges.
+        let corners = par_group_indices(nv, face_vertices.len(), |h| face_vertices[h]);
+        let pairs = faces.match_pairs(&corners);
         report_conflicts(
-            faces,
+            &faces,
             pairs.conflicts,
             self.accept_inconsistent_orientation,
             &mut warnings,
         )?;
-        Ok((
-            faces.number_edges(pairs.link, &pairs.non_manifold),
+        let edges = faces.number_edges(pairs.link, &pairs.non_manifold);
+        Ok(Numbered {
+            face_offsets,
+            half_face,
+            corners,
+            edges,
             warnings,
-        ))
+        })
     }
+}
+
+/// What [`TopologyBuilder::numbered`] gives a build (or an edge census) to go on with.
+struct Numbered {
+    face_offsets: Vec<u32>,
+    half_face: Vec<u32>,
+    corners: Csr<u32>,
+    edges: NumberedEdges,
+    warnings: Vec<BuildWarning>,
 }
 
 /// The edges of a face list ([`TopologyBuilder::edges`]): each face-vertex's edge (the one
