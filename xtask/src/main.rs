@@ -18,6 +18,7 @@ mod geom_conformance;
 mod geom_ref;
 mod osd;
 mod pia_bench;
+mod python_tests;
 mod random_mesh;
 mod refined_limits;
 mod row;
@@ -36,7 +37,8 @@ struct Cli {
 #[derive(Subcommand)]
 enum Task {
     /// Build once in release mode and run every test of the workspace (unit, integration,
-    /// property and doc tests).
+    /// property and doc tests), then the Python package's tests (installed with pip into
+    /// `target/python-env`).
     Test {
         /// Extra arguments passed to `cargo test` (after `--`).
         #[arg(last = true)]
@@ -245,6 +247,14 @@ fn run(cmd: &mut Command) -> Result<(), String> {
     }
 }
 
+/// The workspace's root directory.
+fn workspace_root() -> std::path::PathBuf {
+    std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .map(std::path::Path::to_path_buf)
+        .unwrap_or_default()
+}
+
 fn cargo() -> Command {
     Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
 }
@@ -255,7 +265,8 @@ fn main() -> ExitCode {
         Task::Test { extra } => run(cargo()
             .args(["test", "--workspace", "--release"])
             .arg("--")
-            .args(&extra)),
+            .args(&extra))
+        .and_then(|_| python_tests::run_python_tests(&workspace_root())),
         Task::Conformance {
             shapes,
             random,

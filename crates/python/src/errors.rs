@@ -1,0 +1,43 @@
+//! The package's exceptions, raised from Rust. They are defined in Python
+//! (`subd.SubdError`, `subd.MeshError(SubdError, ValueError)`,
+//! `subd.FormatError(SubdError, ValueError)`), where multiple inheritance is plain, and
+//! looked up here when raised.
+
+use pyo3::exceptions::{PyOSError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyType;
+
+/// An exception of class `name` of the package `subd` with `message`; a `ValueError` if
+/// the package cannot be imported (it always can once `subd._subd` is loaded through it).
+fn subd_error(py: Python<'_>, name: &str, message: String) -> PyErr {
+    let class = py
+        .import("subd")
+        .and_then(|m| m.getattr(name))
+        .and_then(|c| c.cast_into::<PyType>().map_err(PyErr::from));
+    match class {
+        Ok(class) => PyErr::from_type(class, message),
+        Err(_) => PyValueError::new_err(message),
+    }
+}
+
+/// `subd.MeshError`: an invalid mesh, tag or option, naming the element.
+pub(crate) fn mesh_error(message: impl std::fmt::Display) -> PyErr {
+    Python::attach(|py| subd_error(py, "MeshError", message.to_string()))
+}
+
+/// `subd.FormatError`: a file that cannot be parsed, naming file and line.
+fn format_error(message: impl std::fmt::Display) -> PyErr {
+    Python::attach(|py| subd_error(py, "FormatError", message.to_string()))
+}
+
+/// A file error as Python sees one: `OSError` for reading and writing, `FormatError` for
+/// contents, `MeshError` for a valid file whose mesh is not.
+pub(crate) fn io_error(e: subd_io::IoError) -> PyErr {
+    use subd_io::IoError;
+    match e {
+        IoError::Read { .. } | IoError::Write { .. } => PyOSError::new_err(e.to_string()),
+        IoError::UnknownFormat { .. } => PyValueError::new_err(e.to_string()),
+        IoError::Topology { .. } => mesh_error(e),
+        _ => format_error(e),
+    }
+}

@@ -1,0 +1,323 @@
+"""Tests of the Python package against independent computations: the `subd` binary's files
+(the Rust library through its CLI), libigl's Loop, closed forms, and OBJ tags."""
+
+import os
+import pathlib
+import subprocess
+import threading
+
+import numpy as np
+import pytest
+
+import subd
+
+ROOT = pathlib.Path(__file__).resolve().parents[3]
+SHAPES = ROOT.parent / "shared" / "meshes" / "osd"
+SUBD_BIN = os.environ.get("SUBD_BIN")
+
+CUBE_V = np.array(
+    [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]],
+    dtype=float,
+)
+CUBE_F = np.array(
+    [[0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6], [3, 0, 4, 7]]
+)
+
+
+def icosahedron():
+    t = (1 + 5**0.5) / 2
+    v = np.array(
+        [[-1, t, 0], [1, t, 0], [-1, -t, 0], [1, -t, 0], [0, -1, t], [0, 1, t],
+         [0, -1, -t], [0, 1, -t], [t, 0, -1], [t, 0, 1], [-t, 0, -1], [-t, 0, 1]],
+        dtype=float,
+    )
+    f = np.array(
+        [[0, 11, 5], [0, 5, 1], [0, 1, 7], [0, 7, 10], [0, 10, 11], [1, 5, 9], [5, 11, 4],
+         [11, 10, 2], [10, 7, 6], [7, 1, 8], [3, 9, 4], [3, 4, 2], [3, 2, 6], [3, 6, 8],
+         [3, 8, 9], [4, 9, 5], [2, 4, 11], [6, 2, 10], [8, 6, 7], [9, 8, 1]]
+    )
+    return v, f
+
+
+def test_cube_refines_to_the_closed_form_counts_and_keeps_symmetry():
+    mesh = subd.Mesh(CUBE_V, CUBE_F)
+    fine = subd.refine(mesh, "catmull-clark", levels=2)
+    assert fine.faces.shape == (96, 4)
+    assert fine.vertices.shape == (98, 3)
+    # Catmull-Clark's level-1 corner point of a cube corner of valence 3:
+    # (Q + 2R + (n - 3) S) / n with n = 3 (Catmull & Clark 1978).
+    one = subd.refine(mesh, "catmull-clark", levels=1)
+    q = np.array([1 / 3, 1 / 3, 1 / 3])  # mean of the three face points around corner 0
+    r = np.array([1 / 6, 1 / 6, 1 / 6])  # mean of the three edge midpoints
+    want = (q + 2 * r) / 3
+    assert np.allclose(one.vertices[0], want, atol=1e-15)
+    # The cube's symmetry: the centroid stays at the centre.
+    assert np.allclose(fine.vertices.mean(axis=0), [0.5, 0.5, 0.5], atol=1e-14)
+
+
+def test_outputs_are_contiguous_writable_copies():
+    fine = subd.refine(subd.Mesh(CUBE_V, CUBE_F), "catmull-clark", 1)
+    for a, dtype in [(fine.vertices, np.float64), (fine.face_vertices, np.int64),
+                     (fine.face_sizes, np.int64)]:
+        assert a.dtype == dtype and a.flags["C_CONTIGUOUS"] and a.flags["WRITEABLE"]
+    # Each property is the caller's own array: writing to it leaves the mesh alone.
+    v = fine.vertices
+    v[:] = 0.0
+    assert fine.vertices.max() > 0.5
+
+
+@pytest.mark.skipif(not SUBD_BIN, reason="SUBD_BIN (the subd binary) not set")
+@pytest.mark.parametrize("scheme", ["catmull-clark", "loop", "bilinear", "sqrt3", "butterfly",
+                                    "modified-butterfly", "doo-sabin"])
+def test_refine_equals_the_binary_on_every_shape(tmp_path, scheme):
+    compared = 0
+    for obj in sorted(SHAPES.glob("*.obj")):
+        out = tmp_path / f"{obj.stem}.obj"
+        run = subprocess.run([SUBD_BIN, "refine", "--scheme", scheme, "--levels", "2",
+                              str(obj), str(out)], capture_output=True)
+        try:
+            got = subd.refine(subd.read(obj), scheme, levels=2)
+        except subd.SubdError:
+            assert run.returncode != 0, f"{obj.name}: the binary refined it"
+            continue
+        assert run.returncode == 0, run.stderr
+        want = subd.read(out)
+        assert np.array_equal(got.face_sizes, want.face_sizes), obj.name
+        assert np.array_equal(got.face_vertices, want.face_vertices), obj.name
+        # The file holds the shortest decimal that reads back to the same double.
+        assert np.array_equal(got.vertices, want.vertices), obj.name
+        compared += 1
+    assert compared >= 10, f"{scheme}: only {compared} shapes compared"
+
+
+def torus(n=12, m=8):
+    """A closed triangulated torus, every vertex of valence 6."""
+    i, j = np.meshgrid(np.arange(n), np.arange(m), indexing="ij")
+    u, w = 2 * np.pi * i.ravel() / n, 2 * np.pi * j.ravel() / m
+    v = np.stack([(2 + np.cos(w)) * np.cos(u), (2 + np.cos(w)) * np.sin(u), np.sin(w)], axis=1)
+    idx = lambda a, b: (a % n) * m + (b % m)
+    f = []
+    for a in range(n):
+        for b in range(m):
+            f += [[idx(a, b), idx(a + 1, b), idx(a + 1, b + 1)], [idx(a, b), idx(a + 1, b + 1), idx(a, b + 1)]]
+    return v, np.array(f)
+
+
+def matched(points, others, tol):
+    """Whether every point of `others` has one of `points` within `tol`, one to one."""
+    d = np.linalg.norm(others[:, None, :] - points[None, :, :], axis=2)
+    return d.min(axis=1).max() <= tol and len(set(d.argmin(axis=1))) == len(others)
+
+
+def test_loop_equals_libigl_where_both_use_loops_weights():
+    igl = pytest.importorskip("igl")
+    # Every vertex of valence 6, where Loop's β and Warren's coincide (3/48 = 1/16).
+    v, f = torus()
+    got = subd.refine(subd.Mesh(v, f), "loop", levels=2)
+    iv, _ = igl.loop(v, f.astype(np.int64), 2)
+    assert got.vertices.shape == iv.shape
+    assert matched(got.vertices, iv, 1e-12)
+
+
+def test_loop_and_libigl_differ_only_by_the_vertex_weight_at_valence_5():
+    igl = pytest.importorskip("igl")
+    # At valence 5 OpenSubdiv (and subd) use Loop's β = (5/8 − (3/8 + cos(2π/n)/4)²)/n,
+    # libigl Warren's 3/(8n): edge points agree, vertex points follow each author's β.
+    v, f = icosahedron()
+    got = subd.refine(subd.Mesh(v, f), "loop", levels=1).vertices
+    iv, _ = igl.loop(v, f.astype(np.int64), 1)
+    n = 5
+    ring = [sorted({int(x) for face in f if k in face for x in face} - {k}) for k in range(len(v))]
+    for beta, points in [((5 / 8 - (3 / 8 + np.cos(2 * np.pi / n) / 4) ** 2) / n, got),
+                         (3 / (8 * n), iv)]:
+        want = np.array([(1 - n * beta) * v[k] + beta * v[r].sum(axis=0) for k, r in enumerate(ring)])
+        assert np.abs(points[: len(v)] - want).max() <= 1e-14
+    assert matched(got[len(v):], iv[len(v):], 1e-14)
+
+
+def test_creases_as_arrays_equal_obj_tags(tmp_path):
+    path = tmp_path / "creased.obj"
+    lines = [f"v {x} {y} {z}" for x, y, z in CUBE_V]
+    lines += ["f " + " ".join(str(i + 1) for i in face) for face in CUBE_F]
+    lines += ["t crease 2/1/0 0 1 2.5", "t crease 2/1/0 1 2 10", "t corner 1/1/0 6 3"]
+    path.write_text("\n".join(lines) + "\n")
+    tagged = subd.read(path)
+    arrays = subd.Mesh(CUBE_V, CUBE_F, creases=([[0, 1], [1, 2]], [2.5, 10.0]),
+                       corners=([6], [3.0]))
+    a = subd.refine(tagged, "catmull-clark", 3)
+    b = subd.refine(arrays, "catmull-clark", 3)
+    assert np.array_equal(a.vertices, b.vertices)
+    plain = subd.refine(subd.Mesh(CUBE_V, CUBE_F), "catmull-clark", 3)
+    assert not np.array_equal(a.vertices, plain.vertices)
+
+
+def test_limit_lies_on_the_surface_of_deeper_refinement():
+    v, f = icosahedron()
+    mesh = subd.Mesh(v, f)
+    positions, normals = subd.limit(mesh, "loop")
+    # Base vertex i is vertex i at every level of Loop; its level-6 position approaches
+    # the limit like 4^-6.
+    deep = subd.refine(mesh, "loop", 6).vertices[: len(v)]
+    assert np.abs(deep - positions).max() < 1e-3
+    assert np.allclose(np.linalg.norm(normals, axis=1), 1.0)
+    # The icosahedron's limit normals point away from the centre.
+    assert np.all(np.einsum("ij,ij->i", normals, positions) > 0)
+
+
+def test_refine_to_the_limit_gives_the_limit_of_the_refined_mesh():
+    v, f = icosahedron()
+    fine = subd.refine(subd.Mesh(v, f), "loop", 2)
+    moved = subd.refine(subd.Mesh(v, f), "loop", 2, limit=True)
+    p, n = subd.limit(fine, "loop")
+    assert np.abs(moved.vertices - p).max() <= 1e-14 * np.ptp(v)
+    assert np.abs(moved.normals - n).max() <= 1e-12
+
+
+@pytest.mark.parametrize("ext", ["obj", "ply", "glb"])
+def test_round_trip_through_every_writer(tmp_path, ext):
+    mesh = subd.refine(subd.Mesh(CUBE_V, CUBE_F), "catmull-clark", 1)
+    path = tmp_path / f"cube.{ext}"
+    mesh.write(path)
+    back = subd.read(path)
+    if ext == "glb":
+        # glTF holds float32 positions and triangles: each quad as two.
+        assert back.num_faces == 2 * mesh.num_faces
+        assert matched(mesh.vertices, back.vertices, 1e-6)
+    else:
+        assert np.array_equal(back.face_sizes, mesh.face_sizes)
+        assert np.array_equal(back.face_vertices, mesh.face_vertices)
+        assert np.array_equal(back.vertices, mesh.vertices)
+
+
+def test_mixed_polygons_and_the_flat_pair():
+    v = np.array([[0, 0, 0], [1, 0, 0], [2, 0, 0], [0, 1, 0], [1, 1, 0], [2, 1, 0], [1, 2, 0]], float)
+    mesh = subd.Mesh(v, [[0, 1, 4, 3], [1, 2, 5, 4], [3, 4, 6]])
+    assert mesh.face_sizes.tolist() == [4, 4, 3]
+    with pytest.raises(ValueError, match="flat pair"):
+        mesh.faces
+    fine = subd.refine(mesh, "catmull-clark", 1)
+    assert fine.faces.shape == (11, 4)
+
+
+@pytest.mark.parametrize(
+    "vertices, faces, match",
+    [
+        (CUBE_V, [[0, 1, 99]], "face 0 corner 2: vertex index 99 out of range"),
+        (CUBE_V, [[0, 1, 2], [0, -1, 2]], "face 1 corner 1: vertex index -1"),
+        (np.where(np.arange(24).reshape(8, 3) == 21, np.nan, CUBE_V), CUBE_F, "vertex 7"),
+        (CUBE_V, [[0, 1]], "face 0 has 2 corners"),
+        (CUBE_V[:, :2], CUBE_F, r"expected an \(n, 3\) array"),
+        (CUBE_V, [[0.5, 1, 2]], "whole numbers"),
+    ],
+)
+def test_bad_meshes_raise_mesh_error_naming_the_element(vertices, faces, match):
+    with pytest.raises(subd.MeshError, match=match):
+        subd.Mesh(vertices, faces)
+
+
+def test_errors_are_typed():
+    mesh = subd.Mesh(CUBE_V, CUBE_F)
+    with pytest.raises(ValueError, match="schemes: catmull-clark"):
+        subd.refine(mesh, "catmul-clark")
+    with pytest.raises(subd.MeshError):
+        subd.refine(mesh, "loop")  # Loop needs triangles
+    with pytest.raises(subd.MeshError, match="crease 0: no edge"):
+        subd.Mesh(CUBE_V, CUBE_F, creases=([[0, 6]], [1.0]))
+    with pytest.raises(OSError):
+        subd.read("/nonexistent/mesh.obj")
+    with pytest.raises(TypeError):
+        subd.refine(mesh, "catmull-clark", levels=1.5)
+    assert issubclass(subd.MeshError, ValueError) and issubclass(subd.FormatError, ValueError)
+
+
+def test_unreadable_file_raises_format_error_with_its_line(tmp_path):
+    path = tmp_path / "bad.obj"
+    path.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n")
+    with pytest.raises(subd.FormatError, match="bad.obj:4"):
+        subd.read(path)
+
+
+def test_threads_refining_at_once_give_the_results_of_one():
+    v, f = icosahedron()
+    mesh = subd.Mesh(v, f)
+    want = subd.refine(mesh, "loop", 4).vertices
+    results = [None] * 4
+
+    def work(i):
+        results[i] = subd.refine(mesh, "loop", 4).vertices
+
+    threads = [threading.Thread(target=work, args=(i,)) for i in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    for r in results:
+        assert np.array_equal(r, want)
+
+
+def test_thread_count_does_not_change_the_bits():
+    v, f = icosahedron()
+    mesh = subd.Mesh(v, f)
+    before = subd.get_num_threads()
+    try:
+        subd.set_num_threads(1)
+        assert subd.get_num_threads() == 1
+        one = subd.refine(mesh, "loop", 5, limit=True)
+        subd.set_num_threads(3)
+        three = subd.refine(mesh, "loop", 5, limit=True)
+    finally:
+        subd.set_num_threads(before)
+    assert np.array_equal(one.vertices, three.vertices)
+    assert np.array_equal(one.normals, three.normals)
+
+
+hypothesis = pytest.importorskip("hypothesis")
+from hypothesis import given, settings, strategies as st  # noqa: E402
+from hypothesis.extra import numpy as hnp  # noqa: E402
+
+_numbers = st.one_of(
+    st.floats(allow_nan=True, allow_infinity=True, width=64),
+    st.integers(-(2**63), 2**63 - 1),
+)
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    vertices=hnp.arrays(
+        dtype=st.sampled_from([np.float64, np.float32, np.int32, np.uint8, np.int64]),
+        shape=hnp.array_shapes(min_dims=1, max_dims=3, min_side=0, max_side=6),
+        elements=None,
+    ),
+    faces=hnp.arrays(
+        dtype=st.sampled_from([np.int64, np.int8, np.uint64, np.float64, np.bool_]),
+        shape=hnp.array_shapes(min_dims=1, max_dims=3, min_side=0, max_side=6),
+    ),
+    scheme=st.sampled_from(list(subd.SCHEMES) + ["", "loop:x", "butterfly:0.1", "two-phase:0.9"]),
+    levels=st.integers(0, 3),
+    limit=st.booleans(),
+    holes=st.lists(st.integers(-3, 10), max_size=3),
+)
+def test_no_input_crashes(vertices, faces, scheme, levels, limit, holes):
+    # Whatever the arrays, the result is a mesh or one of the documented exceptions: never
+    # a pyo3 PanicException (a BaseException) nor an abort.
+    try:
+        mesh = subd.Mesh(vertices, faces, holes=holes)
+        out = subd.refine(mesh, scheme, levels, limit=limit)
+        assert out.vertices.shape[1] == 3
+    except (subd.SubdError, ValueError, TypeError):
+        pass
+
+
+@settings(max_examples=100, deadline=None)
+@given(
+    edges=st.lists(st.tuples(st.integers(-2, 9), st.integers(-2, 9)), max_size=4),
+    sharp=st.lists(_numbers.filter(lambda x: isinstance(x, float)), max_size=4),
+    corners=st.lists(st.integers(-2, 9), max_size=3),
+)
+def test_no_tag_crashes(edges, sharp, corners):
+    try:
+        mesh = subd.Mesh(CUBE_V, CUBE_F, creases=(edges, sharp[: len(edges)]),
+                         corners=(corners, [1.0] * len(corners)))
+        subd.refine(mesh, "catmull-clark", 1)
+    except (subd.SubdError, ValueError, TypeError):
+        pass
