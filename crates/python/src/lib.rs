@@ -15,11 +15,13 @@ mod errors;
 mod mesh;
 mod ops;
 mod pool;
+mod refiner;
 
 /// The module `subd._subd`.
 #[pymodule]
 fn _subd(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<mesh::CoreMesh>()?;
+    m.add_class::<refiner::CoreRefiner>()?;
     m.add_function(wrap_pyfunction!(ops::read, m)?)?;
     m.add_function(wrap_pyfunction!(ops::refine, m)?)?;
     m.add_function(wrap_pyfunction!(ops::limit, m)?)?;

@@ -18,9 +18,51 @@ pub(crate) const SCHEME_NAMES: [&str; 8] = Scheme::NAMES;
 
 /// `name` (optionally `name:parameter`, the butterfly's tension or the two-phase scheme's
 /// `λ`) as a scheme, or a `ValueError` listing the names.
-fn scheme(name: &str) -> PyResult<Scheme> {
+pub(crate) fn scheme(name: &str) -> PyResult<Scheme> {
     name.parse::<Scheme>()
         .map_err(|e| PyValueError::new_err(format!("{e} (schemes: {})", SCHEME_NAMES.join(", "))))
+}
+
+/// The rule options by the CLI's names (`None`: the mesh's own, from its file's tags, else
+/// OpenSubdiv's defaults).
+pub(crate) struct RuleNames<'a> {
+    pub(crate) boundary: Option<&'a str>,
+    pub(crate) crease_method: Option<&'a str>,
+    pub(crate) triangles: Option<&'a str>,
+}
+
+impl RuleNames<'_> {
+    /// The options for a mesh with `hints`, or a `ValueError` listing the names.
+    pub(crate) fn options(&self, hints: &subd_mesh::SchemeHints) -> PyResult<Options> {
+        use subd_mesh::{BoundaryInterpolation as B, CreaseMethod as C, TriangleSubdivision as T};
+        let mut o = Options::from_hints(hints);
+        let bad = |what: &str, got: &str, names: &str| {
+            PyValueError::new_err(format!("{what}: unknown value {got:?} (one of {names})"))
+        };
+        if let Some(b) = self.boundary {
+            o.boundary_interpolation = match b {
+                "none" => B::None,
+                "edge-only" => B::EdgeOnly,
+                "edge-and-corner" => B::EdgeAndCorner,
+                _ => return Err(bad("boundary", b, "none, edge-only, edge-and-corner")),
+            };
+        }
+        if let Some(c) = self.crease_method {
+            o.crease_method = match c {
+                "uniform" => C::Uniform,
+                "chaikin" => C::Chaikin,
+                _ => return Err(bad("crease_method", c, "uniform, chaikin")),
+            };
+        }
+        if let Some(t) = self.triangles {
+            o.triangle_subdivision = match t {
+                "catmark" => T::Catmark,
+                "smooth" => T::Smooth,
+                _ => return Err(bad("triangles", t, "catmark, smooth")),
+            };
+        }
+        Ok(o)
+    }
 }
 
 /// Reads a mesh file (OBJ with OpenSubdiv's tags, PLY, glTF): the mesh and the reader's
@@ -49,18 +91,29 @@ pub(crate) fn read(
 /// The mesh refined `levels` times with `scheme` (the mesh's own boundary and crease
 /// options), its vertices moved to the limit surface with unit normals when `limit`.
 #[pyfunction]
-#[pyo3(signature = (mesh, scheme_name, levels, limit = false))]
+#[pyo3(signature = (mesh, scheme_name, levels, limit = false, boundary = None, crease_method = None, triangles = None))]
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn refine(
     py: Python<'_>,
     mesh: &CoreMesh,
     scheme_name: &str,
     levels: usize,
     limit: bool,
+    boundary: Option<&str>,
+    crease_method: Option<&str>,
+    triangles: Option<&str>,
 ) -> PyResult<CoreMesh> {
     let scheme = scheme(scheme_name)?;
+    let options = RuleNames {
+        boundary,
+        crease_method,
+        triangles,
+    }
+    .options(&mesh.mesh.hints)?;
     check_size(&mesh.mesh, &scheme, levels)?;
     let (refined, normals) =
-        pool::run(py, || refined(&mesh.mesh, scheme, levels, limit))?.map_err(mesh_error)?;
+        pool::run(py, || refined(&mesh.mesh, scheme, &options, levels, limit))?
+            .map_err(mesh_error)?;
     Ok(CoreMesh {
         mesh: refined,
         normals,
@@ -69,7 +122,7 @@ pub(crate) fn refine(
 
 /// Refuses a refinement whose output would not fit the library's 32-bit indices, before
 /// any of it is allocated.
-fn check_size(mesh: &Mesh, scheme: &Scheme, levels: usize) -> PyResult<()> {
+pub(crate) fn check_size(mesh: &Mesh, scheme: &Scheme, levels: usize) -> PyResult<()> {
     if levels > subd_schemes::MAX_LEVELS {
         return Err(mesh_error(format!(
             "{levels} levels asked for; at most {} are supported",
@@ -92,18 +145,18 @@ fn check_size(mesh: &Mesh, scheme: &Scheme, levels: usize) -> PyResult<()> {
 fn refined(
     mesh: &Mesh,
     scheme: Scheme,
+    options: &Options,
     levels: usize,
     limit: bool,
 ) -> Result<(Mesh, Option<Vec<DVec3>>), String> {
-    let options = Options::from_hints(&mesh.hints);
-    let r = Refinement::new(&mesh.topology, scheme, &options, levels).map_err(|e| e.to_string())?;
+    let r = Refinement::new(&mesh.topology, scheme, options, levels).map_err(|e| e.to_string())?;
     let mut positions = r.points_at(&mesh.positions, levels);
     let mut normals = None;
     if limit {
         let l = subd_limit::level_limit_points(
             &r,
             levels,
-            &options,
+            options,
             &positions,
             subd_limit::Tangents::Dropped,
         )

@@ -321,3 +321,61 @@ def test_no_tag_crashes(edges, sharp, corners):
         subd.refine(mesh, "catmull-clark", 1)
     except (subd.SubdError, ValueError, TypeError):
         pass
+
+
+def test_refiner_apply_equals_refine_of_the_moved_mesh():
+    v, f = icosahedron()
+    r = subd.Refiner(subd.Mesh(v, f), "loop", 3)
+    rng = np.random.default_rng(7)
+    for _ in range(3):
+        moved = v + rng.normal(scale=0.1, size=v.shape)
+        want = subd.refine(subd.Mesh(moved, f), "loop", 3).vertices
+        assert np.array_equal(r.apply(moved), want)
+    assert r.num_vertices == want.shape[0]
+
+
+def test_refiner_other_columns_and_the_stencil_matrix():
+    v, f = torus()
+    mesh = subd.Mesh(v, f)
+    r = subd.Refiner(mesh, "loop", 2)
+    want = subd.refine(mesh, "loop", 2).vertices
+    scale = np.abs(v).max()
+    # One column, and five (positions and two more), through the stencil tables.
+    assert np.abs(r.apply(v[:, 0]) - want[:, 0]).max() <= 1e-14 * scale
+    five = r.apply(np.hstack([v, v[:, :2] * 2.0]))
+    assert five.shape == (want.shape[0], 5)
+    assert np.abs(five[:, :3] - want).max() <= 1e-14 * scale
+    # Affine invariance: every row of weights sums to one, so a constant stays constant.
+    assert np.abs(r.apply(np.full((len(v), 1), 3.5)) - 3.5).max() <= 1e-14
+    m = r.stencil_matrix()
+    if isinstance(m, tuple):
+        pytest.skip("SciPy is not installed")
+    assert m.shape == (want.shape[0], len(v))
+    assert np.abs(m @ v - want).max() <= 1e-13 * scale
+    assert np.abs(np.asarray(m.sum(axis=1)).ravel() - 1).max() <= 1e-14
+    one = r.stencil_matrix(1)
+    assert one.shape[0] == subd.refine(mesh, "loop", 1).num_vertices
+
+
+def test_rule_options_by_name():
+    # An open 3 x 3 grid of quads: the boundary rule moves its corners or not.
+    v = np.array([[i, j, (i * j) % 2] for j in range(4) for i in range(4)], float)
+    f = [[j * 4 + i, j * 4 + i + 1, j * 4 + i + 5, j * 4 + i + 4] for j in range(3) for i in range(3)]
+    mesh = subd.Mesh(v, f)
+    corner = {}
+    for b in ["edge-only", "edge-and-corner"]:
+        corner[b] = subd.refine(mesh, "catmull-clark", 1, boundary=b).vertices[0]
+    # Edge-and-corner keeps a corner of valence 2 where it is (OpenSubdiv's rule).
+    assert np.array_equal(corner["edge-and-corner"], v[0])
+    assert not np.array_equal(corner["edge-only"], v[0])
+    with pytest.raises(ValueError, match="one of none, edge-only, edge-and-corner"):
+        subd.refine(mesh, "catmull-clark", 1, boundary="edges")
+    with pytest.raises(ValueError, match="uniform, chaikin"):
+        subd.Refiner(mesh, "catmull-clark", 1, crease_method="linear")
+    # The smooth triangle rule changes the face points of triangles (OpenSubdiv's
+    # TRI_SUB_SMOOTH): on the icosahedron every level-1 face point moves.
+    iv, ifc = icosahedron()
+    ico = subd.Mesh(iv, ifc)
+    a = subd.refine(ico, "catmull-clark", 1, triangles="smooth").vertices
+    b = subd.refine(ico, "catmull-clark", 1, triangles="catmark").vertices
+    assert a.shape == b.shape and not np.allclose(a, b)

@@ -43,6 +43,7 @@ __all__ = [
     "FormatError",
     "Mesh",
     "MeshError",
+    "Refiner",
     "SubdError",
     "get_num_threads",
     "limit",
@@ -253,19 +254,95 @@ def refine(
     levels: int = 1,
     *,
     limit: bool = False,
+    boundary: Optional[str] = None,
+    crease_method: Optional[str] = None,
+    triangles: Optional[str] = None,
     tension: Optional[float] = None,
     lam: Optional[float] = None,
 ) -> Mesh:
     """The mesh refined ``levels`` times with ``scheme`` (one of :data:`SCHEMES`).
 
     With ``limit=True`` the vertices are moved to the exact limit surface and the result
-    has unit ``normals``. ``tension`` is the butterfly's parameter, ``lam`` the two-phase
-    scheme's.
+    has unit ``normals``. The rule options take the CLI's names and default to the mesh's
+    own (its file's tags, else OpenSubdiv's defaults): ``boundary`` ``"none"``,
+    ``"edge-only"`` or ``"edge-and-corner"``; ``crease_method`` ``"uniform"`` or
+    ``"chaikin"``; ``triangles`` ``"catmark"`` or ``"smooth"``. ``tension`` is the
+    butterfly's parameter, ``lam`` the two-phase scheme's.
     """
     _check_mesh(mesh)
     levels = _count(levels, "levels")
     name = _scheme_name(scheme, tension, lam)
-    return Mesh._wrap(_subd.refine(mesh._core, name, levels, bool(limit)))
+    rules = _rule_names(boundary, crease_method, triangles)
+    return Mesh._wrap(_subd.refine(mesh._core, name, levels, bool(limit), *rules))
+
+
+def _rule_names(boundary, crease_method, triangles):
+    for value, what in ((boundary, "boundary"), (crease_method, "crease_method"),
+                        (triangles, "triangles")):
+        if value is not None and not isinstance(value, str):
+            raise TypeError(f"{what}: expected a name, got {type(value).__name__}")
+    return boundary, crease_method, triangles
+
+
+class Refiner:
+    """A mesh's topology refined once, for many position sets or other per-vertex data.
+
+    >>> r = subd.Refiner(mesh, "loop", 2)                 # doctest: +SKIP
+    >>> frames = [r.apply(p) for p in animation]          # doctest: +SKIP
+
+    ``apply(values)`` refines an (n, k) float array of per-vertex values (positions,
+    colours, any columns) to the last level; with three columns the result is exactly
+    :func:`refine`'s positions for those vertices. ``stencil_matrix(level=None)`` gives the
+    weights from the base vertices to a level as a ``scipy.sparse.csr_matrix`` when SciPy
+    is installed, else as ``(indptr, indices, weights)``.
+    """
+
+    __slots__ = ("_core", "levels")
+
+    def __init__(
+        self,
+        mesh: Mesh,
+        scheme: str = "catmull-clark",
+        levels: int = 1,
+        *,
+        boundary: Optional[str] = None,
+        crease_method: Optional[str] = None,
+        triangles: Optional[str] = None,
+        tension: Optional[float] = None,
+        lam: Optional[float] = None,
+    ) -> None:
+        _check_mesh(mesh)
+        self.levels = _count(levels, "levels")
+        name = _scheme_name(scheme, tension, lam)
+        rules = _rule_names(boundary, crease_method, triangles)
+        self._core = _subd._CoreRefiner(mesh._core, name, self.levels, *rules)
+
+    @property
+    def num_vertices(self) -> int:
+        """Vertices of the last level."""
+        return self._core.num_vertices
+
+    def apply(self, values) -> np.ndarray:
+        """(n, k) per-vertex values of the base mesh refined to the last level: (n_L, k)."""
+        a = _float_array(values, "values")
+        one_column = a.ndim == 1
+        if one_column:
+            a = a.reshape(-1, 1)
+        if a.ndim != 2:
+            raise ValueError(f"values: expected an (n, k) array, got shape {a.shape}")
+        out = self._core.apply(np.ascontiguousarray(a))
+        return out.reshape(-1) if one_column else out
+
+    def stencil_matrix(self, level: Optional[int] = None):
+        """The weights from the base vertices to ``level`` (default the last)."""
+        if level is not None:
+            level = _count(level, "level")
+        indptr, indices, weights, shape = self._core.stencil_matrix(level)
+        try:
+            import scipy.sparse
+        except ImportError:
+            return indptr, indices, weights
+        return scipy.sparse.csr_matrix((weights, indices, indptr), shape=shape)
 
 
 def limit(mesh: Mesh, scheme: str = "catmull-clark") -> Tuple[np.ndarray, np.ndarray]:

@@ -1,0 +1,134 @@
+//! `subd._subd._CoreRefiner`: a mesh's topology refined once, applied to any number of
+//! position sets (animation frames) or other per-vertex columns, and its stencils as a
+//! sparse matrix.
+
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2, PyUntypedArrayMethods};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use subd_mesh::DVec3;
+use subd_schemes::Refinement;
+
+use crate::errors::mesh_error;
+use crate::mesh::{CoreMesh, points};
+use crate::ops::{RuleNames, check_size, scheme};
+use crate::pool;
+
+/// A refinement of one mesh's topology, `levels` deep.
+#[pyclass(name = "_CoreRefiner", module = "subd._subd", frozen)]
+pub(crate) struct CoreRefiner {
+    refinement: Refinement,
+    levels: usize,
+}
+
+#[pymethods]
+impl CoreRefiner {
+    /// Refines `mesh`'s topology `levels` times with `scheme_name` and the rule options.
+    #[new]
+    #[pyo3(signature = (mesh, scheme_name, levels, boundary = None, crease_method = None, triangles = None))]
+    fn new(
+        py: Python<'_>,
+        mesh: &CoreMesh,
+        scheme_name: &str,
+        levels: usize,
+        boundary: Option<&str>,
+        crease_method: Option<&str>,
+        triangles: Option<&str>,
+    ) -> PyResult<CoreRefiner> {
+        let scheme = scheme(scheme_name)?;
+        let options = RuleNames {
+            boundary,
+            crease_method,
+            triangles,
+        }
+        .options(&mesh.mesh.hints)?;
+        check_size(&mesh.mesh, &scheme, levels)?;
+        let topology = &mesh.mesh.topology;
+        let refinement = pool::run(py, || Refinement::new(topology, scheme, &options, levels))?
+            .map_err(mesh_error)?;
+        Ok(CoreRefiner { refinement, levels })
+    }
+
+    /// Number of vertices of the base level.
+    #[getter]
+    fn num_base_vertices(&self) -> usize {
+        self.refinement.num_vertices(0)
+    }
+
+    /// Number of vertices of the last level.
+    #[getter]
+    fn num_vertices(&self) -> usize {
+        self.refinement.num_vertices(self.levels)
+    }
+
+    /// Per-vertex values of the base level, `(n, k)` float64, refined to the last level:
+    /// `(n_L, k)`. Three columns take the positions' own path (`subd.refine`'s numbers).
+    fn apply<'py>(
+        &self,
+        py: Python<'py>,
+        values: PyReadonlyArray2<'_, f64>,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let (n, k) = (values.shape()[0], values.shape()[1]);
+        if n != self.refinement.num_vertices(0) {
+            return Err(PyValueError::new_err(format!(
+                "{n} rows given; the base mesh has {} vertices",
+                self.refinement.num_vertices(0)
+            )));
+        }
+        let src = values
+            .as_slice()
+            .map_err(|_| PyValueError::new_err("values: a C-contiguous array is needed"))?;
+        if k == 3 {
+            let base: Vec<DVec3> = src.chunks_exact(3).map(DVec3::from_slice).collect();
+            let out = pool::run(py, || self.refinement.points_at(&base, self.levels))?;
+            return points(py, &out);
+        }
+        let out = pool::run(py, || {
+            let mut level = src.to_vec();
+            for l in 1..=self.levels {
+                let table = self.refinement.stencils(l);
+                let mut next = vec![0.0; table.num_rows() * k];
+                table.apply(&level, k, &mut next);
+                level = next;
+            }
+            level
+        })?;
+        let rows = out.len().checked_div(k).unwrap_or(0);
+        Array2::from_shape_vec((rows, k), out)
+            .map(|a| a.into_pyarray(py))
+            .map_err(|e| PyValueError::new_err(e.to_string()))
+    }
+
+    /// The stencils from the base vertices to the vertices of `level` (the last when
+    /// `None`) as CSR arrays: `(indptr, indices, weights, shape)`.
+    #[pyo3(signature = (level = None))]
+    #[allow(clippy::type_complexity)]
+    fn stencil_matrix<'py>(
+        &self,
+        py: Python<'py>,
+        level: Option<usize>,
+    ) -> PyResult<(
+        Bound<'py, PyArray1<i64>>,
+        Bound<'py, PyArray1<i64>>,
+        Bound<'py, PyArray1<f64>>,
+        (usize, usize),
+    )> {
+        let level = level.unwrap_or(self.levels);
+        if level > self.levels {
+            return Err(PyValueError::new_err(format!(
+                "level {level}: the refiner has levels 0 to {}",
+                self.levels
+            )));
+        }
+        let table = pool::run(py, || self.refinement.composed(level))?;
+        let indptr: Vec<i64> = table.offsets().iter().map(|&o| i64::from(o)).collect();
+        let indices: Vec<i64> = table.indices().iter().map(|&i| i64::from(i)).collect();
+        let shape = (table.num_rows(), self.refinement.num_vertices(0));
+        Ok((
+            indptr.into_pyarray(py),
+            indices.into_pyarray(py),
+            table.weights().to_vec().into_pyarray(py),
+            shape,
+        ))
+    }
+}
