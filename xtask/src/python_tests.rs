@@ -7,9 +7,9 @@ use std::process::Command;
 
 use crate::run;
 
-/// What the tests import besides `subd` (from PyPI): the runner, property tests, and the
-/// independent references (libigl's Loop).
-const TEST_PACKAGES: &[&str] = &["numpy", "pytest", "hypothesis", "libigl"];
+/// What the tests import besides `subd` (from PyPI): the runner, property tests, SciPy
+/// (the stencil matrices come back as its CSR matrices) and libigl (an independent Loop).
+const TEST_PACKAGES: &[&str] = &["numpy", "pytest", "hypothesis", "scipy", "libigl"];
 
 /// Builds and installs the package in `target/python-env`, then runs its tests.
 pub(crate) fn run_python_tests(root: &Path) -> Result<(), String> {
