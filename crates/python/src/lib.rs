@@ -16,6 +16,7 @@ mod mesh;
 mod ops;
 mod pool;
 mod refiner;
+mod surface;
 
 /// The module `subd._subd`.
 #[pymodule]
@@ -25,6 +26,8 @@ fn _subd(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(ops::read, m)?)?;
     m.add_function(wrap_pyfunction!(ops::refine, m)?)?;
     m.add_function(wrap_pyfunction!(ops::limit, m)?)?;
+    m.add_function(wrap_pyfunction!(surface::evaluate, m)?)?;
+    m.add_function(wrap_pyfunction!(surface::tessellate, m)?)?;
     m.add_function(wrap_pyfunction!(pool::set_num_threads, m)?)?;
     m.add_function(wrap_pyfunction!(pool::get_num_threads, m)?)?;
     m.add("SCHEMES", ops::SCHEME_NAMES.to_vec())?;

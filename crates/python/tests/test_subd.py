@@ -379,3 +379,37 @@ def test_rule_options_by_name():
     a = subd.refine(ico, "catmull-clark", 1, triangles="smooth").vertices
     b = subd.refine(ico, "catmull-clark", 1, triangles="catmark").vertices
     assert a.shape == b.shape and not np.allclose(a, b)
+
+
+def test_evaluate_at_corners_is_the_limit_and_derivatives_agree_with_differences():
+    v, f = icosahedron()
+    mesh = subd.Mesh(v, f)
+    positions, normals = subd.limit(mesh, "loop")
+    # Corner 0 of every face at (0, 0), corner 1 at (1, 0), corner 2 at (0, 1).
+    faces = np.repeat(np.arange(len(f)), 3)
+    u = np.tile([0.0, 1.0, 0.0], len(f))
+    w = np.tile([0.0, 0.0, 1.0], len(f))
+    p, n = subd.evaluate(mesh, "loop", faces, u, w)
+    corners = f.reshape(-1)
+    assert np.abs(p - positions[corners]).max() <= 1e-12
+    assert np.abs(n - normals[corners]).max() <= 1e-9
+    # du against a central difference inside face 3.
+    h = 1e-6
+    at = np.array([0.3 - h, 0.3 + h, 0.3])
+    pp, _, du, *_ = subd.evaluate(mesh, "loop", [3, 3, 3], at, [0.2, 0.2, 0.2], derivatives=True)
+    assert np.abs((pp[1] - pp[0]) / (2 * h) - du[2]).max() <= 1e-6
+    with pytest.raises(subd.MeshError, match="point 0"):
+        subd.evaluate(mesh, "loop", [99], [0.1], [0.1])
+
+
+def test_tessellation_is_watertight_and_on_the_limit():
+    mesh = subd.Mesh(CUBE_V, CUBE_F)
+    t = subd.tessellate(mesh, "catmull-clark", 8)
+    assert t.num_faces == 6 * 64 and t.num_vertices == 6 * 64 + 2
+    # Closed: every edge has two faces (Euler characteristic of a sphere).
+    assert t.num_vertices - t.num_edges + t.num_faces == 2
+    # Its corner samples are the limit points of the cube's corners.
+    positions, _ = subd.limit(mesh, "catmull-clark")
+    for p in positions:
+        assert np.linalg.norm(t.vertices - p, axis=1).min() <= 1e-12
+    assert np.allclose(np.linalg.norm(t.normals, axis=1), 1.0)

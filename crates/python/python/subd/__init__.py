@@ -44,12 +44,14 @@ __all__ = [
     "Mesh",
     "MeshError",
     "Refiner",
+    "evaluate",
     "SubdError",
     "get_num_threads",
     "limit",
     "read",
     "refine",
     "set_num_threads",
+    "tessellate",
 ]
 
 _Faces = Union[np.ndarray, Sequence[Sequence[int]]]
@@ -349,6 +351,44 @@ def limit(mesh: Mesh, scheme: str = "catmull-clark") -> Tuple[np.ndarray, np.nda
     """(positions, normals), both (n, 3) float64: the exact limit of every vertex."""
     _check_mesh(mesh)
     return _subd.limit(mesh._core, _scheme_name(scheme, None, None))
+
+
+def evaluate(
+    mesh: Mesh,
+    scheme: str,
+    faces,
+    u,
+    v,
+    *,
+    sub=None,
+    derivatives: bool = False,
+):
+    """The exact limit surface at ``(faces[i], u[i], v[i])``, vectorised.
+
+    ``u`` and ``v`` lie in [0, 1] (a quad's corners 0, 1, 2, 3 at (0, 0), (1, 0), (1, 1),
+    (0, 1); a Loop triangle's at (0, 0), (1, 0), (0, 1)). ``sub`` picks the corner quad of
+    a Catmull-Clark face that is not a quad (OpenSubdiv's ptex convention; default 0).
+    Returns ``(positions, normals)``, each (m, 3); with ``derivatives=True`` also ``du``,
+    ``dv``, ``duu``, ``duv`` and ``dvv``.
+    """
+    _check_mesh(mesh)
+    f = _index_array(faces, "faces").reshape(-1)
+    s = np.zeros_like(f) if sub is None else _index_array(sub, "sub").reshape(-1)
+    uu = _float_array(u, "u").reshape(-1)
+    vv = _float_array(v, "v").reshape(-1)
+    if s.size == 1 and f.size != 1:
+        s = np.full_like(f, int(s[0]))
+    out = _subd.evaluate(mesh._core, _scheme_name(scheme, None, None), f, s, uu, vv,
+                         bool(derivatives))
+    return tuple(out)
+
+
+def tessellate(mesh: Mesh, scheme: str = "catmull-clark", rate: int = 4) -> Mesh:
+    """The limit surface sampled ``rate`` times along every edge: a watertight mesh of
+    quads (Catmull-Clark) or triangles (Loop) with unit ``normals``."""
+    _check_mesh(mesh)
+    rate = _count(rate, "rate")
+    return Mesh._wrap(_subd.tessellate(mesh._core, _scheme_name(scheme, None, None), rate))
 
 
 def _count(n, what: str) -> int:
