@@ -103,14 +103,12 @@ pub(crate) fn refine(
     crease_method: Option<&str>,
     triangles: Option<&str>,
 ) -> PyResult<CoreMesh> {
-    let scheme = scheme(scheme_name)?;
-    let options = RuleNames {
+    let rules = RuleNames {
         boundary,
         crease_method,
         triangles,
-    }
-    .options(&mesh.mesh.hints)?;
-    check_size(&mesh.mesh, &scheme, levels)?;
+    };
+    let (scheme, options) = request(&mesh.mesh, scheme_name, levels, &rules)?;
     let (refined, normals) =
         pool::run(py, || refined(&mesh.mesh, scheme, &options, levels, limit))?
             .map_err(mesh_error)?;
@@ -120,9 +118,22 @@ pub(crate) fn refine(
     })
 }
 
+/// A refinement request checked: the scheme, the options for `mesh` and the output's size.
+pub(crate) fn request(
+    mesh: &Mesh,
+    scheme_name: &str,
+    levels: usize,
+    rules: &RuleNames<'_>,
+) -> PyResult<(Scheme, Options)> {
+    let scheme = scheme(scheme_name)?;
+    let options = rules.options(&mesh.hints)?;
+    check_size(mesh, &scheme, levels)?;
+    Ok((scheme, options))
+}
+
 /// Refuses a refinement whose output would not fit the library's 32-bit indices, before
 /// any of it is allocated.
-pub(crate) fn check_size(mesh: &Mesh, scheme: &Scheme, levels: usize) -> PyResult<()> {
+fn check_size(mesh: &Mesh, scheme: &Scheme, levels: usize) -> PyResult<()> {
     if levels > subd_schemes::MAX_LEVELS {
         return Err(mesh_error(format!(
             "{levels} levels asked for; at most {} are supported",

@@ -11,7 +11,7 @@ use subd_schemes::Refinement;
 
 use crate::errors::mesh_error;
 use crate::mesh::{CoreMesh, points};
-use crate::ops::{RuleNames, check_size, scheme};
+use crate::ops::{RuleNames, request};
 use crate::pool;
 
 /// A refinement of one mesh's topology, `levels` deep.
@@ -35,14 +35,12 @@ impl CoreRefiner {
         crease_method: Option<&str>,
         triangles: Option<&str>,
     ) -> PyResult<CoreRefiner> {
-        let scheme = scheme(scheme_name)?;
-        let options = RuleNames {
+        let rules = RuleNames {
             boundary,
             crease_method,
             triangles,
-        }
-        .options(&mesh.mesh.hints)?;
-        check_size(&mesh.mesh, &scheme, levels)?;
+        };
+        let (scheme, options) = request(&mesh.mesh, scheme_name, levels, &rules)?;
         let topology = &mesh.mesh.topology;
         let refinement = pool::run(py, || Refinement::new(topology, scheme, &options, levels))?
             .map_err(mesh_error)?;
