@@ -48,7 +48,8 @@ impl Arrays<'_> {
             .zip(self.crease_sharpness)
             .enumerate()
         {
-            let [a, b] = [pair[0], pair[1]].map(|x| u64::try_from(x).unwrap_or(u64::MAX));
+            let a = index(pair[0]).map_err(|e| format!("crease {k}: {e}"))?;
+            let b = index(pair[1]).map_err(|e| format!("crease {k}: {e}"))?;
             match topology.set_crease(a, b, s) {
                 Ok(Some(_)) => {}
                 Ok(None) => {
@@ -63,13 +64,13 @@ impl Arrays<'_> {
             .zip(self.corner_sharpness)
             .enumerate()
         {
-            let v = u64::try_from(v).unwrap_or(u64::MAX);
+            let v = index(v).map_err(|e| format!("corner {k}: {e}"))?;
             topology
                 .set_corner(v, s)
                 .map_err(|e| format!("corner {k}: {e}"))?;
         }
         for (k, &f) in self.holes.iter().enumerate() {
-            let f = u64::try_from(f).unwrap_or(u64::MAX);
+            let f = index(f).map_err(|e| format!("hole {k}: {e}"))?;
             topology
                 .set_hole_checked(f)
                 .map_err(|e| format!("hole {k}: {e}"))?;
@@ -129,6 +130,11 @@ impl Arrays<'_> {
         }
         Ok(out)
     }
+}
+
+/// A tag's index, refused (named) when negative; the library checks the upper bound.
+fn index(i: i64) -> Result<u64, String> {
+    u64::try_from(i).map_err(|_| format!("index {i} is negative"))
 }
 
 /// `values` as a C-contiguous numpy array of `n` rows of `K` numbers, owned by numpy.

@@ -4,6 +4,7 @@
 use numpy::{PyArray2, PyReadonlyArray1};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
+use rayon::prelude::*;
 use subd_limit::eval::{FaceParam, LimitEvaluator};
 use subd_limit::tessellation::tessellate_mesh;
 use subd_mesh::{DVec3, Mesh, TopologyBuilder};
@@ -33,17 +34,15 @@ pub(crate) fn evaluate<'py>(
     derivatives: bool,
 ) -> PyResult<Evaluated<'py>> {
     let scheme = scheme(scheme_name)?;
-    let slice = |a: &PyReadonlyArray1<'_, i64>| {
-        a.as_slice()
-            .map(<[i64]>::to_vec)
-            .map_err(|_| PyValueError::new_err("a C-contiguous array is needed"))
-    };
-    let (faces, subs) = (slice(&faces)?, slice(&subs)?);
+    let contiguous =
+        |what: &str| PyValueError::new_err(format!("{what}: a C-contiguous array is needed"));
+    let (faces, subs) = (
+        faces.as_slice().map_err(|_| contiguous("faces"))?,
+        subs.as_slice().map_err(|_| contiguous("sub"))?,
+    );
     let (u, v) = (
-        u.as_slice()
-            .map_err(|_| PyValueError::new_err("u: a C-contiguous array is needed"))?,
-        v.as_slice()
-            .map_err(|_| PyValueError::new_err("v: a C-contiguous array is needed"))?,
+        u.as_slice().map_err(|_| contiguous("u"))?,
+        v.as_slice().map_err(|_| contiguous("v"))?,
     );
     if [subs.len(), u.len(), v.len()]
         .iter()
@@ -58,11 +57,17 @@ pub(crate) fn evaluate<'py>(
     let samples = pool::run(py, || -> Result<Vec<[DVec3; 7]>, String> {
         let ev = LimitEvaluator::new(&m.topology, &scheme, &options).map_err(|e| e.to_string())?;
         let prepared = ev.prepare(&m.positions);
-        (0..faces.len())
+        // Points evaluated side by side; the first error in point order is the one named.
+        let evaluated: Vec<Result<[DVec3; 7], String>> = (0..faces.len())
+            .into_par_iter()
+            .with_min_len(256)
             .map(|i| {
+                let whole = |x: i64, what: &str| {
+                    usize::try_from(x).map_err(|_| format!("point {i}: {what} {x} is negative"))
+                };
                 let at = FaceParam {
-                    face: usize::try_from(faces[i]).unwrap_or(usize::MAX),
-                    sub: usize::try_from(subs[i]).unwrap_or(usize::MAX),
+                    face: whole(faces[i], "face")?,
+                    sub: whole(subs[i], "sub-face")?,
                     u: u[i],
                     v: v[i],
                 };
@@ -71,7 +76,8 @@ pub(crate) fn evaluate<'py>(
                     .map_err(|e| format!("point {i}: {e}"))?;
                 Ok([p.position, p.normal(), p.du, p.dv, p.duu, p.duv, p.dvv])
             })
-            .collect()
+            .collect();
+        evaluated.into_iter().collect()
     })?
     .map_err(mesh_error)?;
     let kept = if derivatives { 7 } else { 2 };

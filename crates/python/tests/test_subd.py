@@ -223,6 +223,10 @@ def test_errors_are_typed():
         subd.refine(mesh, "loop")  # Loop needs triangles
     with pytest.raises(subd.MeshError, match="crease 0: no edge"):
         subd.Mesh(CUBE_V, CUBE_F, creases=([[0, 6]], [1.0]))
+    with pytest.raises(subd.MeshError, match="crease 0: index -1 is negative"):
+        subd.Mesh(CUBE_V, CUBE_F, creases=([[0, -1]], [1.0]))
+    with pytest.raises(subd.MeshError, match="hole 1: index -2 is negative"):
+        subd.Mesh(CUBE_V, CUBE_F, holes=[0, -2])
     with pytest.raises(OSError):
         subd.read("/nonexistent/mesh.obj")
     with pytest.raises(TypeError):
@@ -400,6 +404,8 @@ def test_evaluate_at_corners_is_the_limit_and_derivatives_agree_with_differences
     assert np.abs((pp[1] - pp[0]) / (2 * h) - du[2]).max() <= 1e-6
     with pytest.raises(subd.MeshError, match="point 0"):
         subd.evaluate(mesh, "loop", [99], [0.1], [0.1])
+    with pytest.raises(subd.MeshError, match="point 1: face -4 is negative"):
+        subd.evaluate(mesh, "loop", [0, -4], [0.1, 0.1], [0.1, 0.1])
 
 
 def test_tessellation_is_watertight_and_on_the_limit():
