@@ -119,6 +119,10 @@ enum Task {
         /// InterpolateFaceVarying).
         #[arg(long)]
         fvar_only: bool,
+        /// Only the Python benchmark: the package's Loop level 3 against trimesh, libigl and
+        /// PyMeshLab, conversions included (installs them in `target/python-env`).
+        #[arg(long)]
+        python_only: bool,
         /// Only the scaling table: every path of the `subd` binary (refine with each kind of
         /// scheme, --limit, UVs, tessellate, adaptive), each phase at 1, 2 and all threads,
         /// OpenSubdiv on one thread beside it.
@@ -310,6 +314,7 @@ fn main() -> ExitCode {
             batch_only,
             tess_only,
             fvar_only,
+            python_only,
             scaling,
             threads,
         } => {
@@ -329,7 +334,9 @@ fn main() -> ExitCode {
             let batch = || batch_bench::run_batch(rounds.max(1), &shapes);
             let tess = || tess_bench::run(repeats);
             let fvar = || fvar_bench::run(levels, repeats, rounds.max(1));
-            if scaling {
+            if python_only {
+                python_tests::run_python_bench(&workspace_root(), repeats)
+            } else if scaling {
                 ensure_system_packages(REFERENCE_PACKAGES)
                     .and_then(|_| scaling_bench::run(repeats, &threads))
             } else if fvar_only {

@@ -169,7 +169,7 @@ pub(crate) fn scan_mesh() -> Result<subd_mesh::Mesh, String> {
 }
 
 /// The bunny scan's path, fetched first when it is not there yet.
-fn bunny() -> Result<PathBuf, String> {
+pub(crate) fn bunny() -> Result<PathBuf, String> {
     let path = bunny_path();
     if !path.exists() {
         fetch_bunny(&path)?;

@@ -4,8 +4,9 @@
 use std::io::Write;
 
 use clap::{Args, ValueEnum};
-use serde::Serialize;
-use subd_limit::split_eigen::{FourierEigenvalue, SpectrumTest, split_spectrum};
+use subd_limit::spectrum::{
+    RingSpectrum, SplitSpectrumReport, SurfaceSpectrum, VALENCES, surface_spectrum,
+};
 use subd_schemes::Scheme;
 use subd_schemes::analysis::{Lattice, analyze, analyze_bivariate};
 
@@ -58,26 +59,13 @@ pub(crate) struct AnalyzeArgs {
     json: bool,
 }
 
-#[derive(Serialize)]
-struct SurfaceReport {
-    scheme: &'static str,
-    valence: usize,
-    /// Eigenvalue moduli, largest first.
-    eigenvalues: Vec<f64>,
-    /// λ₁ = 1 > λ₂ = λ₃ > |λ₄|.
-    passes: bool,
-}
-
 pub(crate) fn run(args: &AnalyzeArgs, out: &mut dyn Write) -> Result<(), Failure> {
     let surface = match &args.surface {
         Some(s) => Some(scheme_arg::with_tension(s, args.tension, "--surface")?),
         None => None,
     };
     if let (Some(scheme), Some(n)) = (surface, args.valence) {
-        return match scheme {
-            Scheme::CatmullClark | Scheme::Loop => run_surface(&scheme, n, args.json, out),
-            scheme => run_split_surface(scheme, n, args.json, out),
-        };
+        return run_surface(&scheme, n, args.json, out);
     }
     if let Some(text) = &args.mask2 {
         return run_bivariate(text, args, out);
@@ -214,116 +202,72 @@ fn parse_number(t: &str) -> Option<f64> {
     }
 }
 
-/// The eigenvalue test of Catmull-Clark or Loop at an interior vertex of valence `n`.
+/// The eigenvalue test of `scheme` at an interior vertex of valence `n`
+/// (`subd_limit::spectrum`).
 fn run_surface(scheme: &Scheme, n: usize, json: bool, out: &mut dyn Write) -> Result<(), Failure> {
-    let (name, min) = (scheme.name(), 3);
-    if !(min..=64).contains(&n) {
-        return Err(bad(format!("--valence {n}: must be {min} to 64")));
+    let name = scheme.name();
+    if !VALENCES.contains(&n) {
+        return Err(bad(format!(
+            "--valence {n}: must be {} to {}",
+            VALENCES.start(),
+            VALENCES.end()
+        )));
     }
-    let m = subd_limit::eigen::ring_matrix(scheme, n, subd_limit::eigen::RingFeature::Smooth)
-        .map_err(|e| bad(format!("--surface {name}: {e}")))?;
-    let ev =
-        subd_limit::eigen::eigenvalues(&m).map_err(|e| bad(format!("--surface {name}: {e}")))?;
-    let mods: Vec<f64> = ev.iter().map(|z| z.norm()).collect();
-    let tol = 1e-9;
-    let passes = mods.len() >= 4
-        && (ev[0].re - 1.0).abs() < tol
-        && ev[0].im.abs() < tol
-        && mods[1] < 1.0 - tol
-        && (mods[1] - mods[2]).abs() < tol
-        && mods[3] < mods[2] - tol;
+    let spectrum =
+        surface_spectrum(scheme, n).map_err(|e| bad(format!("--surface {name}: {e}")))?;
     if json {
-        crate::print_json(
-            out,
-            &SurfaceReport {
-                scheme: name,
-                valence: n,
-                eigenvalues: mods,
-                passes,
-            },
-        );
+        crate::print_json(out, &spectrum);
         return Ok(());
     }
-    let list: Vec<String> = mods.iter().take(6).map(|x| format!("{x:.6}")).collect();
-    let _ = writeln!(
-        out,
-        "{name}, valence {n}: |λ| = [{}{}]; λ1 = 1 > λ2 = λ3 > |λ4|: {}",
-        list.join(", "),
-        if mods.len() > 6 { ", …" } else { "" },
-        if passes { "yes" } else { "no" }
-    );
+    let line = match &spectrum {
+        SurfaceSpectrum::Ring(r) => ring_line(r),
+        SurfaceSpectrum::Split(s) => split_line(s),
+    };
+    let _ = writeln!(out, "{line}");
     Ok(())
 }
 
-#[derive(Serialize)]
-struct SplitSurfaceReport {
-    scheme: &'static str,
-    valence: usize,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    tension: Option<f64>,
-    /// Steps the matrix covers (2 for √3, whose single step turns the mesh).
-    steps: usize,
-    /// Size of the invariant neighbourhood.
-    ball_size: usize,
-    /// Every eigenvalue with its Fourier frequency, largest modulus first.
-    eigenvalues: Vec<FourierEigenvalue>,
-    test: SpectrumTest,
+/// Catmull-Clark's or Loop's verdict, on one line.
+fn ring_line(r: &RingSpectrum) -> String {
+    let list: Vec<String> = r
+        .eigenvalues
+        .iter()
+        .take(6)
+        .map(|x| format!("{x:.6}"))
+        .collect();
+    format!(
+        "{}, valence {}: |λ| = [{}{}]; λ1 = 1 > λ2 = λ3 > |λ4|: {}",
+        r.scheme,
+        r.valence,
+        list.join(", "),
+        if r.eigenvalues.len() > 6 { ", …" } else { "" },
+        if r.passes { "yes" } else { "no" }
+    )
 }
 
-/// The eigenvalue test of a split scheme (Fourier blocks of its local subdivision matrix).
-fn run_split_surface(
-    scheme: subd_schemes::Scheme,
-    n: usize,
-    json: bool,
-    out: &mut dyn Write,
-) -> Result<(), Failure> {
-    let name = scheme.name();
-    if !(3..=64).contains(&n) {
-        return Err(bad(format!("--valence {n}: must be 3 to 64")));
-    }
-    let spectrum = split_spectrum(&scheme, n).map_err(|e| bad(format!("--surface {name}: {e}")))?;
-    let test = spectrum.test();
-    let steps = scheme.period();
-    if json {
-        crate::print_json(
-            out,
-            &SplitSurfaceReport {
-                scheme: name,
-                valence: n,
-                tension: scheme.tension(),
-                steps,
-                ball_size: spectrum.ball_size,
-                eigenvalues: spectrum.eigenvalues,
-                test,
-            },
-        );
-        return Ok(());
-    }
-    let list: Vec<String> = spectrum
+/// A split scheme's verdict, on one line.
+fn split_line(s: &SplitSpectrumReport) -> String {
+    let list: Vec<String> = s
         .eigenvalues
         .iter()
         .take(6)
         .map(|e| format!("{:.6} (k={})", e.norm(), e.frequency))
         .collect();
-    let centre = if scheme == subd_schemes::Scheme::DooSabin {
+    let n = s.valence;
+    let centre = if s.scheme == Scheme::DooSabin.name() {
         format!("{n}-sided face")
     } else {
         format!("valence {n}")
     };
-    let _ = writeln!(
-        out,
-        "{name}, {centre}{}: |λ| = [{}{}]; C¹ eigenvalue test: {}",
-        if steps == 2 { " (two steps)" } else { "" },
+    format!(
+        "{}, {centre}{}: |λ| = [{}{}]; C¹ eigenvalue test: {}",
+        s.scheme,
+        if s.steps == 2 { " (two steps)" } else { "" },
         list.join(", "),
-        if spectrum.eigenvalues.len() > 6 {
-            ", …"
-        } else {
-            ""
-        },
-        match &test.reason {
-            None => format!("yes (λ = {:.6}, frequency 1)", test.subdominant),
+        if s.eigenvalues.len() > 6 { ", …" } else { "" },
+        match &s.test.reason {
+            None => format!("yes (λ = {:.6}, frequency 1)", s.test.subdominant),
             Some(r) => format!("no: {r}"),
         }
-    );
-    Ok(())
+    )
 }

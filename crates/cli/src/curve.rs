@@ -8,7 +8,7 @@ use std::time::Instant;
 use clap::{Args, ValueEnum};
 use glam::{DVec2, DVec3};
 use serde::Serialize;
-use subd_schemes::curve::{CircleScheme, CurveScheme, PointNormal};
+use subd_schemes::named_curve::{CurveParameters, NamedCurve, SubdividedCurve, subdivide_curve};
 
 use crate::Failure;
 use crate::failure::{bad, refuse_overwrite};
@@ -22,8 +22,11 @@ pub(crate) enum CurveSchemeArg {
     /// Interpolatory 4-point scheme, tension --omega (default 1/16).
     FourPoint,
     /// Two-parameter 4-point scheme, --omega (default 1/16) and --mu (default 0).
+    // Spelt as the report and the library name it; the old spelling still works.
+    #[value(name = "four-point-2p", alias = "four-point2p")]
     FourPoint2p,
     /// 3-point ternary interpolatory scheme, --omega (default 1/4).
+    #[value(name = "ternary-3pt", alias = "ternary3pt")]
     Ternary3pt,
     /// Non-stationary tension scheme, --alpha0 (default 1: cubic B-spline).
     Tension,
@@ -154,7 +157,8 @@ fn read_points(path: &Path) -> Result<PointFile, Failure> {
             if n.length() == 0.0 {
                 return Err(at("the normal is zero".into()));
             }
-            normals.push(n.normalize());
+            // Made unit length by the library, once.
+            normals.push(n);
         }
     }
     Ok(PointFile {
@@ -162,31 +166,6 @@ fn read_points(path: &Path) -> Result<PointFile, Failure> {
         columns,
         normals: (columns == 4).then_some(normals),
     })
-}
-
-/// Unit normals of a planar polygon: the perpendicular of the central difference (one-sided
-/// at open ends), on the outer side of a closed polygon (the right of a counter-clockwise
-/// one) and on the right of an open one.
-fn estimate_normals(p: &[DVec3], closed: bool) -> Vec<DVec2> {
-    let n = p.len();
-    let area: f64 = (0..n)
-        .map(|i| {
-            let (a, b) = (p[i], p[(i + 1) % n]);
-            a.x * b.y - b.x * a.y
-        })
-        .sum();
-    let flip = if closed && area < 0.0 { -1.0 } else { 1.0 };
-    (0..n)
-        .map(|i| {
-            let (prev, next) = if closed {
-                (p[(i + n - 1) % n], p[(i + 1) % n])
-            } else {
-                (p[i.saturating_sub(1)], p[(i + 1).min(n - 1)])
-            };
-            let t = (next - prev).truncate();
-            flip * DVec2::new(t.y, -t.x).normalize_or_zero()
-        })
-        .collect()
 }
 
 pub(crate) fn run(
@@ -198,18 +177,34 @@ pub(crate) fn run(
     let ext = check_arguments(args)?;
     let name = args.scheme.name();
     let file = read_points(&args.input)?;
-    let (points, normals, normals_estimated) = match args.scheme {
-        CurveSchemeArg::CircleFourPoint | CurveSchemeArg::CircleTernary => {
-            let (points, normals, estimated) = subdivide_circle_average(args, &file, err)?;
-            (points, Some(normals), estimated)
-        }
-        _ => {
-            let points = linear_scheme(args)
-                .subdivide(&file.points, args.closed, args.levels)
-                .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
-            (points, None, false)
-        }
-    };
+    let scheme = NamedCurve::new(name, &parameters(args))
+        .map_err(|e| bad(format!("--scheme {name}: {e}")))?;
+    let circle = matches!(scheme, NamedCurve::Circle(_));
+    if circle && file.columns == 3 {
+        return Err(bad(format!(
+            "{}: the circle-average schemes work on planar points (`x y` or `x y nx ny`), not `x y z`",
+            args.input.display()
+        )));
+    }
+    if circle && file.normals.is_none() {
+        let _ = writeln!(
+            err,
+            "subd: warning: {}: no normals given; estimated from the polygon",
+            args.input.display()
+        );
+    }
+    let SubdividedCurve {
+        points,
+        normals,
+        normals_estimated,
+    } = subdivide_curve(
+        &scheme,
+        &file.points,
+        file.normals.as_deref(),
+        args.closed,
+        args.levels,
+    )
+    .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
     let body = if ext == "svg" {
         svg(
             &file.points,
@@ -260,22 +255,7 @@ fn check_arguments(args: &CurveArgs) -> Result<String, Failure> {
         )));
     }
     let scheme = args.scheme;
-    let takes = |flag: &str| match flag {
-        "omega" => matches!(
-            scheme,
-            CurveSchemeArg::FourPoint
-                | CurveSchemeArg::FourPoint2p
-                | CurveSchemeArg::Ternary3pt
-                | CurveSchemeArg::CircleFourPoint
-                | CurveSchemeArg::CircleTernary
-        ),
-        "mu" => matches!(
-            scheme,
-            CurveSchemeArg::FourPoint2p | CurveSchemeArg::CircleFourPoint
-        ),
-        "order" => scheme == CurveSchemeArg::Bspline,
-        _ => scheme == CurveSchemeArg::Tension,
-    };
+    let takes = |flag: &str| NamedCurve::takes(scheme.name(), flag);
     for (flag, given) in [
         ("omega", args.omega.is_some()),
         ("mu", args.mu.is_some()),
@@ -292,90 +272,14 @@ fn check_arguments(args: &CurveArgs) -> Result<String, Failure> {
     Ok(ext)
 }
 
-/// `--omega`, or the scheme's default: 1/4 for the ternary schemes, 1/16 for the rest.
-fn omega(args: &CurveArgs) -> f64 {
-    args.omega.unwrap_or(
-        if matches!(
-            args.scheme,
-            CurveSchemeArg::Ternary3pt | CurveSchemeArg::CircleTernary
-        ) {
-            0.25
-        } else {
-            1.0 / 16.0
-        },
-    )
-}
-
-/// The linear scheme the arguments name, with its parameters.
-fn linear_scheme(args: &CurveArgs) -> CurveScheme {
-    let (omega, mu) = (omega(args), args.mu.unwrap_or(0.0));
-    match args.scheme {
-        CurveSchemeArg::Chaikin => CurveScheme::Chaikin,
-        CurveSchemeArg::Bspline => CurveScheme::BSpline {
-            order: args.order.unwrap_or(4),
-        },
-        CurveSchemeArg::FourPoint => CurveScheme::FourPoint { omega },
-        CurveSchemeArg::FourPoint2p => CurveScheme::FourPoint2 { omega, mu },
-        CurveSchemeArg::Ternary3pt => CurveScheme::Ternary3 { omega },
-        CurveSchemeArg::Tension => CurveScheme::Tension {
-            alpha0: args.alpha0.unwrap_or(1.0),
-        },
-        CurveSchemeArg::CirclePreserving => CurveScheme::CirclePreserving,
-        _ => CurveScheme::Variational,
+/// The parameters given (the library supplies the defaults).
+fn parameters(args: &CurveArgs) -> CurveParameters {
+    CurveParameters {
+        omega: args.omega,
+        mu: args.mu,
+        order: args.order,
+        alpha0: args.alpha0,
     }
-}
-
-/// Seed 004's circle-average schemes on planar points with normals (estimated from the
-/// polygon, with a warning, when the file has none): points, normals and whether they were
-/// estimated.
-fn subdivide_circle_average(
-    args: &CurveArgs,
-    file: &PointFile,
-    err: &mut dyn Write,
-) -> Result<(Vec<DVec3>, Vec<DVec2>, bool), Failure> {
-    if file.columns == 3 {
-        return Err(bad(format!(
-            "{}: the circle-average schemes work on planar points (`x y` or `x y nx ny`), not `x y z`",
-            args.input.display()
-        )));
-    }
-    let (normals, estimated) = match &file.normals {
-        Some(n) => (n.clone(), false),
-        None => {
-            let _ = writeln!(
-                err,
-                "subd: warning: {}: no normals given; estimated from the polygon",
-                args.input.display()
-            );
-            (estimate_normals(&file.points, args.closed), true)
-        }
-    };
-    let pn: Vec<PointNormal> = file
-        .points
-        .iter()
-        .zip(&normals)
-        .map(|(p, n)| PointNormal {
-            p: p.truncate(),
-            n: *n,
-        })
-        .collect();
-    let omega = omega(args);
-    let cs = if args.scheme == CurveSchemeArg::CircleFourPoint {
-        CircleScheme::FourPoint {
-            omega,
-            mu: args.mu.unwrap_or(0.0),
-        }
-    } else {
-        CircleScheme::Ternary { omega }
-    };
-    let r = cs
-        .subdivide(&pn, args.closed, args.levels)
-        .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
-    Ok((
-        r.iter().map(|q| q.p.extend(0.0)).collect(),
-        r.iter().map(|q| q.n).collect(),
-        estimated,
-    ))
 }
 
 /// One line per point: `x y` (`z` for 3D input), then the normal where there is one.

@@ -7,11 +7,8 @@ use std::time::Instant;
 
 use clap::{Args, ValueEnum};
 use serde::Serialize;
-use subd_editing::energy::{EnergyMatrix, EnergyOptions, surface_energy_before_after};
-use subd_editing::{
-    Axis, Constraint, Deformation, DependentGroup, EditError, Editor, Location, Method,
-};
-use subd_limit::eval::LimitEvaluator;
+use subd_editing::energy::EnergyOptions;
+use subd_editing::{Constraint, Deformation, DependentGroup, Method};
 use subd_mesh::{DVec3, Mesh};
 use subd_schemes::Scheme;
 
@@ -125,91 +122,6 @@ fn kind(c: &Constraint) -> &'static str {
     }
 }
 
-/// Where a point or normal constraint is, as the constraint file says it.
-fn location(at: &Location) -> String {
-    match at {
-        Location::Vertex(v) => format!("vertex {v}"),
-        Location::Face(p) if p.sub == 0 => format!("face {} uv ({}, {})", p.face, p.u, p.v),
-        Location::Face(p) => format!("face {} sub {} uv ({}, {})", p.face, p.sub, p.u, p.v),
-    }
-}
-
-/// A constraint as the user wrote it: its index in the file, kind and place.
-fn describe(index: usize, c: &Constraint) -> String {
-    match c {
-        Constraint::Point { at, .. } => format!("{index} (point at {})", location(at)),
-        Constraint::Normal { at, .. } => format!("{index} (normal at {})", location(at)),
-        Constraint::Isoline { line, .. } => {
-            let along = match line.along {
-                Axis::U => "u",
-                Axis::V => "v",
-            };
-            format!(
-                "{index} (isoline from face {} along {along} at {})",
-                line.face, line.at
-            )
-        }
-    }
-}
-
-/// "constraint 2 (…)", "constraints 0 (…) and 1 (…)", "constraints 0 (…), 1 (…) and 3 (…)".
-fn name_constraints(indices: &[usize], constraints: &[Constraint]) -> String {
-    let names: Vec<String> = indices
-        .iter()
-        .map(|&i| describe(i, &constraints[i]))
-        .collect();
-    match names.as_slice() {
-        [one] => format!("constraint {one}"),
-        [init @ .., last] => format!("constraints {} and {last}", init.join(", ")),
-        [] => "no constraint".into(),
-    }
-}
-
-/// One warning per dependent group: redundant when its targets agree, else conflicting
-/// with what the least-squares compromise leaves unmet. A rank deficiency the groups do not
-/// explain (a solver's test looser than theirs) gets one line of its own.
-fn dependency_warnings(
-    constraints: &[Constraint],
-    groups: &[DependentGroup],
-    rank: usize,
-    rows: usize,
-) -> Vec<String> {
-    let mut lines: Vec<String> = groups
-        .iter()
-        .map(|g| {
-            let names = name_constraints(&g.constraints, constraints);
-            let single = g.constraints.len() == 1;
-            if g.consistent {
-                format!(
-                    "{names} {} redundant: {} dependent but consistent, every one met",
-                    if single { "is" } else { "are" },
-                    if single {
-                        "its rows are"
-                    } else {
-                        "their rows are"
-                    },
-                )
-            } else {
-                format!(
-                    "{names} conflict{}: no surface meets {} ({} dependent rows); the \
-                     least-squares compromise leaves {:.4e} unmet",
-                    if single { "s with itself" } else { "" },
-                    if single { "all its rows" } else { "them all" },
-                    g.dependent_rows,
-                    g.residual
-                )
-            }
-        })
-        .collect();
-    if groups.is_empty() && rank < rows {
-        lines.push(format!(
-            "the constraint rows are dependent (rank {rank} of {rows} rows): the \
-             least-squares solution"
-        ));
-    }
-    lines
-}
-
 fn read_text(path: &Path) -> Result<String, Failure> {
     std::fs::read_to_string(path).map_err(|e| bad(format!("{}: cannot read: {e}", path.display())))
 }
@@ -293,17 +205,6 @@ fn read_constraints(path: &Path) -> Result<Vec<Constraint>, Failure> {
     Ok(constraints)
 }
 
-/// The largest residual of a point or iso-line over the bounding-box diagonal of `x0`.
-fn largest_relative_distance(constraints: &[Constraint], res: &[f64], x0: &[DVec3]) -> f64 {
-    let diag = subd_pia::bbox_diagonal(x0).max(f64::MIN_POSITIVE);
-    constraints
-        .iter()
-        .zip(res)
-        .filter(|(c, _)| !matches!(c, Constraint::Normal { .. }))
-        .map(|(_, r)| r / diag)
-        .fold(0.0, f64::max)
-}
-
 fn residual_reports(constraints: &[Constraint], res: &[f64]) -> Vec<ConstraintReport> {
     constraints
         .iter()
@@ -315,41 +216,6 @@ fn residual_reports(constraints: &[Constraint], res: &[f64]) -> Vec<ConstraintRe
             residual: r,
         })
         .collect()
-}
-
-/// The energies `subd edit --json` reports (Catmull-Clark).
-struct Energies {
-    /// The thin-plate energy of the whole limit surface before the edit: one definition
-    /// for every method ([`surface_energy_before_after`]).
-    before: f64,
-    /// The same after.
-    after: f64,
-    /// The displacement's energy over the faces the free vertices touch (the method's own
-    /// energy, membrane included, where it assembled one).
-    displacement: f64,
-}
-
-fn energies(
-    ev: &LimitEvaluator,
-    editor: &mut Editor,
-    x0: &[DVec3],
-    x1: &[DVec3],
-) -> Result<Energies, EditError> {
-    let topo = ev.topology();
-    let q = match editor.energy.take() {
-        Some(q) => q,
-        None => {
-            let faces = subd_editing::solve::faces_touching(topo, editor.free_vertices());
-            EnergyMatrix::new(ev, topo.num_vertices(), &faces, &EnergyOptions::default())?
-        }
-    };
-    let d: Vec<DVec3> = x1.iter().zip(x0).map(|(a, b)| *a - *b).collect();
-    let (before, after) = surface_energy_before_after(ev, x0, x1, &EnergyOptions::default())?;
-    Ok(Energies {
-        before,
-        after,
-        displacement: q.energy(&d),
-    })
 }
 
 /// Writes IN's topology, tags and texture coordinates with the edited control vertices.
@@ -385,46 +251,28 @@ fn run_one(
     let scheme = args.scheme.clone();
     let options = args.rules.options(&file.mesh.hints);
     let topo = &file.mesh.topology;
-    let x0 = &file.mesh.positions;
     let named = |e: subd_editing::EditError| match e {
         subd_editing::EditError::Constraint { .. } => {
             bad(format!("{}: {e}", args.constraints.display()))
         }
         e => bad(format!("{}: {e}", job.input.display())),
     };
-    let mut editor =
-        Editor::new(topo, x0, &scheme, &options, &constraints, method).map_err(named)?;
-    let edit = editor.solve_timed(&constraints).map_err(named)?;
-
-    // Residuals measured afresh: a new evaluator on the output positions.
-    let t_check = Instant::now();
-    let ev = subd_limit::eval::LimitEvaluator::new(topo, &scheme, &options)
-        .map_err(|e| bad(format!("{}: {e}", job.input.display())))?;
-    let res = subd_editing::check::residuals(&ev, topo, &scheme, &constraints, x0, &edit.positions)
+    let edited = subd_editing::edit_mesh(&file.mesh, &scheme, &options, &constraints, method, true)
         .map_err(named)?;
-    let max_rel = largest_relative_distance(&constraints, &res, x0);
-    print_warnings(
-        err,
-        &args.constraints,
-        &dependency_warnings(
-            &constraints,
-            &edit.dependencies,
-            editor.rank,
-            editor.rows().rows.len(),
-        ),
-    );
-    let energies = (scheme == Scheme::CatmullClark)
-        .then(|| energies(&ev, &mut editor, x0, &edit.positions))
-        .transpose()
-        .map_err(named)?;
-    let t_check = t_check.elapsed().as_secs_f64();
+    print_warnings(err, &args.constraints, &edited.warnings);
+    let measured = edited
+        .measured
+        .as_ref()
+        .expect("edit_mesh measures when asked to");
+    let edit = &edited.edit;
 
     let t_write = Instant::now();
     write_edited(job, file, &edit.positions, err)?;
     let t_write = t_write.elapsed().as_secs_f64();
 
     if args.json {
-        let t = editor.timings;
+        let t = edited.timings;
+        let energies = measured.energies.as_ref();
         let report = EditReport {
             input: job.input.display().to_string(),
             output: job.output.display().to_string(),
@@ -436,24 +284,24 @@ fn run_one(
             },
             vertices: topo.num_vertices(),
             constraints: constraints.len(),
-            rows: editor.rows().rows.len(),
-            rank: editor.rank,
-            rank_deficient: editor.rank_deficient,
+            rows: edited.rows,
+            rank: edited.rank,
+            rank_deficient: edited.rank_deficient,
             dependencies: edit.dependencies.clone(),
-            free_vertices: editor.free_vertices().len(),
+            free_vertices: edited.free_vertices,
             moved_vertices: edit.moved.clone(),
-            residuals: residual_reports(&constraints, &res),
-            max_residual_relative: max_rel,
-            energy_before: energies.as_ref().map(|e| e.before),
-            energy_after: energies.as_ref().map(|e| e.after),
-            displacement_energy: energies.as_ref().map(|e| e.displacement),
+            residuals: residual_reports(&constraints, &measured.residuals),
+            max_residual_relative: measured.max_residual_relative,
+            energy_before: energies.map(|e| e.before),
+            energy_after: energies.map(|e| e.after),
+            displacement_energy: energies.map(|e| e.displacement),
             seconds: EditSeconds {
                 read: t_read,
                 constraints: t.constraints,
                 assemble: t.assemble,
                 factor: t.factor,
                 solve: t.solve,
-                check: t_check,
+                check: measured.seconds,
                 write: t_write,
                 total: opened.elapsed(),
             },
@@ -512,10 +360,7 @@ fn run_deform_one(
     let started = opened.started;
     let mut mesh = opened.file.mesh;
     let moved = d.apply(&mut mesh.positions);
-    let max_err = cs
-        .iter()
-        .map(|c| (d.displacement(c.center) - c.displacement).length())
-        .fold(0.0, f64::max);
+    let max_err = d.max_constraint_error();
     let mut dropped = Vec::new();
     crate::uv::fit_ply(&mut mesh, &job.output, &mut dropped);
     print_warnings(err, &job.input, &dropped);

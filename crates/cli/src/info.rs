@@ -5,9 +5,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 use serde::Serialize;
-use subd_mesh::analysis::count_irregular;
-use subd_mesh::fvar::{FVarLinearInterpolation, FVarSeams};
-use subd_mesh::{BoundaryInterpolation, TopologySummary};
+use subd_mesh::report::MeshReport;
 
 use crate::{Failure, print_warnings};
 
@@ -21,40 +19,10 @@ pub(crate) struct InfoArgs {
 }
 
 #[derive(Serialize)]
-struct Irregular {
-    /// Regular valence 4 (Catmull-Clark, Bilinear).
-    quad: usize,
-    /// Regular valence 6 (Loop).
-    triangle: usize,
-}
-
-/// One face-varying channel: its size and where its values are discontinuous.
-#[derive(Serialize)]
-struct ChannelReport {
-    /// Numbers per value.
-    components: usize,
-    /// Values the file gives.
-    values: usize,
-    /// Distinct values at vertices (a vertex on a seam counts once per side).
-    vertex_values: usize,
-    /// Edges whose faces name different values at one of their ends.
-    seam_edges: usize,
-    /// Vertices with more than one value.
-    seam_vertices: usize,
-}
-
-#[derive(Serialize)]
 struct InfoReport<'a> {
     file: String,
     #[serde(flatten)]
-    summary: &'a TopologySummary,
-    irregular_vertices: Irregular,
-    orientation_conflicts: usize,
-    boundary_interpolation: Option<BoundaryInterpolation>,
-    /// Face-varying channels (the first is the texture coordinates).
-    fvar_channels: Vec<ChannelReport>,
-    /// The file's face-varying interpolation tag, if any.
-    fvar_interpolation: Option<FVarLinearInterpolation>,
+    mesh: &'a MeshReport,
     warnings: &'a [String],
 }
 
@@ -72,33 +40,10 @@ pub(crate) fn run(
     };
     let file = subd_io::read_mesh(&args.input, &options)?;
     print_warnings(err, &args.input, &file.warnings);
-    let topo = &file.mesh.topology;
-    let summary = TopologySummary::new(topo);
+    let mesh = MeshReport::of(&file.mesh, file.orientation_conflicts);
     let report = InfoReport {
         file: args.input.display().to_string(),
-        summary: &summary,
-        irregular_vertices: Irregular {
-            quad: count_irregular(topo, 4),
-            triangle: count_irregular(topo, 6),
-        },
-        orientation_conflicts: file.orientation_conflicts,
-        boundary_interpolation: file.mesh.hints.boundary_interpolation,
-        fvar_channels: file
-            .mesh
-            .fvar
-            .iter()
-            .map(|c| {
-                let seams = FVarSeams::of(topo, c);
-                ChannelReport {
-                    components: c.components(),
-                    values: c.num_values(),
-                    vertex_values: seams.num_vertex_values(),
-                    seam_edges: seams.num_seam_edges(),
-                    seam_vertices: seams.num_seam_vertices(),
-                }
-            })
-            .collect(),
-        fvar_interpolation: file.mesh.hints.fvar_interpolation,
+        mesh: &mesh,
         warnings: &file.warnings,
     };
     let written = if args.json {
@@ -120,15 +65,16 @@ fn histogram(h: &std::collections::BTreeMap<usize, usize>) -> String {
         .join(" ")
 }
 
-fn write_text(out: &mut dyn Write, r: &InfoReport) -> std::io::Result<()> {
-    let s = r.summary;
+fn write_text(out: &mut dyn Write, report: &InfoReport) -> std::io::Result<()> {
+    let r = report.mesh;
+    let s = &r.summary;
     let opt = |g: Option<i64>| {
         g.map_or(
             "undefined (not every component is a closed manifold)".to_string(),
             |g| g.to_string(),
         )
     };
-    writeln!(out, "file              {}", r.file)?;
+    writeln!(out, "file              {}", report.file)?;
     writeln!(out, "vertices          {}", s.vertices)?;
     writeln!(out, "edges             {}", s.edges)?;
     writeln!(out, "faces             {}", s.faces)?;

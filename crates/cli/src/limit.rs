@@ -177,8 +177,10 @@ fn limit_uv(
     let topo = &mesh.topology;
     if !scheme.is_opensubdiv() {
         crate::uv::split_limit_uv(topo, (scheme, table), channel, mode, warnings)
+            .map_err(|e| e.to_string())
     } else {
         crate::uv::limit_uv(topo, &scheme.at_level(1), options, channel, mode)
+            .map_err(|e| e.to_string())
     }
 }
 

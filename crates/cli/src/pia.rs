@@ -8,7 +8,7 @@ use std::time::Instant;
 use clap::{Args, ValueEnum};
 use serde::Serialize;
 use subd_mesh::Mesh;
-use subd_pia::{Method, Moving, Pia, PiaOptions, Solver, bbox_diagonal};
+use subd_pia::{Method, Moving, Pia, PiaOptions, Solver};
 use subd_schemes::Scheme;
 
 use crate::batch::{self, Files, Job};
@@ -160,17 +160,20 @@ fn run_one(
     // written positions, not the solver's own residual.
     spinner.message("checking");
     let t2 = Instant::now();
+    let positions = &file.mesh.positions;
+    let deviation =
+        subd_pia::deviation(topo, &scheme, &options, &result.points, positions, &moving)
+            .map_err(at_input)?;
+    let (max_error, relative) = (deviation.max_error, deviation.relative);
+    let t_check = t2.elapsed().as_secs_f64();
+    spinner.finish();
+    if !result.converged || !deviation.within(args.tol) {
+        return Err(not_converged(args, job, name, &result, relative));
+    }
     let fitted = Fitted {
         mesh: &file.mesh,
         points: &result.points,
-        moving: &moving,
     };
-    let (max_error, relative) = fitted.max_error(&scheme, &options).map_err(at_input)?;
-    let t_check = t2.elapsed().as_secs_f64();
-    spinner.finish();
-    if !result.converged || relative.is_nan() || relative > args.tol * (1.0 + 1e-6) {
-        return Err(not_converged(args, job, name, &result, relative));
-    }
 
     let t3 = Instant::now();
     fitted.write(job, err)?;
@@ -254,39 +257,9 @@ impl SolverArg {
 struct Fitted<'a> {
     mesh: &'a Mesh,
     points: &'a [subd_mesh::DVec3],
-    moving: &'a Moving,
 }
 
 impl Fitted<'_> {
-    /// The largest distance of a moving vertex's limit from its input position, absolute and
-    /// over the bounding-box diagonal: measured with a limit table built afresh and applied
-    /// to the written positions, not the solver's own residual.
-    fn max_error(
-        &self,
-        scheme: &Scheme,
-        options: &subd_schemes::Options,
-    ) -> Result<(f64, f64), subd_pia::PiaError> {
-        let topo = &self.mesh.topology;
-        let nv = topo.num_vertices();
-        let check = match scheme {
-            Scheme::TwoPhase(tp) => subd_limit::two_phase_base_limit_positions(topo, tp, options),
-            s => subd_limit::base_limit_positions(topo, s, options),
-        }?;
-        let limit = check.apply_points(self.points);
-        let flags = self.moving.flags(nv)?;
-        let max_error = (0..nv)
-            .filter(|&v| flags[v])
-            .map(|v| (limit[v] - self.mesh.positions[v]).length())
-            .fold(0.0, f64::max);
-        let diagonal = bbox_diagonal(&self.mesh.positions);
-        let relative = if diagonal > 0.0 {
-            max_error / diagonal
-        } else {
-            max_error
-        };
-        Ok((max_error, relative))
-    }
-
     /// Writes the fitted mesh: the input's topology, hints and texture coordinates (the
     /// topology is kept, so the coordinates stay as given) with the fitted points.
     fn write(&self, job: &Job, err: &mut dyn Write) -> Result<(), Failure> {

@@ -241,10 +241,12 @@ fn refined_surface(
 ) -> Result<Surface, String> {
     let options = args.rules.options(&file.mesh.hints);
     let refinement =
-        RefinementWithLimit::new(&file.mesh.topology, scheme.clone(), &options, levels)?;
+        RefinementWithLimit::new(&file.mesh.topology, scheme.clone(), &options, levels)
+            .map_err(|e| e.to_string())?;
     let mut positions = refinement.last_positions(&file.mesh.positions);
     let limit_normals = if args.limit {
-        let limit = output_limit(&refinement, levels, &options, &positions)?;
+        let limit =
+            output_limit(&refinement, levels, &options, &positions).map_err(|e| e.to_string())?;
         positions = limit.positions;
         Some(limit.normals)
     } else {

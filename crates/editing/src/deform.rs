@@ -121,6 +121,15 @@ impl Deformation {
         displacement_at(&self.constraints, &self.m, q)
     }
 
+    /// The largest distance between a constraint point's solved displacement and the one
+    /// it asked for (rounding of the solve only).
+    pub fn max_constraint_error(&self) -> f64 {
+        self.constraints
+            .iter()
+            .map(|c| (self.displacement(c.center) - c.displacement).length())
+            .fold(0.0, f64::max)
+    }
+
     /// Moves `points` in place; returns how many moved. Constraint centres among them move
     /// by their displacement exactly (to rounding of the solve).
     pub fn apply(&self, points: &mut [DVec3]) -> usize {

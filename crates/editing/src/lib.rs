@@ -18,7 +18,8 @@
 //! An [`Editor`] factors once per set of constraint locations; [`Editor::solve`] with new
 //! targets only substitutes. Constraints whose rows are dependent are named in
 //! [`Edit::dependencies`]: redundant when their targets agree, conflicting when not.
-//! [`deform`] moves points by radial blends around constraint points (Borrel & Moreau's
+//! [`edit_mesh`] runs one edit of a mesh start to finish (as `subd edit` does), with the
+//! result measured afresh. [`deform`] moves points by radial blends around constraint points (Borrel & Moreau's
 //! Scodef), for a mesh of any level.
 //!
 //! ```
@@ -53,6 +54,7 @@ pub mod deform;
 pub mod dependency;
 pub mod energy;
 pub mod isoline;
+pub mod mesh_edit;
 pub mod solve;
 pub mod spec;
 
@@ -61,6 +63,7 @@ pub use deform::{DeformConstraint, Deformation};
 pub use dependency::DependentGroup;
 pub use energy::{EnergyMatrix, EnergyOptions};
 pub use isoline::{Axis, Isoline};
+pub use mesh_edit::{Energies, Measured, MeshEdit, edit_mesh};
 pub use solve::{Edit, Editor, Method, Timings};
 
 #[cfg(doctest)]

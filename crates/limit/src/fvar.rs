@@ -174,8 +174,9 @@ impl BaseFVarLimit {
 /// ```
 ///
 /// # Errors
-/// As [`crate::base_limit`], and [`LimitError::Param`] for a channel that does not fit
-/// `topology`.
+/// As [`crate::base_limit`], [`LimitError::TooDeep`] when refining the whole mesh until
+/// its semi-sharp creases decay would pass [`crate::MAX_DECAY_FACE_VERTICES`], and
+/// [`LimitError::Param`] for a channel that does not fit `topology`.
 pub fn base_fvar_limit(
     topology: &Topology,
     scheme: &Scheme,
@@ -183,7 +184,21 @@ pub fn base_fvar_limit(
     channel: &FVarChannel,
     mode: FVarLinearInterpolation,
 ) -> Result<BaseFVarLimit, LimitError> {
-    let levels = crate::levels_for_exact_limit(topology, scheme).0.max(1);
+    let (levels, sharpness) = crate::levels_for_exact_limit(topology, scheme);
+    let levels = levels.max(1);
+    // The whole channel is refined until the creases have decayed: refused, as the
+    // positions' whole refinement is, where that would pass the budget (a sharpness of 8
+    // multiplies the mesh by 4^8).
+    let estimate = topology
+        .num_face_vertices()
+        .saturating_mul(4usize.saturating_pow(levels as u32));
+    if estimate > crate::MAX_DECAY_FACE_VERTICES {
+        return Err(LimitError::TooDeep {
+            sharpness,
+            levels,
+            max: crate::MAX_DECAY_FACE_VERTICES,
+        });
+    }
     let r = Refinement::new(topology, scheme.clone(), options, levels)?;
     let fr = FaceVaryingRefinement::new(&r, channel, mode)
         .map_err(|e| LimitError::Param(e.to_string()))?;
@@ -308,5 +323,26 @@ mod tests {
             limit_at_level(&r, &fr, 2),
             Err(LimitError::Param(_))
         ));
+    }
+
+    /// A crease of sharpness 9.5 would need 10 levels of the whole 32-triangle grid (96 ×
+    /// 4^10 face-vertices, over the budget): refused at once instead of allocated.
+    #[test]
+    fn creases_too_sharp_for_the_budget_are_refused_before_refining() {
+        let (_, mut tris, _, ti) = grid();
+        let e = tris.find_edge(11, 12).unwrap() as usize; // interior
+        tris.set_edge_sharpness(e, 9.5);
+        let channel = FVarChannel::new(&tris, 2, vec![0.0; 100], ti).unwrap();
+        let limit = base_fvar_limit(
+            &tris,
+            &Scheme::Loop,
+            &Options::default(),
+            &channel,
+            FVarLinearInterpolation::CornersPlus1,
+        );
+        assert!(
+            matches!(limit, Err(LimitError::TooDeep { levels: 10, .. })),
+            "{limit:?}"
+        );
     }
 }

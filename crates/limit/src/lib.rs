@@ -56,8 +56,10 @@ pub mod masks;
 pub mod patch;
 mod piece;
 pub mod point_stencil;
+pub mod refined_mesh;
 mod sample_numbering;
 mod smooth_closed;
+pub mod spectrum;
 pub mod split_eigen;
 pub mod split_limit;
 pub mod stam;
@@ -77,7 +79,7 @@ pub use point_stencil::{FacePatch, PatchForm, PointStencil};
 pub use table::{LimitPoints, LimitStencilTable, eigen_limit_vertices};
 
 /// What can go wrong computing limits.
-#[derive(Debug, Error)]
+#[derive(Debug, Clone, Error)]
 pub enum LimitError {
     /// A scheme without what was asked for (Bilinear has no limit masks: its limit is the
     /// mesh itself; exact evaluation covers Catmull-Clark and Loop).
@@ -139,6 +141,15 @@ pub enum LimitError {
     /// The eigen analysis failed (a degenerate local configuration).
     #[error("eigen analysis: {0}")]
     Analysis(String),
+    /// A refined mesh that could not be assembled.
+    #[error(transparent)]
+    Mesh(#[from] subd_mesh::TopologyError),
+    /// Texture coordinates that do not fit their mesh.
+    #[error(transparent)]
+    FaceVarying(#[from] subd_mesh::fvar::FVarError),
+    /// Texture coordinates a split scheme cannot refine.
+    #[error(transparent)]
+    SplitFaceVarying(#[from] subd_schemes::split_schemes::SplitFVarError),
 }
 
 /// The scheme whose limit masks a level refined with `scheme` takes: Catmull-Clark's for a

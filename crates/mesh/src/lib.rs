@@ -37,6 +37,7 @@ pub mod geometry;
 pub mod memory;
 pub mod neighbourhood;
 pub mod primitives;
+pub mod report;
 pub mod tags;
 mod topology;
 

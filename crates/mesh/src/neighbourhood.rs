@@ -132,6 +132,10 @@ pub fn vertices_within_rings(t: &Topology, seed: &[u32], rings: usize) -> Vec<u3
         inside[v as usize] = true;
     }
     for _ in 0..rings {
+        // Nothing new to reach: more rings would only spin (a count may be huge).
+        if frontier.is_empty() {
+            break;
+        }
         let mut next = Vec::new();
         for &v in &frontier {
             for &f in t.vertex_faces(v as usize) {

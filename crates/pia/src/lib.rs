@@ -384,6 +384,69 @@ impl Pia {
     }
 }
 
+/// How far a solve's limit surface is from its targets, measured independently of the
+/// solver: with a limit table built afresh and applied to the solved points.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Deviation {
+    /// The largest distance of a moving vertex's limit from its target (model units).
+    pub max_error: f64,
+    /// `max_error` over the targets' bounding-box diagonal (`max_error` itself when the
+    /// diagonal is 0).
+    pub relative: f64,
+}
+
+impl Deviation {
+    /// Whether the relative error is within `tol`, with a margin of `1e-6 tol` for the
+    /// fresh table, whose rounding differs from the solver's.
+    pub fn within(&self, tol: f64) -> bool {
+        !(self.relative.is_nan() || self.relative > tol * (1.0 + 1e-6))
+    }
+}
+
+/// The [`Deviation`] of `points` as control points of `scheme` on `topology` from `targets`
+/// at the `moving` vertices.
+///
+/// # Errors
+/// [`PiaError::Limit`] where the scheme's limit is not defined for the mesh;
+/// [`PiaError::Vertex`] for a bad index in `moving`; [`PiaError::Targets`] when `points` or
+/// `targets` is not one per vertex.
+pub fn deviation(
+    topology: &Topology,
+    scheme: &Scheme,
+    options: &Options,
+    points: &[DVec3],
+    targets: &[DVec3],
+    moving: &Moving,
+) -> Result<Deviation, PiaError> {
+    let nv = topology.num_vertices();
+    if let Some(given) = [points.len(), targets.len()].into_iter().find(|&n| n != nv) {
+        return Err(PiaError::Targets {
+            given,
+            vertices: nv,
+        });
+    }
+    let check = match scheme {
+        Scheme::TwoPhase(tp) => subd_limit::two_phase_base_limit_positions(topology, tp, options),
+        s => subd_limit::base_limit_positions(topology, s, options),
+    }?;
+    let limit = check.apply_points(points);
+    let flags = moving.flags(nv)?;
+    let max_error = (0..nv)
+        .filter(|&v| flags[v])
+        .map(|v| (limit[v] - targets[v]).length())
+        .fold(0.0, f64::max);
+    let diagonal = bbox_diagonal(targets);
+    let relative = if diagonal > 0.0 {
+        max_error / diagonal
+    } else {
+        max_error
+    };
+    Ok(Deviation {
+        max_error,
+        relative,
+    })
+}
+
 /// Length of the diagonal of the axis-aligned bounding box of `points`.
 pub fn bbox_diagonal(points: &[DVec3]) -> f64 {
     if points.is_empty() {

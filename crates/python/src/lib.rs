@@ -11,11 +11,16 @@
 
 use pyo3::prelude::*;
 
+mod adaptive;
+mod analysis;
+mod arrays;
+mod curve;
 mod errors;
 mod mesh;
 mod ops;
 mod pool;
 mod refiner;
+mod shape;
 mod surface;
 
 /// The module `subd._subd`.
@@ -26,8 +31,21 @@ fn _subd(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(ops::read, m)?)?;
     m.add_function(wrap_pyfunction!(ops::refine, m)?)?;
     m.add_function(wrap_pyfunction!(ops::limit, m)?)?;
+    m.add_function(wrap_pyfunction!(ops::info, m)?)?;
+    m.add_function(wrap_pyfunction!(adaptive::adaptive, m)?)?;
+    m.add_function(wrap_pyfunction!(analysis::analyze_mask, m)?)?;
+    m.add_function(wrap_pyfunction!(analysis::analyze_mask2, m)?)?;
+    m.add_function(wrap_pyfunction!(analysis::analyze_surface, m)?)?;
+    m.add_function(wrap_pyfunction!(curve::curve, m)?)?;
+    m.add(
+        "CURVE_SCHEMES",
+        subd_schemes::named_curve::CURVE_SCHEMES.to_vec(),
+    )?;
     m.add_function(wrap_pyfunction!(surface::evaluate, m)?)?;
     m.add_function(wrap_pyfunction!(surface::tessellate, m)?)?;
+    m.add_function(wrap_pyfunction!(shape::pia, m)?)?;
+    m.add_function(wrap_pyfunction!(shape::edit, m)?)?;
+    m.add_function(wrap_pyfunction!(shape::deform, m)?)?;
     m.add_function(wrap_pyfunction!(pool::set_num_threads, m)?)?;
     m.add_function(wrap_pyfunction!(pool::get_num_threads, m)?)?;
     m.add("SCHEMES", ops::SCHEME_NAMES.to_vec())?;

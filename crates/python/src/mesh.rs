@@ -1,23 +1,137 @@
 //! `subd._subd._CoreMesh`: a [`Mesh`] (topology, tags, positions) and, after a refinement
 //! to the limit, its normals. The Python class `subd.Mesh` wraps one.
 
-use numpy::ndarray::Array2;
-use numpy::{
-    IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods,
-};
+use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
+use std::sync::{Mutex, MutexGuard, OnceLock, PoisonError, TryLockError};
+
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
+use subd_limit::refined_mesh::RefinedMesh;
+use subd_mesh::fvar::FVarChannel;
 use subd_mesh::{DVec3, Mesh, TopologyBuilder};
 
+use crate::arrays::{copied1, filled1, filled2, flat_ints, flat_rows, points};
 use crate::errors::{io_error, mesh_error};
 use crate::pool;
 
-/// A mesh held by the library: what `subd.Mesh` stands on.
+/// A mesh held by the library: what `subd.Mesh` stands on. A refinement's result keeps
+/// its last level as faces and positions until something needs the full topology (tags,
+/// edges, writing, refining it again): [`CoreMesh::mesh`] builds it then, once.
 #[pyclass(name = "_CoreMesh", module = "subd._subd", frozen)]
 pub(crate) struct CoreMesh {
-    pub(crate) mesh: Mesh,
+    built: OnceLock<Mesh>,
+    /// A refinement's result whose topology is not built yet.
+    pending: Mutex<Option<RefinedMesh>>,
     /// Unit limit normals, one per vertex, where a refinement to the limit gave them.
     pub(crate) normals: Option<Vec<DVec3>>,
+    /// The refinement level of every face of an adaptive result.
+    pub(crate) face_levels: Option<Vec<u8>>,
+    /// Edges used in the same direction by two faces, as the reader counted them.
+    pub(crate) orientation_conflicts: usize,
+}
+
+/// What the arrays of a mesh are read from, built or not.
+pub(crate) struct Faces<'a> {
+    pub(crate) positions: &'a [DVec3],
+    pub(crate) offsets: &'a [u32],
+    pub(crate) face_vertices: &'a [u32],
+    /// Texture coordinates: values (two numbers each) and one index per face-vertex.
+    pub(crate) uv: Option<(&'a [f64], &'a [u32])>,
+}
+
+impl CoreMesh {
+    /// A mesh with nothing besides its own data.
+    pub(crate) fn plain(mesh: Mesh) -> CoreMesh {
+        CoreMesh {
+            built: OnceLock::from(mesh),
+            pending: Mutex::new(None),
+            normals: None,
+            face_levels: None,
+            orientation_conflicts: 0,
+        }
+    }
+
+    /// A refinement's result, its topology left for later.
+    pub(crate) fn refined(mut refined: RefinedMesh) -> CoreMesh {
+        CoreMesh {
+            built: OnceLock::new(),
+            normals: refined.normals.take(),
+            pending: Mutex::new(Some(refined)),
+            face_levels: None,
+            orientation_conflicts: 0,
+        }
+    }
+
+    /// The mesh with its full topology, built now (the GIL released) if it is not yet.
+    pub(crate) fn mesh(&self, py: Python<'_>) -> PyResult<&Mesh> {
+        if let Some(m) = self.built.get() {
+            return Ok(m);
+        }
+        // The lock is taken on this thread, not on the pool: a pool thread waiting for it
+        // could starve the pool work of the thread that holds it.
+        py.detach(|| -> PyResult<()> {
+            let mut pending = self.pending.lock().unwrap_or_else(PoisonError::into_inner);
+            if let Some(r) = pending.take() {
+                let (mesh, _normals) = pool::install(|| r.into_mesh())?.map_err(mesh_error)?;
+                // Set before the lock is released: a reader that finds nothing pending
+                // finds the mesh.
+                let _ = self.built.set(mesh);
+            }
+            Ok(())
+        })?;
+        self.built
+            .get()
+            .ok_or_else(|| mesh_error("the refined mesh could not be assembled"))
+    }
+
+    /// The pending refinement's lock, waited for with the GIL released: a thread holding
+    /// the lock may need the GIL (to make an array) before it lets go, so no thread may wait
+    /// for the lock while holding the GIL.
+    fn lock_pending(&self, py: Python<'_>) -> MutexGuard<'_, Option<RefinedMesh>> {
+        loop {
+            match self.pending.try_lock() {
+                Ok(guard) => return guard,
+                Err(TryLockError::Poisoned(p)) => return p.into_inner(),
+                Err(TryLockError::WouldBlock) => {
+                    py.detach(|| std::thread::sleep(std::time::Duration::from_micros(200)));
+                }
+            }
+        }
+    }
+
+    /// `read` applied to the mesh's faces, positions and texture coordinates, from the
+    /// refinement's result where its topology is not built.
+    pub(crate) fn with_faces<T>(&self, py: Python<'_>, read: impl FnOnce(Faces<'_>) -> T) -> T {
+        fn of_mesh(m: &Mesh) -> Faces<'_> {
+            Faces {
+                positions: &m.positions,
+                offsets: m.topology.face_offsets(),
+                face_vertices: m.topology.all_face_vertices(),
+                uv: m.uv().map(|c| (c.values(), c.indices())),
+            }
+        }
+        if let Some(m) = self.built.get() {
+            return read(of_mesh(m));
+        }
+        let pending = self.lock_pending(py);
+        match pending.as_ref() {
+            Some(r) => {
+                let (offsets, face_vertices) = r.faces();
+                read(Faces {
+                    positions: r.positions(),
+                    offsets,
+                    face_vertices,
+                    uv: r.uv().map(|u| (&u.values[..], &u.indices[..])),
+                })
+            }
+            // Taken by `mesh`, which set the mesh before letting go of the lock.
+            None => read(of_mesh(
+                self.built
+                    .get()
+                    .expect("built before the lock was released"),
+            )),
+        }
+    }
 }
 
 /// The arrays a mesh is made of, as the Python layer passes them (C-contiguous, exact
@@ -31,6 +145,11 @@ struct Arrays<'a> {
     corner_vertices: &'a [i64],
     corner_sharpness: &'a [f64],
     holes: &'a [i64],
+    /// Texture coordinates (two numbers each) and one index per face-vertex, if given.
+    uv: Option<(&'a [f64], &'a [i64])>,
+    /// Whether an edge two faces use in the same direction is taken (as OpenSubdiv does,
+    /// making it non-manifold) rather than refused.
+    accept_inconsistent_orientation: bool,
 }
 
 impl Arrays<'_> {
@@ -40,6 +159,7 @@ impl Arrays<'_> {
         let sizes = self.face_sizes()?;
         let corners = self.corners(&sizes, nv)?;
         let mut topology = TopologyBuilder::new(nv)
+            .accept_inconsistent_orientation(self.accept_inconsistent_orientation)
             .build(&sizes, &corners)
             .map_err(|e| e.to_string())?;
         for (k, (pair, &s)) in self
@@ -80,7 +200,11 @@ impl Arrays<'_> {
             .chunks_exact(3)
             .map(|c| DVec3::new(c[0], c[1], c[2]))
             .collect();
-        Mesh::new(topology, positions).map_err(|e| e.to_string())
+        let mut mesh = Mesh::new(topology, positions).map_err(|e| e.to_string())?;
+        if let Some((values, indices)) = self.uv {
+            mesh.fvar.push(uv_channel(&mesh, values, indices)?);
+        }
+        Ok(mesh)
     }
 
     /// Face sizes as `u32`, each from 3 to the largest size a face may have.
@@ -132,26 +256,41 @@ impl Arrays<'_> {
     }
 }
 
+/// Texture coordinates as the mesh's face-varying channel: every value finite, one index
+/// per face-vertex, each naming a value.
+fn uv_channel(mesh: &Mesh, values: &[f64], indices: &[i64]) -> Result<FVarChannel, String> {
+    let t = &mesh.topology;
+    if indices.len() != t.num_face_vertices() {
+        return Err(format!(
+            "uv_indices: {} given, one per face corner ({}) needed",
+            indices.len(),
+            t.num_face_vertices()
+        ));
+    }
+    if let Some(i) = values.iter().position(|x| !x.is_finite()) {
+        return Err(format!("uv {}: non-finite coordinate", i / 2));
+    }
+    let nuv = values.len() / 2;
+    let mut checked = Vec::with_capacity(indices.len());
+    for f in 0..t.num_faces() {
+        let start = t.face_offsets()[f] as usize;
+        for (c, &i) in indices[start..start + t.face_size(f)].iter().enumerate() {
+            match u32::try_from(i) {
+                Ok(x) if (x as usize) < nuv => checked.push(x),
+                _ => {
+                    return Err(format!(
+                        "face {f} corner {c}: uv index {i} out of range (there are {nuv} uvs)"
+                    ));
+                }
+            }
+        }
+    }
+    FVarChannel::new(t, 2, values.to_vec(), checked).map_err(|e| e.to_string())
+}
+
 /// A tag's index, refused (named) when negative; the library checks the upper bound.
 fn index(i: i64) -> Result<u64, String> {
     u64::try_from(i).map_err(|_| format!("index {i} is negative"))
-}
-
-/// `values` as a C-contiguous numpy array of `n` rows of `K` numbers, owned by numpy.
-pub(crate) fn rows<'py, const K: usize, T: numpy::Element + Copy>(
-    py: Python<'py>,
-    values: impl Iterator<Item = [T; K]>,
-) -> PyResult<Bound<'py, PyArray2<T>>> {
-    let flat: Vec<T> = values.flat_map(|r| r.into_iter()).collect();
-    let n = flat.len() / K;
-    Array2::from_shape_vec((n, K), flat)
-        .map(|a| a.into_pyarray(py))
-        .map_err(|e| PyValueError::new_err(e.to_string()))
-}
-
-/// Points as an `(n, 3)` float64 array.
-pub(crate) fn points<'py>(py: Python<'py>, p: &[DVec3]) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    rows(py, p.iter().map(|v| v.to_array()))
 }
 
 /// A slice of a contiguous array, or a `ValueError` naming the argument.
@@ -180,6 +319,7 @@ fn slice2<'a, T: numpy::Element>(
 impl CoreMesh {
     /// A mesh from flat arrays (see `subd.Mesh`, which builds them from what a user has).
     #[new]
+    #[pyo3(signature = (vertices, face_sizes, face_vertices, crease_edges, crease_sharpness, corner_vertices, corner_sharpness, holes, uvs = None, uv_indices = None, accept_inconsistent_orientation = false))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -191,7 +331,15 @@ impl CoreMesh {
         corner_vertices: PyReadonlyArray1<'_, i64>,
         corner_sharpness: PyReadonlyArray1<'_, f64>,
         holes: PyReadonlyArray1<'_, i64>,
+        uvs: Option<PyReadonlyArray2<'_, f64>>,
+        uv_indices: Option<PyReadonlyArray1<'_, i64>>,
+        accept_inconsistent_orientation: bool,
     ) -> PyResult<CoreMesh> {
+        let uv = match (&uvs, &uv_indices) {
+            (Some(u), Some(i)) => Some((slice2(u, 2, "uvs")?, slice(i, "uv_indices")?)),
+            (None, None) => None,
+            _ => return Err(mesh_error("uvs and uv_indices come together")),
+        };
         let arrays = Arrays {
             vertices: slice2(&vertices, 3, "vertices")?,
             face_sizes: slice(&face_sizes, "face sizes")?,
@@ -201,6 +349,8 @@ impl CoreMesh {
             corner_vertices: slice(&corner_vertices, "corner vertices")?,
             corner_sharpness: slice(&corner_sharpness, "corner sharpness")?,
             holes: slice(&holes, "holes")?,
+            uv,
+            accept_inconsistent_orientation,
         };
         if arrays.crease_edges.len() / 2 != arrays.crease_sharpness.len()
             || arrays.corner_vertices.len() != arrays.corner_sharpness.len()
@@ -210,16 +360,13 @@ impl CoreMesh {
             ));
         }
         let mesh = pool::run(py, || arrays.build())?.map_err(mesh_error)?;
-        Ok(CoreMesh {
-            mesh,
-            normals: None,
-        })
+        Ok(CoreMesh::plain(mesh))
     }
 
     /// Vertex positions, `(n, 3)` float64.
     #[getter]
     fn vertices<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        points(py, &self.mesh.positions)
+        self.with_faces(py, |f| points(py, f.positions))
     }
 
     /// Unit limit normals, `(n, 3)` float64, or `None`.
@@ -230,18 +377,66 @@ impl CoreMesh {
 
     /// Number of corners of every face, `(m,)` int64.
     #[getter]
-    fn face_sizes<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<i64>> {
-        let t = &self.mesh.topology;
-        let sizes: Vec<i64> = t.face_sizes().map(i64::from).collect();
-        sizes.into_pyarray(py)
+    fn face_sizes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<i64>>> {
+        self.with_faces(py, |f| {
+            let offsets = f.offsets;
+            filled1(py, offsets.len() - 1, |i| {
+                i64::from(offsets[i + 1] - offsets[i])
+            })
+        })
     }
 
     /// Vertex indices of every face, one face after the other, int64.
     #[getter]
-    fn face_vertices<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<i64>> {
-        let fv = self.mesh.topology.all_face_vertices();
-        let v: Vec<i64> = fv.iter().map(|&i| i64::from(i)).collect();
-        v.into_pyarray(py)
+    fn face_vertices<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<i64>>> {
+        self.with_faces(py, |f| {
+            let fv = f.face_vertices;
+            filled1(py, fv.len(), |i| i64::from(fv[i]))
+        })
+    }
+
+    /// The faces as an `(m, k)` int64 array when every face has `k` corners, else `None`.
+    fn uniform_faces<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyArray2<i64>>>> {
+        self.with_faces(py, |f| {
+            let sizes = || f.offsets.windows(2).map(|w| w[1] - w[0]);
+            let k = sizes().next().unwrap_or(3) as usize;
+            if sizes().any(|s| s as usize != k) {
+                return Ok(None);
+            }
+            flat_ints(py, f.face_vertices, k).map(Some)
+        })
+    }
+
+    /// Texture coordinates, `(u, 2)` float64, or `None`.
+    #[getter]
+    fn uvs<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyArray2<f64>>>> {
+        self.with_faces(py, |f| {
+            f.uv.map(|(values, _)| flat_rows(py, values, 2)).transpose()
+        })
+    }
+
+    /// One texture-coordinate index per face-vertex, int64, or `None`.
+    #[getter]
+    fn uv_indices<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyArray1<i64>>>> {
+        self.with_faces(py, |f| {
+            f.uv.map(|(_, x)| filled1(py, x.len(), |i| i64::from(x[i])))
+                .transpose()
+        })
+    }
+
+    /// The refinement level of every face (adaptive results), uint8, or `None`.
+    #[getter]
+    fn face_levels<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyArray1<u8>>>> {
+        self.face_levels
+            .as_deref()
+            .map(|l| copied1(py, l))
+            .transpose()
+    }
+
+    /// Edges used in the same direction by two faces, as the reader counted them.
+    #[getter]
+    fn orientation_conflicts(&self) -> usize {
+        self.orientation_conflicts
     }
 
     /// Creases: `(edges (k, 2) int64, sharpness (k,) float64)`, edges with sharpness > 0.
@@ -251,28 +446,28 @@ impl CoreMesh {
         &self,
         py: Python<'py>,
     ) -> PyResult<(Bound<'py, PyArray2<i64>>, Bound<'py, PyArray1<f64>>)> {
-        let t = &self.mesh.topology;
+        let t = &self.mesh(py)?.topology;
         let creased: Vec<usize> = (0..t.num_edges())
             .filter(|&e| t.edge_sharpness(e) > 0.0)
             .collect();
-        let edges = rows(
-            py,
-            creased.iter().map(|&e| t.edge_vertices(e).map(i64::from)),
-        )?;
+        let edges = filled2(py, creased.len(), |i, r: &mut [i64; 2]| {
+            *r = t.edge_vertices(creased[i]).map(i64::from)
+        })?;
         let s: Vec<f64> = creased
             .iter()
             .map(|&e| f64::from(t.edge_sharpness(e)))
             .collect();
-        Ok((edges, s.into_pyarray(py)))
+        Ok((edges, copied1(py, &s)?))
     }
 
     /// Corners: `(vertices (c,) int64, sharpness (c,) float64)`, vertices with sharpness > 0.
     #[getter]
+    #[allow(clippy::type_complexity)]
     fn corners<'py>(
         &self,
         py: Python<'py>,
-    ) -> (Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<f64>>) {
-        let t = &self.mesh.topology;
+    ) -> PyResult<(Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<f64>>)> {
+        let t = &self.mesh(py)?.topology;
         let tagged: Vec<usize> = (0..t.num_vertices())
             .filter(|&v| t.vertex_sharpness(v) > 0.0)
             .collect();
@@ -281,46 +476,47 @@ impl CoreMesh {
             .iter()
             .map(|&v| f64::from(t.vertex_sharpness(v)))
             .collect();
-        (v.into_pyarray(py), s.into_pyarray(py))
+        Ok((copied1(py, &v)?, copied1(py, &s)?))
     }
 
     /// Indices of the faces that are holes, int64.
     #[getter]
-    fn holes<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<i64>> {
-        let t = &self.mesh.topology;
+    fn holes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<i64>>> {
+        let t = &self.mesh(py)?.topology;
         let h: Vec<i64> = (0..t.num_faces())
             .filter(|&f| t.is_hole(f))
             .map(|f| f as i64)
             .collect();
-        h.into_pyarray(py)
+        copied1(py, &h)
     }
 
     /// Number of vertices.
     #[getter]
-    fn num_vertices(&self) -> usize {
-        self.mesh.topology.num_vertices()
+    fn num_vertices(&self, py: Python<'_>) -> usize {
+        self.with_faces(py, |f| f.positions.len())
     }
 
     /// Number of faces.
     #[getter]
-    fn num_faces(&self) -> usize {
-        self.mesh.topology.num_faces()
+    fn num_faces(&self, py: Python<'_>) -> usize {
+        self.with_faces(py, |f| f.offsets.len() - 1)
     }
 
     /// Number of edges.
     #[getter]
-    fn num_edges(&self) -> usize {
-        self.mesh.topology.num_edges()
+    fn num_edges(&self, py: Python<'_>) -> PyResult<usize> {
+        Ok(self.mesh(py)?.topology.num_edges())
     }
 
     /// Writes the mesh (OBJ with crease tags, PLY, glTF binary by the extension), with its
     /// normals where it has them. The file appears whole or not at all.
     fn write(&self, py: Python<'_>, path: std::path::PathBuf) -> PyResult<()> {
         let options = subd_io::WriteOptions::default();
+        let mesh = self.mesh(py)?;
         pool::run(py, || match &self.normals {
-            None => subd_io::write_mesh(&path, &self.mesh, &options),
+            None => subd_io::write_mesh(&path, mesh, &options),
             Some(n) => {
-                let view = subd_io::MeshView::from_mesh(&self.mesh)
+                let view = subd_io::MeshView::from_mesh(mesh)
                     .with_normals(n)
                     .map_err(|e| subd_io::IoError::Invalid {
                         path: path.clone(),

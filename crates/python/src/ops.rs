@@ -6,11 +6,15 @@ use std::path::PathBuf;
 use numpy::PyArray2;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use subd_mesh::{DVec3, Mesh};
-use subd_schemes::{Options, Refinement, Scheme};
+use subd_limit::refined_mesh::{MeshRefinement, refine_mesh};
+use subd_mesh::Mesh;
+use subd_mesh::fvar::FVarLinearInterpolation;
+use subd_mesh::report::MeshReport;
+use subd_schemes::{Options, Scheme};
 
+use crate::arrays::points;
 use crate::errors::{io_error, mesh_error};
-use crate::mesh::{CoreMesh, points};
+use crate::mesh::CoreMesh;
 use crate::pool;
 
 /// The scheme names `subd.refine` takes (the CLI's `--scheme` values).
@@ -29,6 +33,7 @@ pub(crate) struct RuleNames<'a> {
     pub(crate) boundary: Option<&'a str>,
     pub(crate) crease_method: Option<&'a str>,
     pub(crate) triangles: Option<&'a str>,
+    pub(crate) fvar_interpolation: Option<&'a str>,
 }
 
 impl RuleNames<'_> {
@@ -63,6 +68,32 @@ impl RuleNames<'_> {
         }
         Ok(o)
     }
+
+    /// How texture coordinates interpolate: the name given, else the mesh's own, else
+    /// `corners-plus1` (the CLI's default).
+    pub(crate) fn fvar_mode(
+        &self,
+        hints: &subd_mesh::SchemeHints,
+    ) -> PyResult<FVarLinearInterpolation> {
+        let Some(name) = self.fvar_interpolation else {
+            return Ok(hints
+                .fvar_interpolation
+                .unwrap_or(FVarLinearInterpolation::CornersPlus1));
+        };
+        FVarLinearInterpolation::ALL_MODES
+            .into_iter()
+            .find(|m| m.name() == name)
+            .ok_or_else(|| {
+                let names: Vec<&str> = FVarLinearInterpolation::ALL_MODES
+                    .iter()
+                    .map(|m| m.name())
+                    .collect();
+                PyValueError::new_err(format!(
+                    "fvar_interpolation: unknown value {name:?} (one of {})",
+                    names.join(", ")
+                ))
+            })
+    }
 }
 
 /// Reads a mesh file (OBJ with OpenSubdiv's tags, PLY, glTF): the mesh and the reader's
@@ -79,19 +110,16 @@ pub(crate) fn read(
         ..Default::default()
     };
     let file = pool::run(py, || subd_io::read_mesh(&path, &options))?.map_err(io_error)?;
-    Ok((
-        CoreMesh {
-            mesh: file.mesh,
-            normals: None,
-        },
-        file.warnings,
-    ))
+    let mut core = CoreMesh::plain(file.mesh);
+    core.orientation_conflicts = file.orientation_conflicts;
+    Ok((core, file.warnings))
 }
 
-/// The mesh refined `levels` times with `scheme` (the mesh's own boundary and crease
-/// options), its vertices moved to the limit surface with unit normals when `limit`.
+/// The mesh refined `levels` times with `scheme` (the mesh's own rule options unless
+/// named), its vertices and texture coordinates moved to the limit surface, with unit
+/// normals, when `limit`: the mesh and what was left out (warnings).
 #[pyfunction]
-#[pyo3(signature = (mesh, scheme_name, levels, limit = false, boundary = None, crease_method = None, triangles = None))]
+#[pyo3(signature = (mesh, scheme_name, levels, limit = false, boundary = None, crease_method = None, triangles = None, fvar_interpolation = None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn refine(
     py: Python<'_>,
@@ -102,20 +130,26 @@ pub(crate) fn refine(
     boundary: Option<&str>,
     crease_method: Option<&str>,
     triangles: Option<&str>,
-) -> PyResult<CoreMesh> {
+    fvar_interpolation: Option<&str>,
+) -> PyResult<(CoreMesh, Vec<String>)> {
     let rules = RuleNames {
         boundary,
         crease_method,
         triangles,
+        fvar_interpolation,
     };
-    let (scheme, options) = request(&mesh.mesh, scheme_name, levels, &rules)?;
-    let (refined, normals) =
-        pool::run(py, || refined(&mesh.mesh, scheme, &options, levels, limit))?
-            .map_err(mesh_error)?;
-    Ok(CoreMesh {
-        mesh: refined,
-        normals,
-    })
+    let base = mesh.mesh(py)?;
+    let (scheme, options) = request(base, scheme_name, levels, &rules)?;
+    let request = MeshRefinement {
+        scheme,
+        options,
+        levels,
+        limit,
+        fvar_interpolation: rules.fvar_mode(&base.hints)?,
+    };
+    let mut refined = pool::run(py, || refine_mesh(base, &request))?.map_err(mesh_error)?;
+    let warnings = std::mem::take(&mut refined.warnings);
+    Ok((CoreMesh::refined(refined), warnings))
 }
 
 /// A refinement request checked: the scheme, the options for `mesh` and the output's size.
@@ -152,35 +186,6 @@ fn check_size(mesh: &Mesh, scheme: &Scheme, levels: usize) -> PyResult<()> {
     Ok(())
 }
 
-/// The refined mesh (and its limit normals).
-fn refined(
-    mesh: &Mesh,
-    scheme: Scheme,
-    options: &Options,
-    levels: usize,
-    limit: bool,
-) -> Result<(Mesh, Option<Vec<DVec3>>), String> {
-    let r = Refinement::new(&mesh.topology, scheme, options, levels).map_err(|e| e.to_string())?;
-    let mut positions = r.points_at(&mesh.positions, levels);
-    let mut normals = None;
-    if limit {
-        let l = subd_limit::level_limit_points(
-            &r,
-            levels,
-            options,
-            &positions,
-            subd_limit::Tangents::Dropped,
-        )
-        .map_err(|e| e.to_string())?;
-        positions = l.positions;
-        normals = Some(l.normals);
-    }
-    let topology = r.into_topology(levels);
-    let mut out = Mesh::new(topology, positions).map_err(|e| e.to_string())?;
-    out.hints = mesh.hints;
-    Ok((out, normals))
-}
-
 /// The exact limit position and unit normal of every vertex of `mesh`.
 #[pyfunction]
 #[pyo3(signature = (mesh, scheme_name))]
@@ -191,11 +196,20 @@ pub(crate) fn limit<'py>(
     scheme_name: &str,
 ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
     let scheme = scheme(scheme_name)?;
-    let m = &mesh.mesh;
+    let m = mesh.mesh(py)?;
     let options = Options::from_hints(&m.hints);
     let l = pool::run(py, || {
         subd_limit::limit_points(&m.topology, &scheme, &options, &m.positions)
     })?
     .map_err(mesh_error)?;
     Ok((points(py, &l.positions)?, points(py, &l.normals)?))
+}
+
+/// What `subd info --json` reports of the mesh (its topology summary, irregular vertices,
+/// tags and texture-coordinate seams), as a JSON text the Python layer turns into a dict.
+#[pyfunction]
+pub(crate) fn info(py: Python<'_>, mesh: &CoreMesh) -> PyResult<String> {
+    let m = mesh.mesh(py)?;
+    let report = pool::run(py, || MeshReport::of(m, mesh.orientation_conflicts))?;
+    serde_json::to_string(&report).map_err(|e| PyValueError::new_err(e.to_string()))
 }

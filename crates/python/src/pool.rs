@@ -46,6 +46,12 @@ pub(crate) fn run<T: Send>(py: Python<'_>, work: impl FnOnce() -> T + Send) -> P
     Ok(py.detach(|| pool.install(work)))
 }
 
+/// Runs `work` on the package's pool from a thread that has released the GIL already (see
+/// [`run`]).
+pub(crate) fn install<T: Send>(work: impl FnOnce() -> T + Send) -> PyResult<T> {
+    Ok(current()?.install(work))
+}
+
 /// Sets the number of threads every later call uses (`0`: one per core).
 #[pyfunction]
 pub(crate) fn set_num_threads(threads: usize) -> PyResult<()> {

@@ -2,15 +2,15 @@
 //! position sets (animation frames) or other per-vertex columns, and its stencils as a
 //! sparse matrix.
 
-use numpy::ndarray::Array2;
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2, PyUntypedArrayMethods};
+use numpy::{PyArray1, PyArray2, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use subd_mesh::DVec3;
 use subd_schemes::Refinement;
 
+use crate::arrays::{copied1, filled1, flat_rows, points};
 use crate::errors::mesh_error;
-use crate::mesh::{CoreMesh, points};
+use crate::mesh::CoreMesh;
 use crate::ops::{RuleNames, request};
 use crate::pool;
 
@@ -39,9 +39,11 @@ impl CoreRefiner {
             boundary,
             crease_method,
             triangles,
+            fvar_interpolation: None,
         };
-        let (scheme, options) = request(&mesh.mesh, scheme_name, levels, &rules)?;
-        let topology = &mesh.mesh.topology;
+        let base = mesh.mesh(py)?;
+        let (scheme, options) = request(base, scheme_name, levels, &rules)?;
+        let topology = &base.topology;
         let refinement = pool::run(py, || Refinement::new(topology, scheme, &options, levels))?
             .map_err(mesh_error)?;
         Ok(CoreRefiner { refinement, levels })
@@ -91,10 +93,7 @@ impl CoreRefiner {
             }
             level
         })?;
-        let rows = out.len().checked_div(k).unwrap_or(0);
-        Array2::from_shape_vec((rows, k), out)
-            .map(|a| a.into_pyarray(py))
-            .map_err(|e| PyValueError::new_err(e.to_string()))
+        flat_rows(py, &out, k)
     }
 
     /// The stencils from the base vertices to the vertices of `level` (the last when
@@ -119,13 +118,12 @@ impl CoreRefiner {
             )));
         }
         let table = pool::run(py, || self.refinement.composed(level))?;
-        let indptr: Vec<i64> = table.offsets().iter().map(|&o| i64::from(o)).collect();
-        let indices: Vec<i64> = table.indices().iter().map(|&i| i64::from(i)).collect();
+        let (offsets, indices) = (table.offsets(), table.indices());
         let shape = (table.num_rows(), self.refinement.num_vertices(0));
         Ok((
-            indptr.into_pyarray(py),
-            indices.into_pyarray(py),
-            table.weights().to_vec().into_pyarray(py),
+            filled1(py, offsets.len(), |i| i64::from(offsets[i]))?,
+            filled1(py, indices.len(), |i| i64::from(indices[i]))?,
+            copied1(py, table.weights())?,
             shape,
         ))
     }

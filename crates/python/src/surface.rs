@@ -10,8 +10,9 @@ use subd_limit::tessellation::tessellate_mesh;
 use subd_mesh::{DVec3, Mesh, TopologyBuilder};
 use subd_schemes::Options;
 
+use crate::arrays::points;
 use crate::errors::mesh_error;
-use crate::mesh::{CoreMesh, points};
+use crate::mesh::CoreMesh;
 use crate::ops::scheme;
 use crate::pool;
 
@@ -52,7 +53,7 @@ pub(crate) fn evaluate<'py>(
             "faces, sub, u and v need the same length",
         ));
     }
-    let m = &mesh.mesh;
+    let m = mesh.mesh(py)?;
     let options = Options::from_hints(&m.hints);
     let samples = pool::run(py, || -> Result<Vec<[DVec3; 7]>, String> {
         let ev = LimitEvaluator::new(&m.topology, &scheme, &options).map_err(|e| e.to_string())?;
@@ -100,7 +101,7 @@ pub(crate) fn tessellate(
     rate: usize,
 ) -> PyResult<CoreMesh> {
     let scheme = scheme(scheme_name)?;
-    let m = &mesh.mesh;
+    let m = mesh.mesh(py)?;
     let options = Options::from_hints(&m.hints);
     let (out, normals) = pool::run(py, || -> Result<(Mesh, Vec<DVec3>), String> {
         let t = tessellate_mesh(&m.topology, &scheme, &options, &m.positions, rate)
@@ -115,8 +116,7 @@ pub(crate) fn tessellate(
         Ok((out, t.normals))
     })?
     .map_err(mesh_error)?;
-    Ok(CoreMesh {
-        mesh: out,
-        normals: Some(normals),
-    })
+    let mut core = CoreMesh::plain(out);
+    core.normals = Some(normals);
+    Ok(core)
 }

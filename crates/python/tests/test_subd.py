@@ -1,10 +1,12 @@
 """Tests of the Python package against independent computations: the `subd` binary's files
 (the Rust library through its CLI), libigl's Loop, closed forms, and OBJ tags."""
 
+import json
 import os
 import pathlib
 import subprocess
 import threading
+import warnings
 
 import numpy as np
 import pytest
@@ -69,6 +71,7 @@ def test_outputs_are_contiguous_writable_copies():
 @pytest.mark.skipif(not SUBD_BIN, reason="SUBD_BIN (the subd binary) not set")
 @pytest.mark.parametrize("scheme", ["catmull-clark", "loop", "bilinear", "sqrt3", "butterfly",
                                     "modified-butterfly", "doo-sabin"])
+@pytest.mark.filterwarnings("ignore::subd.SubdWarning")
 def test_refine_equals_the_binary_on_every_shape(tmp_path, scheme):
     compared = 0
     for obj in sorted(SHAPES.glob("*.obj")):
@@ -86,8 +89,105 @@ def test_refine_equals_the_binary_on_every_shape(tmp_path, scheme):
         assert np.array_equal(got.face_vertices, want.face_vertices), obj.name
         # The file holds the shortest decimal that reads back to the same double.
         assert np.array_equal(got.vertices, want.vertices), obj.name
+        same_uvs(got, want, obj.name)
         compared += 1
     assert compared >= 10, f"{scheme}: only {compared} shapes compared"
+
+
+def same_uvs(got, want, name):
+    """The texture coordinates of `got` are those of `want`, bit for bit (or both have none)."""
+    assert (got.uvs is None) == (want.uvs is None), name
+    if want.uvs is not None:
+        assert np.array_equal(got.uvs, want.uvs), name
+        assert np.array_equal(got.uv_indices, want.uv_indices), name
+
+
+@pytest.mark.skipif(not SUBD_BIN, reason="SUBD_BIN (the subd binary) not set")
+@pytest.mark.parametrize("scheme,mode", [("catmull-clark", "all"), ("loop", "none"),
+                                         ("catmull-clark", "corners-plus2"),
+                                         ("sqrt3", None), ("butterfly", "boundaries")])
+def test_refine_to_the_limit_with_uvs_equals_the_binary(tmp_path, scheme, mode):
+    compared = with_uvs = 0
+    for obj in sorted(SHAPES.glob("*.obj")):
+        out = tmp_path / f"{obj.stem}.obj"
+        extra = [] if mode is None else ["--fvar-interpolation", mode]
+        run = subprocess.run([SUBD_BIN, "refine", "--scheme", scheme, "--levels", "1",
+                              "--limit", *extra, str(obj), str(out)], capture_output=True)
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", subd.SubdWarning)
+                got = subd.refine(subd.read(obj), scheme, levels=1, limit=True,
+                                  fvar_interpolation=mode)
+        except subd.SubdError:
+            assert run.returncode != 0, f"{obj.name}: the binary refined it"
+            continue
+        assert run.returncode == 0, run.stderr
+        want = subd.read(out)
+        assert np.array_equal(got.face_vertices, want.face_vertices), obj.name
+        assert np.array_equal(got.vertices, want.vertices), obj.name
+        assert got.normals.shape == got.vertices.shape
+        same_uvs(got, want, obj.name)
+        compared += 1
+        with_uvs += want.uvs is not None
+    assert compared >= 10 and with_uvs >= 3, (compared, with_uvs)
+
+
+def test_uvs_given_as_arrays_equal_the_files_and_survive_refinement():
+    read = subd.read(SHAPES / "catmark_fvar_bound1.obj")
+    assert read.uvs is not None and read.uv_indices.shape == read.face_vertices.shape
+    rebuilt = subd.Mesh(read.vertices, read.faces, creases=read.creases,
+                        corners=read.corners, holes=read.holes, uvs=read.uvs,
+                        uv_indices=read.uv_indices.reshape(read.faces.shape))
+    for mode in ["none", "corners-plus1", "all"]:
+        a = subd.refine(rebuilt, "catmull-clark", 2, fvar_interpolation=mode)
+        b = subd.refine(read, "catmull-clark", 2, fvar_interpolation=mode)
+        same_uvs(a, b, mode)
+    # Linear interpolation ("all") of a channel equal to the positions' x and y gives the
+    # bilinear scheme's positions.
+    xy = read.vertices[:, :2]
+    linear = subd.Mesh(read.vertices, read.faces, uvs=xy, uv_indices=read.face_vertices)
+    fine = subd.refine(linear, "catmull-clark", 2, fvar_interpolation="all")
+    bil = subd.refine(subd.Mesh(read.vertices, read.faces), "bilinear", 2)
+    got = fine.uvs[fine.uv_indices]
+    want = bil.vertices[bil.face_vertices][:, :2]
+    assert np.abs(got - want).max() < 1e-14
+
+
+def test_uv_errors_name_the_element():
+    with pytest.raises(subd.MeshError, match="face 1 corner 2: uv index 9 out of range"):
+        subd.Mesh(CUBE_V, CUBE_F, uvs=np.zeros((4, 2)), uv_indices=np.where(
+            np.arange(24).reshape(6, 4) == 6, 9, 0))
+    with pytest.raises(subd.MeshError, match="come together"):
+        subd.Mesh(CUBE_V, CUBE_F, uvs=np.zeros((4, 2)))
+    with pytest.raises(subd.MeshError, match="one per face corner"):
+        subd.Mesh(CUBE_V, CUBE_F, uvs=np.zeros((4, 2)), uv_indices=[0, 1, 2])
+    with pytest.raises(ValueError, match="fvar_interpolation"):
+        subd.refine(subd.Mesh(CUBE_V, CUBE_F), "loop", 1, fvar_interpolation="linear")
+
+
+@pytest.mark.skipif(not SUBD_BIN, reason="SUBD_BIN (the subd binary) not set")
+def test_info_equals_the_binarys_report():
+    for obj in sorted(SHAPES.glob("*.obj"))[::3]:
+        run = subprocess.run([SUBD_BIN, "info", "--json", str(obj)], capture_output=True,
+                             check=True)
+        want = json.loads(run.stdout)
+        del want["file"], want["warnings"]
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", subd.SubdWarning)
+            got = subd.info(subd.read(obj, accept_inconsistent_orientation=True))
+        want["face_sizes"] = {int(k): v for k, v in want["face_sizes"].items()}
+        want["valences"] = {int(k): v for k, v in want["valences"].items()}
+        assert got == want, obj.name
+    cube = subd.info(subd.Mesh(CUBE_V, CUBE_F))
+    assert (cube["euler"], cube["genus"], cube["face_sizes"]) == (2, 0, {4: 6})
+
+
+def test_outputs_are_owned_by_numpy():
+    fine = subd.refine(subd.Mesh(CUBE_V, CUBE_F, uvs=np.zeros((1, 2)),
+                                 uv_indices=np.zeros(24, int)), "catmull-clark", 2, limit=True)
+    for a in [fine.vertices, fine.normals, fine.faces, fine.face_vertices, fine.face_sizes,
+              fine.uvs, fine.uv_indices, *fine.creases, *subd.limit(fine, "catmull-clark")]:
+        assert a.flags["OWNDATA"] and a.flags["C_CONTIGUOUS"], a.shape
 
 
 def torus(n=12, m=8):
@@ -419,3 +519,186 @@ def test_tessellation_is_watertight_and_on_the_limit():
     for p in positions:
         assert np.linalg.norm(t.vertices - p, axis=1).min() <= 1e-12
     assert np.allclose(np.linalg.norm(t.normals, axis=1), 1.0)
+
+
+@pytest.mark.parametrize("pool", [1, 2])
+def test_a_refined_meshs_topology_is_built_once_under_concurrent_use(pool):
+    subd.set_num_threads(pool)
+    v, f = torus(24, 16)
+    want = subd.refine(subd.Mesh(v, f), "loop", 2)
+    want_edges, want_creases = want.num_edges, want.creases
+    fine = subd.refine(subd.Mesh(v, f), "loop", 2)
+    results = [None] * 8
+
+    def use(i):
+        # Half the threads need the topology (edges, tags), half only the arrays.
+        if i % 2:
+            results[i] = (fine.num_edges, fine.creases[0].shape, fine.vertices.sum())
+        else:
+            results[i] = (None, None, fine.vertices.sum())
+
+    threads = [threading.Thread(target=use, args=(i,)) for i in range(8)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert want_edges == 3 * len(want.faces) // 2  # closed triangle mesh: E = 3F/2
+    subd.set_num_threads(0)
+    for i, r in enumerate(results):
+        assert r[2] == want.vertices.sum()
+        if i % 2:
+            assert r[0] == want_edges and r[1] == want_creases[0].shape
+
+
+@pytest.mark.skipif(not SUBD_BIN, reason="SUBD_BIN (the subd binary) not set")
+@pytest.mark.parametrize("flags,kwargs", [
+    (["--flatness", "10", "--levels", "3"], dict(flatness=10, levels=3)),
+    (["--max-distance", "0.002", "--levels", "3", "--limit"],
+     dict(max_distance=0.002, levels=3, limit=True)),
+    (["--dihedral", "20", "--curvature", "30", "--levels", "2"],
+     dict(dihedral=20, curvature=30, levels=2)),
+])
+@pytest.mark.filterwarnings("ignore::subd.SubdWarning")
+def test_adaptive_equals_the_binary(tmp_path, flags, kwargs):
+    compared = with_uvs = 0
+    for obj in sorted(SHAPES.glob("*.obj"))[::4]:
+        scheme = "loop" if obj.name.startswith("loop") else "catmull-clark"
+        out = tmp_path / f"{obj.stem}.obj"
+        run = subprocess.run([SUBD_BIN, "adaptive", "--scheme", scheme, *flags, str(obj),
+                              str(out)], capture_output=True)
+        try:
+            got = subd.adaptive(subd.read(obj), scheme, **kwargs)
+        except subd.SubdError:
+            assert run.returncode != 0, f"{obj.name}: the binary refined it"
+            continue
+        assert run.returncode == 0, run.stderr
+        want = subd.read(out)
+        assert np.array_equal(got.face_vertices, want.face_vertices), obj.name
+        assert np.array_equal(got.vertices, want.vertices), obj.name
+        same_uvs(got, want, obj.name)
+        # Every face's level is within the cap, and the cap is reached somewhere.
+        assert got.face_levels.shape == (got.num_faces,)
+        assert got.face_levels.max() <= kwargs["levels"]
+        compared += 1
+        with_uvs += want.uvs is not None
+    assert compared >= 8, compared
+
+
+def test_adaptive_selection_refines_only_what_was_asked():
+    mesh = subd.Mesh(CUBE_V, CUBE_F)
+    fine = subd.adaptive(mesh, "catmull-clark", select_faces=[1], levels=3)
+    # Face 1 (the top, z = 1) is refined to level 3: 64 faces there; its neighbours carry
+    # the transition and the far face stays as it was.
+    top = fine.face_levels == 3
+    assert top.sum() == 64
+    starts = np.concatenate([[0], np.cumsum(fine.face_sizes)])
+    centres = np.array([fine.vertices[fine.face_vertices[starts[f]:starts[f + 1]]].mean(axis=0)
+                        for f in np.flatnonzero(top)])
+    assert centres[:, 2].min() > 0.5
+    # The rest stays coarser (the bottom face at level 1 at most).
+    assert fine.face_levels.min() <= 1
+    everywhere = subd.adaptive(mesh, "catmull-clark", levels=2)
+    uniform = subd.refine(mesh, "catmull-clark", 2)
+    assert np.array_equal(np.sort(everywhere.vertices, axis=0), np.sort(uniform.vertices, axis=0))
+    with pytest.raises(subd.MeshError, match="negative"):
+        subd.adaptive(mesh, "catmull-clark", select_faces=[-1])
+    with pytest.raises(subd.MeshError):
+        subd.adaptive(mesh, "catmull-clark", flatness=400)
+    with pytest.raises(subd.MeshError):
+        subd.adaptive(mesh, "sqrt3", levels=1)
+
+
+def test_analyze_gives_the_closed_forms():
+    # The cubic B-spline (mask (1, 4, 6, 4, 1)/8) is C², the 4-point scheme C¹.
+    assert subd.analyze([1 / 8, 1 / 2, 3 / 4, 1 / 2, 1 / 8])["smoothness"] == 2
+    four = subd.analyze(["-1/16", 0, "9/16", 1, "9/16", 0, "-1/16"])
+    assert four["converges"] and four["smoothness"] == 1
+    # Loop's subdominant eigenvalue at valence n: 3/8 + cos(2π/n)/4 (Loop 1987).
+    for n in (3, 5, 7):
+        loop = subd.analyze(surface="loop", valence=n)
+        assert loop["passes"]
+        assert abs(loop["eigenvalues"][1] - (3 / 8 + np.cos(2 * np.pi / n) / 4)) < 1e-12
+    with pytest.raises(subd.MeshError, match="sum to"):
+        subd.analyze([1, 1, 1])
+    with pytest.raises(ValueError, match="exactly one"):
+        subd.analyze([1, 1], surface="loop", valence=4)
+    with pytest.raises(subd.MeshError, match="valence"):
+        subd.analyze(surface="catmull-clark", valence=99)
+
+
+@pytest.mark.skipif(not SUBD_BIN, reason="SUBD_BIN (the subd binary) not set")
+@pytest.mark.parametrize("flags,kwargs", [
+    (["--mask", "1/8,1/2,3/4,1/2,1/8"], dict(mask=[1 / 8, 1 / 2, 3 / 4, 1 / 2, 1 / 8])),
+    (["--mask", "1/3,2/3,1,2/3,1/3", "--arity", "3"],
+     dict(mask=["1/3", "2/3", 1, "2/3", "1/3"], arity=3)),
+    (["--mask2", "0.25,0.5,0.25;0.5,1,0.5;0.25,0.5,0.25"],
+     dict(mask2=[[0.25, 0.5, 0.25], [0.5, 1, 0.5], [0.25, 0.5, 0.25]])),
+    (["--surface", "doo-sabin", "--valence", "5"], dict(surface="doo-sabin", valence=5)),
+    (["--surface", "butterfly", "--tension", "0.05", "--valence", "6"],
+     dict(surface="butterfly", tension=0.05, valence=6)),
+])
+def test_analyze_equals_the_binarys_report(flags, kwargs):
+    run = subprocess.run([SUBD_BIN, "analyze", "--json", *flags], capture_output=True,
+                         check=True)
+    assert subd.analyze(**kwargs) == json.loads(run.stdout)
+
+
+def test_curves_reproduce_circles_and_corner_cutting():
+    t = 2 * np.pi * np.arange(8) / 8
+    octagon = np.stack([np.cos(t), np.sin(t)], axis=1)
+    # The tension scheme with α0 = cos(2π/N) keeps a regular N-gon on a circle (seed 001).
+    fine = subd.curve(octagon, "tension", 4, closed=True, alpha0=np.cos(2 * np.pi / 8))
+    r = np.linalg.norm(fine, axis=1)
+    assert fine.shape == (8 * 16, 2) and np.ptp(r) < 1e-14
+    # The circle-average 4-point scheme keeps points with their circle's normals on it.
+    pts, normals = subd.curve(octagon, "circle-four-point", 3, closed=True, normals=octagon)
+    assert np.abs(np.linalg.norm(pts, axis=1) - 1).max() < 1e-14
+    assert np.abs(normals - pts).max() < 1e-14
+    # Chaikin cuts every edge at 1/4 and 3/4.
+    square = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], float)
+    cut = subd.curve(square, "chaikin", 1, closed=True)
+    assert np.allclose(cut[:2], [[0.25, 0], [0.75, 0]], atol=1e-15)
+    three_d = subd.curve(np.c_[square, np.arange(4.0)], "four-point", 2)
+    assert three_d.shape[1] == 3
+    with pytest.raises(subd.MeshError, match="does not apply"):
+        subd.curve(square, "chaikin", 1, omega=0.1)
+    with pytest.raises(subd.MeshError, match="unknown curve scheme"):
+        subd.curve(square, "bezier", 1)
+    with pytest.raises(subd.MeshError, match="planar"):
+        subd.curve(np.c_[square, np.ones(4)], "circle-ternary", 1)
+
+
+@pytest.mark.skipif(not SUBD_BIN, reason="SUBD_BIN (the subd binary) not set")
+@pytest.mark.parametrize("scheme", ["chaikin", "bspline", "four-point", "four-point-2p",
+                                    "ternary-3pt", "tension", "circle-preserving",
+                                    "variational", "circle-four-point", "circle-ternary"])
+def test_curve_equals_the_binary(tmp_path, scheme):
+    t = 2 * np.pi * np.arange(7) / 7
+    points = np.stack([2 * np.cos(t), np.sin(t) + 0.1 * t], axis=1)
+    src = tmp_path / "in.txt"
+    np.savetxt(src, points, fmt="%.17g")
+    for closed in (False, True):
+        out = tmp_path / f"out{closed}.txt"
+        subprocess.run([SUBD_BIN, "curve", "--scheme", scheme, "--levels", "3", str(src),
+                        str(out), *(["--closed"] if closed else [])], check=True,
+                       capture_output=True)
+        want = np.loadtxt(out, ndmin=2)
+        got = subd.curve(np.loadtxt(src), scheme, 3, closed=closed)
+        got = np.hstack(got) if isinstance(got, tuple) else got
+        assert np.array_equal(got, want), (scheme, closed)
+
+
+@pytest.mark.filterwarnings("ignore::subd.SubdWarning")
+def test_inconsistent_orientation_is_refused_unless_accepted(tmp_path):
+    v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1]], float)
+    f = [[0, 1, 2], [0, 1, 4], [1, 0, 3]]
+    with pytest.raises(subd.MeshError, match="same direction"):
+        subd.Mesh(v, f)
+    mesh = subd.Mesh(v, f, accept_inconsistent_orientation=True)
+    obj = tmp_path / "flipped.obj"
+    obj.write_text("".join(f"v {x} {y} {z}\n" for x, y, z in v)
+                   + "".join("f " + " ".join(str(i + 1) for i in face) + "\n" for face in f))
+    read = subd.read(obj, accept_inconsistent_orientation=True)
+    assert subd.info(mesh)["nonmanifold_edges"] == subd.info(read)["nonmanifold_edges"] == 1
+    assert np.array_equal(subd.refine(mesh, "loop", 2).vertices,
+                          subd.refine(read, "loop", 2).vertices)

@@ -70,6 +70,7 @@ pub mod analysis;
 pub mod curve;
 mod face_varying;
 mod family;
+pub mod named_curve;
 pub mod peak;
 mod refine;
 mod refinement;

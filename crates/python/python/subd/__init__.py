@@ -15,7 +15,9 @@ The work runs in Rust with the GIL released, on the package's thread pool
 
 from __future__ import annotations
 
+import json
 import os
+import warnings
 from typing import Optional, Sequence, Tuple, Union
 
 import numpy as np
@@ -33,6 +35,11 @@ class FormatError(SubdError, ValueError):
     """A file that cannot be read; the message names the file and line."""
 
 
+class SubdWarning(UserWarning):
+    """Something subd left out or changed and went on (a reader's repair, texture
+    coordinates a scheme cannot carry)."""
+
+
 from . import _subd  # noqa: E402  (the exceptions above must exist first: Rust raises them)
 
 SCHEMES: Tuple[str, ...] = tuple(_subd.SCHEMES)
@@ -40,14 +47,21 @@ SCHEMES: Tuple[str, ...] = tuple(_subd.SCHEMES)
 
 __all__ = [
     "SCHEMES",
+    "ConvergenceError",
     "FormatError",
     "Mesh",
     "MeshError",
     "Refiner",
     "evaluate",
     "SubdError",
+    "SubdWarning",
+    "adaptive",
+    "deform",
+    "edit",
+    "info",
     "get_num_threads",
     "limit",
+    "pia",
     "read",
     "refine",
     "set_num_threads",
@@ -112,6 +126,14 @@ class Mesh:
         Edge sharpness; ``inf`` or 10 and above is infinitely sharp.
     corners : (vertices (c,) int, sharpness (c,) float), optional
     holes : sequence of face indices, optional
+    uvs : (u, 2) array-like of float, optional
+        Texture coordinates (a face-varying channel: seams allowed).
+    uv_indices : int array-like, optional
+        One index into ``uvs`` per face corner, face after face (an (m, k) array or the
+        flat (sum of sizes,) form); required with ``uvs``.
+    accept_inconsistent_orientation : bool
+        Take an edge two faces use in the same direction (as OpenSubdiv does, making it
+        non-manifold) instead of raising :class:`MeshError`, as :func:`read` does.
     """
 
     __slots__ = ("_core",)
@@ -124,6 +146,9 @@ class Mesh:
         creases: Optional[Tuple[object, object]] = None,
         corners: Optional[Tuple[object, object]] = None,
         holes=None,
+        uvs=None,
+        uv_indices=None,
+        accept_inconsistent_orientation: bool = False,
     ) -> None:
         v = _float_array(vertices, "vertices")
         if v.ndim != 2 or v.shape[1] != 3:
@@ -134,7 +159,11 @@ class Mesh:
         ce, cs = _pairs(creases, "creases", 2)
         vv, vs = _pairs(corners, "corners", 1)
         h = _index_array([] if holes is None else holes, "holes").reshape(-1)
-        self._core = _subd._CoreMesh(v, sizes, flat, ce.reshape(-1, 2), cs, vv.reshape(-1), vs, h)
+        uv, uvi = _uv_arrays(uvs, uv_indices)
+        self._core = _subd._CoreMesh(
+            v, sizes, flat, ce.reshape(-1, 2), cs, vv.reshape(-1), vs, h, uv, uvi,
+            bool(accept_inconsistent_orientation),
+        )
 
     @classmethod
     def _wrap(cls, core) -> "Mesh":
@@ -165,14 +194,28 @@ class Mesh:
     @property
     def faces(self) -> np.ndarray:
         """Faces as an (m, k) int64 array when every face has k corners."""
-        sizes = self.face_sizes
-        if sizes.size == 0:
-            return np.zeros((0, 3), dtype=np.int64)
-        if np.any(sizes != sizes[0]):
+        faces = self._core.uniform_faces()
+        if faces is None:
             raise ValueError(
                 "faces of several sizes: use face_sizes and face_vertices (the flat pair)"
             )
-        return self.face_vertices.reshape(-1, int(sizes[0]))
+        return faces
+
+    @property
+    def uvs(self) -> Optional[np.ndarray]:
+        """Texture coordinates, (u, 2) float64, or None."""
+        return self._core.uvs
+
+    @property
+    def uv_indices(self) -> Optional[np.ndarray]:
+        """One index into :attr:`uvs` per face corner, face after face, int64; or None."""
+        return self._core.uv_indices
+
+    @property
+    def face_levels(self) -> Optional[np.ndarray]:
+        """The refinement level of every face of an :func:`adaptive` result (uint8), else
+        None."""
+        return self._core.face_levels
 
     @property
     def creases(self) -> Tuple[np.ndarray, np.ndarray]:
@@ -226,15 +269,47 @@ def _pairs(pair, what: str, width: int) -> Tuple[np.ndarray, np.ndarray]:
     return i.reshape(-1, width) if width == 2 else i.reshape(-1), s
 
 
+def _uv_arrays(uvs, uv_indices):
+    """(uvs (u, 2) float64, indices int64) or (None, None)."""
+    if uvs is None and uv_indices is None:
+        return None, None
+    if uvs is None or uv_indices is None:
+        raise MeshError("uvs and uv_indices come together: give both or neither")
+    uv = _float_array(uvs, "uvs")
+    if uv.size == 0:
+        uv = uv.reshape(0, 2)
+    if uv.ndim != 2 or uv.shape[1] != 2:
+        raise MeshError(f"uvs: expected a (u, 2) array, got shape {uv.shape}")
+    return uv, _index_array(uv_indices, "uv_indices").reshape(-1)
+
+
+def _warn(messages) -> None:
+    for m in messages:
+        warnings.warn(m, SubdWarning, stacklevel=3)
+
+
 def _check_mesh(mesh) -> None:
     if not isinstance(mesh, Mesh):
         raise TypeError(f"expected a subd.Mesh, got {type(mesh).__name__}")
 
 
 def read(path: Union[str, os.PathLike], *, accept_inconsistent_orientation: bool = False) -> Mesh:
-    """Reads an OBJ (with OpenSubdiv's crease, corner and hole tags), PLY or glTF file."""
-    core, _warnings = _subd.read(os.fspath(path), bool(accept_inconsistent_orientation))
+    """Reads an OBJ (with OpenSubdiv's crease, corner and hole tags, texture coordinates),
+    PLY or glTF file. What the reader repaired or left out comes as :class:`SubdWarning`."""
+    core, messages = _subd.read(os.fspath(path), bool(accept_inconsistent_orientation))
+    _warn(messages)
     return Mesh._wrap(core)
+
+
+def info(mesh: Mesh) -> dict:
+    """What ``subd info --json`` reports: counts, face-size and valence histograms,
+    boundaries, non-manifold elements, components, Euler characteristic and genus,
+    irregular vertices, tags and the texture coordinates' seams."""
+    _check_mesh(mesh)
+    report = json.loads(_subd.info(mesh._core))
+    for key in ("face_sizes", "valences"):
+        report[key] = {int(k): v for k, v in report[key].items()}
+    return report
 
 
 def _scheme_name(scheme: str, tension: Optional[float], lam: Optional[float]) -> str:
@@ -259,6 +334,7 @@ def refine(
     boundary: Optional[str] = None,
     crease_method: Optional[str] = None,
     triangles: Optional[str] = None,
+    fvar_interpolation: Optional[str] = None,
     tension: Optional[float] = None,
     lam: Optional[float] = None,
 ) -> Mesh:
@@ -270,20 +346,179 @@ def refine(
     ``"edge-only"`` or ``"edge-and-corner"``; ``crease_method`` ``"uniform"`` or
     ``"chaikin"``; ``triangles`` ``"catmark"`` or ``"smooth"``. ``tension`` is the
     butterfly's parameter, ``lam`` the two-phase scheme's.
+
+    Texture coordinates are refined with the mesh (to their limit too with ``limit``),
+    interpolated as ``fvar_interpolation`` says: ``"none"``, ``"corners-only"``,
+    ``"corners-plus1"`` (default, unless the mesh's file names one), ``"corners-plus2"``,
+    ``"boundaries"`` or ``"all"``. Where Doo-Sabin or √3 cannot carry their seams they are
+    left out with a :class:`SubdWarning`.
     """
     _check_mesh(mesh)
     levels = _count(levels, "levels")
     name = _scheme_name(scheme, tension, lam)
-    rules = _rule_names(boundary, crease_method, triangles)
-    return Mesh._wrap(_subd.refine(mesh._core, name, levels, bool(limit), *rules))
+    rules = _rule_names(boundary, crease_method, triangles, fvar_interpolation)
+    core, messages = _subd.refine(mesh._core, name, levels, bool(limit), *rules)
+    _warn(messages)
+    return Mesh._wrap(core)
 
 
-def _rule_names(boundary, crease_method, triangles):
-    for value, what in ((boundary, "boundary"), (crease_method, "crease_method"),
-                        (triangles, "triangles")):
+def adaptive(
+    mesh: Mesh,
+    scheme: str = "catmull-clark",
+    *,
+    flatness: Optional[float] = None,
+    max_distance: Optional[float] = None,
+    curvature: Optional[float] = None,
+    dihedral: Optional[float] = None,
+    select_faces=None,
+    select_vertices=None,
+    levels: int = 4,
+    limit: bool = False,
+    boundary: Optional[str] = None,
+    crease_method: Optional[str] = None,
+    triangles: Optional[str] = None,
+    fvar_interpolation: Optional[str] = None,
+) -> Mesh:
+    """The mesh refined only where the criteria ask (Loop or Catmull-Clark), up to
+    ``levels``, without cracks: every vertex is one of uniform refinement's (or, with
+    ``limit=True``, on the exact limit surface, with unit ``normals``). The result's
+    ``face_levels`` gives the level of every face.
+
+    A face is refined when any criterion asks; with none, every face is refined to
+    ``levels``. ``flatness``: seed 002's test, degrees between the normals at a vertex.
+    ``max_distance``: the largest distance to the limit surface, relative to the bounding-box
+    diagonal. ``curvature``: Gaussian curvature times the squared diagonal (a sphere: 12).
+    ``dihedral``: degrees. ``select_faces``: base faces whose descendants are refined;
+    ``select_vertices``: base vertices, refining the faces with two or more of them. Texture
+    coordinates are carried at their exact limit; the rule options are :func:`refine`'s.
+    """
+    _check_mesh(mesh)
+    levels = _count(levels, "levels")
+    thresholds = {
+        "flatness": _threshold(flatness, "flatness"),
+        "max_distance": _threshold(max_distance, "max_distance"),
+        "curvature": _threshold(curvature, "curvature"),
+        "dihedral": _threshold(dihedral, "dihedral"),
+    }
+    faces = None if select_faces is None else _index_array(select_faces, "select_faces").reshape(-1)
+    verts = (None if select_vertices is None
+             else _index_array(select_vertices, "select_vertices").reshape(-1))
+    rules = _rule_names(boundary, crease_method, triangles, fvar_interpolation)
+    core, messages = _subd.adaptive(mesh._core, _scheme_name(scheme, None, None), levels,
+                                    bool(limit), thresholds, faces, verts, *rules)
+    _warn(messages)
+    return Mesh._wrap(core)
+
+
+def analyze(
+    mask=None,
+    *,
+    mask2=None,
+    lattice: str = "quad",
+    arity: int = 2,
+    max_levels: int = 8,
+    surface: Optional[str] = None,
+    valence: Optional[int] = None,
+    tension: Optional[float] = None,
+) -> dict:
+    """What ``subd analyze --json`` reports, as a dict; give exactly one of:
+
+    * ``mask``: a univariate mask (coefficients by increasing power of z, summing to
+      ``arity``, 2 or 3; fractions such as ``"1/16"`` are accepted): whether the scheme
+      converges and how smooth it is shown to be (norms of the difference schemes for
+      ``L = 1..max_levels``);
+    * ``mask2``: a bivariate binary mask, a sequence of rows (row j holds the coefficients
+      of z1^i z2^j), summing to 4, on ``lattice`` ``"quad"`` or ``"three-direction"``;
+    * ``surface`` and ``valence``: the eigenvalue test of a surface scheme's local
+      subdivision matrix at an interior vertex (``tension`` for the butterfly).
+    """
+    given = [x is not None for x in (mask, mask2, surface)]
+    if sum(given) != 1:
+        raise ValueError("give exactly one of mask, mask2 and surface")
+    levels = _count(max_levels, "max_levels")
+    if surface is not None:
+        if valence is None:
+            raise ValueError("surface needs a valence")
+        name = _scheme_name(surface, tension, None)
+        return json.loads(_subd.analyze_surface(name, _count(valence, "valence")))
+    if mask is not None:
+        coeffs = [_coefficient(c, "mask") for c in np.atleast_1d(np.asarray(mask, dtype=object))]
+        return json.loads(_subd.analyze_mask(coeffs, _count(arity, "arity"), levels))
+    rows = [[_coefficient(c, "mask2") for c in row] for row in mask2]
+    if not isinstance(lattice, str):
+        raise TypeError(f"lattice: expected a name, got {type(lattice).__name__}")
+    return json.loads(_subd.analyze_mask2(rows, lattice, levels))
+
+
+CURVE_SCHEMES: Tuple[str, ...] = tuple(_subd.CURVE_SCHEMES)
+"""The curve scheme names :func:`curve` takes."""
+
+
+def curve(
+    points,
+    scheme: str = "four-point",
+    levels: int = 1,
+    *,
+    closed: bool = False,
+    normals=None,
+    omega: Optional[float] = None,
+    mu: Optional[float] = None,
+    order: Optional[int] = None,
+    alpha0: Optional[float] = None,
+):
+    """A subdivision curve: ``points`` ((n, 2) or (n, 3)) refined ``levels`` times with
+    ``scheme`` (one of :data:`CURVE_SCHEMES`), an open polyline unless ``closed``.
+
+    The parameters are ``subd curve``'s and are refused where the scheme takes none:
+    ``omega`` (4-point and ternary tension; default 1/16, 1/4 for the ternary schemes),
+    ``mu`` (the two-parameter 4-point schemes), ``order`` (``bspline``, default 4) and
+    ``alpha0`` (``tension``, default 1). Returns the points, with the input's columns; for
+    the circle-average schemes (``circle-four-point``, ``circle-ternary``: planar points
+    with normals, seed 004) returns ``(points, normals)``, the input's ``normals`` (n, 2)
+    estimated from the polygon when not given.
+    """
+    p = _float_array(points, "points")
+    if p.ndim != 2 or p.shape[1] not in (2, 3):
+        raise MeshError(f"points: expected an (n, 2) or (n, 3) array, got shape {p.shape}")
+    if not isinstance(scheme, str):
+        raise TypeError(f"scheme: expected a name such as 'four-point', got {type(scheme).__name__}")
+    n = None if normals is None else _float_array(normals, "normals")
+    if n is not None and (n.ndim != 2 or n.shape[1] != 2):
+        raise MeshError(f"normals: expected an (n, 2) array, got shape {n.shape}")
+    parameters = (_threshold(omega, "omega"), _threshold(mu, "mu"),
+                  None if order is None else _count(order, "order"), _threshold(alpha0, "alpha0"))
+    out, out_normals = _subd.curve(p, scheme, _count(levels, "levels"), bool(closed), parameters, n)
+    return out if out_normals is None else (out, out_normals)
+
+
+def _coefficient(c, what: str) -> float:
+    """A number, or a fraction written ``"p/q"``."""
+    if isinstance(c, str):
+        p, slash, q = c.partition("/")
+        try:
+            return float(p) / float(q) if slash else float(p)
+        except (ValueError, ZeroDivisionError):
+            raise MeshError(f"{what}: {c!r} is not a number") from None
+    if isinstance(c, bool) or not isinstance(c, (int, float, np.integer, np.floating)):
+        raise MeshError(f"{what}: {c!r} is not a number")
+    return float(c)
+
+
+def _threshold(value, what: str) -> Optional[float]:
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise TypeError(f"{what}: expected a number, got {type(value).__name__}")
+    return float(value)
+
+
+def _rule_names(boundary, crease_method, triangles, fvar_interpolation=None):
+    names = (boundary, crease_method, triangles, fvar_interpolation)
+    for value, what in zip(names, ("boundary", "crease_method", "triangles",
+                                   "fvar_interpolation")):
         if value is not None and not isinstance(value, str):
             raise TypeError(f"{what}: expected a name, got {type(value).__name__}")
-    return boundary, crease_method, triangles
+    return names
 
 
 class Refiner:
@@ -316,7 +551,7 @@ class Refiner:
         _check_mesh(mesh)
         self.levels = _count(levels, "levels")
         name = _scheme_name(scheme, tension, lam)
-        rules = _rule_names(boundary, crease_method, triangles)
+        rules = _rule_names(boundary, crease_method, triangles)[:3]
         self._core = _subd._CoreRefiner(mesh._core, name, self.levels, *rules)
 
     @property
@@ -407,3 +642,6 @@ def set_num_threads(n: int) -> None:
 def get_num_threads() -> int:
     """The number of threads subd's calls use."""
     return _subd.get_num_threads()
+
+
+from ._shape import ConvergenceError, deform, edit, pia  # noqa: E402

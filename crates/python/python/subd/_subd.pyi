@@ -1,12 +1,13 @@
 """Type stubs of subd's compiled core (``subd._subd``); use the functions of ``subd``."""
 
 from os import PathLike
-from typing import List, Optional, Tuple, Union
+from typing import Dict, List, Optional, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
 
 SCHEMES: List[str]
+CURVE_SCHEMES: List[str]
 
 class _CoreMesh:
     def __init__(
@@ -19,6 +20,9 @@ class _CoreMesh:
         corner_vertices: npt.NDArray[np.int64],
         corner_sharpness: npt.NDArray[np.float64],
         holes: npt.NDArray[np.int64],
+        uvs: Optional[npt.NDArray[np.float64]] = ...,
+        uv_indices: Optional[npt.NDArray[np.int64]] = ...,
+        accept_inconsistent_orientation: bool = ...,
     ) -> None: ...
     @property
     def vertices(self) -> npt.NDArray[np.float64]: ...
@@ -28,6 +32,15 @@ class _CoreMesh:
     def face_sizes(self) -> npt.NDArray[np.int64]: ...
     @property
     def face_vertices(self) -> npt.NDArray[np.int64]: ...
+    def uniform_faces(self) -> Optional[npt.NDArray[np.int64]]: ...
+    @property
+    def uvs(self) -> Optional[npt.NDArray[np.float64]]: ...
+    @property
+    def uv_indices(self) -> Optional[npt.NDArray[np.int64]]: ...
+    @property
+    def face_levels(self) -> Optional[npt.NDArray[np.uint8]]: ...
+    @property
+    def orientation_conflicts(self) -> int: ...
     @property
     def creases(self) -> Tuple[npt.NDArray[np.int64], npt.NDArray[np.float64]]: ...
     @property
@@ -70,7 +83,33 @@ def refine(
     boundary: Optional[str] = ...,
     crease_method: Optional[str] = ...,
     triangles: Optional[str] = ...,
-) -> _CoreMesh: ...
+    fvar_interpolation: Optional[str] = ...,
+) -> Tuple[_CoreMesh, List[str]]: ...
+def info(mesh: _CoreMesh) -> str: ...
+def adaptive(
+    mesh: _CoreMesh,
+    scheme_name: str,
+    levels: int,
+    limit: bool,
+    thresholds: Dict[str, Optional[float]],
+    select_faces: Optional[npt.NDArray[np.int64]] = ...,
+    select_vertices: Optional[npt.NDArray[np.int64]] = ...,
+    boundary: Optional[str] = ...,
+    crease_method: Optional[str] = ...,
+    triangles: Optional[str] = ...,
+    fvar_interpolation: Optional[str] = ...,
+) -> Tuple[_CoreMesh, List[str]]: ...
+def analyze_mask(mask: List[float], arity: int, max_levels: int) -> str: ...
+def analyze_mask2(rows: List[List[float]], lattice: str, max_levels: int) -> str: ...
+def analyze_surface(scheme_name: str, valence: int) -> str: ...
+def curve(
+    points: npt.NDArray[np.float64],
+    scheme_name: str,
+    levels: int,
+    closed: bool,
+    parameters: Tuple[Optional[float], Optional[float], Optional[int], Optional[float]],
+    normals: Optional[npt.NDArray[np.float64]] = ...,
+) -> Tuple[npt.NDArray[np.float64], Optional[npt.NDArray[np.float64]]]: ...
 def limit(mesh: _CoreMesh, scheme_name: str) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
 def evaluate(
     mesh: _CoreMesh,
@@ -82,5 +121,34 @@ def evaluate(
     derivatives: bool = ...,
 ) -> List[npt.NDArray[np.float64]]: ...
 def tessellate(mesh: _CoreMesh, scheme_name: str, rate: int) -> _CoreMesh: ...
+def pia(
+    mesh: _CoreMesh,
+    scheme_name: str,
+    lam: Optional[npt.NDArray[np.float64]],
+    allow_any_lambda: bool,
+    moving: Optional[npt.NDArray[np.int64]],
+    fixed: Optional[npt.NDArray[np.int64]],
+    solver: str,
+    tol: float,
+    max_iter: int,
+    boundary: Optional[str] = ...,
+    crease_method: Optional[str] = ...,
+    triangles: Optional[str] = ...,
+) -> Tuple[Optional[_CoreMesh], str]: ...
+def edit(
+    mesh: _CoreMesh,
+    constraints_json: str,
+    scheme_name: str,
+    method: str,
+    penalty: Optional[float],
+    exact: bool,
+    membrane: float,
+    region_rings: Optional[int],
+    measure: bool,
+    boundary: Optional[str] = ...,
+    crease_method: Optional[str] = ...,
+    triangles: Optional[str] = ...,
+) -> Tuple[_CoreMesh, List[str], str]: ...
+def deform(mesh: _CoreMesh, constraints_json: str) -> Tuple[_CoreMesh, str]: ...
 def set_num_threads(threads: int) -> None: ...
 def get_num_threads() -> int: ...

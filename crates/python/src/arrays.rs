@@ -1,0 +1,126 @@
+//! Arrays handed to Python: allocated by numpy (so they own their data, `OWNDATA` set, and
+//! outlive the mesh they came from) and filled in place, in parallel on the package's pool
+//! with the GIL released: the library's values are converted once, with no intermediate
+//! vector.
+
+use numpy::{Element, PyArray1, PyArray2, PyArrayMethods};
+use pyo3::prelude::*;
+use rayon::prelude::*;
+use subd_mesh::DVec3;
+
+use crate::pool;
+
+/// Rows per parallel task when filling (enough work per task to pay for the split).
+const CHUNK_ROWS: usize = 1 << 14;
+
+/// A new zeroed `(n, K)` array, C-contiguous and owned by numpy, with `fill` writing its
+/// rows (`K` numbers each) on the pool.
+pub(crate) fn filled2<'py, T, const K: usize>(
+    py: Python<'py>,
+    n: usize,
+    fill: impl Fn(usize, &mut [T; K]) + Sync + Send,
+) -> PyResult<Bound<'py, PyArray2<T>>>
+where
+    T: Element + Copy + Send + Sync,
+{
+    let array = PyArray2::<T>::zeros(py, [n, K], false);
+    {
+        let mut rw = array.readwrite();
+        let out = rw.as_slice_mut().expect("a new array is contiguous");
+        pool::run(py, || {
+            out.par_chunks_mut(K * CHUNK_ROWS)
+                .enumerate()
+                .for_each(|(c, chunk)| {
+                    for (i, row) in chunk.chunks_exact_mut(K).enumerate() {
+                        let row: &mut [T; K] = row.try_into().expect("K numbers");
+                        fill(c * CHUNK_ROWS + i, row);
+                    }
+                });
+        })?;
+    }
+    Ok(array)
+}
+
+/// A new zeroed `(n,)` array owned by numpy, `fill` writing its values on the pool.
+pub(crate) fn filled1<'py, T>(
+    py: Python<'py>,
+    n: usize,
+    fill: impl Fn(usize) -> T + Sync + Send,
+) -> PyResult<Bound<'py, PyArray1<T>>>
+where
+    T: Element + Copy + Send + Sync,
+{
+    let array = PyArray1::<T>::zeros(py, n, false);
+    {
+        let mut rw = array.readwrite();
+        fill_values(
+            py,
+            rw.as_slice_mut().expect("a new array is contiguous"),
+            fill,
+        )?;
+    }
+    Ok(array)
+}
+
+/// `out[i] = fill(i)` for every `i`, on the pool.
+fn fill_values<T: Send>(
+    py: Python<'_>,
+    out: &mut [T],
+    fill: impl Fn(usize) -> T + Sync + Send,
+) -> PyResult<()> {
+    const CHUNK: usize = 4 * CHUNK_ROWS;
+    pool::run(py, || {
+        out.par_chunks_mut(CHUNK)
+            .enumerate()
+            .for_each(|(c, chunk)| {
+                for (i, x) in chunk.iter_mut().enumerate() {
+                    *x = fill(c * CHUNK + i);
+                }
+            });
+    })
+}
+
+/// Points as an `(n, 3)` float64 array.
+pub(crate) fn points<'py>(py: Python<'py>, p: &[DVec3]) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    filled2(py, p.len(), |i, row: &mut [f64; 3]| *row = p[i].to_array())
+}
+
+/// A copy of `values` as a 1-D array.
+pub(crate) fn copied1<'py, T>(py: Python<'py>, values: &[T]) -> PyResult<Bound<'py, PyArray1<T>>>
+where
+    T: Element + Copy + Send + Sync,
+{
+    filled1(py, values.len(), |i| values[i])
+}
+
+/// `values` (`k` numbers per row) as an `(n, k)` array, for any `k`.
+pub(crate) fn flat_rows<'py>(
+    py: Python<'py>,
+    values: &[f64],
+    k: usize,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let n = values.len().checked_div(k).unwrap_or(0);
+    let array = PyArray2::<f64>::zeros(py, [n, k], false);
+    {
+        let mut rw = array.readwrite();
+        let out = rw.as_slice_mut().expect("a new array is contiguous");
+        fill_values(py, out, |i| values[i])?;
+    }
+    Ok(array)
+}
+
+/// Indices (`k` per row) as an `(n, k)` int64 array.
+pub(crate) fn flat_ints<'py>(
+    py: Python<'py>,
+    values: &[u32],
+    k: usize,
+) -> PyResult<Bound<'py, PyArray2<i64>>> {
+    let n = values.len().checked_div(k).unwrap_or(0);
+    let array = PyArray2::<i64>::zeros(py, [n, k], false);
+    {
+        let mut rw = array.readwrite();
+        let out = rw.as_slice_mut().expect("a new array is contiguous");
+        fill_values(py, out, |i| i64::from(values[i]))?;
+    }
+    Ok(array)
+}
