@@ -414,8 +414,8 @@ def inputs_table(info):
         if "dropped_faces" in d:
             extra = f"scan less {d['dropped_faces']} faces (one per non-manifold edge)"
         elif "read_warnings" in d:
-            extra += (f"; {d['read_warnings']} orientation warnings from subd.read; faces reordered"
-                      " (minority side of each non-manifold edge first) for subd.Mesh")
+            extra += (f"; {d['read_warnings']} orientation warnings from subd.read (subd.Mesh takes"
+                      " it with accept_inconsistent_orientation=True)")
         lines.append(f"| {name} | {d['vertices']:,} | {d['faces']:,} | {d['boundary_edges']} | "
                      f"{d['non_manifold_edges']} | {'yes' if d['closed'] else 'no'} | {extra} |")
     return "\n".join(lines)
