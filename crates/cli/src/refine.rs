@@ -137,7 +137,12 @@ fn run_one(
     progress.step("topology");
     let t_topology = t0.elapsed().as_secs_f64();
     let osd = refinement.scheme().is_opensubdiv();
-    let mut hints = output_hints(osd, &options, &opened.file.mesh.hints, &args.rules);
+    let mut hints = subd_limit::refined_mesh::refined_hints(
+        refinement.scheme(),
+        &options,
+        &opened.file.mesh.hints,
+        args.rules.triangles.is_some(),
+    );
     hints.fvar_interpolation = uv.as_ref().map(|_| fvar_mode);
     let output = Output {
         args,
@@ -393,27 +398,6 @@ fn write_level(
         edges,
         faces: view.num_faces(),
     })
-}
-
-/// The scheme hints a refined file records: OpenSubdiv's rule options, for its schemes
-/// only.
-fn output_hints(
-    osd: bool,
-    options: &subd_schemes::Options,
-    read: &SchemeHints,
-    rules: &RuleArgs,
-) -> SchemeHints {
-    if !osd {
-        return SchemeHints::default();
-    }
-    SchemeHints {
-        boundary_interpolation: Some(options.boundary_interpolation),
-        crease_method: Some(options.crease_method),
-        triangle_subdivision: read
-            .triangle_subdivision
-            .or(rules.triangles.map(|_| options.triangle_subdivision)),
-        fvar_interpolation: read.fvar_interpolation,
-    }
 }
 
 /// Refuses the request if its estimated peak memory is over the budget (see

@@ -99,15 +99,23 @@ impl RuleNames<'_> {
 /// Reads a mesh file (OBJ with OpenSubdiv's tags, PLY, glTF): the mesh and the reader's
 /// warnings.
 #[pyfunction]
-#[pyo3(signature = (path, accept_inconsistent_orientation = false))]
+#[pyo3(signature = (path, accept_inconsistent_orientation = false, no_transform = false, weld_tolerance = None))]
 pub(crate) fn read(
     py: Python<'_>,
     path: PathBuf,
     accept_inconsistent_orientation: bool,
+    no_transform: bool,
+    weld_tolerance: Option<f64>,
 ) -> PyResult<(CoreMesh, Vec<String>)> {
+    if weld_tolerance.is_some_and(|w| !(w.is_finite() && w >= 0.0)) {
+        return Err(PyValueError::new_err(
+            "weld_tolerance: expected a finite distance ≥ 0",
+        ));
+    }
     let options = subd_io::ReadOptions {
         accept_inconsistent_orientation,
-        ..Default::default()
+        ignore_transforms: no_transform,
+        weld_tolerance,
     };
     let file = pool::run(py, || subd_io::read_mesh(&path, &options))?.map_err(io_error)?;
     let mut core = CoreMesh::plain(file.mesh);

@@ -293,10 +293,24 @@ def _check_mesh(mesh) -> None:
         raise TypeError(f"expected a subd.Mesh, got {type(mesh).__name__}")
 
 
-def read(path: Union[str, os.PathLike], *, accept_inconsistent_orientation: bool = False) -> Mesh:
+def read(
+    path: Union[str, os.PathLike],
+    *,
+    accept_inconsistent_orientation: bool = False,
+    no_transform: bool = False,
+    weld_tolerance: Optional[float] = None,
+) -> Mesh:
     """Reads an OBJ (with OpenSubdiv's crease, corner and hole tags, texture coordinates),
-    PLY or glTF file. What the reader repaired or left out comes as :class:`SubdWarning`."""
-    core, messages = _subd.read(os.fspath(path), bool(accept_inconsistent_orientation))
+    PLY or glTF file. What the reader repaired or left out comes as :class:`SubdWarning`.
+
+    The options are the CLI's: ``accept_inconsistent_orientation`` takes an edge two faces
+    use in the same direction (non-manifold, as OpenSubdiv does) instead of raising;
+    glTF only: ``no_transform`` reads each mesh as stored rather than placed by its nodes,
+    ``weld_tolerance`` welds vertices closer than it (default: identical positions only).
+    """
+    weld = None if weld_tolerance is None else _threshold(weld_tolerance, "weld_tolerance")
+    core, messages = _subd.read(os.fspath(path), bool(accept_inconsistent_orientation),
+                                bool(no_transform), weld)
     _warn(messages)
     return Mesh._wrap(core)
 

@@ -74,7 +74,12 @@ class _CoreRefiner:
         self, level: Optional[int] = ...
     ) -> Tuple[npt.NDArray[np.int64], npt.NDArray[np.int64], npt.NDArray[np.float64], Tuple[int, int]]: ...
 
-def read(path: Union[str, PathLike[str]], accept_inconsistent_orientation: bool = ...) -> Tuple[_CoreMesh, List[str]]: ...
+def read(
+    path: Union[str, PathLike[str]],
+    accept_inconsistent_orientation: bool = ...,
+    no_transform: bool = ...,
+    weld_tolerance: Optional[float] = ...,
+) -> Tuple[_CoreMesh, List[str]]: ...
 def refine(
     mesh: _CoreMesh,
     scheme_name: str,
