@@ -89,18 +89,14 @@ pub fn adapt_mesh(mesh: &Mesh, request: &AdaptiveRequest) -> Result<AdaptedMesh,
     let diagonal = mesh
         .bounding_box()
         .map_or(0.0, |(lo, hi)| (hi - lo).length());
-    let (others, distance) = criteria(mesh, request, diagonal)?;
-    let mut all: Vec<&dyn Criterion> = others.iter().map(|c| c.as_ref()).collect();
-    if let Some(d) = &distance {
-        all.push(d);
-    }
+    let criteria = Criteria::new(mesh, request, diagonal)?;
     let base = &mesh.topology;
     let mut hierarchy = AdaptiveRefinement::new(
         base,
         &mesh.positions,
         &request.scheme,
         &request.options,
-        &all,
+        &criteria.all(),
         request.levels,
     )?;
     let positions = if request.limit {
@@ -113,7 +109,7 @@ pub fn adapt_mesh(mesh: &Mesh, request: &AdaptiveRequest) -> Result<AdaptedMesh,
     let uv = match mesh.uv() {
         None => None,
         Some(_) => {
-            let surface = distance.as_ref().map(|d| d.surface().evaluator());
+            let surface = criteria.distance.as_ref().map(|d| d.surface().evaluator());
             match adapted_uv(mesh, request, surface, &result) {
                 Ok(uv) => Some(uv),
                 Err(e) => {
@@ -130,47 +126,73 @@ pub fn adapt_mesh(mesh: &Mesh, request: &AdaptiveRequest) -> Result<AdaptedMesh,
     })
 }
 
-/// The criteria `request` names (the distance apart: its surface serves the texture
-/// coordinates too).
-#[allow(clippy::type_complexity)]
-fn criteria(
-    mesh: &Mesh,
-    request: &AdaptiveRequest,
-    diagonal: f64,
-) -> Result<(Vec<Box<dyn Criterion>>, Option<LimitDistance>), AdaptiveError> {
-    let base = &mesh.topology;
-    let mut others: Vec<Box<dyn Criterion>> = Vec::new();
-    if let Some(d) = request.flatness {
-        others.push(Box::new(Flatness::new(d)?));
-    }
-    if let Some(d) = request.dihedral {
-        others.push(Box::new(DihedralAngle::new(d)?));
-    }
-    if let Some(k) = request.curvature {
-        others.push(Box::new(GaussianCurvature::new(k, diagonal)?));
-    }
-    if let Some(faces) = &request.select_faces {
-        others.push(Box::new(FaceSelection::from_faces(
-            base.num_faces(),
-            faces,
-        )?));
-    }
-    if let Some(vertices) = &request.select_vertices {
-        others.push(Box::new(FaceSelection::from_vertices(base, vertices)?));
-    }
-    let distance = match request.max_distance {
-        Some(d) => {
-            let s = LimitSurface::new(base, &mesh.positions, &request.scheme, &request.options)?;
-            Some(LimitDistance::new(s, d * diagonal, request.limit)?)
+/// The criteria a request names, the distance criterion apart: its limit surface also
+/// serves the texture coordinates and a report's distance.
+pub struct Criteria {
+    /// Flatness, dihedral angle, curvature and the selections, in that order.
+    pub others: Vec<Box<dyn Criterion>>,
+    /// The distance to the limit surface.
+    pub distance: Option<LimitDistance>,
+}
+
+impl Criteria {
+    /// The criteria of `request` on `mesh`, whose bounding-box diagonal is `diagonal`.
+    ///
+    /// # Errors
+    /// A threshold out of range, a selected index out of range, or a mesh the limit
+    /// evaluator does not cover (with a distance criterion).
+    pub fn new(
+        mesh: &Mesh,
+        request: &AdaptiveRequest,
+        diagonal: f64,
+    ) -> Result<Criteria, AdaptiveError> {
+        let base = &mesh.topology;
+        let mut others: Vec<Box<dyn Criterion>> = Vec::new();
+        if let Some(d) = request.flatness {
+            others.push(Box::new(Flatness::new(d)?));
         }
-        None => None,
-    };
-    Ok((others, distance))
+        if let Some(d) = request.dihedral {
+            others.push(Box::new(DihedralAngle::new(d)?));
+        }
+        if let Some(k) = request.curvature {
+            others.push(Box::new(GaussianCurvature::new(k, diagonal)?));
+        }
+        if let Some(faces) = &request.select_faces {
+            others.push(Box::new(FaceSelection::from_faces(
+                base.num_faces(),
+                faces,
+            )?));
+        }
+        if let Some(vertices) = &request.select_vertices {
+            others.push(Box::new(FaceSelection::from_vertices(base, vertices)?));
+        }
+        let distance = match request.max_distance {
+            Some(d) => {
+                let s =
+                    LimitSurface::new(base, &mesh.positions, &request.scheme, &request.options)?;
+                Some(LimitDistance::new(s, d * diagonal, request.limit)?)
+            }
+            None => None,
+        };
+        Ok(Criteria { others, distance })
+    }
+
+    /// Every criterion, the distance last.
+    pub fn all(&self) -> Vec<&dyn Criterion> {
+        let mut all: Vec<&dyn Criterion> = self.others.iter().map(|c| c.as_ref()).collect();
+        if let Some(d) = &self.distance {
+            all.push(d);
+        }
+        all
+    }
 }
 
 /// The input's texture coordinates at every corner of `result`: their exact limit at the
 /// corner's parameter, with `surface`'s evaluator when there is one.
-fn adapted_uv(
+///
+/// # Panics
+/// If `mesh` has no texture coordinates.
+pub fn adapted_uv(
     mesh: &Mesh,
     request: &AdaptiveRequest,
     surface: Option<&LimitEvaluator>,

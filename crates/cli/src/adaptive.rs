@@ -7,9 +7,9 @@ use std::time::Instant;
 
 use clap::Args;
 use serde::Serialize;
+use subd_adaptive::request::{AdaptiveRequest, Criteria, adapted_uv};
 use subd_adaptive::{
-    AdaptiveError, AdaptiveMesh, AdaptiveRefinement, Conformity, Criterion, DihedralAngle,
-    FaceSelection, Flatness, GaussianCurvature, LimitDistance, LimitSurface, Positions,
+    AdaptiveError, AdaptiveMesh, AdaptiveRefinement, Conformity, LimitSurface, Positions,
 };
 use subd_mesh::{BoundaryInterpolation, CreaseMethod, SchemeHints, TriangleSubdivision};
 use subd_schemes::Scheme;
@@ -163,72 +163,38 @@ fn check_arguments(args: &AdaptiveArgs) -> Result<usize, Failure> {
     Ok(levels)
 }
 
-/// The criteria the command line asks for; the distance criterion apart, since the report
-/// measures with its limit surface.
-struct Selection {
-    others: Vec<Box<dyn Criterion>>,
-    distance: Option<LimitDistance>,
-}
-
-impl Selection {
-    fn new(
-        args: &AdaptiveArgs,
-        job: &Job,
-        mesh: &subd_mesh::Mesh,
-        scheme: &Scheme,
-        options: &subd_schemes::Options,
-        diagonal: f64,
-    ) -> Result<Selection, Failure> {
-        let base = &mesh.topology;
-        let input_err = |e: AdaptiveError| bad(format!("{}: {e}", job.input.display()));
-        let mut others: Vec<Box<dyn Criterion>> = Vec::new();
-        if let Some(d) = args.flatness {
-            others.push(Box::new(Flatness::new(d).map_err(input_err)?));
-        }
-        if let Some(d) = args.dihedral {
-            others.push(Box::new(DihedralAngle::new(d).map_err(input_err)?));
-        }
-        if let Some(k) = args.curvature {
-            others.push(Box::new(
-                GaussianCurvature::new(k, diagonal).map_err(input_err)?,
-            ));
-        }
-        if let Some(f) = &args.select_faces {
-            let faces: Vec<u64> = read_indices(f, base.num_faces(), "face")?
-                .into_iter()
-                .map(u64::from)
-                .collect();
-            others.push(Box::new(
-                FaceSelection::from_faces(base.num_faces(), &faces).map_err(input_err)?,
-            ));
-        }
-        if let Some(f) = &args.select_vertices {
-            let vertices: Vec<u64> = read_indices(f, base.num_vertices(), "vertex")?
-                .into_iter()
-                .map(u64::from)
-                .collect();
-            others.push(Box::new(
-                FaceSelection::from_vertices(base, &vertices).map_err(input_err)?,
-            ));
-        }
-        let distance = match args.max_distance {
-            Some(d) => {
-                let s =
-                    LimitSurface::new(base, &mesh.positions, scheme, options).map_err(input_err)?;
-                Some(LimitDistance::new(s, d * diagonal, args.limit).map_err(input_err)?)
-            }
-            None => None,
-        };
-        Ok(Selection { others, distance })
-    }
-
-    fn criteria(&self) -> Vec<&dyn Criterion> {
-        let mut all: Vec<&dyn Criterion> = self.others.iter().map(|c| c.as_ref()).collect();
-        if let Some(d) = &self.distance {
-            all.push(d);
-        }
-        all
-    }
+/// What the command line asks for, as the library's request (the selections read from
+/// their files).
+fn request_of(
+    args: &AdaptiveArgs,
+    mesh: &subd_mesh::Mesh,
+    options: &subd_schemes::Options,
+    levels: usize,
+) -> Result<AdaptiveRequest, Failure> {
+    let base = &mesh.topology;
+    let read = |f: &Option<PathBuf>, n: usize, what: &str| -> Result<Option<Vec<u64>>, Failure> {
+        f.as_ref()
+            .map(|f| {
+                Ok(read_indices(f, n, what)?
+                    .into_iter()
+                    .map(u64::from)
+                    .collect())
+            })
+            .transpose()
+    };
+    Ok(AdaptiveRequest {
+        scheme: args.scheme.clone(),
+        options: *options,
+        levels,
+        limit: args.limit,
+        flatness: args.flatness,
+        max_distance: args.max_distance,
+        curvature: args.curvature,
+        dihedral: args.dihedral,
+        select_faces: read(&args.select_faces, base.num_faces(), "face")?,
+        select_vertices: read(&args.select_vertices, base.num_vertices(), "vertex")?,
+        fvar_interpolation: args.rules.fvar_mode(&mesh.hints),
+    })
 }
 
 /// `subd adaptive` writes meshes.
@@ -265,7 +231,8 @@ fn run_one(
     let diagonal = mesh
         .bounding_box()
         .map_or(0.0, |(lo, hi)| (hi - lo).length());
-    let selection = Selection::new(args, job, mesh, &scheme, &options, diagonal)?;
+    let request = request_of(args, mesh, &options, levels)?;
+    let selection = Criteria::new(mesh, &request, diagonal).map_err(input_err)?;
 
     let spinner = Spinner::new(args.json || job.quiet, "refining");
     let t0 = Instant::now();
@@ -274,7 +241,7 @@ fn run_one(
         &mesh.positions,
         &scheme,
         &options,
-        &selection.criteria(),
+        &selection.all(),
         levels,
         &mut |level, faces| spinner.message(format!("level {level}: {faces} faces")),
     )
@@ -311,7 +278,7 @@ fn run_one(
     let t_report = t2.elapsed().as_secs_f64();
 
     spinner.message("texture coordinates");
-    let uv = adaptive_uv(args, mesh, surface, (scheme, &options), &result, err, job);
+    let uv = adaptive_uv(mesh, &request, surface, &result, err, job);
     spinner.message("writing");
     let t3 = Instant::now();
     let written = write(job, &result, &options, uv.as_ref())?;
@@ -377,7 +344,7 @@ impl DistanceCheck {
 /// --report-distance and --json here; `None` otherwise.
 fn check_distance(
     args: &AdaptiveArgs,
-    selection: &Selection,
+    selection: &Criteria,
     hierarchy: &AdaptiveRefinement,
     result: &AdaptiveMesh,
     surface: Option<&LimitSurface>,
@@ -394,7 +361,7 @@ fn check_distance(
             met: None,
         };
     };
-    // The distance criterion is the last one (Selection::criteria).
+    // The distance criterion is the last one (Criteria::all).
     let judged = hierarchy.final_errors().last().copied().flatten();
     // With --limit the criterion left the leaves to its level-by-level selection, which
     // cleared those below the cap: the cap's leaves decide the tolerance, all of them the
@@ -490,39 +457,16 @@ fn measure(mesh: &AdaptiveMesh) -> (Conformity, f64) {
 /// The input's texture coordinates on the adaptive mesh: their exact limit at every corner's
 /// parameter (`None` without UVs, or with a warning where they cannot be evaluated).
 fn adaptive_uv(
-    args: &AdaptiveArgs,
     mesh: &subd_mesh::Mesh,
+    request: &AdaptiveRequest,
     surface: Option<&LimitSurface>,
-    (scheme, options): (Scheme, &subd_schemes::Options),
     result: &AdaptiveMesh,
     err: &mut dyn Write,
     job: &Job,
 ) -> Option<crate::uv::RefinedUv> {
-    let channel = mesh.uv()?;
-    let mode = args.rules.fvar_mode(&mesh.hints);
-    // The surface's evaluator when there is one; otherwise building one names the problem.
-    let mut own = None;
-    let evaluator = match surface {
-        Some(s) => Ok(s.evaluator()),
-        None => own
-            .insert(subd_limit::eval::LimitEvaluator::new(
-                &mesh.topology,
-                &scheme,
-                options,
-            ))
-            .as_ref()
-            .map_err(|e| e.to_string()),
-    };
-    let computed = evaluator.and_then(|ev| {
-        let uv_eval = ev.face_varying(channel, mode).map_err(|e| e.to_string())?;
-        let values = uv_eval
-            .prepare(channel.values())
-            .map_err(|e| e.to_string())?;
-        result
-            .face_varying_limit(&uv_eval, &values)
-            .map_err(|e| e.to_string())
-    });
-    match computed {
+    mesh.uv()?;
+    let evaluator = surface.map(LimitSurface::evaluator);
+    match adapted_uv(mesh, request, evaluator, result) {
         Ok(uv) => Some(crate::uv::RefinedUv {
             values: uv.values,
             indices: uv.indices,
