@@ -93,20 +93,34 @@ where
     filled1(py, values.len(), |i| values[i])
 }
 
+/// `values` (`k` per row) as an `(n, k)` array of `T`, each converted by `convert`.
+fn flat<'py, S, T>(
+    py: Python<'py>,
+    values: &[S],
+    k: usize,
+    convert: impl Fn(S) -> T + Sync + Send,
+) -> PyResult<Bound<'py, PyArray2<T>>>
+where
+    S: Copy + Sync,
+    T: Element + Copy + Send + Sync,
+{
+    let n = values.len().checked_div(k).unwrap_or(0);
+    let array = PyArray2::<T>::zeros(py, [n, k], false);
+    {
+        let mut rw = array.readwrite();
+        let out = rw.as_slice_mut().expect("a new array is contiguous");
+        fill_values(py, out, |i| convert(values[i]))?;
+    }
+    Ok(array)
+}
+
 /// `values` (`k` numbers per row) as an `(n, k)` array, for any `k`.
 pub(crate) fn flat_rows<'py>(
     py: Python<'py>,
     values: &[f64],
     k: usize,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let n = values.len().checked_div(k).unwrap_or(0);
-    let array = PyArray2::<f64>::zeros(py, [n, k], false);
-    {
-        let mut rw = array.readwrite();
-        let out = rw.as_slice_mut().expect("a new array is contiguous");
-        fill_values(py, out, |i| values[i])?;
-    }
-    Ok(array)
+    flat(py, values, k, |x| x)
 }
 
 /// Indices (`k` per row) as an `(n, k)` int64 array.
@@ -115,12 +129,5 @@ pub(crate) fn flat_ints<'py>(
     values: &[u32],
     k: usize,
 ) -> PyResult<Bound<'py, PyArray2<i64>>> {
-    let n = values.len().checked_div(k).unwrap_or(0);
-    let array = PyArray2::<i64>::zeros(py, [n, k], false);
-    {
-        let mut rw = array.readwrite();
-        let out = rw.as_slice_mut().expect("a new array is contiguous");
-        fill_values(py, out, |i| i64::from(values[i]))?;
-    }
-    Ok(array)
+    flat(py, values, k, i64::from)
 }

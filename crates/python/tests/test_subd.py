@@ -74,24 +74,36 @@ def test_outputs_are_contiguous_writable_copies():
 @pytest.mark.filterwarnings("ignore::subd.SubdWarning")
 def test_refine_equals_the_binary_on_every_shape(tmp_path, scheme):
     compared = 0
-    for obj in sorted(SHAPES.glob("*.obj")):
-        out = tmp_path / f"{obj.stem}.obj"
-        run = subprocess.run([SUBD_BIN, "refine", "--scheme", scheme, "--levels", "2",
-                              str(obj), str(out)], capture_output=True)
-        try:
-            got = subd.refine(subd.read(obj), scheme, levels=2)
-        except subd.SubdError:
-            assert run.returncode != 0, f"{obj.name}: the binary refined it"
-            continue
-        assert run.returncode == 0, run.stderr
-        want = subd.read(out)
-        assert np.array_equal(got.face_sizes, want.face_sizes), obj.name
-        assert np.array_equal(got.face_vertices, want.face_vertices), obj.name
+    for got, want, name in binary_and_binding(
+        tmp_path, sorted(SHAPES.glob("*.obj")),
+        lambda obj: ["refine", "--scheme", scheme, "--levels", "2"],
+        lambda mesh, obj: subd.refine(mesh, scheme, levels=2),
+    ):
+        assert np.array_equal(got.face_sizes, want.face_sizes), name
+        assert np.array_equal(got.face_vertices, want.face_vertices), name
         # The file holds the shortest decimal that reads back to the same double.
-        assert np.array_equal(got.vertices, want.vertices), obj.name
-        same_uvs(got, want, obj.name)
+        assert np.array_equal(got.vertices, want.vertices), name
+        same_uvs(got, want, name)
         compared += 1
     assert compared >= 10, f"{scheme}: only {compared} shapes compared"
+
+
+def binary_and_binding(tmp_path, shapes, flags, call):
+    """For every shape both the `subd` binary (with `flags(obj)`) and the binding
+    (`call(mesh, obj)`) take: `(binding's mesh, the binary's file read back, name)`. Where the
+    binding raises, the binary must have refused too."""
+    for obj in shapes:
+        out = tmp_path / f"{obj.stem}.obj"
+        run = subprocess.run([SUBD_BIN, *flags(obj), str(obj), str(out)], capture_output=True)
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", subd.SubdWarning)
+                got = call(subd.read(obj), obj)
+        except subd.SubdError:
+            assert run.returncode != 0, f"{obj.name}: the binary took it"
+            continue
+        assert run.returncode == 0, run.stderr
+        yield got, subd.read(out), obj.name
 
 
 def same_uvs(got, want, name):
@@ -108,25 +120,17 @@ def same_uvs(got, want, name):
                                          ("sqrt3", None), ("butterfly", "boundaries")])
 def test_refine_to_the_limit_with_uvs_equals_the_binary(tmp_path, scheme, mode):
     compared = with_uvs = 0
-    for obj in sorted(SHAPES.glob("*.obj")):
-        out = tmp_path / f"{obj.stem}.obj"
-        extra = [] if mode is None else ["--fvar-interpolation", mode]
-        run = subprocess.run([SUBD_BIN, "refine", "--scheme", scheme, "--levels", "1",
-                              "--limit", *extra, str(obj), str(out)], capture_output=True)
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore", subd.SubdWarning)
-                got = subd.refine(subd.read(obj), scheme, levels=1, limit=True,
-                                  fvar_interpolation=mode)
-        except subd.SubdError:
-            assert run.returncode != 0, f"{obj.name}: the binary refined it"
-            continue
-        assert run.returncode == 0, run.stderr
-        want = subd.read(out)
-        assert np.array_equal(got.face_vertices, want.face_vertices), obj.name
-        assert np.array_equal(got.vertices, want.vertices), obj.name
+    extra = [] if mode is None else ["--fvar-interpolation", mode]
+    for got, want, name in binary_and_binding(
+        tmp_path, sorted(SHAPES.glob("*.obj")),
+        lambda obj: ["refine", "--scheme", scheme, "--levels", "1", "--limit", *extra],
+        lambda mesh, obj: subd.refine(mesh, scheme, levels=1, limit=True,
+                                      fvar_interpolation=mode),
+    ):
+        assert np.array_equal(got.face_vertices, want.face_vertices), name
+        assert np.array_equal(got.vertices, want.vertices), name
         assert got.normals.shape == got.vertices.shape
-        same_uvs(got, want, obj.name)
+        same_uvs(got, want, name)
         compared += 1
         with_uvs += want.uvs is not None
     assert compared >= 10 and with_uvs >= 3, (compared, with_uvs)
@@ -561,22 +565,16 @@ def test_a_refined_meshs_topology_is_built_once_under_concurrent_use(pool):
 @pytest.mark.filterwarnings("ignore::subd.SubdWarning")
 def test_adaptive_equals_the_binary(tmp_path, flags, kwargs):
     compared = with_uvs = 0
-    for obj in sorted(SHAPES.glob("*.obj"))[::4]:
-        scheme = "loop" if obj.name.startswith("loop") else "catmull-clark"
-        out = tmp_path / f"{obj.stem}.obj"
-        run = subprocess.run([SUBD_BIN, "adaptive", "--scheme", scheme, *flags, str(obj),
-                              str(out)], capture_output=True)
-        try:
-            got = subd.adaptive(subd.read(obj), scheme, **kwargs)
-        except subd.SubdError:
-            assert run.returncode != 0, f"{obj.name}: the binary refined it"
-            continue
-        assert run.returncode == 0, run.stderr
-        want = subd.read(out)
-        assert np.array_equal(got.face_vertices, want.face_vertices), obj.name
-        assert np.array_equal(got.vertices, want.vertices), obj.name
-        same_uvs(got, want, obj.name)
-        # Every face's level is within the cap, and the cap is reached somewhere.
+    scheme = lambda obj: "loop" if obj.name.startswith("loop") else "catmull-clark"  # noqa: E731
+    for got, want, name in binary_and_binding(
+        tmp_path, sorted(SHAPES.glob("*.obj"))[::4],
+        lambda obj: ["adaptive", "--scheme", scheme(obj), *flags],
+        lambda mesh, obj: subd.adaptive(mesh, scheme(obj), **kwargs),
+    ):
+        assert np.array_equal(got.face_vertices, want.face_vertices), name
+        assert np.array_equal(got.vertices, want.vertices), name
+        same_uvs(got, want, name)
+        # Every face's level is within the cap.
         assert got.face_levels.shape == (got.num_faces,)
         assert got.face_levels.max() <= kwargs["levels"]
         compared += 1
