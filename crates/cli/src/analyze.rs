@@ -8,7 +8,7 @@ use subd_limit::spectrum::{
     RingSpectrum, SplitSpectrumReport, SurfaceSpectrum, VALENCES, surface_spectrum,
 };
 use subd_schemes::Scheme;
-use subd_schemes::analysis::{Lattice, analyze, analyze_bivariate};
+use subd_schemes::analysis::{Lattice, analyze, analyze_bivariate, check_total};
 
 use crate::Failure;
 use crate::failure::bad;
@@ -89,13 +89,12 @@ pub(crate) fn run(args: &AnalyzeArgs, out: &mut dyn Write) -> Result<(), Failure
     if !(2..=3).contains(&args.arity) {
         return Err(bad(format!("--arity {}: must be 2 or 3", args.arity)));
     }
-    let sum: f64 = coeffs.iter().sum();
-    if (sum - args.arity as f64).abs() > 1e-9 * coeffs.len() as f64 {
-        return Err(bad(format!(
-            "--mask: the coefficients sum to {sum}; a mask of arity {} must sum to {} (each old point's weights in the new points)",
-            args.arity, args.arity
-        )));
-    }
+    check_total(
+        &coeffs,
+        args.arity as f64,
+        &format!("a mask of arity {}", args.arity),
+    )
+    .map_err(|e| bad(format!("--mask: {e}")))?;
     if args.max_levels == 0 || args.max_levels > 20 {
         return Err(bad(format!(
             "--max-levels {}: must be 1 to 20",
@@ -157,12 +156,8 @@ fn run_bivariate(text: &str, args: &AnalyzeArgs, out: &mut dyn Write) -> Result<
                 .collect::<Result<Vec<f64>, _>>()
         })
         .collect::<Result<_, _>>()?;
-    let sum: f64 = rows.iter().flatten().sum();
-    if (sum - 4.0).abs() > 1e-9 * rows.iter().map(Vec::len).sum::<usize>().max(1) as f64 {
-        return Err(bad(format!(
-            "--mask2: the coefficients sum to {sum}; a bivariate binary mask must sum to 4"
-        )));
-    }
+    let all: Vec<f64> = rows.iter().flatten().copied().collect();
+    check_total(&all, 4.0, "a bivariate binary mask").map_err(|e| bad(format!("--mask2: {e}")))?;
     let lattice = match args.lattice {
         LatticeArg::Quad => Lattice::Quad,
         LatticeArg::ThreeDirection => Lattice::ThreeDirection,

@@ -7,6 +7,7 @@ use subd_adaptive::request::{AdaptedMesh, AdaptiveRequest, adapt_mesh};
 use subd_mesh::fvar::FVarChannel;
 use subd_mesh::{Mesh, SchemeHints, TopologyBuilder};
 
+use crate::arrays::index;
 use crate::errors::mesh_error;
 use crate::mesh::CoreMesh;
 use crate::ops::{RuleNames, scheme};
@@ -79,9 +80,7 @@ pub(crate) fn adaptive(
 fn indices(a: &PyReadonlyArray1<'_, i64>, what: &str) -> PyResult<Vec<u64>> {
     a.as_array()
         .iter()
-        .map(|&i| {
-            u64::try_from(i).map_err(|_| mesh_error(format!("{what}: index {i} is negative")))
-        })
+        .map(|&i| index(i).map_err(|e| mesh_error(format!("{what}: {e}"))))
         .collect()
 }
 

@@ -5,7 +5,7 @@
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use serde::Serialize;
-use subd_schemes::analysis::{Lattice, analyze, analyze_bivariate};
+use subd_schemes::analysis::{Lattice, analyze, analyze_bivariate, check_total};
 
 use crate::errors::mesh_error;
 use crate::ops::scheme;
@@ -23,7 +23,8 @@ pub(crate) fn analyze_mask(
     max_levels: usize,
 ) -> PyResult<String> {
     check_levels(max_levels)?;
-    check_sum(&mask, arity as f64, &format!("a mask of arity {arity}"))?;
+    check_total(&mask, arity as f64, &format!("a mask of arity {arity}"))
+        .map_err(|e| mesh_error(format!("mask: {e}")))?;
     let verdict = pool::run(py, || analyze(&mask, arity, max_levels))?
         .map_err(|e| mesh_error(format!("mask: {e}")))?;
     json(&verdict)
@@ -49,7 +50,8 @@ pub(crate) fn analyze_mask2(
         }
     };
     let all: Vec<f64> = rows.iter().flatten().copied().collect();
-    check_sum(&all, 4.0, "a bivariate binary mask")?;
+    check_total(&all, 4.0, "a bivariate binary mask")
+        .map_err(|e| mesh_error(format!("mask2: {e}")))?;
     let verdict = pool::run(py, || analyze_bivariate(&rows, lattice, max_levels))?
         .map_err(|e| mesh_error(format!("mask2: {e}")))?;
     json(&verdict)
@@ -79,18 +81,6 @@ fn check_levels(max_levels: usize) -> PyResult<()> {
         MAX_LEVELS.start(),
         MAX_LEVELS.end()
     )))
-}
-
-/// Refuses coefficients that do not sum to `want` (each old point's weights in the new
-/// points), as `subd analyze` does.
-fn check_sum(coeffs: &[f64], want: f64, what: &str) -> PyResult<()> {
-    let sum: f64 = coeffs.iter().sum();
-    if (sum - want).abs() > 1e-9 * coeffs.len().max(1) as f64 {
-        return Err(mesh_error(format!(
-            "the coefficients sum to {sum}; {what} must sum to {want}"
-        )));
-    }
-    Ok(())
 }
 
 fn json(value: &impl Serialize) -> PyResult<String> {

@@ -3,7 +3,12 @@
 //! with the GIL released: the library's values are converted once, with no intermediate
 //! vector.
 
-use numpy::{Element, PyArray1, PyArray2, PyArrayMethods};
+use numpy::ndarray::Dimension;
+use numpy::{
+    Element, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray, PyReadonlyArray2,
+    PyUntypedArrayMethods,
+};
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use rayon::prelude::*;
 use subd_mesh::DVec3;
@@ -130,4 +135,34 @@ pub(crate) fn flat_ints<'py>(
     k: usize,
 ) -> PyResult<Bound<'py, PyArray2<i64>>> {
     flat(py, values, k, i64::from)
+}
+
+/// The elements of a C-contiguous array, or a `ValueError` naming the argument `what`.
+pub(crate) fn contiguous<'a, T: Element, D: Dimension>(
+    a: &'a PyReadonlyArray<'_, T, D>,
+    what: &str,
+) -> PyResult<&'a [T]> {
+    a.as_slice()
+        .map_err(|_| PyValueError::new_err(format!("{what}: a C-contiguous array is needed")))
+}
+
+/// The elements of a C-contiguous 2-D array of `k` columns, or a `ValueError` naming `what`.
+pub(crate) fn columns<'a, T: Element>(
+    a: &'a PyReadonlyArray2<'_, T>,
+    k: usize,
+    what: &str,
+) -> PyResult<&'a [T]> {
+    if a.shape()[1] != k {
+        return Err(PyValueError::new_err(format!(
+            "{what}: shape {:?}, expected (n, {k})",
+            a.shape()
+        )));
+    }
+    contiguous(a, what)
+}
+
+/// An index given as `i64`, refused (named) when negative; the library checks the upper
+/// bound.
+pub(crate) fn index(i: i64) -> Result<u64, String> {
+    u64::try_from(i).map_err(|_| format!("index {i} is negative"))
 }

@@ -6,7 +6,7 @@ use pyo3::prelude::*;
 use subd_mesh::DVec3;
 use subd_schemes::named_curve::{CurveParameters, NamedCurve, subdivide_curve};
 
-use crate::arrays::filled2;
+use crate::arrays::{columns, contiguous, filled2};
 use crate::errors::mesh_error;
 use crate::pool;
 
@@ -73,20 +73,9 @@ pub(crate) fn curve<'py>(
     Ok((points, normals))
 }
 
-fn contiguous<'a>(a: &'a PyReadonlyArray2<'_, f64>, what: &str) -> PyResult<&'a [f64]> {
-    a.as_slice()
-        .map_err(|_| PyValueError::new_err(format!("{what}: a C-contiguous array is needed")))
-}
-
 /// Normals given as an `(n, 2)` array.
 fn normal_rows(n: &PyReadonlyArray2<'_, f64>) -> PyResult<Vec<glam::DVec2>> {
-    if n.shape()[1] != 2 {
-        return Err(PyValueError::new_err(format!(
-            "normals: shape {:?}, expected (n, 2)",
-            n.shape()
-        )));
-    }
-    Ok(contiguous(n, "normals")?
+    Ok(columns(n, 2, "normals")?
         .chunks_exact(2)
         .map(|c| glam::DVec2::new(c[0], c[1]))
         .collect())

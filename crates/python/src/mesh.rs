@@ -1,16 +1,17 @@
 //! `subd._subd._CoreMesh`: a [`Mesh`] (topology, tags, positions) and, after a refinement
 //! to the limit, its normals. The Python class `subd.Mesh` wraps one.
 
-use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
+use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use std::sync::{Mutex, MutexGuard, OnceLock, PoisonError, TryLockError};
 
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use subd_limit::refined_mesh::RefinedMesh;
 use subd_mesh::fvar::FVarChannel;
 use subd_mesh::{DVec3, Mesh, TopologyBuilder};
 
-use crate::arrays::{copied1, filled1, filled2, flat_ints, flat_rows, points};
+use crate::arrays::{
+    columns, contiguous, copied1, filled1, filled2, flat_ints, flat_rows, index, points,
+};
 use crate::errors::{io_error, mesh_error};
 use crate::pool;
 
@@ -288,33 +289,6 @@ fn uv_channel(mesh: &Mesh, values: &[f64], indices: &[i64]) -> Result<FVarChanne
     FVarChannel::new(t, 2, values.to_vec(), checked).map_err(|e| e.to_string())
 }
 
-/// A tag's index, refused (named) when negative; the library checks the upper bound.
-fn index(i: i64) -> Result<u64, String> {
-    u64::try_from(i).map_err(|_| format!("index {i} is negative"))
-}
-
-/// A slice of a contiguous array, or a `ValueError` naming the argument.
-fn slice<'a, T: numpy::Element>(a: &'a PyReadonlyArray1<'_, T>, what: &str) -> PyResult<&'a [T]> {
-    a.as_slice()
-        .map_err(|_| PyValueError::new_err(format!("{what}: a C-contiguous array is needed")))
-}
-
-/// A slice of a contiguous 2-D array of `k` columns.
-fn slice2<'a, T: numpy::Element>(
-    a: &'a PyReadonlyArray2<'_, T>,
-    k: usize,
-    what: &str,
-) -> PyResult<&'a [T]> {
-    if a.shape()[1] != k {
-        return Err(PyValueError::new_err(format!(
-            "{what}: shape {:?}, expected (n, {k})",
-            a.shape()
-        )));
-    }
-    a.as_slice()
-        .map_err(|_| PyValueError::new_err(format!("{what}: a C-contiguous array is needed")))
-}
-
 #[pymethods]
 impl CoreMesh {
     /// A mesh from flat arrays (see `subd.Mesh`, which builds them from what a user has).
@@ -336,19 +310,19 @@ impl CoreMesh {
         accept_inconsistent_orientation: bool,
     ) -> PyResult<CoreMesh> {
         let uv = match (&uvs, &uv_indices) {
-            (Some(u), Some(i)) => Some((slice2(u, 2, "uvs")?, slice(i, "uv_indices")?)),
+            (Some(u), Some(i)) => Some((columns(u, 2, "uvs")?, contiguous(i, "uv_indices")?)),
             (None, None) => None,
             _ => return Err(mesh_error("uvs and uv_indices come together")),
         };
         let arrays = Arrays {
-            vertices: slice2(&vertices, 3, "vertices")?,
-            face_sizes: slice(&face_sizes, "face sizes")?,
-            face_vertices: slice(&face_vertices, "face vertices")?,
-            crease_edges: slice2(&crease_edges, 2, "crease edges")?,
-            crease_sharpness: slice(&crease_sharpness, "crease sharpness")?,
-            corner_vertices: slice(&corner_vertices, "corner vertices")?,
-            corner_sharpness: slice(&corner_sharpness, "corner sharpness")?,
-            holes: slice(&holes, "holes")?,
+            vertices: columns(&vertices, 3, "vertices")?,
+            face_sizes: contiguous(&face_sizes, "face sizes")?,
+            face_vertices: contiguous(&face_vertices, "face vertices")?,
+            crease_edges: columns(&crease_edges, 2, "crease edges")?,
+            crease_sharpness: contiguous(&crease_sharpness, "crease sharpness")?,
+            corner_vertices: contiguous(&corner_vertices, "corner vertices")?,
+            corner_sharpness: contiguous(&corner_sharpness, "corner sharpness")?,
+            holes: contiguous(&holes, "holes")?,
             uv,
             accept_inconsistent_orientation,
         };

@@ -8,7 +8,7 @@ use pyo3::prelude::*;
 use subd_mesh::DVec3;
 use subd_schemes::Refinement;
 
-use crate::arrays::{copied1, filled1, flat_rows, points};
+use crate::arrays::{contiguous, copied1, filled1, flat_rows, points};
 use crate::errors::mesh_error;
 use crate::mesh::CoreMesh;
 use crate::ops::{RuleNames, request};
@@ -75,9 +75,7 @@ impl CoreRefiner {
                 self.refinement.num_vertices(0)
             )));
         }
-        let src = values
-            .as_slice()
-            .map_err(|_| PyValueError::new_err("values: a C-contiguous array is needed"))?;
+        let src = contiguous(&values, "values")?;
         if k == 3 {
             let base: Vec<DVec3> = src.chunks_exact(3).map(DVec3::from_slice).collect();
             let out = pool::run(py, || self.refinement.points_at(&base, self.levels))?;

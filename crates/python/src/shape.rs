@@ -17,6 +17,7 @@ use subd_mesh::{DVec3, Mesh};
 use subd_pia::{Moving, Pia, PiaOptions, Solver};
 use subd_schemes::{Options, Scheme, TwoPhase};
 
+use crate::arrays::contiguous;
 use crate::errors::mesh_error;
 use crate::mesh::CoreMesh;
 use crate::ops::{RuleNames, scheme};
@@ -29,15 +30,6 @@ fn reshaped(base: &Mesh, positions: Vec<DVec3>) -> Result<Mesh, String> {
     // Only control points move: texture coordinates stay as given.
     mesh.fvar = base.fvar.clone();
     Ok(mesh)
-}
-
-/// A slice of a contiguous array, or a `ValueError` naming the argument.
-fn contiguous<'a, T: numpy::Element>(
-    a: &'a PyReadonlyArray1<'_, T>,
-    what: &str,
-) -> PyResult<&'a [T]> {
-    a.as_slice()
-        .map_err(|_| PyValueError::new_err(format!("{what}: a C-contiguous array is needed")))
 }
 
 /// Vertex indices as `u32`, each named when negative or past the mesh's `nv` vertices.

@@ -10,7 +10,7 @@ use subd_limit::tessellation::tessellate_mesh;
 use subd_mesh::{DVec3, Mesh, TopologyBuilder};
 use subd_schemes::Options;
 
-use crate::arrays::points;
+use crate::arrays::{contiguous, points};
 use crate::errors::mesh_error;
 use crate::mesh::CoreMesh;
 use crate::ops::scheme;
@@ -35,16 +35,8 @@ pub(crate) fn evaluate<'py>(
     derivatives: bool,
 ) -> PyResult<Evaluated<'py>> {
     let scheme = scheme(scheme_name)?;
-    let contiguous =
-        |what: &str| PyValueError::new_err(format!("{what}: a C-contiguous array is needed"));
-    let (faces, subs) = (
-        faces.as_slice().map_err(|_| contiguous("faces"))?,
-        subs.as_slice().map_err(|_| contiguous("sub"))?,
-    );
-    let (u, v) = (
-        u.as_slice().map_err(|_| contiguous("u"))?,
-        v.as_slice().map_err(|_| contiguous("v"))?,
-    );
+    let (faces, subs) = (contiguous(&faces, "faces")?, contiguous(&subs, "sub")?);
+    let (u, v) = (contiguous(&u, "u")?, contiguous(&v, "v")?);
     if [subs.len(), u.len(), v.len()]
         .iter()
         .any(|&n| n != faces.len())

@@ -59,6 +59,23 @@ pub struct Verdict {
     pub note: String,
 }
 
+/// Refuses a mask whose coefficients do not sum to `total` (the arity of a univariate mask,
+/// 4 for a bivariate binary one), `what` naming it in the message: the front ends' check
+/// before [`analyze`] or [`analyze_bivariate`], which themselves report such a mask as not
+/// convergent rather than refuse it.
+///
+/// # Errors
+/// [`AnalysisError::Mask`] with the sum found.
+pub fn check_total(coeffs: &[f64], total: f64, what: &str) -> Result<(), AnalysisError> {
+    let sum: f64 = coeffs.iter().sum();
+    if (sum - total).abs() > 1e-9 * coeffs.len().max(1) as f64 {
+        return Err(AnalysisError::Mask(format!(
+            "the coefficients sum to {sum}; {what} must sum to {total} (each old point's weights in the new points)"
+        )));
+    }
+    Ok(())
+}
+
 /// Decides convergence and smoothness of the mask `coeffs` (`a_j` in order of increasing
 /// power of `z`; they must sum to the arity), trying `L = 1..=max_levels`.
 ///
