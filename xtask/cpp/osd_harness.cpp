@@ -269,6 +269,85 @@ double bfrTessellate(Far::TopologyRefiner const &refiner, Mesh const &m, int rat
     return check;
 }
 
+// The patch table of an adaptive refinement to isolation level `m.levels` with the given
+// factory options (--patches ENDCAP SINGLE_CREASE INF_SHARP LEGACY_CORNERS; ENDCAP is
+// PatchTableFactory::Options::EndCapType), evaluated in double precision at the points that
+// follow the mesh (u32 count, {u32 ptex face, f64 u, f64 v}). Output: u32 arrays, per array
+// u32 type (PatchDescriptor::Type), u32 control points, u32 patches, per patch u32 face, u, v,
+// depth, nonquad, boundary, transition, regular, f32 single-crease sharpness, u32 cvs[n];
+// then u32 local points, u32 refined vertices, per point f64 P, Du, Dv, Duu, Duv, Dvv [3],
+// then f64 pos[3 (refined + local)].
+void patchTable(Mesh const &m, Reader &r, char **argv, std::vector<unsigned char> &out) {
+    uint32_t count = r.get<uint32_t>();
+    std::vector<int> faces(count);
+    std::vector<double> us(count), vs(count);
+    for (uint32_t i = 0; i < count; ++i) {
+        faces[i] = (int)r.get<uint32_t>();
+        us[i] = r.get<double>();
+        vs[i] = r.get<double>();
+    }
+    Far::TopologyRefiner *refiner = createRefiner(m);
+    Far::PatchTableFactory::Options po(m.levels);
+    po.SetPatchPrecision<double>();
+    po.endCapType = (Far::PatchTableFactory::Options::EndCapType)std::atoi(argv[2]);
+    po.useSingleCreasePatch = std::atoi(argv[3]) != 0;
+    po.useInfSharpPatch = std::atoi(argv[4]) != 0;
+    po.generateLegacySharpCornerPatches = std::atoi(argv[5]) != 0;
+    po.generateVaryingTables = false;
+    refiner->RefineAdaptive(po.GetRefineAdaptiveOptions());
+    Far::PatchTable const *table = Far::PatchTableFactory::Create(*refiner, po);
+    put<uint32_t>(out, (uint32_t)table->GetNumPatchArrays());
+    for (int a = 0; a < table->GetNumPatchArrays(); ++a) {
+        Far::PatchDescriptor d = table->GetPatchArrayDescriptor(a);
+        int np = table->GetNumPatches(a);
+        put<uint32_t>(out, (uint32_t)d.GetType());
+        put<uint32_t>(out, (uint32_t)d.GetNumControlVertices());
+        put<uint32_t>(out, (uint32_t)np);
+        for (int p = 0; p < np; ++p) {
+            Far::PatchParam pp = table->GetPatchParam(a, p);
+            for (int x : {pp.GetFaceId(), (int)pp.GetU(), (int)pp.GetV(), (int)pp.GetDepth(),
+                          (int)pp.NonQuadRoot(), (int)pp.GetBoundary(), (int)pp.GetTransition(), (int)pp.IsRegular()})
+                put<uint32_t>(out, (uint32_t)x);
+            // The sharpness arrays exist only with single-crease patches.
+            put<float>(out, po.useSingleCreasePatch ? table->GetSingleCreasePatchSharpnessValue(a, p) : 0.0f);
+            Far::ConstIndexArray cvs = table->GetPatchVertices(a, p);
+            for (int c = 0; c < cvs.size(); ++c) put<uint32_t>(out, (uint32_t)cvs[c]);
+        }
+    }
+    int nRefined = refiner->GetNumVerticesTotal();
+    int nLocal = table->GetNumLocalPoints();
+    put<uint32_t>(out, (uint32_t)nLocal);
+    put<uint32_t>(out, (uint32_t)nRefined);
+    std::vector<Point> verts(nRefined + nLocal);
+    std::copy(m.pos.begin(), m.pos.end(), verts.begin());
+    Far::PrimvarRefinerReal<double> primvar(*refiner);
+    Point *src = verts.data();
+    for (int l = 1; l < refiner->GetNumLevels(); ++l) {
+        Point *dst = src + refiner->GetLevel(l - 1).GetNumVertices();
+        primvar.Interpolate(l, src, dst);
+        src = dst;
+    }
+    if (nLocal) table->GetLocalPointStencilTable<double>()->UpdateValues(verts.data(), verts.data() + nRefined);
+    Far::PatchMap map(*table);
+    double w[6][20];
+    for (uint32_t i = 0; i < count; ++i) {
+        Far::PatchTable::PatchHandle const *h = map.FindPatch(faces[i], us[i], vs[i]);
+        if (!h) throw std::runtime_error("no patch at point " + std::to_string(i));
+        table->EvaluateBasis(*h, us[i], vs[i], w[0], w[1], w[2], w[3], w[4], w[5]);
+        Far::ConstIndexArray cvs = table->GetPatchVertices(*h);
+        for (int d = 0; d < 6; ++d) {
+            Point acc;
+            acc.Clear();
+            for (int c = 0; c < cvs.size(); ++c) acc.AddWithWeight(verts[cvs[c]], w[d][c]);
+            for (double x : acc.p) put<double>(out, x);
+        }
+    }
+    for (auto const &p : verts)
+        for (double c : p.p) put<double>(out, c);
+    delete table;
+    delete refiner;
+}
+
 } // namespace
 
 int main(int argc, char **argv) {
@@ -321,6 +400,12 @@ int main(int argc, char **argv) {
             std::printf("{\"seconds\": %.9f, \"topology_seconds\": %.9f, \"primvar_seconds\": %.9f, "
                         "\"cpu_seconds\": %.9f, \"peak_rss_bytes\": %ld}\n",
                         median(total), median(topo), median(prim), median(cpu), peakRssBytes());
+            return 0;
+        }
+        if (argc > 5 && std::string(argv[1]) == "--patches") {
+            std::vector<unsigned char> out;
+            patchTable(m, r, argv, out);
+            std::fwrite(out.data(), 1, out.size(), stdout);
             return 0;
         }
         bool bfrBench = argc > 1 && std::string(argv[1]) == "--bfr-bench";

@@ -17,6 +17,7 @@ mod fvar_conformance;
 mod geom_conformance;
 mod geom_ref;
 mod osd;
+mod patch_conformance;
 mod pia_bench;
 mod python_tests;
 mod random_mesh;
@@ -59,6 +60,9 @@ enum Task {
         /// LimitFaceVarying).
         #[arg(long)]
         fvar_only: bool,
+        /// Only the patch-table checks (OpenSubdiv's RefineAdaptive and PatchTableFactory).
+        #[arg(long)]
+        patches_only: bool,
     },
     /// Time subd against OpenSubdiv on ~100k-face meshes (levels 1..L, 1 and all threads).
     Bench {
@@ -276,10 +280,15 @@ fn main() -> ExitCode {
             random,
             against,
             fvar_only,
+            patches_only,
         } => ensure_system_packages(REFERENCE_PACKAGES).and_then(|_| {
             let mut rows = Vec::new();
-            if against != Against::CgalOpenmesh {
+            if patches_only {
                 let exe = osd::build_harness()?;
+                rows.extend(patch_conformance::shapes(&exe, &shapes)?);
+            } else if against != Against::CgalOpenmesh {
+                let exe = osd::build_harness()?;
+                rows.extend(patch_conformance::shapes(&exe, &shapes)?);
                 if !fvar_only {
                     rows.extend(conformance::shapes(&exe, &shapes)?);
                     rows.extend(conformance::random(&exe, random));
@@ -287,7 +296,7 @@ fn main() -> ExitCode {
                 rows.extend(fvar_conformance::shapes(&exe, &shapes)?);
                 rows.extend(fvar_conformance::random(&exe, random));
             }
-            if against != Against::Opensubdiv && !fvar_only {
+            if against != Against::Opensubdiv && !fvar_only && !patches_only {
                 let geom = geom_ref::build_harness()?;
                 rows.extend(geom_conformance::shapes(&geom, &shapes)?);
                 rows.extend(geom_conformance::random(&geom, random));

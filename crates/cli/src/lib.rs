@@ -25,6 +25,7 @@ mod info;
 mod level_stream;
 mod limit;
 mod opening;
+mod patches;
 mod pia;
 mod progress;
 mod raster;
@@ -76,6 +77,10 @@ enum Command {
     /// The exact Catmull-Clark or Loop limit surface (position and unit normal) at given
     /// (face, u, v) parameters, in OpenSubdiv's parameterisation.
     Eval(eval::EvalArgs),
+    /// The feature-adaptive patch table of a Catmull-Clark or Loop mesh (OpenSubdiv's
+    /// RefineAdaptive + PatchTableFactory, same patches): its census, and its flat arrays
+    /// (control points, patch parameters, local-point stencils) as JSON.
+    Patches(patches::PatchesArgs),
     /// The Catmull-Clark or Loop limit surface on a uniform grid of N segments per base edge,
     /// positions and normals, watertight (OpenSubdiv Bfr's uniform tessellation).
     Tessellate(tessellate::TessellateArgs),
@@ -172,6 +177,7 @@ where
         Command::Limit(a) => limit::run(&a, out, err),
         Command::Eval(a) => refusal_alone(err, |err| eval::run(&a, out, err)),
         Command::Tessellate(a) => refusal_alone(err, |err| tessellate::run(&a, out, err)),
+        Command::Patches(a) => refusal_alone(err, |err| patches::run(&a, out, err)),
         Command::Pia(a) => pia::run(&a, out, err),
         Command::Adaptive(a) => adaptive::run(&a, out, err),
         Command::Edit(a) => edit::run(&a, out, err),

@@ -54,6 +54,7 @@ pub mod local;
 pub mod loop_patch;
 pub mod masks;
 pub mod patch;
+pub mod patches;
 mod piece;
 pub mod point_stencil;
 pub mod refined_mesh;

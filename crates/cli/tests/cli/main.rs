@@ -13,6 +13,7 @@ mod edit;
 mod eval;
 mod input;
 mod limit;
+mod patches;
 mod pia;
 mod refine;
 mod render;

@@ -1,0 +1,119 @@
+//! `subd patches`: the feature-adaptive patch table of a mesh (OpenSubdiv's
+//! `RefineAdaptive` + `PatchTableFactory`), its census, and its arrays as JSON.
+
+use std::io::Write;
+use std::path::PathBuf;
+
+use clap::{Args, ValueEnum};
+use subd_limit::patches::{EndCaps, MAX_ISOLATION, PatchOptions, PatchTable};
+use subd_schemes::Scheme;
+
+use crate::failure::{bad, refuse_overwrite};
+use crate::rule_args::RuleArgs;
+use crate::scheme_arg;
+use crate::{Failure, print_warnings};
+
+/// `--end-caps`.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum EndCapsArg {
+    /// Gregory patches (20 points; Gregory triangles of 18 for Loop), OpenSubdiv's default.
+    Gregory,
+    /// Regular B-spline (box-spline) patches fitted to the irregular ones.
+    Bspline,
+    /// Bilinear quads (linear triangles) through the corners' limit points.
+    Bilinear,
+    /// The irregular patches evaluated exactly (subd's own).
+    Exact,
+}
+
+impl From<EndCapsArg> for EndCaps {
+    fn from(a: EndCapsArg) -> EndCaps {
+        match a {
+            EndCapsArg::Gregory => EndCaps::GregoryBasis,
+            EndCapsArg::Bspline => EndCaps::BSpline,
+            EndCapsArg::Bilinear => EndCaps::Bilinear,
+            EndCapsArg::Exact => EndCaps::Exact,
+        }
+    }
+}
+
+#[derive(Debug, Args)]
+pub(crate) struct PatchesArgs {
+    /// Subdivision scheme.
+    #[arg(long, value_parser = scheme_arg::parser(scheme_arg::evaluated))]
+    scheme: Scheme,
+    #[command(flatten)]
+    rules: RuleArgs,
+    /// Levels of feature-adaptive refinement around irregular features (1 to 10).
+    #[arg(long, default_value_t = MAX_ISOLATION,
+          value_parser = clap::value_parser!(u8).range(1..=i64::from(MAX_ISOLATION)))]
+    isolation: u8,
+    /// How the irregular patches left at the isolation level are represented.
+    #[arg(long, value_enum, default_value = "gregory")]
+    end_caps: EndCapsArg,
+    /// Regular patches along one semi-sharp crease keep it instead of isolating it.
+    #[arg(long)]
+    single_crease: bool,
+    /// Infinitely sharp features of regular topology become regular boundary patches.
+    #[arg(long)]
+    inf_sharp: bool,
+    /// Smooth one-face corners are not approximated by sharp-corner patches.
+    #[arg(long)]
+    no_legacy_sharp_corners: bool,
+    /// Input mesh.
+    input: PathBuf,
+    /// Output (.json): the table's arrays (see `subd_limit::patches::PatchTableLayout`).
+    output: Option<PathBuf>,
+    /// Print the census (patches by type, depth and boundary mask) on stdout as JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+impl PatchesArgs {
+    fn options(&self) -> PatchOptions {
+        PatchOptions {
+            isolation: self.isolation,
+            end_caps: self.end_caps.into(),
+            single_crease: self.single_crease,
+            inf_sharp: self.inf_sharp,
+            legacy_sharp_corners: !self.no_legacy_sharp_corners,
+        }
+    }
+}
+
+pub(crate) fn run(
+    args: &PatchesArgs,
+    out: &mut dyn Write,
+    err: &mut dyn Write,
+) -> Result<(), Failure> {
+    if let Some(output) = &args.output {
+        refuse_overwrite(&args.input, output)?;
+        if output.extension().is_none_or(|e| e != "json") {
+            return Err(bad(format!(
+                "{}: the arrays are written as .json",
+                output.display()
+            )));
+        }
+    }
+    let file = subd_io::read_mesh(&args.input, &args.rules.read_options())?;
+    print_warnings(err, &args.input, &file.warnings);
+    let rules = args.rules.options(&file.mesh.hints);
+    let table = PatchTable::new(
+        &file.mesh.topology,
+        &file.mesh.positions,
+        &args.scheme,
+        &rules,
+        &args.options(),
+    )
+    .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
+    if let Some(output) = &args.output {
+        subd_io::atomic_write(output, |w| {
+            serde_json::to_writer(&mut *w, &table.layout()).map_err(std::io::Error::other)?;
+            writeln!(w)
+        })?;
+    }
+    if args.json {
+        crate::print_json(out, &table.census());
+    }
+    Ok(())
+}

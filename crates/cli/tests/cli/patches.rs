@@ -1,0 +1,110 @@
+//! `subd patches`: the census on stdout, the arrays in a JSON file whose parts agree with
+//! each other and with `subd eval`, and one-line refusals.
+
+use super::{Scratch, meshes, subd};
+
+fn json(s: &str) -> serde_json::Value {
+    serde_json::from_str(s.trim()).unwrap_or_else(|e| panic!("{e}: {s}"))
+}
+
+#[test]
+fn the_census_and_the_arrays_agree() {
+    let dir = Scratch::new("patches");
+    let out = dir.0.join("cube.json");
+    let cube = meshes().join("catmark_cube.obj");
+    let (code, stdout, stderr) = subd(&[
+        "patches",
+        "--scheme",
+        "catmull-clark",
+        "--isolation",
+        "3",
+        cube.to_str().unwrap(),
+        out.to_str().unwrap(),
+        "--json",
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let census = json(&stdout);
+    let keys: Vec<&str> = census
+        .as_object()
+        .unwrap()
+        .keys()
+        .map(String::as_str)
+        .collect();
+    assert_eq!(
+        keys,
+        [
+            "by_depth",
+            "by_type",
+            "local_points",
+            "patches",
+            "regular_by_boundary_mask"
+        ]
+    );
+    let layout = json(&std::fs::read_to_string(&out).unwrap());
+    let arrays = layout["arrays"].as_array().unwrap();
+    let total: u64 = arrays.iter().map(|a| a["patches"].as_u64().unwrap()).sum();
+    assert_eq!(total, census["patches"].as_u64().unwrap());
+    let by_type: u64 = census["by_type"]
+        .as_object()
+        .unwrap()
+        .values()
+        .map(|v| v.as_u64().unwrap())
+        .sum();
+    assert_eq!(by_type, total);
+    // Every control point indexes the points; every array holds its stated count.
+    let points = layout["points"].as_array().unwrap().len() as u64;
+    for a in arrays {
+        let n = a["control_points_per_patch"].as_u64().unwrap();
+        let cps = a["control_points"].as_array().unwrap();
+        assert_eq!(cps.len() as u64, n * a["patches"].as_u64().unwrap());
+        assert!(cps.iter().all(|c| c.as_u64().unwrap() < points));
+        // Depth in the low 4 bits of the second word, as the census counts them.
+        for p in a["params"].as_array().unwrap() {
+            let depth = p[1].as_u64().unwrap() & 15;
+            assert!(census["by_depth"][depth.to_string()].as_u64().unwrap() > 0);
+        }
+    }
+    let levels: u64 = layout["level_vertex_counts"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_u64().unwrap())
+        .sum();
+    assert_eq!(levels + layout["local_points"].as_u64().unwrap(), points);
+}
+
+#[test]
+fn bad_requests_are_refused_in_one_line() {
+    let dir = Scratch::new("patches-bad");
+    let cube = meshes().join("catmark_cube.obj");
+    let cube = cube.to_str().unwrap();
+    for (args, needle) in [
+        (vec!["patches", "--scheme", "loop", cube], "needs triangles"),
+        (
+            vec![
+                "patches",
+                "--scheme",
+                "catmull-clark",
+                "--isolation",
+                "0",
+                cube,
+            ],
+            "0 is not in 1..=10",
+        ),
+        (vec!["patches", "--scheme", "bilinear", cube], "bilinear"),
+    ] {
+        let (code, _, stderr) = subd(&args);
+        assert_eq!(code, 2, "{args:?}: {stderr}");
+        assert!(stderr.contains(needle), "{args:?}: {stderr}");
+    }
+    let bad_out = dir.0.join("table.txt");
+    let (code, _, stderr) = subd(&[
+        "patches",
+        "--scheme",
+        "catmull-clark",
+        cube,
+        bad_out.to_str().unwrap(),
+    ]);
+    assert_eq!((code, stderr.lines().count()), (2, 1), "{stderr}");
+    assert!(!bad_out.exists());
+}

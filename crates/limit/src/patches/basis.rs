@@ -1,0 +1,316 @@
+//! Basis functions of the regular patches and their boundary forms: the weight of each
+//! control point for the position and the five derivatives (∂u, ∂v, ∂uu, ∂uv, ∂vv) at
+//! `(s, t)` in the patch's own unit domain.
+//!
+//! **Boundaries.** A regular patch on a boundary (or, with infinitely sharp patches, along
+//! a sharp edge) has no points beyond the edge; the table fills those slots with any point
+//! and the basis gives them weight zero, after moving their weight onto *phantom points*
+//! extrapolated from the points inside: beyond a B-spline edge row `B` with inner row `I`,
+//! `P = 2B − I` (the cubic end condition that interpolates the boundary curve, OpenSubdiv's
+//! `adjustBSplineBoundaryWeights`); beyond a box-spline edge, the parallelogram completion
+//! `P = B₁ + B₂ − I` of the two nearest boundary points and the inner point across from them
+//! (`adjustBoxSplineTriBoundaryWeights`).
+
+use crate::loop_patch::BoxSpline;
+use crate::patch::bspline_basis;
+
+/// Weights for position, ∂s, ∂t, ∂ss, ∂st, ∂tt.
+pub(crate) type Weights<const N: usize> = [[f64; N]; 6];
+
+/// Bicubic B-spline weights of the 16 points (rows bottom to top) at `(s, t)`, with the
+/// boundary mask's phantom points folded in (bit 0: the bottom row is missing, 1: right
+/// column, 2: top row, 3: left column).
+pub(crate) fn bspline(s: f64, t: f64, boundary: u8) -> Weights<16> {
+    let (bs, ds, dss) = bspline_basis(s);
+    let (bt, dt, dtt) = bspline_basis(t);
+    let tensor =
+        |a: &[f64; 4], b: &[f64; 4]| -> [f64; 16] { std::array::from_fn(|k| a[k % 4] * b[k / 4]) };
+    let mut w = [
+        tensor(&bs, &bt),
+        tensor(&ds, &bt),
+        tensor(&bs, &dt),
+        tensor(&dss, &bt),
+        tensor(&ds, &dt),
+        tensor(&bs, &dtt),
+    ];
+    if boundary != 0 {
+        for row in &mut w {
+            fold_bspline_boundary(row, boundary);
+        }
+    }
+    w
+}
+
+/// Moves the weight of the missing rows and columns onto `2B − I`.
+fn fold_bspline_boundary(w: &mut [f64; 16], boundary: u8) {
+    // (missing, boundary, inner) index of point k along the side, for each side.
+    type Side = fn(usize) -> (usize, usize, usize);
+    let sides: [Side; 4] = [
+        |k| (k, k + 4, k + 8),
+        |k| (4 * k + 3, 4 * k + 2, 4 * k + 1),
+        |k| (k + 12, k + 8, k + 4),
+        |k| (4 * k, 4 * k + 1, 4 * k + 2),
+    ];
+    for (bit, side) in sides.iter().enumerate() {
+        if boundary & (1 << bit) == 0 {
+            continue;
+        }
+        for k in 0..4 {
+            let (m, b, i) = side(k);
+            let x = w[m];
+            w[b] += 2.0 * x;
+            w[i] -= x;
+            w[m] = 0.0;
+        }
+    }
+}
+
+/// The corner-patch order of [`BoxSpline`] (the corner `x0`, its six neighbours
+/// counter-clockwise from `x1`, three further neighbours of `x1`, two of `x2`) for each
+/// point of OpenSubdiv's 12-point layout (rows {0,1,2}, {3,4,5,6}, {7,8,9}, {10,11}; the
+/// triangle is 4, 5, 8).
+const BOX_SPLINE_ORDER: [usize; 12] = [5, 6, 7, 4, 0, 1, 8, 3, 2, 9, 11, 10];
+
+/// Quartic box-spline weights of the 12 points at `(s, t)` (barycentric `(1 − s − t, s, t)`),
+/// with OpenSubdiv's five-bit boundary mask folded in.
+pub(crate) fn box_spline(basis: &BoxSpline, s: f64, t: f64, boundary: u8) -> Weights<12> {
+    let derived = basis.weights(s, t);
+    let mut w = derived.map(|row| std::array::from_fn(|k| row[BOX_SPLINE_ORDER[k]]));
+    if boundary != 0 {
+        let (edges, vertices) = phantom_sides(boundary);
+        for row in &mut w {
+            fold_box_spline_boundary(row, edges, vertices);
+        }
+    }
+    w
+}
+
+/// The boundary edges and the lone boundary vertices a five-bit triangle mask asks the
+/// basis to extrapolate across: edges only (their vertices follow from them), vertices only,
+/// or one edge and the vertex opposite it.
+fn phantom_sides(mask: u8) -> (u8, u8) {
+    let lower = mask & 7;
+    match mask >> 3 {
+        1 => (0, lower),
+        // Edge i's opposite vertex is i + 2.
+        2 => (lower, ((lower & 1) << 2) | (lower >> 1)),
+        _ => (lower, 0),
+    }
+}
+
+/// One phantom point: `phantom = a + b − inner`.
+#[derive(Clone, Copy)]
+struct Phantom {
+    phantom: usize,
+    a: usize,
+    b: usize,
+    inner: usize,
+}
+
+const fn ph(phantom: usize, a: usize, b: usize, inner: usize) -> Phantom {
+    Phantom {
+        phantom,
+        a,
+        b,
+        inner,
+    }
+}
+
+/// Per boundary edge of the triangle (4, 5, 8): its three phantom points, the first and
+/// last in two forms, for when the neighbouring edge (previous, next) is a boundary too
+/// (the phantom then mirrors through the shared corner).
+struct EdgePhantoms {
+    first: (Phantom, Phantom),
+    middle: Phantom,
+    last: (Phantom, Phantom),
+    /// The edges before and after this one around the triangle.
+    prev: usize,
+    next: usize,
+}
+
+const EDGE_PHANTOMS: [EdgePhantoms; 3] = [
+    EdgePhantoms {
+        first: (ph(0, 4, 3, 7), ph(0, 4, 4, 8)),
+        middle: ph(1, 4, 5, 8),
+        last: (ph(2, 5, 6, 9), ph(2, 5, 5, 8)),
+        prev: 2,
+        next: 1,
+    },
+    EdgePhantoms {
+        first: (ph(6, 5, 2, 1), ph(6, 5, 5, 4)),
+        middle: ph(9, 5, 8, 4),
+        last: (ph(11, 8, 10, 7), ph(11, 8, 8, 4)),
+        prev: 0,
+        next: 2,
+    },
+    EdgePhantoms {
+        first: (ph(10, 8, 11, 9), ph(10, 8, 8, 5)),
+        middle: ph(7, 8, 4, 5),
+        last: (ph(3, 4, 0, 1), ph(3, 4, 4, 5)),
+        prev: 1,
+        next: 0,
+    },
+];
+
+/// The two phantom points beyond a boundary vertex whose edges in the triangle are interior.
+const VERTEX_PHANTOMS: [[Phantom; 2]; 3] = [
+    [ph(3, 4, 7, 8), ph(0, 4, 1, 5)],
+    [ph(2, 5, 1, 4), ph(6, 5, 9, 8)],
+    [ph(11, 8, 9, 5), ph(10, 8, 7, 4)],
+];
+
+fn fold(w: &mut [f64; 12], p: Phantom) {
+    let x = w[p.phantom];
+    w[p.a] += x;
+    w[p.b] += x;
+    w[p.inner] -= x;
+    w[p.phantom] = 0.0;
+}
+
+/// Moves the weight of the phantom points beyond boundary edges and vertices onto the
+/// points they are extrapolated from (edges first, each edge's points in order).
+fn fold_box_spline_boundary(w: &mut [f64; 12], edges: u8, vertices: u8) {
+    for (e, ep) in EDGE_PHANTOMS.iter().enumerate() {
+        if edges & (1 << e) == 0 {
+            continue;
+        }
+        let prev_boundary = edges & (1 << ep.prev) != 0;
+        let next_boundary = edges & (1 << ep.next) != 0;
+        fold(
+            w,
+            if prev_boundary {
+                ep.first.1
+            } else {
+                ep.first.0
+            },
+        );
+        fold(w, ep.middle);
+        fold(w, if next_boundary { ep.last.1 } else { ep.last.0 });
+    }
+    for (v, pair) in VERTEX_PHANTOMS.iter().enumerate() {
+        if vertices & (1 << v) != 0 {
+            fold(w, pair[0]);
+            fold(w, pair[1]);
+        }
+    }
+}
+
+/// Bilinear weights of a quad's corners (v0 v1 v2 v3) at `(s, t)`.
+pub(crate) fn bilinear(s: f64, t: f64) -> Weights<4> {
+    let (a, b) = (1.0 - s, 1.0 - t);
+    [
+        [a * b, s * b, s * t, a * t],
+        [-b, b, t, -t],
+        [-a, -s, s, a],
+        [0.0; 4],
+        [1.0, -1.0, 1.0, -1.0],
+        [0.0; 4],
+    ]
+}
+
+/// Linear weights of a triangle's corners at `(s, t)`.
+pub(crate) fn linear(s: f64, t: f64) -> Weights<3> {
+    [
+        [1.0 - s - t, s, t],
+        [-1.0, 1.0, 0.0],
+        [-1.0, 0.0, 1.0],
+        [0.0; 3],
+        [0.0; 3],
+        [0.0; 3],
+    ]
+}
+
+/// Cubic Bernstein polynomials at `t` and their first two derivatives.
+fn bernstein(t: f64) -> ([f64; 4], [f64; 4], [f64; 4]) {
+    let s = 1.0 - t;
+    (
+        [s * s * s, 3.0 * t * s * s, 3.0 * t * t * s, t * t * t],
+        [
+            -3.0 * s * s,
+            9.0 * t * t - 12.0 * t + 3.0,
+            -9.0 * t * t + 6.0 * t,
+            3.0 * t * t,
+        ],
+        [6.0 * s, 18.0 * t - 12.0, -18.0 * t + 6.0, 6.0 * t],
+    )
+}
+
+/// Where each of the 20 Gregory points sits in the 4 × 4 Bézier net (column, row), the
+/// interior pairs `Fp`, `Fm` sharing a place; per corner `P, Ep, Em, Fp, Fm`.
+const GREGORY_NET: [(usize, usize); 20] = [
+    (0, 0),
+    (1, 0),
+    (0, 1),
+    (1, 1),
+    (1, 1),
+    (3, 0),
+    (3, 1),
+    (2, 0),
+    (2, 1),
+    (2, 1),
+    (3, 3),
+    (2, 3),
+    (3, 2),
+    (2, 2),
+    (2, 2),
+    (0, 3),
+    (0, 2),
+    (1, 3),
+    (1, 2),
+    (1, 2),
+];
+
+/// Gregory patch weights of the 20 points at `(s, t)`: the Bézier net whose interior
+/// points blend each corner's `Fp` and `Fm` rationally (`Fp` towards the corner's `Ep`
+/// edge). Derivatives hold the blend constant, as OpenSubdiv's evaluation does (the
+/// Bézier net at `(s, t)` differentiated).
+pub(crate) fn gregory(s: f64, t: f64) -> Weights<20> {
+    let (bs, ds, dss) = bernstein(s);
+    let (bt, dt, dtt) = bernstein(t);
+    let recip = |x: f64| if x <= 0.0 { 1.0 } else { 1.0 / x };
+    // The Fp share of each corner's interior point; a corner's own sum is 0 exactly there.
+    let fp = [
+        s * recip(s + t),
+        t * recip((1.0 - s) + t),
+        (1.0 - s) * recip((1.0 - s) + (1.0 - t)),
+        (1.0 - t) * recip(s + (1.0 - t)),
+    ];
+    let mut w = [[0.0; 20]; 6];
+    for (k, &(col, row)) in GREGORY_NET.iter().enumerate() {
+        let blend = match k % 5 {
+            3 => fp[k / 5],
+            4 => 1.0 - fp[k / 5],
+            _ => 1.0,
+        };
+        w[0][k] = blend * bs[col] * bt[row];
+        w[1][k] = blend * ds[col] * bt[row];
+        w[2][k] = blend * bs[col] * dt[row];
+        w[3][k] = blend * dss[col] * bt[row];
+        w[4][k] = blend * ds[col] * dt[row];
+        w[5][k] = blend * bs[col] * dtt[row];
+    }
+    w
+}
+
+/// Widens `N` weights to the 20 slots every patch type fits in.
+fn widen<const N: usize>(w: Weights<N>) -> Weights<20> {
+    w.map(|row| std::array::from_fn(|k| if k < N { row[k] } else { 0.0 }))
+}
+
+/// The weights of a patch of type `kind` at `(s, t)` of its own domain, `boundary` the
+/// mask of a regular patch (0 for end caps).
+pub(crate) fn weights(kind: super::PatchType, s: f64, t: f64, boundary: u8) -> Weights<20> {
+    use super::PatchType as T;
+    match kind {
+        T::Regular => widen(bspline(s, t, boundary)),
+        T::Loop => {
+            let basis = crate::loop_patch::box_spline()
+                .expect("the box-spline basis derives on a fixed grid");
+            widen(box_spline(basis, s, t, boundary))
+        }
+        T::GregoryBasis => gregory(s, t),
+        T::Quads => widen(bilinear(s, t)),
+        T::Triangles => widen(linear(s, t)),
+        T::GregoryTriangle | T::Exact => unreachable!("{kind} patches are evaluated elsewhere"),
+    }
+}

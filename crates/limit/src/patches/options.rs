@@ -1,0 +1,107 @@
+//! What a patch table is built with: OpenSubdiv 3.5's `PatchTableFactory::Options`, and the
+//! exact end caps no other library has.
+
+use std::fmt;
+use std::str::FromStr;
+
+/// How the patches around an irregular feature that isolation leaves behind (an
+/// extraordinary vertex, an irregular sharp feature) are represented.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum EndCaps {
+    /// A bilinear quad (a linear triangle for Loop) through the four (three) limit points
+    /// of the corners (`ENDCAP_BILINEAR_BASIS`).
+    Bilinear,
+    /// A regular B-spline (box-spline for Loop) patch fitted to the irregular one
+    /// (`ENDCAP_BSPLINE_BASIS`).
+    BSpline,
+    /// A Gregory patch: 20 points for a quad, 18 for a triangle (`ENDCAP_GREGORY_BASIS`),
+    /// OpenSubdiv's default.
+    #[default]
+    #[serde(rename = "gregory")]
+    GregoryBasis,
+    /// The irregular patch evaluated exactly (Stam's eigenbasis, or local refinement next to
+    /// irregular sharp features), so the table is the limit surface everywhere.
+    Exact,
+}
+
+impl EndCaps {
+    /// Every kind, in the order the command line lists them.
+    pub const ALL: [EndCaps; 4] = [
+        EndCaps::GregoryBasis,
+        EndCaps::BSpline,
+        EndCaps::Bilinear,
+        EndCaps::Exact,
+    ];
+
+    /// The command-line name (`gregory`, `bspline`, `bilinear`, `exact`).
+    pub fn name(self) -> &'static str {
+        match self {
+            EndCaps::Bilinear => "bilinear",
+            EndCaps::BSpline => "bspline",
+            EndCaps::GregoryBasis => "gregory",
+            EndCaps::Exact => "exact",
+        }
+    }
+}
+
+impl fmt::Display for EndCaps {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for EndCaps {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        EndCaps::ALL
+            .into_iter()
+            .find(|e| e.name() == s)
+            .ok_or_else(|| format!("unknown end caps '{s}' (gregory, bspline, bilinear, exact)"))
+    }
+}
+
+/// The deepest isolation level (OpenSubdiv's patch parameters hold 4 bits of depth and 10 of
+/// u and v).
+pub const MAX_ISOLATION: u8 = 10;
+
+/// Options of a patch table, with OpenSubdiv 3.5's defaults
+/// (`Far::PatchTableFactory::Options`): isolation 10, Gregory basis end caps, legacy sharp
+/// corner patches on, single-crease and infinitely sharp patches off.
+///
+/// ```
+/// use subd_limit::patches::{EndCaps, PatchOptions};
+/// let o = PatchOptions::default();
+/// assert_eq!((o.isolation, o.end_caps), (10, EndCaps::GregoryBasis));
+/// assert!(o.legacy_sharp_corners && !o.single_crease && !o.inf_sharp);
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize)]
+pub struct PatchOptions {
+    /// Levels of feature-adaptive refinement around irregular features, 1 to
+    /// [`MAX_ISOLATION`].
+    pub isolation: u8,
+    /// How the irregular patches left at the isolation level are represented.
+    pub end_caps: EndCaps,
+    /// Regular patches along a single semi-sharp crease stop isolating it
+    /// (`useSingleCreasePatch`): the crease is evaluated with the patch's sharpness.
+    pub single_crease: bool,
+    /// Infinitely sharp features of regular topology become regular patches with boundary
+    /// masks (`useInfSharpPatch`) instead of being isolated to the last level.
+    pub inf_sharp: bool,
+    /// A smooth corner (a boundary vertex with one face under edge-only interpolation)
+    /// gets a sharp-corner regular patch, as OpenSubdiv did before 3.5
+    /// (`generateLegacySharpCornerPatches`).
+    pub legacy_sharp_corners: bool,
+}
+
+impl Default for PatchOptions {
+    fn default() -> Self {
+        PatchOptions {
+            isolation: MAX_ISOLATION,
+            end_caps: EndCaps::GregoryBasis,
+            single_crease: false,
+            inf_sharp: false,
+            legacy_sharp_corners: true,
+        }
+    }
+}

@@ -1,0 +1,606 @@
+//! [`PatchTable`]: the patches of a feature-adaptive refinement as flat arrays.
+
+use std::collections::BTreeMap;
+
+use glam::DVec3;
+use subd_mesh::Topology;
+use subd_schemes::{Options, Scheme, StencilTable};
+
+use super::assembly::Assembly;
+use super::basis;
+use super::classify::Classifier;
+use super::features::{FeatureMask, Regularity, VTag, single_crease_edge};
+use super::levels::PatchLevel;
+use super::map::PatchMap;
+use super::{EndCaps, MAX_ISOLATION, PatchOptions, PatchParam, PatchType};
+use crate::LimitError;
+use crate::eval::{FaceParam, LimitEvaluator, PatchPoints};
+use crate::patch::SurfacePoint;
+
+/// The patches of one type, in level order and face order within a level.
+#[derive(Debug, Clone)]
+pub struct PatchArray {
+    kind: PatchType,
+    params: Vec<PatchParam>,
+    sharpness: Vec<f32>,
+    control_points: Vec<u32>,
+}
+
+impl PatchArray {
+    pub(crate) fn new_of(kind: PatchType) -> PatchArray {
+        PatchArray {
+            kind,
+            params: Vec::new(),
+            sharpness: Vec::new(),
+            control_points: Vec::new(),
+        }
+    }
+
+    /// Appends a patch.
+    pub(crate) fn push(&mut self, param: PatchParam, sharpness: f32, points: &[u32]) {
+        self.params.push(param);
+        self.sharpness.push(sharpness);
+        self.control_points.extend_from_slice(points);
+    }
+
+    /// The patches' type.
+    pub fn kind(&self) -> PatchType {
+        self.kind
+    }
+
+    /// Number of patches.
+    pub fn len(&self) -> usize {
+        self.params.len()
+    }
+
+    /// Whether the array holds no patch.
+    pub fn is_empty(&self) -> bool {
+        self.params.is_empty()
+    }
+
+    /// One [`PatchParam`] per patch.
+    pub fn params(&self) -> &[PatchParam] {
+        &self.params
+    }
+
+    /// Per patch, the sharpness of its single crease (0 for every other patch; only with
+    /// [`PatchOptions::single_crease`]).
+    pub fn sharpness(&self) -> &[f32] {
+        &self.sharpness
+    }
+
+    /// The control points, [`PatchType::num_control_points`] per patch, as indices into the
+    /// refined vertices of all levels followed by the local points
+    /// ([`PatchTable::points`]); empty for exact patches.
+    pub fn control_points(&self) -> &[u32] {
+        &self.control_points
+    }
+
+    /// The control points of patch `i`.
+    pub fn patch_points(&self, i: usize) -> &[u32] {
+        let n = self.kind.num_control_points().unwrap_or(0);
+        &self.control_points[n * i..n * (i + 1)]
+    }
+}
+
+/// Counts of a table's patches, as `subd patches --json` prints them.
+#[derive(Debug, Clone, Default, PartialEq, Eq, serde::Serialize)]
+pub struct PatchCensus {
+    /// Every patch.
+    pub patches: usize,
+    /// Patches by type.
+    pub by_type: BTreeMap<PatchType, usize>,
+    /// Patches by depth.
+    pub by_depth: BTreeMap<u8, usize>,
+    /// Regular patches by boundary mask.
+    pub regular_by_boundary_mask: BTreeMap<u8, usize>,
+    /// Local points (end-cap points computed from the refined vertices).
+    pub local_points: usize,
+}
+
+/// One patch array as a file stores it ([`PatchTableLayout`]).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct PatchArrayLayout<'a> {
+    /// OpenSubdiv's name of the patch type.
+    #[serde(rename = "type")]
+    pub kind: &'static str,
+    /// Control points per patch (0 for exact patches).
+    pub control_points_per_patch: usize,
+    /// Number of patches.
+    pub patches: usize,
+    /// The control points, patch after patch: indices into `points`.
+    pub control_points: &'a [u32],
+    /// Per patch, the two words of its [`PatchParam`] (OpenSubdiv's bit layout).
+    pub params: Vec<[u32; 2]>,
+    /// Per patch, its single-crease sharpness (0 when none).
+    pub sharpness: &'a [f32],
+}
+
+/// A whole table as flat arrays, the layout `subd patches OUT.json` writes: the options,
+/// the vertex count of each refined level, the arrays, the local points' stencils (CSR
+/// over the refined vertices of all levels) and the points themselves (refined vertices of
+/// all levels, then local points), which the control points index.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct PatchTableLayout<'a> {
+    /// The scheme's name.
+    pub scheme: &'static str,
+    /// The options.
+    pub options: PatchOptions,
+    /// Vertices of each refined level (level 0: the base vertices).
+    pub level_vertex_counts: Vec<usize>,
+    /// Number of local points.
+    pub local_points: usize,
+    /// The patch arrays.
+    pub arrays: Vec<PatchArrayLayout<'a>>,
+    /// Row offsets of the local points' stencils (one more than local points).
+    pub local_point_offsets: &'a [u32],
+    /// Column (refined vertex) of each stencil entry.
+    pub local_point_indices: &'a [u32],
+    /// Weight of each stencil entry.
+    pub local_point_weights: &'a [f64],
+    /// Refined vertices of all levels, then local points.
+    pub points: Vec<[f64; 3]>,
+}
+
+/// The exact evaluator behind [`EndCaps::Exact`], with its points.
+#[derive(Debug)]
+struct ExactCaps {
+    evaluator: LimitEvaluator,
+    points: PatchPoints,
+}
+
+/// A feature-adaptive patch table of a Catmull-Clark or Loop mesh (OpenSubdiv's
+/// `Far::PatchTable`), with the points of one set of base positions
+/// ([`Self::update`] moves them).
+#[derive(Debug)]
+pub struct PatchTable {
+    scheme: Scheme,
+    options: PatchOptions,
+    levels: Vec<PatchLevel>,
+    arrays: Vec<PatchArray>,
+    /// First index of each level's vertices among the refined vertices.
+    level_offsets: Vec<u32>,
+    /// Local points as weights of the refined vertices.
+    local: StencilTable,
+    /// Refined vertices of all levels, then the local points.
+    points: Vec<DVec3>,
+    /// First root (ptex) index of each base face.
+    ptex: Vec<u32>,
+    /// The array and index of each patch, in global order.
+    handles: Vec<(u32, u32)>,
+    map: PatchMap,
+    exact: Option<ExactCaps>,
+}
+
+impl PatchTable {
+    /// Refines `base` adaptively with `scheme` (Catmull-Clark or Loop) and the rules
+    /// `rules`, builds its patches with `options`, and computes their points from the base
+    /// positions `positions`.
+    ///
+    /// # Errors
+    /// [`LimitError::Scheme`] for another scheme, [`LimitError::Param`] for an isolation level
+    /// outside `1..=10` or a position count that is not the vertex count, and the
+    /// refinement's errors (a Loop mesh that is not all triangles).
+    pub fn new(
+        base: &Topology,
+        positions: &[DVec3],
+        scheme: &Scheme,
+        rules: &Options,
+        options: &PatchOptions,
+    ) -> Result<PatchTable, LimitError> {
+        let reg = regularity(scheme)?;
+        if !(1..=MAX_ISOLATION).contains(&options.isolation) {
+            return Err(LimitError::Param(format!(
+                "isolation level {} is outside 1..={MAX_ISOLATION}",
+                options.isolation
+            )));
+        }
+        check_positions(base, positions)?;
+        let levels = refine_adaptive(base, scheme, rules, options, reg)?;
+        let ptex = ptex_offsets(base, reg.face_size);
+        let irregular_faces = (0..base.num_faces()).any(|f| base.face_size(f) != reg.face_size);
+        let found = Classifier {
+            levels: &levels,
+            options,
+            reg,
+            ptex: &ptex,
+            irregular_faces,
+            mask: feature_mask(options, reg),
+        }
+        .patches();
+        let level_offsets = level_offsets(&levels);
+        let caps = end_cap_type(options.end_caps, reg);
+        let (arrays, handles, local) =
+            Assembly::new(&levels, &level_offsets, options, reg).run(&found, caps)?;
+        let num_roots = ptex_count(base, reg.face_size);
+        let map = PatchMap::new(
+            handles
+                .iter()
+                .map(|&(a, i)| arrays[a as usize].params[i as usize]),
+            num_roots,
+            reg.face_size == 3,
+        );
+        let exact = if options.end_caps == EndCaps::Exact {
+            let evaluator = LimitEvaluator::new(base, scheme, rules)?;
+            let points = evaluator.prepare(positions);
+            Some(ExactCaps { evaluator, points })
+        } else {
+            None
+        };
+        let mut table = PatchTable {
+            scheme: scheme.clone(),
+            options: *options,
+            levels,
+            arrays,
+            level_offsets,
+            local,
+            points: Vec::new(),
+            ptex,
+            handles,
+            map,
+            exact,
+        };
+        table.points = table.compute_points(positions);
+        Ok(table)
+    }
+
+    /// Recomputes the refined and local points (and the exact end caps' points) for moved
+    /// base vertices, keeping the topology: animation refines once, updates every frame.
+    ///
+    /// # Errors
+    /// [`LimitError::Param`] when `positions` does not have one point per base vertex.
+    pub fn update(&mut self, positions: &[DVec3]) -> Result<(), LimitError> {
+        check_positions(&self.levels[0].topology, positions)?;
+        self.points = self.compute_points(positions);
+        if let Some(exact) = &mut self.exact {
+            exact.points = exact.evaluator.prepare(positions);
+        }
+        Ok(())
+    }
+
+    /// The refined vertices of every level, then the local points.
+    fn compute_points(&self, positions: &[DVec3]) -> Vec<DVec3> {
+        let mut points = positions.to_vec();
+        for (l, level) in self.levels.iter().enumerate().skip(1) {
+            let rows = level.rows.as_ref().expect("a refined level has rows");
+            let above = &points[self.level_offsets[l - 1] as usize..self.level_offsets[l] as usize];
+            let next = rows.apply_points(above);
+            points.extend(next);
+        }
+        let local = self.local.apply_points(&points);
+        points.extend(local);
+        points
+    }
+
+    /// The scheme.
+    pub fn scheme(&self) -> &Scheme {
+        &self.scheme
+    }
+
+    /// The options the table was built with.
+    pub fn options(&self) -> &PatchOptions {
+        &self.options
+    }
+
+    /// The patch arrays: the regular type first, then the end caps' (B-spline end caps
+    /// share the regular array); empty arrays left out.
+    pub fn arrays(&self) -> &[PatchArray] {
+        &self.arrays
+    }
+
+    /// Number of refinement levels (the deepest patch's depth).
+    pub fn max_depth(&self) -> usize {
+        self.levels.len() - 1
+    }
+
+    /// Vertices of each refined level (level 0 = the base vertices); the control points of
+    /// the patches index them concatenated, then the local points.
+    pub fn level_vertex_counts(&self) -> Vec<usize> {
+        self.levels
+            .iter()
+            .map(|l| l.topology.num_vertices())
+            .collect()
+    }
+
+    /// The refined vertices of all levels, then the local points: what the control points
+    /// index.
+    pub fn points(&self) -> &[DVec3] {
+        &self.points
+    }
+
+    /// The local points as weights of the refined vertices of all levels (OpenSubdiv's
+    /// local-point stencil table).
+    pub fn local_point_stencils(&self) -> &StencilTable {
+        &self.local
+    }
+
+    /// The patch map: (root face, u, v) to the patch (global index, arrays in order).
+    pub fn patch_map(&self) -> &PatchMap {
+        &self.map
+    }
+
+    /// The patch covering `at` (its array and index in the array).
+    ///
+    /// # Errors
+    /// [`LimitError::Param`] for a face, sub-face or parameter out of range,
+    /// [`LimitError::Unsupported`] where the face has no surface (a hole).
+    pub fn find(&self, at: &FaceParam) -> Result<(usize, usize), LimitError> {
+        let base = &self.levels[0].topology;
+        crate::eval::check_param(base, &self.scheme, at)?;
+        let root = self.ptex[at.face] as usize + at.sub;
+        let p = self
+            .map
+            .find(root, at.u, at.v)
+            .ok_or(LimitError::Unsupported {
+                face: at.face,
+                reason: "a hole: no surface there",
+            })?;
+        let (a, i) = self.handles[p];
+        Ok((a as usize, i as usize))
+    }
+
+    /// The surface at `at`: position and first and second derivatives with respect to the
+    /// face's (sub-face's) parameters.
+    ///
+    /// # Errors
+    /// As [`Self::find`].
+    pub fn evaluate(&self, at: FaceParam) -> Result<SurfacePoint, LimitError> {
+        let (a, i) = self.find(&at)?;
+        let array = &self.arrays[a];
+        if array.kind == PatchType::Exact {
+            let exact = self
+                .exact
+                .as_ref()
+                .expect("exact end caps have their evaluator");
+            return exact.evaluator.evaluate(&exact.points, at);
+        }
+        let param = array.params[i];
+        let cps = array.patch_points(i);
+        Ok(evaluate_patch(
+            array.kind,
+            param,
+            cps,
+            &self.points,
+            at.u,
+            at.v,
+        ))
+    }
+
+    /// The table as flat arrays ([`PatchTableLayout`]).
+    pub fn layout(&self) -> PatchTableLayout<'_> {
+        PatchTableLayout {
+            scheme: self.scheme.name(),
+            options: self.options,
+            level_vertex_counts: self.level_vertex_counts(),
+            local_points: self.local.num_rows(),
+            arrays: self
+                .arrays
+                .iter()
+                .map(|a| PatchArrayLayout {
+                    kind: a.kind.name(),
+                    control_points_per_patch: a.kind.num_control_points().unwrap_or(0),
+                    patches: a.len(),
+                    control_points: &a.control_points,
+                    params: a.params.iter().map(|p| [p.field0, p.field1]).collect(),
+                    sharpness: &a.sharpness,
+                })
+                .collect(),
+            local_point_offsets: self.local.offsets(),
+            local_point_indices: self.local.indices(),
+            local_point_weights: self.local.weights(),
+            points: self.points.iter().map(|p| p.to_array()).collect(),
+        }
+    }
+
+    /// Counts of the patches by type, depth and boundary mask.
+    pub fn census(&self) -> PatchCensus {
+        let mut c = PatchCensus {
+            local_points: self.local.num_rows(),
+            ..Default::default()
+        };
+        let regular = regular_type_of(&self.scheme);
+        for a in &self.arrays {
+            for p in &a.params {
+                let place = p.place();
+                c.patches += 1;
+                let kind = if place.regular { regular } else { a.kind };
+                *c.by_type.entry(kind).or_default() += 1;
+                *c.by_depth.entry(place.depth).or_default() += 1;
+                if place.regular {
+                    *c.regular_by_boundary_mask
+                        .entry(place.boundary)
+                        .or_default() += 1;
+                }
+            }
+        }
+        c
+    }
+}
+
+/// Evaluates one patch of type `kind` at `(u, v)` of its root face: the basis in the
+/// patch's own domain, derivatives taken back to the root's parameters.
+fn evaluate_patch(
+    kind: PatchType,
+    param: PatchParam,
+    cps: &[u32],
+    points: &[DVec3],
+    u: f64,
+    v: f64,
+) -> SurfacePoint {
+    let triangle = matches!(
+        kind,
+        PatchType::Loop | PatchType::Triangles | PatchType::GregoryTriangle
+    );
+    let (s, t) = if triangle {
+        param.normalize_triangle(u, v)
+    } else {
+        param.normalize(u, v)
+    };
+    let place = param.place();
+    let mut d1 = 1.0 / param.fraction();
+    if triangle && param.is_triangle_rotated() {
+        d1 = -d1;
+    }
+    let combine = |w: &[[f64; 20]; 6], n: usize| {
+        let mut acc = [DVec3::ZERO; 6];
+        for (k, &cp) in cps.iter().enumerate().take(n) {
+            let p = points[cp as usize];
+            for (a, row) in acc.iter_mut().zip(w) {
+                *a += row[k] * p;
+            }
+        }
+        acc
+    };
+    let w = basis::weights(kind, s, t, if place.regular { place.boundary } else { 0 });
+    let acc = combine(&w, cps.len());
+    let d2 = d1 * d1;
+    SurfacePoint {
+        position: acc[0],
+        du: acc[1] * d1,
+        dv: acc[2] * d1,
+        duu: acc[3] * d2,
+        duv: acc[4] * d2,
+        dvv: acc[5] * d2,
+    }
+}
+
+fn check_positions(base: &Topology, positions: &[DVec3]) -> Result<(), LimitError> {
+    if positions.len() == base.num_vertices() {
+        Ok(())
+    } else {
+        Err(LimitError::Param(format!(
+            "{} positions given for {} vertices",
+            positions.len(),
+            base.num_vertices()
+        )))
+    }
+}
+
+fn regularity(scheme: &Scheme) -> Result<Regularity, LimitError> {
+    match scheme {
+        Scheme::CatmullClark => Ok(Regularity {
+            valence: 4,
+            face_size: 4,
+        }),
+        Scheme::Loop => Ok(Regularity {
+            valence: 6,
+            face_size: 3,
+        }),
+        s => Err(LimitError::Scheme {
+            scheme: s.to_string(),
+            what: "patch tables exist for catmull-clark and loop only",
+        }),
+    }
+}
+
+/// First index of each level's vertices in the concatenation of all levels.
+fn level_offsets(levels: &[PatchLevel]) -> Vec<u32> {
+    let mut offsets = Vec::with_capacity(levels.len() + 1);
+    let mut next = 0u32;
+    for l in levels {
+        offsets.push(next);
+        next += l.topology.num_vertices() as u32;
+    }
+    offsets.push(next);
+    offsets
+}
+
+/// Number of root (ptex) faces.
+fn ptex_count(base: &Topology, regular_size: usize) -> usize {
+    (0..base.num_faces())
+        .map(|f| match base.face_size(f) {
+            n if n == regular_size => 1,
+            n => n,
+        })
+        .sum()
+}
+
+fn regular_type_of(scheme: &Scheme) -> PatchType {
+    if *scheme == Scheme::Loop {
+        PatchType::Loop
+    } else {
+        PatchType::Regular
+    }
+}
+
+fn regular_type(reg: Regularity) -> PatchType {
+    if reg.face_size == 3 {
+        PatchType::Loop
+    } else {
+        PatchType::Regular
+    }
+}
+
+/// The patch type of the end caps `caps` for the scheme (`patchTypeFromBasisArray`).
+fn end_cap_type(caps: EndCaps, reg: Regularity) -> PatchType {
+    let tri = reg.face_size == 3;
+    match caps {
+        EndCaps::Bilinear if tri => PatchType::Triangles,
+        EndCaps::Bilinear => PatchType::Quads,
+        EndCaps::BSpline => regular_type(reg),
+        EndCaps::GregoryBasis if tri => PatchType::GregoryTriangle,
+        EndCaps::GregoryBasis => PatchType::GregoryBasis,
+        EndCaps::Exact => PatchType::Exact,
+    }
+}
+
+/// The first root (ptex) index of every base face: a face of the regular size has one, any
+/// other face one per corner (its sub-faces).
+fn ptex_offsets(base: &Topology, regular_size: usize) -> Vec<u32> {
+    let mut next = 0u32;
+    (0..base.num_faces())
+        .map(|f| {
+            let first = next;
+            let n = base.face_size(f);
+            next += if n == regular_size { 1 } else { n as u32 };
+            first
+        })
+        .collect()
+}
+
+/// The sparse levels: each level's faces with features selected and refined, until the
+/// isolation level or until nothing is selected (`RefineAdaptive`).
+/// The features isolated with `options` (single-crease patches are Catmull-Clark's only).
+fn feature_mask(options: &PatchOptions, reg: Regularity) -> FeatureMask {
+    FeatureMask::new(
+        options.single_crease && reg.face_size == 4,
+        options.inf_sharp,
+    )
+}
+
+fn refine_adaptive(
+    base: &Topology,
+    scheme: &Scheme,
+    rules: &Options,
+    options: &PatchOptions,
+    reg: Regularity,
+) -> Result<Vec<PatchLevel>, LimitError> {
+    let mask = feature_mask(options, reg);
+    let mut levels = vec![PatchLevel::base(base, scheme, rules, reg)?];
+    for _ in 0..options.isolation {
+        let level = levels.last_mut().expect("the base level");
+        let t = &level.topology;
+        let mut any = false;
+        for f in 0..t.num_faces() {
+            if t.is_hole(f) {
+                continue;
+            }
+            let corners: Vec<VTag> = t
+                .face_vertices(f)
+                .iter()
+                .map(|&v| level.tags[v as usize])
+                .collect();
+            let select = mask.select(&corners, reg.face_size, level.depth, || {
+                single_crease_edge(t, f, &corners).is_some()
+            });
+            level.selected[f] = select;
+            any |= select;
+        }
+        if !any {
+            break;
+        }
+        let next = level.refine(scheme, rules, reg)?;
+        levels.push(next);
+    }
+    Ok(levels)
+}

@@ -1,0 +1,483 @@
+//! Patch tables: the patch map covers every face's domain exactly once, neighbouring
+//! patches meet along their edges (across faces and across depth changes), exact end caps
+//! are the exact limit, and `update` equals a rebuild.
+
+use proptest::prelude::*;
+use subd_limit::eval::{FaceParam, LimitEvaluator};
+use subd_limit::patches::{EndCaps, PatchOptions, PatchTable, PatchType};
+use subd_mesh::{DVec3, Topology, TopologyBuilder};
+use subd_schemes::{Options, Scheme};
+
+/// A mesh for the tests: topology, positions, scheme.
+struct Case {
+    topology: Topology,
+    positions: Vec<DVec3>,
+    scheme: Scheme,
+}
+
+fn build(sizes: &[u32], faces: &[u32], positions: Vec<DVec3>, scheme: Scheme) -> Case {
+    let topology = TopologyBuilder::new(positions.len())
+        .build(sizes, faces)
+        .unwrap();
+    Case {
+        topology,
+        positions,
+        scheme,
+    }
+}
+
+/// A cube with a pentagon-free twist: valence-3 corners everywhere.
+fn cube() -> Case {
+    let faces = [
+        0, 1, 3, 2, 2, 3, 5, 4, 4, 5, 7, 6, 6, 7, 1, 0, 1, 7, 5, 3, 6, 0, 2, 4,
+    ];
+    let p = (0..8)
+        .map(|i| {
+            DVec3::new(
+                (i & 1) as f64,
+                ((i >> 1) & 1) as f64,
+                ((i >> 2) & 1) as f64 * 1.3,
+            )
+        })
+        .collect();
+    build(&[4; 6], &faces, p, Scheme::CatmullClark)
+}
+
+/// A 4 × 4 grid of quads with an open boundary, one interior vertex raised, one crease.
+fn open_grid() -> Case {
+    let mut faces = Vec::new();
+    for y in 0..4u32 {
+        for x in 0..4u32 {
+            let v = x + 5 * y;
+            faces.extend([v, v + 1, v + 6, v + 5]);
+        }
+    }
+    let p = (0..25)
+        .map(|v| {
+            let (x, y) = ((v % 5) as f64, (v / 5) as f64);
+            DVec3::new(x, y, if v == 12 { 1.0 } else { 0.1 * x * y })
+        })
+        .collect();
+    let mut c = build(&[4; 16], &faces, p, Scheme::CatmullClark);
+    c.topology.set_crease(6, 7, 2.5).unwrap();
+    c.topology.set_crease(7, 8, 2.5).unwrap();
+    c
+}
+
+/// A pentagon surrounded by quads (a non-quad base face), closed into a cap.
+fn pentagon() -> Case {
+    // Pentagon 0..4, outer ring 5..9, quads between; the outer ring closed by a second
+    // pentagon.
+    let mut faces = vec![0, 1, 2, 3, 4];
+    let mut sizes = vec![5];
+    for i in 0..5u32 {
+        let j = (i + 1) % 5;
+        faces.extend([i, i + 5, j + 5, j]);
+        sizes.push(4);
+    }
+    faces.extend([9, 8, 7, 6, 5]);
+    sizes.push(5);
+    let p = (0..10)
+        .map(|v| {
+            let a = (v % 5) as f64 * std::f64::consts::TAU / 5.0;
+            let r = if v < 5 { 1.0 } else { 1.4 };
+            DVec3::new(r * a.cos(), r * a.sin(), if v < 5 { 0.5 } else { -0.5 })
+        })
+        .collect();
+    build(&sizes, &faces, p, Scheme::CatmullClark)
+}
+
+/// An octahedron with one vertex pulled (Loop, valence 4 everywhere).
+fn octahedron() -> Case {
+    let fv = [
+        0, 1, 2, 0, 2, 3, 0, 3, 4, 0, 4, 1, 5, 2, 1, 5, 3, 2, 5, 4, 3, 5, 1, 4,
+    ];
+    let p = vec![
+        DVec3::new(0.0, 0.0, 1.2),
+        DVec3::X,
+        DVec3::Y,
+        -DVec3::X,
+        -DVec3::Y,
+        -DVec3::Z,
+    ];
+    build(&[3; 8], &fv, p, Scheme::Loop)
+}
+
+/// A triangle fan with a boundary (Loop): an open hexagon missing one triangle.
+fn open_fan() -> Case {
+    let fv = [0, 1, 2, 0, 2, 3, 0, 3, 4, 0, 4, 5, 0, 5, 6];
+    let p = (0..7)
+        .map(|v| {
+            if v == 0 {
+                DVec3::new(0.0, 0.0, 0.4)
+            } else {
+                let a = (v - 1) as f64 * std::f64::consts::TAU / 6.0;
+                DVec3::new(a.cos(), a.sin(), 0.0)
+            }
+        })
+        .collect();
+    build(&[3; 5], &fv, p, Scheme::Loop)
+}
+
+fn cases() -> Vec<Case> {
+    vec![cube(), open_grid(), pentagon(), octahedron(), open_fan()]
+}
+
+/// The root faces of a base face: one, or one per corner of a Catmull-Clark non-quad.
+fn subs(c: &Case, f: usize) -> usize {
+    let n = c.topology.face_size(f);
+    if c.scheme == Scheme::Loop || n == 4 {
+        1
+    } else {
+        n
+    }
+}
+
+/// The patch map covers each root face exactly once: every sample lies in the domain of the
+/// patch found for it, and the patches of a root face add up to its area.
+fn check_coverage(c: &Case, table: &PatchTable) {
+    let triangles = c.scheme == Scheme::Loop;
+    let mut area = vec![0.0f64; 0];
+    for a in table.arrays() {
+        for p in a.params() {
+            let place = p.place();
+            let root = place.face as usize;
+            if area.len() <= root {
+                area.resize(root + 1, 0.0);
+            }
+            let side = p.fraction();
+            area[root] += if triangles {
+                side * side / 2.0
+            } else {
+                side * side
+            };
+        }
+    }
+    let mut root = 0;
+    for f in 0..c.topology.num_faces() {
+        for sub in 0..subs(c, f) {
+            let want = if triangles { 0.5 } else { 1.0 };
+            assert!(
+                (area[root] - want).abs() < 1e-12,
+                "root {root}: patches cover {}",
+                area[root]
+            );
+            for i in 0..=8 {
+                for j in 0..=8 {
+                    let (u, v) = (i as f64 / 8.0, j as f64 / 8.0);
+                    if triangles && u + v > 1.0 {
+                        continue;
+                    }
+                    let at = FaceParam { face: f, sub, u, v };
+                    let (a, k) = table.find(&at).unwrap();
+                    let p = table.arrays()[a].params()[k];
+                    let (s, t) = if triangles {
+                        p.normalize_triangle(u, v)
+                    } else {
+                        p.normalize(u, v)
+                    };
+                    let inside = if triangles {
+                        s >= -1e-12 && t >= -1e-12 && s + t <= 1.0 + 1e-12
+                    } else {
+                        (-1e-12..=1.0 + 1e-12).contains(&s) && (-1e-12..=1.0 + 1e-12).contains(&t)
+                    };
+                    assert!(
+                        inside,
+                        "({u}, {v}) of root {root} outside its patch ({s}, {t})"
+                    );
+                }
+            }
+            root += 1;
+        }
+    }
+}
+
+/// The parameters of the point at `t` along edge `e` (corner `e` to corner `e + 1`) of base
+/// face `f`: the face (or sub-face) and its (u, v).
+fn on_edge(c: &Case, f: usize, e: usize, t: f64) -> FaceParam {
+    let n = c.topology.face_size(f);
+    if c.scheme == Scheme::Loop {
+        let corners = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)];
+        let (a, b) = (corners[e], corners[(e + 1) % 3]);
+        return FaceParam {
+            face: f,
+            sub: 0,
+            u: a.0 + t * (b.0 - a.0),
+            v: a.1 + t * (b.1 - a.1),
+        };
+    }
+    if n == 4 {
+        let corners = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)];
+        let (a, b) = (corners[e], corners[(e + 1) % 4]);
+        return FaceParam {
+            face: f,
+            sub: 0,
+            u: a.0 + t * (b.0 - a.0),
+            v: a.1 + t * (b.1 - a.1),
+        };
+    }
+    // Sub-face e runs along the first half of edge e as its u axis; sub-face e + 1 has the
+    // second half as its v axis, from the midpoint (v = 1) to its corner (v = 0).
+    if t <= 0.5 {
+        FaceParam {
+            face: f,
+            sub: e,
+            u: 2.0 * t,
+            v: 0.0,
+        }
+    } else {
+        FaceParam {
+            face: f,
+            sub: (e + 1) % n,
+            u: 0.0,
+            v: 2.0 * (1.0 - t),
+        }
+    }
+}
+
+/// Neighbouring base faces give the same point along their shared edges.
+fn check_edges_agree(c: &Case, table: &PatchTable, tol: f64) {
+    let t = &c.topology;
+    for e in 0..t.num_edges() {
+        let faces = t.edge_faces(e);
+        if faces.len() != 2 {
+            continue;
+        }
+        let [a, b] = t.edge_vertices(e);
+        let side = |f: usize| {
+            let fv = t.face_vertices(f);
+            let i = fv.iter().position(|&x| x == a).unwrap();
+            let forward = fv[(i + 1) % fv.len()] == b;
+            (
+                if forward {
+                    i
+                } else {
+                    (i + fv.len() - 1) % fv.len()
+                },
+                forward,
+            )
+        };
+        let (f, g) = (faces[0] as usize, faces[1] as usize);
+        let ((ef, ff), (eg, fg)) = (side(f), side(g));
+        for k in 1..8 {
+            let s = k as f64 / 8.0 + 0.013;
+            let pf = table
+                .evaluate(on_edge(c, f, ef, if ff { s } else { 1.0 - s }))
+                .unwrap()
+                .position;
+            let pg = table
+                .evaluate(on_edge(c, g, eg, if fg { s } else { 1.0 - s }))
+                .unwrap()
+                .position;
+            assert!((pf - pg).length() < tol, "edge {e} at {s}: {pf} vs {pg}");
+        }
+    }
+}
+
+/// Inside each root face, points on the boundaries between patches (including where a
+/// patch meets deeper ones) evaluate the same from both sides.
+fn check_inner_edges_agree(c: &Case, table: &PatchTable, tol: f64) {
+    let triangles = c.scheme == Scheme::Loop;
+    for f in 0..c.topology.num_faces() {
+        for sub in 0..subs(c, f) {
+            for i in 1..16 {
+                let x = i as f64 / 16.0;
+                for j in 0..20 {
+                    let y = (j as f64 + 0.37) / 20.0;
+                    let (u, v) = (x, y * if triangles { 1.0 - x } else { 1.0 });
+                    let eps = 1e-9;
+                    let lo = table
+                        .evaluate(FaceParam {
+                            face: f,
+                            sub,
+                            u: u - eps,
+                            v,
+                        })
+                        .unwrap();
+                    let hi = table
+                        .evaluate(FaceParam {
+                            face: f,
+                            sub,
+                            u: u + eps,
+                            v,
+                        })
+                        .unwrap();
+                    // Allow the tiny step's own change along the surface.
+                    let slack = 4.0 * eps * (lo.du.length() + hi.du.length());
+                    assert!(
+                        (lo.position - hi.position).length() < tol + slack,
+                        "face {f}.{sub} at u = {u}, v = {v}: {} apart",
+                        (lo.position - hi.position).length()
+                    );
+                }
+            }
+        }
+    }
+}
+
+fn options(isolation: u8, end_caps: EndCaps, inf_sharp: bool) -> PatchOptions {
+    PatchOptions {
+        isolation,
+        end_caps,
+        inf_sharp,
+        single_crease: false,
+        legacy_sharp_corners: false,
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    #[test]
+    fn the_patch_map_covers_every_face_once(case in 0usize..5, isolation in 1u8..5, inf_sharp: bool, caps in 0usize..3) {
+        let c = &cases()[case];
+        let caps = [EndCaps::GregoryBasis, EndCaps::Bilinear, EndCaps::Exact][caps];
+        let caps = if c.scheme == Scheme::Loop && caps == EndCaps::GregoryBasis { EndCaps::Bilinear } else { caps };
+        let table = PatchTable::new(&c.topology, &c.positions, &c.scheme, &Options::default(), &options(isolation, caps, inf_sharp)).unwrap();
+        check_coverage(c, &table);
+    }
+
+    #[test]
+    fn neighbouring_patches_meet(case in 0usize..5, isolation in 1u8..5, inf_sharp: bool) {
+        let c = &cases()[case];
+        // Gregory end caps share their boundary points with their neighbours; exact end
+        // caps are the limit itself. Bilinear caps are not continuous with the B-splines.
+        let caps = if c.scheme == Scheme::Loop { EndCaps::Exact } else { EndCaps::GregoryBasis };
+        let table = PatchTable::new(&c.topology, &c.positions, &c.scheme, &Options::default(), &options(isolation, caps, inf_sharp)).unwrap();
+        check_edges_agree(c, &table, 1e-12);
+        check_inner_edges_agree(c, &table, 1e-12);
+    }
+}
+
+#[test]
+fn exact_end_caps_are_the_exact_limit_everywhere() {
+    for c in cases() {
+        let eval = LimitEvaluator::new(&c.topology, &c.scheme, &Options::default()).unwrap();
+        let points = eval.prepare(&c.positions);
+        let mut regular = 0;
+        for isolation in [1, 3] {
+            let o = options(isolation, EndCaps::Exact, true);
+            let table = PatchTable::new(
+                &c.topology,
+                &c.positions,
+                &c.scheme,
+                &Options::default(),
+                &o,
+            )
+            .unwrap();
+            for f in 0..c.topology.num_faces() {
+                for sub in 0..subs(&c, f) {
+                    for &(u, v) in &[(0.3, 0.2), (0.05, 0.61), (0.7, 0.15), (0.011, 0.013)] {
+                        let at = FaceParam { face: f, sub, u, v };
+                        let (a, _) = table.find(&at).unwrap();
+                        regular += usize::from(table.arrays()[a].kind() != PatchType::Exact);
+                        let mine = table.evaluate(at).unwrap();
+                        let exact = eval.evaluate(&points, at).unwrap();
+                        assert!(
+                            (mine.position - exact.position).length() < 1e-12,
+                            "{:?} {at:?}: {} vs {} in a {} patch",
+                            c.scheme,
+                            mine.position,
+                            exact.position,
+                            table.arrays()[a].kind()
+                        );
+                        assert!(
+                            (mine.du - exact.du).length() < 1e-9
+                                && (mine.dv - exact.dv).length() < 1e-9,
+                            "{at:?}"
+                        );
+                    }
+                }
+            }
+        }
+        // The regular patches were compared too, not only the delegated end caps.
+        assert!(regular > 0);
+    }
+}
+
+#[test]
+fn update_equals_a_rebuild() {
+    for c in cases() {
+        let o = options(
+            3,
+            if c.scheme == Scheme::Loop {
+                EndCaps::Bilinear
+            } else {
+                EndCaps::GregoryBasis
+            },
+            false,
+        );
+        let mut table = PatchTable::new(
+            &c.topology,
+            &c.positions,
+            &c.scheme,
+            &Options::default(),
+            &o,
+        )
+        .unwrap();
+        let moved: Vec<DVec3> = c
+            .positions
+            .iter()
+            .enumerate()
+            .map(|(i, p)| *p * 1.5 + DVec3::new(0.1 * i as f64, 0.0, 0.2))
+            .collect();
+        table.update(&moved).unwrap();
+        let rebuilt =
+            PatchTable::new(&c.topology, &moved, &c.scheme, &Options::default(), &o).unwrap();
+        assert_eq!(table.points(), rebuilt.points());
+    }
+}
+
+#[test]
+fn bad_requests_are_errors_naming_the_problem() {
+    let c = cube();
+    let o = PatchOptions {
+        isolation: 11,
+        ..Default::default()
+    };
+    let e = PatchTable::new(
+        &c.topology,
+        &c.positions,
+        &c.scheme,
+        &Options::default(),
+        &o,
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("isolation level 11"), "{e}");
+    let o = PatchOptions::default();
+    let e = PatchTable::new(
+        &c.topology,
+        &c.positions[..7],
+        &c.scheme,
+        &Options::default(),
+        &o,
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("7 positions"), "{e}");
+    let e = PatchTable::new(
+        &c.topology,
+        &c.positions,
+        &Scheme::Loop,
+        &Options::default(),
+        &o,
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("triangles"), "{e}");
+    let table = PatchTable::new(
+        &c.topology,
+        &c.positions,
+        &c.scheme,
+        &Options::default(),
+        &PatchOptions { isolation: 2, ..o },
+    )
+    .unwrap();
+    let e = table
+        .evaluate(FaceParam {
+            face: 6,
+            sub: 0,
+            u: 0.5,
+            v: 0.5,
+        })
+        .unwrap_err();
+    assert!(e.to_string().contains('6'), "{e}");
+}

@@ -1,0 +1,412 @@
+//! Patch tables against OpenSubdiv's `Far::PatchTableFactory`: for every shape, scheme,
+//! isolation level and option set, the same patches (type, root face, u, v, depth, boundary
+//! and transition masks), and the same values where they are evaluated.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use subd_limit::eval::FaceParam;
+use subd_limit::patches::{EndCaps, PatchOptions, PatchTable};
+use subd_mesh::{DVec3, Topology};
+use subd_schemes::{Options, Scheme};
+
+use crate::osd;
+use crate::row::Row;
+
+/// One patch as the harness writes it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub struct OsdPatch {
+    /// OpenSubdiv's `PatchDescriptor::Type`.
+    pub kind: u32,
+    pub face: u32,
+    pub u: u32,
+    pub v: u32,
+    pub depth: u32,
+    pub non_quad: u32,
+    pub boundary: u32,
+    pub transition: u32,
+    pub regular: u32,
+}
+
+/// The harness's patch table: its patches, local point count, and the evaluations.
+pub struct OsdPatchTable {
+    pub patches: Vec<OsdPatch>,
+    pub local_points: usize,
+    pub evaluations: Vec<[DVec3; 6]>,
+}
+
+/// The harness's `--patches` arguments for `options`.
+pub fn harness_args(options: &PatchOptions) -> Vec<String> {
+    let end_cap = match options.end_caps {
+        EndCaps::Bilinear => 1,
+        EndCaps::BSpline => 2,
+        EndCaps::GregoryBasis | EndCaps::Exact => 3,
+    };
+    [
+        "--patches".to_string(),
+        end_cap.to_string(),
+        u8::from(options.single_crease).to_string(),
+        u8::from(options.inf_sharp).to_string(),
+        u8::from(options.legacy_sharp_corners).to_string(),
+    ]
+    .to_vec()
+}
+
+struct Cursor<'a> {
+    bytes: &'a [u8],
+    pos: usize,
+}
+
+impl Cursor<'_> {
+    fn take(&mut self, n: usize) -> Result<&[u8], String> {
+        let s = self
+            .bytes
+            .get(self.pos..self.pos + n)
+            .ok_or("harness output truncated")?;
+        self.pos += n;
+        Ok(s)
+    }
+    fn u32(&mut self) -> Result<u32, String> {
+        Ok(u32::from_le_bytes(self.take(4)?.try_into().unwrap()))
+    }
+    fn f64(&mut self) -> Result<f64, String> {
+        Ok(f64::from_le_bytes(self.take(8)?.try_into().unwrap()))
+    }
+}
+
+/// Decodes `--patches` output for `points` evaluation points.
+pub fn decode(bytes: &[u8], points: usize) -> Result<OsdPatchTable, String> {
+    let mut c = Cursor { bytes, pos: 0 };
+    let mut patches = Vec::new();
+    for _ in 0..c.u32()? {
+        let (kind, cvs, n) = (c.u32()?, c.u32()? as usize, c.u32()?);
+        for _ in 0..n {
+            let f: Vec<u32> = (0..8).map(|_| c.u32()).collect::<Result<_, _>>()?;
+            c.take(4 + 4 * cvs)?;
+            patches.push(OsdPatch {
+                kind,
+                face: f[0],
+                u: f[1],
+                v: f[2],
+                depth: f[3],
+                non_quad: f[4],
+                boundary: f[5],
+                transition: f[6],
+                regular: f[7],
+            });
+        }
+    }
+    let local_points = c.u32()? as usize;
+    let _refined = c.u32()?;
+    let mut evaluations = Vec::with_capacity(points);
+    for _ in 0..points {
+        let mut e = [DVec3::ZERO; 6];
+        for d in &mut e {
+            *d = DVec3::new(c.f64()?, c.f64()?, c.f64()?);
+        }
+        evaluations.push(e);
+    }
+    Ok(OsdPatchTable {
+        patches,
+        local_points,
+        evaluations,
+    })
+}
+
+/// subd's patches in the harness's form.
+pub fn subd_patches(table: &PatchTable) -> Vec<OsdPatch> {
+    let mut out = Vec::new();
+    for array in table.arrays() {
+        for p in array.params() {
+            let p = p.place();
+            out.push(OsdPatch {
+                kind: array.kind().opensubdiv_type(),
+                face: p.face,
+                u: p.u.into(),
+                v: p.v.into(),
+                depth: p.depth.into(),
+                non_quad: p.non_quad.into(),
+                boundary: p.boundary.into(),
+                transition: p.transition.into(),
+                regular: p.regular.into(),
+            });
+        }
+    }
+    out
+}
+
+/// The first difference between two patch lists (compared as sets keyed by type and place),
+/// or `None`.
+pub fn census_difference(osd: &[OsdPatch], subd: &[OsdPatch]) -> Option<String> {
+    let key = |p: &OsdPatch| (p.kind, p.face, p.u, p.v, p.depth, p.non_quad);
+    let a: BTreeMap<_, _> = osd.iter().map(|p| (key(p), *p)).collect();
+    let b: BTreeMap<_, _> = subd.iter().map(|p| (key(p), *p)).collect();
+    if a.len() != osd.len() || b.len() != subd.len() {
+        return Some("a patch listed twice".into());
+    }
+    for (k, p) in &a {
+        match b.get(k) {
+            None => {
+                return Some(format!(
+                    "{} patches vs OpenSubdiv's {}: missing {p:?}",
+                    subd.len(),
+                    osd.len()
+                ));
+            }
+            Some(q) if q != p => return Some(format!("OpenSubdiv {p:?}, subd {q:?}")),
+            _ => {}
+        }
+    }
+    b.iter().find(|(k, _)| !a.contains_key(k)).map(|(_, q)| {
+        format!(
+            "{} patches vs OpenSubdiv's {}: extra {q:?}",
+            subd.len(),
+            osd.len()
+        )
+    })
+}
+
+/// The option sets a mesh of `scheme` is checked with: every isolation level of a few,
+/// each flag combination, and the end caps built for the scheme.
+pub fn option_sets(scheme: &Scheme) -> Vec<PatchOptions> {
+    let mut sets = Vec::new();
+    let caps: &[EndCaps] = if *scheme == Scheme::Loop {
+        &[EndCaps::Bilinear]
+    } else {
+        &[EndCaps::GregoryBasis, EndCaps::Bilinear]
+    };
+    for isolation in [1u8, 2, 3, 6] {
+        for (single_crease, inf_sharp, legacy_sharp_corners) in [
+            (false, false, true),
+            (true, true, false),
+            (false, true, true),
+            (true, false, false),
+        ] {
+            for (i, &end_caps) in caps.iter().enumerate() {
+                // Every flag set with the first end caps; the others at two levels.
+                if i > 0 && !matches!(isolation, 2 | 6) {
+                    continue;
+                }
+                sets.push(PatchOptions {
+                    isolation,
+                    end_caps,
+                    single_crease,
+                    inf_sharp,
+                    legacy_sharp_corners,
+                });
+            }
+        }
+    }
+    sets
+}
+
+/// Evaluation points: a few per root face the table covers, as (base face, sub-face, u, v)
+/// and the harness's (ptex face, u, v).
+fn eval_points(
+    table: &PatchTable,
+    topo: &Topology,
+    scheme: &Scheme,
+    seed: u64,
+) -> Vec<(FaceParam, u32)> {
+    let mut state = seed
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
+    let mut next = move || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((state >> 11) as f64) / ((1u64 << 53) as f64)
+    };
+    let mut out = Vec::new();
+    let mut ptex = 0u32;
+    for f in 0..topo.num_faces() {
+        let n = topo.face_size(f);
+        let subs = if *scheme == Scheme::Loop || n == 4 {
+            1
+        } else {
+            n
+        };
+        for sub in 0..subs {
+            for _ in 0..2 {
+                let (mut u, mut v) = (next(), next());
+                if *scheme == Scheme::Loop && u + v > 1.0 {
+                    (u, v) = (1.0 - u, 1.0 - v);
+                }
+                let at = FaceParam { face: f, sub, u, v };
+                if table.find(&at).is_ok() {
+                    out.push((at, ptex + sub as u32));
+                }
+            }
+        }
+        ptex += subs as u32;
+    }
+    // Keep the harness's input small on big meshes.
+    let step = out.len().div_ceil(400).max(1);
+    out.into_iter().step_by(step).collect()
+}
+
+/// The largest difference between subd's and OpenSubdiv's evaluations, relative to the
+/// bounding-box diagonal, with OpenSubdiv's derivative conventions undone: its derivatives
+/// in patches of non-quad faces are twice (first) and four times (second) the derivatives
+/// with respect to the sub-face, and its second derivatives of half-turned triangles have
+/// the wrong sign.
+fn eval_error(
+    table: &PatchTable,
+    points: &[(FaceParam, u32)],
+    osd: &[[DVec3; 6]],
+    diag: f64,
+) -> Result<f64, String> {
+    let mut worst = 0.0f64;
+    for ((at, _), theirs) in points.iter().zip(osd) {
+        let (a, i) = table.find(at).map_err(|e| e.to_string())?;
+        let param = table.arrays()[a].params()[i];
+        let place = param.place();
+        let (mut d1, mut d2) = (1.0, 1.0);
+        if place.non_quad {
+            (d1, d2) = (0.5, 0.25);
+        }
+        if *table.scheme() == Scheme::Loop && param.is_triangle_rotated() {
+            d2 = -d2;
+        }
+        let mine = table.evaluate(*at).map_err(|e| e.to_string())?;
+        let ours = [
+            mine.position,
+            mine.du,
+            mine.dv,
+            mine.duu,
+            mine.duv,
+            mine.dvv,
+        ];
+        // Derivatives compared in the patch's own parameters: both sides round there and
+        // scale by 2^depth per order afterwards.
+        let frac = param.fraction();
+        for (k, (m, t)) in ours.iter().zip(theirs).enumerate() {
+            let scale = [1.0, d1, d1, d2, d2, d2][k];
+            let own = [1.0, frac, frac, frac * frac, frac * frac, frac * frac][k];
+            worst = worst.max((*m - *t * scale).length() * own / diag);
+        }
+    }
+    Ok(worst)
+}
+
+/// Compares the census and the evaluation of one mesh with every option set; one row per
+/// option set.
+pub fn compare_census(
+    exe: &Path,
+    name: &str,
+    topo: &Topology,
+    positions: &[DVec3],
+    scheme: &Scheme,
+    options: &Options,
+) -> Vec<Row> {
+    let diag = bbox_diagonal(positions);
+    option_sets(scheme)
+        .iter()
+        .enumerate()
+        .map(|(k, po)| {
+            let mut row = Row::pending(name, "patches", po.isolation as usize);
+            let result = PatchTable::new(topo, positions, scheme, options, po)
+                .map_err(|e| e.to_string())
+                .and_then(|table| {
+                    let points = eval_points(&table, topo, scheme, k as u64);
+                    let harness_points: Vec<(u32, f64, f64)> = points
+                        .iter()
+                        .map(|(at, root)| (*root, at.u, at.v))
+                        .collect();
+                    let input = osd::encode(topo, positions, scheme, options, po.isolation.into());
+                    let input = osd::encode_eval_points(input, &harness_points);
+                    let args = harness_args(po);
+                    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+                    let osd = decode(&osd::run(exe, &input, &args)?, points.len())?;
+                    let mine = subd_patches(&table);
+                    if let Some(d) = census_difference(&osd.patches, &mine) {
+                        return Err(d);
+                    }
+                    if osd.local_points != table.census().local_points {
+                        return Err(format!(
+                            "{} local points vs OpenSubdiv's {}",
+                            table.census().local_points,
+                            osd.local_points
+                        ));
+                    }
+                    let error = eval_error(&table, &points, &osd.evaluations, diag)?;
+                    Ok((osd.patches.len(), points.len(), error))
+                });
+            match result {
+                Ok((n, p, error)) => {
+                    row.vertices = n;
+                    row.error = error;
+                    row.note = Some(format!("{}; {p} points evaluated", option_label(po)));
+                    if error > 1e-12 {
+                        row.problem = Some(format!(
+                            "{}: evaluation off by {error:.3e}",
+                            option_label(po)
+                        ));
+                    }
+                }
+                Err(e) => row.problem = Some(format!("{}: {e}", option_label(po))),
+            }
+            row
+        })
+        .collect()
+}
+
+fn bbox_diagonal(p: &[DVec3]) -> f64 {
+    let (lo, hi) = p.iter().fold(
+        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+        |(a, b), &x| (a.min(x), b.max(x)),
+    );
+    (hi - lo).length().max(f64::MIN_POSITIVE)
+}
+
+/// A short label of an option set.
+pub fn option_label(o: &PatchOptions) -> String {
+    format!(
+        "isolation {} {}{}{}{}",
+        o.isolation,
+        o.end_caps,
+        if o.single_crease {
+            " single-crease"
+        } else {
+            ""
+        },
+        if o.inf_sharp { " inf-sharp" } else { "" },
+        if o.legacy_sharp_corners {
+            ""
+        } else {
+            " no-legacy-corners"
+        },
+    )
+}
+
+/// The census of every Catmull-Clark and Loop shape of the OpenSubdiv directory, shapes in
+/// parallel, rows in shape order.
+pub fn shapes(exe: &Path, dir: &Path) -> Result<Vec<Row>, String> {
+    use rayon::prelude::*;
+    let paths = crate::conformance::shape_paths(dir)?;
+    let opts = subd_io::ReadOptions {
+        accept_inconsistent_orientation: true,
+        ..Default::default()
+    };
+    let per_shape = paths
+        .par_iter()
+        .map(|p| -> Result<Vec<Row>, String> {
+            let name = p.file_stem().unwrap().to_string_lossy().to_string();
+            let scheme = match crate::conformance::scheme_of(&name) {
+                Some(s @ (Scheme::CatmullClark | Scheme::Loop)) => s,
+                _ => return Ok(Vec::new()),
+            };
+            let file = subd_io::read_mesh(p, &opts).map_err(|e| e.to_string())?;
+            let options = Options::from_hints(&file.mesh.hints);
+            Ok(compare_census(
+                exe,
+                &name,
+                &file.mesh.topology,
+                &file.mesh.positions,
+                &scheme,
+                &options,
+            ))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(per_shape.into_iter().flatten().collect())
+}
