@@ -348,6 +348,74 @@ void patchTable(Mesh const &m, Reader &r, char **argv, std::vector<unsigned char
     delete refiner;
 }
 
+// --patches-bench ENDCAP SINGLE_CREASE INF_SHARP LEGACY_CORNERS REPEATS: the medians of
+// building (topology refiner, RefineAdaptive, PatchTableFactory::Create with its local-point
+// stencils, the refined and local points of the mesh's positions) and of evaluating the
+// points that follow the mesh (PatchMap::FindPatch, EvaluateBasis with first derivatives,
+// the weighted sums); one line of JSON.
+void patchBench(Mesh const &m, Reader &r, char **argv) {
+    uint32_t count = r.get<uint32_t>();
+    std::vector<int> faces(count);
+    std::vector<double> us(count), vs(count);
+    for (uint32_t i = 0; i < count; ++i) {
+        faces[i] = (int)r.get<uint32_t>();
+        us[i] = r.get<double>();
+        vs[i] = r.get<double>();
+    }
+    int reps = std::atoi(argv[6]);
+    std::vector<double> build, eval;
+    double check = 0.0;
+    for (int rep = 0; rep < reps; ++rep) {
+        auto t0 = std::chrono::steady_clock::now();
+        Far::TopologyRefiner *refiner = createRefiner(m);
+        Far::PatchTableFactory::Options po(m.levels);
+        po.SetPatchPrecision<double>();
+        po.endCapType = (Far::PatchTableFactory::Options::EndCapType)std::atoi(argv[2]);
+        po.useSingleCreasePatch = std::atoi(argv[3]) != 0;
+        po.useInfSharpPatch = std::atoi(argv[4]) != 0;
+        po.generateLegacySharpCornerPatches = std::atoi(argv[5]) != 0;
+        po.generateVaryingTables = false;
+        refiner->RefineAdaptive(po.GetRefineAdaptiveOptions());
+        Far::PatchTable const *table = Far::PatchTableFactory::Create(*refiner, po);
+        int nRefined = refiner->GetNumVerticesTotal();
+        int nLocal = table->GetNumLocalPoints();
+        std::vector<Point> verts(nRefined + nLocal);
+        std::copy(m.pos.begin(), m.pos.end(), verts.begin());
+        Far::PrimvarRefinerReal<double> primvar(*refiner);
+        Point *src = verts.data();
+        for (int l = 1; l < refiner->GetNumLevels(); ++l) {
+            Point *dst = src + refiner->GetLevel(l - 1).GetNumVertices();
+            primvar.Interpolate(l, src, dst);
+            src = dst;
+        }
+        if (nLocal) table->GetLocalPointStencilTable<double>()->UpdateValues(verts.data(), verts.data() + nRefined);
+        auto t1 = std::chrono::steady_clock::now();
+        Far::PatchMap map(*table);
+        auto t2 = std::chrono::steady_clock::now();
+        double w[3][20];
+        for (uint32_t i = 0; i < count; ++i) {
+            Far::PatchTable::PatchHandle const *h = map.FindPatch(faces[i], us[i], vs[i]);
+            if (!h) continue;
+            table->EvaluateBasis(*h, us[i], vs[i], w[0], w[1], w[2]);
+            Far::ConstIndexArray cvs = table->GetPatchVertices(*h);
+            Point acc[3];
+            for (auto &p : acc) p.Clear();
+            for (int c = 0; c < cvs.size(); ++c)
+                for (int d = 0; d < 3; ++d) acc[d].AddWithWeight(verts[cvs[c]], w[d][c]);
+            check += acc[0].p[0] + acc[1].p[1] + acc[2].p[2];
+        }
+        auto t3 = std::chrono::steady_clock::now();
+        build.push_back(std::chrono::duration<double>(t1 - t0).count());
+        eval.push_back(std::chrono::duration<double>(t3 - t2).count());
+        delete table;
+        delete refiner;
+    }
+    std::sort(build.begin(), build.end());
+    std::sort(eval.begin(), eval.end());
+    std::printf("{\"build_seconds\": %.9f, \"eval_seconds\": %.9f, \"check\": %.6f}\n",
+                build[build.size() / 2], eval[eval.size() / 2], check);
+}
+
 } // namespace
 
 int main(int argc, char **argv) {
@@ -400,6 +468,10 @@ int main(int argc, char **argv) {
             std::printf("{\"seconds\": %.9f, \"topology_seconds\": %.9f, \"primvar_seconds\": %.9f, "
                         "\"cpu_seconds\": %.9f, \"peak_rss_bytes\": %ld}\n",
                         median(total), median(topo), median(prim), median(cpu), peakRssBytes());
+            return 0;
+        }
+        if (argc > 6 && std::string(argv[1]) == "--patches-bench") {
+            patchBench(m, r, argv);
             return 0;
         }
         if (argc > 5 && std::string(argv[1]) == "--patches") {

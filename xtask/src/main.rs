@@ -17,6 +17,7 @@ mod fvar_conformance;
 mod geom_conformance;
 mod geom_ref;
 mod osd;
+mod patch_bench;
 mod patch_conformance;
 mod pia_bench;
 mod python_tests;
@@ -119,6 +120,10 @@ enum Task {
         /// Only the tessellation benchmark (`subd tessellate` against OpenSubdiv's Bfr).
         #[arg(long)]
         tess_only: bool,
+        /// Only the patch-table benchmark (building and evaluating 1M points against
+        /// OpenSubdiv's RefineAdaptive + PatchTableFactory and PatchMap + EvaluateBasis).
+        #[arg(long)]
+        patches_only: bool,
         /// Only the face-varying benchmark (UVs with seams against OpenSubdiv's
         /// InterpolateFaceVarying).
         #[arg(long)]
@@ -322,6 +327,7 @@ fn main() -> ExitCode {
             split_only,
             batch_only,
             tess_only,
+            patches_only,
             fvar_only,
             python_only,
             scaling,
@@ -352,6 +358,8 @@ fn main() -> ExitCode {
                 ensure_system_packages(REFERENCE_PACKAGES).and_then(|_| fvar())
             } else if tess_only {
                 ensure_system_packages(REFERENCE_PACKAGES).and_then(|_| tess())
+            } else if patches_only {
+                ensure_system_packages(REFERENCE_PACKAGES).and_then(|_| patch_bench::run(repeats))
             } else if batch_only {
                 batch()
             } else if split_only {

@@ -98,6 +98,24 @@ fn phantom_sides(mask: u8) -> (u8, u8) {
     }
 }
 
+/// An interior box-spline patch's position and first derivatives at `(s, t)` from its 12
+/// control points (indices into `points`, OpenSubdiv's order).
+pub(crate) fn box_spline_first(
+    cps: &[u32],
+    points: &[glam::DVec3],
+    s: f64,
+    t: f64,
+) -> [glam::DVec3; 3] {
+    let basis =
+        crate::loop_patch::box_spline().expect("the box-spline basis derives on a fixed grid");
+    let mut corner = [glam::DVec3::ZERO; 12];
+    for (k, &cp) in cps.iter().enumerate() {
+        corner[BOX_SPLINE_ORDER[k]] = points[cp as usize];
+    }
+    let (p, du, dv) = basis.evaluate_first(&corner, s, t);
+    [p, du, dv]
+}
+
 /// One phantom point: `phantom = a + b − inner`.
 #[derive(Clone, Copy)]
 struct Phantom {

@@ -8,22 +8,19 @@
 
 use super::param::PatchParam;
 
-/// A child slot of a node.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Slot {
-    Empty,
-    /// A patch (its global index) covers the slot.
-    Patch(u32),
-    /// A deeper node.
-    Node(u32),
-}
+/// A child slot, packed in 32 bits so that a node is 16 bytes: [`EMPTY`], a patch (its
+/// global index), or with [`NODE`] set a deeper node. A root face covered by one patch holds
+/// it directly, so the common lookup touches one word.
+type Slot = u32;
+const EMPTY: Slot = u32::MAX;
+const NODE: Slot = 1 << 31;
 
 /// Quadtrees over the root faces.
 #[derive(Debug, Clone)]
 pub struct PatchMap {
     triangles: bool,
-    /// Node of each root face (`u32::MAX` where no patch lies on it: holes).
-    roots: Vec<u32>,
+    /// Slot of each root face: one patch, a node, or empty (holes).
+    roots: Vec<Slot>,
     nodes: Vec<[Slot; 4]>,
 }
 
@@ -70,9 +67,9 @@ impl PatchMap {
         map
     }
 
-    fn new_node(&mut self) -> u32 {
-        self.nodes.push([Slot::Empty; 4]);
-        (self.nodes.len() - 1) as u32
+    fn new_node(&mut self) -> Slot {
+        self.nodes.push([EMPTY; 4]);
+        NODE | (self.nodes.len() - 1) as u32
     }
 
     /// Inserts patch `index`: a leaf at its depth below its root, reached through the
@@ -80,19 +77,18 @@ impl PatchMap {
     fn insert(&mut self, index: u32, param: PatchParam) {
         let place = param.place();
         let root = place.face as usize;
-        if self.roots[root] == u32::MAX {
-            self.roots[root] = self.new_node();
-        }
-        let mut node = self.roots[root];
         let steps = usize::from(place.depth) - usize::from(place.non_quad);
         if steps == 0 {
-            self.nodes[node as usize] = [Slot::Patch(index); 4];
+            self.roots[root] = index;
             return;
         }
+        if self.roots[root] == EMPTY {
+            self.roots[root] = self.new_node();
+        }
+        let mut node = (self.roots[root] & !NODE) as usize;
         // A point inside the patch, in the root's coordinates.
         let (mut u, mut v) = if self.triangles {
-            let (s, t) = param.unnormalize_triangle(0.25, 0.25);
-            (s, t)
+            param.unnormalize_triangle(0.25, 0.25)
         } else {
             param.unnormalize(0.5, 0.5)
         };
@@ -103,18 +99,14 @@ impl PatchMap {
                 quad_child(u, v)
             };
             (u, v) = (cu, cv);
-            let slots = &mut self.nodes[node as usize];
             if step + 1 == steps {
-                slots[k] = Slot::Patch(index);
+                self.nodes[node][k] = index;
             } else {
-                node = match slots[k] {
-                    Slot::Node(n) => n,
-                    _ => {
-                        let n = self.new_node();
-                        self.nodes[node as usize][k] = Slot::Node(n);
-                        n
-                    }
-                };
+                if self.nodes[node][k] == EMPTY {
+                    let n = self.new_node();
+                    self.nodes[node][k] = n;
+                }
+                node = (self.nodes[node][k] & !NODE) as usize;
             }
         }
     }
@@ -122,22 +114,19 @@ impl PatchMap {
     /// The patch (global index) at `(u, v)` of root face `root`, or `None` where no patch
     /// lies (a hole, a root out of range).
     pub fn find(&self, root: usize, u: f64, v: f64) -> Option<usize> {
-        let mut node = *self.roots.get(root)?;
-        if node == u32::MAX {
-            return None;
-        }
+        let mut slot = *self.roots.get(root)?;
         let (mut u, mut v) = (u, v);
         loop {
-            let (k, cu, cv) = if self.triangles {
-                triangle_child(u, v)
-            } else {
-                quad_child(u, v)
-            };
-            match self.nodes[node as usize][k] {
-                Slot::Empty => return None,
-                Slot::Patch(p) => return Some(p as usize),
-                Slot::Node(n) => {
-                    node = n;
+            match slot {
+                EMPTY => return None,
+                s if s & NODE == 0 => return Some(s as usize),
+                s => {
+                    let (k, cu, cv) = if self.triangles {
+                        triangle_child(u, v)
+                    } else {
+                        quad_child(u, v)
+                    };
+                    slot = self.nodes[(s & !NODE) as usize][k];
                     (u, v) = (cu, cv);
                 }
             }

@@ -1,0 +1,79 @@
+//! Times building a patch table and evaluating it on the bench torus (`cargo xtask bench`'s
+//! quad mesh, or its triangulation for Loop): `patch_time <cc|loop> <isolation> <repeats>
+//! [eval]`; prints the seconds of each run. Run it with `RAYON_NUM_THREADS` set.
+
+use std::time::Instant;
+
+use subd_limit::eval::FaceParam;
+use subd_limit::patches::{EndCaps, PatchOptions, PatchTable};
+use subd_mesh::{DVec3, Topology, TopologyBuilder};
+use subd_schemes::{Options, Refinement, Scheme};
+
+fn bench_torus() -> (Topology, Vec<DVec3>) {
+    let base = subd_mesh::primitives::torus_with_hexagons(160, 160, 8, 3.0, 1.0);
+    let r = Refinement::new(&base.topology, Scheme::CatmullClark, &Options::default(), 1)
+        .expect("refine");
+    let pts = r.refine_points(&base.positions).pop().expect("level 1");
+    (r.into_topology(1), pts)
+}
+
+fn split_quads(t: &Topology) -> Topology {
+    let mut idx = Vec::with_capacity(t.num_faces() * 6);
+    for f in 0..t.num_faces() {
+        let v = t.face_vertices(f);
+        idx.extend_from_slice(&[v[0], v[1], v[2], v[0], v[2], v[3]]);
+    }
+    TopologyBuilder::new(t.num_vertices())
+        .build(&vec![3; 2 * t.num_faces()], &idx)
+        .expect("valid")
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let loop_scheme = args.get(1).is_some_and(|s| s == "loop");
+    let isolation: u8 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(2);
+    let repeats: usize = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(5);
+    let eval = args.get(4).is_some_and(|s| s == "eval");
+    let (quads, points) = bench_torus();
+    let (topo, scheme, caps) = if loop_scheme {
+        (split_quads(&quads), Scheme::Loop, EndCaps::Bilinear)
+    } else {
+        (quads, Scheme::CatmullClark, EndCaps::GregoryBasis)
+    };
+    let options = PatchOptions {
+        isolation,
+        end_caps: caps,
+        inf_sharp: true,
+        legacy_sharp_corners: false,
+        single_crease: false,
+    };
+    let rules = Options::default();
+    let table = PatchTable::new(&topo, &points, &scheme, &rules, &options).expect("table");
+    let at: Vec<FaceParam> = (0..1_000_000usize)
+        .map(|i| {
+            let face = (i * 7919) % topo.num_faces();
+            let (u, v) = (
+                ((i * 37) % 101) as f64 / 101.0,
+                ((i * 53) % 97) as f64 / 97.0,
+            );
+            let (u, v) = if loop_scheme && u + v > 1.0 {
+                (1.0 - u, 1.0 - v)
+            } else {
+                (u, v)
+            };
+            FaceParam { face, sub: 0, u, v }
+        })
+        .collect();
+    for _ in 0..repeats {
+        let t = Instant::now();
+        let n = if eval {
+            table.evaluate_first(&at).expect("evaluate").len()
+        } else {
+            PatchTable::new(&topo, &points, &scheme, &rules, &options)
+                .expect("table")
+                .census()
+                .patches
+        };
+        println!("{:.4} s ({n})", t.elapsed().as_secs_f64());
+    }
+}
