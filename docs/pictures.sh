@@ -23,3 +23,8 @@ awk '/^f /{print "f", $2, $3, $4; print "f", $2, $4, $5; next} {print}' "$torus"
 "$subd" adaptive --scheme loop --dihedral 30 --levels 4 "$tmp/tris.obj" "$tmp/adaptive.ply"
 "$subd" render "$tmp/adaptive.ply" "$out"/adaptive_levels.png --wireframe --size 480x360 \
     --view 20,55
+
+# The creased torus's patch table (isolation 3): regular B-spline patches coloured by depth,
+# Gregory end caps red, each patch drawn on its own grid with its edges.
+"$subd" render "$torus" "$out"/patches.png --patches --isolation 3 --wireframe --size 480x360 \
+    --view 20,55

@@ -33,6 +33,8 @@ const LEVELS: [Rgb; 8] = [
     [229, 196, 148],
     [179, 179, 179],
 ];
+/// End caps of a patch table (`--patches`), darker the deeper.
+const END_CAP: Rgb = [215, 48, 39];
 const CAGE: Rgb = [214, 96, 20];
 const WIRE: Rgb = [55, 60, 75];
 const POINT: Rgb = [200, 20, 40];
@@ -49,6 +51,14 @@ pub(crate) struct RenderArgs {
     /// Tension w of --scheme butterfly (default 1/16).
     #[arg(long, allow_hyphen_values = true)]
     tension: Option<f64>,
+    /// Draw the patches of the mesh's feature-adaptive patch table (Catmull-Clark or Loop),
+    /// regular patches coloured by depth, end caps red.
+    #[arg(long, conflicts_with_all = ["levels", "limit"])]
+    patches: bool,
+    /// Isolation level of --patches.
+    #[arg(long, default_value_t = 3, requires = "patches",
+          value_parser = clap::value_parser!(u8).range(1..=10))]
+    isolation: u8,
     /// Draw the limit surface: the refined vertices at their exact limit positions, shaded
     /// with their limit normals.
     #[arg(long)]
@@ -136,7 +146,7 @@ pub(crate) fn run(
 ) -> Result<(), Failure> {
     let t0 = Instant::now();
     let chosen = check_arguments(args)?;
-    let refining = args.scheme.is_some() || args.limit;
+    let refining = (args.scheme.is_some() || args.limit) && !args.patches;
     let file = subd_io::read_mesh(&args.input, &args.rules.read_options())?;
     print_warnings(err, &args.input, &file.warnings);
     let points = match &args.points {
@@ -158,7 +168,9 @@ pub(crate) fn run(
     } else {
         0
     };
-    let surface = if refining {
+    let surface = if args.patches {
+        patches_surface(args, &file, &scheme)
+    } else if refining {
         refined_surface(args, &file, &scheme, levels)
     } else {
         let holes = base.tags().holes().to_vec();
@@ -230,6 +242,62 @@ fn check_arguments(args: &RenderArgs) -> Result<Option<Scheme>, Failure> {
         return Err(bad("--levels needs --scheme or --limit".into()));
     }
     Ok(chosen)
+}
+
+/// The patch table's patches to draw, each sampled on a small grid and coloured by its
+/// type and depth.
+fn patches_surface(
+    args: &RenderArgs,
+    file: &subd_io::MeshFile,
+    scheme: &Scheme,
+) -> Result<Surface, String> {
+    use subd_limit::patches::{EndCaps, PatchOptions, PatchTable};
+    if !scheme_arg::evaluated(scheme) {
+        return Err(format!(
+            "--patches needs catmull-clark or loop, not {scheme}"
+        ));
+    }
+    let options = PatchOptions {
+        isolation: args.isolation,
+        end_caps: if *scheme == Scheme::Loop {
+            EndCaps::Bilinear
+        } else {
+            EndCaps::GregoryBasis
+        },
+        ..Default::default()
+    };
+    let rules = args.rules.options(&file.mesh.hints);
+    let table = PatchTable::new(
+        &file.mesh.topology,
+        &file.mesh.positions,
+        scheme,
+        &rules,
+        &options,
+    )
+    .map_err(|e| e.to_string())?;
+    let grid = table.patch_grid(4).map_err(|e| e.to_string())?;
+    let n = grid.patch.len();
+    let colors = grid
+        .patch
+        .iter()
+        .map(|&(a, i)| {
+            let place = table.arrays()[a as usize].params()[i as usize].place();
+            if place.regular {
+                LEVELS[usize::from(place.depth) % LEVELS.len()]
+            } else {
+                let k = 1.0 - 0.06 * f64::from(place.depth.min(8));
+                END_CAP.map(|c| (f64::from(c) * k) as u8)
+            }
+        })
+        .collect();
+    Ok(Surface {
+        offsets: (0..=n as u32).map(|i| i * grid.face_size as u32).collect(),
+        vertices: grid.faces,
+        holes: vec![false; n],
+        positions: grid.positions,
+        normals: grid.normals,
+        colors,
+    })
 }
 
 /// The refined surface to draw: `levels` levels of `scheme`, at the limit with `--limit`.

@@ -18,6 +18,7 @@ mod curve;
 mod errors;
 mod mesh;
 mod ops;
+mod patches;
 mod pool;
 mod refiner;
 mod shape;
@@ -28,6 +29,7 @@ mod surface;
 fn _subd(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<mesh::CoreMesh>()?;
     m.add_class::<refiner::CoreRefiner>()?;
+    m.add_class::<patches::CorePatchTable>()?;
     m.add_function(wrap_pyfunction!(ops::read, m)?)?;
     m.add_function(wrap_pyfunction!(ops::refine, m)?)?;
     m.add_function(wrap_pyfunction!(ops::limit, m)?)?;

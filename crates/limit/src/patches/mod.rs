@@ -58,4 +58,6 @@ pub use kind::PatchType;
 pub use map::PatchMap;
 pub use options::{EndCaps, MAX_ISOLATION, PatchOptions};
 pub use param::{PatchParam, PatchPlace};
-pub use table::{PatchArray, PatchArrayLayout, PatchCensus, PatchTable, PatchTableLayout};
+pub use table::{
+    PatchArray, PatchArrayLayout, PatchCensus, PatchGrid, PatchTable, PatchTableLayout,
+};

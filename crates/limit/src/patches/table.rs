@@ -142,6 +142,21 @@ pub struct PatchTableLayout<'a> {
     pub points: Vec<[f64; 3]>,
 }
 
+/// The patches of a table sampled on grids ([`PatchTable::patch_grid`]).
+#[derive(Debug, Clone, Default)]
+pub struct PatchGrid {
+    /// Vertices per face (4 for Catmull-Clark, 3 for Loop).
+    pub face_size: usize,
+    /// Face vertices, `face_size` per face.
+    pub faces: Vec<u32>,
+    /// Positions.
+    pub positions: Vec<DVec3>,
+    /// Unit normals.
+    pub normals: Vec<DVec3>,
+    /// The patch (array, index in the array) of each face.
+    pub patch: Vec<(u32, u32)>,
+}
+
 /// The exact evaluator behind [`EndCaps::Exact`], with its points.
 #[derive(Debug)]
 struct ExactCaps {
@@ -346,24 +361,7 @@ impl PatchTable {
     /// As [`Self::find`].
     pub fn evaluate(&self, at: FaceParam) -> Result<SurfacePoint, LimitError> {
         let (a, i) = self.find(&at)?;
-        let array = &self.arrays[a];
-        if array.kind == PatchType::Exact {
-            let exact = self
-                .exact
-                .as_ref()
-                .expect("exact end caps have their evaluator");
-            return exact.evaluator.evaluate(&exact.points, at);
-        }
-        let param = array.params[i];
-        let cps = array.patch_points(i);
-        Ok(evaluate_patch(
-            array.kind,
-            param,
-            cps,
-            &self.points,
-            at.u,
-            at.v,
-        ))
+        self.evaluate_in(a, i, at)
     }
 
     /// The table as flat arrays ([`PatchTableLayout`]).
@@ -459,6 +457,102 @@ impl PatchTable {
             return Ok([p, du * d1, dv * d1]);
         }
         self.evaluate(at).map(|s| [s.position, s.du, s.dv])
+    }
+
+    /// Every patch sampled on its own `rate × rate` grid of its domain (a triangle's in
+    /// `rate²` triangles): a mesh of the patches as they lie, for pictures (adjacent
+    /// patches of different depths share no vertices).
+    ///
+    /// # Errors
+    /// An evaluation's error (none for a table that was built).
+    pub fn patch_grid(&self, rate: usize) -> Result<PatchGrid, LimitError> {
+        let rate = rate.max(1);
+        let roots = self.root_faces();
+        let triangles = self.scheme == Scheme::Loop;
+        let mut grid = PatchGrid::default();
+        for (a, array) in self.arrays.iter().enumerate() {
+            for (i, param) in array.params.iter().enumerate() {
+                let (face, sub) = roots[param.place().face as usize];
+                let first = grid.positions.len() as u32;
+                let id = |x: usize, y: usize| first + (y * (rate + 1) + x) as u32;
+                for y in 0..=rate {
+                    for x in 0..=rate {
+                        let (s, t) = (x as f64 / rate as f64, y as f64 / rate as f64);
+                        // Points past a triangle's hypotenuse are folded onto it.
+                        let (s, t) = if triangles && s + t > 1.0 {
+                            (s / (s + t), t / (s + t))
+                        } else {
+                            (s, t)
+                        };
+                        let (u, v) = if triangles {
+                            param.unnormalize_triangle(s, t)
+                        } else {
+                            param.unnormalize(s, t)
+                        };
+                        let p = self.evaluate_in(a, i, FaceParam { face, sub, u, v })?;
+                        grid.positions.push(p.position);
+                        grid.normals.push(p.normal());
+                    }
+                }
+                for y in 0..rate {
+                    for x in 0..rate {
+                        if triangles {
+                            if x + y < rate {
+                                grid.faces.extend([id(x, y), id(x + 1, y), id(x, y + 1)]);
+                                grid.patch.push((a as u32, i as u32));
+                            }
+                            if x + y + 1 < rate {
+                                grid.faces
+                                    .extend([id(x + 1, y), id(x + 1, y + 1), id(x, y + 1)]);
+                                grid.patch.push((a as u32, i as u32));
+                            }
+                        } else {
+                            grid.faces.extend([
+                                id(x, y),
+                                id(x + 1, y),
+                                id(x + 1, y + 1),
+                                id(x, y + 1),
+                            ]);
+                            grid.patch.push((a as u32, i as u32));
+                        }
+                    }
+                }
+            }
+        }
+        grid.face_size = if triangles { 3 } else { 4 };
+        Ok(grid)
+    }
+
+    /// The base face and sub-face of each root (ptex) face.
+    fn root_faces(&self) -> Vec<(usize, usize)> {
+        let base = &self.levels[0].topology;
+        let regular = if self.scheme == Scheme::Loop { 3 } else { 4 };
+        (0..base.num_faces())
+            .flat_map(|f| {
+                let n = base.face_size(f);
+                (0..if n == regular { 1 } else { n }).map(move |sub| (f, sub))
+            })
+            .collect()
+    }
+
+    /// Patch `i` of array `a` at `at` (which it covers).
+    fn evaluate_in(&self, a: usize, i: usize, at: FaceParam) -> Result<SurfacePoint, LimitError> {
+        let array = &self.arrays[a];
+        if array.kind == PatchType::Exact {
+            let exact = self
+                .exact
+                .as_ref()
+                .expect("exact end caps have their evaluator");
+            return exact.evaluator.evaluate(&exact.points, at);
+        }
+        Ok(evaluate_patch(
+            array.kind,
+            array.params[i],
+            array.patch_points(i),
+            &self.points,
+            at.u,
+            at.v,
+        ))
     }
 
     /// Counts of the patches by type, depth and boundary mask.

@@ -51,6 +51,7 @@ __all__ = [
     "FormatError",
     "Mesh",
     "MeshError",
+    "PatchTable",
     "Refiner",
     "evaluate",
     "SubdError",
@@ -594,6 +595,109 @@ class Refiner:
         except ImportError:
             return indptr, indices, weights
         return scipy.sparse.csr_matrix((weights, indices, indptr), shape=shape)
+
+
+class PatchTable:
+    """A mesh's feature-adaptive patch table, as OpenSubdiv's ``Far::PatchTable``.
+
+    >>> t = subd.PatchTable(mesh, "catmull-clark", isolation=3)   # doctest: +SKIP
+    >>> t.census()["by_type"]                                     # doctest: +SKIP
+    {'GREGORY_BASIS': 24, 'REGULAR': 144}
+
+    The topology is refined around irregular features (extraordinary vertices, sharp
+    features, boundaries, non-quads) to ``isolation`` levels; faces with a regular
+    neighbourhood become bicubic B-spline (Catmull-Clark) or quartic box-spline (Loop)
+    patches, the faces still at an irregular feature *end caps*: ``"gregory"`` (OpenSubdiv's
+    default), ``"bilinear"``, ``"bspline"`` or ``"exact"`` (the exact limit). The defaults
+    are OpenSubdiv 3.5's ``PatchTableFactory::Options``.
+
+    * ``arrays``: per patch type, a dict with ``type`` (OpenSubdiv's name),
+      ``control_points`` ((n, k) indices into ``points``), ``params`` ((n, 2) uint32,
+      OpenSubdiv's packed ``PatchParam``) and ``sharpness`` (single creases).
+    * ``points``: refined vertices of every level, then the local points.
+    * ``local_point_stencils``: the local points as weights of the refined vertices
+      (``scipy.sparse.csr_matrix`` when SciPy is installed, else CSR arrays).
+    * ``evaluate(faces, u, v, sub=None, derivatives=False)``: vectorised.
+    * ``update(vertices)``: new base positions, same topology (animation).
+    """
+
+    __slots__ = ("_core",)
+
+    def __init__(
+        self,
+        mesh: Mesh,
+        scheme: str = "catmull-clark",
+        *,
+        isolation: int = 10,
+        end_caps: str = "gregory",
+        single_crease: bool = False,
+        inf_sharp: bool = False,
+        legacy_sharp_corners: bool = True,
+        boundary: Optional[str] = None,
+        crease_method: Optional[str] = None,
+        triangles: Optional[str] = None,
+    ) -> None:
+        _check_mesh(mesh)
+        isolation = _count(isolation, "isolation")
+        if not 1 <= isolation <= 10:
+            raise ValueError(f"isolation: {isolation} is outside 1..10")
+        if end_caps not in ("gregory", "bspline", "bilinear", "exact"):
+            raise ValueError(f"end_caps: unknown value {end_caps!r} "
+                             "(one of gregory, bspline, bilinear, exact)")
+        rules = _rule_names(boundary, crease_method, triangles)[:3]
+        self._core = _subd._CorePatchTable(
+            mesh._core, _scheme_name(scheme, None, None), isolation, end_caps,
+            bool(single_crease), bool(inf_sharp), bool(legacy_sharp_corners), *rules)
+
+    def census(self) -> dict:
+        """Patches by type, depth and boundary mask, and the local points (as ``subd
+        patches --json`` prints them)."""
+        return json.loads(self._core.census())
+
+    @property
+    def arrays(self) -> list:
+        """The patch arrays (copies), in table order."""
+        return [dict(type=t, control_points=c, params=p, sharpness=s)
+                for t, c, p, s in self._core.arrays()]
+
+    @property
+    def points(self) -> np.ndarray:
+        """(n, 3): refined vertices of every level, then the local points."""
+        return self._core.points()
+
+    @property
+    def level_vertex_counts(self) -> list:
+        """Vertices of each refined level (level 0: the base vertices)."""
+        return self._core.level_vertex_counts()
+
+    @property
+    def local_point_stencils(self):
+        """The local points as weights of the refined vertices of all levels."""
+        indptr, indices, weights, shape = self._core.local_point_stencils()
+        try:
+            import scipy.sparse
+        except ImportError:
+            return indptr, indices, weights
+        return scipy.sparse.csr_matrix((weights, indices, indptr), shape=shape)
+
+    def evaluate(self, faces, u, v, *, sub=None, derivatives: bool = False):
+        """The surface at ``(faces[i], u[i], v[i])`` (``sub``: the corner quad of a
+        Catmull-Clark face that is not a quad). Returns ``(positions, du, dv)``, each
+        (m, 3), and with ``derivatives=True`` also ``duu``, ``duv``, ``dvv``."""
+        f = _index_array(faces, "faces").reshape(-1)
+        s = np.zeros_like(f) if sub is None else _index_array(sub, "sub").reshape(-1)
+        uu = _float_array(u, "u").reshape(-1)
+        vv = _float_array(v, "v").reshape(-1)
+        if s.size == 1 and f.size != 1:
+            s = np.full_like(f, int(s[0]))
+        return tuple(self._core.evaluate(f, s, uu, vv, bool(derivatives)))
+
+    def update(self, vertices) -> None:
+        """Moves the base vertices ((n, 3)); the refined and local points follow."""
+        a = _float_array(vertices, "vertices")
+        if a.ndim != 2 or a.shape[1] != 3:
+            raise ValueError(f"vertices: expected an (n, 3) array, got shape {a.shape}")
+        self._core.update(np.ascontiguousarray(a))
 
 
 def limit(mesh: Mesh, scheme: str = "catmull-clark") -> Tuple[np.ndarray, np.ndarray]:

@@ -74,6 +74,39 @@ class _CoreRefiner:
         self, level: Optional[int] = ...
     ) -> Tuple[npt.NDArray[np.int64], npt.NDArray[np.int64], npt.NDArray[np.float64], Tuple[int, int]]: ...
 
+class _CorePatchTable:
+    def __init__(
+        self,
+        mesh: _CoreMesh,
+        scheme_name: str,
+        isolation: int,
+        end_caps: str,
+        single_crease: bool,
+        inf_sharp: bool,
+        legacy_sharp_corners: bool,
+        boundary: Optional[str] = ...,
+        crease_method: Optional[str] = ...,
+        triangles: Optional[str] = ...,
+    ) -> None: ...
+    def census(self) -> str: ...
+    def arrays(
+        self,
+    ) -> List[Tuple[str, npt.NDArray[np.int64], npt.NDArray[np.uint32], npt.NDArray[np.float32]]]: ...
+    def points(self) -> npt.NDArray[np.float64]: ...
+    def level_vertex_counts(self) -> List[int]: ...
+    def local_point_stencils(
+        self,
+    ) -> Tuple[npt.NDArray[np.int64], npt.NDArray[np.int64], npt.NDArray[np.float64], Tuple[int, int]]: ...
+    def evaluate(
+        self,
+        faces: npt.NDArray[np.int64],
+        subs: npt.NDArray[np.int64],
+        u: npt.NDArray[np.float64],
+        v: npt.NDArray[np.float64],
+        derivatives: bool = ...,
+    ) -> List[npt.NDArray[np.float64]]: ...
+    def update(self, vertices: npt.NDArray[np.float64]) -> None: ...
+
 def read(
     path: Union[str, PathLike[str]],
     accept_inconsistent_orientation: bool = ...,

@@ -1,0 +1,214 @@
+//! `subd._subd._CorePatchTable`: a mesh's feature-adaptive patch table (OpenSubdiv's
+//! `PatchTable`), its arrays, its local-point stencils, vectorised evaluation and `update`.
+
+use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyList;
+use subd_limit::eval::FaceParam;
+use subd_limit::patches::{EndCaps, PatchOptions, PatchTable};
+use subd_mesh::DVec3;
+
+use crate::arrays::{contiguous, copied1, filled1, filled2, flat_ints, points};
+use crate::errors::mesh_error;
+use crate::mesh::CoreMesh;
+use crate::ops::{RuleNames, scheme};
+use crate::pool;
+
+/// A patch table of one mesh, with the points of its current positions.
+#[pyclass(name = "_CorePatchTable", module = "subd._subd")]
+pub(crate) struct CorePatchTable {
+    table: PatchTable,
+}
+
+/// One array's parts: type name, control points `(n, k)`, parameters `(n, 2)` (OpenSubdiv's
+/// two packed words), single-crease sharpness `(n,)`.
+type ArrayParts<'py> = (
+    &'static str,
+    Bound<'py, PyArray2<i64>>,
+    Bound<'py, PyArray2<u32>>,
+    Bound<'py, PyArray1<f32>>,
+);
+
+#[pymethods]
+impl CorePatchTable {
+    /// Builds the table of `mesh` with `scheme_name` and the options.
+    #[new]
+    #[pyo3(signature = (mesh, scheme_name, isolation, end_caps, single_crease, inf_sharp, legacy_sharp_corners, boundary = None, crease_method = None, triangles = None))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        py: Python<'_>,
+        mesh: &CoreMesh,
+        scheme_name: &str,
+        isolation: u8,
+        end_caps: &str,
+        single_crease: bool,
+        inf_sharp: bool,
+        legacy_sharp_corners: bool,
+        boundary: Option<&str>,
+        crease_method: Option<&str>,
+        triangles: Option<&str>,
+    ) -> PyResult<CorePatchTable> {
+        let scheme = scheme(scheme_name)?;
+        let end_caps: EndCaps = end_caps.parse().map_err(PyValueError::new_err)?;
+        let base = mesh.mesh(py)?;
+        let rules = RuleNames {
+            boundary,
+            crease_method,
+            triangles,
+            fvar_interpolation: None,
+        }
+        .options(&base.hints)?;
+        let options = PatchOptions {
+            isolation,
+            end_caps,
+            single_crease,
+            inf_sharp,
+            legacy_sharp_corners,
+        };
+        let table = pool::run(py, || {
+            PatchTable::new(&base.topology, &base.positions, &scheme, &rules, &options)
+        })?
+        .map_err(mesh_error)?;
+        Ok(CorePatchTable { table })
+    }
+
+    /// The census as JSON text (the Python layer makes it a dict).
+    fn census(&self) -> PyResult<String> {
+        serde_json::to_string(&self.table.census())
+            .map_err(|e| PyValueError::new_err(e.to_string()))
+    }
+
+    /// Every array's parts, in table order.
+    fn arrays<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+        let parts: Vec<ArrayParts<'py>> = self
+            .table
+            .arrays()
+            .iter()
+            .map(|a| {
+                let k = a.kind().num_control_points().unwrap_or(0);
+                let params = a.params();
+                Ok((
+                    a.kind().name(),
+                    flat_ints(py, a.control_points(), k.max(1))?,
+                    filled2(py, params.len(), |i, row: &mut [u32; 2]| {
+                        *row = [params[i].field0, params[i].field1]
+                    })?,
+                    copied1(py, a.sharpness())?,
+                ))
+            })
+            .collect::<PyResult<_>>()?;
+        PyList::new(py, parts)
+    }
+
+    /// Refined vertices of all levels, then local points, `(n, 3)`.
+    fn points<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        points(py, self.table.points())
+    }
+
+    /// Vertices of each refined level.
+    fn level_vertex_counts(&self) -> Vec<usize> {
+        self.table.level_vertex_counts()
+    }
+
+    /// The local points' stencils over the refined vertices of all levels, as CSR arrays:
+    /// `(indptr, indices, weights, shape)`.
+    #[allow(clippy::type_complexity)]
+    fn local_point_stencils<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(
+        Bound<'py, PyArray1<i64>>,
+        Bound<'py, PyArray1<i64>>,
+        Bound<'py, PyArray1<f64>>,
+        (usize, usize),
+    )> {
+        let s = self.table.local_point_stencils();
+        let (offsets, indices) = (s.offsets(), s.indices());
+        Ok((
+            filled1(py, offsets.len(), |i| i64::from(offsets[i]))?,
+            filled1(py, indices.len(), |i| i64::from(indices[i]))?,
+            copied1(py, s.weights())?,
+            (s.num_rows(), s.num_sources()),
+        ))
+    }
+
+    /// The surface at `(faces[i], subs[i], u[i], v[i])`: positions, du, dv and, with
+    /// `derivatives`, duu, duv, dvv, each `(m, 3)`.
+    #[pyo3(signature = (faces, subs, u, v, derivatives = false))]
+    fn evaluate<'py>(
+        &self,
+        py: Python<'py>,
+        faces: PyReadonlyArray1<'_, i64>,
+        subs: PyReadonlyArray1<'_, i64>,
+        u: PyReadonlyArray1<'_, f64>,
+        v: PyReadonlyArray1<'_, f64>,
+        derivatives: bool,
+    ) -> PyResult<Vec<Bound<'py, PyArray2<f64>>>> {
+        let (faces, subs) = (contiguous(&faces, "faces")?, contiguous(&subs, "sub")?);
+        let (u, v) = (contiguous(&u, "u")?, contiguous(&v, "v")?);
+        if [subs.len(), u.len(), v.len()]
+            .iter()
+            .any(|&n| n != faces.len())
+        {
+            return Err(PyValueError::new_err(
+                "faces, sub, u and v need the same length",
+            ));
+        }
+        let at = (0..faces.len())
+            .map(|i| {
+                let whole = |x: i64, what: &str| {
+                    usize::try_from(x).map_err(|_| {
+                        PyValueError::new_err(format!("point {i}: {what} {x} is negative"))
+                    })
+                };
+                Ok(FaceParam {
+                    face: whole(faces[i], "face")?,
+                    sub: whole(subs[i], "sub-face")?,
+                    u: u[i],
+                    v: v[i],
+                })
+            })
+            .collect::<PyResult<Vec<_>>>()?;
+        let table = &self.table;
+        let columns: Vec<Vec<DVec3>> = pool::run(py, || -> Result<Vec<Vec<DVec3>>, String> {
+            use rayon::prelude::*;
+            let rows: Vec<[DVec3; 6]> = at
+                .par_iter()
+                .enumerate()
+                .with_min_len(1024)
+                .map(|(i, p)| {
+                    table
+                        .evaluate(*p)
+                        .map(|s| [s.position, s.du, s.dv, s.duu, s.duv, s.dvv])
+                        .map_err(|e| format!("point {i}: {e}"))
+                })
+                .collect::<Result<_, _>>()?;
+            let kept = if derivatives { 6 } else { 3 };
+            Ok((0..kept)
+                .map(|k| rows.iter().map(|r| r[k]).collect())
+                .collect())
+        })?
+        .map_err(mesh_error)?;
+        columns.iter().map(|c| points(py, c)).collect()
+    }
+
+    /// Moves the base vertices: recomputes the refined and local points.
+    fn update(&mut self, py: Python<'_>, vertices: PyReadonlyArray2<'_, f64>) -> PyResult<()> {
+        if vertices.shape()[1] != 3 {
+            return Err(PyValueError::new_err(format!(
+                "vertices: expected an (n, 3) array, got {} columns",
+                vertices.shape()[1]
+            )));
+        }
+        let flat = contiguous(&vertices, "vertices")?;
+        let base: Vec<DVec3> = flat.chunks_exact(3).map(DVec3::from_slice).collect();
+        if let Some(i) = base.iter().position(|p| !p.is_finite()) {
+            return Err(PyValueError::new_err(format!(
+                "vertices: row {i} is not finite"
+            )));
+        }
+        let table = &mut self.table;
+        pool::run(py, || table.update(&base))?.map_err(mesh_error)
+    }
+}

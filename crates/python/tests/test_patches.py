@@ -1,0 +1,93 @@
+"""subd.PatchTable against independent computations: the `subd` binary's census, the exact
+limit (subd.evaluate), finite differences, and its own stencils applied by SciPy."""
+
+import json
+import os
+import pathlib
+import subprocess
+
+import numpy as np
+import pytest
+
+import subd
+from test_subd import CUBE_F, CUBE_V, icosahedron
+
+SHAPES = pathlib.Path(__file__).resolve().parents[3].parent / "shared" / "meshes" / "osd"
+SUBD_BIN = os.environ.get("SUBD_BIN")
+
+
+@pytest.mark.skipif(not SUBD_BIN, reason="SUBD_BIN not set")
+@pytest.mark.parametrize("shape,scheme,iso", [("catmark_cube", "catmull-clark", 3),
+                                               ("catmark_car", "catmull-clark", 2),
+                                               ("loop_xord_boundary", "loop", 2)])
+def test_census_equals_the_binary(shape, scheme, iso):
+    path = SHAPES / f"{shape}.obj"
+    caps = "gregory" if scheme == "catmull-clark" else "bilinear"
+    out = subprocess.run([SUBD_BIN, "patches", "--scheme", scheme, "--isolation", str(iso),
+                          "--end-caps", caps, str(path), "--json"],
+                         check=True, capture_output=True, text=True).stdout
+    table = subd.PatchTable(subd.read(path), scheme, isolation=iso, end_caps=caps)
+    assert table.census() == json.loads(out)
+
+
+def test_exact_end_caps_equal_the_exact_evaluator():
+    mesh = subd.Mesh(CUBE_V, CUBE_F)
+    table = subd.PatchTable(mesh, "catmull-clark", isolation=2, end_caps="exact",
+                            inf_sharp=True, legacy_sharp_corners=False)
+    rng = np.random.default_rng(4)
+    faces = rng.integers(0, 6, 200)
+    u, v = rng.random(200), rng.random(200)
+    p, du, dv = table.evaluate(faces, u, v)
+    q, _, qdu, qdv, *_ = subd.evaluate(mesh, "catmull-clark", faces, u, v, derivatives=True)
+    assert np.abs(p - q).max() <= 1e-12
+    assert np.abs(du - qdu).max() <= 1e-9 and np.abs(dv - qdv).max() <= 1e-9
+
+
+def test_derivatives_agree_with_differences():
+    v, f = icosahedron()
+    table = subd.PatchTable(subd.Mesh(v, f), "loop", isolation=3, end_caps="bilinear")
+    h = 1e-6
+    # Inside a box-spline patch of face 3 (away from the corner end caps).
+    uu = np.array([0.4 - h, 0.4 + h, 0.4])
+    p, du, *_ = table.evaluate([3, 3, 3], uu, [0.3, 0.3, 0.3], derivatives=True)
+    assert np.abs((p[1] - p[0]) / (2 * h) - du[2]).max() <= 1e-6
+
+
+def test_arrays_points_and_stencils_fit_together():
+    pytest.importorskip("scipy")
+    mesh = subd.Mesh(CUBE_V, CUBE_F)
+    table = subd.PatchTable(mesh, "catmull-clark", isolation=3)
+    points = table.points
+    refined = sum(table.level_vertex_counts)
+    stencils = table.local_point_stencils
+    # The local points are their stencils applied to the refined vertices.
+    assert np.abs(stencils @ points[:refined] - points[refined:]).max() <= 1e-14
+    census = table.census()
+    assert sum(len(a["params"]) for a in table.arrays) == census["patches"]
+    for a in table.arrays:
+        assert a["control_points"].max() < len(points)
+        assert a["params"].dtype == np.uint32 and a["params"].shape[1] == 2
+
+
+def test_update_equals_a_rebuild():
+    mesh = subd.Mesh(CUBE_V, CUBE_F)
+    table = subd.PatchTable(mesh, "catmull-clark", isolation=2)
+    moved = CUBE_V * 2.0 + [0.5, 0.0, -1.0]
+    table.update(moved)
+    rebuilt = subd.PatchTable(subd.Mesh(moved, CUBE_F), "catmull-clark", isolation=2)
+    assert np.array_equal(table.points, rebuilt.points)
+
+
+def test_bad_requests_raise_typed_errors():
+    mesh = subd.Mesh(CUBE_V, CUBE_F)
+    with pytest.raises(ValueError, match="isolation: 11"):
+        subd.PatchTable(mesh, "catmull-clark", isolation=11)
+    with pytest.raises(ValueError, match="end_caps"):
+        subd.PatchTable(mesh, "catmull-clark", end_caps="smooth")
+    with pytest.raises(subd.MeshError, match="triangles"):
+        subd.PatchTable(mesh, "loop")
+    table = subd.PatchTable(mesh, "catmull-clark", isolation=1)
+    with pytest.raises(subd.MeshError, match="point 1"):
+        table.evaluate([0, 9], [0.5, 0.5], [0.5, 0.5])
+    with pytest.raises(ValueError, match="vertices"):
+        table.update(np.zeros((8, 2)))
