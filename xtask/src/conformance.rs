@@ -1050,6 +1050,8 @@ pub fn report(rows: &[Row]) -> bool {
                 format!(" ({n} points left out: Bfr's Gregory-cap corners off the exact limit, or faces subd does not evaluate; there |Δ|/diag ≤ {e:.1e})")
             } else if r.check.starts_with("fvar-limit") {
                 format!(" ({n} values where OpenSubdiv is inexact checked apart: seam creases to 1e-7 (its float weights), Bilinear seam values kept, eigen-limit vertices; there |Δ|/diag ≤ {e:.1e})")
+            } else if r.check == "patches" {
+                format!(" ({n} points in Loop box-spline end caps checked apart: OpenSubdiv fits them with float constants off the exact fit by up to 2.6e-5; there |Δ|/diag ≤ {e:.1e})")
             } else if r.check == "eval" {
                 format!(" ({n} points not on the surface (holes) or not covered left out; in the 2^-10 end-cap squares |Δ|/diag ≤ {e:.1e})")
             } else {

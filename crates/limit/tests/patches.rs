@@ -9,6 +9,7 @@ use subd_mesh::{DVec3, Topology, TopologyBuilder};
 use subd_schemes::{Options, Scheme};
 
 /// A mesh for the tests: topology, positions, scheme.
+#[derive(Clone)]
 struct Case {
     topology: Topology,
     positions: Vec<DVec3>,
@@ -325,27 +326,65 @@ fn options(isolation: u8, end_caps: EndCaps, inf_sharp: bool) -> PatchOptions {
     }
 }
 
+/// Every kind of end caps, for either scheme.
+const ALL_CAPS: [EndCaps; 4] = [
+    EndCaps::GregoryBasis,
+    EndCaps::Bilinear,
+    EndCaps::BSpline,
+    EndCaps::Exact,
+];
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(24))]
 
     #[test]
-    fn the_patch_map_covers_every_face_once(case in 0usize..5, isolation in 1u8..5, inf_sharp: bool, caps in 0usize..3) {
+    fn the_patch_map_covers_every_face_once(case in 0usize..5, isolation in 1u8..5, inf_sharp: bool, caps in 0usize..4) {
         let c = &cases()[case];
-        let caps = [EndCaps::GregoryBasis, EndCaps::Bilinear, EndCaps::Exact][caps];
-        let caps = if c.scheme == Scheme::Loop && caps == EndCaps::GregoryBasis { EndCaps::Bilinear } else { caps };
-        let table = PatchTable::new(&c.topology, &c.positions, &c.scheme, &Options::default(), &options(isolation, caps, inf_sharp)).unwrap();
+        let table = PatchTable::new(&c.topology, &c.positions, &c.scheme, &Options::default(), &options(isolation, ALL_CAPS[caps], inf_sharp)).unwrap();
         check_coverage(c, &table);
     }
 
     #[test]
-    fn neighbouring_patches_meet(case in 0usize..5, isolation in 1u8..5, inf_sharp: bool) {
+    fn neighbouring_patches_meet(case in 0usize..5, isolation in 1u8..5, inf_sharp: bool, exact: bool) {
         let c = &cases()[case];
-        // Gregory end caps share their boundary points with their neighbours; exact end
-        // caps are the limit itself. Bilinear caps are not continuous with the B-splines.
-        let caps = if c.scheme == Scheme::Loop { EndCaps::Exact } else { EndCaps::GregoryBasis };
+        // Gregory end caps (quads and triangles) share their boundary curves with their
+        // neighbours; exact end caps are the limit itself. Bilinear caps, and B-spline and
+        // box-spline caps (fitted, each on its own), are not continuous with the regular
+        // patches.
+        let caps = if exact { EndCaps::Exact } else { EndCaps::GregoryBasis };
         let table = PatchTable::new(&c.topology, &c.positions, &c.scheme, &Options::default(), &options(isolation, caps, inf_sharp)).unwrap();
         check_edges_agree(c, &table, 1e-12);
         check_inner_edges_agree(c, &table, 1e-12);
+    }
+}
+
+/// B-spline end caps are patches of the regular type, in the regular array: the irregular
+/// corner of a Catmull-Clark cube needs 7 new points per cap (the other 9 are the level's
+/// vertices), a Loop box-spline cap 12.
+#[test]
+fn b_spline_end_caps_join_the_regular_patches() {
+    for (c, regular, new_per_cap) in [
+        (cube(), PatchType::Regular, 7),
+        (octahedron(), PatchType::Loop, 12),
+    ] {
+        let o = options(2, EndCaps::BSpline, false);
+        let table = PatchTable::new(
+            &c.topology,
+            &c.positions,
+            &c.scheme,
+            &Options::default(),
+            &o,
+        )
+        .unwrap();
+        assert_eq!(table.arrays().len(), 1);
+        assert_eq!(table.arrays()[0].kind(), regular);
+        let caps = table.arrays()[0]
+            .params()
+            .iter()
+            .filter(|p| !p.place().regular)
+            .count();
+        assert!(caps > 0);
+        assert_eq!(table.census().local_points, new_per_cap * caps);
     }
 }
 
@@ -397,16 +436,11 @@ fn exact_end_caps_are_the_exact_limit_everywhere() {
 
 #[test]
 fn update_equals_a_rebuild() {
-    for c in cases() {
-        let o = options(
-            3,
-            if c.scheme == Scheme::Loop {
-                EndCaps::Bilinear
-            } else {
-                EndCaps::GregoryBasis
-            },
-            false,
-        );
+    for (c, caps) in cases()
+        .into_iter()
+        .flat_map(|c| ALL_CAPS.map(|e| (c.clone(), e)))
+    {
+        let o = options(3, caps, false);
         let mut table = PatchTable::new(
             &c.topology,
             &c.positions,

@@ -5,14 +5,15 @@ use std::collections::HashMap;
 
 use subd_schemes::StencilTable;
 
+use super::bspline_caps::{self, CapPoint};
 use super::classify::FoundPatch;
 use super::end_caps::{self, CornerRules, Row};
 use super::features::Regularity;
 use super::gather;
 use super::levels::PatchLevel;
+use super::loop_caps;
 use super::table::PatchArray;
 use super::{EndCaps, PatchOptions, PatchType};
-use crate::LimitError;
 
 /// What a local point is shared under (`shareEndCapPatchPoints`): a corner's limit
 /// position by its vertex, an edge point by its edge and the end it is nearest, within a
@@ -62,7 +63,7 @@ impl<'a> Assembly<'a> {
 
     /// The arrays for `found` with end caps of type `caps`: the regular type first (end
     /// caps of the same type in it), then the end caps'; empty arrays dropped.
-    pub fn run(mut self, found: &[FoundPatch], caps: PatchType) -> Result<Assembled, LimitError> {
+    pub fn run(mut self, found: &[FoundPatch], caps: PatchType) -> Assembled {
         let regular = if self.reg.face_size == 3 {
             PatchType::Loop
         } else {
@@ -75,7 +76,7 @@ impl<'a> Assembly<'a> {
             let points = if p.regular {
                 self.regular_points(p)
             } else {
-                self.end_cap_points(p)?
+                self.end_cap_points(p)
             };
             slots.push((a, arrays[a].len()));
             arrays[a].push(p.param, p.sharpness, &points);
@@ -94,7 +95,7 @@ impl<'a> Assembly<'a> {
         let total = *self.level_offsets.last().expect("offsets") as usize;
         let local = StencilTable::from_rows(total, &self.local_rows);
         let arrays = arrays.into_iter().filter(|a| !a.is_empty()).collect();
-        Ok((arrays, handles, local))
+        (arrays, handles, local)
     }
 
     /// The 16 or 12 points of a regular patch, as refined-vertex indices.
@@ -110,9 +111,10 @@ impl<'a> Assembly<'a> {
         local.into_iter().map(|v| v + offset).collect()
     }
 
-    /// The local points of an end cap (new ones appended, shared ones reused), as indices
-    /// past the refined vertices.
-    fn end_cap_points(&mut self, p: &FoundPatch) -> Result<Vec<u32>, LimitError> {
+    /// The points of an end cap: local points (new ones appended, shared ones reused) as
+    /// indices past the refined vertices, and the level's vertices a B-spline end cap takes
+    /// as they are.
+    fn end_cap_points(&mut self, p: &FoundPatch) -> Vec<u32> {
         let level = &self.levels[p.level as usize];
         let (t, tags, f) = (&level.topology, &level.tags, p.face as usize);
         let rules = CornerRules {
@@ -120,33 +122,31 @@ impl<'a> Assembly<'a> {
             legacy_sharp_corners: self.options.legacy_sharp_corners,
         };
         let quads = self.reg.face_size == 4;
-        let rows = match self.options.end_caps {
-            EndCaps::Exact => return Ok(Vec::new()),
-            EndCaps::GregoryBasis if quads => end_caps::gregory(t, tags, f, &rules),
-            EndCaps::Bilinear if quads => end_caps::bilinear(t, tags, f, &rules),
-            EndCaps::Bilinear => end_caps::linear_triangle(t, tags, f, &rules),
-            _ => {
-                return Err(LimitError::Unsupported {
-                    face: f,
-                    reason: if quads {
-                        "b-spline end caps are not built yet (gregory, bilinear and exact are)"
-                    } else {
-                        "loop end caps other than bilinear and exact are not built yet"
-                    },
-                });
-            }
+        let local = |rows: Vec<Row>| rows.into_iter().map(CapPoint::Local).collect();
+        let points: Vec<CapPoint> = match self.options.end_caps {
+            EndCaps::Exact => return Vec::new(),
+            EndCaps::GregoryBasis if quads => local(end_caps::gregory(t, tags, f, &rules)),
+            EndCaps::GregoryBasis => local(loop_caps::gregory_triangle(t, tags, f, &rules)),
+            EndCaps::BSpline if quads => bspline_caps::bspline(t, tags, f, &rules),
+            EndCaps::BSpline => local(loop_caps::box_spline(t, tags, f, &rules)),
+            EndCaps::Bilinear if quads => local(end_caps::bilinear(t, tags, f, &rules)),
+            EndCaps::Bilinear => local(end_caps::linear_triangle(t, tags, f, &rules)),
         };
-        let keys = self.share_keys(p, rows.len());
-        Ok(rows
+        let keys = self.share_keys(p, points.len());
+        let offset = self.level_offsets[p.level as usize];
+        points
             .into_iter()
             .zip(keys)
-            .map(|(row, key)| self.local_point(p.level, row, key))
-            .collect())
+            .map(|(point, key)| match point {
+                CapPoint::Vertex(v) => v + offset,
+                CapPoint::Local(row) => self.local_point(p.level, row, key),
+            })
+            .collect()
     }
 
     /// The sharing key of each of an end cap's points (`None`: never shared). Gregory quads
     /// share `P` by vertex and `Ep`/`Em` by edge end on interior edges; bilinear quads
-    /// share corners by vertex; triangles share nothing.
+    /// share corners by vertex; B-spline end caps and triangles share nothing.
     fn share_keys(&self, p: &FoundPatch, n: usize) -> Vec<Option<ShareKey>> {
         let level = &self.levels[p.level as usize];
         let t = &level.topology;

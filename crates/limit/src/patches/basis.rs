@@ -310,6 +310,98 @@ pub(crate) fn gregory(s: f64, t: f64) -> Weights<20> {
     w
 }
 
+/// `u^i v^j w^k` differentiated `di`, `dj`, `dk` times in `u`, `v`, `w`.
+fn barycentric_monomial(uvw: [f64; 3], ijk: [i32; 3], d: [i32; 3]) -> f64 {
+    let mut x = 1.0;
+    for a in 0..3 {
+        // Falling factorial: the derivative's coefficient; zero past the power.
+        for r in 0..d[a] {
+            x *= f64::from(ijk[a] - r);
+        }
+        if ijk[a] >= d[a] {
+            x *= uvw[a].powi(ijk[a] - d[a]);
+        }
+    }
+    x
+}
+
+/// Quartic Bernstein weights of the 15 points of a Bézier triangle, row by row from corner
+/// 0 (`p004, p103, p202, p301, p400, p013, …, p040`; `p_{ijk}` weighs `u^i v^j w^k` with
+/// `u = s`, `v = t`, `w = 1 − s − t`), and their derivatives by the chain rule
+/// `∂s = ∂u − ∂w`, `∂t = ∂v − ∂w`.
+pub(crate) fn bezier_triangle(s: f64, t: f64) -> Weights<15> {
+    let uvw = [s, t, 1.0 - s - t];
+    // Each derivative as a sum of barycentric derivative orders (du, dv, dw) with signs.
+    const PARTIALS: [&[(f64, [i32; 3])]; 6] = [
+        &[(1.0, [0, 0, 0])],
+        &[(1.0, [1, 0, 0]), (-1.0, [0, 0, 1])],
+        &[(1.0, [0, 1, 0]), (-1.0, [0, 0, 1])],
+        &[(1.0, [2, 0, 0]), (-2.0, [1, 0, 1]), (1.0, [0, 0, 2])],
+        &[
+            (1.0, [1, 1, 0]),
+            (-1.0, [1, 0, 1]),
+            (-1.0, [0, 1, 1]),
+            (1.0, [0, 0, 2]),
+        ],
+        &[(1.0, [0, 2, 0]), (-2.0, [0, 1, 1]), (1.0, [0, 0, 2])],
+    ];
+    let factorial = [1.0, 1.0, 2.0, 6.0, 24.0];
+    let mut w = [[0.0; 15]; 6];
+    let mut q = 0;
+    for j in 0..=4i32 {
+        for i in 0..=(4 - j) {
+            let k = 4 - i - j;
+            let multinomial =
+                24.0 / (factorial[i as usize] * factorial[j as usize] * factorial[k as usize]);
+            for (row, terms) in w.iter_mut().zip(PARTIALS) {
+                row[q] = multinomial
+                    * terms
+                        .iter()
+                        .map(|&(sign, d)| sign * barycentric_monomial(uvw, [i, j, k], d))
+                        .sum::<f64>();
+            }
+            q += 1;
+        }
+    }
+    w
+}
+
+/// The Bézier point (index into [`bezier_triangle`]'s order) of each of the 18 Gregory
+/// triangle points (per corner `P, Ep, Em, Fp, Fm`, then `M_0, M_1, M_2`), with the pair
+/// at an interior point sharing it.
+const GREGORY_TRIANGLE_NET: [usize; 18] =
+    [0, 1, 5, 6, 6, 4, 8, 3, 7, 7, 14, 12, 13, 10, 10, 2, 11, 9];
+
+/// Gregory triangle weights of the 18 points at `(s, t)`: the quartic Bézier triangle whose
+/// interior point next to each corner blends that corner's `Fp` and `Fm` by the
+/// barycentric distances to the two edges (the `Fp` share `u/(u + v)`, `v/(v + w)`,
+/// `w/(w + u)` at corners 0, 1, 2; all `Fp` where the sum vanishes, as OpenSubdiv chooses).
+/// Derivatives hold the blend constant, as OpenSubdiv's evaluation does.
+pub(crate) fn gregory_triangle(s: f64, t: f64) -> Weights<18> {
+    let b = bezier_triangle(s, t);
+    let (u, v, w) = (s, t, 1.0 - s - t);
+    let shares = |x: f64, y: f64| {
+        if x + y > 0.0 {
+            [x / (x + y), y / (x + y)]
+        } else {
+            [1.0, 0.0]
+        }
+    };
+    let pairs = [shares(u, v), shares(v, w), shares(w, u)];
+    let mut out = [[0.0; 18]; 6];
+    for (k, &q) in GREGORY_TRIANGLE_NET.iter().enumerate() {
+        let blend = match (k < 15, k % 5) {
+            (true, 3) => pairs[k / 5][0],
+            (true, 4) => pairs[k / 5][1],
+            _ => 1.0,
+        };
+        for (o, row) in out.iter_mut().zip(&b) {
+            o[k] = blend * row[q];
+        }
+    }
+    out
+}
+
 /// Widens `N` weights to the 20 slots every patch type fits in.
 fn widen<const N: usize>(w: Weights<N>) -> Weights<20> {
     w.map(|row| std::array::from_fn(|k| if k < N { row[k] } else { 0.0 }))
@@ -327,8 +419,130 @@ pub(crate) fn weights(kind: super::PatchType, s: f64, t: f64, boundary: u8) -> W
             widen(box_spline(basis, s, t, boundary))
         }
         T::GregoryBasis => gregory(s, t),
+        T::GregoryTriangle => widen(gregory_triangle(s, t)),
         T::Quads => widen(bilinear(s, t)),
         T::Triangles => widen(linear(s, t)),
-        T::GregoryTriangle | T::Exact => unreachable!("{kind} patches are evaluated elsewhere"),
+        T::Exact => unreachable!("{kind} patches are evaluated elsewhere"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const POINTS: [(f64, f64); 6] = [
+        (0.2, 0.3),
+        (0.0, 0.0),
+        (1.0, 0.0),
+        (0.0, 1.0),
+        (0.61, 0.05),
+        (0.25, 0.74),
+    ];
+
+    /// `x (x − 1) … (x − n + 1)`.
+    fn falling(x: i32, n: i32) -> f64 {
+        (0..n).map(|r| f64::from(x - r)).product()
+    }
+
+    /// Every barycentric monomial `u^a v^b w^c` of degree ≤ 4 is reproduced, with its
+    /// derivatives: its quartic Bézier coefficients are the blossom values
+    /// `i^(a) j^(b) k^(c) (4 − a − b − c)! / 4!` (falling factorials).
+    #[test]
+    fn the_bezier_triangle_reproduces_quartic_polynomials() {
+        for a in 0..=4 {
+            for b in 0..=(4 - a) {
+                for c in 0..=(4 - a - b) {
+                    let scale = falling(4 - a - b - c, 4 - a - b - c) / 24.0;
+                    let mut coeffs = Vec::new();
+                    for j in 0..=4i32 {
+                        for i in 0..=(4 - j) {
+                            let k = 4 - i - j;
+                            coeffs.push(falling(i, a) * falling(j, b) * falling(k, c) * scale);
+                        }
+                    }
+                    for &(s, t) in &POINTS {
+                        let w = bezier_triangle(s, t);
+                        let uvw = [s, t, 1.0 - s - t];
+                        let exact = |d: [i32; 3]| barycentric_monomial(uvw, [a, b, c], d);
+                        let want = [
+                            exact([0, 0, 0]),
+                            exact([1, 0, 0]) - exact([0, 0, 1]),
+                            exact([0, 1, 0]) - exact([0, 0, 1]),
+                            exact([2, 0, 0]) - 2.0 * exact([1, 0, 1]) + exact([0, 0, 2]),
+                            exact([1, 1, 0]) - exact([1, 0, 1]) - exact([0, 1, 1])
+                                + exact([0, 0, 2]),
+                            exact([0, 2, 0]) - 2.0 * exact([0, 1, 1]) + exact([0, 0, 2]),
+                        ];
+                        for d in 0..6 {
+                            let got: f64 = w[d].iter().zip(&coeffs).map(|(x, y)| x * y).sum();
+                            assert!(
+                                (got - want[d]).abs() < 1e-12,
+                                "u^{a} v^{b} w^{c} at ({s}, {t}), derivative {d}: {got} vs {}",
+                                want[d]
+                            );
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn bezier_triangle_derivatives_are_those_of_the_position() {
+        let h = 1e-6;
+        for &(s, t) in &POINTS[..1] {
+            let at = |s, t| bezier_triangle(s, t);
+            let (ps, ms, pt, mt) = (at(s + h, t), at(s - h, t), at(s, t + h), at(s, t - h));
+            let w = at(s, t);
+            for q in 0..15 {
+                let ds = (ps[0][q] - ms[0][q]) / (2.0 * h);
+                let dt = (pt[0][q] - mt[0][q]) / (2.0 * h);
+                let dss = (ps[1][q] - ms[1][q]) / (2.0 * h);
+                let dst = (pt[1][q] - mt[1][q]) / (2.0 * h);
+                let dtt = (pt[2][q] - mt[2][q]) / (2.0 * h);
+                for (got, want) in [
+                    (w[1][q], ds),
+                    (w[2][q], dt),
+                    (w[3][q], dss),
+                    (w[4][q], dst),
+                    (w[5][q], dtt),
+                ] {
+                    assert!((got - want).abs() < 1e-6, "point {q}: {got} vs {want}");
+                }
+            }
+        }
+    }
+
+    /// With each corner's `Fp` and `Fm` the same point, the Gregory triangle is the Bézier
+    /// triangle: the blends are a partition of unity.
+    #[test]
+    fn the_gregory_triangle_with_equal_pairs_is_the_bezier_triangle() {
+        for &(s, t) in &POINTS {
+            let g = gregory_triangle(s, t);
+            let b = bezier_triangle(s, t);
+            for d in 0..6 {
+                let mut folded = [0.0; 15];
+                for (k, &q) in GREGORY_TRIANGLE_NET.iter().enumerate() {
+                    folded[q] += g[d][k];
+                }
+                for q in 0..15 {
+                    assert!((folded[q] - b[d][q]).abs() < 1e-14, "({s}, {t}) {d} {q}");
+                }
+            }
+            let total: f64 = g[0].iter().sum();
+            assert!((total - 1.0).abs() < 1e-14);
+        }
+    }
+
+    #[test]
+    fn gregory_triangle_pairs_blend_by_distance_to_the_edges() {
+        // On edge 0 (t = 0) the cross derivative sees only Fp0, the point paired with that
+        // edge; on edge 2 (s = 0) only Fm0; at the corner itself OpenSubdiv picks Fp.
+        let g = gregory_triangle(0.3, 0.0);
+        assert!(g[2][3] > 0.0 && g[2][4] == 0.0);
+        let g = gregory_triangle(0.0, 0.3);
+        assert!(g[1][4] > 0.0 && g[1][3] == 0.0);
+        let g = gregory_triangle(0.0, 0.0);
+        assert!(g[4][3] == 12.0 && g[4][4] == 0.0);
     }
 }

@@ -1,6 +1,8 @@
 //! End caps of Catmull-Clark patches: the points of a Gregory patch (20) or a bilinear quad
 //! (4) fitted to an irregular face, as weights of the face's level vertices
-//! (OpenSubdiv's `GregoryConverter` and `LinearConverter`; formulas restated, code our own).
+//! (OpenSubdiv's `GregoryConverter` and `LinearConverter`; formulas restated, code our own);
+//! and the corners every end cap is built from, quads and triangles alike
+//! (`bspline_caps` and `loop_caps` build the other kinds on them).
 //!
 //! **Corners.** Each corner `V` of the face sees a fan of faces `G_0 … G_{m−1}` counter-
 //! clockwise, the patch face at position `k`: the whole ring of an interior vertex, the fan
@@ -27,58 +29,118 @@ use super::features::VTag;
 /// A point as weights of the level's vertices.
 pub(crate) type Row = Vec<(u32, f64)>;
 
-fn add(out: &mut Row, w: f64, row: &[(u32, f64)]) {
+/// Appends `w` times `row` to `out`.
+pub(crate) fn add(out: &mut Row, w: f64, row: &[(u32, f64)]) {
     out.extend(row.iter().map(|&(i, x)| (i, w * x)));
 }
 
-fn point(v: u32) -> Row {
+pub(crate) fn point(v: u32) -> Row {
     vec![(v, 1.0)]
 }
 
 /// One corner of the patch face and its fan.
 #[derive(Debug)]
-struct Corner {
-    v: u32,
+pub(crate) struct Corner {
+    pub v: u32,
     /// Faces in the fan.
-    m: usize,
+    pub m: usize,
     /// The patch face's position in the fan.
-    k: usize,
+    pub k: usize,
     /// The fan does not close around `v`.
-    boundary: bool,
-    sharp: bool,
+    pub boundary: bool,
+    pub sharp: bool,
     /// `e_0 … e_{m−1}` (and `e_m` on a boundary).
-    e: Vec<u32>,
-    /// `f_0 … f_{m−1}`.
-    f: Vec<u32>,
+    pub e: Vec<u32>,
+    /// `f_0 … f_{m−1}` (quads only: the vertex diagonally across `G_j`).
+    pub f: Vec<u32>,
+    /// Faces around a regular interior vertex: 4 for quads, 6 for triangles.
+    regular_faces: usize,
 }
 
 impl Corner {
-    fn valence(&self) -> usize {
+    pub fn valence(&self) -> usize {
         self.m + usize::from(self.boundary)
     }
-    fn e(&self, i: usize) -> u32 {
+    /// `e_i`, the index taken around the fan's edges.
+    pub fn e(&self, i: usize) -> u32 {
         self.e[i % self.valence()]
     }
-    fn f(&self, i: usize) -> u32 {
+    pub fn f(&self, i: usize) -> u32 {
         self.f[i % self.m]
     }
-    fn next(&self) -> u32 {
+    /// The patch face's next corner (`e_k`).
+    pub fn next(&self) -> u32 {
         self.e[self.k]
     }
-    fn prev(&self) -> u32 {
+    /// The patch face's previous corner (`e_{k+1}`).
+    pub fn prev(&self) -> u32 {
         self.e((self.k + 1) % self.valence())
     }
-    fn regular(&self) -> bool {
-        (self.m << usize::from(self.boundary)) == 4 && !self.sharp
+    /// Regular valence (a boundary fan counts double) and not sharp.
+    pub fn regular(&self) -> bool {
+        (self.m << usize::from(self.boundary)) == self.regular_faces && !self.sharp
     }
-    fn cos_a(&self) -> f64 {
+    /// `Ep` lies along the boundary edge `e_0`.
+    pub fn ep_on_boundary(&self) -> bool {
+        self.boundary && self.k == 0
+    }
+    /// `Em` lies along the boundary edge `e_m`.
+    pub fn em_on_boundary(&self) -> bool {
+        self.boundary && self.k + 1 == self.m
+    }
+    /// The cosine of the corner's face angle, which the face points blend with: the
+    /// regular angle's exactly (0 for quads, ½ for triangles), else `cos(2π/m)` (`π/m` on a
+    /// boundary).
+    pub fn cos_a(&self) -> f64 {
         if self.regular() {
-            0.0
+            if self.regular_faces == 4 { 0.0 } else { 0.5 }
         } else {
             let full = if self.boundary { PI } else { 2.0 * PI };
             (full / self.m as f64).cos()
         }
     }
+}
+
+/// How a corner's face point is made (OpenSubdiv's `GregoryConverter::Initialize`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum FacePoint {
+    /// The regular-neighbourhood formula.
+    Regular,
+    /// Blended from the edge points of this corner and the next one along the edge.
+    Computed,
+    /// The same as the corner's other face point: beside a boundary edge the two sides
+    /// must agree, the edge having no second patch to match.
+    CopyOther,
+}
+
+/// How `Fp` and `Fm` of corner `c` are made, `next` and `prev` its neighbours around the
+/// face. Both sides of a face point must be regular for the regular formula; a 1-face
+/// corner always uses it.
+pub(crate) fn face_point_kinds(c: &Corner, next: &Corner, prev: &Corner) -> [FacePoint; 2] {
+    let mut fp_regular = c.regular() && next.regular();
+    let mut fm_regular = c.regular() && prev.regular();
+    let (mut fp_copy, mut fm_copy) = (false, false);
+    if c.boundary {
+        if c.m > 1 {
+            if c.ep_on_boundary() {
+                fp_regular = fm_regular;
+                fp_copy = !fp_regular;
+            }
+            if c.em_on_boundary() {
+                fm_regular = fp_regular;
+                fm_copy = !fm_regular;
+            }
+        } else {
+            fp_regular = true;
+            fm_regular = true;
+        }
+    }
+    let kind = |regular: bool, copy: bool| match (regular, copy) {
+        (true, _) => FacePoint::Regular,
+        (false, true) => FacePoint::CopyOther,
+        (false, false) => FacePoint::Computed,
+    };
+    [kind(fp_regular, fp_copy), kind(fm_regular, fm_copy)]
 }
 
 /// What decides a corner's fan and sharpness.
@@ -159,6 +221,7 @@ fn corner(t: &Topology, tags: &[VTag], f: usize, c: usize, rules: &CornerRules) 
         e.push(at(last, t.face_size(last) - 1));
     }
     let m = fan.len();
+    let regular_faces = if t.face_size(f) == 3 { 6 } else { 4 };
     let sharp = if tag.has(VTag::CORNER) {
         true
     } else if tag.has(VTag::NON_MANIFOLD) {
@@ -186,6 +249,7 @@ fn corner(t: &Topology, tags: &[VTag], f: usize, c: usize, rules: &CornerRules) 
         sharp: sharp || legacy,
         e,
         f: f_pts,
+        regular_faces,
     }
 }
 
@@ -212,12 +276,12 @@ fn interior_limit(c: &Corner) -> Row {
 }
 
 /// The limit position of a boundary vertex (the cubic B-spline of its boundary).
-fn boundary_limit(c: &Corner) -> Row {
+pub(crate) fn boundary_limit(c: &Corner) -> Row {
     vec![(c.v, 2.0 / 3.0), (c.e[0], 1.0 / 6.0), (c.e[c.m], 1.0 / 6.0)]
 }
 
 /// `P`, `Ep`, `Em` of an interior corner of any valence.
-fn interior_points(c: &Corner) -> [Row; 3] {
+pub(crate) fn interior_points(c: &Corner) -> [Row; 3] {
     let n = c.m;
     let p = interior_limit(c);
     let theta = 2.0 * PI / n as f64;
@@ -341,8 +405,8 @@ fn edge_points(c: &Corner) -> [Row; 3] {
     }
 }
 
-/// The corners of quad `f` of a level.
-fn corners(t: &Topology, tags: &[VTag], f: usize, rules: &CornerRules) -> Vec<Corner> {
+/// The corners of face `f` of a level.
+pub(crate) fn corners(t: &Topology, tags: &[VTag], f: usize, rules: &CornerRules) -> Vec<Corner> {
     (0..t.face_size(f))
         .map(|c| corner(t, tags, f, c, rules))
         .collect()
@@ -350,74 +414,75 @@ fn corners(t: &Topology, tags: &[VTag], f: usize, rules: &CornerRules) -> Vec<Co
 
 /// The 20 points of the Gregory patch of quad `f`: per corner `P, Ep, Em, Fp, Fm`.
 pub(crate) fn gregory(t: &Topology, tags: &[VTag], f: usize, rules: &CornerRules) -> Vec<Row> {
-    let cs = corners(t, tags, f, rules);
+    gregory_points(&corners(t, tags, f, rules))
+}
+
+/// The 20 Gregory points of a quad with corners `cs`.
+pub(crate) fn gregory_points(cs: &[Corner]) -> Vec<Row> {
     let edges: Vec<[Row; 3]> = cs.iter().map(edge_points).collect();
     let mut out = Vec::with_capacity(20);
-    for (i, c) in cs.iter().enumerate() {
-        let (next, prev) = (&cs[(i + 1) % 4], &cs[(i + 3) % 4]);
-        let [p, ep, em] = &edges[i];
-        let mut fp_regular = c.regular() && next.regular();
-        let mut fm_regular = c.regular() && prev.regular();
-        let (mut fp_copy, mut fm_copy) = (false, false);
-        if c.boundary {
-            if c.m > 1 {
-                if c.k == 0 {
-                    fp_regular = fm_regular;
-                    fp_copy = !fp_regular;
-                }
-                if c.k == c.m - 1 {
-                    fm_regular = fp_regular;
-                    fm_copy = !fm_regular;
-                }
-            } else {
-                fp_regular = true;
-                fm_regular = true;
-            }
-        }
-        let opposite = t.face_vertices(f)[(i + 2) % 4];
-        let face_regular = || {
-            vec![
-                (c.v, 4.0 / 9.0),
-                (c.prev(), 2.0 / 9.0),
-                (c.next(), 2.0 / 9.0),
-                (opposite, 1.0 / 9.0),
-            ]
-        };
-        let val = c.valence();
-        let irregular = |sign: f64, ring: usize, near: &Row, far_c: &Corner, far: &Row| {
-            let (ca_near, ca_far) = (c.cos_a(), far_c.cos_a());
-            let mut r: Row = Vec::new();
-            add(&mut r, ca_far / 3.0, p);
-            add(&mut r, (3.0 - 2.0 * ca_near - ca_far) / 3.0, near);
-            add(&mut r, 2.0 * ca_near / 3.0, far);
-            let (en, ep_) = (c.e((ring + 1) % val), c.e((ring + val - 1) % val));
-            let (fi, fim) = (c.f[ring % c.m], c.f[(ring + c.m - 1) % c.m]);
-            r.extend([
-                (en, sign / 9.0),
-                (ep_, -sign / 9.0),
-                (fi, sign / 18.0),
-                (fim, -sign / 18.0),
-            ]);
-            r
-        };
-        let fp_point = if fp_regular {
-            face_regular()
-        } else {
-            irregular(1.0, c.k, ep, next, &edges[(i + 1) % 4][2])
-        };
-        let fm_point = if fm_regular {
-            face_regular()
-        } else {
-            irregular(-1.0, (c.k + 1) % val, em, prev, &edges[(i + 3) % 4][1])
-        };
-        let (fp, fm) = match (fp_copy, fm_copy) {
-            (true, _) => (fm_point.clone(), fm_point),
-            (_, true) => (fp_point.clone(), fp_point),
-            _ => (fp_point, fm_point),
-        };
+    for (i, [p, ep, em]) in edges.iter().enumerate() {
+        let [fp, fm] = quad_face_points(cs, &edges, i);
         out.extend([p.clone(), ep.clone(), em.clone(), fp, fm]);
     }
     out
+}
+
+/// `Fp` and `Fm` of corner `i` of a quad, from the corners' `P, Ep, Em`.
+fn quad_face_points(cs: &[Corner], edges: &[[Row; 3]], i: usize) -> [Row; 2] {
+    let c = &cs[i];
+    let (next, prev) = (&cs[(i + 1) % 4], &cs[(i + 3) % 4]);
+    let [p, ep, em] = &edges[i];
+    let regular = || {
+        vec![
+            (c.v, 4.0 / 9.0),
+            (c.prev(), 2.0 / 9.0),
+            (c.next(), 2.0 / 9.0),
+            (c.f(c.k), 1.0 / 9.0),
+        ]
+    };
+    let val = c.valence();
+    // Loop et al. 2009: the cross tangent blends the two corners' edge points by their
+    // face angles, plus the twist of the ring's points on either side of edge `ring`.
+    let computed = |sign: f64, ring: usize, near: &Row, far_c: &Corner, far: &Row| {
+        let (ca_near, ca_far) = (c.cos_a(), far_c.cos_a());
+        let mut r: Row = Vec::new();
+        add(&mut r, ca_far / 3.0, p);
+        add(&mut r, (3.0 - 2.0 * ca_near - ca_far) / 3.0, near);
+        add(&mut r, 2.0 * ca_near / 3.0, far);
+        r.extend([
+            (c.e(ring + 1), sign / 9.0),
+            (c.e(ring + val - 1), -sign / 9.0),
+            (c.f(ring), sign / 18.0),
+            (c.f(ring + c.m - 1), -sign / 18.0),
+        ]);
+        r
+    };
+    let kinds = face_point_kinds(c, next, prev);
+    let make = |kind: FacePoint, plus: bool| match (kind, plus) {
+        (FacePoint::Regular, _) => Some(regular()),
+        (FacePoint::Computed, true) => Some(computed(1.0, c.k, ep, next, &edges[(i + 1) % 4][2])),
+        (FacePoint::Computed, false) => Some(computed(
+            -1.0,
+            (c.k + 1) % val,
+            em,
+            prev,
+            &edges[(i + 3) % 4][1],
+        )),
+        (FacePoint::CopyOther, _) => None,
+    };
+    resolve_copies(make(kinds[0], true), make(kinds[1], false))
+}
+
+/// `[Fp, Fm]`, the one not made (`None`: a copy) taken from the other.
+pub(crate) fn resolve_copies(fp: Option<Row>, fm: Option<Row>) -> [Row; 2] {
+    match (fp, fm) {
+        (Some(fp), Some(fm)) => [fp, fm],
+        (None, Some(fm)) => [fm.clone(), fm],
+        (Some(fp), None) => [fp.clone(), fp],
+        // Copying both sides needs the patch face first and last in a fan of two or more.
+        (None, None) => unreachable!("a corner copies at most one face point"),
+    }
 }
 
 /// The 4 points of the bilinear end cap of quad `f`: its corners' limit positions.
@@ -438,7 +503,7 @@ pub(crate) fn bilinear(t: &Topology, tags: &[VTag], f: usize, rules: &CornerRule
 
 /// Loop's limit position of an interior vertex of valence `n` (Loop 1987; the valence-6
 /// mask `1/2, 1/12`).
-fn loop_interior_limit(c: &Corner) -> Row {
+pub(crate) fn loop_interior_limit(c: &Corner) -> Row {
     let n = c.m as f64;
     let we = if c.m == 6 {
         1.0 / 12.0

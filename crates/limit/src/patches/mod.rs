@@ -43,12 +43,15 @@
 
 mod assembly;
 mod basis;
+mod box_fit;
+mod bspline_caps;
 mod classify;
 mod end_caps;
 mod features;
 mod gather;
 mod kind;
 mod levels;
+mod loop_caps;
 mod map;
 mod options;
 mod param;

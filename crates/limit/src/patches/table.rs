@@ -226,7 +226,7 @@ impl PatchTable {
         let level_offsets = level_offsets(&levels);
         let caps = end_cap_type(options.end_caps, reg);
         let (arrays, handles, local) =
-            Assembly::new(&levels, &level_offsets, options, reg).run(&found, caps)?;
+            Assembly::new(&levels, &level_offsets, options, reg).run(&found, caps);
         let num_roots = ptex_count(base, reg.face_size);
         let map = PatchMap::new(
             handles
