@@ -101,7 +101,7 @@ pub fn run(repeats: usize) -> Result<(), String> {
             quad_bench_mesh(),
             EndCaps::GregoryBasis,
         ),
-        (Scheme::Loop, tri_bench_mesh(), EndCaps::Bilinear),
+        (Scheme::Loop, tri_bench_mesh(), EndCaps::GregoryBasis),
     ] {
         let rules = Options::default();
         let points = random_points(&mesh, &scheme, POINTS);

@@ -251,7 +251,7 @@ fn patches_surface(
     file: &subd_io::MeshFile,
     scheme: &Scheme,
 ) -> Result<Surface, String> {
-    use subd_limit::patches::{EndCaps, PatchOptions, PatchTable};
+    use subd_limit::patches::{PatchOptions, PatchTable};
     if !scheme_arg::evaluated(scheme) {
         return Err(format!(
             "--patches needs catmull-clark or loop, not {scheme}"
@@ -259,11 +259,6 @@ fn patches_surface(
     }
     let options = PatchOptions {
         isolation: args.isolation,
-        end_caps: if *scheme == Scheme::Loop {
-            EndCaps::Bilinear
-        } else {
-            EndCaps::GregoryBasis
-        },
         ..Default::default()
     };
     let rules = args.rules.options(&file.mesh.hints);

@@ -36,7 +36,7 @@ fn main() {
     let eval = args.get(4).is_some_and(|s| s == "eval");
     let (quads, points) = bench_torus();
     let (topo, scheme, caps) = if loop_scheme {
-        (split_quads(&quads), Scheme::Loop, EndCaps::Bilinear)
+        (split_quads(&quads), Scheme::Loop, EndCaps::GregoryBasis)
     } else {
         (quads, Scheme::CatmullClark, EndCaps::GregoryBasis)
     };
