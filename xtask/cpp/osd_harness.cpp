@@ -269,6 +269,31 @@ double bfrTessellate(Far::TopologyRefiner const &refiner, Mesh const &m, int rat
     return check;
 }
 
+// The factory options of --patches and --patches-bench (argv[2..5]: ENDCAP SINGLE_CREASE
+// INF_SHARP LEGACY_CORNERS), double precision, no varying tables.
+Far::PatchTableFactory::Options patchOptions(Mesh const &m, char **argv) {
+    Far::PatchTableFactory::Options po = patchOptions(m, argv);
+    return po;
+}
+
+// The refined vertices of every level of an adaptive refinement, then the table's local
+// points, from the mesh's positions.
+std::vector<Point> patchPoints(Mesh const &m, Far::TopologyRefiner const &refiner, Far::PatchTable const &table) {
+    int nRefined = refiner.GetNumVerticesTotal();
+    int nLocal = table.GetNumLocalPoints();
+    std::vector<Point> verts(nRefined + nLocal);
+    std::copy(m.pos.begin(), m.pos.end(), verts.begin());
+    Far::PrimvarRefinerReal<double> primvar(refiner);
+    Point *src = verts.data();
+    for (int l = 1; l < refiner.GetNumLevels(); ++l) {
+        Point *dst = src + refiner.GetLevel(l - 1).GetNumVertices();
+        primvar.Interpolate(l, src, dst);
+        src = dst;
+    }
+    if (nLocal) table.GetLocalPointStencilTable<double>()->UpdateValues(verts.data(), verts.data() + nRefined);
+    return verts;
+}
+
 // The patch table of an adaptive refinement to isolation level `m.levels` with the given
 // factory options (--patches ENDCAP SINGLE_CREASE INF_SHARP LEGACY_CORNERS; ENDCAP is
 // PatchTableFactory::Options::EndCapType), evaluated in double precision at the points that
@@ -314,20 +339,9 @@ void patchTable(Mesh const &m, Reader &r, char **argv, std::vector<unsigned char
             for (int c = 0; c < cvs.size(); ++c) put<uint32_t>(out, (uint32_t)cvs[c]);
         }
     }
-    int nRefined = refiner->GetNumVerticesTotal();
-    int nLocal = table->GetNumLocalPoints();
-    put<uint32_t>(out, (uint32_t)nLocal);
-    put<uint32_t>(out, (uint32_t)nRefined);
-    std::vector<Point> verts(nRefined + nLocal);
-    std::copy(m.pos.begin(), m.pos.end(), verts.begin());
-    Far::PrimvarRefinerReal<double> primvar(*refiner);
-    Point *src = verts.data();
-    for (int l = 1; l < refiner->GetNumLevels(); ++l) {
-        Point *dst = src + refiner->GetLevel(l - 1).GetNumVertices();
-        primvar.Interpolate(l, src, dst);
-        src = dst;
-    }
-    if (nLocal) table->GetLocalPointStencilTable<double>()->UpdateValues(verts.data(), verts.data() + nRefined);
+    put<uint32_t>(out, (uint32_t)table->GetNumLocalPoints());
+    put<uint32_t>(out, (uint32_t)refiner->GetNumVerticesTotal());
+    std::vector<Point> verts = patchPoints(m, *refiner, *table);
     Far::PatchMap map(*table);
     double w[6][20];
     for (uint32_t i = 0; i < count; ++i) {
@@ -368,27 +382,10 @@ void patchBench(Mesh const &m, Reader &r, char **argv) {
     for (int rep = 0; rep < reps; ++rep) {
         auto t0 = std::chrono::steady_clock::now();
         Far::TopologyRefiner *refiner = createRefiner(m);
-        Far::PatchTableFactory::Options po(m.levels);
-        po.SetPatchPrecision<double>();
-        po.endCapType = (Far::PatchTableFactory::Options::EndCapType)std::atoi(argv[2]);
-        po.useSingleCreasePatch = std::atoi(argv[3]) != 0;
-        po.useInfSharpPatch = std::atoi(argv[4]) != 0;
-        po.generateLegacySharpCornerPatches = std::atoi(argv[5]) != 0;
-        po.generateVaryingTables = false;
+        Far::PatchTableFactory::Options po = patchOptions(m, argv);
         refiner->RefineAdaptive(po.GetRefineAdaptiveOptions());
         Far::PatchTable const *table = Far::PatchTableFactory::Create(*refiner, po);
-        int nRefined = refiner->GetNumVerticesTotal();
-        int nLocal = table->GetNumLocalPoints();
-        std::vector<Point> verts(nRefined + nLocal);
-        std::copy(m.pos.begin(), m.pos.end(), verts.begin());
-        Far::PrimvarRefinerReal<double> primvar(*refiner);
-        Point *src = verts.data();
-        for (int l = 1; l < refiner->GetNumLevels(); ++l) {
-            Point *dst = src + refiner->GetLevel(l - 1).GetNumVertices();
-            primvar.Interpolate(l, src, dst);
-            src = dst;
-        }
-        if (nLocal) table->GetLocalPointStencilTable<double>()->UpdateValues(verts.data(), verts.data() + nRefined);
+        std::vector<Point> verts = patchPoints(m, *refiner, *table);
         auto t1 = std::chrono::steady_clock::now();
         Far::PatchMap map(*table);
         auto t2 = std::chrono::steady_clock::now();

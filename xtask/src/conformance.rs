@@ -984,9 +984,14 @@ pub(crate) fn shape_paths(dir: &Path) -> Result<Vec<PathBuf>, String> {
     Ok(paths)
 }
 
-/// Every shape of the OpenSubdiv directory. Shapes are compared in parallel (each mostly
-/// waits on its own harness process); the rows keep the shapes' order.
-pub fn shapes(exe: &Path, dir: &Path) -> Result<Vec<Row>, String> {
+/// `compare` run on every shape of the OpenSubdiv directory whose scheme `wanted` takes,
+/// in parallel (each mostly waits on its own harness process); the rows keep the shapes'
+/// order.
+pub(crate) fn per_shape(
+    dir: &Path,
+    wanted: impl Fn(&Scheme) -> bool + Sync,
+    compare: impl Fn(&str, &subd_mesh::Mesh, &Scheme, &Options) -> Vec<Row> + Sync,
+) -> Result<Vec<Row>, String> {
     let paths = shape_paths(dir)?;
     let opts = subd_io::ReadOptions {
         accept_inconsistent_orientation: true,
@@ -996,22 +1001,26 @@ pub fn shapes(exe: &Path, dir: &Path) -> Result<Vec<Row>, String> {
         .par_iter()
         .map(|p| -> Result<Vec<Row>, String> {
             let name = p.file_stem().unwrap().to_string_lossy().to_string();
-            let Some(scheme) = scheme_of(&name) else {
+            let Some(scheme) = scheme_of(&name).filter(|s| wanted(s)) else {
                 return Ok(Vec::new());
             };
             let file = subd_io::read_mesh(p, &opts).map_err(|e| e.to_string())?;
             let options = Options::from_hints(&file.mesh.hints);
-            Ok(compare(
-                exe,
-                &name,
-                &file.mesh.topology,
-                &file.mesh.positions,
-                &scheme,
-                &options,
-            ))
+            Ok(compare(&name, &file.mesh, &scheme, &options))
         })
         .collect::<Result<Vec<_>, _>>()?;
     Ok(per_shape.into_iter().flatten().collect())
+}
+
+/// Every shape of the OpenSubdiv directory.
+pub fn shapes(exe: &Path, dir: &Path) -> Result<Vec<Row>, String> {
+    per_shape(
+        dir,
+        |_| true,
+        |name, mesh, scheme, options| {
+            compare(exe, name, &mesh.topology, &mesh.positions, scheme, options)
+        },
+    )
 }
 
 /// `count` random meshes (see `random_mesh`), in parallel, rows in seed order.

@@ -312,13 +312,17 @@ pub struct OsdFVarLevel {
 }
 
 /// Little-endian reader of the harness output.
-struct Cursor<'a> {
+pub struct Cursor<'a> {
     bytes: &'a [u8],
     pos: usize,
 }
 
-impl Cursor<'_> {
-    fn take(&mut self, n: usize) -> Result<&[u8], String> {
+impl<'a> Cursor<'a> {
+    /// A reader at the start of `bytes`.
+    pub fn new(bytes: &'a [u8]) -> Cursor<'a> {
+        Cursor { bytes, pos: 0 }
+    }
+    pub fn take(&mut self, n: usize) -> Result<&[u8], String> {
         let s = self
             .bytes
             .get(self.pos..self.pos + n)
@@ -326,10 +330,10 @@ impl Cursor<'_> {
         self.pos += n;
         Ok(s)
     }
-    fn u32(&mut self) -> Result<u32, String> {
+    pub fn u32(&mut self) -> Result<u32, String> {
         Ok(u32::from_le_bytes(self.take(4)?.try_into().unwrap()))
     }
-    fn f64s(&mut self, n: usize) -> Result<Vec<f64>, String> {
+    pub fn f64s(&mut self, n: usize) -> Result<Vec<f64>, String> {
         Ok(self
             .take(8 * n)?
             .chunks_exact(8)

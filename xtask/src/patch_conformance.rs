@@ -52,31 +52,9 @@ pub fn harness_args(options: &PatchOptions) -> Vec<String> {
     .to_vec()
 }
 
-struct Cursor<'a> {
-    bytes: &'a [u8],
-    pos: usize,
-}
-
-impl Cursor<'_> {
-    fn take(&mut self, n: usize) -> Result<&[u8], String> {
-        let s = self
-            .bytes
-            .get(self.pos..self.pos + n)
-            .ok_or("harness output truncated")?;
-        self.pos += n;
-        Ok(s)
-    }
-    fn u32(&mut self) -> Result<u32, String> {
-        Ok(u32::from_le_bytes(self.take(4)?.try_into().unwrap()))
-    }
-    fn f64(&mut self) -> Result<f64, String> {
-        Ok(f64::from_le_bytes(self.take(8)?.try_into().unwrap()))
-    }
-}
-
 /// Decodes `--patches` output for `points` evaluation points.
 pub fn decode(bytes: &[u8], points: usize) -> Result<OsdPatchTable, String> {
-    let mut c = Cursor { bytes, pos: 0 };
+    let mut c = osd::Cursor::new(bytes);
     let mut patches = Vec::new();
     for _ in 0..c.u32()? {
         let (kind, cvs, n) = (c.u32()?, c.u32()? as usize, c.u32()?);
@@ -102,7 +80,7 @@ pub fn decode(bytes: &[u8], points: usize) -> Result<OsdPatchTable, String> {
     for _ in 0..points {
         let mut e = [DVec3::ZERO; 6];
         for d in &mut e {
-            *d = DVec3::new(c.f64()?, c.f64()?, c.f64()?);
+            *d = DVec3::from_slice(&c.f64s(3)?);
         }
         evaluations.push(e);
     }
@@ -449,31 +427,11 @@ pub fn option_label(o: &PatchOptions) -> String {
 /// The census of every Catmull-Clark and Loop shape of the OpenSubdiv directory, shapes in
 /// parallel, rows in shape order.
 pub fn shapes(exe: &Path, dir: &Path) -> Result<Vec<Row>, String> {
-    use rayon::prelude::*;
-    let paths = crate::conformance::shape_paths(dir)?;
-    let opts = subd_io::ReadOptions {
-        accept_inconsistent_orientation: true,
-        ..Default::default()
-    };
-    let per_shape = paths
-        .par_iter()
-        .map(|p| -> Result<Vec<Row>, String> {
-            let name = p.file_stem().unwrap().to_string_lossy().to_string();
-            let scheme = match crate::conformance::scheme_of(&name) {
-                Some(s @ (Scheme::CatmullClark | Scheme::Loop)) => s,
-                _ => return Ok(Vec::new()),
-            };
-            let file = subd_io::read_mesh(p, &opts).map_err(|e| e.to_string())?;
-            let options = Options::from_hints(&file.mesh.hints);
-            Ok(compare_census(
-                exe,
-                &name,
-                &file.mesh.topology,
-                &file.mesh.positions,
-                &scheme,
-                &options,
-            ))
-        })
-        .collect::<Result<Vec<_>, _>>()?;
-    Ok(per_shape.into_iter().flatten().collect())
+    crate::conformance::per_shape(
+        dir,
+        |s| matches!(s, Scheme::CatmullClark | Scheme::Loop),
+        |name, mesh, scheme, options| {
+            compare_census(exe, name, &mesh.topology, &mesh.positions, scheme, options)
+        },
+    )
 }

@@ -8,6 +8,7 @@ use std::time::Instant;
 use clap::Args;
 use serde::Serialize;
 use subd_limit::eval::{FaceParam, LimitEvaluator};
+use subd_limit::patches::PatchTable;
 use subd_schemes::Scheme;
 
 use crate::failure::{bad, refuse_overwrite};
@@ -22,6 +23,8 @@ pub(crate) struct EvalArgs {
     scheme: Scheme,
     #[command(flatten)]
     rules: RuleArgs,
+    #[command(flatten)]
+    on_patches: crate::patches::OnPatchesArgs,
     /// Input mesh (.obj or .ply).
     input: PathBuf,
     /// Points to evaluate, one per line: `face u v`, or `face sub u v` for a face that is not
@@ -114,6 +117,14 @@ pub(crate) fn run(
     let sizes: Vec<u32> = topo.face_sizes().collect();
     let points = read_points(&args.at, &ev, &sizes, scheme == Scheme::CatmullClark)?;
     let patch_points = ev.prepare(&file.mesh.positions);
+    // On a patch table when asked for (its end caps' surface), else the exact limit.
+    let table = match args.on_patches.options() {
+        Some(po) => Some(
+            PatchTable::new(topo, &file.mesh.positions, &scheme, &options, &po)
+                .map_err(|e| bad(format!("{}: {e}", args.input.display())))?,
+        ),
+        None => None,
+    };
     let at_point = |i: usize, p: &FaceParam, e: subd_limit::LimitError| {
         bad(format!(
             "{}: point {} (face {}): {e}",
@@ -144,9 +155,11 @@ pub(crate) fn run(
     };
     let mut body = String::with_capacity(points.len() * 160);
     for (i, p) in points.iter().enumerate() {
-        let s = ev
-            .evaluate(&patch_points, *p)
-            .map_err(|e| at_point(i, p, e))?;
+        let s = match &table {
+            Some(t) => t.evaluate(*p),
+            None => ev.evaluate(&patch_points, *p),
+        }
+        .map_err(|e| at_point(i, p, e))?;
         let (x, n) = (s.position, s.normal());
         let _ = write!(body, "{} {} {} {} {} {}", x.x, x.y, x.z, n.x, n.y, n.z);
         if let Some((uv_eval, values)) = &uv {

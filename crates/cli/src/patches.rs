@@ -15,7 +15,7 @@ use crate::{Failure, print_warnings};
 
 /// `--end-caps`.
 #[derive(Debug, Clone, Copy, ValueEnum)]
-enum EndCapsArg {
+pub(crate) enum EndCapsArg {
     /// Gregory patches (20 points; Gregory triangles of 18 for Loop), OpenSubdiv's default.
     Gregory,
     /// Regular B-spline (box-spline) patches fitted to the irregular ones.
@@ -116,4 +116,32 @@ pub(crate) fn run(
         crate::print_json(out, &table.census());
     }
     Ok(())
+}
+
+/// `--isolation` and `--end-caps` of `subd eval` and `subd tessellate`: given either, the
+/// surface is the patch table's (OpenSubdiv's defaults otherwise); given neither, the exact
+/// limit as before.
+#[derive(Debug, Args)]
+pub(crate) struct OnPatchesArgs {
+    /// Evaluate on a patch table isolated this many levels (1 to 10; default 10 when
+    /// --end-caps is given).
+    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=i64::from(MAX_ISOLATION)))]
+    isolation: Option<u8>,
+    /// Evaluate on a patch table with these end caps (default: the exact limit).
+    #[arg(long, value_enum)]
+    end_caps: Option<EndCapsArg>,
+}
+
+impl OnPatchesArgs {
+    /// The patch options asked for, or `None` for the exact limit's own evaluator.
+    pub(crate) fn options(&self) -> Option<PatchOptions> {
+        if self.isolation.is_none() && self.end_caps.is_none() {
+            return None;
+        }
+        Some(PatchOptions {
+            isolation: self.isolation.unwrap_or(MAX_ISOLATION),
+            end_caps: self.end_caps.map_or(EndCaps::Exact, EndCaps::from),
+            ..Default::default()
+        })
+    }
 }

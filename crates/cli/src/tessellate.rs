@@ -7,7 +7,8 @@ use std::time::Instant;
 
 use clap::Args;
 use serde::Serialize;
-use subd_limit::tessellation::tessellate_mesh;
+use subd_limit::patches::PatchTable;
+use subd_limit::tessellation::{tessellate_mesh, tessellate_patches};
 
 use subd_schemes::Scheme;
 
@@ -28,6 +29,8 @@ pub(crate) struct TessellateArgs {
     rate: usize,
     #[command(flatten)]
     rules: RuleArgs,
+    #[command(flatten)]
+    on_patches: crate::patches::OnPatchesArgs,
     /// Input mesh (.obj, .ply, .glb, .gltf).
     input: PathBuf,
     /// Output mesh (.obj, .ply, .glb) with normals: quads (Catmull-Clark) or triangles (Loop).
@@ -80,8 +83,12 @@ pub(crate) fn run(
     // Refinement and the last level's limit masks at a rate that is a power of two, the
     // evaluator (set up inside, so counted here) at others.
     let (topology, positions) = (&file.mesh.topology, &file.mesh.positions);
-    let t = tessellate_mesh(topology, &scheme, &options, positions, args.rate)
-        .map_err(|e| in_file(&e))?;
+    let t = match args.on_patches.options() {
+        Some(po) => PatchTable::new(topology, positions, &scheme, &options, &po)
+            .and_then(|table| tessellate_patches(&table, args.rate)),
+        None => tessellate_mesh(topology, &scheme, &options, positions, args.rate),
+    }
+    .map_err(|e| in_file(&e))?;
     let t_evaluate = t2.elapsed().as_secs_f64();
     let t3 = Instant::now();
     let holes = vec![false; t.face_offsets.len() - 1];

@@ -27,6 +27,7 @@ use subd_schemes::{Options, Scheme};
 
 use crate::LimitError;
 use crate::eval::{FaceParam, GatheredPatch, LimitEvaluator, PatchPoints};
+use crate::patches::PatchTable;
 use crate::sample_numbering::number_samples;
 
 /// The largest rate accepted.
@@ -114,6 +115,29 @@ pub fn tessellate(
         params, mut out, ..
     } = number_samples(topo, loop_scheme, rate as u32);
     (out.positions, out.normals) = evaluate_samples(evaluator, points, &params)?;
+    out.params = params;
+    Ok(out)
+}
+
+/// The surface of a patch table sampled as [`tessellate`] samples the exact limit: the same
+/// samples, faces and grids, each sample evaluated on the table (its regular patches and
+/// end caps, OpenSubdiv's approximation where its end caps approximate).
+///
+/// # Errors
+/// As [`tessellate`].
+pub fn tessellate_patches(table: &PatchTable, rate: usize) -> Result<Tessellation, LimitError> {
+    let topo = table.base_topology();
+    let loop_scheme = *table.scheme() == Scheme::Loop;
+    check_rate(topo, loop_scheme, rate)?;
+    let Numbered {
+        params, mut out, ..
+    } = number_samples(topo, loop_scheme, rate as u32);
+    let samples: Vec<(DVec3, DVec3)> = params
+        .par_iter()
+        .with_min_len(SAMPLE_CHUNK)
+        .map(|&at| table.evaluate(at).map(|p| (p.position, p.normal())))
+        .collect::<Result<_, _>>()?;
+    (out.positions, out.normals) = samples.into_iter().unzip();
     out.params = params;
     Ok(out)
 }

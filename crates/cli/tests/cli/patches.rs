@@ -108,3 +108,93 @@ fn bad_requests_are_refused_in_one_line() {
     assert_eq!((code, stderr.lines().count()), (2, 1), "{stderr}");
     assert!(!bad_out.exists());
 }
+
+/// Numbers of a text output, line by line.
+fn numbers(path: &std::path::Path) -> Vec<Vec<f64>> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .filter(|l| !l.is_empty() && !l.starts_with('#'))
+        .map(|l| {
+            l.split_whitespace()
+                .filter_map(|x| x.parse().ok())
+                .collect()
+        })
+        .collect()
+}
+
+#[test]
+fn eval_and_tessellate_on_exact_end_caps_are_the_exact_limit() {
+    let dir = Scratch::new("patches-eval");
+    let shape = meshes().join("catmark_cube_creases1.obj");
+    let shape = shape.to_str().unwrap();
+    let at = dir.file("at.txt", b"0 0.3 0.2\n3 0.7 0.9\n5 0.01 0.02\n2 0.5 0.5\n");
+    let at = at.to_str().unwrap();
+    let (exact, table, gregory) = (
+        dir.0.join("e.txt"),
+        dir.0.join("t.txt"),
+        dir.0.join("g.txt"),
+    );
+    for (out, extra) in [
+        (&exact, vec![]),
+        (&table, vec!["--end-caps", "exact", "--isolation", "2"]),
+        (&gregory, vec!["--end-caps", "gregory"]),
+    ] {
+        let mut args = vec![
+            "eval",
+            "--scheme",
+            "catmull-clark",
+            shape,
+            "--at",
+            at,
+            out.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        let (code, _, stderr) = subd(&args);
+        assert_eq!(code, 0, "{stderr}");
+    }
+    let (e, t, g) = (numbers(&exact), numbers(&table), numbers(&gregory));
+    assert_eq!(e.len(), 4);
+    for ((a, b), c) in e.iter().zip(&t).zip(&g) {
+        for k in 0..3 {
+            assert!((a[k] - b[k]).abs() < 1e-12, "{a:?} vs {b:?}");
+            // Gregory end caps approximate the limit near the corners only.
+            assert!((a[k] - c[k]).abs() < 1e-2, "{a:?} vs {c:?}");
+        }
+    }
+    // Tessellation: the same samples, on the table or the exact evaluator (rate 3 is not a
+    // power of two, so both evaluate every sample).
+    let (ta, tb) = (dir.0.join("a.obj"), dir.0.join("b.obj"));
+    let (code, _, stderr) = subd(&[
+        "tessellate",
+        "--scheme",
+        "catmull-clark",
+        "--rate",
+        "3",
+        shape,
+        ta.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let (code, _, stderr) = subd(&[
+        "tessellate",
+        "--scheme",
+        "catmull-clark",
+        "--rate",
+        "3",
+        "--end-caps",
+        "exact",
+        "--isolation",
+        "3",
+        shape,
+        tb.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let (a, b) = (numbers(&ta), numbers(&tb));
+    assert_eq!(a.len(), b.len());
+    for (x, y) in a.iter().zip(&b) {
+        assert_eq!(x.len(), y.len());
+        for (p, q) in x.iter().zip(y) {
+            assert!((p - q).abs() < 1e-12, "{x:?} vs {y:?}");
+        }
+    }
+}

@@ -129,8 +129,7 @@ impl<'a> Assembly<'a> {
             EndCaps::GregoryBasis => local(loop_caps::gregory_triangle(t, tags, f, &rules)),
             EndCaps::BSpline if quads => bspline_caps::bspline(t, tags, f, &rules),
             EndCaps::BSpline => local(loop_caps::box_spline(t, tags, f, &rules)),
-            EndCaps::Bilinear if quads => local(end_caps::bilinear(t, tags, f, &rules)),
-            EndCaps::Bilinear => local(end_caps::linear_triangle(t, tags, f, &rules)),
+            EndCaps::Bilinear => local(end_caps::linear(t, tags, f, &rules)),
         };
         let keys = self.share_keys(p, points.len());
         let offset = self.level_offsets[p.level as usize];

@@ -485,22 +485,6 @@ pub(crate) fn resolve_copies(fp: Option<Row>, fm: Option<Row>) -> [Row; 2] {
     }
 }
 
-/// The 4 points of the bilinear end cap of quad `f`: its corners' limit positions.
-pub(crate) fn bilinear(t: &Topology, tags: &[VTag], f: usize, rules: &CornerRules) -> Vec<Row> {
-    corners(t, tags, f, rules)
-        .iter()
-        .map(|c| {
-            if c.sharp {
-                point(c.v)
-            } else if c.boundary {
-                boundary_limit(c)
-            } else {
-                interior_limit(c)
-            }
-        })
-        .collect()
-}
-
 /// Loop's limit position of an interior vertex of valence `n` (Loop 1987; the valence-6
 /// mask `1/2, 1/12`).
 pub(crate) fn loop_interior_limit(c: &Corner) -> Row {
@@ -517,13 +501,11 @@ pub(crate) fn loop_interior_limit(c: &Corner) -> Row {
     p
 }
 
-/// The 3 points of the linear end cap of Loop triangle `f`: its corners' limit positions.
-pub(crate) fn linear_triangle(
-    t: &Topology,
-    tags: &[VTag],
-    f: usize,
-    rules: &CornerRules,
-) -> Vec<Row> {
+/// The points of the linear end cap of face `f` (a bilinear quad, a linear triangle): its
+/// corners' limit positions (`V` at a sharp corner, the B-spline's on a boundary, the
+/// scheme's interior mask inside).
+pub(crate) fn linear(t: &Topology, tags: &[VTag], f: usize, rules: &CornerRules) -> Vec<Row> {
+    let quad = t.face_size(f) == 4;
     corners(t, tags, f, rules)
         .iter()
         .map(|c| {
@@ -531,6 +513,8 @@ pub(crate) fn linear_triangle(
                 point(c.v)
             } else if c.boundary {
                 boundary_limit(c)
+            } else if quad {
+                interior_limit(c)
             } else {
                 loop_interior_limit(c)
             }

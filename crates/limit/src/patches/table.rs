@@ -287,6 +287,12 @@ impl PatchTable {
         points
     }
 
+    /// The base level as the table sees it (OpenSubdiv's tags applied: boundary faces are
+    /// holes under `BoundaryInterpolation::None`).
+    pub fn base_topology(&self) -> &Topology {
+        &self.levels[0].topology
+    }
+
     /// The scheme.
     pub fn scheme(&self) -> &Scheme {
         &self.scheme
