@@ -515,3 +515,26 @@ fn bad_requests_are_errors_naming_the_problem() {
         .unwrap_err();
     assert!(e.to_string().contains('6'), "{e}");
 }
+
+#[test]
+fn local_points_factorised_to_the_base_vertices_are_the_local_points() {
+    for c in cases() {
+        let o = options(3, EndCaps::GregoryBasis, false);
+        let table = PatchTable::new(
+            &c.topology,
+            &c.positions,
+            &c.scheme,
+            &Options::default(),
+            &o,
+        )
+        .unwrap();
+        let base = table.local_point_stencils_base();
+        let local = base.apply_points(&c.positions);
+        let refined: usize = table.level_vertex_counts().iter().sum();
+        assert_eq!(local.len(), table.points().len() - refined);
+        let scale = c.positions.iter().map(|p| p.length()).fold(1.0, f64::max);
+        for (a, b) in local.iter().zip(&table.points()[refined..]) {
+            assert!((*a - *b).length() <= 1e-13 * scale, "{a} vs {b}");
+        }
+    }
+}

@@ -335,6 +335,26 @@ impl PatchTable {
         &self.local
     }
 
+    /// The local points as weights of the base vertices: the level stencils composed down
+    /// to level 0 and the local points' stencils applied to them (OpenSubdiv's
+    /// `AppendLocalPointStencilTable` with `factorize`), so a caller with only the base
+    /// positions gets the end caps' points in one product.
+    pub fn local_point_stencils_base(&self) -> StencilTable {
+        let base = self.levels[0].topology.num_vertices();
+        let mut level = StencilTable::identity(base);
+        let (mut offsets, mut indices, mut weights) = (vec![0u32], Vec::new(), Vec::new());
+        for (l, next) in self.levels.iter().enumerate() {
+            if l > 0 {
+                level = level.then(next.rows.as_ref().expect("a refined level has rows"));
+            }
+            let shift = *offsets.last().expect("offsets start at 0");
+            offsets.extend(level.offsets()[1..].iter().map(|&o| o + shift));
+            indices.extend_from_slice(level.indices());
+            weights.extend_from_slice(level.weights());
+        }
+        StencilTable::from_csr(base, offsets, indices, weights).then(&self.local)
+    }
+
     /// The patch map: (root face, u, v) to the patch (global index, arrays in order).
     pub fn patch_map(&self) -> &PatchMap {
         &self.map
