@@ -12,6 +12,7 @@ pub(crate) mod par;
 mod rows;
 pub(crate) mod split;
 mod stream;
+mod tags;
 
 pub use counts::{LevelCounts, refined_counts};
 pub(crate) use counts::{last_level_bytes, topology_bytes};
@@ -20,6 +21,7 @@ pub(crate) use fvar::{base_corner_kinds, check_channel};
 pub use layout::ChildLayout;
 pub(crate) use osd::OsdRefinement;
 pub use stream::{FaceStream, PointStream};
+pub(crate) use tags::{child_explicit_tags, explicit_tags, prepare_base};
 
 pub(crate) use fused::{
     applies as fusion_applies, child_too_large as fused_child_too_large, grandchild_faces,
@@ -28,8 +30,8 @@ pub(crate) use fused::{
 
 use glam::DVec3;
 use rayon::prelude::*;
-use subd_mesh::tags::{SHARPNESS_INFINITE, is_infinite, is_semi_sharp};
-use subd_mesh::{BoundaryInterpolation, CreaseMethod, Topology, TriangleSubdivision};
+use subd_mesh::tags::{is_infinite, is_semi_sharp};
+use subd_mesh::{CreaseMethod, Topology, TriangleSubdivision};
 
 use crate::rules::{self, Rule};
 use crate::stencil::{RowSink, StencilTable};
@@ -71,71 +73,8 @@ impl Sdc {
 /// Rows per parallel task when evaluating points.
 const CHUNK: usize = 4096;
 
-/// OpenSubdiv's notion of a non-manifold vertex includes isolated ones.
-fn nm_vertex(t: &Topology, v: usize) -> bool {
-    t.is_non_manifold_vertex(v) || t.is_isolated_vertex(v)
-}
-
-/// Applies the boundary rules to the base level and determines its vertex rules
-/// (`Far::TopologyRefinerFactoryBase::prepareComponentTagsAndSharpness`): boundary and
-/// non-manifold edges become infinitely sharp, non-manifold vertices (except interior "fin"
-/// vertices) and, with edge-and-corner, one-face corners become infinitely sharp, and with
-/// boundary `None` the faces around unsharpened boundaries become holes.
-pub(crate) fn prepare_base(
-    base: &Topology,
-    scheme: Sdc,
-    options: &Options,
-) -> (Topology, Vec<Rule>) {
-    let mut t = base.clone();
-    if options.boundary_interpolation == BoundaryInterpolation::None && scheme != Sdc::Bilinear {
-        let mut holes = Vec::new();
-        for v in 0..t.num_vertices() {
-            let (ve, vf) = (t.vertex_edges(v), t.vertex_faces(v));
-            if ve.len() == vf.len() && !nm_vertex(&t, v) {
-                continue;
-            }
-            let open = ve.iter().any(|&e| {
-                t.edge_faces(e as usize).len() == 1 && !is_infinite(t.edge_sharpness(e as usize))
-            });
-            if open {
-                holes.extend_from_slice(vf);
-            }
-        }
-        for f in holes {
-            t.set_hole(f as usize, true);
-        }
-    }
-    for e in 0..t.num_edges() {
-        if t.is_boundary_edge(e) || t.is_non_manifold_edge(e) {
-            t.set_edge_sharpness(e, SHARPNESS_INFINITE);
-        }
-    }
-    let mut rules = Vec::with_capacity(t.num_vertices());
-    for v in 0..t.num_vertices() {
-        let (ve, nf) = (t.vertex_edges(v), t.vertex_faces(v).len());
-        let (mut boundary, mut sharp, mut nm) = (0usize, 0usize, 0usize);
-        for &e in ve {
-            let e = e as usize;
-            boundary += t.is_boundary_edge(e) as usize;
-            sharp += (t.edge_sharpness(e) > 0.0) as usize;
-            nm += t.is_non_manifold_edge(e) as usize;
-        }
-        let corner = nf == 1 && ve.len() == 2;
-        if corner && options.boundary_interpolation == BoundaryInterpolation::EdgeAndCorner {
-            t.set_vertex_sharpness(v, SHARPNESS_INFINITE);
-        } else if nm_vertex(&t, v) {
-            let fin = nm == 2 && boundary == 0 && nf > ve.len();
-            if !fin {
-                t.set_vertex_sharpness(v, SHARPNESS_INFINITE);
-            }
-        }
-        rules.push(Rule::determine(t.vertex_sharpness(v), sharp));
-    }
-    (t, rules)
-}
-
 /// Sharpness of the half of parent edge `e` at its end vertex `u`.
-fn half_sharpness(p: &Topology, e: usize, u: usize, method: CreaseMethod) -> f32 {
+pub(super) fn half_sharpness(p: &Topology, e: usize, u: usize, method: CreaseMethod) -> f32 {
     let s = p.edge_sharpness(e);
     if method == CreaseMethod::Chaikin && is_semi_sharp(s) {
         let around = p
@@ -199,68 +138,6 @@ pub(crate) fn child_has_sharpness(p: &Topology, options: &Options) -> bool {
         || (0..p.num_vertices())
             .into_par_iter()
             .any(|v| rules::child_vertex_sharpness(p.vertex_sharpness(v)) > 0.0)
-}
-
-/// Whether the boundary rules make vertex `v` of `t` sharp whatever its tags say: a
-/// non-manifold or isolated vertex, or a one-face corner under edge-and-corner interpolation.
-fn implied_sharp_vertex(t: &Topology, v: usize, options: &Options) -> bool {
-    let corner = t.vertex_faces(v).len() == 1 && t.valence(v) == 2;
-    nm_vertex(t, v)
-        || (corner && options.boundary_interpolation == BoundaryInterpolation::EdgeAndCorner)
-}
-
-/// [`crate::ExplicitTags`] of a built level.
-pub(crate) fn explicit_tags(t: &Topology, options: &Options) -> crate::ExplicitTags {
-    crate::ExplicitTags {
-        creases: (0..t.num_edges())
-            .filter(|&e| {
-                t.edge_sharpness(e) > 0.0 && !t.is_boundary_edge(e) && !t.is_non_manifold_edge(e)
-            })
-            .map(|e| (t.edge_vertices(e), t.edge_sharpness(e)))
-            .collect(),
-        corners: (0..t.num_vertices())
-            .filter(|&v| t.vertex_sharpness(v) > 0.0 && !implied_sharp_vertex(t, v, options))
-            .map(|v| (v as u32, t.vertex_sharpness(v)))
-            .collect(),
-    }
-}
-
-/// [`crate::ExplicitTags`] of the child of `p`, from `p` alone: the values and order
-/// [`child_topology`] would give. Only halves of parent edges can be sharp (half `k` of
-/// edge `e` joins the edge point to end `k`, in edge order after the interior edges), and
-/// they are boundary or non-manifold exactly when their parent edge is; only vertex
-/// children keep a vertex sharpness, with their parent's face and edge counts and kind.
-pub(crate) fn child_explicit_tags(
-    p: &Topology,
-    scheme: Sdc,
-    options: &Options,
-) -> crate::ExplicitTags {
-    let method = options.crease_method;
-    let edge_point_base = Layout::new(p, scheme).edge_vertex_base;
-    let mut creases = Vec::new();
-    for e in 0..p.num_edges() {
-        if p.edge_sharpness(e) <= 0.0 || p.is_boundary_edge(e) || p.is_non_manifold_edge(e) {
-            continue;
-        }
-        let ep = edge_point_base + e as u32;
-        for u in p.edge_vertices(e) {
-            let s = half_sharpness(p, e, u as usize, method);
-            if s > 0.0 {
-                creases.push(([ep, u], s));
-            }
-        }
-    }
-    let corners = (0..p.num_vertices())
-        .filter(|&v| !implied_sharp_vertex(p, v, options))
-        .map(|v| {
-            (
-                v as u32,
-                rules::child_vertex_sharpness(p.vertex_sharpness(v)),
-            )
-        })
-        .filter(|&(_, s)| s > 0.0)
-        .collect();
-    crate::ExplicitTags { creases, corners }
 }
 
 /// Faces of a child level without the other relations: what a last level needs for output.
@@ -1032,65 +909,4 @@ fn fractional_weight_at(p: &Topology, v: usize, ps: f32, cs: f32, method: Crease
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use subd_mesh::TopologyBuilder;
-
-    /// A 6 x 5 grid of vertices cut into triangles (a boundary all round), with a
-    /// semi-sharp crease across it and a corner.
-    fn open_triangles() -> Topology {
-        let (w, h) = (6u32, 5u32);
-        let mut corners = Vec::new();
-        for y in 0..h - 1 {
-            for x in 0..w - 1 {
-                let v = y * w + x;
-                corners.extend_from_slice(&[v, v + 1, v + w + 1, v, v + w + 1, v + w]);
-            }
-        }
-        let mut t = TopologyBuilder::new((w * h) as usize)
-            .build(&vec![3; corners.len() / 3], &corners)
-            .expect("valid grid");
-        for x in 0..w - 1 {
-            let e = t.find_edge(2 * w + x, 2 * w + x + 1).expect("grid edge");
-            t.set_edge_sharpness(e as usize, 1.5);
-        }
-        t.set_vertex_sharpness((w + 2) as usize, 2.0);
-        t
-    }
-
-    /// The smooth Loop rows agree bit for bit with the general mask machinery at every level
-    /// of an open, creased mesh, and leave the boundary and crease rows to it.
-    #[test]
-    fn smooth_loop_rows_match_the_general_masks() {
-        let base = open_triangles();
-        let r = OsdRefinement::new(&base, Sdc::Loop, &Options::default(), 3).expect("refine");
-        let mut src: Vec<DVec3> = (0..base.num_vertices())
-            .map(|v| {
-                let x = v as f64;
-                DVec3::new(x.sin(), (1.3 * x).cos(), 0.1 * x)
-            })
-            .collect();
-        let (mut fast, mut general) = (0, 0);
-        for level in 1..=3 {
-            let step = r.step(level);
-            for row in 0..step.layout.num_child_vertices {
-                let expected: DVec3 = step.general_point(row, &src[..], &[][..]);
-                match step.smooth_loop_point(row, &src[..]) {
-                    Some(p) => {
-                        fast += 1;
-                        assert_eq!(
-                            p.to_array().map(f64::to_bits),
-                            expected.to_array().map(f64::to_bits)
-                        );
-                    }
-                    None => general += 1,
-                }
-            }
-            src = step.points(&src);
-        }
-        assert!(
-            fast > 0 && general > 0,
-            "{fast} fast rows, {general} general rows"
-        );
-    }
-}
+mod tests;
