@@ -66,7 +66,6 @@ pub mod split_limit;
 pub mod stam;
 mod support;
 mod table;
-mod tess_refined;
 pub mod tessellation;
 mod two_phase_closed;
 

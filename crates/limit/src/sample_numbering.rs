@@ -364,14 +364,7 @@ pub(crate) fn number_samples(topo: &Topology, loop_scheme: bool, rate: u32) -> N
     };
     let params = assign(&grid, &numbers, &starts);
     let out = emit(&grid, &numbers, &starts, total);
-    Numbered {
-        params,
-        out,
-        vertex_sample: vertex_sample
-            .into_iter()
-            .map(AtomicU32::into_inner)
-            .collect(),
-    }
+    Numbered { params, out }
 }
 
 /// Which face numbers each vertex's and edge's samples.
@@ -743,7 +736,6 @@ mod tests {
         Numbered {
             params: s.params,
             out: s.out,
-            vertex_sample: s.vertex_sample,
         }
     }
 
@@ -756,7 +748,6 @@ mod tests {
             .unwrap()
             .install(|| number_samples(topo, loop_scheme, rate));
         assert_eq!(a.params, b.params, "rate {rate}");
-        assert_eq!(a.vertex_sample, b.vertex_sample);
         assert_eq!(a.out.face_offsets, b.out.face_offsets);
         assert_eq!(a.out.face_vertices, b.out.face_vertices);
         assert_eq!(a.out.grids, b.out.grids);

@@ -27,7 +27,7 @@ use subd_schemes::{Options, Scheme};
 
 use crate::LimitError;
 use crate::eval::{FaceParam, GatheredPatch, LimitEvaluator, PatchPoints};
-use crate::patches::PatchTable;
+use crate::patches::{PatchOptions, PatchTable};
 use crate::sample_numbering::number_samples;
 
 /// The largest rate accepted.
@@ -132,12 +132,7 @@ pub fn tessellate_patches(table: &PatchTable, rate: usize) -> Result<Tessellatio
     let Numbered {
         params, mut out, ..
     } = number_samples(topo, loop_scheme, rate as u32);
-    let samples: Vec<(DVec3, DVec3)> = params
-        .par_iter()
-        .with_min_len(SAMPLE_CHUNK)
-        .map(|&at| table.evaluate(at).map(|p| (p.position, p.normal())))
-        .collect::<Result<_, _>>()?;
-    (out.positions, out.normals) = samples.into_iter().unzip();
+    (out.positions, out.normals) = table.evaluate_grid_samples(&params, rate as u32)?;
     out.params = params;
     Ok(out)
 }
@@ -181,11 +176,9 @@ fn evaluate_samples(
 
 /// Tessellates the limit surface of `positions` on `topology` at `rate`, as [`tessellate`]
 /// does with an evaluator of the mesh: the same samples, faces and grids, the same values to
-/// rounding. A rate that is a power of two on a manifold Catmull-Clark or Loop mesh takes
-/// uniform refinement instead, its samples being the vertices of the refined level: the
-/// limit masks of that level ([`crate::level_limit_points`]), one pass over its vertices,
-/// in place of one patch evaluation per sample (positions agree with the evaluator's to
-/// ~1e-15 of the mesh's size, normals to ~1e-12). Other rates build a [`LimitEvaluator`].
+/// rounding, evaluated on a patch table that is the exact limit
+/// ([`PatchOptions::exact_limit`], [`tessellate_patches`]): each patch's control points
+/// gathered once for its samples, the basis computed once per rate.
 ///
 /// ```
 /// use subd_limit::tessellation::tessellate_mesh;
@@ -212,21 +205,15 @@ pub fn tessellate_mesh(
     positions: &[DVec3],
     rate: usize,
 ) -> Result<Tessellation, LimitError> {
-    if positions.len() != topology.num_vertices() {
-        return Err(LimitError::Param(format!(
-            "{} positions for {} vertices",
-            positions.len(),
-            topology.num_vertices()
-        )));
-    }
     check_range(rate)?;
-    if let Some(levels) = crate::tess_refined::depth(topology, scheme, rate) {
-        return crate::tess_refined::tessellate_refined(
-            topology, scheme, options, positions, levels,
-        );
-    }
-    let evaluator = LimitEvaluator::new(topology, scheme, options)?;
-    tessellate(&evaluator, &evaluator.prepare(positions), rate)
+    let table = PatchTable::new(
+        topology,
+        positions,
+        scheme,
+        options,
+        &PatchOptions::exact_limit(),
+    )?;
+    tessellate_patches(&table, rate)
 }
 
 /// Checks `rate`: 1 to [`MAX_RATE`], even where a Catmull-Clark face is not a quad.
@@ -263,8 +250,6 @@ pub(crate) struct Numbered {
     pub params: Vec<FaceParam>,
     /// The output faces and grids over the samples (positions and normals left empty).
     pub out: Tessellation,
-    /// Each base vertex's sample (`u32::MAX` where no face reaches it).
-    pub vertex_sample: Vec<u32>,
 }
 
 #[cfg(test)]

@@ -49,6 +49,7 @@ mod classify;
 mod end_caps;
 mod features;
 mod gather;
+mod grid_samples;
 mod kind;
 mod levels;
 mod loop_caps;

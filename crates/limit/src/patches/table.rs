@@ -14,7 +14,7 @@ use super::levels::PatchLevel;
 use super::map::PatchMap;
 use super::{EndCaps, MAX_ISOLATION, PatchOptions, PatchParam, PatchType};
 use crate::LimitError;
-use crate::eval::{FaceParam, LimitEvaluator, PatchPoints};
+use crate::eval::{FaceParam, GatheredPatch, LimitEvaluator, PatchPoints};
 use crate::patch::SurfacePoint;
 
 /// The patches of one type, in level order and face order within a level.
@@ -235,7 +235,9 @@ impl PatchTable {
             num_roots,
             reg.face_size == 3,
         );
-        let exact = if options.end_caps == EndCaps::Exact {
+        // The exact evaluator only where an end cap needs it (a mesh of regular faces has
+        // none): its setup costs as much as the table's.
+        let exact = if arrays.iter().any(|a| a.kind == PatchType::Exact) {
             let evaluator = LimitEvaluator::new(base, scheme, rules)?;
             let points = evaluator.prepare(positions);
             Some(ExactCaps { evaluator, points })
@@ -366,6 +368,16 @@ impl PatchTable {
     /// [`LimitError::Param`] for a face, sub-face or parameter out of range,
     /// [`LimitError::Unsupported`] where the face has no surface (a hole).
     pub fn find(&self, at: &FaceParam) -> Result<(usize, usize), LimitError> {
+        self.locate(at).map(|(_, a, i)| (a, i))
+    }
+
+    /// The root (ptex) index of `at`'s face and sub-face.
+    pub(crate) fn root_of(&self, at: &FaceParam) -> usize {
+        self.ptex[at.face] as usize + at.sub
+    }
+
+    /// [`Self::find`] with the patch's global index first.
+    pub(crate) fn locate(&self, at: &FaceParam) -> Result<(usize, usize, usize), LimitError> {
         let base = &self.levels[0].topology;
         crate::eval::check_param(base, &self.scheme, at)?;
         let root = self.ptex[at.face] as usize + at.sub;
@@ -377,7 +389,23 @@ impl PatchTable {
                 reason: "a hole: no surface there",
             })?;
         let (a, i) = self.handles[p];
-        Ok((a as usize, i as usize))
+        Ok((p, a as usize, i as usize))
+    }
+
+    /// Position and normal at `at` of an exact end cap, from the exact evaluator (`patch`
+    /// keeps the control points of the regular face it met last).
+    pub(crate) fn exact_position_normal(
+        &self,
+        at: FaceParam,
+        patch: &mut GatheredPatch,
+    ) -> Result<(DVec3, DVec3), LimitError> {
+        let exact = self
+            .exact
+            .as_ref()
+            .expect("exact end caps have their evaluator");
+        exact
+            .evaluator
+            .evaluate_position_normal_in(&exact.points, at, patch)
     }
 
     /// The surface at `at`: position and first and second derivatives with respect to the
