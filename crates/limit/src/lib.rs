@@ -42,41 +42,157 @@
 //! assert!((limit.normals[5] - DVec3::Z).length() < 1e-15);
 //! ```
 
-pub mod acc;
-mod child_limit;
-mod child_param;
-mod composed_rows;
-pub mod eigen;
-pub mod eval;
-pub mod fvar;
-pub mod fvar_eval;
-pub mod local;
-pub mod loop_patch;
-pub mod masks;
-pub mod patch;
-pub mod patches;
-mod piece;
-pub mod point_stencil;
-pub mod refined_mesh;
-mod sample_numbering;
-mod smooth_closed;
-pub mod spectrum;
-pub mod split_eigen;
-pub mod split_limit;
-pub mod stam;
-mod support;
-mod table;
-pub mod tessellation;
-mod two_phase_closed;
+// The crate's parts, one folder each, all private: the public surface is below.
+mod evaluation;
+mod limit_masks;
+mod patch_table;
+mod split_limits;
+mod uniform_tessellation;
+mod whole_mesh;
+
+use limit_masks::{child_limit, smooth_closed, table, two_phase_closed};
+
+pub mod acc {
+    //! Loop & Schaefer's approximation of Catmull-Clark by bicubic patches (ACC): geometry
+    //! and tangent patches.
+    pub use crate::evaluation::acc::{AccPatch, acc_patches};
+}
+
+pub mod eigen {
+    //! The local subdivision matrix around a vertex of any valence, read off the
+    //! refinement itself, and its eigen analysis (limit and tangent masks where no closed
+    //! form is exact).
+    pub use crate::limit_masks::eigen::{
+        RingFeature, dominant_left_eigenvector, eigenvalues, ring_limit_mask, ring_matrix,
+    };
+}
+
+pub mod eval {
+    //! Exact evaluation at any (face, u, v) with derivatives.
+    pub use crate::evaluation::eval::{
+        FaceParam, LimitEvaluator, PatchPoints, dyadic_corner, dyadic_vertex,
+    };
+}
+
+pub mod fvar {
+    //! Limits of face-varying values (UVs), as OpenSubdiv's `LimitFaceVarying`, with exact
+    //! weights.
+    pub use crate::limit_masks::fvar::{
+        BaseFVarLimit, base_fvar_limit, limit_at_level, limit_values,
+    };
+}
+
+pub mod fvar_eval {
+    //! Exact evaluation of face-varying values at any (face, u, v).
+    pub use crate::evaluation::fvar_eval::{FVarEvaluator, FVarPatchValues, FVarPoint};
+}
+
+pub mod local {
+    //! Exact evaluation and limits next to irregular sharp features by local refinement.
+    pub use crate::evaluation::local::{MAX_LOCAL_LEVELS, base_limit};
+}
+
+pub mod loop_patch {
+    //! Loop's limit near an extraordinary vertex: box splines and the eigenbasis.
+    pub use crate::evaluation::loop_patch::{
+        BoxSpline, LoopCornerMatrices, box_spline, loop_corner_matrices, loop_sharp_regular,
+        tri_corner_patch,
+    };
+}
+
+pub mod masks {
+    //! Closed-form limit position and tangent masks of Catmull-Clark and Loop for smooth,
+    //! crease and corner vertices (OpenSubdiv's `Sdc` formulas, with their sources).
+    pub use crate::limit_masks::masks::{
+        LimitMask, RingMask, catmark_crease, catmark_smooth, catmark_subdominant, corner,
+        loop_crease, loop_smooth, loop_subdominant,
+    };
+}
+
+pub mod patch {
+    //! Regular bicubic patches: the B-spline basis, the 16 points of a regular face, and
+    //! surface points with derivatives.
+    pub use crate::evaluation::patch::{
+        GridPoint, REGULAR_GRID, SurfacePoint, bspline_basis, corner_patch, eval_bicubic,
+        eval_bicubic_first, regular_sharp_corner, sharp_regular_grid, smooth_neighbourhood,
+    };
+}
+
+pub mod patches {
+    //! Patch tables: feature-adaptive refinement into patches, as OpenSubdiv's
+    //! `TopologyRefiner::RefineAdaptive` + `Far::PatchTableFactory` make them, with exact
+    //! end caps besides OpenSubdiv's. See [`PatchTable`].
+    pub use crate::patch_table::{
+        EndCaps, MAX_ISOLATION, PatchArray, PatchArrayLayout, PatchCensus, PatchGrid, PatchMap,
+        PatchOptions, PatchParam, PatchPlace, PatchTable, PatchTableLayout, PatchType,
+    };
+}
+
+pub mod point_stencil {
+    //! The limit surface as linear functions of the base control vertices.
+    pub use crate::evaluation::point_stencil::{
+        ControlRow, DU, DV, FacePatch, POSITION, PatchForm, PointStencil,
+    };
+}
+
+pub mod refined_mesh {
+    //! A whole mesh refined in one call, optionally to the exact limit, texture coordinates
+    //! included.
+    pub use crate::whole_mesh::{
+        LimitedRefinement, MeshRefinement, RefinedMesh, RefinedUv, limit_uv, output_limit,
+        refine_mesh, refined_hints, refined_uv, split_limit_uv,
+    };
+}
+
+pub mod spectrum {
+    //! The eigenvalue test of a surface scheme's local subdivision matrix at an interior
+    //! vertex of a valence (Reif's necessary conditions for a C¹ limit).
+    pub use crate::limit_masks::spectrum::{
+        RingSpectrum, SplitSpectrumReport, SurfaceSpectrum, VALENCES, surface_spectrum,
+    };
+}
+
+pub mod split_eigen {
+    //! The split schemes' local subdivision matrices in Fourier blocks: eigenvalues, limit
+    //! and tangent masks, and the masks of crease and corner features.
+    pub use crate::split_limits::split_eigen::{
+        FeatureCentre, FeatureMasks, FourierEigenvalue, LocalMasks, SpectrumTest, SplitSpectrum,
+        expand_row, feature_ball, feature_masks, feature_matrix, feature_spoke, local_masks,
+        row_between, split_spectrum,
+    };
+}
+
+pub mod split_limit {
+    //! Limit stencils of the split schemes.
+    pub use crate::split_limits::split_limit::{
+        MAX_LEVELS, Neighbourhoods, SplitLimitPoints, SplitLimitStencils, split_limit_stencils,
+        split_limit_stencils_in, split_limit_table,
+    };
+}
+
+pub mod stam {
+    //! Stam's eigenbasis evaluation of Catmull-Clark near an extraordinary vertex.
+    pub use crate::evaluation::stam::{
+        CornerPatchMatrices, Projected, SubpatchSubdivision, corner_patch_matrices,
+    };
+}
+
+pub mod tessellation {
+    //! Uniform tessellation of the limit surface, in OpenSubdiv's `Bfr` parameterisation,
+    //! into one watertight mesh.
+    pub use crate::uniform_tessellation::{
+        MAX_RATE, SampleGrid, Tessellation, tessellate, tessellate_mesh, tessellate_patches,
+    };
+}
 
 use subd_mesh::Topology;
 use subd_mesh::tags::is_semi_sharp;
 use subd_schemes::{Options, RefineError, Refinement, Scheme, StencilTable, TwoPhase};
 use thiserror::Error;
 
-pub use masks::{LimitMask, RingMask};
-pub use point_stencil::{FacePatch, PatchForm, PointStencil};
-pub use table::{LimitPoints, LimitStencilTable, eigen_limit_vertices};
+pub use evaluation::point_stencil::{FacePatch, PatchForm, PointStencil};
+pub use limit_masks::masks::{LimitMask, RingMask};
+pub use limit_masks::table::{LimitPoints, LimitStencilTable, eigen_limit_vertices};
 
 /// What can go wrong computing limits.
 #[derive(Debug, Clone, Error)]
@@ -235,7 +351,7 @@ pub fn limit_stencils(
     match scheme {
         Scheme::TwoPhase(tp) => two_phase_base_limit(topology, tp, options),
         s if s.is_opensubdiv() => base_limit(topology, s, options),
-        s => split_limit::split_limit_table(topology, s),
+        s => split_limits::split_limit::split_limit_table(topology, s),
     }
 }
 
@@ -333,7 +449,7 @@ pub enum Tangents {
 /// ([`LimitStencilTable::at_level`]) and composes them back to the base mesh; base vertex
 /// `v` is vertex `v` at every level. Where refining the whole mesh that far would pass
 /// [`MAX_DECAY_FACE_VERTICES`], only the neighbourhoods of the semi-sharp features are
-/// refined ([`local::base_limit`], same limits).
+/// refined ([`evaluation::local::base_limit`], same limits).
 pub fn base_limit(
     topology: &Topology,
     scheme: &Scheme,
@@ -341,7 +457,7 @@ pub fn base_limit(
 ) -> Result<LimitStencilTable, LimitError> {
     match whole_refinement(topology, scheme, options)? {
         Some((r, levels)) => limit_through(&r, levels),
-        None => local::base_limit(topology, scheme, options),
+        None => evaluation::local::base_limit(topology, scheme, options),
     }
 }
 
@@ -375,7 +491,7 @@ pub fn base_limit_positions(
     }
     match whole_refinement(topology, scheme, options)? {
         Some((r, levels)) => positions_through(&r, levels),
-        None => Ok(local::base_limit(topology, scheme, options)?.position),
+        None => Ok(evaluation::local::base_limit(topology, scheme, options)?.position),
     }
 }
 
@@ -426,7 +542,7 @@ fn whole_refinement(
 ///
 /// # Errors
 /// [`LimitError::Refine`] for a mesh the scheme refuses (a face that is not a quad, a
-/// wrong `λ` count), [`LimitError::TooDeep`] as for [`local::base_limit`].
+/// wrong `λ` count), [`LimitError::TooDeep`] as for [`evaluation::local::base_limit`].
 pub fn two_phase_base_limit(
     topology: &Topology,
     two_phase: &TwoPhase,
@@ -434,7 +550,7 @@ pub fn two_phase_base_limit(
 ) -> Result<LimitStencilTable, LimitError> {
     match two_phase_refinement(topology, two_phase, options)? {
         (r, Some(levels)) => limit_through(&r, levels),
-        (r, None) => local::base_limit_after(&r, options),
+        (r, None) => evaluation::local::base_limit_after(&r, options),
     }
 }
 
@@ -457,7 +573,7 @@ pub fn two_phase_base_limit_positions(
     }
     match two_phase_refinement(topology, two_phase, options)? {
         (r, Some(levels)) => positions_through(&r, levels),
-        (r, None) => Ok(local::base_limit_after(&r, options)?.position),
+        (r, None) => Ok(evaluation::local::base_limit_after(&r, options)?.position),
     }
 }
 

@@ -539,8 +539,7 @@ fn local_points_factorised_to_the_base_vertices_are_the_local_points() {
     }
 }
 
-/// A gear (Loop): infinitely sharp creases along its rims, which the exact-limit table takes
-/// as the boundaries of regular patches.
+/// A gear (Loop): infinitely sharp creases along its rims and teeth.
 fn gear() -> Case {
     let g = subd_mesh::primitives::gear(6, 4, 2);
     Case {

@@ -1,5 +1,5 @@
-//! `tessellate_mesh` at rates that are powers of two (uniform refinement and the limit
-//! masks of the last level) against `tessellate` with the exact evaluator (one patch
+//! `tessellate_mesh` (the exact-limit patch table, each patch's samples from one gather and
+//! a basis tabulated per rate) against `tessellate` with the exact evaluator (one patch
 //! evaluation per sample, a separate route), on every OpenSubdiv shape, Catmull-Clark and
 //! Loop, rates 1 (where the faces allow), 2, 4 and 8.
 
@@ -14,10 +14,8 @@ fn diagonal(p: &[DVec3]) -> f64 {
 
 /// The same samples (parameters), faces and grids. Positions within 2.5e-14 of the bounding
 /// box; unit normals within 2e-10, and within 1e-12 but for a few near extraordinary
-/// vertices. The larger differences are the evaluator's: its eigenbasis sums near an
-/// extraordinary vertex (worst: a face centre of valence 12 on catmark_rook, 1.3e-10),
-/// where the masks of the refined level agree with the stencil tables to 1e-13
-/// (`level_limit`).
+/// vertices, where the evaluator's eigenbasis sums and the table's regular patches one
+/// level down round differently.
 #[test]
 fn refined_tessellation_equals_the_evaluated_one() {
     let (mut compared, mut samples, mut loose) = (0, 0, 0);

@@ -11,8 +11,8 @@
 //! `P = B₁ + B₂ − I` of the two nearest boundary points and the inner point across from them
 //! (`adjustBoxSplineTriBoundaryWeights`).
 
-use crate::loop_patch::BoxSpline;
-use crate::patch::bspline_basis;
+use crate::evaluation::loop_patch::BoxSpline;
+use crate::evaluation::patch::bspline_basis;
 
 /// Weights for position, ∂s, ∂t, ∂ss, ∂st, ∂tt.
 pub(crate) type Weights<const N: usize> = [[f64; N]; 6];
@@ -106,8 +106,8 @@ pub(crate) fn box_spline_first(
     s: f64,
     t: f64,
 ) -> [glam::DVec3; 3] {
-    let basis =
-        crate::loop_patch::box_spline().expect("the box-spline basis derives on a fixed grid");
+    let basis = crate::evaluation::loop_patch::box_spline()
+        .expect("the box-spline basis derives on a fixed grid");
     let mut corner = [glam::DVec3::ZERO; 12];
     for (k, &cp) in cps.iter().enumerate() {
         corner[BOX_SPLINE_ORDER[k]] = points[cp as usize];
@@ -414,7 +414,7 @@ pub(crate) fn weights(kind: super::PatchType, s: f64, t: f64, boundary: u8) -> W
     match kind {
         T::Regular => widen(bspline(s, t, boundary)),
         T::Loop => {
-            let basis = crate::loop_patch::box_spline()
+            let basis = crate::evaluation::loop_patch::box_spline()
                 .expect("the box-spline basis derives on a fixed grid");
             widen(box_spline(basis, s, t, boundary))
         }

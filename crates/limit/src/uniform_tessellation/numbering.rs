@@ -21,8 +21,8 @@ use std::sync::atomic::{AtomicU32, Ordering};
 use rayon::prelude::*;
 use subd_mesh::Topology;
 
-use crate::eval::FaceParam;
-use crate::tessellation::{Numbered, SampleGrid, Tessellation};
+use super::output::{Numbered, SampleGrid, Tessellation};
+use crate::evaluation::eval::FaceParam;
 
 /// Not numbered yet.
 pub(crate) const UNSET: u32 = u32::MAX;

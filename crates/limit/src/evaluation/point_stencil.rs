@@ -20,11 +20,11 @@ use glam::DVec3;
 use subd_schemes::{Refinement, Scheme};
 
 use crate::LimitError;
-use crate::eval::{FaceParam, LimitEvaluator};
-use crate::patch::SurfacePoint;
-use crate::piece::{Piece, eval_piece, project_all};
-use crate::stam::CornerPatchMatrices;
-use crate::support::{face_support, linear_weights};
+use crate::evaluation::eval::{FaceParam, LimitEvaluator};
+use crate::evaluation::patch::SurfacePoint;
+use crate::evaluation::piece::{Piece, eval_piece, project_all};
+use crate::evaluation::stam::CornerPatchMatrices;
+use crate::evaluation::support::{face_support, linear_weights};
 
 /// Position, ∂u, ∂v, ∂uu, ∂uv, ∂vv of the limit surface at one point as weights over base
 /// control vertices.
@@ -227,7 +227,7 @@ impl LimitEvaluator {
             let support = face_support(t2top, f2);
             let n2 = t2top.num_vertices();
             let pairs = match &self.level2_pieces[f2] {
-                Piece::Local => crate::local::stencil(
+                Piece::Local => crate::evaluation::local::stencil(
                     t2top,
                     r.vertex_rules(2),
                     f2,
@@ -236,7 +236,7 @@ impl LimitEvaluator {
                     s2,
                     t2,
                 )
-                .map_err(|e| crate::eval::on_base_face(e, at.face))?,
+                .map_err(|e| crate::evaluation::eval::on_base_face(e, at.face))?,
                 p2 => linear_weights(level2_buf, n2, &support, |p| {
                     single_piece(p2, p, at.face, s2, t2)
                 })?,

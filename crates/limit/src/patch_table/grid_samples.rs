@@ -24,7 +24,7 @@ use super::table::PatchTable;
 use super::{PatchParam, PatchType};
 
 use crate::LimitError;
-use crate::eval::{FaceParam, GatheredPatch};
+use crate::evaluation::eval::{FaceParam, GatheredPatch};
 
 /// Samples per parallel job: many faces' worth, so that a face's run of samples is rarely
 /// split.
@@ -54,7 +54,8 @@ impl GridBasis {
         let cubic = spans.map(|m| {
             (0..=m)
                 .map(|k| {
-                    let (b, d, _) = crate::patch::bspline_basis(f64::from(k) / f64::from(m));
+                    let (b, d, _) =
+                        crate::evaluation::patch::bspline_basis(f64::from(k) / f64::from(m));
                     [b, d]
                 })
                 .collect()
@@ -202,7 +203,10 @@ impl PatchTable {
             });
         if failed {
             // The first failing sample's error, not whichever a thread met first.
-            let first = params.iter().find_map(|at| self.find(at).err());
+            let mut gathered = Gathered::new();
+            let first = params
+                .iter()
+                .find_map(|&at| self.grid_sample(&basis, at, &mut gathered).err());
             return Err(first.unwrap_or_else(|| LimitError::Param("a sample failed".into())));
         }
         Ok((positions, normals))

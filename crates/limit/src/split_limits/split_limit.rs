@@ -40,8 +40,8 @@ use subd_schemes::StencilTable;
 use subd_schemes::split_schemes::{Features, doo_sabin};
 use subd_schemes::{Options, Refinement, Scheme, Split};
 
-use crate::composed_rows::{ComposedRows, Row};
-use crate::split_eigen::{
+use crate::split_limits::composed_rows::{ComposedRows, Row};
+use crate::split_limits::split_eigen::{
     FeatureCentre, FeatureMasks, LocalMasks, expand_row, feature_ball, feature_masks,
     feature_matrix, local_masks, row_between,
 };

@@ -32,9 +32,11 @@ use subd_schemes::{Options, Refinement, Rule, Scheme};
 use crate::LimitError;
 use subd_mesh::neighbourhood::face_ring;
 
-use crate::patch::{GridPoint, SurfacePoint};
-use crate::stam::{PerValence, Projected, SubpatchSubdivision, cached, steps_to_regular};
-use crate::table::LimitStencilTable;
+use crate::evaluation::patch::{GridPoint, SurfacePoint};
+use crate::evaluation::stam::{
+    PerValence, Projected, SubpatchSubdivision, cached, steps_to_regular,
+};
+use crate::limit_masks::table::LimitStencilTable;
 
 /// The ring of `v` from face `f`: per incident triangle counter-clockwise, (next, previous).
 fn tri_ring(t: &Topology, v: usize, f: usize) -> Option<Vec<[u32; 2]>> {
@@ -385,7 +387,7 @@ const LATTICE_RING: [(i32, i32); 6] = [(1, 0), (0, 1), (-1, 1), (-1, 0), (0, -1)
 /// straight through it (interior valence 6, edges opposite; or a boundary vertex with three
 /// faces). No semi-sharp edge, no vertex sharpness, no hole, only triangles.
 fn loop_regular_vertex(t: &Topology, rules: &[Rule], v: usize) -> bool {
-    let Some(sharp) = crate::patch::infinitely_sharp_edges(t, v, 3) else {
+    let Some(sharp) = crate::evaluation::patch::infinitely_sharp_edges(t, v, 3) else {
         return false;
     };
     let (ne, nf) = (t.vertex_edges(v).len(), t.vertex_faces(v).len());
@@ -595,7 +597,7 @@ mod tests {
                     "n={n}"
                 );
             }
-            let mask = crate::masks::loop_smooth(n).position;
+            let mask = crate::limit_masks::masks::loop_smooth(n).position;
             let mut limit = mask.vertex * cp[0];
             for i in 0..n {
                 limit += mask.edges[i] * cp[1 + i];

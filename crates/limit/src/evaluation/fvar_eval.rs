@@ -36,7 +36,7 @@ use subd_schemes::{
 };
 
 use crate::LimitError;
-use crate::eval::{FaceParam, LimitEvaluator, PatchPoints, descend};
+use crate::evaluation::eval::{FaceParam, LimitEvaluator, PatchPoints, descend};
 
 /// A face-varying value and its first derivatives with respect to the face parameters,
 /// `components` numbers each.
@@ -405,7 +405,7 @@ impl FVarEvaluator {
         at: FaceParam,
         out: &mut FVarPoint,
     ) -> Result<(), LimitError> {
-        crate::eval::check_param(&self.base, &self.scheme, &at)?;
+        crate::evaluation::eval::check_param(&self.base, &self.scheme, &at)?;
         if self.blocked[at.face] && self.patches.is_some() {
             return Err(LimitError::Unsupported {
                 face: at.face,
@@ -429,7 +429,7 @@ impl FVarEvaluator {
             let s = p
                 .evaluator
                 .evaluate(points, at_level)
-                .map_err(|e| crate::eval::on_base_face(e, at.face))?;
+                .map_err(|e| crate::evaluation::eval::on_base_face(e, at.face))?;
             for i in 0..3.min(c - 3 * g) {
                 out.value[3 * g + i] = s.position[i];
                 out.du[3 * g + i] = scale * s.du[i];
@@ -465,7 +465,7 @@ impl FVarEvaluator {
         at: FaceParam,
         out: &mut FVarPoint,
     ) -> Result<(), LimitError> {
-        crate::eval::check_param(&self.base, &self.scheme, &at)?;
+        crate::evaluation::eval::check_param(&self.base, &self.scheme, &at)?;
         self.linear(&values.values, &at, out);
         Ok(())
     }

@@ -6,15 +6,15 @@ use subd_mesh::Topology;
 use subd_schemes::Scheme;
 
 use crate::LimitError;
-use crate::loop_patch::{
+use crate::evaluation::loop_patch::{
     LoopCornerMatrices, box_spline, loop_corner_matrices, loop_sharp_regular, tri_corner_patch,
 };
-use crate::masks;
-use crate::patch::{
+use crate::evaluation::patch::{
     GridPoint, REGULAR_GRID, SurfacePoint, corner_patch, eval_bicubic, sharp_regular_grid,
     smooth_neighbourhood,
 };
-use crate::stam::{CornerPatchMatrices, Projected, corner_patch_matrices};
+use crate::evaluation::stam::{CornerPatchMatrices, Projected, corner_patch_matrices};
+use crate::limit_masks::masks;
 use std::sync::Arc;
 
 /// How one face (of the base level or of level 2) is evaluated.
@@ -300,7 +300,11 @@ pub(crate) fn eval_piece(
 fn at_extraordinary_vertex(c: &[DVec3], n: usize) -> Result<SurfacePoint, LimitError> {
     // Valence 2 has no closed form (OpenSubdiv's is not the limit): the eigen analysis.
     let m = if n == 2 {
-        crate::eigen::ring_limit_mask(&Scheme::CatmullClark, 2, crate::eigen::RingFeature::Smooth)?
+        crate::limit_masks::eigen::ring_limit_mask(
+            &Scheme::CatmullClark,
+            2,
+            crate::limit_masks::eigen::RingFeature::Smooth,
+        )?
     } else {
         masks::catmark_smooth(n)
     };

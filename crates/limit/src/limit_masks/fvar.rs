@@ -24,7 +24,7 @@ use subd_mesh::fvar::{FVarChannel, FVarLinearInterpolation};
 use subd_schemes::{FaceVaryingRefinement, Options, Refinement, Scheme, StencilTable};
 
 use crate::LimitError;
-use crate::table::{LevelMasks, ring_terms_by};
+use crate::limit_masks::table::{LevelMasks, ring_terms_by};
 
 /// The cubic B-spline's limit along a crease: the ends' weight and the centre's.
 const CREASE_END: f64 = 1.0 / 6.0;

@@ -24,7 +24,7 @@ use subd_schemes::{Options, Refinement, Rule, Scheme, StencilTable};
 use crate::LimitStencilTable;
 
 use crate::LimitError;
-use crate::patch::SurfacePoint;
+use crate::evaluation::patch::SurfacePoint;
 
 /// Levels of local refinement before a point that still is not on a known patch is taken
 /// as its face's nearest corner (the distance is then below `2^-MAX_LOCAL_LEVELS` of the
@@ -322,12 +322,13 @@ fn corner_limit<P>(
         };
     }
     let t = r.topology(levels);
-    let side = crate::table::crease_side_mask(t, v, r.vertex_rules(levels)[v], scheme, face);
+    let side =
+        crate::limit_masks::table::crease_side_mask(t, v, r.vertex_rules(levels)[v], scheme, face);
     Ok(match side {
         Some(m) => SurfacePoint {
             position: row(&table.position),
-            du: crate::table::apply_ring(t, v, &m.tangent1, &points),
-            dv: crate::table::apply_ring(t, v, &m.tangent2, &points),
+            du: crate::limit_masks::table::apply_ring(t, v, &m.tangent1, &points),
+            dv: crate::limit_masks::table::apply_ring(t, v, &m.tangent2, &points),
             ..SurfacePoint::default()
         },
         None => SurfacePoint {
@@ -343,10 +344,10 @@ fn corner_limit<P>(
 /// parameters there and the scale of the parameter map.
 fn child_at(t: &Topology, scheme: &Scheme, f: usize, u: f64, v: f64) -> (usize, f64, f64, f64) {
     if *scheme == Scheme::Loop {
-        let (j, s, tt, k) = crate::child_param::tri_child(u, v.min(1.0 - u));
+        let (j, s, tt, k) = crate::evaluation::child_param::tri_child(u, v.min(1.0 - u));
         (4 * f + j, s, tt, k)
     } else {
-        let (j, s, tt) = crate::child_param::quadrant(u, v);
+        let (j, s, tt) = crate::evaluation::child_param::quadrant(u, v);
         (t.face_offsets()[f] as usize + j, s, tt, 2.0)
     }
 }
@@ -400,9 +401,9 @@ pub(crate) fn stencil(
         let nb = ending.piece();
         // The final piece's weights over its own support, one unit-vector evaluation per
         // three vertices, then carried back to the sources through the weights.
-        let support = crate::support::face_support(&nb.topology, nb.face);
+        let support = crate::evaluation::support::face_support(&nb.topology, nb.face);
         let mut buf = Vec::new();
-        let local = crate::support::linear_weights(
+        let local = crate::evaluation::support::linear_weights(
             &mut buf,
             nb.topology.num_vertices(),
             &support,
@@ -449,7 +450,7 @@ impl<P> Ending<P> {
     /// face the descent started from in errors).
     fn value(&self, pts: &[DVec3], scheme: &Scheme, f: usize) -> Result<SurfacePoint, LimitError> {
         match self {
-            Ending::Patch { nb, u, v, scale } => crate::piece::direct_evaluation(
+            Ending::Patch { nb, u, v, scale } => crate::evaluation::piece::direct_evaluation(
                 &nb.topology,
                 &nb.rules,
                 pts,
@@ -492,7 +493,7 @@ fn descend<P: Carried>(
     for depth in 0..MAX_LOCAL_LEVELS {
         let r = nb.refine(scheme, &options, 1)?;
         let (t0, rules0) = (r.topology(0), r.vertex_rules(0));
-        if crate::piece::is_direct(t0, rules0, nb.face, scheme)? {
+        if crate::evaluation::piece::is_direct(t0, rules0, nb.face, scheme)? {
             return Ok(Ending::Patch { nb, u, v, scale });
         }
         // At a corner: once the other corners are refined away (two levels) and nothing

@@ -6,8 +6,8 @@ use serde::Serialize;
 use subd_schemes::Scheme;
 
 use crate::LimitError;
-use crate::eigen::{RingFeature, eigenvalues, ring_matrix};
-use crate::split_eigen::{FourierEigenvalue, SpectrumTest, split_spectrum};
+use crate::limit_masks::eigen::{RingFeature, eigenvalues, ring_matrix};
+use crate::split_limits::split_eigen::{FourierEigenvalue, SpectrumTest, split_spectrum};
 
 /// The valences the test takes.
 pub const VALENCES: std::ops::RangeInclusive<usize> = 3..=64;

@@ -12,8 +12,8 @@ use rayon::prelude::*;
 use subd_mesh::Topology;
 use subd_schemes::{Scheme, StencilTable};
 
-use crate::masks::{self, RingMask};
-use crate::table::emit;
+use crate::limit_masks::masks::{self, RingMask};
+use crate::limit_masks::table::emit;
 
 /// Faces or vertices per parallel block.
 const CHUNK: usize = 4096;

@@ -14,8 +14,8 @@ use super::levels::PatchLevel;
 use super::map::PatchMap;
 use super::{EndCaps, MAX_ISOLATION, PatchOptions, PatchParam, PatchType};
 use crate::LimitError;
-use crate::eval::{FaceParam, GatheredPatch, LimitEvaluator, PatchPoints};
-use crate::patch::SurfacePoint;
+use crate::evaluation::eval::{FaceParam, GatheredPatch, LimitEvaluator, PatchPoints};
+use crate::evaluation::patch::SurfacePoint;
 
 /// The patches of one type, in level order and face order within a level.
 #[derive(Debug, Clone)]
@@ -379,7 +379,7 @@ impl PatchTable {
     /// [`Self::find`] with the patch's global index first.
     pub(crate) fn locate(&self, at: &FaceParam) -> Result<(usize, usize, usize), LimitError> {
         let base = &self.levels[0].topology;
-        crate::eval::check_param(base, &self.scheme, at)?;
+        crate::evaluation::eval::check_param(base, &self.scheme, at)?;
         let root = self.ptex[at.face] as usize + at.sub;
         let p = self
             .map
@@ -684,8 +684,8 @@ fn evaluate_patch(
 /// An interior bicubic B-spline patch's position and first derivatives at `(s, t)`, summed
 /// row by row (the tensor product's 32 products instead of 48).
 fn bspline_first(cps: &[u32], points: &[DVec3], s: f64, t: f64) -> [DVec3; 3] {
-    let (bs, ds, _) = crate::patch::bspline_basis(s);
-    let (bt, dt, _) = crate::patch::bspline_basis(t);
+    let (bs, ds, _) = crate::evaluation::patch::bspline_basis(s);
+    let (bt, dt, _) = crate::evaluation::patch::bspline_basis(t);
     let mut out = [DVec3::ZERO; 3];
     for (r, row) in cps.chunks_exact(4).enumerate() {
         let (mut p, mut d) = (DVec3::ZERO, DVec3::ZERO);

@@ -9,8 +9,8 @@ use subd_mesh::Topology;
 use subd_mesh::tags::is_infinite;
 use subd_schemes::{Refinement, RowSink, Rule, Scheme, StencilTable, rules};
 
-use crate::eigen::{RingFeature, ring_limit_mask};
-use crate::masks::{self, LimitMask, RingMask};
+use crate::limit_masks::eigen::{RingFeature, ring_limit_mask};
+use crate::limit_masks::masks::{self, LimitMask, RingMask};
 use crate::{LimitError, Tangents};
 
 /// Limit position, tangents and unit normals of a set of vertices.

@@ -34,11 +34,11 @@ use subd_mesh::Topology;
 use subd_schemes::{Options, Refinement, Scheme};
 
 use crate::LimitError;
-use crate::child_param::{quadrant, tri_child};
-use crate::loop_patch::box_spline;
-use crate::patch::SurfacePoint;
-use crate::piece::{Piece, eval_piece, piece_of, project_all};
-use crate::stam::Projected;
+use crate::evaluation::child_param::{quadrant, tri_child};
+use crate::evaluation::loop_patch::box_spline;
+use crate::evaluation::patch::SurfacePoint;
+use crate::evaluation::piece::{Piece, eval_piece, piece_of, project_all};
+use crate::evaluation::stam::Projected;
 
 /// A place on the limit surface: base face, sub-face (for a Catmull-Clark face that is not a
 /// quad; 0 otherwise) and parameters in `[0, 1]²`.
@@ -201,7 +201,7 @@ impl LimitEvaluator {
                 let (f2, s2, t2, scale) = self.level2_location(&at);
                 debug_assert!(f2 < r.topology(2).num_faces());
                 if let Piece::Local = self.level2_pieces[f2] {
-                    let p = crate::local::evaluate(
+                    let p = crate::evaluation::local::evaluate(
                         r.topology(2),
                         r.vertex_rules(2),
                         &points.level2,
@@ -260,7 +260,7 @@ impl LimitEvaluator {
             Piece::Regular(grid) => {
                 self.check(&at)?;
                 let g = patch.of(at.face, || grid.map(|i| points.base[i as usize]));
-                let (p, du, dv) = crate::patch::eval_bicubic_first(g, at.u, at.v);
+                let (p, du, dv) = crate::evaluation::patch::eval_bicubic_first(g, at.u, at.v);
                 return Ok((p, du.cross(dv).normalize_or_zero()));
             }
             Piece::LoopRegular(cp) if cp.len() == 12 => {

@@ -50,7 +50,7 @@ fn derive() -> FitMatrix {
     let box_weights: Vec<[f64; 12]> = points
         .iter()
         .map(|&(s, t)| {
-            let spline = crate::loop_patch::box_spline()
+            let spline = crate::evaluation::loop_patch::box_spline()
                 .expect("the box-spline basis derives on a fixed grid");
             basis::box_spline(spline, s, t, 0)[0]
         })
@@ -108,7 +108,7 @@ mod tests {
         }
         // The Bézier net of a box-spline patch: its values at enough points determine it;
         // fitting it must give the box-spline points back.
-        let spline = crate::loop_patch::box_spline().unwrap();
+        let spline = crate::evaluation::loop_patch::box_spline().unwrap();
         let controls: Vec<f64> = (0..12).map(|i| ((i * 7 + 3) % 11) as f64 - 4.0).collect();
         let samples: Vec<(f64, f64)> = (0..5)
             .flat_map(|j| (0..5 - j).map(move |i| (f64::from(i) / 4.0, f64::from(j) / 4.0)))

@@ -61,7 +61,7 @@ impl LimitedRefinement {
         self.last_limit
             .get_or_init(|| {
                 let last = self.topology(self.num_levels());
-                crate::split_limit::split_limit_table(last, self.scheme())
+                crate::split_limits::split_limit::split_limit_table(last, self.scheme())
             })
             .as_ref()
             .map_err(Clone::clone)
@@ -240,7 +240,8 @@ pub fn limit_uv(
     channel: &FVarChannel,
     mode: FVarLinearInterpolation,
 ) -> Result<RefinedUv, LimitError> {
-    let limit = crate::fvar::base_fvar_limit(topology, scheme, options, channel, mode)?;
+    let limit =
+        crate::limit_masks::fvar::base_fvar_limit(topology, scheme, options, channel, mode)?;
     let mut indices = Vec::with_capacity(topology.num_face_vertices());
     for f in 0..topology.num_faces() {
         for (&v, &x) in topology

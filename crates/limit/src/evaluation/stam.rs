@@ -28,7 +28,7 @@ use subd_mesh::TopologyBuilder;
 use subd_schemes::{Options, Refinement, Scheme};
 
 use crate::LimitError;
-use crate::patch::{REGULAR_GRID, SurfacePoint, bicubic_weights, corner_patch};
+use crate::evaluation::patch::{REGULAR_GRID, SurfacePoint, bicubic_weights, corner_patch};
 
 /// Subdivision matrices of the corner patch of valence `n`, and their eigen decomposition.
 #[derive(Debug)]
@@ -388,8 +388,8 @@ pub(crate) fn cached<T>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::masks;
-    use crate::patch::eval_bicubic;
+    use crate::evaluation::patch::eval_bicubic;
+    use crate::limit_masks::masks;
 
     /// Some control points.
     fn points(k: usize) -> Vec<DVec3> {
@@ -491,13 +491,13 @@ mod tests {
         for n in [3, 5, 8] {
             let m = CornerPatchMatrices::new(n).unwrap();
             let big = m.eigenvalues();
-            let ring = crate::eigen::ring_matrix(
+            let ring = crate::limit_masks::eigen::ring_matrix(
                 &Scheme::CatmullClark,
                 n,
-                crate::eigen::RingFeature::Smooth,
+                crate::limit_masks::eigen::RingFeature::Smooth,
             )
             .unwrap();
-            let small = crate::eigen::eigenvalues(&ring).unwrap();
+            let small = crate::limit_masks::eigen::eigenvalues(&ring).unwrap();
             let mut used = vec![false; big.len()];
             for z in &small {
                 let hit = (0..big.len())

@@ -5,7 +5,7 @@ use glam::DVec3;
 use subd_mesh::Topology;
 
 use crate::LimitError;
-use crate::patch::SurfacePoint;
+use crate::evaluation::patch::SurfacePoint;
 
 /// Vertices of the faces around the vertices of face `f`, ascending.
 pub(crate) fn face_support(t: &Topology, f: usize) -> Vec<u32> {

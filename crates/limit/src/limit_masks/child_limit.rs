@@ -20,8 +20,8 @@ use glam::DVec3;
 use subd_mesh::Topology;
 use subd_schemes::{Refinement, Scheme};
 
-use crate::masks::{self, LimitMask};
-use crate::table::{LevelMasks, Ring, limit_by_vertex};
+use crate::limit_masks::masks::{self, LimitMask};
+use crate::limit_masks::table::{LevelMasks, Ring, limit_by_vertex};
 use crate::{LimitError, LimitPoints, Tangents, levels_for_exact_limit};
 
 /// Whether [`child_level_limit`] covers level `level` of `refinement`: Catmull-Clark or Loop

@@ -327,10 +327,10 @@ mod tests {
     use subd_schemes::{Options, Scheme};
 
     use super::*;
-    use crate::patches::basis;
-    use crate::patches::features::Regularity;
-    use crate::patches::gather;
-    use crate::patches::levels::PatchLevel;
+    use crate::patch_table::basis;
+    use crate::patch_table::features::Regularity;
+    use crate::patch_table::gather;
+    use crate::patch_table::levels::PatchLevel;
 
     const RULES: CornerRules = CornerRules {
         inf_sharp: false,
@@ -389,7 +389,7 @@ mod tests {
         let l = level(&t);
         let regular = gather::triangle_points(&l.topology, f, 0);
         let gregory = gregory_triangle(&l.topology, &l.tags, f, &RULES);
-        let spline = crate::loop_patch::box_spline().unwrap();
+        let spline = crate::evaluation::loop_patch::box_spline().unwrap();
         for &(s, u) in &[
             (0.2, 0.3),
             (0.0, 0.0),

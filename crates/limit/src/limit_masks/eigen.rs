@@ -20,7 +20,7 @@ use subd_mesh::{Topology, TopologyBuilder};
 use subd_schemes::{Options, Refinement, Scheme};
 
 use crate::LimitError;
-use crate::masks::{LimitMask, RingMask};
+use crate::limit_masks::masks::{LimitMask, RingMask};
 
 /// Features of the centre vertex of a local ring.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -296,7 +296,7 @@ pub fn ring_limit_mask(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::masks;
+    use crate::limit_masks::masks;
 
     fn close(a: f64, b: f64, tol: f64) -> bool {
         (a - b).abs() <= tol

@@ -247,8 +247,8 @@ mod tests {
     use subd_schemes::{Options, Refinement, Scheme};
 
     use super::*;
-    use crate::patches::features::Regularity;
-    use crate::patches::levels::PatchLevel;
+    use crate::patch_table::features::Regularity;
+    use crate::patch_table::levels::PatchLevel;
 
     const RULES: CornerRules = CornerRules {
         inf_sharp: false,
