@@ -124,7 +124,7 @@ pub mod patches {
     //! end caps besides OpenSubdiv's. See [`PatchTable`].
     pub use crate::patch_table::{
         EndCaps, MAX_ISOLATION, PatchArray, PatchArrayLayout, PatchCensus, PatchGrid, PatchMap,
-        PatchOptions, PatchParam, PatchPlace, PatchTable, PatchTableLayout, PatchType,
+        PatchOptions, PatchParam, PatchPlace, PatchTable, PatchTableLayout, PatchType, TablePoints,
     };
 }
 

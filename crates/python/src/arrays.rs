@@ -166,3 +166,23 @@ pub(crate) fn columns<'a, T: Element>(
 pub(crate) fn index(i: i64) -> Result<u64, String> {
     u64::try_from(i).map_err(|_| format!("index {i} is negative"))
 }
+
+/// A read-only `(n, k)` numpy view of `data` (`k` per row), whose memory `owner` keeps.
+///
+/// # Safety
+/// `data` must be memory `owner` holds, and `owner` must neither free nor move it while
+/// any Python object is alive (numpy keeps `owner` as the view's base).
+#[allow(unsafe_code)] // a view without a copy is the point: numpy's own borrowing constructor
+pub(crate) unsafe fn view2<'py, T: Element>(
+    data: &[T],
+    k: usize,
+    owner: Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyArray2<T>>> {
+    let rows = data.len().checked_div(k).unwrap_or(0);
+    let view = numpy::ndarray::ArrayView2::from_shape((rows, k), data)
+        .map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))?;
+    // SAFETY: as the caller promises.
+    let array = unsafe { PyArray2::borrow_from_array(&view, owner) };
+    array.readwrite().make_nonwriteable();
+    Ok(array)
+}

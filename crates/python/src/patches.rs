@@ -9,7 +9,7 @@ use subd_limit::eval::FaceParam;
 use subd_limit::patches::{EndCaps, PatchOptions, PatchTable};
 use subd_mesh::DVec3;
 
-use crate::arrays::{contiguous, copied1, filled1, filled2, flat_ints, points};
+use crate::arrays::{contiguous, copied1, filled1, points, view2};
 use crate::errors::mesh_error;
 use crate::mesh::CoreMesh;
 use crate::ops::{RuleNames, scheme};
@@ -25,9 +25,9 @@ pub(crate) struct CorePatchTable {
 /// two packed words), single-crease sharpness `(n,)`.
 type ArrayParts<'py> = (
     &'static str,
-    Bound<'py, PyArray2<i64>>,
     Bound<'py, PyArray2<u32>>,
-    Bound<'py, PyArray1<f32>>,
+    Bound<'py, PyArray2<u32>>,
+    Bound<'py, PyArray2<f32>>,
 );
 
 #[pymethods]
@@ -79,31 +79,49 @@ impl CorePatchTable {
             .map_err(|e| PyValueError::new_err(e.to_string()))
     }
 
-    /// Every array's parts, in table order.
-    fn arrays<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
-        let parts: Vec<ArrayParts<'py>> = self
+    /// Every array's parts, in table order, as read-only views of the table's memory.
+    #[allow(unsafe_code)] // views without copies: see each SAFETY note
+    fn arrays<'py>(slf: Bound<'py, Self>) -> PyResult<Bound<'py, PyList>> {
+        let py = slf.py();
+        let this = slf.borrow();
+        let parts: Vec<ArrayParts<'py>> = this
             .table
             .arrays()
             .iter()
             .map(|a| {
-                let k = a.kind().num_control_points().unwrap_or(0);
+                let k = a.kind().num_control_points().unwrap_or(0).max(1);
                 let params = a.params();
-                Ok((
-                    a.kind().name(),
-                    flat_ints(py, a.control_points(), k.max(1))?,
-                    filled2(py, params.len(), |i, row: &mut [u32; 2]| {
-                        *row = [params[i].field0, params[i].field1]
-                    })?,
-                    copied1(py, a.sharpness())?,
-                ))
+                // SAFETY: `PatchParam` is `#[repr(C)]`, two `u32` words.
+                let words = unsafe {
+                    std::slice::from_raw_parts(params.as_ptr().cast::<u32>(), 2 * params.len())
+                };
+                let owner = || slf.clone().into_any();
+                // SAFETY: the arrays are built once and never change; `slf` owns them.
+                Ok(unsafe {
+                    (
+                        a.kind().name(),
+                        view2(a.control_points(), k, owner())?,
+                        view2(words, 2, owner())?,
+                        view2(a.sharpness(), 1, owner())?,
+                    )
+                })
             })
             .collect::<PyResult<_>>()?;
         PyList::new(py, parts)
     }
 
-    /// Refined vertices of all levels, then local points, `(n, 3)`.
-    fn points<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        points(py, self.table.points())
+    /// Refined vertices of all levels, then local points, `(n, 3)`: a read-only view of the
+    /// table's points (`update` overwrites them in place, so the view follows).
+    #[allow(unsafe_code)] // a view without a copy: see the SAFETY note
+    fn points<'py>(slf: Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let this = slf.borrow();
+        let p = this.table.points();
+        // SAFETY: `DVec3` is `#[repr(C)]`, three `f64`; the table keeps this buffer where it
+        // is for its life (`set_points` copies into it), and `slf` owns the table.
+        unsafe {
+            let flat = std::slice::from_raw_parts(p.as_ptr().cast::<f64>(), 3 * p.len());
+            view2(flat, 3, slf.clone().into_any())
+        }
     }
 
     /// Vertices of each refined level.
@@ -208,7 +226,11 @@ impl CorePatchTable {
                 "vertices: row {i} is not finite"
             )));
         }
-        let table = &mut self.table;
-        pool::run(py, || table.update(&base))?.map_err(mesh_error)
+        // The points are computed with the GIL released and put in place with it held, so
+        // no Python thread reads a view of them while they change.
+        let table = &self.table;
+        let next = pool::run(py, || table.points_for(&base))?.map_err(mesh_error)?;
+        self.table.set_points(next);
+        Ok(())
     }
 }

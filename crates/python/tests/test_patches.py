@@ -91,3 +91,50 @@ def test_bad_requests_raise_typed_errors():
         table.evaluate([0, 9], [0.5, 0.5], [0.5, 0.5])
     with pytest.raises(ValueError, match="vertices"):
         table.update(np.zeros((8, 2)))
+
+
+def test_arrays_and_points_are_read_only_views_that_follow_update():
+    mesh = subd.Mesh(CUBE_V, CUBE_F)
+    table = subd.PatchTable(mesh, "catmull-clark", isolation=2)
+    points = table.points
+    # A view of the table's memory: not its own data, not writeable, the same buffer twice.
+    assert not points.flags.owndata and not points.flags.writeable
+    assert np.shares_memory(points, table.points)
+    with pytest.raises(ValueError):
+        points[0, 0] = 1.0
+    for a in table.arrays:
+        assert not a["control_points"].flags.owndata and a["control_points"].dtype == np.uint32
+        assert not a["params"].flags.writeable
+    # `update` overwrites the points in place: the view taken before shows the new ones.
+    moved = CUBE_V * 3.0 - 1.0
+    table.update(moved)
+    rebuilt = subd.PatchTable(subd.Mesh(moved, CUBE_F), "catmull-clark", isolation=2)
+    assert np.array_equal(points, rebuilt.points)
+    # The view keeps the table's memory alive after the table itself is gone.
+    del table
+    assert np.array_equal(points, rebuilt.points)
+
+
+@pytest.mark.skipif(not SUBD_BIN, reason="SUBD_BIN not set")
+def test_npz_holds_the_binarys_json_layout(tmp_path):
+    path = SHAPES / "catmark_car.obj"
+    out = tmp_path / "car.json"
+    subprocess.run([SUBD_BIN, "patches", "--scheme", "catmull-clark", "--isolation", "2",
+                    str(path), str(out)], check=True, capture_output=True)
+    layout = json.loads(out.read_text())
+    table = subd.PatchTable(subd.read(path), "catmull-clark", isolation=2)
+    table.save(tmp_path / "car.npz")
+    z = np.load(tmp_path / "car.npz")
+    assert str(z["scheme"]) == layout["scheme"]
+    assert list(z["level_vertex_counts"]) == layout["level_vertex_counts"]
+    assert np.array_equal(z["points"], np.array(layout["points"]))
+    assert np.array_equal(z["local_point_offsets"], layout["local_point_offsets"])
+    assert np.array_equal(z["local_point_indices"], layout["local_point_indices"])
+    assert np.array_equal(z["local_point_weights"], layout["local_point_weights"])
+    assert list(z["array_types"]) == [a["type"] for a in layout["arrays"]]
+    for i, a in enumerate(layout["arrays"]):
+        k = a["control_points_per_patch"]
+        cps = np.array(a["control_points"], dtype=np.int64).reshape(-1, k)
+        assert np.array_equal(z[f"array{i}_control_points"], cps)
+        assert np.array_equal(z[f"array{i}_params"], np.array(a["params"]).reshape(-1, 2))
+        assert np.array_equal(z[f"array{i}_sharpness"], np.array(a["sharpness"], np.float32))

@@ -63,5 +63,5 @@ pub use map::PatchMap;
 pub use options::{EndCaps, MAX_ISOLATION, PatchOptions};
 pub use param::{PatchParam, PatchPlace};
 pub use table::{
-    PatchArray, PatchArrayLayout, PatchCensus, PatchGrid, PatchTable, PatchTableLayout,
+    PatchArray, PatchArrayLayout, PatchCensus, PatchGrid, PatchTable, PatchTableLayout, TablePoints,
 };

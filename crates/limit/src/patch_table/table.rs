@@ -157,6 +157,13 @@ pub struct PatchGrid {
     pub patch: Vec<(u32, u32)>,
 }
 
+/// The points of one set of base positions ([`PatchTable::points_for`]).
+#[derive(Debug, Clone)]
+pub struct TablePoints {
+    points: Vec<DVec3>,
+    exact: Option<PatchPoints>,
+}
+
 /// The exact evaluator behind [`EndCaps::Exact`], with its points.
 #[derive(Debug)]
 struct ExactCaps {
@@ -267,12 +274,35 @@ impl PatchTable {
     /// # Errors
     /// [`LimitError::Param`] when `positions` does not have one point per base vertex.
     pub fn update(&mut self, positions: &[DVec3]) -> Result<(), LimitError> {
-        check_positions(&self.levels[0].topology, positions)?;
-        self.points = self.compute_points(positions);
-        if let Some(exact) = &mut self.exact {
-            exact.points = exact.evaluator.prepare(positions);
-        }
+        let next = self.points_for(positions)?;
+        self.set_points(next);
         Ok(())
+    }
+
+    /// [`Self::update`]'s work without changing the table: the points of new base
+    /// positions, to be put in place by [`Self::set_points`] (so a renderer can read the
+    /// table while the next frame's points are computed).
+    ///
+    /// # Errors
+    /// [`LimitError::Param`] when `positions` does not have one point per base vertex.
+    pub fn points_for(&self, positions: &[DVec3]) -> Result<TablePoints, LimitError> {
+        check_positions(&self.levels[0].topology, positions)?;
+        Ok(TablePoints {
+            points: self.compute_points(positions),
+            exact: self.exact.as_ref().map(|e| e.evaluator.prepare(positions)),
+        })
+    }
+
+    /// Puts points from [`Self::points_for`] in place. The buffer [`Self::points`] returns
+    /// stays where it is (its values are overwritten), so views of it stay valid.
+    ///
+    /// # Panics
+    /// If `next` was computed by another table (a different point count).
+    pub fn set_points(&mut self, next: TablePoints) {
+        self.points.copy_from_slice(&next.points);
+        if let (Some(exact), Some(points)) = (&mut self.exact, next.exact) {
+            exact.points = points;
+        }
     }
 
     /// The refined vertices of every level, then the local points.

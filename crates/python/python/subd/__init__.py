@@ -612,16 +612,18 @@ class PatchTable:
     are OpenSubdiv 3.5's ``PatchTableFactory::Options``.
 
     * ``arrays``: per patch type, a dict with ``type`` (OpenSubdiv's name),
-      ``control_points`` ((n, k) indices into ``points``), ``params`` ((n, 2) uint32,
-      OpenSubdiv's packed ``PatchParam``) and ``sharpness`` (single creases).
-    * ``points``: refined vertices of every level, then the local points.
+      ``control_points`` ((n, k) uint32 indices into ``points``), ``params`` ((n, 2)
+      uint32, OpenSubdiv's packed ``PatchParam``) and ``sharpness`` (single creases):
+      read-only views of the table's own memory, no copies.
+    * ``points``: refined vertices of every level, then the local points (a view too).
+    * ``save(path)``: the arrays as a ``.npz`` archive.
     * ``local_point_stencils``: the local points as weights of the refined vertices
       (``scipy.sparse.csr_matrix`` when SciPy is installed, else CSR arrays).
     * ``evaluate(faces, u, v, sub=None, derivatives=False)``: vectorised.
     * ``update(vertices)``: new base positions, same topology (animation).
     """
 
-    __slots__ = ("_core",)
+    __slots__ = ("_core", "_scheme", "_end_caps", "_isolation")
 
     def __init__(
         self,
@@ -645,8 +647,10 @@ class PatchTable:
             raise ValueError(f"end_caps: unknown value {end_caps!r} "
                              "(one of gregory, bspline, bilinear, exact)")
         rules = _rule_names(boundary, crease_method, triangles)[:3]
+        self._scheme, self._end_caps, self._isolation = (
+            _scheme_name(scheme, None, None), end_caps, isolation)
         self._core = _subd._CorePatchTable(
-            mesh._core, _scheme_name(scheme, None, None), isolation, end_caps,
+            mesh._core, self._scheme, isolation, end_caps,
             bool(single_crease), bool(inf_sharp), bool(legacy_sharp_corners), *rules)
 
     def census(self) -> dict:
@@ -656,14 +660,39 @@ class PatchTable:
 
     @property
     def arrays(self) -> list:
-        """The patch arrays (copies), in table order."""
-        return [dict(type=t, control_points=c, params=p, sharpness=s)
+        """The patch arrays, in table order: read-only views of the table's memory (no
+        copies; ``control_points`` and ``params`` uint32, ``sharpness`` float32)."""
+        return [dict(type=t, control_points=c, params=p, sharpness=s.reshape(-1))
                 for t, c, p, s in self._core.arrays()]
 
     @property
     def points(self) -> np.ndarray:
-        """(n, 3): refined vertices of every level, then the local points."""
+        """(n, 3): refined vertices of every level, then the local points. A read-only view
+        of the table's memory: ``update`` overwrites it in place, so it follows."""
         return self._core.points()
+
+    def save(self, path) -> None:
+        """Writes the table to ``path`` as a ``.npz`` archive (``numpy.load`` reads it back),
+        the arrays of ``subd patches ... OUT.json`` under these names: ``scheme`` and
+        ``end_caps`` (strings), ``isolation``, ``level_vertex_counts``, ``points`` (n, 3),
+        ``local_point_offsets``, ``local_point_indices``, ``local_point_weights`` (CSR over
+        the refined vertices), ``array_types`` (OpenSubdiv's type names, in table order)
+        and, for the i-th array, ``array{i}_control_points`` (patches, k),
+        ``array{i}_params`` (patches, 2) and ``array{i}_sharpness`` (patches,)."""
+        indptr, indices, weights, _ = self._core.local_point_stencils()
+        arrays = self.arrays
+        fields = dict(scheme=np.array(self._scheme), end_caps=np.array(self._end_caps),
+                      isolation=np.array(self._isolation),
+                      level_vertex_counts=np.array(self.level_vertex_counts, dtype=np.int64),
+                      points=self.points, local_point_offsets=indptr,
+                      local_point_indices=indices, local_point_weights=weights,
+                      array_types=np.array([a["type"] for a in arrays]))
+        for i, a in enumerate(arrays):
+            fields[f"array{i}_control_points"] = a["control_points"]
+            fields[f"array{i}_params"] = a["params"]
+            fields[f"array{i}_sharpness"] = a["sharpness"]
+        with open(os.fspath(path), "wb") as f:
+            np.savez(f, **fields)
 
     @property
     def level_vertex_counts(self) -> list:
