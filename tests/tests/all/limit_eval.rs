@@ -460,3 +460,104 @@ fn loop_dyadic_points_are_limits_of_refined_vertices() {
     }
     assert!(checked > 500, "{checked}");
 }
+
+/// At a corner vertex with more than one sector (three or more sharp edges, boundaries
+/// included), each face's normal is its own sector's, checked against the normal of the
+/// face's corner child after 5 and 7 levels of uniform refinement: where those agree (to
+/// 2e-3) the evaluator is within 1e-2 of them; where they still turn (a smooth edge inside
+/// the sector whose direction converges like 1/level, `catmark_inf_crease0`) the refinement
+/// moves towards the evaluator's normal. A face given another sector's tangent plane fails
+/// both (`catmark_inf_crease1`'s corners: off by 0.57, converged).
+#[test]
+fn corner_normals_are_their_sectors() {
+    use subd_tests::surface_shapes;
+    let mut checked = 0;
+    for s in surface_shapes() {
+        let t = &s.mesh.topology;
+        if t.num_face_vertices() > 300 {
+            continue;
+        }
+        let sharp =
+            |e: usize| t.is_boundary_edge(e) || subd_mesh::tags::is_infinite(t.edge_sharpness(e));
+        let multi = |v: usize| {
+            !t.is_non_manifold_vertex(v)
+                && t.vertex_edges(v)
+                    .iter()
+                    .filter(|&&e| sharp(e as usize))
+                    .count()
+                    >= 3
+        };
+        if !(0..t.num_vertices()).any(multi) {
+            continue;
+        }
+        let Ok(ev) = LimitEvaluator::new(t, &s.scheme, &s.options) else {
+            continue;
+        };
+        let pts = ev.prepare(&s.mesh.positions);
+        let Ok(r) = Refinement::new(t, s.scheme.clone(), &s.options, 7) else {
+            continue;
+        };
+        let loop_scheme = s.scheme == Scheme::Loop;
+        let refined = [5, 7].map(|l| r.points_at(&s.mesh.positions, l));
+        // The normal of the child of face `f` at its corner `c` after `levels` levels.
+        let corner_normal = |f: usize, c: usize, k: usize| {
+            let levels = [5, 7][k];
+            let mut child = f;
+            for l in 0..levels {
+                child = if loop_scheme {
+                    4 * child + c
+                } else {
+                    r.topology(l).face_offsets()[child] as usize + c
+                };
+            }
+            let q: Vec<DVec3> = r
+                .topology(levels)
+                .face_vertices(child)
+                .iter()
+                .map(|&i| refined[k][i as usize])
+                .collect();
+            let n = if loop_scheme {
+                (q[1] - q[0]).cross(q[2] - q[0])
+            } else {
+                (q[2] - q[0]).cross(q[3] - q[1])
+            };
+            n.normalize()
+        };
+        for f in 0..t.num_faces() {
+            let fv = t.face_vertices(f);
+            if t.is_hole(f) || (!loop_scheme && fv.len() != 4) {
+                continue;
+            }
+            for (c, &v) in fv.iter().enumerate() {
+                if !multi(v as usize) {
+                    continue;
+                }
+                let (u, w) = match (loop_scheme, c) {
+                    (_, 0) => (0.0, 0.0),
+                    (_, 1) => (1.0, 0.0),
+                    (true, _) => (0.0, 1.0),
+                    (false, 2) => (1.0, 1.0),
+                    _ => (0.0, 1.0),
+                };
+                let at = FaceParam {
+                    face: f,
+                    sub: 0,
+                    u,
+                    v: w,
+                };
+                let Ok(n) = ev.evaluate(&pts, at).map(|p| p.normal()) else {
+                    continue;
+                };
+                let (n5, n7) = (corner_normal(f, c, 0), corner_normal(f, c, 1));
+                let name = format!("{} face {f} corner {c}: {n} vs refined {n5}, {n7}", s.name);
+                if (n5 - n7).length() < 2e-3 {
+                    assert!((n - n7).length() < 1e-2, "{name}");
+                } else {
+                    assert!((n - n7).length() < (n - n5).length(), "{name}");
+                }
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked > 10, "{checked} corners checked");
+}

@@ -322,8 +322,18 @@ fn corner_limit<P>(
         };
     }
     let t = r.topology(levels);
-    let side =
-        crate::limit_masks::table::crease_side_mask(t, v, r.vertex_rules(levels)[v], scheme, face);
+    let rule = r.vertex_rules(levels)[v];
+    if rule == subd_schemes::Rule::Corner
+        && let Some((du, dv)) = corner_sector_tangents(t, v, face, &points, scheme)
+    {
+        return Ok(SurfacePoint {
+            position: row(&table.position),
+            du,
+            dv,
+            ..SurfacePoint::default()
+        });
+    }
+    let side = crate::limit_masks::table::crease_side_mask(t, v, rule, scheme, face);
     Ok(match side {
         Some(m) => SurfacePoint {
             position: row(&table.position),
@@ -337,6 +347,58 @@ fn corner_limit<P>(
             dv: row(&table.tangent2),
             ..SurfacePoint::default()
         },
+    })
+}
+
+/// The limit tangents at corner vertex `v` on face `f`'s side: along the two sharp edges
+/// (infinitely sharp or boundary) that bound the sector of faces around `v` holding `f`,
+/// oriented so that their cross product is `f`'s normal. A sharp edge's points stay its
+/// midpoints at every level, so the limit curve leaves the corner towards the edge's other
+/// end. `None` where `f`'s sector is not bounded by sharp edges on both sides (a corner
+/// made by vertex sharpness alone) or `v` is not manifold: the vertex's own masks apply.
+///
+/// The vertex's corner mask takes the tangents of its first sector for every face, which
+/// is the limit's only where the corner has one sector (OpenSubdiv's `Limit` convention).
+fn corner_sector_tangents(
+    t: &Topology,
+    v: usize,
+    f: usize,
+    points: &[DVec3],
+    scheme: &Scheme,
+) -> Option<(DVec3, DVec3)> {
+    let (ve, vf) = (t.vertex_edges(v), t.vertex_faces(v));
+    if t.is_non_manifold_vertex(v) || !(ve.len() == vf.len() || ve.len() == vf.len() + 1) {
+        return None;
+    }
+    let sharp = |e: u32| {
+        let e = e as usize;
+        t.is_boundary_edge(e) || subd_mesh::tags::is_infinite(t.edge_sharpness(e))
+    };
+    if ve.iter().filter(|&&e| sharp(e)).count() <= 2 {
+        return None;
+    }
+    // Face k lies between edges k and k + 1 (cyclic around an interior vertex).
+    let k = vf.iter().position(|&g| g as usize == f)?;
+    let ne = ve.len();
+    let before = (0..ne).map(|i| (k + ne - i) % ne).find(|&i| sharp(ve[i]))?;
+    let after = (1..=ne).map(|i| (k + i) % ne).find(|&i| sharp(ve[i]))?;
+    let scale = if *scheme == Scheme::Loop { 3.0 } else { 1.0 };
+    let toward = |e: u32| {
+        let [a, b] = t.edge_vertices(e as usize);
+        let other = if a as usize == v { b } else { a };
+        scale * (points[other as usize] - points[v])
+    };
+    let (ta, tb) = (toward(ve[before]), toward(ve[after]));
+    // Orientation from the face itself: its corner at v, from the previous vertex to the
+    // next.
+    let fv = t.face_vertices(f);
+    let c = fv.iter().position(|&x| x as usize == v)?;
+    let next = points[fv[(c + 1) % fv.len()] as usize] - points[v];
+    let prev = points[fv[(c + fv.len() - 1) % fv.len()] as usize] - points[v];
+    Some(if ta.cross(tb).dot(next.cross(prev)) >= 0.0 {
+        (ta, tb)
+    } else {
+        (tb, ta)
     })
 }
 

@@ -109,22 +109,23 @@ impl Default for PatchOptions {
 impl PatchOptions {
     /// The cheapest table that is the exact limit everywhere, what tessellation takes by
     /// default: exact end caps one level from the base (most of the surface in regular
-    /// patches, each irregular corner's quarter of a face exact). Infinitely sharp features
-    /// stay irregular (their faces exact caps): OpenSubdiv's infinitely sharp patches
-    /// differ from the exact limit at some crease corners.
+    /// patches, each irregular corner's quarter of a face exact), and infinitely sharp
+    /// edges as the boundaries of regular patches (along a regular crease the limit is the
+    /// boundary surface on each side, so those patches are exact; irregular crease and
+    /// corner vertices still get exact caps).
     ///
     /// ```
     /// use subd_limit::patches::{EndCaps, PatchOptions};
     ///
     /// let o = PatchOptions::exact_limit();
-    /// assert_eq!((o.isolation, o.end_caps, o.inf_sharp), (1, EndCaps::Exact, false));
+    /// assert_eq!((o.isolation, o.end_caps, o.inf_sharp), (1, EndCaps::Exact, true));
     /// ```
     pub fn exact_limit() -> PatchOptions {
         PatchOptions {
             isolation: 1,
             end_caps: EndCaps::Exact,
             single_crease: false,
-            inf_sharp: false,
+            inf_sharp: true,
             legacy_sharp_corners: false,
         }
     }
