@@ -5,6 +5,7 @@ use std::collections::HashMap;
 
 use subd_schemes::StencilTable;
 
+use super::array::PatchArray;
 use super::bspline_caps::{self, CapPoint};
 use super::classify::FoundPatch;
 use super::end_caps::{self, CornerRules, Row};
@@ -12,7 +13,6 @@ use super::features::Regularity;
 use super::gather;
 use super::levels::PatchLevel;
 use super::loop_caps;
-use super::table::PatchArray;
 use super::{EndCaps, PatchOptions, PatchType};
 
 /// What a local point is shared under (`shareEndCapPatchPoints`): a corner's limit

@@ -41,22 +41,26 @@ pub(crate) fn bspline(s: f64, t: f64, boundary: u8) -> Weights<16> {
     w
 }
 
+/// The (missing, boundary, inner) points, among the 16 of a B-spline patch, of the k-th
+/// place along boundary side `side` (bit `side` of the boundary mask): the phantom point
+/// `missing` is `2 boundary − inner`.
+pub(super) fn bspline_side(side: usize, k: usize) -> (usize, usize, usize) {
+    match side {
+        0 => (k, k + 4, k + 8),
+        1 => (4 * k + 3, 4 * k + 2, 4 * k + 1),
+        2 => (k + 12, k + 8, k + 4),
+        _ => (4 * k, 4 * k + 1, 4 * k + 2),
+    }
+}
+
 /// Moves the weight of the missing rows and columns onto `2B − I`.
 fn fold_bspline_boundary(w: &mut [f64; 16], boundary: u8) {
-    // (missing, boundary, inner) index of point k along the side, for each side.
-    type Side = fn(usize) -> (usize, usize, usize);
-    let sides: [Side; 4] = [
-        |k| (k, k + 4, k + 8),
-        |k| (4 * k + 3, 4 * k + 2, 4 * k + 1),
-        |k| (k + 12, k + 8, k + 4),
-        |k| (4 * k, 4 * k + 1, 4 * k + 2),
-    ];
-    for (bit, side) in sides.iter().enumerate() {
+    for bit in 0..4 {
         if boundary & (1 << bit) == 0 {
             continue;
         }
         for k in 0..4 {
-            let (m, b, i) = side(k);
+            let (m, b, i) = bspline_side(bit, k);
             let x = w[m];
             w[b] += 2.0 * x;
             w[i] -= x;

@@ -324,19 +324,12 @@ fn bspline_points(param: PatchParam, cps: &[u32], points: &[DVec3]) -> [DVec3; 1
     let mut p: [DVec3; 16] = std::array::from_fn(|k| points[cps[k] as usize]);
     let place = param.place();
     let boundary = if place.regular { place.boundary } else { 0 };
-    // (missing, boundary, inner) of point k along each side; the weights fold the sides in
-    // the order 0, 1, 2, 3, so the points take them in the reverse order.
-    type Side = fn(usize) -> (usize, usize, usize);
-    let sides: [Side; 4] = [
-        |k| (k, k + 4, k + 8),
-        |k| (4 * k + 3, 4 * k + 2, 4 * k + 1),
-        |k| (k + 12, k + 8, k + 4),
-        |k| (4 * k, 4 * k + 1, 4 * k + 2),
-    ];
+    // The weights fold the sides in the order 0, 1, 2, 3, so the points take them in the
+    // reverse order.
     for bit in (0..4).rev() {
         if boundary & (1 << bit) != 0 {
             for k in 0..4 {
-                let (m, b, i) = sides[bit](k);
+                let (m, b, i) = basis::bspline_side(bit, k);
                 p[m] = 2.0 * p[b] - p[i];
             }
         }

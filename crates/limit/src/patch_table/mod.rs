@@ -41,6 +41,7 @@
 //! assert!((p.position.x - 0.5).abs() < 1e-15 && (p.position.y - 0.5).abs() < 1e-15);
 //! ```
 
+mod array;
 mod assembly;
 mod basis;
 mod box_fit;
@@ -58,10 +59,11 @@ mod options;
 mod param;
 mod table;
 
+pub use array::PatchArray;
 pub use kind::PatchType;
 pub use map::PatchMap;
 pub use options::{EndCaps, MAX_ISOLATION, PatchOptions};
 pub use param::{PatchParam, PatchPlace};
 pub use table::{
-    PatchArray, PatchArrayLayout, PatchCensus, PatchGrid, PatchTable, PatchTableLayout, TablePoints,
+    PatchArrayLayout, PatchCensus, PatchGrid, PatchTable, PatchTableLayout, TablePoints,
 };

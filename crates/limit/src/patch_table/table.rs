@@ -6,6 +6,7 @@ use glam::DVec3;
 use subd_mesh::Topology;
 use subd_schemes::{Options, Scheme, StencilTable};
 
+use super::array::PatchArray;
 use super::assembly::Assembly;
 use super::basis;
 use super::classify::Classifier;
@@ -16,72 +17,6 @@ use super::{EndCaps, MAX_ISOLATION, PatchOptions, PatchParam, PatchType};
 use crate::LimitError;
 use crate::evaluation::eval::{FaceParam, GatheredPatch, LimitEvaluator, PatchPoints};
 use crate::evaluation::patch::SurfacePoint;
-
-/// The patches of one type, in level order and face order within a level.
-#[derive(Debug, Clone)]
-pub struct PatchArray {
-    kind: PatchType,
-    params: Vec<PatchParam>,
-    sharpness: Vec<f32>,
-    control_points: Vec<u32>,
-}
-
-impl PatchArray {
-    pub(crate) fn new_of(kind: PatchType) -> PatchArray {
-        PatchArray {
-            kind,
-            params: Vec::new(),
-            sharpness: Vec::new(),
-            control_points: Vec::new(),
-        }
-    }
-
-    /// Appends a patch.
-    pub(crate) fn push(&mut self, param: PatchParam, sharpness: f32, points: &[u32]) {
-        self.params.push(param);
-        self.sharpness.push(sharpness);
-        self.control_points.extend_from_slice(points);
-    }
-
-    /// The patches' type.
-    pub fn kind(&self) -> PatchType {
-        self.kind
-    }
-
-    /// Number of patches.
-    pub fn len(&self) -> usize {
-        self.params.len()
-    }
-
-    /// Whether the array holds no patch.
-    pub fn is_empty(&self) -> bool {
-        self.params.is_empty()
-    }
-
-    /// One [`PatchParam`] per patch.
-    pub fn params(&self) -> &[PatchParam] {
-        &self.params
-    }
-
-    /// Per patch, the sharpness of its single crease (0 for every other patch; only with
-    /// [`PatchOptions::single_crease`]).
-    pub fn sharpness(&self) -> &[f32] {
-        &self.sharpness
-    }
-
-    /// The control points, [`PatchType::num_control_points`] per patch, as indices into the
-    /// refined vertices of all levels followed by the local points
-    /// ([`PatchTable::points`]); empty for exact patches.
-    pub fn control_points(&self) -> &[u32] {
-        &self.control_points
-    }
-
-    /// The control points of patch `i`.
-    pub fn patch_points(&self, i: usize) -> &[u32] {
-        let n = self.kind.num_control_points().unwrap_or(0);
-        &self.control_points[n * i..n * (i + 1)]
-    }
-}
 
 /// Counts of a table's patches, as `subd patches --json` prints them.
 #[derive(Debug, Clone, Default, PartialEq, Eq, serde::Serialize)]
