@@ -64,6 +64,12 @@ enum Task {
         /// Only the patch-table checks (OpenSubdiv's RefineAdaptive and PatchTableFactory).
         #[arg(long)]
         patches_only: bool,
+        /// Also check patch tables on this many random meshes (four option sets each). Not
+        /// in the default run yet: 21 of 1,272 rows on 360 meshes disagree with OpenSubdiv,
+        /// in at least one case because OpenSubdiv's Gregory patch leaves the exact limit
+        /// (issue 49's note lists them); the others are still being sorted out.
+        #[arg(long, default_value_t = 0)]
+        random_patches: u64,
     },
     /// Time subd against OpenSubdiv on ~100k-face meshes (levels 1..L, 1 and all threads).
     Bench {
@@ -286,14 +292,21 @@ fn main() -> ExitCode {
             against,
             fvar_only,
             patches_only,
+            random_patches,
         } => ensure_system_packages(REFERENCE_PACKAGES).and_then(|_| {
             let mut rows = Vec::new();
+            let patch_rows = |exe: &std::path::Path| -> Result<Vec<_>, String> {
+                let mut rows = patch_conformance::shapes(exe, &shapes)?;
+                rows.extend(patch_conformance::real_meshes(exe)?);
+                rows.extend(patch_conformance::random(exe, random_patches));
+                Ok(rows)
+            };
             if patches_only {
                 let exe = osd::build_harness()?;
-                rows.extend(patch_conformance::shapes(&exe, &shapes)?);
+                rows.extend(patch_rows(&exe)?);
             } else if against != Against::CgalOpenmesh {
                 let exe = osd::build_harness()?;
-                rows.extend(patch_conformance::shapes(&exe, &shapes)?);
+                rows.extend(patch_rows(&exe)?);
                 if !fvar_only {
                     rows.extend(conformance::shapes(&exe, &shapes)?);
                     rows.extend(conformance::random(&exe, random));

@@ -10,6 +10,8 @@ use subd_limit::patches::{EndCaps, PatchOptions, PatchTable, PatchType};
 use subd_mesh::{DVec3, Topology};
 use subd_schemes::{Options, Scheme};
 
+use rayon::prelude::*;
+
 use crate::osd;
 use crate::row::Row;
 
@@ -334,9 +336,29 @@ pub fn compare_census(
     scheme: &Scheme,
     options: &Options,
 ) -> Vec<Row> {
+    compare_sets(
+        exe,
+        name,
+        topo,
+        positions,
+        scheme,
+        options,
+        &option_sets(scheme),
+    )
+}
+
+/// [`compare_census`] with the option sets `sets`.
+fn compare_sets(
+    exe: &Path,
+    name: &str,
+    topo: &Topology,
+    positions: &[DVec3],
+    scheme: &Scheme,
+    options: &Options,
+    sets: &[PatchOptions],
+) -> Vec<Row> {
     let diag = bbox_diagonal(positions);
-    option_sets(scheme)
-        .iter()
+    sets.iter()
         .enumerate()
         .map(|(k, po)| {
             let mut row = Row::pending(name, "patches", po.isolation as usize);
@@ -434,4 +456,109 @@ pub fn shapes(exe: &Path, dir: &Path) -> Result<Vec<Row>, String> {
             compare_census(exe, name, &mesh.topology, &mesh.positions, scheme, options)
         },
     )
+}
+
+/// Real meshes beside the regression shapes, every option set: a CAD part (the gear of
+/// 13,000 triangles with 2,600 infinitely sharp edges, Loop) and a piece of a laser scan
+/// (the bunny of `pymeshfix`, fetched once: an open piece with a ragged boundary, under
+/// Loop and, its triangles split into quads, under Catmull-Clark).
+pub fn real_meshes(exe: &Path) -> Result<Vec<Row>, String> {
+    let scan = scan_piece()?;
+    let meshes = [
+        (
+            "gear_65_5_9",
+            Scheme::Loop,
+            subd_mesh::primitives::gear(65, 5, 9),
+        ),
+        ("bunny_piece", Scheme::Loop, scan.clone()),
+        ("bunny_piece", Scheme::CatmullClark, scan),
+    ];
+    Ok(meshes
+        .par_iter()
+        .flat_map_iter(|(name, scheme, mesh)| {
+            let label = format!(
+                "{name}_{}",
+                if *scheme == Scheme::Loop {
+                    "loop"
+                } else {
+                    "catmark"
+                }
+            );
+            let options = Options::from_hints(&mesh.hints);
+            compare_census(
+                exe,
+                &label,
+                &mesh.topology,
+                &mesh.positions,
+                scheme,
+                &options,
+            )
+        })
+        .collect())
+}
+
+/// The faces of the bunny scan within 12 rings of its vertex 0 (a few thousand triangles,
+/// open, with the scan's irregular valences and its own holes where the ring runs out).
+fn scan_piece() -> Result<subd_mesh::Mesh, String> {
+    let scan = crate::pia_bench::scan_mesh()?;
+    let t = &scan.topology;
+    let from = t
+        .vertex_ring(0)
+        .next()
+        .ok_or("the scan's vertex 0 has no neighbour")?;
+    let ball = subd_mesh::neighbourhood::labelled_ball(t, &[(0, from)], 12);
+    let inside: std::collections::HashSet<u32> = ball.into_iter().collect();
+    let faces: Vec<u32> = (0..t.num_faces() as u32)
+        .filter(|&f| {
+            t.face_vertices(f as usize)
+                .iter()
+                .all(|v| inside.contains(v))
+        })
+        .collect();
+    // Rebuilt from its face lists, as a file holding the piece would give it.
+    let mut index = vec![u32::MAX; t.num_vertices()];
+    let mut positions = Vec::new();
+    let mut corners = Vec::new();
+    for &f in &faces {
+        for &v in t.face_vertices(f as usize) {
+            if index[v as usize] == u32::MAX {
+                index[v as usize] = positions.len() as u32;
+                positions.push(scan.positions[v as usize]);
+            }
+            corners.push(index[v as usize]);
+        }
+    }
+    let sizes = vec![3u32; faces.len()];
+    let topology = subd_mesh::TopologyBuilder::new(positions.len())
+        .accept_inconsistent_orientation(true)
+        .build(&sizes, &corners)
+        .map_err(|e| format!("bunny piece: {e}"))?;
+    subd_mesh::Mesh::new(topology, positions).map_err(|e| e.to_string())
+}
+
+/// `count` random meshes (`random_mesh`, the Catmull-Clark and Loop ones), four option sets
+/// each, taken in turn from [`option_sets`] so that the run covers every set.
+pub fn random(exe: &Path, count: u64) -> Vec<Row> {
+    (0..count)
+        .into_par_iter()
+        .flat_map_iter(|seed| {
+            let c = crate::random_mesh::case(seed);
+            if !matches!(c.scheme, Scheme::CatmullClark | Scheme::Loop) {
+                return Vec::new();
+            }
+            let all = option_sets(&c.scheme);
+            let sets: Vec<PatchOptions> = (0..4)
+                .map(|k| all[(seed as usize * 4 + k) % all.len()])
+                .collect();
+            compare_sets(
+                exe,
+                &c.name,
+                &c.topology,
+                &c.positions,
+                &c.scheme,
+                &c.options,
+                &sets,
+            )
+        })
+        .collect()
 }
