@@ -36,8 +36,8 @@ use subd_schemes::{Options, Refinement, Scheme};
 use crate::LimitError;
 use crate::evaluation::child_param::{quadrant, tri_child};
 use crate::evaluation::loop_patch::box_spline;
-use crate::evaluation::patch::SurfacePoint;
-use crate::evaluation::piece::{Piece, eval_piece, piece_of, project_all};
+use crate::evaluation::patch::{Derivatives, SurfacePoint};
+use crate::evaluation::piece::{Piece, eval_piece_to, piece_of, project_all};
 use crate::evaluation::stam::Projected;
 
 /// A place on the limit surface: base face, sub-face (for a Catmull-Clark face that is not a
@@ -194,6 +194,17 @@ impl LimitEvaluator {
         points: &PatchPoints,
         at: FaceParam,
     ) -> Result<SurfacePoint, LimitError> {
+        self.evaluate_to(points, at, Derivatives::Second)
+    }
+
+    /// [`Self::evaluate`] up to the derivatives `d` (with [`Derivatives::First`] the
+    /// eigenbasis pieces leave the second derivatives zero: half their work).
+    fn evaluate_to(
+        &self,
+        points: &PatchPoints,
+        at: FaceParam,
+        d: Derivatives,
+    ) -> Result<SurfacePoint, LimitError> {
         self.check(&at)?;
         match &self.base_pieces[at.face] {
             Piece::Refined => {
@@ -215,23 +226,23 @@ impl LimitEvaluator {
                     .map_err(|e| on_base_face(e, at.face))?;
                     return Ok(p.scaled(scale));
                 }
-                let p = eval_piece(
+                let p = eval_piece_to(
                     &self.level2_pieces[f2],
                     &points.level2,
                     points.level2_projected[f2].as_ref(),
                     at.face,
-                    s2,
-                    t2,
+                    (s2, t2),
+                    d,
                 )?;
                 Ok(p.scaled(scale))
             }
-            piece => eval_piece(
+            piece => eval_piece_to(
                 piece,
                 &points.base,
                 points.base_projected[at.face].as_ref(),
                 at.face,
-                at.u,
-                at.v,
+                (at.u, at.v),
+                d,
             ),
         }
     }
@@ -276,7 +287,8 @@ impl LimitEvaluator {
             }
             _ => {}
         }
-        self.evaluate(points, at).map(|p| (p.position, p.normal()))
+        self.evaluate_to(points, at, Derivatives::First)
+            .map(|p| (p.position, p.normal()))
     }
 
     /// The level-2 face holding `at` of a base face that is refined, its parameters there,

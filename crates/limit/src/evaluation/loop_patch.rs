@@ -32,7 +32,7 @@ use subd_schemes::{Options, Refinement, Rule, Scheme};
 use crate::LimitError;
 use subd_mesh::neighbourhood::face_ring;
 
-use crate::evaluation::patch::{GridPoint, SurfacePoint};
+use crate::evaluation::patch::{Derivatives, GridPoint, SurfacePoint};
 use crate::evaluation::stam::{
     PerValence, Projected, SubpatchSubdivision, cached, steps_to_regular,
 };
@@ -67,19 +67,26 @@ pub fn tri_corner_patch(t: &Topology, f: usize, c: usize) -> Option<Vec<u32>> {
 
 /// Monomials u^a v^b of total degree ≤ 4, and their first and second derivatives.
 fn monomials(u: f64, v: f64) -> [[f64; 15]; 6] {
+    // x^k for k ≤ 4 by the products `powi` forms (square and multiply: x·x², (x²)²), so
+    // the same bits without a library call per term.
+    let powers = |x: f64| {
+        let x2 = x * x;
+        [1.0, x, x2, x * x2, x2 * x2]
+    };
+    let (pu, pv) = (powers(u), powers(v));
+    let pw = |p: &[f64; 5], k: i32| if k < 0 { 0.0 } else { p[k as usize] };
     let mut m = [[0.0; 15]; 6];
-    let pw = |x: f64, k: i32| if k < 0 { 0.0 } else { x.powi(k) };
     let mut k = 0;
     for d in 0..=4i32 {
         for b in 0..=d {
             let a = d - b;
             let (af, bf) = (f64::from(a), f64::from(b));
-            m[0][k] = pw(u, a) * pw(v, b);
-            m[1][k] = af * pw(u, a - 1) * pw(v, b);
-            m[2][k] = bf * pw(u, a) * pw(v, b - 1);
-            m[3][k] = af * (af - 1.0) * pw(u, a - 2) * pw(v, b);
-            m[4][k] = af * bf * pw(u, a - 1) * pw(v, b - 1);
-            m[5][k] = bf * (bf - 1.0) * pw(u, a) * pw(v, b - 2);
+            m[0][k] = pw(&pu, a) * pw(&pv, b);
+            m[1][k] = af * pw(&pu, a - 1) * pw(&pv, b);
+            m[2][k] = bf * pw(&pu, a) * pw(&pv, b - 1);
+            m[3][k] = af * (af - 1.0) * pw(&pu, a - 2) * pw(&pv, b);
+            m[4][k] = af * bf * pw(&pu, a - 1) * pw(&pv, b - 1);
+            m[5][k] = bf * (bf - 1.0) * pw(&pu, a) * pw(&pv, b - 2);
             k += 1;
         }
     }
@@ -187,9 +194,14 @@ impl BoxSpline {
 
     /// Weights of the 12 control points for position and the five derivatives at (u, v).
     pub fn weights(&self, u: f64, v: f64) -> [[f64; 12]; 6] {
+        self.weights_to(u, v, Derivatives::Second)
+    }
+
+    /// [`Self::weights`] up to the derivatives `d` (the other rows zero).
+    pub(crate) fn weights_to(&self, u: f64, v: f64, d: Derivatives) -> [[f64; 12]; 6] {
         let m = monomials(u, v);
         let mut w = [[0.0; 12]; 6];
-        for d in 0..6 {
+        for d in 0..d.rows() {
             for k in 0..12 {
                 w[d][k] = self.coeffs[k].iter().zip(&m[d]).map(|(c, x)| c * x).sum();
             }
@@ -325,6 +337,17 @@ impl LoopCornerMatrices {
 
     /// The surface at (u, v) ≠ (0, 0) of the corner patch (parameters of the module docs).
     pub fn evaluate(&self, c: &Projected, u: f64, v: f64) -> Result<SurfacePoint, LimitError> {
+        self.evaluate_to(c, u, v, Derivatives::Second)
+    }
+
+    /// [`Self::evaluate`] up to the derivatives `d` (the others zero).
+    pub(crate) fn evaluate_to(
+        &self,
+        c: &Projected,
+        u: f64,
+        v: f64,
+        d: Derivatives,
+    ) -> Result<SurfacePoint, LimitError> {
         let basis = box_spline()?;
         let (steps, scale) = steps_to_regular(u + v);
         let (u1, v1) = (u * scale, v * scale);
@@ -341,7 +364,8 @@ impl LoopCornerMatrices {
                 [[-2.0, 0.0], [0.0, -2.0]],
             )
         };
-        let out = self.sub.combine(c, steps, sub, &basis.weights(s, t));
+        let w = basis.weights_to(s, t, d);
+        let out = self.sub.combine(c, steps, sub, &w[..d.rows()]);
         // Chain rule: (s, t) = J (u1, v1) + const, (u1, v1) = scale (u, v).
         let (js, jt) = (j[0][0] * scale, j[1][1] * scale);
         Ok(SurfacePoint {

@@ -46,6 +46,24 @@ pub fn bspline_basis(t: f64) -> ([f64; 4], [f64; 4], [f64; 4]) {
     (b, d, dd)
 }
 
+/// How many derivatives an evaluation computes: positions and first derivatives only (what
+/// a tessellation needs: half of an eigenbasis evaluation's work), or second ones too.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Derivatives {
+    First,
+    Second,
+}
+
+impl Derivatives {
+    /// Rows of a weight table: position, ∂u, ∂v (then ∂uu, ∂uv, ∂vv).
+    pub(crate) fn rows(self) -> usize {
+        match self {
+            Derivatives::First => 3,
+            Derivatives::Second => 6,
+        }
+    }
+}
+
 /// Position and derivatives of a surface point with respect to the face parameters.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct SurfacePoint {

@@ -10,8 +10,8 @@ use crate::evaluation::loop_patch::{
     LoopCornerMatrices, box_spline, loop_corner_matrices, loop_sharp_regular, tri_corner_patch,
 };
 use crate::evaluation::patch::{
-    GridPoint, REGULAR_GRID, SurfacePoint, corner_patch, eval_bicubic, sharp_regular_grid,
-    smooth_neighbourhood,
+    Derivatives, GridPoint, REGULAR_GRID, SurfacePoint, corner_patch, eval_bicubic,
+    sharp_regular_grid, smooth_neighbourhood,
 };
 use crate::evaluation::stam::{CornerPatchMatrices, Projected, corner_patch_matrices};
 use crate::limit_masks::masks;
@@ -212,6 +212,19 @@ pub(crate) fn eval_piece(
     s: f64,
     tp: f64,
 ) -> Result<SurfacePoint, LimitError> {
+    eval_piece_to(piece, pts, projected, face, (s, tp), Derivatives::Second)
+}
+
+/// [`eval_piece`] up to the derivatives `d`: the eigenbasis pieces leave the second
+/// derivatives out (zero) for [`Derivatives::First`]; the others compute them anyway.
+pub(crate) fn eval_piece_to(
+    piece: &Piece,
+    pts: &[DVec3],
+    projected: Option<&Projected>,
+    face: usize,
+    (s, tp): (f64, f64),
+    d: Derivatives,
+) -> Result<SurfacePoint, LimitError> {
     match piece {
         Piece::Regular(grid) => {
             let g: [DVec3; 16] = std::array::from_fn(|i| pts[grid[i] as usize]);
@@ -239,7 +252,8 @@ pub(crate) fn eval_piece(
                 let c: Vec<DVec3> = cp.iter().map(|&i| pts[i as usize]).collect();
                 at_extraordinary_vertex(&c, n)?
             } else {
-                matrices.evaluate_projected(projected.expect("corner pieces are projected"), a, b)
+                let c = projected.expect("corner pieces are projected");
+                matrices.evaluate_projected_to(c, a, b, d)
             };
             Ok(pull_back(&q, j))
         }
@@ -280,10 +294,11 @@ pub(crate) fn eval_piece(
                     ..SurfacePoint::default()
                 }
             } else {
-                matrices.evaluate(
+                matrices.evaluate_to(
                     projected.expect("corner pieces are projected"),
                     a.max(0.0),
                     b.max(0.0),
+                    d,
                 )?
             };
             Ok(pull_back(&q, j))

@@ -28,7 +28,9 @@ use subd_mesh::TopologyBuilder;
 use subd_schemes::{Options, Refinement, Scheme};
 
 use crate::LimitError;
-use crate::evaluation::patch::{REGULAR_GRID, SurfacePoint, bicubic_weights, corner_patch};
+use crate::evaluation::patch::{
+    Derivatives, REGULAR_GRID, SurfacePoint, bicubic_weights, corner_patch,
+};
 
 /// Subdivision matrices of the corner patch of valence `n`, and their eigen decomposition.
 #[derive(Debug)]
@@ -154,6 +156,17 @@ impl CornerPatchMatrices {
 
     /// [`Self::evaluate`] from [`Self::project`]ed control points.
     pub fn evaluate_projected(&self, c: &Projected, s: f64, t: f64) -> SurfacePoint {
+        self.evaluate_projected_to(c, s, t, Derivatives::Second)
+    }
+
+    /// [`Self::evaluate_projected`] up to the derivatives `d` (the others zero).
+    pub(crate) fn evaluate_projected_to(
+        &self,
+        c: &Projected,
+        s: f64,
+        t: f64,
+        d: Derivatives,
+    ) -> SurfacePoint {
         debug_assert!(s > 0.0 || t > 0.0);
         let (steps, scale) = steps_to_regular(s.max(t));
         let (s1, t1) = (s * scale, t * scale);
@@ -164,7 +177,8 @@ impl CornerPatchMatrices {
         } else {
             (2, 2.0 * s1, 2.0 * t1 - 1.0)
         };
-        let out = self.sub.combine(c, steps, quarter, &bicubic_weights(u, v));
+        let w = bicubic_weights(u, v);
+        let out = self.sub.combine(c, steps, quarter, &w[..d.rows()]);
         SurfacePoint {
             position: out[0],
             du: out[1],
@@ -239,8 +253,9 @@ impl<const G: usize> SubpatchSubdivision<G> {
     }
 
     /// Position and derivatives (in sub-patch parameters) after `steps` subdivisions, in
-    /// regular sub-patch `sub` (0..3 for k = 1..3), from its control weights `w`.
-    pub fn combine(&self, c: &Projected, steps: i32, sub: usize, w: &[[f64; G]; 6]) -> [DVec3; 6] {
+    /// regular sub-patch `sub` (0..3 for k = 1..3), from its control weights `w`: one output
+    /// per row of `w` (position, ∂u, ∂v, then the second derivatives), the rest zero.
+    pub fn combine(&self, c: &Projected, steps: i32, sub: usize, w: &[[f64; G]]) -> [DVec3; 6] {
         let mut out = [DVec3::ZERO; 6];
         match c {
             Projected::Eigen(chat) => {
@@ -255,7 +270,7 @@ impl<const G: usize> SubpatchSubdivision<G> {
                     // of a constant are exactly zero, and leaving it out keeps derivatives
                     // near the vertex to full relative precision (its round-off would be
                     // scaled up by 2^m).
-                    let outputs = if *lam == one { 1 } else { 6 };
+                    let outputs = if *lam == one { 1 } else { w.len() };
                     for (o, wd) in out.iter_mut().zip(w).take(outputs) {
                         let b = phi
                             .iter()
@@ -278,8 +293,8 @@ impl<const G: usize> SubpatchSubdivision<G> {
                 let ab = &self.abar[sub];
                 for g in 0..G {
                     let q = (0..c.len()).fold(DVec3::ZERO, |acc, j| acc + ab[(g, j)] * c[j]);
-                    for (d, o) in out.iter_mut().enumerate() {
-                        *o += w[d][g] * q;
+                    for (o, wd) in out.iter_mut().zip(w) {
+                        *o += wd[g] * q;
                     }
                 }
             }
