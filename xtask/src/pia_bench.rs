@@ -186,7 +186,15 @@ fn bunny_path() -> PathBuf {
 fn fetch_bunny(dest: &Path) -> Result<(), String> {
     let dir = dest.parent().ok_or("no parent")?.join("pymeshfix");
     std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
-    let status = Command::new("python3")
+    // The test environment's interpreter where `cargo xtask test` made one (it has pip on
+    // any system); the system's otherwise.
+    let venv = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/python-env/bin/python");
+    let python = if venv.exists() {
+        venv.into_os_string()
+    } else {
+        "python3".into()
+    };
+    let status = Command::new(&python)
         .args([
             "-m",
             "pip",
@@ -205,7 +213,7 @@ fn fetch_bunny(dest: &Path) -> Result<(), String> {
     let script = "import sys, zipfile, glob\n\
                   w = glob.glob(sys.argv[1] + '/pymeshfix-*.whl')[0]\n\
                   open(sys.argv[2], 'wb').write(zipfile.ZipFile(w).read('pymeshfix/examples/StanfordBunny.ply'))\n";
-    let status = Command::new("python3")
+    let status = Command::new(&python)
         .args(["-c", script])
         .arg(&dir)
         .arg(dest)
