@@ -272,7 +272,13 @@ double bfrTessellate(Far::TopologyRefiner const &refiner, Mesh const &m, int rat
 // The factory options of --patches and --patches-bench (argv[2..5]: ENDCAP SINGLE_CREASE
 // INF_SHARP LEGACY_CORNERS), double precision, no varying tables.
 Far::PatchTableFactory::Options patchOptions(Mesh const &m, char **argv) {
-    Far::PatchTableFactory::Options po = patchOptions(m, argv);
+    Far::PatchTableFactory::Options po(m.levels);
+    po.SetPatchPrecision<double>();
+    po.endCapType = (Far::PatchTableFactory::Options::EndCapType)std::atoi(argv[2]);
+    po.useSingleCreasePatch = std::atoi(argv[3]) != 0;
+    po.useInfSharpPatch = std::atoi(argv[4]) != 0;
+    po.generateLegacySharpCornerPatches = std::atoi(argv[5]) != 0;
+    po.generateVaryingTables = false;
     return po;
 }
 
@@ -312,13 +318,7 @@ void patchTable(Mesh const &m, Reader &r, char **argv, std::vector<unsigned char
         vs[i] = r.get<double>();
     }
     Far::TopologyRefiner *refiner = createRefiner(m);
-    Far::PatchTableFactory::Options po(m.levels);
-    po.SetPatchPrecision<double>();
-    po.endCapType = (Far::PatchTableFactory::Options::EndCapType)std::atoi(argv[2]);
-    po.useSingleCreasePatch = std::atoi(argv[3]) != 0;
-    po.useInfSharpPatch = std::atoi(argv[4]) != 0;
-    po.generateLegacySharpCornerPatches = std::atoi(argv[5]) != 0;
-    po.generateVaryingTables = false;
+    Far::PatchTableFactory::Options po = patchOptions(m, argv);
     refiner->RefineAdaptive(po.GetRefineAdaptiveOptions());
     Far::PatchTable const *table = Far::PatchTableFactory::Create(*refiner, po);
     put<uint32_t>(out, (uint32_t)table->GetNumPatchArrays());

@@ -67,6 +67,12 @@ pub fn tri_corner_patch(t: &Topology, f: usize, c: usize) -> Option<Vec<u32>> {
 
 /// Monomials u^a v^b of total degree ≤ 4, and their first and second derivatives.
 fn monomials(u: f64, v: f64) -> [[f64; 15]; 6] {
+    monomial_rows::<6>(u, v)
+}
+
+/// The first `R` rows of [`monomials`] (3: the monomials and their first derivatives), each
+/// computed as there.
+fn monomial_rows<const R: usize>(u: f64, v: f64) -> [[f64; 15]; R] {
     // x^k for k ≤ 4 by the products `powi` forms (square and multiply: x·x², (x²)²), so
     // the same bits without a library call per term.
     let powers = |x: f64| {
@@ -75,18 +81,23 @@ fn monomials(u: f64, v: f64) -> [[f64; 15]; 6] {
     };
     let (pu, pv) = (powers(u), powers(v));
     let pw = |p: &[f64; 5], k: i32| if k < 0 { 0.0 } else { p[k as usize] };
-    let mut m = [[0.0; 15]; 6];
+    let mut m = [[0.0; 15]; R];
     let mut k = 0;
     for d in 0..=4i32 {
         for b in 0..=d {
             let a = d - b;
             let (af, bf) = (f64::from(a), f64::from(b));
-            m[0][k] = pw(&pu, a) * pw(&pv, b);
-            m[1][k] = af * pw(&pu, a - 1) * pw(&pv, b);
-            m[2][k] = bf * pw(&pu, a) * pw(&pv, b - 1);
-            m[3][k] = af * (af - 1.0) * pw(&pu, a - 2) * pw(&pv, b);
-            m[4][k] = af * bf * pw(&pu, a - 1) * pw(&pv, b - 1);
-            m[5][k] = bf * (bf - 1.0) * pw(&pu, a) * pw(&pv, b - 2);
+            let row = |r: usize| match r {
+                0 => pw(&pu, a) * pw(&pv, b),
+                1 => af * pw(&pu, a - 1) * pw(&pv, b),
+                2 => bf * pw(&pu, a) * pw(&pv, b - 1),
+                3 => af * (af - 1.0) * pw(&pu, a - 2) * pw(&pv, b),
+                4 => af * bf * pw(&pu, a - 1) * pw(&pv, b - 1),
+                _ => bf * (bf - 1.0) * pw(&pu, a) * pw(&pv, b - 2),
+            };
+            for (r, mr) in m.iter_mut().enumerate() {
+                mr[k] = row(r);
+            }
             k += 1;
         }
     }
@@ -199,7 +210,11 @@ impl BoxSpline {
 
     /// [`Self::weights`] up to the derivatives `d` (the other rows zero).
     pub(crate) fn weights_to(&self, u: f64, v: f64, d: Derivatives) -> [[f64; 12]; 6] {
-        let m = monomials(u, v);
+        let mut m = [[0.0; 15]; 6];
+        match d {
+            Derivatives::First => m[..3].copy_from_slice(&monomial_rows::<3>(u, v)),
+            Derivatives::Second => m = monomials(u, v),
+        }
         let mut w = [[0.0; 12]; 6];
         for d in 0..d.rows() {
             for k in 0..12 {
@@ -212,7 +227,7 @@ impl BoxSpline {
     /// Position and first derivatives of the regular patch over `cp` at (u, v): half of
     /// [`Self::evaluate`]'s work, for callers that need no second derivatives.
     pub fn evaluate_first(&self, cp: &[DVec3; 12], u: f64, v: f64) -> (DVec3, DVec3, DVec3) {
-        let m = monomials(u, v);
+        let m = monomial_rows::<3>(u, v);
         let mut out = [DVec3::ZERO; 3];
         for (k, p) in cp.iter().enumerate() {
             for (d, o) in out.iter_mut().enumerate() {
