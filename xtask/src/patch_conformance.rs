@@ -288,7 +288,7 @@ fn is_valence_two_dart(t: &Topology, v: u32) -> bool {
         && edges.iter().all(|&e| t.edge_faces(e as usize).len() == 2)
         && edges
             .iter()
-            .filter(|&&e| t.edge_sharpness(e as usize) >= 10.0)
+            .filter(|&&e| subd_mesh::tags::is_infinite(t.edge_sharpness(e as usize)))
             .count()
             == 1
 }

@@ -188,7 +188,8 @@ fn fetch_bunny(dest: &Path) -> Result<(), String> {
     std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
     // The test environment's interpreter where `cargo xtask test` made one (it has pip on
     // any system); the system's otherwise.
-    let venv = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/python-env/bin/python");
+    let venv =
+        crate::python_tests::env_python(&PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(".."));
     let python = if venv.exists() {
         venv.into_os_string()
     } else {

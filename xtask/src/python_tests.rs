@@ -49,11 +49,17 @@ pub(crate) fn run_python_bench(root: &Path, repeats: usize) -> Result<(), String
         .arg(json))
 }
 
+/// The interpreter of the test environment `target/python-env` (there once `cargo xtask
+/// test` has made it).
+pub(crate) fn env_python(root: &Path) -> PathBuf {
+    root.join("target/python-env/bin/python")
+}
+
 /// The environment `target/python-env` with the test packages, `optional` ones where they
 /// install, and the package built and installed as a user installs it: its interpreter.
 fn python_env(root: &Path, optional: &[&str]) -> Result<PathBuf, String> {
     let env = root.join("target/python-env");
-    let python = env.join("bin/python");
+    let python = env_python(root);
     if !python.exists() {
         run(Command::new(python3()).args(["-m", "venv"]).arg(&env))?;
     }
