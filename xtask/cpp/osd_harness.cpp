@@ -300,6 +300,34 @@ std::vector<Point> patchPoints(Mesh const &m, Far::TopologyRefiner const &refine
     return verts;
 }
 
+// The face-varying channel 0 of a patch table at each point: value, du, dv (f64[2] each).
+void patchFVar(Mesh const &m, Far::TopologyRefiner const &refiner, Far::PatchTable const &table,
+               std::vector<int> const &faces, std::vector<double> const &us, std::vector<double> const &vs,
+               std::vector<unsigned char> &out) {
+    std::vector<Uv> values(refiner.GetNumFVarValuesTotal(0));
+    std::copy(m.fvarValues.begin(), m.fvarValues.end(), values.begin());
+    Far::PrimvarRefinerReal<double> primvar(refiner);
+    Uv *src = values.data();
+    for (int l = 1; l < refiner.GetNumLevels(); ++l) {
+        Uv *dst = src + refiner.GetLevel(l - 1).GetNumFVarValues(0);
+        primvar.InterpolateFaceVarying(l, src, dst, 0);
+        src = dst;
+    }
+    Far::PatchMap map(table);
+    double w[3][20];
+    for (size_t i = 0; i < faces.size(); ++i) {
+        Far::PatchTable::PatchHandle const *h = map.FindPatch(faces[i], us[i], vs[i]);
+        table.EvaluateBasisFaceVarying(*h, us[i], vs[i], w[0], w[1], w[2], 0, 0, 0, 0);
+        Far::ConstIndexArray cvs = table.GetPatchFVarValues(*h, 0);
+        for (int d = 0; d < 3; ++d) {
+            Uv acc;
+            acc.Clear();
+            for (int c = 0; c < cvs.size(); ++c) acc.AddWithWeight(values[cvs[c]], w[d][c]);
+            for (double x : acc.p) put<double>(out, x);
+        }
+    }
+}
+
 // The patch table of an adaptive refinement to isolation level `m.levels` with the given
 // factory options (--patches ENDCAP SINGLE_CREASE INF_SHARP LEGACY_CORNERS; ENDCAP is
 // PatchTableFactory::Options::EndCapType), evaluated in double precision at the points that
@@ -307,7 +335,10 @@ std::vector<Point> patchPoints(Mesh const &m, Far::TopologyRefiner const &refine
 // u32 type (PatchDescriptor::Type), u32 control points, u32 patches, per patch u32 face, u, v,
 // depth, nonquad, boundary, transition, regular, f32 single-crease sharpness, u32 cvs[n];
 // then u32 local points, u32 refined vertices, per point f64 P, Du, Dv, Duu, Duv, Dvv [3],
-// then f64 pos[3 (refined + local)].
+// then f64 pos[3 (refined + local)]. With a face-varying channel (--patches ... MODE, the
+// channel between the mesh and the points), the table also has its face-varying patches
+// (generateFVarTables, OpenSubdiv's default linear ones), and per point f64 value[2], du[2],
+// dv[2] follow (EvaluateBasisFaceVarying over the values refined per level).
 void patchTable(Mesh const &m, Reader &r, char **argv, std::vector<unsigned char> &out) {
     uint32_t count = r.get<uint32_t>();
     std::vector<int> faces(count);
@@ -319,6 +350,8 @@ void patchTable(Mesh const &m, Reader &r, char **argv, std::vector<unsigned char
     }
     Far::TopologyRefiner *refiner = createRefiner(m);
     Far::PatchTableFactory::Options po = patchOptions(m, argv);
+    bool fvar = !m.fvarIndices.empty();
+    po.generateFVarTables = fvar;
     refiner->RefineAdaptive(po.GetRefineAdaptiveOptions());
     Far::PatchTable const *table = Far::PatchTableFactory::Create(*refiner, po);
     put<uint32_t>(out, (uint32_t)table->GetNumPatchArrays());
@@ -358,6 +391,7 @@ void patchTable(Mesh const &m, Reader &r, char **argv, std::vector<unsigned char
     }
     for (auto const &p : verts)
         for (double c : p.p) put<double>(out, c);
+    if (fvar) patchFVar(m, *refiner, *table, faces, us, vs, out);
     delete table;
     delete refiner;
 }
@@ -472,6 +506,10 @@ int main(int argc, char **argv) {
             return 0;
         }
         if (argc > 5 && std::string(argv[1]) == "--patches") {
+            if (argc > 6) {
+                m.options.SetFVarLinearInterpolation((Sdc::Options::FVarLinearInterpolation)std::atoi(argv[6]));
+                readFVar(r, m);
+            }
             std::vector<unsigned char> out;
             patchTable(m, r, argv, out);
             std::fwrite(out.data(), 1, out.size(), stdout);

@@ -153,7 +153,7 @@ fn compare_limit(
 }
 
 /// Diagonal of the bounding box of two-component values.
-fn uv_diagonal(values: &[f64]) -> f64 {
+pub(crate) fn uv_diagonal(values: &[f64]) -> f64 {
     let mut lo = [f64::INFINITY; 2];
     let mut hi = [f64::NEG_INFINITY; 2];
     for uv in values.chunks_exact(2) {

@@ -19,6 +19,7 @@ mod geom_ref;
 mod osd;
 mod patch_bench;
 mod patch_conformance;
+mod patch_fvar_conformance;
 mod pia_bench;
 mod python_tests;
 mod random_mesh;
@@ -300,6 +301,7 @@ fn main() -> ExitCode {
                 let mut rows = patch_conformance::shapes(exe, &shapes)?;
                 rows.extend(patch_conformance::real_meshes(exe)?);
                 rows.extend(patch_conformance::random(exe, random_patches));
+                rows.extend(patch_fvar_conformance::shapes(exe, &shapes)?);
                 Ok(rows)
             };
             if patches_only {

@@ -330,6 +330,10 @@ impl<'a> Cursor<'a> {
         self.pos += n;
         Ok(s)
     }
+    /// Whether every byte has been read.
+    pub fn is_empty(&self) -> bool {
+        self.pos >= self.bytes.len()
+    }
     pub fn u32(&mut self) -> Result<u32, String> {
         Ok(u32::from_le_bytes(self.take(4)?.try_into().unwrap()))
     }

@@ -30,11 +30,13 @@ pub struct OsdPatch {
     pub regular: u32,
 }
 
-/// The harness's patch table: its patches, local point count, and the evaluations.
+/// The harness's patch table: its patches, local point count, the evaluations, and with a
+/// face-varying channel its evaluations (value, du, dv; two numbers each).
 pub struct OsdPatchTable {
     pub patches: Vec<OsdPatch>,
     pub local_points: usize,
     pub evaluations: Vec<[DVec3; 6]>,
+    pub fvar: Vec<[f64; 6]>,
 }
 
 /// The harness's `--patches` arguments for `options`.
@@ -77,7 +79,7 @@ pub fn decode(bytes: &[u8], points: usize) -> Result<OsdPatchTable, String> {
         }
     }
     let local_points = c.u32()? as usize;
-    let _refined = c.u32()?;
+    let refined = c.u32()? as usize;
     let mut evaluations = Vec::with_capacity(points);
     for _ in 0..points {
         let mut e = [DVec3::ZERO; 6];
@@ -86,10 +88,19 @@ pub fn decode(bytes: &[u8], points: usize) -> Result<OsdPatchTable, String> {
         }
         evaluations.push(e);
     }
+    c.take(24 * (refined + local_points))?;
+    let mut fvar = Vec::new();
+    if !c.is_empty() {
+        for _ in 0..points {
+            let x = c.f64s(6)?;
+            fvar.push(std::array::from_fn(|k| x[k]));
+        }
+    }
     Ok(OsdPatchTable {
         patches,
         local_points,
         evaluations,
+        fvar,
     })
 }
 
@@ -196,7 +207,7 @@ fn uniform(seed: u64) -> impl FnMut() -> f64 {
 /// Evaluation points: a few per root face the table covers, and one inside each of up to
 /// 100 end caps (spread over the table), as (base face, sub-face, u, v) and the harness's
 /// (ptex face, u, v).
-fn eval_points(
+pub(crate) fn eval_points(
     table: &PatchTable,
     topo: &Topology,
     scheme: &Scheme,
@@ -489,7 +500,7 @@ fn compare_sets(
         .collect()
 }
 
-fn bbox_diagonal(p: &[DVec3]) -> f64 {
+pub(crate) fn bbox_diagonal(p: &[DVec3]) -> f64 {
     let (lo, hi) = p.iter().fold(
         (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
         |(a, b), &x| (a.min(x), b.max(x)),

@@ -62,7 +62,8 @@ pub(crate) struct PatchesArgs {
     no_legacy_sharp_corners: bool,
     /// Input mesh.
     input: PathBuf,
-    /// Output (.json): the table's arrays (see `subd_limit::patches::PatchTableLayout`).
+    /// Output (.json): the table's arrays (see `subd_limit::patches::PatchTableLayout`), and
+    /// with texture coordinates in the input their face-varying patches (`face_varying`).
     output: Option<PathBuf>,
     /// Print the census (patches by type, depth and boundary mask) on stdout as JSON.
     #[arg(long)]
@@ -98,7 +99,7 @@ pub(crate) fn run(
     let file = subd_io::read_mesh(&args.input, &args.rules.read_options())?;
     print_warnings(err, &args.input, &file.warnings);
     let rules = args.rules.options(&file.mesh.hints);
-    let table = PatchTable::new(
+    let mut table = PatchTable::new(
         &file.mesh.topology,
         &file.mesh.positions,
         &args.scheme,
@@ -106,6 +107,17 @@ pub(crate) fn run(
         &args.options(),
     )
     .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
+    // Texture coordinates become the table's face-varying channel (OpenSubdiv's
+    // generateFVarTables), refined with the file's or the command's interpolation mode.
+    if let Some(uv) = file.mesh.uv() {
+        let mode = args.rules.fvar_mode(&file.mesh.hints);
+        table.add_face_varying(uv, mode).map_err(|e| {
+            bad(format!(
+                "{}: texture coordinates: {e}",
+                args.input.display()
+            ))
+        })?;
+    }
     if let Some(output) = &args.output {
         subd_io::atomic_write(output, |w| {
             serde_json::to_writer(&mut *w, &table.layout()).map_err(std::io::Error::other)?;

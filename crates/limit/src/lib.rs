@@ -122,9 +122,11 @@ pub mod patches {
     //! Patch tables: feature-adaptive refinement into patches, as OpenSubdiv's
     //! `TopologyRefiner::RefineAdaptive` + `Far::PatchTableFactory` make them, with exact
     //! end caps besides OpenSubdiv's. See [`PatchTable`].
+    pub use crate::evaluation::fvar_eval::FVarPoint;
     pub use crate::patch_table::{
-        EndCaps, MAX_ISOLATION, PatchArray, PatchArrayLayout, PatchCensus, PatchGrid, PatchMap,
-        PatchOptions, PatchParam, PatchPlace, PatchTable, PatchTableLayout, PatchType, TablePoints,
+        EndCaps, FVarPatches, FVarPatchesLayout, MAX_ISOLATION, PatchArray, PatchArrayLayout,
+        PatchCensus, PatchGrid, PatchMap, PatchOptions, PatchParam, PatchPlace, PatchTable,
+        PatchTableLayout, PatchType, TablePoints,
     };
 }
 

@@ -5,6 +5,7 @@
 use proptest::prelude::*;
 use subd_limit::eval::{FaceParam, LimitEvaluator};
 use subd_limit::patches::{EndCaps, PatchOptions, PatchTable, PatchType};
+use subd_mesh::fvar::{FVarChannel, FVarLinearInterpolation};
 use subd_mesh::{DVec3, Topology, TopologyBuilder};
 use subd_schemes::{Options, Scheme};
 
@@ -580,4 +581,180 @@ fn tessellation_on_the_exact_table_is_the_evaluators() {
             }
         }
     }
+}
+
+/// Random values, one per face corner (every edge a seam): `components` numbers each.
+fn seamed_channel(c: &Case, components: usize, seed: u64) -> FVarChannel {
+    let n = c.topology.num_face_vertices();
+    let mut state = seed;
+    let values = (0..n * components)
+        .map(|_| {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        })
+        .collect();
+    FVarChannel::new(&c.topology, components, values, (0..n as u32).collect()).unwrap()
+}
+
+/// The bilinear (quads; a non-quad's sub-face runs corner, edge midpoint, centre, edge
+/// midpoint) or linear (triangles) interpolation of a face's corner values: what mode
+/// `all` refines to at every level.
+fn linear_in_face(c: &Case, ch: &FVarChannel, at: FaceParam) -> Vec<f64> {
+    let k = ch.components();
+    let corners = ch.face_values(&c.topology, at.face);
+    let n = corners.len();
+    let corner = |j: usize| ch.value(corners[j % n] as usize).to_vec();
+    let mix = |a: &[f64], b: &[f64], wa: f64, wb: f64| -> Vec<f64> {
+        a.iter().zip(b).map(|(x, y)| wa * x + wb * y).collect()
+    };
+    let (u, v) = (at.u, at.v);
+    if c.scheme == Scheme::Loop {
+        let ab = mix(&corner(0), &corner(1), 1.0 - u - v, u);
+        return mix(&ab, &corner(2), 1.0, v);
+    }
+    let [p00, p10, p11, p01] = if n == 4 {
+        [0, 1, 2, 3].map(corner)
+    } else {
+        let s = at.sub;
+        let centre: Vec<f64> = (0..k)
+            .map(|i| (0..n).map(|j| corner(j)[i]).sum::<f64>() / n as f64)
+            .collect();
+        [
+            corner(s),
+            mix(&corner(s), &corner(s + 1), 0.5, 0.5),
+            centre,
+            mix(&corner(s + n - 1), &corner(s), 0.5, 0.5),
+        ]
+    };
+    let bottom = mix(&p00, &p10, 1.0 - u, u);
+    let top = mix(&p01, &p11, 1.0 - u, u);
+    mix(&bottom, &top, 1.0 - v, v)
+}
+
+/// With every value refined linearly (mode `all`), each face-varying patch is the base
+/// face's own bilinear or linear interpolation, at every depth and under every end cap.
+#[test]
+fn linear_face_varying_patches_are_the_faces_interpolation() {
+    for (ci, c) in cases().iter().enumerate() {
+        let ch = seamed_channel(c, 2, ci as u64 + 7);
+        for isolation in [1u8, 3] {
+            for caps in ALL_CAPS {
+                let mut table = PatchTable::new(
+                    &c.topology,
+                    &c.positions,
+                    &c.scheme,
+                    &Options::default(),
+                    &options(isolation, caps, false),
+                )
+                .unwrap();
+                let channel = table
+                    .add_face_varying(&ch, FVarLinearInterpolation::All)
+                    .unwrap();
+                for f in 0..c.topology.num_faces() {
+                    for sub in 0..subs(c, f) {
+                        for (u, v) in [(0.1, 0.2), (0.7, 0.05), (0.33, 0.6), (0.0, 0.0)] {
+                            let at = FaceParam { face: f, sub, u, v };
+                            let got = table.evaluate_face_varying(channel, at).unwrap();
+                            let want = linear_in_face(c, &ch, at);
+                            for (g, w) in got.value.iter().zip(&want) {
+                                assert!(
+                                    (g - w).abs() < 1e-14,
+                                    "case {ci} face {f} sub {sub} at ({u}, {v}): {g} vs {w}"
+                                );
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// A channel without seams holding the positions, refined smoothly (mode `none`) on a
+/// closed mesh without creases, is refined by the vertex rules: each regular patch's
+/// face-varying values are its face's refined vertices, its control points at the face's
+/// corners.
+#[test]
+fn smooth_face_varying_without_seams_follows_the_vertices() {
+    for c in [cube(), pentagon(), octahedron()] {
+        let positions: Vec<f64> = c.positions.iter().flat_map(|p| p.to_array()).collect();
+        let indices = c.topology.all_face_vertices().to_vec();
+        let ch = FVarChannel::new(&c.topology, 3, positions, indices).unwrap();
+        let mut table = PatchTable::new(
+            &c.topology,
+            &c.positions,
+            &c.scheme,
+            &Options::default(),
+            &options(4, EndCaps::GregoryBasis, false),
+        )
+        .unwrap();
+        table
+            .add_face_varying(&ch, FVarLinearInterpolation::None)
+            .unwrap();
+        let fvar = &table.face_varying()[0];
+        let corners: &[usize] = if c.scheme == Scheme::Loop {
+            &[4, 5, 8]
+        } else {
+            &[5, 6, 10, 9]
+        };
+        let mut checked = 0;
+        for (a, array) in table.arrays().iter().enumerate() {
+            if !matches!(array.kind(), PatchType::Regular | PatchType::Loop) {
+                continue;
+            }
+            let n = corners.len();
+            for i in 0..array.len() {
+                let cps = array.patch_points(i);
+                let values = &fvar.patch_values(a)[n * i..n * (i + 1)];
+                for (k, &corner) in corners.iter().enumerate() {
+                    let p = table.points()[cps[corner] as usize];
+                    let x = &fvar.values()[3 * values[k] as usize..3 * values[k] as usize + 3];
+                    assert!(
+                        (p - DVec3::from_slice(x)).length() < 1e-13,
+                        "array {a} patch {i} corner {k}: {p} vs {x:?}"
+                    );
+                    checked += 1;
+                }
+            }
+        }
+        assert!(checked > 100, "only {checked} corners checked");
+    }
+}
+
+/// Face-varying requests that do not fit are errors, not panics.
+#[test]
+fn bad_face_varying_requests_are_errors() {
+    let c = cube();
+    let mut table = PatchTable::new(
+        &c.topology,
+        &c.positions,
+        &c.scheme,
+        &Options::default(),
+        &PatchOptions::default(),
+    )
+    .unwrap();
+    let at = FaceParam {
+        face: 0,
+        sub: 0,
+        u: 0.5,
+        v: 0.5,
+    };
+    assert!(table.evaluate_face_varying(0, at).is_err());
+    let ch = seamed_channel(&c, 2, 1);
+    let i = table
+        .add_face_varying(&ch, FVarLinearInterpolation::CornersPlus1)
+        .unwrap();
+    assert!(table.update_face_varying(i, &[0.0; 3]).is_err());
+    let moved: Vec<f64> = ch.values().iter().map(|x| x + 1.0).collect();
+    let before = table.evaluate_face_varying(i, at).unwrap();
+    table.update_face_varying(i, &moved).unwrap();
+    let after = table.evaluate_face_varying(i, at).unwrap();
+    // Refinement is affine: moving every value by one moves every refined value by one.
+    for (b, a) in before.value.iter().zip(&after.value) {
+        assert!((a - b - 1.0).abs() < 1e-14);
+    }
+    let bad = FaceParam { face: 9, ..at };
+    assert!(table.evaluate_face_varying(i, bad).is_err());
 }

@@ -198,3 +198,80 @@ fn eval_and_tessellate_on_exact_end_caps_are_the_exact_limit() {
         }
     }
 }
+
+/// Texture coordinates in the input become the table's face-varying channel: its base
+/// values are the file's, every patch names `values_per_patch` of them, and refined
+/// linearly (mode `all`) every value is a convex combination of the file's, so it lies in
+/// their bounding box.
+#[test]
+fn texture_coordinates_become_face_varying_patches() {
+    let dir = Scratch::new("patches_fvar");
+    let out = dir.0.join("cube.json");
+    let cube = meshes().join("catmark_cube.obj");
+    let (code, _, stderr) = subd(&[
+        "patches",
+        "--scheme",
+        "catmull-clark",
+        "--isolation",
+        "3",
+        "--fvar-interpolation",
+        "all",
+        cube.to_str().unwrap(),
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let layout = json(&std::fs::read_to_string(&out).unwrap());
+    let fvar = &layout["face_varying"].as_array().unwrap()[0];
+    assert_eq!(fvar["interpolation"], "all");
+    assert_eq!(fvar["components"], 2);
+    let file_uvs: Vec<f64> = std::fs::read_to_string(&cube)
+        .unwrap()
+        .lines()
+        .filter_map(|l| l.strip_prefix("vt "))
+        .flat_map(|l| {
+            l.split_whitespace()
+                .take(2)
+                .map(|x| x.parse::<f64>().unwrap())
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    let values: Vec<f64> = fvar["values"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    let counts: Vec<u64> = fvar["level_value_counts"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_u64().unwrap())
+        .collect();
+    assert_eq!(counts[0] as usize * 2, file_uvs.len());
+    assert_eq!(values[..file_uvs.len()], file_uvs[..]);
+    assert_eq!(values.len() as u64, 2 * counts.iter().sum::<u64>());
+    let (lo, hi) = file_uvs
+        .chunks(2)
+        .fold(([f64::MAX; 2], [f64::MIN; 2]), |(lo, hi), p| {
+            (
+                [lo[0].min(p[0]), lo[1].min(p[1])],
+                [hi[0].max(p[0]), hi[1].max(p[1])],
+            )
+        });
+    for p in values.chunks(2) {
+        for k in 0..2 {
+            assert!(p[k] >= lo[k] - 1e-15 && p[k] <= hi[k] + 1e-15, "{p:?}");
+        }
+    }
+    let arrays = layout["arrays"].as_array().unwrap();
+    let per_patch = fvar["values_per_patch"].as_u64().unwrap();
+    assert_eq!(per_patch, 4);
+    for (a, pv) in arrays.iter().zip(fvar["patch_values"].as_array().unwrap()) {
+        let pv = pv.as_array().unwrap();
+        assert_eq!(pv.len() as u64, per_patch * a["patches"].as_u64().unwrap());
+        assert!(
+            pv.iter()
+                .all(|v| v.as_u64().unwrap() < values.len() as u64 / 2)
+        );
+    }
+}

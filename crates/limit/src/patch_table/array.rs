@@ -10,6 +10,8 @@ pub struct PatchArray {
     pub(super) params: Vec<PatchParam>,
     pub(super) sharpness: Vec<f32>,
     pub(super) control_points: Vec<u32>,
+    /// Level and face (in that level) of each patch.
+    pub(super) faces: Vec<(u8, u32)>,
 }
 
 impl PatchArray {
@@ -19,11 +21,19 @@ impl PatchArray {
             params: Vec::new(),
             sharpness: Vec::new(),
             control_points: Vec::new(),
+            faces: Vec::new(),
         }
     }
 
     /// Appends a patch.
-    pub(crate) fn push(&mut self, param: PatchParam, sharpness: f32, points: &[u32]) {
+    pub(crate) fn push(
+        &mut self,
+        (level, face): (u8, u32),
+        param: PatchParam,
+        sharpness: f32,
+        points: &[u32],
+    ) {
+        self.faces.push((level, face));
         self.params.push(param);
         self.sharpness.push(sharpness);
         self.control_points.extend_from_slice(points);

@@ -79,7 +79,7 @@ impl<'a> Assembly<'a> {
                 self.end_cap_points(p)
             };
             slots.push((a, arrays[a].len()));
-            arrays[a].push(p.param, p.sharpness, &points);
+            arrays[a].push((p.level, p.face), p.param, p.sharpness, &points);
         }
         let keep: Vec<bool> = arrays.iter().map(|a| !a.is_empty()).collect();
         // Global order: arrays in order, patches in order within each.

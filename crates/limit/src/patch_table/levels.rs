@@ -47,6 +47,19 @@ pub(crate) struct PatchLevel {
     pub rows: Option<StencilTable>,
 }
 
+/// A level's faces around its selected vertices, refined one step ([`PatchLevel::piece`]).
+pub(crate) struct Piece {
+    pub sel: Selected,
+    /// The level's faces in the piece, in level order.
+    pub faces: Vec<u32>,
+    pub cut: submesh::SubMesh,
+    layout: PieceLayout,
+    /// The piece refined one uniform step.
+    pub refinement: Refinement,
+    /// The children the next level keeps.
+    pub kept: KeptChildren,
+}
+
 /// The vertices and edges of a level's selected faces.
 pub(crate) struct Selected {
     pub vertices: Vec<bool>,
@@ -143,6 +156,28 @@ impl PatchLevel {
             .collect()
     }
 
+    /// The faces of the level around its selected vertices, cut out and refined one
+    /// uniform step, with the children the next level keeps (the refinement's input, shared
+    /// by the vertices and each face-varying channel).
+    pub(crate) fn piece(&self, scheme: &Scheme, options: &Options) -> Result<Piece, LimitError> {
+        let sel = self.selected_parts();
+        let faces = self.piece_faces(&sel);
+        let cut = submesh::cut(&self.topology, &faces);
+        let rules = self.piece_rules(&cut);
+        let layout = PieceLayout::new(&cut.topology, *scheme == Scheme::Loop);
+        let refinement =
+            Refinement::from_prepared(cut.topology.clone(), rules, scheme.clone(), options, 1)?;
+        let kept = self.kept_children(&faces, &sel, &layout);
+        Ok(Piece {
+            sel,
+            faces,
+            cut,
+            layout,
+            refinement,
+            kept,
+        })
+    }
+
     /// The next level: every child of a selected face, each other face's child at a
     /// selected corner, and (Loop) the middle child of a face with a transitional edge.
     pub(crate) fn refine(
@@ -151,13 +186,14 @@ impl PatchLevel {
         options: &Options,
         reg: Regularity,
     ) -> Result<PatchLevel, LimitError> {
-        let sel = self.selected_parts();
-        let piece_faces = self.piece_faces(&sel);
-        let cut = submesh::cut(&self.topology, &piece_faces);
-        let rules = self.piece_rules(&cut);
-        let layout = PieceLayout::new(&cut.topology, *scheme == Scheme::Loop);
-        let r = Refinement::from_prepared(cut.topology.clone(), rules, scheme.clone(), options, 1)?;
-        let kept = self.kept_children(&piece_faces, &sel, &layout);
+        let Piece {
+            sel,
+            faces: piece_faces,
+            cut,
+            layout,
+            refinement: r,
+            kept,
+        } = self.piece(scheme, options)?;
         let next = submesh::cut(r.topology(1), &kept.faces);
         let child_rules: Vec<Rule> = {
             let all = r.vertex_rules(1);
@@ -318,9 +354,9 @@ impl PieceLayout {
 /// The kept child faces (indices in the piece's child level), with their parent in the
 /// level and their index among its children.
 #[derive(Default)]
-struct KeptChildren {
-    faces: Vec<u32>,
-    parent: Vec<(u32, u8)>,
+pub(crate) struct KeptChildren {
+    pub faces: Vec<u32>,
+    pub parent: Vec<(u32, u8)>,
 }
 
 /// The kept vertices' rows of the piece's stencils, as weights of the level's vertices.

@@ -48,6 +48,7 @@ mod box_fit;
 mod bspline_caps;
 mod classify;
 mod end_caps;
+mod face_varying;
 mod features;
 mod gather;
 mod grid_samples;
@@ -60,6 +61,7 @@ mod param;
 mod table;
 
 pub use array::PatchArray;
+pub use face_varying::{FVarPatches, FVarPatchesLayout};
 pub use kind::PatchType;
 pub use map::PatchMap;
 pub use options::{EndCaps, MAX_ISOLATION, PatchOptions};

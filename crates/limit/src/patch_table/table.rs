@@ -10,13 +10,16 @@ use super::array::PatchArray;
 use super::assembly::Assembly;
 use super::basis;
 use super::classify::Classifier;
+use super::face_varying::FVarPatches;
 use super::features::{FeatureMask, Regularity, VTag, single_crease_edge};
 use super::levels::PatchLevel;
 use super::map::PatchMap;
 use super::{EndCaps, MAX_ISOLATION, PatchOptions, PatchParam, PatchType};
 use crate::LimitError;
 use crate::evaluation::eval::{FaceParam, GatheredPatch, LimitEvaluator, PatchPoints};
+use crate::evaluation::fvar_eval::FVarPoint;
 use crate::evaluation::patch::SurfacePoint;
+use subd_mesh::fvar::{FVarChannel, FVarLinearInterpolation};
 
 /// Counts of a table's patches, as `subd patches --json` prints them.
 #[derive(Debug, Clone, Default, PartialEq, Eq, serde::Serialize)]
@@ -75,6 +78,8 @@ pub struct PatchTableLayout<'a> {
     pub local_point_weights: &'a [f64],
     /// Refined vertices of all levels, then local points.
     pub points: Vec<[f64; 3]>,
+    /// The face-varying channels ([`PatchTable::add_face_varying`]).
+    pub face_varying: Vec<super::FVarPatchesLayout<'a>>,
 }
 
 /// The patches of a table sampled on grids ([`PatchTable::patch_grid`]).
@@ -112,6 +117,8 @@ struct ExactCaps {
 #[derive(Debug)]
 pub struct PatchTable {
     scheme: Scheme,
+    /// The refinement rules (boundaries, creases) the levels were made with.
+    rules: Options,
     options: PatchOptions,
     levels: Vec<PatchLevel>,
     arrays: Vec<PatchArray>,
@@ -127,6 +134,8 @@ pub struct PatchTable {
     handles: Vec<(u32, u32)>,
     map: PatchMap,
     exact: Option<ExactCaps>,
+    /// Face-varying channels ([`Self::add_face_varying`]).
+    face_varying: Vec<FVarPatches>,
 }
 
 impl PatchTable {
@@ -188,6 +197,7 @@ impl PatchTable {
         };
         let mut table = PatchTable {
             scheme: scheme.clone(),
+            rules: *rules,
             options: *options,
             levels,
             arrays,
@@ -198,6 +208,7 @@ impl PatchTable {
             handles,
             map,
             exact,
+            face_varying: Vec::new(),
         };
         table.points = table.compute_points(positions);
         Ok(table)
@@ -406,6 +417,7 @@ impl PatchTable {
             local_point_indices: self.local.indices(),
             local_point_weights: self.local.weights(),
             points: self.points.iter().map(|p| p.to_array()).collect(),
+            face_varying: self.face_varying.iter().map(FVarPatches::layout).collect(),
         }
     }
 
@@ -572,6 +584,76 @@ impl PatchTable {
             at.u,
             at.v,
         ))
+    }
+
+    /// Adds a face-varying channel (texture coordinates with seams; one value index per
+    /// base face corner) refined with `mode` through the table's levels, and returns its
+    /// index: OpenSubdiv's `generateFVarTables` with its default linear face-varying
+    /// patches (each patch's values are its face's at its level, interpolated bilinearly on
+    /// quads, linearly on triangles).
+    ///
+    /// # Errors
+    /// [`LimitError::Param`] or [`LimitError::FaceVarying`] when the channel does not fit
+    /// the base mesh.
+    pub fn add_face_varying(
+        &mut self,
+        channel: &FVarChannel,
+        mode: FVarLinearInterpolation,
+    ) -> Result<usize, LimitError> {
+        let fvar = FVarPatches::build(
+            &self.levels,
+            &self.arrays,
+            &self.scheme,
+            &self.rules,
+            channel,
+            mode,
+        )?;
+        self.face_varying.push(fvar);
+        Ok(self.face_varying.len() - 1)
+    }
+
+    /// The face-varying channels, in the order they were added.
+    pub fn face_varying(&self) -> &[FVarPatches] {
+        &self.face_varying
+    }
+
+    /// Face-varying channel `channel` at `at`: its value and first derivatives with respect
+    /// to the face's (sub-face's) parameters (OpenSubdiv's `EvaluateBasisFaceVarying`).
+    ///
+    /// # Errors
+    /// [`LimitError::Param`] for a channel that was not added, else as [`Self::find`].
+    pub fn evaluate_face_varying(
+        &self,
+        channel: usize,
+        at: FaceParam,
+    ) -> Result<FVarPoint, LimitError> {
+        let fvar = self.face_varying_channel(channel)?;
+        let (a, i) = self.find(&at)?;
+        Ok(fvar.evaluate(a, i, self.arrays[a].params[i], at.u, at.v))
+    }
+
+    /// Recomputes channel `channel`'s refined values for new values (the channel's layout:
+    /// its components per value), keeping the topology.
+    ///
+    /// # Errors
+    /// [`LimitError::Param`] for a channel that was not added or a value count that is not
+    /// the channel's.
+    pub fn update_face_varying(
+        &mut self,
+        channel: usize,
+        values: &[f64],
+    ) -> Result<(), LimitError> {
+        self.face_varying_channel(channel)?;
+        self.face_varying[channel].update(values)
+    }
+
+    fn face_varying_channel(&self, channel: usize) -> Result<&FVarPatches, LimitError> {
+        self.face_varying.get(channel).ok_or_else(|| {
+            LimitError::Param(format!(
+                "face-varying channel {channel}: the table has {}",
+                self.face_varying.len()
+            ))
+        })
     }
 
     /// Counts of the patches by type, depth and boundary mask.

@@ -1,0 +1,370 @@
+//! Face-varying patches: a channel of per-corner values (texture coordinates with seams)
+//! carried through the table's sparse levels and taken over each patch's face, as
+//! OpenSubdiv's `PatchTableFactory` does with `generateFVarTables` and its default
+//! `generateFVarLegacyLinearPatches`: each patch's face-varying patch is its face at the
+//! patch's level, bilinear (quads) or linear (triangles) in the values refined to that level
+//! with the channel's own rules (`FVarLinearInterpolation`).
+//!
+//! The values of a level are refined from the level above exactly as the vertices are
+//! ([`PatchLevel::piece`]): the faces around the selected vertices are cut out and refined
+//! one step with the channel, and the kept children's corner values are renumbered. Every
+//! value a kept face reads is computed from a neighbourhood that is whole in the piece, so
+//! it equals the uniform refinement's value.
+
+use subd_mesh::Topology;
+use subd_mesh::fvar::{FVarChannel, FVarLinearInterpolation};
+use subd_schemes::{FaceVaryingRefinement, Options, Scheme, StencilTable};
+
+use super::array::PatchArray;
+use super::levels::PatchLevel;
+use super::param::PatchParam;
+use crate::LimitError;
+use crate::evaluation::fvar_eval::FVarPoint;
+
+/// One face-varying channel of a [`super::PatchTable`]: the values of every sparse level
+/// and, per patch, the values of its face.
+#[derive(Debug, Clone)]
+pub struct FVarPatches {
+    mode: FVarLinearInterpolation,
+    components: usize,
+    /// Values of each level (level 0: the channel's own).
+    level_value_counts: Vec<usize>,
+    /// Level `l + 1`'s values as weights of level `l`'s.
+    rows: Vec<StencilTable>,
+    /// Per patch array, the values of each patch's face (`face_size` per patch), as
+    /// indices into the values of all levels.
+    patch_values: Vec<Vec<u32>>,
+    /// Values of all levels, `components` numbers each.
+    values: Vec<f64>,
+    face_size: usize,
+}
+
+/// A face-varying channel as flat arrays, in a table's layout
+/// ([`super::PatchTableLayout::face_varying`]).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct FVarPatchesLayout<'a> {
+    /// The interpolation mode's name (`Sdc::Options::FVarLinearInterpolation`).
+    pub interpolation: &'static str,
+    /// Numbers per value.
+    pub components: usize,
+    /// Values per patch (4: bilinear quads; 3: linear triangles).
+    pub values_per_patch: usize,
+    /// Values of each level (level 0: the channel's own).
+    pub level_value_counts: &'a [usize],
+    /// Per patch array (the table's order), the values of each patch, indices into
+    /// `values`.
+    pub patch_values: Vec<&'a [u32]>,
+    /// The values of all levels, `components` numbers each.
+    pub values: &'a [f64],
+}
+
+/// One level's face-varying values: which value each face corner takes, how many values.
+struct LevelValues {
+    face_values: Vec<u32>,
+    num_values: usize,
+}
+
+impl FVarPatches {
+    /// The channel refined through `levels` (the table's) and taken over each patch of
+    /// `arrays`.
+    pub(crate) fn build(
+        levels: &[PatchLevel],
+        arrays: &[PatchArray],
+        scheme: &Scheme,
+        rules: &Options,
+        channel: &FVarChannel,
+        mode: FVarLinearInterpolation,
+    ) -> Result<FVarPatches, LimitError> {
+        let base = &levels[0].topology;
+        if channel.indices().len() != base.num_face_vertices() {
+            return Err(LimitError::Param(format!(
+                "face-varying channel: {} corner indices for {} face corners",
+                channel.indices().len(),
+                base.num_face_vertices()
+            )));
+        }
+        let mut level_values = vec![LevelValues {
+            face_values: channel.indices().to_vec(),
+            num_values: channel.num_values(),
+        }];
+        let mut rows = Vec::with_capacity(levels.len());
+        for (l, level) in levels.iter().enumerate().take(levels.len() - 1) {
+            let above = level_values.last().expect("the base level's values");
+            let (next, step) = refine_values(level, above, scheme, rules, mode)?;
+            debug_assert_eq!(
+                next.face_values.len(),
+                levels[l + 1].topology.num_face_vertices()
+            );
+            level_values.push(next);
+            rows.push(step);
+        }
+        let offsets = value_offsets(&level_values);
+        let face_size = if *scheme == Scheme::Loop { 3 } else { 4 };
+        let patch_values = arrays
+            .iter()
+            .map(|a| patch_values_of(a, levels, &level_values, &offsets))
+            .collect();
+        let mut out = FVarPatches {
+            mode,
+            components: channel.components(),
+            level_value_counts: level_values.iter().map(|l| l.num_values).collect(),
+            rows,
+            patch_values,
+            values: Vec::new(),
+            face_size,
+        };
+        out.values = out.refined_values(channel.values());
+        Ok(out)
+    }
+
+    /// The values of every level from the channel's values.
+    fn refined_values(&self, base: &[f64]) -> Vec<f64> {
+        let c = self.components;
+        let total: usize = self.level_value_counts.iter().sum();
+        let mut values = Vec::with_capacity(total * c);
+        values.extend_from_slice(base);
+        let mut start = 0;
+        for rows in &self.rows {
+            let end = values.len();
+            let mut next = vec![0.0; rows.num_rows() * c];
+            rows.apply(&values[start..end], c, &mut next);
+            values.extend_from_slice(&next);
+            start = end;
+        }
+        values
+    }
+
+    /// Recomputes the refined values for new channel values (same layout: `components`
+    /// numbers per value).
+    pub(crate) fn update(&mut self, base: &[f64]) -> Result<(), LimitError> {
+        let expected = self.level_value_counts[0] * self.components;
+        if base.len() != expected {
+            return Err(LimitError::Param(format!(
+                "face-varying channel: {} numbers given for {} values of {} components",
+                base.len(),
+                self.level_value_counts[0],
+                self.components
+            )));
+        }
+        self.values = self.refined_values(base);
+        Ok(())
+    }
+
+    /// The interpolation mode the values were refined with.
+    pub fn mode(&self) -> FVarLinearInterpolation {
+        self.mode
+    }
+
+    /// Numbers per value.
+    pub fn components(&self) -> usize {
+        self.components
+    }
+
+    /// Values of each level (level 0 = the channel's own values).
+    pub fn level_value_counts(&self) -> &[usize] {
+        &self.level_value_counts
+    }
+
+    /// Values per patch: 4 (a bilinear quad, OpenSubdiv's `QUADS`) for Catmull-Clark, 3 (a
+    /// linear triangle, `TRIANGLES`) for Loop.
+    pub fn values_per_patch(&self) -> usize {
+        self.face_size
+    }
+
+    /// The values of array `array`'s patches, [`Self::values_per_patch`] per patch, as
+    /// indices into [`Self::values`] (OpenSubdiv's `GetPatchArrayFVarValues`).
+    pub fn patch_values(&self, array: usize) -> &[u32] {
+        &self.patch_values[array]
+    }
+
+    /// The values of every level, [`Self::components`] numbers each: what
+    /// [`Self::patch_values`] indexes.
+    pub fn values(&self) -> &[f64] {
+        &self.values
+    }
+
+    /// Each refined level's values as weights of the level above's (level `l + 1` from
+    /// level `l`, `l` from 0).
+    pub fn level_stencils(&self) -> &[StencilTable] {
+        &self.rows
+    }
+
+    /// The channel as flat arrays.
+    pub fn layout(&self) -> FVarPatchesLayout<'_> {
+        FVarPatchesLayout {
+            interpolation: self.mode.name(),
+            components: self.components,
+            values_per_patch: self.face_size,
+            level_value_counts: &self.level_value_counts,
+            patch_values: self.patch_values.iter().map(Vec::as_slice).collect(),
+            values: &self.values,
+        }
+    }
+
+    /// The value and its first derivatives on patch `i` of array `array` at `(u, v)` of its
+    /// root face (the patch's parameter `param` places it).
+    pub(crate) fn evaluate(
+        &self,
+        array: usize,
+        i: usize,
+        param: PatchParam,
+        u: f64,
+        v: f64,
+    ) -> FVarPoint {
+        let n = self.face_size;
+        let corners = &self.patch_values[array][n * i..n * (i + 1)];
+        let mut d1 = 1.0 / param.fraction();
+        let (w, ws, wt) = if n == 3 {
+            let (s, t) = param.normalize_triangle(u, v);
+            if param.is_triangle_rotated() {
+                d1 = -d1;
+            }
+            linear_triangle(s, t)
+        } else {
+            let (s, t) = param.normalize(u, v);
+            bilinear_quad(s, t)
+        };
+        let c = self.components;
+        let mut out = FVarPoint {
+            value: vec![0.0; c],
+            du: vec![0.0; c],
+            dv: vec![0.0; c],
+        };
+        for (k, &value) in corners.iter().enumerate() {
+            let x = &self.values[value as usize * c..(value as usize + 1) * c];
+            let sums = out.value.iter_mut().zip(&mut out.du).zip(&mut out.dv);
+            for (((p, du), dv), &xj) in sums.zip(x) {
+                *p += w[k] * xj;
+                *du += ws[k] * xj * d1;
+                *dv += wt[k] * xj * d1;
+            }
+        }
+        out
+    }
+}
+
+/// The bilinear basis over a quad's corners (0,0), (1,0), (1,1), (0,1) and its derivatives.
+fn bilinear_quad(s: f64, t: f64) -> ([f64; 4], [f64; 4], [f64; 4]) {
+    (
+        [(1.0 - s) * (1.0 - t), s * (1.0 - t), s * t, (1.0 - s) * t],
+        [t - 1.0, 1.0 - t, t, -t],
+        [s - 1.0, -s, s, 1.0 - s],
+    )
+}
+
+/// The linear basis over a triangle's corners (0,0), (1,0), (0,1) and its derivatives.
+fn linear_triangle(s: f64, t: f64) -> ([f64; 4], [f64; 4], [f64; 4]) {
+    (
+        [1.0 - s - t, s, t, 0.0],
+        [-1.0, 1.0, 0.0, 0.0],
+        [-1.0, 0.0, 1.0, 0.0],
+    )
+}
+
+/// The next level's values: the piece around the level's selected vertices refined one
+/// step with the channel, its kept children's corner values renumbered in order of first
+/// use, and their rows over the level's values.
+fn refine_values(
+    level: &PatchLevel,
+    above: &LevelValues,
+    scheme: &Scheme,
+    rules: &Options,
+    mode: FVarLinearInterpolation,
+) -> Result<(LevelValues, StencilTable), LimitError> {
+    let piece = level.piece(scheme, rules)?;
+    // The piece's channel: its faces' corner values, numbered in order of first use.
+    let t = &level.topology;
+    let mut piece_of_value = vec![u32::MAX; above.num_values];
+    let mut piece_values: Vec<u32> = Vec::new();
+    let mut piece_indices = Vec::new();
+    for &f in &piece.faces {
+        for &value in corner_values(t, &above.face_values, f as usize) {
+            let slot = &mut piece_of_value[value as usize];
+            if *slot == u32::MAX {
+                *slot = piece_values.len() as u32;
+                piece_values.push(value);
+            }
+            piece_indices.push(*slot);
+        }
+    }
+    let channel = FVarChannel::new(
+        &piece.cut.topology,
+        1,
+        vec![0.0; piece_values.len()],
+        piece_indices,
+    )?;
+    let fr = FaceVaryingRefinement::new(&piece.refinement, &channel, mode)?;
+    let child_values = fr.face_values(1);
+    let stencils = fr.stencils(&piece.refinement, 1);
+    let children = piece.refinement.topology(1);
+    let mut next_of_child = vec![u32::MAX; fr.num_values(1)];
+    let mut kept_values: Vec<u32> = Vec::new();
+    let mut face_values = Vec::new();
+    for &cf in &piece.kept.faces {
+        for &value in corner_values(children, &child_values, cf as usize) {
+            let slot = &mut next_of_child[value as usize];
+            if *slot == u32::MAX {
+                *slot = kept_values.len() as u32;
+                kept_values.push(value);
+            }
+            face_values.push(*slot);
+        }
+    }
+    let rows: Vec<Vec<(u32, f64)>> = kept_values
+        .iter()
+        .map(|&cv| {
+            let (idx, w) = stencils.row(cv as usize);
+            idx.iter()
+                .map(|&i| piece_values[i as usize])
+                .zip(w.iter().copied())
+                .collect()
+        })
+        .collect();
+    let step = StencilTable::from_rows(above.num_values, &rows);
+    Ok((
+        LevelValues {
+            face_values,
+            num_values: kept_values.len(),
+        },
+        step,
+    ))
+}
+
+/// The corner values of face `f` of `t` from its face-vertex values.
+fn corner_values<'a>(t: &Topology, face_values: &'a [u32], f: usize) -> &'a [u32] {
+    let offsets = t.face_offsets();
+    &face_values[offsets[f] as usize..offsets[f + 1] as usize]
+}
+
+/// First index of each level's values among the values of all levels.
+fn value_offsets(levels: &[LevelValues]) -> Vec<u32> {
+    let mut next = 0u32;
+    levels
+        .iter()
+        .map(|l| {
+            let first = next;
+            next += l.num_values as u32;
+            first
+        })
+        .collect()
+}
+
+/// The values of each patch of `array`: its face's corner values at its level.
+fn patch_values_of(
+    array: &PatchArray,
+    levels: &[PatchLevel],
+    level_values: &[LevelValues],
+    offsets: &[u32],
+) -> Vec<u32> {
+    let mut out = Vec::new();
+    for &(level, face) in &array.faces {
+        let l = level as usize;
+        let corners = corner_values(
+            &levels[l].topology,
+            &level_values[l].face_values,
+            face as usize,
+        );
+        out.extend(corners.iter().map(|&v| v + offsets[l]));
+    }
+    out
+}
