@@ -34,7 +34,9 @@ type ArrayParts<'py> = (
 impl CorePatchTable {
     /// Builds the table of `mesh` with `scheme_name` and the options.
     #[new]
-    #[pyo3(signature = (mesh, scheme_name, isolation, end_caps, single_crease, inf_sharp, legacy_sharp_corners, boundary = None, crease_method = None, triangles = None))]
+    /// Texture coordinates of the mesh become face-varying channel 0, refined with
+    /// `fvar_interpolation` (else the mesh's own mode, else corners-plus1).
+    #[pyo3(signature = (mesh, scheme_name, isolation, end_caps, single_crease, inf_sharp, legacy_sharp_corners, boundary = None, crease_method = None, triangles = None, fvar_interpolation = None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -48,17 +50,19 @@ impl CorePatchTable {
         boundary: Option<&str>,
         crease_method: Option<&str>,
         triangles: Option<&str>,
+        fvar_interpolation: Option<&str>,
     ) -> PyResult<CorePatchTable> {
         let scheme = scheme(scheme_name)?;
         let end_caps: EndCaps = end_caps.parse().map_err(PyValueError::new_err)?;
         let base = mesh.mesh(py)?;
-        let rules = RuleNames {
+        let names = RuleNames {
             boundary,
             crease_method,
             triangles,
-            fvar_interpolation: None,
-        }
-        .options(&base.hints)?;
+            fvar_interpolation,
+        };
+        let rules = names.options(&base.hints)?;
+        let mode = names.fvar_mode(&base.hints)?;
         let options = PatchOptions {
             isolation,
             end_caps,
@@ -67,7 +71,12 @@ impl CorePatchTable {
             legacy_sharp_corners,
         };
         let table = pool::run(py, || {
-            PatchTable::new(&base.topology, &base.positions, &scheme, &rules, &options)
+            let mut table =
+                PatchTable::new(&base.topology, &base.positions, &scheme, &rules, &options)?;
+            if let Some(uv) = base.uv() {
+                table.add_face_varying(uv, mode)?;
+            }
+            Ok::<_, subd_limit::LimitError>(table)
         })?
         .map_err(mesh_error)?;
         Ok(CorePatchTable { table })
@@ -163,31 +172,7 @@ impl CorePatchTable {
         v: PyReadonlyArray1<'_, f64>,
         derivatives: bool,
     ) -> PyResult<Vec<Bound<'py, PyArray2<f64>>>> {
-        let (faces, subs) = (contiguous(&faces, "faces")?, contiguous(&subs, "sub")?);
-        let (u, v) = (contiguous(&u, "u")?, contiguous(&v, "v")?);
-        if [subs.len(), u.len(), v.len()]
-            .iter()
-            .any(|&n| n != faces.len())
-        {
-            return Err(PyValueError::new_err(
-                "faces, sub, u and v need the same length",
-            ));
-        }
-        let at = (0..faces.len())
-            .map(|i| {
-                let whole = |x: i64, what: &str| {
-                    usize::try_from(x).map_err(|_| {
-                        PyValueError::new_err(format!("point {i}: {what} {x} is negative"))
-                    })
-                };
-                Ok(FaceParam {
-                    face: whole(faces[i], "face")?,
-                    sub: whole(subs[i], "sub-face")?,
-                    u: u[i],
-                    v: v[i],
-                })
-            })
-            .collect::<PyResult<Vec<_>>>()?;
+        let at = places(&faces, &subs, &u, &v)?;
         let table = &self.table;
         let columns: Vec<Vec<DVec3>> = pool::run(py, || -> Result<Vec<Vec<DVec3>>, String> {
             use rayon::prelude::*;
@@ -209,6 +194,109 @@ impl CorePatchTable {
         })?
         .map_err(mesh_error)?;
         columns.iter().map(|c| points(py, c)).collect()
+    }
+
+    /// The texture coordinates' face-varying patches, or `None` without them: the mode's
+    /// name, the values of each level, per array the values of each patch `(n, k)` and the
+    /// values of all levels `(m, 2)`, read-only views of the table's memory.
+    #[allow(unsafe_code)] // views without copies: see the SAFETY note
+    #[allow(clippy::type_complexity)]
+    fn face_varying<'py>(
+        slf: Bound<'py, Self>,
+    ) -> PyResult<
+        Option<(
+            &'static str,
+            Vec<usize>,
+            Vec<Bound<'py, PyArray2<u32>>>,
+            Bound<'py, PyArray2<f64>>,
+        )>,
+    > {
+        let this = slf.borrow();
+        let Some(fvar) = this.table.face_varying().first() else {
+            return Ok(None);
+        };
+        let owner = || slf.clone().into_any();
+        let k = fvar.values_per_patch();
+        // SAFETY: the patch values never change after the build; the values are overwritten
+        // in place by `update_uv` (never moved); `slf` owns the table.
+        unsafe {
+            let patches = (0..this.table.arrays().len())
+                .map(|a| view2(fvar.patch_values(a), k, owner()))
+                .collect::<PyResult<Vec<_>>>()?;
+            let values = view2(fvar.values(), fvar.components(), owner())?;
+            Ok(Some((
+                fvar.mode().name(),
+                fvar.level_value_counts().to_vec(),
+                patches,
+                values,
+            )))
+        }
+    }
+
+    /// The texture coordinates at `(faces[i], subs[i], u[i], v[i])` on the face-varying
+    /// patches: values, du, dv, each `(m, 2)`.
+    fn evaluate_uv<'py>(
+        &self,
+        py: Python<'py>,
+        faces: PyReadonlyArray1<'_, i64>,
+        subs: PyReadonlyArray1<'_, i64>,
+        u: PyReadonlyArray1<'_, f64>,
+        v: PyReadonlyArray1<'_, f64>,
+    ) -> PyResult<Vec<Bound<'py, PyArray2<f64>>>> {
+        if self.table.face_varying().is_empty() {
+            return Err(PyValueError::new_err(
+                "the mesh has no texture coordinates: the table has no face-varying patches",
+            ));
+        }
+        let at = places(&faces, &subs, &u, &v)?;
+        let table = &self.table;
+        let rows: Vec<[f64; 6]> = pool::run(py, || -> Result<Vec<[f64; 6]>, String> {
+            use rayon::prelude::*;
+            at.par_iter()
+                .enumerate()
+                .with_min_len(1024)
+                .map(|(i, p)| {
+                    let t = table
+                        .evaluate_face_varying(0, *p)
+                        .map_err(|e| format!("point {i}: {e}"))?;
+                    Ok([t.value[0], t.value[1], t.du[0], t.du[1], t.dv[0], t.dv[1]])
+                })
+                .collect()
+        })?
+        .map_err(mesh_error)?;
+        (0..3)
+            .map(|k| {
+                let flat: Vec<f64> = rows.iter().flat_map(|r| [r[2 * k], r[2 * k + 1]]).collect();
+                crate::arrays::flat_rows(py, &flat, 2)
+            })
+            .collect()
+    }
+
+    /// New texture coordinates `(n, 2)` for the same layout: the refined values follow.
+    fn update_uv(&mut self, py: Python<'_>, uvs: PyReadonlyArray2<'_, f64>) -> PyResult<()> {
+        let Some(fvar) = self.table.face_varying().first() else {
+            return Err(PyValueError::new_err(
+                "the mesh has no texture coordinates: the table has no face-varying patches",
+            ));
+        };
+        if uvs.shape()[1] != fvar.components() {
+            return Err(PyValueError::new_err(format!(
+                "uvs: expected an (n, {}) array, got {} columns",
+                fvar.components(),
+                uvs.shape()[1]
+            )));
+        }
+        let flat = contiguous(&uvs, "uvs")?;
+        if let Some(i) = flat.iter().position(|x| !x.is_finite()) {
+            return Err(PyValueError::new_err(format!(
+                "uvs: row {} is not finite",
+                i / fvar.components()
+            )));
+        }
+        // Computed with the GIL released, put in place with it held (see `update`).
+        let next = pool::run(py, || fvar.values_for(flat))?.map_err(mesh_error)?;
+        self.table.set_face_varying_values(0, &next);
+        Ok(())
     }
 
     /// Moves the base vertices: recomputes the refined and local points.
@@ -233,4 +321,39 @@ impl CorePatchTable {
         self.table.set_points(next);
         Ok(())
     }
+}
+
+/// The evaluation places `(faces[i], subs[i], u[i], v[i])`, checked for equal lengths and
+/// non-negative indices.
+fn places(
+    faces: &PyReadonlyArray1<'_, i64>,
+    subs: &PyReadonlyArray1<'_, i64>,
+    u: &PyReadonlyArray1<'_, f64>,
+    v: &PyReadonlyArray1<'_, f64>,
+) -> PyResult<Vec<FaceParam>> {
+    let (faces, subs) = (contiguous(faces, "faces")?, contiguous(subs, "sub")?);
+    let (u, v) = (contiguous(u, "u")?, contiguous(v, "v")?);
+    if [subs.len(), u.len(), v.len()]
+        .iter()
+        .any(|&n| n != faces.len())
+    {
+        return Err(PyValueError::new_err(
+            "faces, sub, u and v need the same length",
+        ));
+    }
+    (0..faces.len())
+        .map(|i| {
+            let whole = |x: i64, what: &str| {
+                usize::try_from(x).map_err(|_| {
+                    PyValueError::new_err(format!("point {i}: {what} {x} is negative"))
+                })
+            };
+            Ok(FaceParam {
+                face: whole(faces[i], "face")?,
+                sub: whole(subs[i], "sub-face")?,
+                u: u[i],
+                v: v[i],
+            })
+        })
+        .collect::<PyResult<Vec<_>>>()
 }

@@ -132,9 +132,65 @@ def test_npz_holds_the_binarys_json_layout(tmp_path):
     assert np.array_equal(z["local_point_indices"], layout["local_point_indices"])
     assert np.array_equal(z["local_point_weights"], layout["local_point_weights"])
     assert list(z["array_types"]) == [a["type"] for a in layout["arrays"]]
+    # The car's texture coordinates: the same face-varying patches from both fronts.
+    fvar = layout["face_varying"][0]
+    assert str(z["uv_interpolation"]) == fvar["interpolation"] == "corners-plus1"
+    assert list(z["uv_level_value_counts"]) == fvar["level_value_counts"]
+    assert np.array_equal(z["uv_values"].reshape(-1), np.array(fvar["values"]))
+    for i, pv in enumerate(fvar["patch_values"]):
+        assert np.array_equal(z[f"array{i}_uv_values"].reshape(-1), np.array(pv))
     for i, a in enumerate(layout["arrays"]):
         k = a["control_points_per_patch"]
         cps = np.array(a["control_points"], dtype=np.int64).reshape(-1, k)
         assert np.array_equal(z[f"array{i}_control_points"], cps)
         assert np.array_equal(z[f"array{i}_params"], np.array(a["params"]).reshape(-1, 2))
         assert np.array_equal(z[f"array{i}_sharpness"], np.array(a["sharpness"], np.float32))
+
+
+def _bilinear_uv(mesh, faces, u, v):
+    """The bilinear interpolation of each quad's corner texture coordinates."""
+    idx = np.asarray(mesh.uv_indices).reshape(-1, 4)[faces]
+    c = np.asarray(mesh.uvs)[idx]
+    u, v = u[:, None], v[:, None]
+    return ((1 - u) * (1 - v) * c[:, 0] + u * (1 - v) * c[:, 1] + u * v * c[:, 2]
+            + (1 - u) * v * c[:, 3])
+
+
+def test_uv_patches_refined_linearly_are_each_faces_interpolation():
+    mesh = subd.read(SHAPES / "catmark_cube.obj")
+    table = subd.PatchTable(mesh, "catmull-clark", isolation=3, fvar_interpolation="all")
+    rng = np.random.default_rng(9)
+    faces = rng.integers(0, 6, 300)
+    u, v = rng.random(300), rng.random(300)
+    uv, du, dv = table.evaluate_uv(faces, u, v)
+    assert uv.shape == (300, 2)
+    assert np.abs(uv - _bilinear_uv(mesh, faces, u, v)).max() <= 1e-14
+    h = 1e-6
+    up, _, _ = table.evaluate_uv(faces, np.clip(u + h, 0, 1), v)
+    um, _, _ = table.evaluate_uv(faces, np.clip(u - h, 0, 1), v)
+    inside = (u > h) & (u < 1 - h)
+    assert np.abs((up - um)[inside] / (2 * h) - du[inside]).max() <= 1e-8
+    fv = table.face_varying
+    assert fv["interpolation"] == "all"
+    assert fv["level_value_counts"][0] == len(mesh.uvs)
+    assert not fv["values"].flags.writeable and fv["values"].shape[1] == 2
+
+
+def test_update_uv_moves_the_refined_values_in_place():
+    mesh = subd.read(SHAPES / "catmark_car.obj")
+    table = subd.PatchTable(mesh, "catmull-clark", isolation=2)
+    values = table.face_varying["values"]
+    faces = np.arange(50)
+    u = np.full(faces.shape, 0.3)
+    before, _, _ = table.evaluate_uv(faces, u, u)
+    # Refinement is affine: moving every coordinate moves every refined value alike.
+    table.update_uv(np.asarray(mesh.uvs) * 2.0 + [1.0, -3.0])
+    after, _, _ = table.evaluate_uv(faces, u, u)
+    assert np.abs(after - (before * 2.0 + [1.0, -3.0])).max() <= 1e-12
+    assert np.abs(values[: len(mesh.uvs)] - (np.asarray(mesh.uvs) * 2.0 + [1.0, -3.0])).max() == 0
+    with pytest.raises(ValueError):
+        table.update_uv(np.zeros((3, 2)))
+    plain = subd.PatchTable(subd.Mesh(CUBE_V, CUBE_F), "catmull-clark", isolation=2)
+    assert plain.face_varying is None
+    with pytest.raises(ValueError):
+        plain.evaluate_uv([0], [0.5], [0.5])

@@ -134,9 +134,13 @@ impl FVarPatches {
         values
     }
 
-    /// Recomputes the refined values for new channel values (same layout: `components`
-    /// numbers per value).
-    pub(crate) fn update(&mut self, base: &[f64]) -> Result<(), LimitError> {
+    /// The values of every level for new channel values (same layout: `components` numbers
+    /// per value), without changing the table ([`super::PatchTable::update_face_varying`]
+    /// puts them in place).
+    ///
+    /// # Errors
+    /// [`LimitError::Param`] when `base` is not the channel's value count × components.
+    pub fn values_for(&self, base: &[f64]) -> Result<Vec<f64>, LimitError> {
         let expected = self.level_value_counts[0] * self.components;
         if base.len() != expected {
             return Err(LimitError::Param(format!(
@@ -146,8 +150,12 @@ impl FVarPatches {
                 self.components
             )));
         }
-        self.values = self.refined_values(base);
-        Ok(())
+        Ok(self.refined_values(base))
+    }
+
+    /// Overwrites the values in place (views of [`Self::values`] stay valid).
+    pub(crate) fn set_values(&mut self, values: &[f64]) {
+        self.values.copy_from_slice(values);
     }
 
     /// The interpolation mode the values were refined with.

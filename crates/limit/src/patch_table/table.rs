@@ -633,7 +633,8 @@ impl PatchTable {
     }
 
     /// Recomputes channel `channel`'s refined values for new values (the channel's layout:
-    /// its components per value), keeping the topology.
+    /// its components per value), keeping the topology. The buffer
+    /// [`FVarPatches::values`] returns stays where it is.
     ///
     /// # Errors
     /// [`LimitError::Param`] for a channel that was not added or a value count that is not
@@ -643,8 +644,18 @@ impl PatchTable {
         channel: usize,
         values: &[f64],
     ) -> Result<(), LimitError> {
-        self.face_varying_channel(channel)?;
-        self.face_varying[channel].update(values)
+        let next = self.face_varying_channel(channel)?.values_for(values)?;
+        self.set_face_varying_values(channel, &next);
+        Ok(())
+    }
+
+    /// Puts values from [`FVarPatches::values_for`] in place (overwriting the buffer, so
+    /// views of it stay valid).
+    ///
+    /// # Panics
+    /// If `channel` was not added or `values` came from another table (a different length).
+    pub fn set_face_varying_values(&mut self, channel: usize, values: &[f64]) {
+        self.face_varying[channel].set_values(values);
     }
 
     fn face_varying_channel(&self, channel: usize) -> Result<&FVarPatches, LimitError> {

@@ -621,6 +621,10 @@ class PatchTable:
       (``scipy.sparse.csr_matrix`` when SciPy is installed, else CSR arrays).
     * ``evaluate(faces, u, v, sub=None, derivatives=False)``: vectorised.
     * ``update(vertices)``: new base positions, same topology (animation).
+    * With texture coordinates in the mesh, their face-varying patches (OpenSubdiv's
+      ``generateFVarTables`` with its default linear patches, refined with
+      ``fvar_interpolation``): ``face_varying`` (views of the arrays),
+      ``evaluate_uv(faces, u, v, sub=None)`` and ``update_uv(uvs)``.
     """
 
     __slots__ = ("_core", "_scheme", "_end_caps", "_isolation")
@@ -638,6 +642,7 @@ class PatchTable:
         boundary: Optional[str] = None,
         crease_method: Optional[str] = None,
         triangles: Optional[str] = None,
+        fvar_interpolation: Optional[str] = None,
     ) -> None:
         _check_mesh(mesh)
         isolation = _count(isolation, "isolation")
@@ -646,7 +651,7 @@ class PatchTable:
         if end_caps not in ("gregory", "bspline", "bilinear", "exact"):
             raise ValueError(f"end_caps: unknown value {end_caps!r} "
                              "(one of gregory, bspline, bilinear, exact)")
-        rules = _rule_names(boundary, crease_method, triangles)[:3]
+        rules = _rule_names(boundary, crease_method, triangles, fvar_interpolation)
         self._scheme, self._end_caps, self._isolation = (
             _scheme_name(scheme, None, None), end_caps, isolation)
         self._core = _subd._CorePatchTable(
@@ -678,7 +683,9 @@ class PatchTable:
         ``local_point_offsets``, ``local_point_indices``, ``local_point_weights`` (CSR over
         the refined vertices), ``array_types`` (OpenSubdiv's type names, in table order)
         and, for the i-th array, ``array{i}_control_points`` (patches, k),
-        ``array{i}_params`` (patches, 2) and ``array{i}_sharpness`` (patches,)."""
+        ``array{i}_params`` (patches, 2) and ``array{i}_sharpness`` (patches,); with texture
+        coordinates also ``uv_interpolation``, ``uv_level_value_counts``, ``uv_values``
+        (m, 2) and ``array{i}_uv_values`` (patches, 4 or 3)."""
         indptr, indices, weights, _ = self._core.local_point_stencils()
         arrays = self.arrays
         fields = dict(scheme=np.array(self._scheme), end_caps=np.array(self._end_caps),
@@ -691,6 +698,13 @@ class PatchTable:
             fields[f"array{i}_control_points"] = a["control_points"]
             fields[f"array{i}_params"] = a["params"]
             fields[f"array{i}_sharpness"] = a["sharpness"]
+        fvar = self.face_varying
+        if fvar is not None:
+            fields["uv_interpolation"] = np.array(fvar["interpolation"])
+            fields["uv_level_value_counts"] = np.array(fvar["level_value_counts"], dtype=np.int64)
+            fields["uv_values"] = fvar["values"]
+            for i, pv in enumerate(fvar["patch_values"]):
+                fields[f"array{i}_uv_values"] = pv
         with open(os.fspath(path), "wb") as f:
             np.savez(f, **fields)
 
@@ -727,6 +741,39 @@ class PatchTable:
         if a.ndim != 2 or a.shape[1] != 3:
             raise ValueError(f"vertices: expected an (n, 3) array, got shape {a.shape}")
         self._core.update(np.ascontiguousarray(a))
+
+    @property
+    def face_varying(self) -> Optional[dict]:
+        """The texture coordinates' face-varying patches, or ``None`` when the mesh has
+        none: ``interpolation`` (the mode's name), ``level_value_counts``,
+        ``patch_values`` (per array, (n, 4) for Catmull-Clark or (n, 3) for Loop uint32
+        indices into ``values``: the patch's face at its level) and ``values`` ((m, 2),
+        the coordinates refined to every level). Read-only views of the table's memory."""
+        parts = self._core.face_varying()
+        if parts is None:
+            return None
+        mode, counts, patch_values, values = parts
+        return dict(interpolation=mode, level_value_counts=counts,
+                    patch_values=patch_values, values=values)
+
+    def evaluate_uv(self, faces, u, v, *, sub=None):
+        """The texture coordinates at ``(faces[i], u[i], v[i])`` on the face-varying patches
+        (OpenSubdiv's ``EvaluateBasisFaceVarying``): ``(uv, du, dv)``, each (m, 2)."""
+        f = _index_array(faces, "faces").reshape(-1)
+        s = np.zeros_like(f) if sub is None else _index_array(sub, "sub").reshape(-1)
+        uu = _float_array(u, "u").reshape(-1)
+        vv = _float_array(v, "v").reshape(-1)
+        if s.size == 1 and f.size != 1:
+            s = np.full_like(f, int(s[0]))
+        return tuple(self._core.evaluate_uv(f, s, uu, vv))
+
+    def update_uv(self, uvs) -> None:
+        """New texture coordinates ((n, 2), the mesh's layout); the refined values follow
+        (in place: views of ``face_varying["values"]`` follow too)."""
+        a = _float_array(uvs, "uvs")
+        if a.ndim != 2:
+            raise ValueError(f"uvs: expected an (n, 2) array, got shape {a.shape}")
+        self._core.update_uv(np.ascontiguousarray(a))
 
 
 def limit(mesh: Mesh, scheme: str = "catmull-clark") -> Tuple[np.ndarray, np.ndarray]:

@@ -87,6 +87,7 @@ class _CorePatchTable:
         boundary: Optional[str] = ...,
         crease_method: Optional[str] = ...,
         triangles: Optional[str] = ...,
+        fvar_interpolation: Optional[str] = ...,
     ) -> None: ...
     def census(self) -> str: ...
     def arrays(
@@ -106,6 +107,17 @@ class _CorePatchTable:
         derivatives: bool = ...,
     ) -> List[npt.NDArray[np.float64]]: ...
     def update(self, vertices: npt.NDArray[np.float64]) -> None: ...
+    def face_varying(
+        self,
+    ) -> Optional[Tuple[str, List[int], List[npt.NDArray[np.uint32]], npt.NDArray[np.float64]]]: ...
+    def evaluate_uv(
+        self,
+        faces: npt.NDArray[np.int64],
+        subs: npt.NDArray[np.int64],
+        u: npt.NDArray[np.float64],
+        v: npt.NDArray[np.float64],
+    ) -> List[npt.NDArray[np.float64]]: ...
+    def update_uv(self, uvs: npt.NDArray[np.float64]) -> None: ...
 
 def read(
     path: Union[str, PathLike[str]],
