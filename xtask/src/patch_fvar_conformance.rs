@@ -89,7 +89,8 @@ pub fn compare_channel(
                     row.error = error / diag;
                     row.note = Some(format!("{}; {points} points", option_label(po)));
                     let off = row.error.is_nan() || row.error > 1e-12;
-                    if off && has_non_manifold_vertex(topo) && mode != FVarLinearInterpolation::All {
+                    if off && has_non_manifold_vertex(topo) && mode != FVarLinearInterpolation::All
+                    {
                         // A known subd defect, reported rather than hidden: see the note on
                         // `has_non_manifold_vertex`.
                         row.excluded = Some((points, row.error));

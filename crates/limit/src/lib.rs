@@ -126,7 +126,7 @@ pub mod patches {
     pub use crate::patch_table::{
         EndCaps, FVarPatches, FVarPatchesLayout, MAX_ISOLATION, PatchArray, PatchArrayLayout,
         PatchCensus, PatchGrid, PatchMap, PatchOptions, PatchParam, PatchPlace, PatchTable,
-        PatchTableLayout, PatchType, TablePoints,
+        PatchTableLayout, PatchType, PatchWeights, TablePoints,
     };
 }
 

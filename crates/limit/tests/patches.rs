@@ -758,3 +758,52 @@ fn bad_face_varying_requests_are_errors() {
     let bad = FaceParam { face: 9, ..at };
     assert!(table.evaluate_face_varying(i, bad).is_err());
 }
+
+/// `evaluate_basis` is OpenSubdiv's `EvaluateBasis`: its position weights sum to one and its
+/// derivative weights to zero (a partition of unity), and the renderer's own sums of the
+/// table's points with them are the table's evaluation (the tensor-product path for
+/// regular patches, the patch sums elsewhere).
+#[test]
+fn basis_weights_are_a_partition_of_unity_that_gives_the_evaluation() {
+    for c in cases() {
+        let table = PatchTable::new(
+            &c.topology,
+            &c.positions,
+            &c.scheme,
+            &Options::default(),
+            &options(3, EndCaps::GregoryBasis, true),
+        )
+        .unwrap();
+        let mut checked = 0;
+        for f in 0..c.topology.num_faces() {
+            for sub in 0..subs(&c, f) {
+                for (u, v) in [(0.15, 0.3), (0.6, 0.2), (0.45, 0.45)] {
+                    let at = FaceParam { face: f, sub, u, v };
+                    let Ok((a, i)) = table.find(&at) else {
+                        continue;
+                    };
+                    let w = table.evaluate_basis(a, i, u, v).unwrap();
+                    let cps = table.arrays()[a].patch_points(i);
+                    let sum: f64 = w.rows[0].iter().sum();
+                    assert!((sum - 1.0).abs() < 1e-13, "position weights sum to {sum}");
+                    for row in &w.rows[1..] {
+                        let s: f64 = row.iter().sum();
+                        assert!(s.abs() < 1e-9, "derivative weights sum to {s}");
+                    }
+                    let weighted = |k: usize| -> DVec3 {
+                        cps.iter()
+                            .zip(&w.rows[k])
+                            .map(|(&p, &x)| x * table.points()[p as usize])
+                            .sum()
+                    };
+                    let first = table.evaluate_first(&[at]).unwrap()[0];
+                    for (k, want) in first.iter().enumerate() {
+                        assert!((weighted(k) - *want).length() < 1e-12, "row {k} at {at:?}");
+                    }
+                    checked += 1;
+                }
+            }
+        }
+        assert!(checked > 0);
+    }
+}

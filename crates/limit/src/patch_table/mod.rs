@@ -58,6 +58,7 @@ mod loop_caps;
 mod map;
 mod options;
 mod param;
+mod patch_eval;
 mod table;
 
 pub use array::PatchArray;
@@ -66,6 +67,7 @@ pub use kind::PatchType;
 pub use map::PatchMap;
 pub use options::{EndCaps, MAX_ISOLATION, PatchOptions};
 pub use param::{PatchParam, PatchPlace};
+pub use patch_eval::PatchWeights;
 pub use table::{
     PatchArrayLayout, PatchCensus, PatchGrid, PatchTable, PatchTableLayout, TablePoints,
 };

@@ -14,7 +14,8 @@ use super::face_varying::FVarPatches;
 use super::features::{FeatureMask, Regularity, VTag, single_crease_edge};
 use super::levels::PatchLevel;
 use super::map::PatchMap;
-use super::{EndCaps, MAX_ISOLATION, PatchOptions, PatchParam, PatchType};
+use super::patch_eval::{bspline_first, evaluate_patch, patch_weights};
+use super::{EndCaps, MAX_ISOLATION, PatchOptions, PatchType, PatchWeights};
 use crate::LimitError;
 use crate::evaluation::eval::{FaceParam, GatheredPatch, LimitEvaluator, PatchPoints};
 use crate::evaluation::fvar_eval::FVarPoint;
@@ -48,7 +49,7 @@ pub struct PatchArrayLayout<'a> {
     pub patches: usize,
     /// The control points, patch after patch: indices into `points`.
     pub control_points: &'a [u32],
-    /// Per patch, the two words of its [`PatchParam`] (OpenSubdiv's bit layout).
+    /// Per patch, the two words of its [`super::PatchParam`] (OpenSubdiv's bit layout).
     pub params: Vec<[u32; 2]>,
     /// Per patch, its single-crease sharpness (0 when none).
     pub sharpness: &'a [f32],
@@ -394,6 +395,38 @@ impl PatchTable {
         self.evaluate_in(a, i, at)
     }
 
+    /// The weights of patch `index` of array `array`'s control points at `(u, v)` of its
+    /// root face (OpenSubdiv's `PatchTable::EvaluateBasis`): a renderer's own sums of
+    /// [`Self::points`] with them give [`Self::evaluate`]'s values.
+    ///
+    /// # Errors
+    /// [`LimitError::Param`] for a patch that does not exist, [`LimitError::Unsupported`] for
+    /// an exact end cap (it has no control points).
+    pub fn evaluate_basis(
+        &self,
+        array: usize,
+        index: usize,
+        u: f64,
+        v: f64,
+    ) -> Result<PatchWeights, LimitError> {
+        let a = self
+            .arrays
+            .get(array)
+            .filter(|a| index < a.len())
+            .ok_or_else(|| LimitError::Param(format!("no patch {index} in array {array}")))?;
+        let Some(n) = a.kind.num_control_points() else {
+            let (face, _) = self.root_faces()[a.params[index].place().face as usize];
+            return Err(LimitError::Unsupported {
+                face,
+                reason: "an exact end cap has no control points",
+            });
+        };
+        let w = patch_weights(a.kind, a.params[index], u, v);
+        Ok(PatchWeights {
+            rows: w.map(|row| row[..n].to_vec()),
+        })
+    }
+
     /// The table as flat arrays ([`PatchTableLayout`]).
     pub fn layout(&self) -> PatchTableLayout<'_> {
         PatchTableLayout {
@@ -690,73 +723,6 @@ impl PatchTable {
         }
         c
     }
-}
-
-/// Evaluates one patch of type `kind` at `(u, v)` of its root face: the basis in the
-/// patch's own domain, derivatives taken back to the root's parameters.
-fn evaluate_patch(
-    kind: PatchType,
-    param: PatchParam,
-    cps: &[u32],
-    points: &[DVec3],
-    u: f64,
-    v: f64,
-) -> SurfacePoint {
-    let triangle = matches!(
-        kind,
-        PatchType::Loop | PatchType::Triangles | PatchType::GregoryTriangle
-    );
-    let (s, t) = if triangle {
-        param.normalize_triangle(u, v)
-    } else {
-        param.normalize(u, v)
-    };
-    let place = param.place();
-    let mut d1 = 1.0 / param.fraction();
-    if triangle && param.is_triangle_rotated() {
-        d1 = -d1;
-    }
-    let combine = |w: &[[f64; 20]; 6], n: usize| {
-        let mut acc = [DVec3::ZERO; 6];
-        for (k, &cp) in cps.iter().enumerate().take(n) {
-            let p = points[cp as usize];
-            for (a, row) in acc.iter_mut().zip(w) {
-                *a += row[k] * p;
-            }
-        }
-        acc
-    };
-    let w = basis::weights(kind, s, t, if place.regular { place.boundary } else { 0 });
-    let acc = combine(&w, cps.len());
-    let d2 = d1 * d1;
-    SurfacePoint {
-        position: acc[0],
-        du: acc[1] * d1,
-        dv: acc[2] * d1,
-        duu: acc[3] * d2,
-        duv: acc[4] * d2,
-        dvv: acc[5] * d2,
-    }
-}
-
-/// An interior bicubic B-spline patch's position and first derivatives at `(s, t)`, summed
-/// row by row (the tensor product's 32 products instead of 48).
-fn bspline_first(cps: &[u32], points: &[DVec3], s: f64, t: f64) -> [DVec3; 3] {
-    let (bs, ds, _) = crate::evaluation::patch::bspline_basis(s);
-    let (bt, dt, _) = crate::evaluation::patch::bspline_basis(t);
-    let mut out = [DVec3::ZERO; 3];
-    for (r, row) in cps.chunks_exact(4).enumerate() {
-        let (mut p, mut d) = (DVec3::ZERO, DVec3::ZERO);
-        for (c, &cp) in row.iter().enumerate() {
-            let x = points[cp as usize];
-            p += bs[c] * x;
-            d += ds[c] * x;
-        }
-        out[0] += bt[r] * p;
-        out[1] += bt[r] * d;
-        out[2] += dt[r] * p;
-    }
-    out
 }
 
 fn check_positions(base: &Topology, positions: &[DVec3]) -> Result<(), LimitError> {
