@@ -62,6 +62,29 @@ pub struct FVarPatchesLayout<'a> {
 struct LevelValues {
     face_values: Vec<u32>,
     num_values: usize,
+    /// Per value, the value of the level above it is a plain copy of (a pinned value), or
+    /// `u32::MAX`; `None` at the base level.
+    copy_of: Option<Vec<u32>>,
+}
+
+impl LevelValues {
+    /// The value a piece of this level refines value `v` as: copies of one value of the
+    /// level above are one value, as the base level has them. A non-manifold vertex keeps a
+    /// sibling per fan; where the base level's fans share a value index its edges are
+    /// continuous, but its children's siblings are distinct values and a fresh analysis
+    /// would take the edges between the fans as seams (OpenSubdiv inherits them as
+    /// continuous). Pinned values are copies, so taking them as one changes no number.
+    fn identity(&self, v: u32) -> u32 {
+        match &self.copy_of {
+            Some(copy) if copy[v as usize] != u32::MAX => self.num_values as u32 + copy[v as usize],
+            _ => v,
+        }
+    }
+
+    /// Identities are below this (`above_values`: the level above's value count).
+    fn identity_bound(&self, above_values: usize) -> usize {
+        self.num_values + above_values
+    }
 }
 
 impl FVarPatches {
@@ -86,11 +109,16 @@ impl FVarPatches {
         let mut level_values = vec![LevelValues {
             face_values: channel.indices().to_vec(),
             num_values: channel.num_values(),
+            copy_of: None,
         }];
         let mut rows = Vec::with_capacity(levels.len());
         for (l, level) in levels.iter().enumerate().take(levels.len() - 1) {
             let above = level_values.last().expect("the base level's values");
-            let (next, step) = refine_values(level, above, scheme, rules, mode)?;
+            let above_above = level_values
+                .len()
+                .checked_sub(2)
+                .map_or(0, |k| level_values[k].num_values);
+            let (next, step) = refine_values(level, above, above_above, scheme, rules, mode)?;
             debug_assert_eq!(
                 next.face_values.len(),
                 levels[l + 1].topology.num_face_vertices()
@@ -275,19 +303,21 @@ fn linear_triangle(s: f64, t: f64) -> ([f64; 4], [f64; 4], [f64; 4]) {
 fn refine_values(
     level: &PatchLevel,
     above: &LevelValues,
+    above_above: usize,
     scheme: &Scheme,
     rules: &Options,
     mode: FVarLinearInterpolation,
 ) -> Result<(LevelValues, StencilTable), LimitError> {
     let piece = level.piece(scheme, rules)?;
-    // The piece's channel: its faces' corner values, numbered in order of first use.
+    // The piece's channel: its faces' corner values (copies of one value as one),
+    // numbered in order of first use.
     let t = &level.topology;
-    let mut piece_of_value = vec![u32::MAX; above.num_values];
+    let mut piece_of_value = vec![u32::MAX; above.identity_bound(above_above)];
     let mut piece_values: Vec<u32> = Vec::new();
     let mut piece_indices = Vec::new();
     for &f in &piece.faces {
         for &value in corner_values(t, &above.face_values, f as usize) {
-            let slot = &mut piece_of_value[value as usize];
+            let slot = &mut piece_of_value[above.identity(value) as usize];
             if *slot == u32::MAX {
                 *slot = piece_values.len() as u32;
                 piece_values.push(value);
@@ -328,11 +358,19 @@ fn refine_values(
                 .collect()
         })
         .collect();
+    let copy_of = rows
+        .iter()
+        .map(|row| match row.as_slice() {
+            [(v, w)] if *w == 1.0 => *v,
+            _ => u32::MAX,
+        })
+        .collect();
     let step = StencilTable::from_rows(above.num_values, &rows);
     Ok((
         LevelValues {
             face_values,
             num_values: kept_values.len(),
+            copy_of: Some(copy_of),
         },
         step,
     ))
