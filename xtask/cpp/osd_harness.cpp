@@ -300,7 +300,8 @@ std::vector<Point> patchPoints(Mesh const &m, Far::TopologyRefiner const &refine
     return verts;
 }
 
-// The face-varying channel 0 of a patch table at each point: value, du, dv (f64[2] each).
+// The face-varying channel 0 of a patch table at each point: value, du, dv (f64[2] each),
+// then u32 n and the n values (f64[2]) of the point's face-varying patch.
 void patchFVar(Mesh const &m, Far::TopologyRefiner const &refiner, Far::PatchTable const &table,
                std::vector<int> const &faces, std::vector<double> const &us, std::vector<double> const &vs,
                std::vector<unsigned char> &out) {
@@ -325,6 +326,9 @@ void patchFVar(Mesh const &m, Far::TopologyRefiner const &refiner, Far::PatchTab
             for (int c = 0; c < cvs.size(); ++c) acc.AddWithWeight(values[cvs[c]], w[d][c]);
             for (double x : acc.p) put<double>(out, x);
         }
+        put<uint32_t>(out, (uint32_t)cvs.size());
+        for (int c = 0; c < cvs.size(); ++c)
+            for (double x : values[cvs[c]].p) put<double>(out, x);
     }
 }
 
@@ -338,7 +342,8 @@ void patchFVar(Mesh const &m, Far::TopologyRefiner const &refiner, Far::PatchTab
 // then f64 pos[3 (refined + local)]. With a face-varying channel (--patches ... MODE, the
 // channel between the mesh and the points), the table also has its face-varying patches
 // (generateFVarTables, OpenSubdiv's default linear ones), and per point f64 value[2], du[2],
-// dv[2] follow (EvaluateBasisFaceVarying over the values refined per level).
+// dv[2] (EvaluateBasisFaceVarying over the values refined per level), u32 n and the n
+// values of its patch follow.
 void patchTable(Mesh const &m, Reader &r, char **argv, std::vector<unsigned char> &out) {
     uint32_t count = r.get<uint32_t>();
     std::vector<int> faces(count);

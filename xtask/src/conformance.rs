@@ -1061,6 +1061,8 @@ pub fn report(rows: &[Row]) -> bool {
                 format!(" ({n} values where OpenSubdiv is inexact checked apart: seam creases to 1e-7 (its float weights), Bilinear seam values kept, eigen-limit vertices; there |Δ|/diag ≤ {e:.1e})")
             } else if r.check == "patches" {
                 format!(" ({n} points checked apart: in Loop box-spline end caps, held to 1e-5 as OpenSubdiv fits them with float constants off the exact fit by up to 2.6e-5, at valence-2 darts, or where OpenSubdiv's adaptive refinement leaves its uniform one; there |Δ|/diag ≤ {e:.1e})")
+            } else if r.check.starts_with("patch fvar") {
+                format!(" ({n} points compared apart: where OpenSubdiv's adaptive refinement leaves its uniform one (subd's patch values are uniform refinement's, OpenSubdiv's are not); there |Δ|/diag ≤ {e:.1e})")
             } else if r.check == "eval" {
                 format!(" ({n} points not on the surface (holes) or not covered left out; in the 2^-10 end-cap squares |Δ|/diag ≤ {e:.1e})")
             } else {

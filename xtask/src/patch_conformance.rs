@@ -30,8 +30,15 @@ pub struct OsdPatch {
     pub regular: u32,
 }
 
+/// One evaluation of the harness's face-varying patches: value, du, dv (two numbers each),
+/// and the values of the patch (two numbers each).
+pub struct OsdFVarPoint {
+    pub eval: [f64; 6],
+    pub patch_values: Vec<[f64; 2]>,
+}
+
 /// The harness's patch table: its patches, local point count, the evaluations, and with a
-/// face-varying channel its evaluations (value, du, dv; two numbers each).
+/// face-varying channel its evaluations.
 pub struct OsdPatchTable {
     pub patches: Vec<OsdPatch>,
     /// Each patch's control points (indices into `points`).
@@ -40,7 +47,7 @@ pub struct OsdPatchTable {
     pub points: Vec<DVec3>,
     pub local_points: usize,
     pub evaluations: Vec<[DVec3; 6]>,
-    pub fvar: Vec<[f64; 6]>,
+    pub fvar: Vec<OsdFVarPoint>,
 }
 
 /// The harness's `--patches` arguments for `options`.
@@ -102,7 +109,12 @@ pub fn decode(bytes: &[u8], points: usize) -> Result<OsdPatchTable, String> {
     if !c.is_empty() {
         for _ in 0..points {
             let x = c.f64s(6)?;
-            fvar.push(std::array::from_fn(|k| x[k]));
+            let n = c.u32()? as usize;
+            let values = c.f64s(2 * n)?;
+            fvar.push(OsdFVarPoint {
+                eval: std::array::from_fn(|k| x[k]),
+                patch_values: values.chunks_exact(2).map(|v| [v[0], v[1]]).collect(),
+            });
         }
     }
     Ok(OsdPatchTable {

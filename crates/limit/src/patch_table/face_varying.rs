@@ -7,13 +7,20 @@
 //!
 //! The values of a level are refined from the level above exactly as the vertices are
 //! ([`PatchLevel::piece`]): the faces around the selected vertices are cut out and refined
-//! one step with the channel, and the kept children's corner values are renumbered. Every
-//! value a kept face reads is computed from a neighbourhood that is whole in the piece, so
-//! it equals the uniform refinement's value.
+//! one step with the channel, and the kept children's values are the next level's. The
+//! piece's values continue from the level's state (`subd_schemes::FVarLevelState`: each
+//! value's tags as the levels above passed them down, as OpenSubdiv's `FVarRefinement` does),
+//! not from tags found afresh on the piece, which part from the inherited ones at semi-sharp
+//! values, at values where several UV regions meet and at non-manifold vertices. Every value
+//! a kept face reads is computed from a neighbourhood that is whole in the piece, so it
+//! equals the uniform refinement's value.
 
 use subd_mesh::Topology;
+use subd_mesh::cut as submesh;
 use subd_mesh::fvar::{FVarChannel, FVarLinearInterpolation};
-use subd_schemes::{FaceVaryingRefinement, Options, Scheme, StencilTable};
+use subd_schemes::{
+    FVarLevelState, FaceVaryingRefinement, Options, Refinement, Scheme, StencilTable,
+};
 
 use super::array::PatchArray;
 use super::levels::PatchLevel;
@@ -58,33 +65,12 @@ pub struct FVarPatchesLayout<'a> {
     pub values: &'a [f64],
 }
 
-/// One level's face-varying values: which value each face corner takes, how many values.
+/// One level's face-varying values: which value each face corner takes, how many values,
+/// and the refinement's state of them (their tags), which the next level continues from.
 struct LevelValues {
     face_values: Vec<u32>,
     num_values: usize,
-    /// Per value, the value of the level above it is a plain copy of (a pinned value), or
-    /// `u32::MAX`; `None` at the base level.
-    copy_of: Option<Vec<u32>>,
-}
-
-impl LevelValues {
-    /// The value a piece of this level refines value `v` as: copies of one value of the
-    /// level above are one value, as the base level has them. A non-manifold vertex keeps a
-    /// sibling per fan; where the base level's fans share a value index its edges are
-    /// continuous, but its children's siblings are distinct values and a fresh analysis
-    /// would take the edges between the fans as seams (OpenSubdiv inherits them as
-    /// continuous). Pinned values are copies, so taking them as one changes no number.
-    fn identity(&self, v: u32) -> u32 {
-        match &self.copy_of {
-            Some(copy) if copy[v as usize] != u32::MAX => self.num_values as u32 + copy[v as usize],
-            _ => v,
-        }
-    }
-
-    /// Identities are below this (`above_values`: the level above's value count).
-    fn identity_bound(&self, above_values: usize) -> usize {
-        self.num_values + above_values
-    }
+    state: FVarLevelState,
 }
 
 impl FVarPatches {
@@ -106,19 +92,27 @@ impl FVarPatches {
                 base.num_face_vertices()
             )));
         }
+        // The base level's state: the channel analysed on the whole base level, as uniform
+        // refinement analyses it.
+        let prepared = Refinement::from_prepared(
+            base.clone(),
+            levels[0].rules.clone(),
+            scheme.clone(),
+            rules,
+            0,
+        )?;
+        let base_state = FaceVaryingRefinement::new(&prepared, channel, mode)?.level_state(0);
         let mut level_values = vec![LevelValues {
             face_values: channel.indices().to_vec(),
             num_values: channel.num_values(),
-            copy_of: None,
+            state: base_state,
         }];
         let mut rows = Vec::with_capacity(levels.len());
         for (l, level) in levels.iter().enumerate().take(levels.len() - 1) {
             let above = level_values.last().expect("the base level's values");
-            let above_above = level_values
-                .len()
-                .checked_sub(2)
-                .map_or(0, |k| level_values[k].num_values);
-            let (next, step) = refine_values(level, above, above_above, scheme, rules, mode)?;
+            // Level 0's values are the channel's own; a refined level's are its slots.
+            let base_level = l == 0;
+            let (next, step) = refine_values(level, above, base_level, scheme, rules, mode)?;
             debug_assert_eq!(
                 next.face_values.len(),
                 levels[l + 1].topology.num_face_vertices()
@@ -298,79 +292,60 @@ fn linear_triangle(s: f64, t: f64) -> ([f64; 4], [f64; 4], [f64; 4]) {
 }
 
 /// The next level's values: the piece around the level's selected vertices refined one
-/// step with the channel, its kept children's corner values renumbered in order of first
-/// use, and their rows over the level's values.
+/// step, its values continuing from the level's state (so their tags are the inherited
+/// ones), the kept children's values as the next level's, with their rows over the level's
+/// values (`base_level`: the level's values are the channel's own, which its slots copy).
 fn refine_values(
     level: &PatchLevel,
     above: &LevelValues,
-    above_above: usize,
+    base_level: bool,
     scheme: &Scheme,
     rules: &Options,
     mode: FVarLinearInterpolation,
 ) -> Result<(LevelValues, StencilTable), LimitError> {
     let piece = level.piece(scheme, rules)?;
-    // The piece's channel: its faces' corner values (copies of one value as one),
-    // numbered in order of first use.
-    let t = &level.topology;
-    let mut piece_of_value = vec![u32::MAX; above.identity_bound(above_above)];
-    let mut piece_values: Vec<u32> = Vec::new();
-    let mut piece_indices = Vec::new();
-    for &f in &piece.faces {
-        for &value in corner_values(t, &above.face_values, f as usize) {
-            let slot = &mut piece_of_value[above.identity(value) as usize];
-            if *slot == u32::MAX {
-                *slot = piece_values.len() as u32;
-                piece_values.push(value);
-            }
-            piece_indices.push(*slot);
-        }
-    }
-    let channel = FVarChannel::new(
+    let (piece_state, piece_slots) = above.state.restrict(
+        &level.topology,
         &piece.cut.topology,
-        1,
-        vec![0.0; piece_values.len()],
-        piece_indices,
-    )?;
-    let fr = FaceVaryingRefinement::new(&piece.refinement, &channel, mode)?;
-    let child_values = fr.face_values(1);
+        &piece.faces,
+        &piece.cut.vertices,
+        &piece.cut.edges,
+    );
+    let level_value = |piece_slot: u32| {
+        let slot = piece_slots[piece_slot as usize];
+        if base_level {
+            above.state.source(slot as usize)
+        } else {
+            slot
+        }
+    };
+    let fr = FaceVaryingRefinement::from_state(&piece.refinement, piece_state, mode)?;
     let stencils = fr.stencils(&piece.refinement, 1);
     let children = piece.refinement.topology(1);
-    let mut next_of_child = vec![u32::MAX; fr.num_values(1)];
-    let mut kept_values: Vec<u32> = Vec::new();
-    let mut face_values = Vec::new();
-    for &cf in &piece.kept.faces {
-        for &value in corner_values(children, &child_values, cf as usize) {
-            let slot = &mut next_of_child[value as usize];
-            if *slot == u32::MAX {
-                *slot = kept_values.len() as u32;
-                kept_values.push(value);
-            }
-            face_values.push(*slot);
-        }
-    }
-    let rows: Vec<Vec<(u32, f64)>> = kept_values
+    let next = submesh::cut(children, &piece.kept.faces);
+    let (state, child_slots) = fr.level_state(1).restrict(
+        children,
+        &next.topology,
+        &piece.kept.faces,
+        &next.vertices,
+        &next.edges,
+    );
+    let rows: Vec<Vec<(u32, f64)>> = child_slots
         .iter()
-        .map(|&cv| {
-            let (idx, w) = stencils.row(cv as usize);
+        .map(|&c| {
+            let (idx, w) = stencils.row(c as usize);
             idx.iter()
-                .map(|&i| piece_values[i as usize])
+                .map(|&i| level_value(i))
                 .zip(w.iter().copied())
                 .collect()
-        })
-        .collect();
-    let copy_of = rows
-        .iter()
-        .map(|row| match row.as_slice() {
-            [(v, w)] if *w == 1.0 => *v,
-            _ => u32::MAX,
         })
         .collect();
     let step = StencilTable::from_rows(above.num_values, &rows);
     Ok((
         LevelValues {
-            face_values,
-            num_values: kept_values.len(),
-            copy_of: Some(copy_of),
+            face_values: state.face_values().to_vec(),
+            num_values: state.num_values(),
+            state,
         },
         step,
     ))

@@ -949,8 +949,11 @@ impl ChannelLevel {
 
 mod base;
 mod child;
+mod state;
 #[cfg(test)]
 mod tests;
+
+pub use state::FVarLevelState;
 
 use base::*;
 pub(crate) use base::{base_corner_kinds, check_channel};

@@ -274,3 +274,65 @@ fn values_coming_back_a_b_a_b_make_three_siblings_as_opensubdiv() {
         assert_eq!(walk, [0, 1, 0, 2], "{mode:?}");
     }
 }
+
+/// Continuing from a level's state (`level_state` → `restrict` → `from_state`) on the whole
+/// level, its faces cut out in order, refines one more level exactly as a two-level
+/// refinement does, in every mode: the values' tags are passed down, with a seam, a
+/// semi-sharp crease and a semi-sharp vertex whose values' tags depend on their history.
+#[test]
+fn continuing_from_a_levels_state_is_the_next_level() {
+    let (mut t, _) = grid();
+    let e = t.find_edge(5, 6).unwrap() as usize;
+    t.set_edge_sharpness(e, 1.5);
+    t.set_vertex_sharpness(9, 1.25);
+    // A seam along x = 1: the faces of column 0 have values of their own there.
+    let mut indices = Vec::new();
+    for f in 0..9 {
+        for &v in t.face_vertices(f) {
+            let own = f % 3 == 0 && v % 4 == 1;
+            indices.push(if own { 16 + v / 4 } else { v });
+        }
+    }
+    let values: Vec<f64> = (0..2 * 20)
+        .map(|i| ((i * 7919) % 97) as f64 / 97.0)
+        .collect();
+    let ch = FVarChannel::new(&t, 2, values.clone(), indices).unwrap();
+    let options = Options::default();
+    for mode in FVarLinearInterpolation::ALL_MODES {
+        let r2 = Refinement::new(&t, Scheme::CatmullClark, &options, 2).unwrap();
+        let fr2 = FaceVaryingRefinement::new(&r2, &ch, mode).unwrap();
+        let want = corners(&r2, &fr2, &values, 2, 2);
+        let r1 = Refinement::new(&t, Scheme::CatmullClark, &options, 1).unwrap();
+        let fr1 = FaceVaryingRefinement::new(&r1, &ch, mode).unwrap();
+        let level1 = r1.topology(1);
+        let faces: Vec<u32> = (0..level1.num_faces() as u32).collect();
+        let cut = subd_mesh::cut::cut(level1, &faces);
+        let (state, slots) =
+            fr1.level_state(1)
+                .restrict(level1, &cut.topology, &faces, &cut.vertices, &cut.edges);
+        let rules: Vec<_> = cut
+            .vertices
+            .iter()
+            .map(|&v| r1.vertex_rules(1)[v as usize])
+            .collect();
+        let next = Refinement::from_prepared(
+            cut.topology.clone(),
+            rules,
+            Scheme::CatmullClark,
+            &options,
+            1,
+        )
+        .unwrap();
+        let fr = FaceVaryingRefinement::from_state(&next, state, mode).unwrap();
+        let v1 = fr1.refine_values(&r1, &values, 2).swap_remove(1);
+        let start: Vec<f64> = slots
+            .iter()
+            .flat_map(|&s| [v1[2 * s as usize], v1[2 * s as usize + 1]])
+            .collect();
+        let got = corners(&next, &fr, &start, 2, 1);
+        assert_eq!(got.len(), want.len());
+        for (k, (g, w)) in got.iter().zip(&want).enumerate() {
+            assert!((g - w).abs() < 1e-15, "{mode:?}: corner {k}: {g} vs {w}");
+        }
+    }
+}

@@ -1,0 +1,164 @@
+//! A level's face-varying state carried to a piece of that level: adaptive refinement
+//! refines pieces of a level one step at a time, and each piece's values must be refined
+//! with the tags the values have at that level (inherited from the levels above, as
+//! OpenSubdiv's `Vtr::FVarRefinement` passes them down), not with tags found afresh from the
+//! piece as if it were a base mesh: the two part where a value's tag depends on its history
+//! (semi-sharp values, siblings of a non-manifold vertex that share a value).
+
+use subd_mesh::Topology;
+use subd_mesh::fvar::{FVarError, FVarLinearInterpolation};
+
+use super::{ChannelLevel, FaceVaryingRefinement, ModeFlags, child_level, geometric_vertices};
+use crate::Refinement;
+use std::sync::OnceLock;
+
+/// One level of a face-varying refinement: its values (one per vertex and sibling), the
+/// value of every face corner, and each value's tags and each edge's seams
+/// ([`FaceVaryingRefinement::level_state`]).
+#[derive(Debug, Clone)]
+pub struct FVarLevelState {
+    level: ChannelLevel,
+}
+
+impl FVarLevelState {
+    /// Number of values (per-vertex slots).
+    pub fn num_values(&self) -> usize {
+        self.level.num_values()
+    }
+
+    /// The value of every face corner, face after face.
+    pub fn face_values(&self) -> &[u32] {
+        &self.level.face_values
+    }
+
+    /// The index a stencil reads for value `slot`: the channel's own value at a base level,
+    /// the slot itself at a refined one.
+    pub fn source(&self, slot: usize) -> u32 {
+        self.level.source(slot)
+    }
+
+    /// The state on a cut of its topology `source`: `target` holds the source faces
+    /// `faces` (in order, corners in the same order), its vertices and edges are the source's
+    /// `vertices` and `edges`. Each target vertex keeps all its source vertex's values.
+    /// Returns the state and the source slot of each of its values.
+    ///
+    /// The tags of a vertex whose ring is not whole in the cut are kept as they are (their
+    /// span ends clamped into its ring): refining the cut is right only where rings are whole.
+    pub fn restrict(
+        &self,
+        source: &Topology,
+        target: &Topology,
+        faces: &[u32],
+        vertices: &[u32],
+        edges: &[u32],
+    ) -> (FVarLevelState, Vec<u32>) {
+        let src = &self.level;
+        let mut value_offsets = Vec::with_capacity(vertices.len() + 1);
+        value_offsets.push(0u32);
+        let mut slots = Vec::new();
+        for &v in vertices {
+            let (o, n) = (src.offset(v as usize), src.count(v as usize));
+            slots.extend((o..o + n).map(|s| s as u32));
+            value_offsets.push(slots.len() as u32);
+        }
+        let tags = slots.iter().map(|&s| src.tags[s as usize]).collect();
+        let ends = vertices
+            .iter()
+            .enumerate()
+            .flat_map(|(pv, &v)| {
+                let last = target.vertex_faces(pv).len().saturating_sub(1) as u16;
+                let (o, n) = (src.offset(v as usize), src.count(v as usize));
+                src.ends[o..o + n]
+                    .iter()
+                    .map(move |&[a, b]| [a.min(last), b.min(last)])
+            })
+            .collect();
+        let mut face_values = Vec::with_capacity(target.num_face_vertices());
+        for (j, &f) in faces.iter().enumerate() {
+            let corners = source.face_vertices(f as usize);
+            let first = source.face_offsets()[f as usize] as usize;
+            for (k, &pv) in target.face_vertices(j).iter().enumerate() {
+                let s = src.face_values[first + k] as usize;
+                let within = s - src.offset(corners[k] as usize);
+                face_values.push(value_offsets[pv as usize] + within as u32);
+            }
+        }
+        let per_edge = |flags: &[bool]| edges.iter().map(|&e| flags[e as usize]).collect();
+        let geometric = if src.geometric.is_empty() {
+            Vec::new()
+        } else {
+            vertices
+                .iter()
+                .map(|&v| src.geometric[v as usize])
+                .collect()
+        };
+        let level = ChannelLevel {
+            value_offsets,
+            face_values,
+            user: None,
+            tags,
+            ends,
+            edge_mismatch: per_edge(&src.edge_mismatch),
+            edge_linear: per_edge(&src.edge_linear),
+            geometric,
+        };
+        (FVarLevelState { level }, slots)
+    }
+}
+
+impl FaceVaryingRefinement {
+    /// The state of `level` ([`FVarLevelState`]), to continue from on a piece of it.
+    ///
+    /// # Panics
+    /// If `level` is past the last level.
+    pub fn level_state(&self, level: usize) -> FVarLevelState {
+        FVarLevelState {
+            level: self.levels[level].clone(),
+        }
+    }
+
+    /// Continues a face-varying refinement from `state`, the state of the level
+    /// `refinement` starts from (a piece of a refined level, as [`FVarLevelState::restrict`]
+    /// makes it), refined with `mode` to every level of `refinement`. Level 0's values are
+    /// the state's values: the stencils of level 1 read them.
+    ///
+    /// # Errors
+    /// [`FVarError::Scheme`] for a scheme that is not OpenSubdiv's, [`FVarError::IndexCount`]
+    /// when the state is not one value per face-vertex of `refinement`'s base.
+    pub fn from_state(
+        refinement: &Refinement,
+        state: FVarLevelState,
+        mode: FVarLinearInterpolation,
+    ) -> Result<FaceVaryingRefinement, FVarError> {
+        let Some(osd) = refinement.opensubdiv() else {
+            return Err(FVarError::Scheme {
+                scheme: refinement.scheme().to_string(),
+            });
+        };
+        let base = refinement.topology(0);
+        if state.level.face_values.len() != base.num_face_vertices() {
+            return Err(FVarError::IndexCount {
+                given: state.level.face_values.len(),
+                expected: base.num_face_vertices(),
+            });
+        }
+        let flags = ModeFlags::new(mode, refinement.options().boundary_interpolation);
+        let num_user_values = state.level.num_values();
+        let mut levels = vec![state.level];
+        for l in 1..=refinement.num_levels() {
+            let step = osd.step(l);
+            let mut child = child_level(&step, &levels[l - 1], flags);
+            child.geometric = geometric_vertices(&step, &levels[l - 1], &child, flags);
+            levels.push(child);
+        }
+        Ok(FaceVaryingRefinement {
+            mode,
+            flags,
+            num_user_values,
+            stencils: (0..refinement.num_levels())
+                .map(|_| OnceLock::new())
+                .collect(),
+            levels,
+        })
+    }
+}
