@@ -1,11 +1,14 @@
 //! Times building a patch table and evaluating it on the bench torus (`cargo xtask bench`'s
 //! quad mesh, or its triangulation for Loop): `patch_time <cc|loop> <isolation> <repeats>
-//! [eval]`; prints the seconds of each run. Run it with `RAYON_NUM_THREADS` set.
+//! [eval|fvar]`; prints the seconds of each run (`fvar`: adding a face-varying channel, a
+//! UV layout with a seam around the torus, to a built table). Run it with
+//! `RAYON_NUM_THREADS` set.
 
 use std::time::Instant;
 
 use subd_limit::eval::FaceParam;
 use subd_limit::patches::{EndCaps, PatchOptions, PatchTable};
+use subd_mesh::fvar::{FVarChannel, FVarLinearInterpolation};
 use subd_mesh::{DVec3, Topology, TopologyBuilder};
 use subd_schemes::{Options, Refinement, Scheme};
 
@@ -34,6 +37,7 @@ fn main() {
     let isolation: u8 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(2);
     let repeats: usize = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(5);
     let eval = args.get(4).is_some_and(|s| s == "eval");
+    let fvar = args.get(4).is_some_and(|s| s == "fvar");
     let (quads, points) = bench_torus();
     let (topo, scheme, caps) = if loop_scheme {
         (split_quads(&quads), Scheme::Loop, EndCaps::GregoryBasis)
@@ -64,9 +68,16 @@ fn main() {
             FaceParam { face, sub: 0, u, v }
         })
         .collect();
+    let channel = uv_layout(&topo, &points);
     for _ in 0..repeats {
+        let mut built = fvar.then(|| table_clone(&topo, &points, &scheme, &rules, &options));
         let t = Instant::now();
-        let n = if eval {
+        let n = if let Some(table) = &mut built {
+            table
+                .add_face_varying(&channel, FVarLinearInterpolation::CornersPlus1)
+                .expect("face-varying");
+            table.face_varying()[0].values().len() / 2
+        } else if eval {
             table.evaluate_first(&at).expect("evaluate").len()
         } else {
             PatchTable::new(&topo, &points, &scheme, &rules, &options)
@@ -76,4 +87,37 @@ fn main() {
         };
         println!("{:.4} s ({n})", t.elapsed().as_secs_f64());
     }
+}
+
+fn table_clone(
+    topo: &Topology,
+    points: &[DVec3],
+    scheme: &Scheme,
+    rules: &Options,
+    options: &PatchOptions,
+) -> PatchTable {
+    PatchTable::new(topo, points, scheme, rules, options).expect("table")
+}
+
+/// A UV layout: the angle around the torus's axis and the height, with a seam where the
+/// angle wraps (faces across it take values of their own for their vertices past it).
+fn uv_layout(topo: &Topology, points: &[DVec3]) -> FVarChannel {
+    let angle = |p: DVec3| p.y.atan2(p.x) / std::f64::consts::TAU + 0.5;
+    let mut values: Vec<f64> = points.iter().flat_map(|&p| [angle(p), p.z]).collect();
+    let mut indices = Vec::with_capacity(topo.num_face_vertices());
+    for f in 0..topo.num_faces() {
+        let fv = topo.face_vertices(f);
+        let wraps = fv.iter().any(|&v| angle(points[v as usize]) > 0.75)
+            && fv.iter().any(|&v| angle(points[v as usize]) < 0.25);
+        for &v in fv {
+            let p = points[v as usize];
+            if wraps && angle(p) < 0.25 {
+                indices.push((values.len() / 2) as u32);
+                values.extend([angle(p) + 1.0, p.z]);
+            } else {
+                indices.push(v);
+            }
+        }
+    }
+    FVarChannel::new(topo, 2, values, indices).expect("layout")
 }
