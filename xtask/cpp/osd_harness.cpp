@@ -318,6 +318,7 @@ void patchFVar(Mesh const &m, Far::TopologyRefiner const &refiner, Far::PatchTab
     double w[3][20];
     for (size_t i = 0; i < faces.size(); ++i) {
         Far::PatchTable::PatchHandle const *h = map.FindPatch(faces[i], us[i], vs[i]);
+        if (!h) throw std::runtime_error("no patch at point " + std::to_string(i));
         table.EvaluateBasisFaceVarying(*h, us[i], vs[i], w[0], w[1], w[2], 0, 0, 0, 0);
         Far::ConstIndexArray cvs = table.GetPatchFVarValues(*h, 0);
         for (int d = 0; d < 3; ++d) {

@@ -313,23 +313,44 @@ struct EvalErrors {
 
 /// subd's refined vertices that OpenSubdiv's refinement lacks: no refined vertex of
 /// OpenSubdiv lies within 1e-12 of the diagonal of them (OpenSubdiv's adaptive refinement
-/// put its counterpart elsewhere).
-fn refined_points_osd_lacks(table: &PatchTable, osd: &OsdPatchTable, diag: f64) -> Vec<bool> {
+/// put its counterpart elsewhere), while subd's uniform refinement (`uniform`, all levels,
+/// asked for only when some vertex is missing) has it: a subd vertex off uniform
+/// refinement is never taken for OpenSubdiv's departure.
+fn refined_points_osd_lacks(
+    table: &PatchTable,
+    osd: &OsdPatchTable,
+    diag: f64,
+    uniform: impl FnOnce() -> Vec<DVec3>,
+) -> Vec<bool> {
     let refined: usize = table.level_vertex_counts().iter().sum();
     let tol = 1e-12 * diag;
-    // OpenSubdiv's refined points sorted by x: each search looks at a narrow slab.
-    let mut by_x: Vec<DVec3> = osd.points[..osd.points.len() - osd.local_points].to_vec();
-    by_x.sort_by(|p, q| p.x.total_cmp(&q.x));
-    table.points()[..refined]
+    let osd_refined = sorted_by_x(&osd.points[..osd.points.len() - osd.local_points]);
+    let mut lacking: Vec<bool> = table.points()[..refined]
         .iter()
-        .map(|p| {
-            let first = by_x.partition_point(|q| q.x < p.x - tol);
-            !by_x[first..]
-                .iter()
-                .take_while(|q| q.x <= p.x + tol)
-                .any(|q| (*p - *q).length() <= tol)
-        })
-        .collect()
+        .map(|p| !has_near(&osd_refined, *p, tol))
+        .collect();
+    if lacking.iter().any(|&l| l) {
+        let uniform = sorted_by_x(&uniform());
+        for (l, p) in lacking.iter_mut().zip(table.points()) {
+            *l = *l && has_near(&uniform, *p, tol);
+        }
+    }
+    lacking
+}
+
+fn sorted_by_x(points: &[DVec3]) -> Vec<DVec3> {
+    let mut by_x = points.to_vec();
+    by_x.sort_by(|p, q| p.x.total_cmp(&q.x));
+    by_x
+}
+
+/// Whether `by_x` (sorted by x) has a point within `tol` of `p`.
+fn has_near(by_x: &[DVec3], p: DVec3, tol: f64) -> bool {
+    let first = by_x.partition_point(|q| q.x < p.x - tol);
+    by_x[first..]
+        .iter()
+        .take_while(|q| q.x <= p.x + tol)
+        .any(|q| (p - *q).length() <= tol)
 }
 
 /// Whether patch `i` of array `a` reads a refined vertex in `lacking`: as a control point,
@@ -469,6 +490,7 @@ fn eval_error(
     points: &[(FaceParam, u32)],
     osd: &OsdPatchTable,
     diag: f64,
+    uniform: impl FnOnce() -> Vec<DVec3>,
 ) -> Result<EvalErrors, String> {
     let mut errors = EvalErrors {
         strict: 0.0,
@@ -476,7 +498,7 @@ fn eval_error(
         darts: (0, 0.0),
         osd_points: (0, 0.0),
     };
-    let lacking = refined_points_osd_lacks(table, osd, diag);
+    let lacking = refined_points_osd_lacks(table, osd, diag, uniform);
     let keys: BTreeMap<PatchKey, usize> = osd
         .patches
         .iter()
@@ -594,7 +616,18 @@ fn compare_sets(
                             osd.local_points
                         ));
                     }
-                    let error = eval_error(&table, &points, &osd, diag)?;
+                    // subd's uniform refinement to the table's depth, every level.
+                    let uniform = || {
+                        subd_schemes::Refinement::new(
+                            topo,
+                            scheme.clone(),
+                            options,
+                            table.max_depth(),
+                        )
+                        .map(|r| r.refine_points(positions).into_iter().flatten().collect())
+                        .unwrap_or_default()
+                    };
+                    let error = eval_error(&table, &points, &osd, diag, uniform)?;
                     Ok((osd.patches.len(), points.len(), error))
                 });
             match result {

@@ -169,8 +169,7 @@ fn compare_one(
         if error.is_nan() || error > tol {
             let depth = param.place().depth as usize;
             let fvar = &table.face_varying()[fvc];
-            let n = fvar.values_per_patch();
-            let ours = fvar.patch_values(a)[n * i..n * (i + 1)].iter().map(|&v| {
+            let ours = fvar.patch_values(a, i).iter().map(|&v| {
                 let x = &fvar.values()[2 * v as usize..2 * v as usize + 2];
                 [x[0], x[1]]
             });
@@ -188,26 +187,37 @@ fn compare_one(
         }
     }
     if out.strict.is_nan() || out.strict > tol {
-        // Whether the sparse levels or the patch are at fault: subd's values there are
-        // uniform refinement's or not.
-        let (a, i) = worst_patch;
-        let depth = table.arrays()[a].params()[i].place().depth as usize;
-        let fvar = &table.face_varying()[fvc];
-        let n = fvar.values_per_patch();
-        let foreign = fvar.patch_values(a)[n * i..n * (i + 1)]
-            .iter()
-            .filter(|&&v| {
-                let x = &fvar.values()[2 * v as usize..2 * v as usize + 2];
-                !uniform.holds(depth, std::iter::once([x[0], x[1]]), tol)
-            })
-            .count();
+        let diag = uv_diagonal(channel.values());
         return Err(format!(
-            "off by {:.3e} of the UV layout; at the worst point {foreign} of the patch's {n} \
-             values are not uniform level-{depth} values",
-            out.strict / uv_diagonal(channel.values()),
+            "off by {:.3e} of the UV layout; at the worst point {}",
+            out.strict / diag,
+            diagnose(&table, fvc, worst_patch, &mut uniform, tol)
         ));
     }
     Ok(out)
+}
+
+/// Whether the sparse levels or the patch are at fault where a row fails: how many of the
+/// values of patch `(a, i)` are not values of subd's uniform refinement at its depth.
+fn diagnose(
+    table: &PatchTable,
+    fvc: usize,
+    (a, i): (usize, usize),
+    uniform: &mut Uniform<'_>,
+    tol: f64,
+) -> String {
+    let depth = table.arrays()[a].params()[i].place().depth as usize;
+    let fvar = &table.face_varying()[fvc];
+    let n = fvar.values_per_patch();
+    let foreign = fvar
+        .patch_values(a, i)
+        .iter()
+        .filter(|&&v| {
+            let x = &fvar.values()[2 * v as usize..2 * v as usize + 2];
+            !uniform.holds(depth, std::iter::once([x[0], x[1]]), tol)
+        })
+        .count();
+    format!("{foreign} of the patch's {n} values are not uniform level-{depth} values")
 }
 
 /// One comparison's outcome: points, the largest difference, and the points (with their

@@ -68,6 +68,9 @@ pub(crate) struct PatchesArgs {
     /// Print the census (patches by type, depth and boundary mask) on stdout as JSON.
     #[arg(long)]
     json: bool,
+    /// Leave the input's texture coordinates out of the table (no face-varying patches).
+    #[arg(long)]
+    no_uv: bool,
 }
 
 impl PatchesArgs {
@@ -109,7 +112,7 @@ pub(crate) fn run(
     .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
     // Texture coordinates become the table's face-varying channel (OpenSubdiv's
     // generateFVarTables), refined with the file's or the command's interpolation mode.
-    if let Some(uv) = file.mesh.uv() {
+    if let Some(uv) = file.mesh.uv().filter(|_| !args.no_uv) {
         let mode = args.rules.fvar_mode(&file.mesh.hints);
         table.add_face_varying(uv, mode).map_err(|e| {
             bad(format!(

@@ -1,7 +1,7 @@
 //! Times building a patch table and evaluating it on the bench torus (`cargo xtask bench`'s
 //! quad mesh, or its triangulation for Loop): `patch_time <cc|loop> <isolation> <repeats>
 //! [eval|fvar]`; prints the seconds of each run (`fvar`: adding a face-varying channel, a
-//! UV layout with a seam around the torus, to a built table). Run it with
+//! UV layout cut along one ring of the torus, to a built table). Run it with
 //! `RAYON_NUM_THREADS` set.
 
 use std::time::Instant;
@@ -70,7 +70,7 @@ fn main() {
         .collect();
     let channel = uv_layout(&topo, &points);
     for _ in 0..repeats {
-        let mut built = fvar.then(|| table_clone(&topo, &points, &scheme, &rules, &options));
+        let mut built = fvar.then(|| build_table(&topo, &points, &scheme, &rules, &options));
         let t = Instant::now();
         let n = if let Some(table) = &mut built {
             table
@@ -89,7 +89,8 @@ fn main() {
     }
 }
 
-fn table_clone(
+/// A table of its own for each face-varying run (the channel is added to it).
+fn build_table(
     topo: &Topology,
     points: &[DVec3],
     scheme: &Scheme,
@@ -99,12 +100,15 @@ fn table_clone(
     PatchTable::new(topo, points, scheme, rules, options).expect("table")
 }
 
-/// A UV layout: the angle around the torus's axis and the height, with a seam where the
-/// angle wraps (faces across it take values of their own for their vertices past it).
+/// A UV layout: the angle around the torus's axis and the height, cut where the angle wraps:
+/// the faces across the cut take values of their own for their vertices past it, so the
+/// cut is a seam (and every vertex on it has two values).
 fn uv_layout(topo: &Topology, points: &[DVec3]) -> FVarChannel {
     let angle = |p: DVec3| p.y.atan2(p.x) / std::f64::consts::TAU + 0.5;
     let mut values: Vec<f64> = points.iter().flat_map(|&p| [angle(p), p.z]).collect();
     let mut indices = Vec::with_capacity(topo.num_face_vertices());
+    // The second value of each vertex past the cut, shared by the faces across it.
+    let mut across = vec![u32::MAX; points.len()];
     for f in 0..topo.num_faces() {
         let fv = topo.face_vertices(f);
         let wraps = fv.iter().any(|&v| angle(points[v as usize]) > 0.75)
@@ -112,8 +116,11 @@ fn uv_layout(topo: &Topology, points: &[DVec3]) -> FVarChannel {
         for &v in fv {
             let p = points[v as usize];
             if wraps && angle(p) < 0.25 {
-                indices.push((values.len() / 2) as u32);
-                values.extend([angle(p) + 1.0, p.z]);
+                if across[v as usize] == u32::MAX {
+                    across[v as usize] = (values.len() / 2) as u32;
+                    values.extend([angle(p) + 1.0, p.z]);
+                }
+                indices.push(across[v as usize]);
             } else {
                 indices.push(v);
             }

@@ -664,6 +664,38 @@ fn linear_face_varying_patches_are_the_faces_interpolation() {
                                     "case {ci} face {f} sub {sub} at ({u}, {v}): {g} vs {w}"
                                 );
                             }
+                            // The derivatives: central differences of the closed form.
+                            if u > 0.0 && v > 0.0 {
+                                let h = 1e-6;
+                                let d = |du: f64, dv: f64| {
+                                    let a = FaceParam {
+                                        u: u + du,
+                                        v: v + dv,
+                                        ..at
+                                    };
+                                    let b = FaceParam {
+                                        u: u - du,
+                                        v: v - dv,
+                                        ..at
+                                    };
+                                    let (a, b) =
+                                        (linear_in_face(c, &ch, a), linear_in_face(c, &ch, b));
+                                    a.iter()
+                                        .zip(&b)
+                                        .map(|(x, y)| (x - y) / (2.0 * h))
+                                        .collect::<Vec<_>>()
+                                };
+                                for (k, (du, dv)) in d(h, 0.0).iter().zip(d(0.0, h)).enumerate() {
+                                    assert!(
+                                        (got.du[k] - du).abs() < 1e-7,
+                                        "case {ci} face {f}: du"
+                                    );
+                                    assert!(
+                                        (got.dv[k] - dv).abs() < 1e-7,
+                                        "case {ci} face {f}: dv"
+                                    );
+                                }
+                            }
                         }
                     }
                 }
@@ -704,10 +736,9 @@ fn smooth_face_varying_without_seams_follows_the_vertices() {
             if !matches!(array.kind(), PatchType::Regular | PatchType::Loop) {
                 continue;
             }
-            let n = corners.len();
             for i in 0..array.len() {
                 let cps = array.patch_points(i);
-                let values = &fvar.patch_values(a)[n * i..n * (i + 1)];
+                let values = fvar.patch_values(a, i);
                 for (k, &corner) in corners.iter().enumerate() {
                     let p = table.points()[cps[corner] as usize];
                     let x = &fvar.values()[3 * values[k] as usize..3 * values[k] as usize + 3];

@@ -221,7 +221,7 @@ impl CorePatchTable {
         // in place by `update_uv` (never moved); `slf` owns the table.
         unsafe {
             let patches = (0..this.table.arrays().len())
-                .map(|a| view2(fvar.patch_values(a), k, owner()))
+                .map(|a| view2(fvar.array_values(a), k, owner()))
                 .collect::<PyResult<Vec<_>>>()?;
             let values = view2(fvar.values(), fvar.components(), owner())?;
             Ok(Some((
@@ -295,8 +295,9 @@ impl CorePatchTable {
         }
         // Computed with the GIL released, put in place with it held (see `update`).
         let next = pool::run(py, || fvar.values_for(flat))?.map_err(mesh_error)?;
-        self.table.set_face_varying_values(0, &next);
-        Ok(())
+        self.table
+            .set_face_varying_values(0, &next)
+            .map_err(mesh_error)
     }
 
     /// Moves the base vertices: recomputes the refined and local points.

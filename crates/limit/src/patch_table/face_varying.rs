@@ -38,7 +38,7 @@ pub struct FVarPatches {
     level_value_counts: Vec<usize>,
     /// Level `l + 1`'s values as weights of level `l`'s.
     rows: Vec<StencilTable>,
-    /// Per patch array, the values of each patch's face (`face_size` per patch), as
+    /// Per patch array, the values of each patch's face (`face_size` per patch), as value
     /// indices into the values of all levels.
     patch_values: Vec<Vec<u32>>,
     /// Values of all levels, `components` numbers each.
@@ -58,8 +58,8 @@ pub struct FVarPatchesLayout<'a> {
     pub values_per_patch: usize,
     /// Values of each level (level 0: the channel's own).
     pub level_value_counts: &'a [usize],
-    /// Per patch array (the table's order), the values of each patch, indices into
-    /// `values`.
+    /// Per patch array (the table's order), the values of each patch: value indices (value
+    /// `k` is `values[components * k..components * (k + 1)]`).
     pub patch_values: Vec<&'a [u32]>,
     /// The values of all levels, `components` numbers each.
     pub values: &'a [f64],
@@ -112,7 +112,7 @@ impl FVarPatches {
             let above = level_values.last().expect("the base level's values");
             // Level 0's values are the channel's own; a refined level's are its slots.
             let base_level = l == 0;
-            let (next, step) = refine_values(level, above, base_level, scheme, rules, mode)?;
+            let (next, step) = refine_values(level, above, base_level, scheme, rules)?;
             debug_assert_eq!(
                 next.face_values.len(),
                 levels[l + 1].topology.num_face_vertices()
@@ -172,12 +172,26 @@ impl FVarPatches {
                 self.components
             )));
         }
+        if let Some(k) = base.iter().position(|x| !x.is_finite()) {
+            return Err(LimitError::Param(format!(
+                "face-varying channel: value {} is not finite",
+                k / self.components
+            )));
+        }
         Ok(self.refined_values(base))
     }
 
     /// Overwrites the values in place (views of [`Self::values`] stay valid).
-    pub(crate) fn set_values(&mut self, values: &[f64]) {
+    pub(crate) fn set_values(&mut self, values: &[f64]) -> Result<(), LimitError> {
+        if values.len() != self.values.len() {
+            return Err(LimitError::Param(format!(
+                "face-varying channel: {} numbers given for {} refined values",
+                values.len(),
+                self.values.len()
+            )));
+        }
         self.values.copy_from_slice(values);
+        Ok(())
     }
 
     /// The interpolation mode the values were refined with.
@@ -202,13 +216,23 @@ impl FVarPatches {
     }
 
     /// The values of array `array`'s patches, [`Self::values_per_patch`] per patch, as
-    /// indices into [`Self::values`] (OpenSubdiv's `GetPatchArrayFVarValues`).
-    pub fn patch_values(&self, array: usize) -> &[u32] {
+    /// value indices (value `k` is `values()[components * k..components * (k + 1)]`;
+    /// OpenSubdiv's `GetPatchArrayFVarValues`).
+    pub fn array_values(&self, array: usize) -> &[u32] {
         &self.patch_values[array]
     }
 
+    /// The values of patch `index` of array `array` ([`Self::values_per_patch`] value
+    /// indices; OpenSubdiv's `GetPatchFVarValues`).
+    pub fn patch_values(&self, array: usize, index: usize) -> &[u32] {
+        let n = self.face_size;
+        &self.patch_values[array][n * index..n * (index + 1)]
+    }
+
     /// The values of every level, [`Self::components`] numbers each: what
-    /// [`Self::patch_values`] indexes.
+    /// [`Self::array_values`] indexes. A refined level also holds values no patch reads
+    /// (a vertex at the edge of a level's piece keeps all its values, also those of faces
+    /// the level left out), so its count is not OpenSubdiv's `GetNumFVarValues`.
     pub fn values(&self) -> &[f64] {
         &self.values
     }
@@ -301,7 +325,6 @@ fn refine_values(
     base_level: bool,
     scheme: &Scheme,
     rules: &Options,
-    mode: FVarLinearInterpolation,
 ) -> Result<(LevelValues, StencilTable), LimitError> {
     let piece = level.piece(scheme, rules)?;
     let (piece_state, piece_slots) = above.state.restrict(
@@ -319,7 +342,7 @@ fn refine_values(
             slot
         }
     };
-    let fr = FaceVaryingRefinement::from_state(&piece.refinement, piece_state, mode)?;
+    let fr = FaceVaryingRefinement::from_state(&piece.refinement, piece_state)?;
     let stencils = fr.stencils(&piece.refinement, 1);
     let children = piece.refinement.topology(1);
     let next = submesh::cut(children, &piece.kept.faces);

@@ -397,7 +397,10 @@ impl PatchTable {
 
     /// The weights of patch `index` of array `array`'s control points at `(u, v)` of its
     /// root face (OpenSubdiv's `PatchTable::EvaluateBasis`): a renderer's own sums of
-    /// [`Self::points`] with them give [`Self::evaluate`]'s values.
+    /// [`Self::points`] with them give [`Self::evaluate`]'s values. Derivatives are with
+    /// respect to the root's parameters; in a sub-face of a face that is not a quad that is
+    /// the sub-face's `(u, v)`, where OpenSubdiv's are twice (first) and four times (second)
+    /// these, being taken with respect to the face's half-size ptex parameters.
     ///
     /// # Errors
     /// [`LimitError::Param`] for a patch that does not exist, [`LimitError::Unsupported`] for
@@ -651,7 +654,8 @@ impl PatchTable {
     }
 
     /// Face-varying channel `channel` at `at`: its value and first derivatives with respect
-    /// to the face's (sub-face's) parameters (OpenSubdiv's `EvaluateBasisFaceVarying`).
+    /// to the face's (sub-face's) parameters (OpenSubdiv's `EvaluateBasisFaceVarying`, whose
+    /// derivatives in a sub-face are twice these, as [`Self::evaluate_basis`] says).
     ///
     /// # Errors
     /// [`LimitError::Param`] for a channel that was not added, else as [`Self::find`].
@@ -678,17 +682,21 @@ impl PatchTable {
         values: &[f64],
     ) -> Result<(), LimitError> {
         let next = self.face_varying_channel(channel)?.values_for(values)?;
-        self.set_face_varying_values(channel, &next);
-        Ok(())
+        self.set_face_varying_values(channel, &next)
     }
 
-    /// Puts values from [`FVarPatches::values_for`] in place (overwriting the buffer, so
-    /// views of it stay valid).
+    /// Puts values from [`FVarPatches::values_for`] of channel `channel` in place
+    /// (overwriting the buffer, so views of it stay valid).
     ///
-    /// # Panics
-    /// If `channel` was not added or `values` came from another table (a different length).
-    pub fn set_face_varying_values(&mut self, channel: usize, values: &[f64]) {
-        self.face_varying[channel].set_values(values);
+    /// # Errors
+    /// [`LimitError::Param`] for a channel that was not added or values of another length.
+    pub fn set_face_varying_values(
+        &mut self,
+        channel: usize,
+        values: &[f64],
+    ) -> Result<(), LimitError> {
+        self.face_varying_channel(channel)?;
+        self.face_varying[channel].set_values(values)
     }
 
     fn face_varying_channel(&self, channel: usize) -> Result<&FVarPatches, LimitError> {

@@ -13,11 +13,12 @@ use crate::Refinement;
 use std::sync::OnceLock;
 
 /// One level of a face-varying refinement: its values (one per vertex and sibling), the
-/// value of every face corner, and each value's tags and each edge's seams
-/// ([`FaceVaryingRefinement::level_state`]).
+/// value of every face corner, each value's tags and each edge's seams, and the mode they
+/// were found with ([`FaceVaryingRefinement::level_state`]).
 #[derive(Debug, Clone)]
 pub struct FVarLevelState {
     level: ChannelLevel,
+    mode: FVarLinearInterpolation,
 }
 
 impl FVarLevelState {
@@ -31,10 +32,15 @@ impl FVarLevelState {
         &self.level.face_values
     }
 
-    /// The index a stencil reads for value `slot`: the channel's own value at a base level,
-    /// the slot itself at a refined one.
+    /// The value `slot` stands for: the channel's own value at a base level (a value used
+    /// at two vertices has a slot at each), the slot itself at a refined one.
     pub fn source(&self, slot: usize) -> u32 {
         self.level.source(slot)
+    }
+
+    /// The interpolation mode the tags were found with.
+    pub fn mode(&self) -> FVarLinearInterpolation {
+        self.mode
     }
 
     /// The state on a cut of its topology `source`: `target` holds the source faces
@@ -43,7 +49,12 @@ impl FVarLevelState {
     /// Returns the state and the source slot of each of its values.
     ///
     /// The tags of a vertex whose ring is not whole in the cut are kept as they are (their
-    /// span ends clamped into its ring): refining the cut is right only where rings are whole.
+    /// span ends clamped into its ring), and such a vertex keeps all its values, also those
+    /// of faces left out: refining the cut is right only where rings are whole.
+    ///
+    /// # Panics
+    /// If `faces`, `vertices` and `edges` do not describe `target` as a cut of `source`
+    /// (lengths; in debug builds also each corner's vertex).
     pub fn restrict(
         &self,
         source: &Topology,
@@ -53,6 +64,12 @@ impl FVarLevelState {
         edges: &[u32],
     ) -> (FVarLevelState, Vec<u32>) {
         let src = &self.level;
+        assert!(
+            faces.len() == target.num_faces()
+                && vertices.len() == target.num_vertices()
+                && edges.len() == target.num_edges(),
+            "restrict: the faces, vertices and edges of a cut of the state's topology"
+        );
         let mut value_offsets = Vec::with_capacity(vertices.len() + 1);
         value_offsets.push(0u32);
         let mut slots = Vec::new();
@@ -78,6 +95,7 @@ impl FVarLevelState {
             let corners = source.face_vertices(f as usize);
             let first = source.face_offsets()[f as usize] as usize;
             for (k, &pv) in target.face_vertices(j).iter().enumerate() {
+                debug_assert_eq!(vertices[pv as usize], corners[k], "a cut keeps corners");
                 let s = src.face_values[first + k] as usize;
                 let within = s - src.offset(corners[k] as usize);
                 face_values.push(value_offsets[pv as usize] + within as u32);
@@ -102,7 +120,13 @@ impl FVarLevelState {
             edge_linear: per_edge(&src.edge_linear),
             geometric,
         };
-        (FVarLevelState { level }, slots)
+        (
+            FVarLevelState {
+                level,
+                mode: self.mode,
+            },
+            slots,
+        )
     }
 }
 
@@ -114,21 +138,25 @@ impl FaceVaryingRefinement {
     pub fn level_state(&self, level: usize) -> FVarLevelState {
         FVarLevelState {
             level: self.levels[level].clone(),
+            mode: self.mode,
         }
     }
 
     /// Continues a face-varying refinement from `state`, the state of the level
     /// `refinement` starts from (a piece of a refined level, as [`FVarLevelState::restrict`]
-    /// makes it), refined with `mode` to every level of `refinement`. Level 0's values are
-    /// the state's values: the stencils of level 1 read them.
+    /// makes it), refined with the state's mode to every level of `refinement`. Level 0's
+    /// values are the state's slots (one per vertex and sibling; [`FVarLevelState::source`]
+    /// says which value each stands for): the stencils of level 1 read them.
     ///
     /// # Errors
     /// [`FVarError::Scheme`] for a scheme that is not OpenSubdiv's, [`FVarError::IndexCount`]
     /// when the state is not one value per face-vertex of `refinement`'s base.
+    ///
+    /// # Panics
+    /// If the state's vertices or edges are not as many as the base's.
     pub fn from_state(
         refinement: &Refinement,
         state: FVarLevelState,
-        mode: FVarLinearInterpolation,
     ) -> Result<FaceVaryingRefinement, FVarError> {
         let Some(osd) = refinement.opensubdiv() else {
             return Err(FVarError::Scheme {
@@ -142,9 +170,18 @@ impl FaceVaryingRefinement {
                 expected: base.num_face_vertices(),
             });
         }
+        assert!(
+            state.level.value_offsets.len() == base.num_vertices() + 1
+                && state.level.edge_mismatch.len() == base.num_edges(),
+            "from_state: a state of another topology"
+        );
+        let mode = state.mode;
         let flags = ModeFlags::new(mode, refinement.options().boundary_interpolation);
-        let num_user_values = state.level.num_values();
-        let mut levels = vec![state.level];
+        let mut first = state.level;
+        // The slots are the values level 1 reads.
+        first.user = None;
+        let num_user_values = first.num_values();
+        let mut levels = vec![first];
         for l in 1..=refinement.num_levels() {
             let step = osd.step(l);
             let mut child = child_level(&step, &levels[l - 1], flags);

@@ -323,7 +323,7 @@ fn continuing_from_a_levels_state_is_the_next_level() {
             1,
         )
         .unwrap();
-        let fr = FaceVaryingRefinement::from_state(&next, state, mode).unwrap();
+        let fr = FaceVaryingRefinement::from_state(&next, state).unwrap();
         let v1 = fr1.refine_values(&r1, &values, 2).swap_remove(1);
         let start: Vec<f64> = slots
             .iter()
