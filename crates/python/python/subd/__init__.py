@@ -597,6 +597,18 @@ class Refiner:
         return scipy.sparse.csr_matrix((weights, indices, indptr), shape=shape)
 
 
+def _places(faces, u, v, sub):
+    """(faces, sub, u, v) as flat arrays for the core: ``sub`` defaults to 0 and a single
+    sub-face applies to every face."""
+    f = _index_array(faces, "faces").reshape(-1)
+    s = np.zeros_like(f) if sub is None else _index_array(sub, "sub").reshape(-1)
+    uu = _float_array(u, "u").reshape(-1)
+    vv = _float_array(v, "v").reshape(-1)
+    if s.size == 1 and f.size != 1:
+        s = np.full_like(f, int(s[0]))
+    return f, s, uu, vv
+
+
 class PatchTable:
     """A mesh's feature-adaptive patch table, as OpenSubdiv's ``Far::PatchTable``.
 
@@ -727,13 +739,7 @@ class PatchTable:
         """The surface at ``(faces[i], u[i], v[i])`` (``sub``: the corner quad of a
         Catmull-Clark face that is not a quad). Returns ``(positions, du, dv)``, each
         (m, 3), and with ``derivatives=True`` also ``duu``, ``duv``, ``dvv``."""
-        f = _index_array(faces, "faces").reshape(-1)
-        s = np.zeros_like(f) if sub is None else _index_array(sub, "sub").reshape(-1)
-        uu = _float_array(u, "u").reshape(-1)
-        vv = _float_array(v, "v").reshape(-1)
-        if s.size == 1 and f.size != 1:
-            s = np.full_like(f, int(s[0]))
-        return tuple(self._core.evaluate(f, s, uu, vv, bool(derivatives)))
+        return tuple(self._core.evaluate(*_places(faces, u, v, sub), bool(derivatives)))
 
     def update(self, vertices) -> None:
         """Moves the base vertices ((n, 3)); the refined and local points follow."""
@@ -759,13 +765,7 @@ class PatchTable:
     def evaluate_uv(self, faces, u, v, *, sub=None):
         """The texture coordinates at ``(faces[i], u[i], v[i])`` on the face-varying patches
         (OpenSubdiv's ``EvaluateBasisFaceVarying``): ``(uv, du, dv)``, each (m, 2)."""
-        f = _index_array(faces, "faces").reshape(-1)
-        s = np.zeros_like(f) if sub is None else _index_array(sub, "sub").reshape(-1)
-        uu = _float_array(u, "u").reshape(-1)
-        vv = _float_array(v, "v").reshape(-1)
-        if s.size == 1 and f.size != 1:
-            s = np.full_like(f, int(s[0]))
-        return tuple(self._core.evaluate_uv(f, s, uu, vv))
+        return tuple(self._core.evaluate_uv(*_places(faces, u, v, sub)))
 
     def update_uv(self, uvs) -> None:
         """New texture coordinates ((n, 2), the mesh's layout); the refined values follow

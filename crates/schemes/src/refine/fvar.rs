@@ -313,22 +313,42 @@ impl FaceVaryingRefinement {
         check_channel(base, channel)?;
         let options = refinement.options();
         let flags = ModeFlags::new(mode, options.boundary_interpolation);
-        let mut levels = vec![base_level(base, channel.indices(), flags)];
+        let first = base_level(base, channel.indices(), flags);
+        Ok(Self::refined_from(
+            refinement,
+            first,
+            mode,
+            flags,
+            channel.num_values(),
+        ))
+    }
+
+    /// The channel from its level-0 state `first` down every level of `refinement`, each
+    /// child level's tags passed down from its parent's; level 1's stencils read
+    /// `num_user_values` values.
+    fn refined_from(
+        refinement: &Refinement,
+        first: ChannelLevel,
+        mode: FVarLinearInterpolation,
+        flags: ModeFlags,
+        num_user_values: usize,
+    ) -> FaceVaryingRefinement {
+        let mut levels = vec![first];
         for l in 1..=refinement.num_levels() {
             let step = osd(refinement).step(l);
             let mut child = child_level(&step, &levels[l - 1], flags);
             child.geometric = geometric_vertices(&step, &levels[l - 1], &child, flags);
             levels.push(child);
         }
-        Ok(FaceVaryingRefinement {
+        FaceVaryingRefinement {
             mode,
             flags,
-            num_user_values: channel.num_values(),
+            num_user_values,
             stencils: (0..refinement.num_levels())
                 .map(|_| OnceLock::new())
                 .collect(),
             levels,
-        })
+        }
     }
 
     /// The interpolation mode.

@@ -8,9 +8,8 @@
 use subd_mesh::Topology;
 use subd_mesh::fvar::{FVarError, FVarLinearInterpolation};
 
-use super::{ChannelLevel, FaceVaryingRefinement, ModeFlags, child_level, geometric_vertices};
+use super::{ChannelLevel, FaceVaryingRefinement, ModeFlags};
 use crate::Refinement;
-use std::sync::OnceLock;
 
 /// One level of a face-varying refinement: its values (one per vertex and sibling), the
 /// value of every face corner, each value's tags and each edge's seams, and the mode they
@@ -158,11 +157,11 @@ impl FaceVaryingRefinement {
         refinement: &Refinement,
         state: FVarLevelState,
     ) -> Result<FaceVaryingRefinement, FVarError> {
-        let Some(osd) = refinement.opensubdiv() else {
+        if refinement.opensubdiv().is_none() {
             return Err(FVarError::Scheme {
                 scheme: refinement.scheme().to_string(),
             });
-        };
+        }
         let base = refinement.topology(0);
         if state.level.face_values.len() != base.num_face_vertices() {
             return Err(FVarError::IndexCount {
@@ -181,21 +180,12 @@ impl FaceVaryingRefinement {
         // The slots are the values level 1 reads.
         first.user = None;
         let num_user_values = first.num_values();
-        let mut levels = vec![first];
-        for l in 1..=refinement.num_levels() {
-            let step = osd.step(l);
-            let mut child = child_level(&step, &levels[l - 1], flags);
-            child.geometric = geometric_vertices(&step, &levels[l - 1], &child, flags);
-            levels.push(child);
-        }
-        Ok(FaceVaryingRefinement {
+        Ok(Self::refined_from(
+            refinement,
+            first,
             mode,
             flags,
             num_user_values,
-            stencils: (0..refinement.num_levels())
-                .map(|_| OnceLock::new())
-                .collect(),
-            levels,
-        })
+        ))
     }
 }
