@@ -45,8 +45,7 @@ impl RefinedLimits {
     /// vertices at dyadic parameters, to 1e-12 of the diagonal (quads and Loop triangles).
     pub(crate) fn agrees(
         &self,
-        ev: &subd_limit::eval::LimitEvaluator,
-        pts: &subd_limit::eval::PatchPoints,
+        table: &subd_limit::patches::PatchTable,
         (f, sub): (usize, usize),
         diag: f64,
     ) -> bool {
@@ -62,7 +61,8 @@ impl RefinedLimits {
             let Some(vtx) = dyadic_vertex(&self.refinement, self.level, f, u, v) else {
                 return false;
             };
-            ev.evaluate(pts, FaceParam { face: f, sub, u, v })
+            table
+                .evaluate(FaceParam { face: f, sub, u, v })
                 .is_ok_and(|p| (p.position - self.limits.positions[vtx]).length() <= 1e-12 * diag)
         })
     }

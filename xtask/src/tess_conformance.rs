@@ -6,8 +6,9 @@
 use std::collections::HashMap;
 use std::path::Path;
 
-use subd_limit::eval::{FaceParam, LimitEvaluator};
-use subd_limit::tessellation::tessellate;
+use subd_limit::eval::FaceParam;
+use subd_limit::patches::{PatchOptions, PatchTable};
+use subd_limit::tessellation::tessellate_mesh;
 use subd_mesh::{DVec3, Topology, TopologyBuilder};
 use subd_schemes::{Options, Scheme};
 
@@ -76,14 +77,20 @@ pub fn compare(
     diag: f64,
 ) -> Row {
     let mut row = Row::pending(name, "tessellate", RATE);
-    let ev = match LimitEvaluator::new(topo, scheme, options) {
-        Ok(e) => e,
+    // What `subd tessellate` runs: the exact limit's patch table.
+    let table = match PatchTable::new(
+        topo,
+        positions,
+        scheme,
+        options,
+        &PatchOptions::exact_limit(),
+    ) {
+        Ok(t) => t,
         Err(e) => {
             row.problem = Some(format!("subd: {e}"));
             return row;
         }
     };
-    let pts = ev.prepare(positions);
     let input = osd::encode(topo, positions, scheme, options, 0);
     let theirs = match osd::run(exe, &input, &["--bfr", &RATE.to_string()]).and_then(|b| decode(&b))
     {
@@ -95,7 +102,7 @@ pub fn compare(
     };
     // subd's own tessellation; a mesh with a face the evaluator does not cover has none, and
     // its points are then checked by direct evaluation only.
-    let ours = tessellate(&ev, &pts, RATE).ok();
+    let ours = tessellate_mesh(topo, scheme, options, positions, RATE).ok();
     let grids: HashMap<(usize, usize), subd_limit::tessellation::SampleGrid> = ours
         .as_ref()
         .map(|t| t.grids.iter().map(|g| ((g.face, g.sub), *g)).collect())
@@ -126,7 +133,7 @@ pub fn compare(
                     continue;
                 }
             },
-            None => ev.evaluate(&pts, at).ok().map(|s| s.position),
+            None => table.evaluate(at).ok().map(|s| s.position),
         };
         let Some(ours_p) = sample else {
             uncovered += 1;

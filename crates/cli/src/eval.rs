@@ -8,7 +8,7 @@ use std::time::Instant;
 use clap::Args;
 use serde::Serialize;
 use subd_limit::eval::{FaceParam, LimitEvaluator};
-use subd_limit::patches::PatchTable;
+use subd_limit::patches::{PatchOptions, PatchTable};
 use subd_schemes::Scheme;
 
 use crate::failure::{bad, refuse_overwrite};
@@ -54,7 +54,7 @@ struct EvalReport {
 /// Parses the parameter file into points, checking each against the mesh.
 fn read_points(
     path: &Path,
-    ev: &LimitEvaluator,
+    table: &PatchTable,
     sizes: &[u32],
     catmark: bool,
 ) -> Result<Vec<FaceParam>, Failure> {
@@ -94,7 +94,7 @@ fn read_points(
             )));
         }
         let p = FaceParam { face, sub, u, v };
-        ev.check(&p).map_err(|e| at_line(e.to_string()))?;
+        table.check(&p).map_err(|e| at_line(e.to_string()))?;
         out.push(p);
     }
     Ok(out)
@@ -112,19 +112,22 @@ pub(crate) fn run(
     let scheme = args.scheme.clone();
     let options = args.rules.options(&file.mesh.hints);
     let topo = &file.mesh.topology;
-    let ev = LimitEvaluator::new(topo, &scheme, &options)
-        .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
+    // On the patch table: the exact limit's (exact end caps) unless other patches are
+    // asked for.
+    let patch_options = args
+        .on_patches
+        .options()
+        .unwrap_or_else(PatchOptions::exact_limit);
+    let table = PatchTable::new(
+        topo,
+        &file.mesh.positions,
+        &scheme,
+        &options,
+        &patch_options,
+    )
+    .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
     let sizes: Vec<u32> = topo.face_sizes().collect();
-    let points = read_points(&args.at, &ev, &sizes, scheme == Scheme::CatmullClark)?;
-    let patch_points = ev.prepare(&file.mesh.positions);
-    // On a patch table when asked for (its end caps' surface), else the exact limit.
-    let table = match args.on_patches.options() {
-        Some(po) => Some(
-            PatchTable::new(topo, &file.mesh.positions, &scheme, &options, &po)
-                .map_err(|e| bad(format!("{}: {e}", args.input.display())))?,
-        ),
-        None => None,
-    };
+    let points = read_points(&args.at, &table, &sizes, scheme == Scheme::CatmullClark)?;
     let at_point = |i: usize, p: &FaceParam, e: subd_limit::LimitError| {
         bad(format!(
             "{}: point {} (face {}): {e}",
@@ -137,6 +140,10 @@ pub(crate) fn run(
     let uv = match file.mesh.uv() {
         Some(channel) => {
             let mode = args.rules.fvar_mode(&file.mesh.hints);
+            // The exact limit of the texture coordinates (the table's face-varying patches
+            // are OpenSubdiv's linear ones).
+            let ev = LimitEvaluator::new(topo, &scheme, &options)
+                .map_err(|e| bad(format!("{}: {e}", args.input.display())))?;
             let uv_eval = ev.face_varying(channel, mode).map_err(|e| {
                 bad(format!(
                     "{}: texture coordinates: {e}",
@@ -155,11 +162,7 @@ pub(crate) fn run(
     };
     let mut body = String::with_capacity(points.len() * 160);
     for (i, p) in points.iter().enumerate() {
-        let s = match &table {
-            Some(t) => t.evaluate(*p),
-            None => ev.evaluate(&patch_points, *p),
-        }
-        .map_err(|e| at_point(i, p, e))?;
+        let s = table.evaluate(*p).map_err(|e| at_point(i, p, e))?;
         let (x, n) = (s.position, s.normal());
         let _ = write!(body, "{} {} {} {} {} {}", x.x, x.y, x.z, n.x, n.y, n.z);
         if let Some((uv_eval, values)) = &uv {

@@ -148,7 +148,7 @@ pub(crate) struct OnPatchesArgs {
 }
 
 impl OnPatchesArgs {
-    /// The patch options asked for, or `None` for the exact limit's own evaluator.
+    /// The patch options asked for, or `None` when none are (the exact limit's table).
     pub(crate) fn options(&self) -> Option<PatchOptions> {
         if self.isolation.is_none() && self.end_caps.is_none() {
             return None;

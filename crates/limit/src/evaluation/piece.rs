@@ -146,20 +146,23 @@ fn piece_kind(
 
 /// Projected control points of every corner piece.
 pub(crate) fn project_all(pieces: &[Piece], pts: &[DVec3]) -> Vec<Option<Projected>> {
-    pieces
-        .iter()
-        .map(|p| match p {
-            Piece::Corner { cp, matrices, .. } => {
-                let c: Vec<DVec3> = cp.iter().map(|&i| pts[i as usize]).collect();
-                Some(matrices.project(&c))
-            }
-            Piece::LoopCorner { cp, matrices, .. } => {
-                let c: Vec<DVec3> = cp.iter().map(|&i| pts[i as usize]).collect();
-                Some(matrices.project(&c))
-            }
-            _ => None,
-        })
-        .collect()
+    pieces.iter().map(|p| project(p, pts)).collect()
+}
+
+/// The control points of a corner piece (Stam's, Catmull-Clark or Loop) projected on its
+/// eigenbasis; `None` for every other piece.
+pub(crate) fn project(piece: &Piece, pts: &[DVec3]) -> Option<Projected> {
+    match piece {
+        Piece::Corner { cp, matrices, .. } => {
+            let c: Vec<DVec3> = cp.iter().map(|&i| pts[i as usize]).collect();
+            Some(matrices.project(&c))
+        }
+        Piece::LoopCorner { cp, matrices, .. } => {
+            let c: Vec<DVec3> = cp.iter().map(|&i| pts[i as usize]).collect();
+            Some(matrices.project(&c))
+        }
+        _ => None,
+    }
 }
 
 /// Face `f` of `t` evaluated directly when it is a patch (B-spline, box spline, Stam corner),

@@ -12,7 +12,7 @@
 //!
 //! A B-spline patch on a boundary gathers its phantom points (`2B − I`) instead of folding
 //! them into the weights ([`super::basis`] folds the weights): the same sums, grouped
-//! differently. Exact end caps evaluate each sample with the exact evaluator.
+//! differently. Exact end caps evaluate each sample on their own (`super::exact_caps`).
 
 use std::collections::HashMap;
 
@@ -24,7 +24,7 @@ use super::table::PatchTable;
 use super::{PatchParam, PatchType};
 
 use crate::LimitError;
-use crate::evaluation::eval::{FaceParam, GatheredPatch};
+use crate::evaluation::eval::FaceParam;
 
 /// Samples per parallel job: many faces' worth, so that a face's run of samples is rarely
 /// split.
@@ -167,7 +167,6 @@ struct Gathered {
     row: usize,
     /// A B-spline patch's points, phantoms in place.
     points: [DVec3; 16],
-    exact: GatheredPatch,
 }
 
 impl PatchTable {
@@ -232,7 +231,10 @@ impl PatchTable {
         let m = cur.span;
         let steps = grid_step(s, m).zip(grid_step(t, m));
         let (p, du, dv) = match (cur.kind, steps) {
-            (PatchType::Exact, _) => return self.exact_position_normal(at, &mut cur.exact),
+            (PatchType::Exact, _) => {
+                let (a, i) = cur.handle;
+                return self.exact_position_normal(i, self.arrays()[a].params[i], at);
+            }
             (PatchType::Regular, Some((ks, kt))) => cubic_first(
                 &cur.points,
                 &basis.cubic[cur.row][ks as usize],
@@ -274,7 +276,6 @@ impl Gathered {
             span: 1,
             row: 0,
             points: [DVec3::ZERO; 16],
-            exact: GatheredPatch::default(),
         }
     }
 

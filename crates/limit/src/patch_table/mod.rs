@@ -48,6 +48,7 @@ mod box_fit;
 mod bspline_caps;
 mod classify;
 mod end_caps;
+mod exact_caps;
 mod face_varying;
 mod features;
 mod gather;

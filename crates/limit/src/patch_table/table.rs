@@ -10,15 +10,17 @@ use super::array::PatchArray;
 use super::assembly::Assembly;
 use super::basis;
 use super::classify::Classifier;
+use super::exact_caps::{CapContext, CapPoints, ExactCaps};
 use super::face_varying::FVarPatches;
 use super::features::{FeatureMask, Regularity, VTag, single_crease_edge};
 use super::levels::PatchLevel;
 use super::map::PatchMap;
 use super::patch_eval::{bspline_first, evaluate_patch, patch_weights};
-use super::{EndCaps, MAX_ISOLATION, PatchOptions, PatchType, PatchWeights};
+use super::{EndCaps, MAX_ISOLATION, PatchOptions, PatchParam, PatchType, PatchWeights};
 use crate::LimitError;
-use crate::evaluation::eval::{FaceParam, GatheredPatch, LimitEvaluator, PatchPoints};
+use crate::evaluation::eval::FaceParam;
 use crate::evaluation::fvar_eval::FVarPoint;
+use crate::evaluation::patch::Derivatives;
 use crate::evaluation::patch::SurfacePoint;
 use subd_mesh::fvar::{FVarChannel, FVarLinearInterpolation};
 
@@ -102,14 +104,7 @@ pub struct PatchGrid {
 #[derive(Debug, Clone)]
 pub struct TablePoints {
     points: Vec<DVec3>,
-    exact: Option<PatchPoints>,
-}
-
-/// The exact evaluator behind [`EndCaps::Exact`], with its points.
-#[derive(Debug)]
-struct ExactCaps {
-    evaluator: LimitEvaluator,
-    points: PatchPoints,
+    exact: Option<CapPoints>,
 }
 
 /// A feature-adaptive patch table of a Catmull-Clark or Loop mesh (OpenSubdiv's
@@ -187,15 +182,6 @@ impl PatchTable {
             num_roots,
             reg.face_size == 3,
         );
-        // The exact evaluator only where an end cap needs it (a mesh of regular faces has
-        // none): its setup costs as much as the table's.
-        let exact = if arrays.iter().any(|a| a.kind == PatchType::Exact) {
-            let evaluator = LimitEvaluator::new(base, scheme, rules)?;
-            let points = evaluator.prepare(positions);
-            Some(ExactCaps { evaluator, points })
-        } else {
-            None
-        };
         let mut table = PatchTable {
             scheme: scheme.clone(),
             rules: *rules,
@@ -208,10 +194,17 @@ impl PatchTable {
             ptex,
             handles,
             map,
-            exact,
+            exact: None,
             face_varying: Vec::new(),
         };
         table.points = table.compute_points(positions);
+        if let Some(a) = table.arrays.iter().position(|a| a.kind == PatchType::Exact) {
+            table.exact = Some(ExactCaps::new(
+                &table.arrays[a],
+                &table.cap_context(),
+                positions,
+            )?);
+        }
         Ok(table)
     }
 
@@ -234,10 +227,15 @@ impl PatchTable {
     /// [`LimitError::Param`] when `positions` does not have one point per base vertex.
     pub fn points_for(&self, positions: &[DVec3]) -> Result<TablePoints, LimitError> {
         check_positions(&self.levels[0].topology, positions)?;
-        Ok(TablePoints {
-            points: self.compute_points(positions),
-            exact: self.exact.as_ref().map(|e| e.evaluator.prepare(positions)),
-        })
+        let points = self.compute_points(positions);
+        let exact = self.exact.as_ref().map(|e| {
+            let cx = CapContext {
+                points: &points,
+                ..self.cap_context()
+            };
+            e.points_for(&cx, positions)
+        });
+        Ok(TablePoints { points, exact })
     }
 
     /// Puts points from [`Self::points_for`] in place. The buffer [`Self::points`] returns
@@ -249,6 +247,17 @@ impl PatchTable {
         self.points.copy_from_slice(&next.points);
         if let (Some(exact), Some(points)) = (&mut self.exact, next.exact) {
             exact.points = points;
+        }
+    }
+
+    /// What the exact caps read of the table.
+    fn cap_context(&self) -> CapContext<'_> {
+        CapContext {
+            levels: &self.levels,
+            level_offsets: &self.level_offsets,
+            points: &self.points,
+            scheme: &self.scheme,
+            rules: &self.rules,
         }
     }
 
@@ -339,6 +348,15 @@ impl PatchTable {
         &self.map
     }
 
+    /// Checks `at` against the base topology: face and sub-face in range, parameters in
+    /// the face's domain (holes are found by [`Self::find`]).
+    ///
+    /// # Errors
+    /// [`LimitError::Param`] naming what is out of range.
+    pub fn check(&self, at: &FaceParam) -> Result<(), LimitError> {
+        crate::evaluation::eval::check_param(&self.levels[0].topology, &self.scheme, at)
+    }
+
     /// The patch covering `at` (its array and index in the array).
     ///
     /// # Errors
@@ -355,34 +373,29 @@ impl PatchTable {
 
     /// [`Self::find`] with the patch's global index first.
     pub(crate) fn locate(&self, at: &FaceParam) -> Result<(usize, usize, usize), LimitError> {
-        let base = &self.levels[0].topology;
-        crate::evaluation::eval::check_param(base, &self.scheme, at)?;
+        self.check(at)?;
         let root = self.ptex[at.face] as usize + at.sub;
         let p = self
             .map
             .find(root, at.u, at.v)
             .ok_or(LimitError::Unsupported {
                 face: at.face,
-                reason: "a hole: no surface there",
+                reason: "the face is a hole",
             })?;
         let (a, i) = self.handles[p];
         Ok((p, a as usize, i as usize))
     }
 
-    /// Position and normal at `at` of an exact end cap, from the exact evaluator (`patch`
-    /// keeps the control points of the regular face it met last).
+    /// Position and normal at `at` of exact end cap `i` (index in the exact array).
     pub(crate) fn exact_position_normal(
         &self,
+        i: usize,
+        param: PatchParam,
         at: FaceParam,
-        patch: &mut GatheredPatch,
     ) -> Result<(DVec3, DVec3), LimitError> {
-        let exact = self
-            .exact
-            .as_ref()
-            .expect("exact end caps have their evaluator");
-        exact
-            .evaluator
-            .evaluate_position_normal_in(&exact.points, at, patch)
+        let exact = self.exact.as_ref().expect("exact end caps are set up");
+        let p = exact.evaluate(&self.cap_context(), i, param, at, Derivatives::First)?;
+        Ok((p.position, p.normal()))
     }
 
     /// The surface at `at`: position and first and second derivatives with respect to the
@@ -606,11 +619,9 @@ impl PatchTable {
     fn evaluate_in(&self, a: usize, i: usize, at: FaceParam) -> Result<SurfacePoint, LimitError> {
         let array = &self.arrays[a];
         if array.kind == PatchType::Exact {
-            let exact = self
-                .exact
-                .as_ref()
-                .expect("exact end caps have their evaluator");
-            return exact.evaluator.evaluate(&exact.points, at);
+            let exact = self.exact.as_ref().expect("exact end caps are set up");
+            let cx = self.cap_context();
+            return exact.evaluate(&cx, i, array.params[i], at, Derivatives::Second);
         }
         Ok(evaluate_patch(
             array.kind,

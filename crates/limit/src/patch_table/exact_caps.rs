@@ -1,0 +1,221 @@
+//! The exact end caps ([`super::EndCaps::Exact`]): each irregular patch evaluated exactly
+//! on its own face of the table's sparse level, so the table is the limit surface
+//! everywhere. A face with one extraordinary corner is Stam's eigenbasis (Catmull-Clark or
+//! Loop), a face along straight sharp features a spline with phantom points, and a face
+//! next to an irregular sharp feature (or with several extraordinary corners) is refined
+//! locally, as deep as the point needs (`crate::evaluation::local`).
+//!
+//! A sparse level keeps only the faces its patches need. A cap whose evaluation would read
+//! past them (its corners' rings for a direct piece, two rings of faces for local
+//! refinement) is evaluated by the whole-mesh exact evaluator instead, which is then built
+//! with the table: the same surface, computed from the base level.
+
+use glam::DVec3;
+use rayon::prelude::*;
+use subd_schemes::{Options, Scheme};
+
+use super::array::PatchArray;
+use super::levels::PatchLevel;
+use super::param::PatchParam;
+use crate::LimitError;
+use crate::evaluation::eval::{FaceParam, LimitEvaluator, PatchPoints, on_base_face};
+use crate::evaluation::patch::{Derivatives, SurfacePoint};
+use crate::evaluation::piece::{Piece, eval_piece_to, piece_of, project};
+use crate::evaluation::stam::Projected;
+
+/// How each exact patch of a table is evaluated, with the points of one set of base
+/// positions.
+#[derive(Debug)]
+pub(crate) struct ExactCaps {
+    /// One per patch of the exact array, in its order.
+    caps: Vec<Cap>,
+    /// The whole-mesh exact evaluator, only when some cap needs it.
+    whole: Option<LimitEvaluator>,
+    pub(super) points: CapPoints,
+}
+
+/// How one exact patch is evaluated.
+#[derive(Debug)]
+enum Cap {
+    /// On face `face` of level `level`: a piece evaluated directly, or [`Piece::Local`].
+    OnLevel { level: u8, face: u32, piece: Piece },
+    /// By the whole-mesh evaluator.
+    Whole,
+}
+
+/// The caps' points beyond the table's own: eigenbasis projections of the corner pieces
+/// and the whole-mesh evaluator's points.
+#[derive(Debug, Clone)]
+pub(crate) struct CapPoints {
+    projected: Vec<Option<Projected>>,
+    whole: Option<PatchPoints>,
+}
+
+/// What the caps read of their table.
+pub(crate) struct CapContext<'a> {
+    pub levels: &'a [PatchLevel],
+    pub level_offsets: &'a [u32],
+    /// The table's points (refined vertices of every level first).
+    pub points: &'a [DVec3],
+    pub scheme: &'a Scheme,
+    pub rules: &'a Options,
+}
+
+impl ExactCaps {
+    /// The caps of `array` (the table's exact patches), with the points of `positions`.
+    pub(crate) fn new(
+        array: &PatchArray,
+        cx: &CapContext<'_>,
+        positions: &[DVec3],
+    ) -> Result<ExactCaps, LimitError> {
+        let caps: Vec<Cap> = array
+            .faces
+            .par_iter()
+            .with_min_len(64)
+            .map(|&(level, face)| cap_of(&cx.levels[level as usize], level, face, cx.scheme))
+            .collect();
+        let whole = if caps.iter().any(|c| matches!(c, Cap::Whole)) {
+            let base = &cx.levels[0].topology;
+            Some(LimitEvaluator::new(base, cx.scheme, cx.rules)?)
+        } else {
+            None
+        };
+        let mut exact = ExactCaps {
+            caps,
+            whole,
+            points: CapPoints {
+                projected: Vec::new(),
+                whole: None,
+            },
+        };
+        exact.points = exact.points_for(cx, positions);
+        Ok(exact)
+    }
+
+    /// The caps' points for the table points in `cx`, made from base `positions`.
+    pub(crate) fn points_for(&self, cx: &CapContext<'_>, positions: &[DVec3]) -> CapPoints {
+        let projected = self
+            .caps
+            .par_iter()
+            .with_min_len(64)
+            .map(|cap| match cap {
+                Cap::OnLevel { level, piece, .. } => {
+                    let first = cx.level_offsets[*level as usize] as usize;
+                    project(piece, &cx.points[first..])
+                }
+                Cap::Whole => None,
+            })
+            .collect();
+        CapPoints {
+            projected,
+            whole: self.whole.as_ref().map(|ev| ev.prepare(positions)),
+        }
+    }
+
+    /// Exact patch `i` (placed by `param`) at `at`, up to the derivatives `d`, with respect
+    /// to `at`'s (sub-)face parameters.
+    pub(crate) fn evaluate(
+        &self,
+        cx: &CapContext<'_>,
+        i: usize,
+        param: PatchParam,
+        at: FaceParam,
+        d: Derivatives,
+    ) -> Result<SurfacePoint, LimitError> {
+        let (level, face, piece) = match &self.caps[i] {
+            Cap::OnLevel { level, face, piece } => (*level as usize, *face as usize, piece),
+            Cap::Whole => {
+                let ev = self.whole.as_ref().expect("whole caps have the evaluator");
+                let points = self.points.whole.as_ref().expect("and its points");
+                return ev.evaluate_to(points, at, d);
+            }
+        };
+        let (s, t, scale) = patch_local(param, *cx.scheme == Scheme::Loop, at.u, at.v);
+        let first = cx.level_offsets[level] as usize;
+        let end = cx.level_offsets[level + 1] as usize;
+        let points = &cx.points[first..end];
+        let p = match piece {
+            Piece::Local => {
+                let lv = &cx.levels[level];
+                crate::evaluation::local::evaluate(
+                    &lv.topology,
+                    &lv.rules,
+                    level,
+                    points,
+                    face,
+                    cx.scheme,
+                    cx.rules,
+                    s,
+                    t,
+                )
+                .map_err(|e| on_base_face(e, at.face))?
+            }
+            piece => eval_piece_to(
+                piece,
+                points,
+                self.points.projected[i].as_ref(),
+                at.face,
+                (s, t),
+                d,
+            )?,
+        };
+        Ok(p.scaled(scale))
+    }
+}
+
+/// How face `face` of `level` (an exact patch's) is evaluated: on the level when what its
+/// evaluation reads is whole there, else by the whole-mesh evaluator.
+fn cap_of(level: &PatchLevel, depth: u8, face: u32, scheme: &Scheme) -> Cap {
+    let t = &level.topology;
+    let f = face as usize;
+    let regular = if *scheme == Scheme::Loop { 3 } else { 4 };
+    let corners_whole = |g: usize| {
+        t.face_vertices(g)
+            .iter()
+            .all(|&v| level.is_complete(v as usize))
+    };
+    if t.face_size(f) != regular || !corners_whole(f) {
+        return Cap::Whole;
+    }
+    // What the level cannot tell (and its errors) is the whole-mesh evaluator's to say.
+    let piece = match piece_of(t, &level.rules, f, scheme) {
+        Err(_) | Ok(Piece::Unsupported(_)) => return Cap::Whole,
+        Ok(Piece::Refined | Piece::Local) => {
+            // Local refinement cuts out two rings of faces: whole when every face around
+            // the first ring's vertices is present.
+            let ring_whole = t.face_vertices(f).iter().all(|&v| {
+                t.vertex_faces(v as usize)
+                    .iter()
+                    .all(|&g| corners_whole(g as usize))
+            });
+            if !ring_whole {
+                return Cap::Whole;
+            }
+            Piece::Local
+        }
+        Ok(piece) => piece,
+    };
+    Cap::OnLevel {
+        level: depth,
+        face,
+        piece,
+    }
+}
+
+/// The patch's own parameters at `(u, v)` of its root face, and the factor its derivatives
+/// take back to the root's (negative for a turned-around triangle).
+fn patch_local(param: PatchParam, triangle: bool, u: f64, v: f64) -> (f64, f64, f64) {
+    let scale = 1.0 / param.fraction();
+    if triangle {
+        let (s, t) = param.normalize_triangle(u, v);
+        let sign = if param.is_triangle_rotated() {
+            -1.0
+        } else {
+            1.0
+        };
+        (s, t, sign * scale)
+    } else {
+        let (s, t) = param.normalize(u, v);
+        (s, t, scale)
+    }
+}
