@@ -846,3 +846,43 @@ fn basis_weights_are_a_partition_of_unity_that_gives_the_evaluation() {
         assert!(checked > 0);
     }
 }
+
+/// Many places (past the count from which they are taken face by face) in a scrambled
+/// order: each value is the one a single place gets, bit for bit, in the caller's order,
+/// and a bad place among them is the error, the first in the caller's order.
+#[test]
+fn many_places_are_each_places_own_value() {
+    for c in [cube(), octahedron()] {
+        let o = options(3, EndCaps::GregoryBasis, false);
+        let table =
+            PatchTable::new(&c.topology, &c.positions, &c.scheme, &Options::default(), &o)
+                .unwrap();
+        let nf = c.topology.num_faces();
+        let mut state = 7u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let at: Vec<FaceParam> = (0..40_000)
+            .map(|_| {
+                let face = ((next() * nf as f64) as usize).min(nf - 1);
+                let (mut u, mut v) = (next(), next());
+                if c.scheme == Scheme::Loop && u + v > 1.0 {
+                    (u, v) = (1.0 - u, 1.0 - v);
+                }
+                FaceParam { face, sub: 0, u, v }
+            })
+            .collect();
+        let many = table.evaluate_first(&at).unwrap();
+        for (p, got) in at.iter().zip(&many).step_by(97) {
+            assert_eq!(*got, table.evaluate_first(&[*p]).unwrap()[0], "{p:?}");
+        }
+        let mut bad = at.clone();
+        bad[30_000].face = nf + 3;
+        bad[20_000].u = 2.0;
+        let e = table.evaluate_first(&bad).unwrap_err().to_string();
+        assert!(e.contains("(2, "), "the first bad place in order is named: {e}");
+    }
+}

@@ -107,7 +107,7 @@ fn monomial_rows<const R: usize>(u: f64, v: f64) -> [[f64; 15]; R] {
 /// The 12 quartic box-spline basis functions of the regular patch (monomial coefficients).
 #[derive(Debug)]
 pub struct BoxSpline {
-    coeffs: [[f64; 15]; 12],
+    coeffs: [[f64; 12]; 15],
 }
 
 /// A regular triangle grid of `(2r + 1)²` vertices around the origin: every interior vertex
@@ -199,7 +199,7 @@ impl BoxSpline {
             }
         }
         let sol = a.full_piv_lu().solve(&rhs);
-        let coeffs = std::array::from_fn(|k| std::array::from_fn(|m| sol[(m, k)]));
+        let coeffs = std::array::from_fn(|m| std::array::from_fn(|k| sol[(m, k)]));
         Ok(BoxSpline { coeffs })
     }
 
@@ -216,9 +216,21 @@ impl BoxSpline {
             Derivatives::Second => m = monomials(u, v),
         }
         let mut w = [[0.0; 12]; 6];
-        for d in 0..d.rows() {
-            for k in 0..12 {
-                w[d][k] = self.coeffs[k].iter().zip(&m[d]).map(|(c, x)| c * x).sum();
+        for (wd, md) in w.iter_mut().zip(&m).take(d.rows()) {
+            *wd = self.row_weights(md);
+        }
+        w
+    }
+
+    /// The 12 weights `Σ_j coeffs[j][k] · m[j]` of one row of monomials: each sum in the
+    /// order of `j` from `-0.0` (as `Iterator::sum` takes it), the twelve side by side so
+    /// that they do not wait on one another.
+    #[inline]
+    fn row_weights(&self, m: &[f64; 15]) -> [f64; 12] {
+        let mut w = [-0.0; 12];
+        for (&x, cj) in m.iter().zip(&self.coeffs) {
+            for (wk, c) in w.iter_mut().zip(cj) {
+                *wk += c * x;
             }
         }
         w
@@ -228,11 +240,15 @@ impl BoxSpline {
     /// [`Self::evaluate`]'s work, for callers that need no second derivatives.
     pub fn evaluate_first(&self, cp: &[DVec3; 12], u: f64, v: f64) -> (DVec3, DVec3, DVec3) {
         let m = monomial_rows::<3>(u, v);
+        let w = [
+            self.row_weights(&m[0]),
+            self.row_weights(&m[1]),
+            self.row_weights(&m[2]),
+        ];
         let mut out = [DVec3::ZERO; 3];
         for (k, p) in cp.iter().enumerate() {
-            for (d, o) in out.iter_mut().enumerate() {
-                let w: f64 = self.coeffs[k].iter().zip(&m[d]).map(|(c, x)| c * x).sum();
-                *o += w * *p;
+            for (o, wd) in out.iter_mut().zip(&w) {
+                *o += wd[k] * *p;
             }
         }
         (out[0], out[1], out[2])
