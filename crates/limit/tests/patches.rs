@@ -854,9 +854,14 @@ fn basis_weights_are_a_partition_of_unity_that_gives_the_evaluation() {
 fn many_places_are_each_places_own_value() {
     for c in [cube(), octahedron()] {
         let o = options(3, EndCaps::GregoryBasis, false);
-        let table =
-            PatchTable::new(&c.topology, &c.positions, &c.scheme, &Options::default(), &o)
-                .unwrap();
+        let table = PatchTable::new(
+            &c.topology,
+            &c.positions,
+            &c.scheme,
+            &Options::default(),
+            &o,
+        )
+        .unwrap();
         let nf = c.topology.num_faces();
         let mut state = 7u64;
         let mut next = || {
@@ -883,6 +888,9 @@ fn many_places_are_each_places_own_value() {
         bad[30_000].face = nf + 3;
         bad[20_000].u = 2.0;
         let e = table.evaluate_first(&bad).unwrap_err().to_string();
-        assert!(e.contains("(2, "), "the first bad place in order is named: {e}");
+        assert!(
+            e.contains("(2, "),
+            "the first bad place in order is named: {e}"
+        );
     }
 }

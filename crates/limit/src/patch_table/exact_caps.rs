@@ -74,7 +74,6 @@ impl ExactCaps {
             .with_min_len(64)
             .map(|&(level, face)| cap_of(&cx.levels[level as usize], level, face, cx.scheme))
             .collect();
-        if std::env::var("CAPDBG").is_ok() { eprintln!("caps {} whole {} local {}", caps.len(), caps.iter().filter(|c| matches!(c, Cap::Whole)).count(), caps.iter().filter(|c| matches!(c, Cap::OnLevel{piece: Piece::Local, ..})).count()); }
         let whole = if caps.iter().any(|c| matches!(c, Cap::Whole)) {
             let base = &cx.levels[0].topology;
             Some(LimitEvaluator::new(base, cx.scheme, cx.rules)?)
