@@ -15,10 +15,11 @@ fn diagonal(p: &[DVec3]) -> f64 {
 /// The same samples (parameters), faces and grids. Positions within 2.5e-14 of the bounding
 /// box; unit normals within 2e-10, and within 1e-12 but for a few near extraordinary
 /// vertices, where the evaluator's eigenbasis sums and the table's regular patches one
-/// level down round differently.
+/// level down round differently. Where a tangent vanishes (back-to-back faces fold over
+/// along their edges) the normal is undefined, rounding on either side: not compared.
 #[test]
 fn refined_tessellation_equals_the_evaluated_one() {
-    let (mut compared, mut samples, mut loose) = (0, 0, 0);
+    let (mut compared, mut samples, mut loose, mut folds) = (0, 0, 0, 0);
     let (mut worst_p, mut worst_n) = (0.0f64, 0.0f64);
     for s in surface_shapes() {
         let diag = diagonal(&s.mesh.positions);
@@ -29,8 +30,12 @@ fn refined_tessellation_equals_the_evaluated_one() {
             let name = format!("{} rate {rate}", s.name);
             let (topo, p) = (&s.mesh.topology, &s.mesh.positions);
             let ours = tessellate_mesh(topo, &s.scheme, &s.options, p, rate);
-            let reference = LimitEvaluator::new(topo, &s.scheme, &s.options)
-                .and_then(|ev| tessellate(&ev, &ev.prepare(p), rate));
+            let evaluator =
+                LimitEvaluator::new(topo, &s.scheme, &s.options).map(|ev| (ev.prepare(p), ev));
+            let reference = evaluator
+                .as_ref()
+                .map_err(Clone::clone)
+                .and_then(|(pts, ev)| tessellate(ev, pts, rate));
             let (reference, ours) = match (reference, ours) {
                 (Ok(a), Ok(b)) => (a, b),
                 (Err(a), Err(b)) => {
@@ -50,6 +55,15 @@ fn refined_tessellation_equals_the_evaluated_one() {
                 assert!(d <= 2.5e-14, "{name} sample {v} at {at:?}: position {d:e}");
                 let (a, b) = (reference.normals[v], ours.normals[v]);
                 let dn = (a - b).length();
+                if dn > 2e-10 {
+                    let (pts, ev) = evaluator.as_ref().expect("the reference had one");
+                    let d = ev.evaluate(pts, at).expect("on the surface");
+                    let (du, dv) = (d.du.length(), d.dv.length());
+                    if du.min(dv) <= 1e-9 * du.max(dv) {
+                        folds += 1;
+                        continue;
+                    }
+                }
                 assert!(
                     dn <= 2e-10,
                     "{name} sample {v} at {at:?}: normal {a} vs {b}"
@@ -62,7 +76,11 @@ fn refined_tessellation_equals_the_evaluated_one() {
         }
     }
     eprintln!(
-        "{compared} tessellations, {samples} samples: worst position {worst_p:e}, normal {worst_n:e}; {loose} normals beyond 1e-12"
+        "{compared} tessellations, {samples} samples: worst position {worst_p:e}, normal {worst_n:e}; {loose} normals beyond 1e-12; {folds} at folds"
+    );
+    assert!(
+        folds * 1000 < samples,
+        "{folds} of {samples} samples at folds"
     );
     assert!(compared > 150, "{compared} tessellations compared");
     assert!(
