@@ -607,16 +607,10 @@ fn compare_eval(
     diag: f64,
 ) -> Row {
     use subd_limit::eval::FaceParam;
-    use subd_limit::patches::{PatchOptions, PatchTable};
+    use subd_limit::patches::PatchTable;
     let mut row = Row::pending(name, "eval", ISOLATION as usize);
     // What `subd eval` runs: the exact limit's patch table.
-    let table = match PatchTable::new(
-        topo,
-        positions,
-        scheme,
-        options,
-        &PatchOptions::exact_limit(),
-    ) {
+    let table = match PatchTable::exact_limit(topo, positions, scheme, options) {
         Ok(t) => t,
         Err(e) => {
             row.problem = Some(format!("subd: {e}"));

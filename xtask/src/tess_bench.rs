@@ -13,7 +13,7 @@
 
 use std::time::Instant;
 
-use subd_limit::patches::{PatchOptions, PatchTable};
+use subd_limit::patches::PatchTable;
 use subd_limit::tessellation::tessellate_mesh;
 use subd_mesh::Mesh;
 use subd_schemes::{Options, Scheme};
@@ -72,13 +72,7 @@ pub fn run(repeats: usize) -> Result<(), String> {
                 let t = Instant::now();
                 if table_only {
                     pool.install(|| {
-                        PatchTable::new(
-                            &mesh.topology,
-                            &mesh.positions,
-                            &scheme,
-                            &options,
-                            &PatchOptions::exact_limit(),
-                        )
+                        PatchTable::exact_limit(&mesh.topology, &mesh.positions, &scheme, &options)
                     })
                     .map_err(|e| e.to_string())?;
                     times.push(t.elapsed().as_secs_f64());

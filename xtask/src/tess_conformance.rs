@@ -7,7 +7,7 @@ use std::collections::HashMap;
 use std::path::Path;
 
 use subd_limit::eval::FaceParam;
-use subd_limit::patches::{PatchOptions, PatchTable};
+use subd_limit::patches::PatchTable;
 use subd_limit::tessellation::tessellate_mesh;
 use subd_mesh::{DVec3, Topology, TopologyBuilder};
 use subd_schemes::{Options, Scheme};
@@ -78,13 +78,7 @@ pub fn compare(
 ) -> Row {
     let mut row = Row::pending(name, "tessellate", RATE);
     // What `subd tessellate` runs: the exact limit's patch table.
-    let table = match PatchTable::new(
-        topo,
-        positions,
-        scheme,
-        options,
-        &PatchOptions::exact_limit(),
-    ) {
+    let table = match PatchTable::exact_limit(topo, positions, scheme, options) {
         Ok(t) => t,
         Err(e) => {
             row.problem = Some(format!("subd: {e}"));

@@ -6,7 +6,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use rayon::prelude::*;
 use subd_limit::eval::FaceParam;
-use subd_limit::patches::{PatchOptions, PatchTable};
+use subd_limit::patches::PatchTable;
 use subd_limit::tessellation::tessellate_mesh;
 use subd_mesh::{DVec3, Mesh, TopologyBuilder};
 use subd_schemes::Options;
@@ -50,14 +50,8 @@ pub(crate) fn evaluate<'py>(
     let options = Options::from_hints(&m.hints);
     let samples = pool::run(py, || -> Result<Vec<[DVec3; 7]>, String> {
         // The exact limit's patch table, as `subd eval` evaluates it.
-        let table = PatchTable::new(
-            &m.topology,
-            &m.positions,
-            &scheme,
-            &options,
-            &PatchOptions::exact_limit(),
-        )
-        .map_err(|e| e.to_string())?;
+        let table = PatchTable::exact_limit(&m.topology, &m.positions, &scheme, &options)
+            .map_err(|e| e.to_string())?;
         // Points evaluated side by side; the first error in point order is the one named.
         let evaluated: Vec<Result<[DVec3; 7], String>> = (0..faces.len())
             .into_par_iter()

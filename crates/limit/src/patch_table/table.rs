@@ -208,6 +208,20 @@ impl PatchTable {
         Ok(table)
     }
 
+    /// The cheapest table that is the exact limit ([`PatchOptions::exact_limit`]), what
+    /// `subd eval` and `subd tessellate` evaluate.
+    ///
+    /// # Errors
+    /// As [`Self::new`].
+    pub fn exact_limit(
+        base: &Topology,
+        positions: &[DVec3],
+        scheme: &Scheme,
+        rules: &Options,
+    ) -> Result<PatchTable, LimitError> {
+        Self::new(base, positions, scheme, rules, &PatchOptions::exact_limit())
+    }
+
     /// Recomputes the refined and local points (and the exact end caps' points) for moved
     /// base vertices, keeping the topology: animation refines once, updates every frame.
     ///

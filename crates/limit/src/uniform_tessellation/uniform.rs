@@ -29,7 +29,7 @@ use super::numbering::number_samples;
 use super::output::{Numbered, Tessellation};
 use crate::LimitError;
 use crate::evaluation::eval::{FaceParam, GatheredPatch, LimitEvaluator, PatchPoints};
-use crate::patch_table::{PatchOptions, PatchTable};
+use crate::patch_table::PatchTable;
 
 /// The largest rate accepted.
 pub const MAX_RATE: usize = 1024;
@@ -131,7 +131,7 @@ fn evaluate_samples(
 /// Tessellates the limit surface of `positions` on `topology` at `rate`, as [`tessellate`]
 /// does with an evaluator of the mesh: the same samples, faces and grids, the same values to
 /// rounding, evaluated on a patch table that is the exact limit
-/// ([`PatchOptions::exact_limit`], [`tessellate_patches`]): each patch's control points
+/// ([`PatchTable::exact_limit`], [`tessellate_patches`]): each patch's control points
 /// gathered once for its samples, the basis computed once per rate.
 ///
 /// ```
@@ -160,13 +160,7 @@ pub fn tessellate_mesh(
     rate: usize,
 ) -> Result<Tessellation, LimitError> {
     check_range(rate)?;
-    let table = PatchTable::new(
-        topology,
-        positions,
-        scheme,
-        options,
-        &PatchOptions::exact_limit(),
-    )?;
+    let table = PatchTable::exact_limit(topology, positions, scheme, options)?;
     tessellate_patches(&table, rate)
 }
 
