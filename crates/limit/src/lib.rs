@@ -13,10 +13,10 @@
 //!   scheme: [`base_limit`] gives the exact limit of every base vertex of Catmull-Clark and
 //!   Loop, refining first as far as semi-sharp creases need to decay,
 //!   [`two_phase_base_limit`] the two-phase scheme's, [`split_limit`] the split schemes'.
-//! * [`eval`]: exact evaluation at any (face, u, v) with derivatives — bicubic B-splines and
-//!   [`stam`]'s eigenbasis for Catmull-Clark, box splines and [`loop_patch`] for Loop.
-//!   Next to irregular sharp features the evaluator refines locally, as deep as the point
-//!   needs ([`local`]).
+//! * [`eval`]: exact evaluation at any (face, u, v) with derivatives, on a patch table that
+//!   is the exact limit ([`patches`]) — bicubic B-splines and [`stam`]'s eigenbasis for
+//!   Catmull-Clark, box splines and [`loop_patch`] for Loop. Next to irregular sharp
+//!   features the evaluator refines locally, as deep as the point needs ([`local`]).
 //! * [`acc`]: Loop & Schaefer's bicubic approximation (geometry and tangent patches).
 //!
 //! ```
@@ -44,6 +44,7 @@
 
 // The crate's parts, one folder each, all private: the public surface is below.
 mod evaluation;
+mod limit_evaluator;
 mod limit_masks;
 mod patch_table;
 mod split_limits;
@@ -69,9 +70,8 @@ pub mod eigen {
 
 pub mod eval {
     //! Exact evaluation at any (face, u, v) with derivatives.
-    pub use crate::evaluation::eval::{
-        FaceParam, LimitEvaluator, PatchPoints, dyadic_corner, dyadic_vertex,
-    };
+    pub use crate::evaluation::eval::{FaceParam, dyadic_corner, dyadic_vertex};
+    pub use crate::limit_evaluator::{LimitEvaluator, PatchPoints};
 }
 
 pub mod fvar {

@@ -54,29 +54,13 @@ pub struct FaceParam {
     pub v: f64,
 }
 
-/// Exact limit-surface evaluator for one mesh topology (Catmull-Clark).
-///
-/// ```
-/// use subd_mesh::{DVec3, TopologyBuilder};
-/// use subd_schemes::{Options, Scheme};
-/// use subd_limit::eval::{FaceParam, LimitEvaluator};
-///
-/// // A cube: every face has four extraordinary (valence-3) corners.
-/// let faces = [0, 1, 3, 2, 2, 3, 5, 4, 4, 5, 7, 6, 6, 7, 1, 0, 1, 7, 5, 3, 6, 0, 2, 4];
-/// let topo = TopologyBuilder::new(8).build(&[4; 6], &faces).unwrap();
-/// let s = [(-1., -1., 1.), (1., -1., 1.), (-1., 1., 1.), (1., 1., 1.),
-///          (-1., 1., -1.), (1., 1., -1.), (-1., -1., -1.), (1., -1., -1.)];
-/// let p: Vec<DVec3> = s.iter().map(|&(x, y, z)| DVec3::new(x, y, z)).collect();
-/// let eval = LimitEvaluator::new(&topo, &Scheme::CatmullClark, &Options::default()).unwrap();
-/// let points = eval.prepare(&p);
-/// // The centre of face 0 (z = 1): on the z axis, below the face, normal +z.
-/// let c = eval.evaluate(&points, FaceParam { face: 0, sub: 0, u: 0.5, v: 0.5 }).unwrap();
-/// assert!(c.position.x.abs() < 1e-15 && c.position.y.abs() < 1e-15);
-/// assert!(c.position.z > 0.5 && c.position.z < 1.0);
-/// assert!((c.normal() - DVec3::Z).length() < 1e-12);
-/// ```
+/// The exact limit evaluated from the base mesh and two uniform levels of the whole mesh
+/// (where some face needs them): what [`crate::eval::LimitEvaluator`] was before it ran on a
+/// patch table, kept for what is not evaluated on the table yet (point stencils, the pieces
+/// of each face, face-varying channels) and for the exact caps the table's sparse levels
+/// cannot evaluate.
 #[derive(Debug)]
-pub struct LimitEvaluator {
+pub(crate) struct WholeMeshEvaluator {
     pub(crate) scheme: Scheme,
     pub(crate) options: Options,
     pub(crate) base: Topology,
@@ -89,14 +73,14 @@ pub struct LimitEvaluator {
 /// Control points of every level the evaluator reads, for one set of base positions, with
 /// the corner patches' points already projected on their eigenbases.
 #[derive(Clone, Debug)]
-pub struct PatchPoints {
+pub(crate) struct WholePoints {
     base: Vec<DVec3>,
     level2: Vec<DVec3>,
     base_projected: Vec<Option<Projected>>,
     level2_projected: Vec<Option<Projected>>,
 }
 
-impl LimitEvaluator {
+impl WholeMeshEvaluator {
     /// Prepares evaluation on `topology` (the rules of `options`; Catmull-Clark only).
     pub fn new(
         topology: &Topology,
@@ -145,7 +129,7 @@ impl LimitEvaluator {
         } else {
             (None, Vec::new())
         };
-        Ok(LimitEvaluator {
+        Ok(WholeMeshEvaluator {
             scheme: scheme.clone(),
             options: *options,
             base,
@@ -155,17 +139,11 @@ impl LimitEvaluator {
         })
     }
 
-    /// The base topology as the evaluator sees it (boundary faces are holes under
-    /// `BoundaryInterpolation::None`).
-    pub fn topology(&self) -> &Topology {
-        &self.base
-    }
-
     /// The control points for base positions `points` (one per base vertex).
     ///
     /// # Panics
     /// If `points.len()` is not the number of base vertices.
-    pub fn prepare(&self, points: &[DVec3]) -> PatchPoints {
+    pub fn prepare(&self, points: &[DVec3]) -> WholePoints {
         assert_eq!(
             points.len(),
             self.base.num_vertices(),
@@ -175,7 +153,7 @@ impl LimitEvaluator {
             Some(r) => r.refine_points(points).pop().expect("level 2"),
             None => Vec::new(),
         };
-        PatchPoints {
+        WholePoints {
             base_projected: project_all(&self.base_pieces, points),
             level2_projected: project_all(&self.level2_pieces, &level2),
             base: points.to_vec(),
@@ -191,7 +169,7 @@ impl LimitEvaluator {
     /// The limit surface at `at`: position and first and second derivatives.
     pub fn evaluate(
         &self,
-        points: &PatchPoints,
+        points: &WholePoints,
         at: FaceParam,
     ) -> Result<SurfacePoint, LimitError> {
         self.evaluate_to(points, at, Derivatives::Second)
@@ -201,7 +179,7 @@ impl LimitEvaluator {
     /// eigenbasis pieces leave the second derivatives zero: half their work).
     pub(crate) fn evaluate_to(
         &self,
-        points: &PatchPoints,
+        points: &WholePoints,
         at: FaceParam,
         d: Derivatives,
     ) -> Result<SurfacePoint, LimitError> {
@@ -247,84 +225,12 @@ impl LimitEvaluator {
             ),
         }
     }
-    /// Position and unit normal at `at`, as [`Self::evaluate`] gives them (to rounding), with
-    /// a faster path for regular faces (bicubic B-spline and quartic box spline): no second
-    /// derivatives, no allocation. For tessellation, which needs nothing more.
-    pub fn evaluate_position_normal(
-        &self,
-        points: &PatchPoints,
-        at: FaceParam,
-    ) -> Result<(DVec3, DVec3), LimitError> {
-        self.evaluate_position_normal_in(points, at, &mut GatheredPatch::default())
-    }
-
-    /// [`Self::evaluate_position_normal`] with the control points of a regular face kept in
-    /// `patch` for the next sample of the same face: a tessellation evaluates its samples
-    /// face by face, and gathering them was a third of a regular sample's work. The same
-    /// points in the same sums, so the same bits.
-    pub(crate) fn evaluate_position_normal_in(
-        &self,
-        points: &PatchPoints,
-        at: FaceParam,
-        patch: &mut GatheredPatch,
-    ) -> Result<(DVec3, DVec3), LimitError> {
-        match &self.base_pieces[at.face] {
-            Piece::Regular(grid) => {
-                self.check(&at)?;
-                let g = patch.of(at.face, || grid.map(|i| points.base[i as usize]));
-                let (p, du, dv) = crate::evaluation::patch::eval_bicubic_first(g, at.u, at.v);
-                return Ok((p, du.cross(dv).normalize_or_zero()));
-            }
-            Piece::LoopRegular(cp) if cp.len() == 12 => {
-                self.check(&at)?;
-                let g = patch.of(at.face, || {
-                    std::array::from_fn(|i| {
-                        cp.get(i).map_or(DVec3::ZERO, |&c| points.base[c as usize])
-                    })
-                });
-                let c: &[DVec3; 12] = g[..12].try_into().expect("12 of 16");
-                let (p, du, dv) = box_spline()?.evaluate_first(c, at.u, at.v);
-                return Ok((p, du.cross(dv).normalize_or_zero()));
-            }
-            _ => {}
-        }
-        self.evaluate_to(points, at, Derivatives::First)
-            .map(|p| (p.position, p.normal()))
-    }
-
     /// The level-2 face holding `at` of a base face that is refined, its parameters there,
     /// and the scale of the map from the base (sub-)face's parameters to the level-2 face's.
     pub(crate) fn level2_location(&self, at: &FaceParam) -> (usize, f64, f64, f64) {
         let r = self.refined.as_ref().expect("refined when a face needs it");
         let (p, scale) = descend(r, 2, *at);
         (p.face, p.u, p.v, scale)
-    }
-}
-
-/// The control points of the regular face evaluated last (16 for a bicubic patch, the first
-/// 12 for a box spline).
-pub(crate) struct GatheredPatch {
-    face: usize,
-    points: [DVec3; 16],
-}
-
-impl Default for GatheredPatch {
-    fn default() -> Self {
-        GatheredPatch {
-            face: usize::MAX,
-            points: [DVec3::ZERO; 16],
-        }
-    }
-}
-
-impl GatheredPatch {
-    /// The points of `face`, gathered by `gather` unless they are the ones kept.
-    fn of(&mut self, face: usize, gather: impl FnOnce() -> [DVec3; 16]) -> &[DVec3; 16] {
-        if self.face != face {
-            self.points = gather();
-            self.face = face;
-        }
-        &self.points
     }
 }
 

@@ -36,7 +36,7 @@ use subd_schemes::{
 };
 
 use crate::LimitError;
-use crate::evaluation::eval::{FaceParam, LimitEvaluator, PatchPoints, descend};
+use crate::evaluation::eval::{FaceParam, WholeMeshEvaluator, WholePoints, descend};
 
 /// A face-varying value and its first derivatives with respect to the face parameters,
 /// `components` numbers each.
@@ -120,7 +120,7 @@ struct ValuePatches {
     refined: Option<(Refinement, FaceVaryingRefinement)>,
     /// At level 0: the channel value of each vertex of the mesh of values.
     slot_values: Vec<u32>,
-    evaluator: LimitEvaluator,
+    evaluator: WholeMeshEvaluator,
 }
 
 /// A channel's values prepared for [`FVarEvaluator::evaluate`].
@@ -129,52 +129,45 @@ pub struct FVarPatchValues {
     /// The channel's values.
     values: Vec<f64>,
     /// Smooth modes: the patch points of each group of three components.
-    groups: Vec<PatchPoints>,
+    groups: Vec<WholePoints>,
 }
 
-impl LimitEvaluator {
-    /// An evaluator of `channel` (defined on this evaluator's mesh) interpolated by `mode`.
-    ///
-    /// # Errors
-    /// [`LimitError::Param`] when the channel does not fit the mesh or has no values;
-    /// [`LimitError::TooDeep`] when a semi-sharp seam would need the whole mesh refined past
-    /// [`crate::MAX_DECAY_FACE_VERTICES`]; the errors of [`LimitEvaluator::new`] on the mesh
-    /// of values.
-    pub fn face_varying(
-        &self,
-        channel: &FVarChannel,
-        mode: FVarLinearInterpolation,
-    ) -> Result<FVarEvaluator, LimitError> {
-        let base = &self.base;
-        if channel.indices().len() != base.num_face_vertices() || channel.num_values() == 0 {
-            return Err(LimitError::Param(format!(
-                "face-varying channel with {} values and {} indices does not fit a mesh of {} face-vertices",
-                channel.num_values(),
-                channel.indices().len(),
-                base.num_face_vertices()
-            )));
-        }
-        let patches = if mode == FVarLinearInterpolation::All {
-            None
-        } else {
-            Some(value_patches(
-                base,
-                &self.scheme,
-                &self.options,
-                channel,
-                mode,
-            )?)
-        };
-        Ok(FVarEvaluator {
-            scheme: self.scheme.clone(),
-            components: channel.components(),
-            num_values: channel.num_values(),
-            base: base.clone(),
-            indices: channel.indices().to_vec(),
-            blocked: near_split_degenerate_edges(base, channel.indices()),
-            patches,
-        })
+/// An evaluator of `channel` (defined on `base`, refined by `scheme` with the rules
+/// `options`) interpolated by `mode` ([`crate::eval::LimitEvaluator::face_varying`]).
+///
+/// # Errors
+/// [`LimitError::Param`] when the channel does not fit the mesh or has no values;
+/// [`LimitError::TooDeep`] when a semi-sharp seam would need the whole mesh refined past
+/// [`crate::MAX_DECAY_FACE_VERTICES`]; the errors of the evaluator on the mesh of values.
+pub(crate) fn face_varying_evaluator(
+    base: &Topology,
+    scheme: &Scheme,
+    options: &subd_schemes::Options,
+    channel: &FVarChannel,
+    mode: FVarLinearInterpolation,
+) -> Result<FVarEvaluator, LimitError> {
+    if channel.indices().len() != base.num_face_vertices() || channel.num_values() == 0 {
+        return Err(LimitError::Param(format!(
+            "face-varying channel with {} values and {} indices does not fit a mesh of {} face-vertices",
+            channel.num_values(),
+            channel.indices().len(),
+            base.num_face_vertices()
+        )));
     }
+    let patches = if mode == FVarLinearInterpolation::All {
+        None
+    } else {
+        Some(value_patches(base, scheme, options, channel, mode)?)
+    };
+    Ok(FVarEvaluator {
+        scheme: scheme.clone(),
+        components: channel.components(),
+        num_values: channel.num_values(),
+        base: base.clone(),
+        indices: channel.indices().to_vec(),
+        blocked: near_split_degenerate_edges(base, channel.indices()),
+        patches,
+    })
 }
 
 /// Faces within two rings of a degenerate edge (a face's two consecutive corners on one
@@ -237,7 +230,7 @@ fn value_patches(
                 boundary_interpolation: BoundaryInterpolation::EdgeOnly,
                 ..*options
             };
-            let evaluator = LimitEvaluator::new(&mesh, scheme, &mesh_options)?;
+            let evaluator = WholeMeshEvaluator::new(&mesh, scheme, &mesh_options)?;
             let slot_values = (0..values.num_slots())
                 .map(|s| values.slot_value(s))
                 .collect();

@@ -447,14 +447,15 @@ pub(crate) fn evaluate(
     })
 }
 
-/// [`evaluate`] as weights: the limit at (u, v) of face `f` of `t` (level 2 of the
-/// evaluator's refinement) as (vertex of `t`,
+/// [`evaluate`] as weights: the limit at (u, v) of face `f` of `t` (level `level` of a
+/// refinement) as (vertex of `t`,
 /// weights of position, ∂u, ∂v, ∂uu, ∂uv, ∂vv) pairs, from one descent that carries each
 /// vertex's weights over the first piece's vertices.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn stencil(
     t: &Topology,
     rules: &[Rule],
+    level: usize,
     f: usize,
     scheme: &Scheme,
     options: &Options,
@@ -470,7 +471,7 @@ pub(crate) fn stencil(
             }
         };
         let start = cut_out(t, rules, pick, f)?;
-        let ending = descend(start, LIMIT_EVALUATOR_LEVEL, scheme, options, u, v)?;
+        let ending = descend(start, level, scheme, options, u, v)?;
         let nb = ending.piece();
         // The final piece's weights over its own support, one unit-vector evaluation per
         // three vertices, then carried back to the sources through the weights.

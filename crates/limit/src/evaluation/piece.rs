@@ -13,7 +13,9 @@ use crate::evaluation::patch::{
     Derivatives, GridPoint, REGULAR_GRID, SurfacePoint, corner_patch, eval_bicubic,
     sharp_regular_grid, smooth_neighbourhood,
 };
-use crate::evaluation::stam::{CornerPatchMatrices, Projected, corner_patch_matrices};
+use crate::evaluation::stam::{
+    CornerPatchMatrices, Projected, corner_patch_matrices, steps_to_regular,
+};
 use crate::limit_masks::masks;
 use std::sync::Arc;
 
@@ -254,6 +256,12 @@ pub(crate) fn eval_piece_to(
             let q = if a == 0.0 && b == 0.0 {
                 let c: Vec<DVec3> = cp.iter().map(|&i| pts[i as usize]).collect();
                 at_extraordinary_vertex(&c, n)?
+            } else if steps_to_regular(a.max(b)).0 <= DIRECT_STEPS {
+                // Within a step of the regular sub-patches the subdivision matrix applied to
+                // the points themselves costs about what the eigenbasis does, without its
+                // round-off (V⁻¹ is ill-conditioned at valence 3: 1e-12 in the derivatives).
+                let c = Projected::Points(cp.iter().map(|&i| pts[i as usize]).collect());
+                matrices.evaluate_projected_to(&c, a, b, d)
             } else {
                 let c = projected.expect("corner pieces are projected");
                 matrices.evaluate_projected_to(c, a, b, d)
@@ -296,6 +304,11 @@ pub(crate) fn eval_piece_to(
                     dv: apply(&m.tangent2),
                     ..SurfacePoint::default()
                 }
+            } else if steps_to_regular(a.max(0.0) + b.max(0.0)).0 <= DIRECT_STEPS {
+                // As for Catmull-Clark corners: the points themselves near the regular
+                // sub-patches.
+                let c = Projected::Points(cp.iter().map(|&i| pts[i as usize]).collect());
+                matrices.evaluate_to(&c, a.max(0.0), b.max(0.0), d)?
             } else {
                 matrices.evaluate_to(
                     projected.expect("corner pieces are projected"),
@@ -310,6 +323,10 @@ pub(crate) fn eval_piece_to(
         Piece::Unsupported(reason) => Err(LimitError::Unsupported { face, reason }),
     }
 }
+
+/// Subdivision steps up to which a corner piece is evaluated from its points rather than
+/// their eigenbasis projection.
+const DIRECT_STEPS: i32 = 1;
 
 /// At the extraordinary vertex itself the parametric derivatives are singular (they vanish
 /// or grow without bound with the valence); the position is the limit mask's and the first

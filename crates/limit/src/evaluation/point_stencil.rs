@@ -20,7 +20,7 @@ use glam::DVec3;
 use subd_schemes::{Refinement, Scheme};
 
 use crate::LimitError;
-use crate::evaluation::eval::{FaceParam, LimitEvaluator};
+use crate::evaluation::eval::{FaceParam, WholeMeshEvaluator};
 use crate::evaluation::patch::SurfacePoint;
 use crate::evaluation::piece::{Piece, eval_piece, project_all};
 use crate::evaluation::stam::CornerPatchMatrices;
@@ -95,7 +95,7 @@ impl PointStencil {
     }
 
     /// From (vertex, weights) pairs, merging repeated vertices and dropping all-zero ones.
-    fn from_pairs(mut pairs: Vec<(u32, [f64; 6])>) -> PointStencil {
+    pub(crate) fn from_pairs(mut pairs: Vec<(u32, [f64; 6])>) -> PointStencil {
         pairs.sort_unstable_by_key(|p| p.0);
         let mut out = PointStencil::default();
         let mut i = 0;
@@ -159,7 +159,7 @@ thread_local! {
 }
 
 /// One piece evaluated on its own (projecting a corner patch's points first).
-fn single_piece(
+pub(crate) fn single_piece(
     piece: &Piece,
     pts: &[DVec3],
     face: usize,
@@ -196,13 +196,7 @@ fn merge_row(mut row: Vec<(u32, f64)>) -> Vec<(u32, f64)> {
     out
 }
 
-impl LimitEvaluator {
-    /// The base vertices the limit surface over `face` can depend on: the vertices of the
-    /// faces around its vertices.
-    pub fn support(&self, face: usize) -> Vec<u32> {
-        face_support(&self.base, face)
-    }
-
+impl WholeMeshEvaluator {
     /// The limit surface at `at` as weights over the base control vertices: position and
     /// derivatives, equal (to rounding) to [`LimitEvaluator::evaluate`] for any points.
     ///
@@ -230,6 +224,7 @@ impl LimitEvaluator {
                 Piece::Local => crate::evaluation::local::stencil(
                     t2top,
                     r.vertex_rules(2),
+                    crate::evaluation::local::LIMIT_EVALUATOR_LEVEL,
                     f2,
                     &self.scheme,
                     &self.options,

@@ -19,20 +19,21 @@ use super::array::PatchArray;
 use super::levels::PatchLevel;
 use super::param::PatchParam;
 use crate::LimitError;
-use crate::evaluation::eval::{FaceParam, LimitEvaluator, PatchPoints, on_base_face};
+use crate::evaluation::eval::{FaceParam, WholeMeshEvaluator, WholePoints, on_base_face};
 use crate::evaluation::patch::{Derivatives, SurfacePoint};
 use crate::evaluation::piece::{Piece, eval_piece_to, piece_of, project};
+use crate::evaluation::point_stencil::{PointStencil, single_piece};
 use crate::evaluation::stam::Projected;
+use crate::evaluation::support::{face_support, linear_weights};
 
-/// How each exact patch of a table is evaluated, with the points of one set of base
-/// positions.
+/// How each exact patch of a table is evaluated (their points are in
+/// [`super::TablePoints`]).
 #[derive(Debug)]
 pub(crate) struct ExactCaps {
     /// One per patch of the exact array, in its order.
     caps: Vec<Cap>,
     /// The whole-mesh exact evaluator, only when some cap needs it.
-    whole: Option<LimitEvaluator>,
-    pub(super) points: CapPoints,
+    whole: Option<WholeMeshEvaluator>,
 }
 
 /// How one exact patch is evaluated.
@@ -49,7 +50,7 @@ enum Cap {
 #[derive(Debug, Clone)]
 pub(crate) struct CapPoints {
     projected: Vec<Option<Projected>>,
-    whole: Option<PatchPoints>,
+    whole: Option<WholePoints>,
 }
 
 /// What the caps read of their table.
@@ -63,12 +64,8 @@ pub(crate) struct CapContext<'a> {
 }
 
 impl ExactCaps {
-    /// The caps of `array` (the table's exact patches), with the points of `positions`.
-    pub(crate) fn new(
-        array: &PatchArray,
-        cx: &CapContext<'_>,
-        positions: &[DVec3],
-    ) -> Result<ExactCaps, LimitError> {
+    /// The caps of `array` (the table's exact patches); `cx` needs no points.
+    pub(crate) fn new(array: &PatchArray, cx: &CapContext<'_>) -> Result<ExactCaps, LimitError> {
         let caps: Vec<Cap> = array
             .faces
             .par_iter()
@@ -77,20 +74,11 @@ impl ExactCaps {
             .collect();
         let whole = if caps.iter().any(|c| matches!(c, Cap::Whole)) {
             let base = &cx.levels[0].topology;
-            Some(LimitEvaluator::new(base, cx.scheme, cx.rules)?)
+            Some(WholeMeshEvaluator::new(base, cx.scheme, cx.rules)?)
         } else {
             None
         };
-        let mut exact = ExactCaps {
-            caps,
-            whole,
-            points: CapPoints {
-                projected: Vec::new(),
-                whole: None,
-            },
-        };
-        exact.points = exact.points_for(cx, positions);
-        Ok(exact)
+        Ok(ExactCaps { caps, whole })
     }
 
     /// The caps' points for the table points in `cx`, made from base `positions`.
@@ -114,10 +102,12 @@ impl ExactCaps {
     }
 
     /// Exact patch `i` (placed by `param`) at `at`, up to the derivatives `d`, with respect
-    /// to `at`'s (sub-)face parameters.
+    /// to `at`'s (sub-)face parameters; `cap_points` are [`Self::points_for`] the points in
+    /// `cx`.
     pub(crate) fn evaluate(
         &self,
         cx: &CapContext<'_>,
+        cap_points: &CapPoints,
         i: usize,
         param: PatchParam,
         at: FaceParam,
@@ -127,7 +117,7 @@ impl ExactCaps {
             Cap::OnLevel { level, face, piece } => (*level as usize, *face as usize, piece),
             Cap::Whole => {
                 let ev = self.whole.as_ref().expect("whole caps have the evaluator");
-                let points = self.points.whole.as_ref().expect("and its points");
+                let points = cap_points.whole.as_ref().expect("and its points");
                 return ev.evaluate_to(points, at, d);
             }
         };
@@ -154,13 +144,78 @@ impl ExactCaps {
             piece => eval_piece_to(
                 piece,
                 points,
-                self.points.projected[i].as_ref(),
+                cap_points.projected[i].as_ref(),
                 at.face,
                 (s, t),
                 d,
             )?,
         };
         Ok(p.scaled(scale))
+    }
+}
+
+/// The weights of an exact cap at a place: over one level's vertices, or (a cap the
+/// whole-mesh evaluator takes) over the base vertices already.
+pub(crate) enum CapStencil {
+    /// Level and `(vertex of the level, weights of position, ∂u, ∂v, ∂uu, ∂uv, ∂vv)`.
+    OnLevel(usize, Vec<(u32, [f64; 6])>),
+    /// Over the base vertices.
+    Base(PointStencil),
+}
+
+impl ExactCaps {
+    /// [`Self::evaluate`] as weights of the points it reads (linear in them, so the
+    /// weights applied to any points give the evaluation to rounding).
+    pub(crate) fn stencil(
+        &self,
+        cx: &CapContext<'_>,
+        i: usize,
+        param: PatchParam,
+        at: FaceParam,
+    ) -> Result<CapStencil, LimitError> {
+        let (level, face, piece) = match &self.caps[i] {
+            Cap::OnLevel { level, face, piece } => (*level as usize, *face as usize, piece),
+            Cap::Whole => {
+                let ev = self.whole.as_ref().expect("whole caps have the evaluator");
+                return ev.stencil(at).map(CapStencil::Base);
+            }
+        };
+        let (s, t, scale) = patch_local(param, *cx.scheme == Scheme::Loop, at.u, at.v);
+        let lv = &cx.levels[level];
+        let mut pairs = match piece {
+            Piece::Local => crate::evaluation::local::stencil(
+                &lv.topology,
+                &lv.rules,
+                level,
+                face,
+                cx.scheme,
+                cx.rules,
+                s,
+                t,
+            )
+            .map_err(|e| on_base_face(e, at.face))?,
+            piece => {
+                let support = face_support(&lv.topology, face);
+                let n = lv.topology.num_vertices();
+                linear_weights(&mut Vec::new(), n, &support, |pts| {
+                    single_piece(piece, pts, at.face, s, t)
+                })?
+            }
+        };
+        let factors = [
+            1.0,
+            scale,
+            scale,
+            scale * scale,
+            scale * scale,
+            scale * scale,
+        ];
+        for (_, w) in &mut pairs {
+            for (x, f) in w.iter_mut().zip(factors) {
+                *x *= f;
+            }
+        }
+        Ok(CapStencil::OnLevel(level, pairs))
     }
 }
 

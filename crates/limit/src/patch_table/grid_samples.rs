@@ -20,7 +20,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::basis;
-use super::table::PatchTable;
+use super::table::{PatchTable, TablePoints};
 use super::{PatchParam, PatchType};
 
 use crate::LimitError;
@@ -180,6 +180,7 @@ impl PatchTable {
     /// As [`Self::find`], for the first failing sample.
     pub(crate) fn evaluate_grid_samples(
         &self,
+        pts: &TablePoints,
         params: &[FaceParam],
         rate: u32,
     ) -> Result<(Vec<DVec3>, Vec<DVec3>), LimitError> {
@@ -193,7 +194,7 @@ impl PatchTable {
             .any(|((p, n), at)| {
                 let mut gathered = Gathered::new();
                 for k in 0..at.len() {
-                    match self.grid_sample(&basis, at[k], &mut gathered) {
+                    match self.grid_sample(pts, &basis, at[k], &mut gathered) {
                         Ok(value) => (p[k], n[k]) = value,
                         Err(_) => return true,
                     }
@@ -205,7 +206,7 @@ impl PatchTable {
             let mut gathered = Gathered::new();
             let first = params
                 .iter()
-                .find_map(|&at| self.grid_sample(&basis, at, &mut gathered).err());
+                .find_map(|&at| self.grid_sample(pts, &basis, at, &mut gathered).err());
             return Err(first.unwrap_or_else(|| LimitError::Param("a sample failed".into())));
         }
         Ok((positions, normals))
@@ -214,6 +215,7 @@ impl PatchTable {
     /// One sample's position and normal.
     fn grid_sample(
         &self,
+        pts: &TablePoints,
         basis: &GridBasis,
         at: FaceParam,
         cur: &mut Gathered,
@@ -223,7 +225,7 @@ impl PatchTable {
         if root != cur.root || !cur.whole {
             let (patch, a, i) = self.locate(&at)?;
             if patch != cur.patch {
-                cur.enter(self, basis, patch, a, i);
+                cur.enter(self, pts, basis, patch, a, i);
             }
             cur.root = root;
         }
@@ -232,8 +234,7 @@ impl PatchTable {
         let steps = grid_step(s, m).zip(grid_step(t, m));
         let (p, du, dv) = match (cur.kind, steps) {
             (PatchType::Exact, _) => {
-                let (a, i) = cur.handle;
-                return self.exact_position_normal(i, self.arrays()[a].params[i], at);
+                return self.exact_position_normal(pts, cur.handle.1, at);
             }
             (PatchType::Regular, Some((ks, kt))) => cubic_first(
                 &cur.points,
@@ -247,12 +248,12 @@ impl PatchTable {
                     Some(w) => {
                         let n = cps.len();
                         let at = 3 * n * grid_index(cur.triangle, m, ks, kt);
-                        tabulated_first(&w[at..at + 3 * n], cps, self.points())
+                        tabulated_first(&w[at..at + 3 * n], cps, &pts.points)
                     }
-                    None => return self.evaluate(at).map(|p| (p.position, p.normal())),
+                    None => return self.evaluate_on(pts, at).map(|p| (p.position, p.normal())),
                 }
             }
-            _ => return self.evaluate(at).map(|p| (p.position, p.normal())),
+            _ => return self.evaluate_on(pts, at).map(|p| (p.position, p.normal())),
         };
         // Derivatives in the patch's own parameters: the map to the root's scales both by
         // the same factor (negated for a turned triangle), which leaves the normal as it is.
@@ -280,7 +281,15 @@ impl Gathered {
     }
 
     /// Takes patch `patch` (array `a`, index `i`) as the current one.
-    fn enter(&mut self, table: &PatchTable, basis: &GridBasis, patch: usize, a: usize, i: usize) {
+    fn enter(
+        &mut self,
+        table: &PatchTable,
+        pts: &TablePoints,
+        basis: &GridBasis,
+        patch: usize,
+        a: usize,
+        i: usize,
+    ) {
         let array = &table.arrays()[a];
         let param = array.params()[i];
         let place = param.place();
@@ -296,7 +305,7 @@ impl Gathered {
         self.scale = 1.0 / param.fraction();
         self.origin = (f64::from(place.u), f64::from(place.v));
         if self.kind == PatchType::Regular {
-            self.points = bspline_points(param, array.patch_points(i), table.points());
+            self.points = bspline_points(param, array.patch_points(i), &pts.points);
         }
     }
 

@@ -61,6 +61,7 @@ mod options;
 mod param;
 mod patch_eval;
 mod table;
+mod table_stencil;
 
 pub use array::PatchArray;
 pub use face_varying::{FVarPatches, FVarPatchesLayout};

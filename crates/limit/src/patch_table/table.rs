@@ -10,13 +10,13 @@ use super::array::PatchArray;
 use super::assembly::Assembly;
 use super::basis;
 use super::classify::Classifier;
-use super::exact_caps::{CapContext, CapPoints, ExactCaps};
+use super::exact_caps::{CapContext, CapPoints, CapStencil, ExactCaps};
 use super::face_varying::FVarPatches;
 use super::features::{FeatureMask, Regularity, VTag, single_crease_edge};
 use super::levels::PatchLevel;
 use super::map::PatchMap;
 use super::patch_eval::{bspline_first, evaluate_patch, patch_weights};
-use super::{EndCaps, MAX_ISOLATION, PatchOptions, PatchParam, PatchType, PatchWeights};
+use super::{EndCaps, MAX_ISOLATION, PatchOptions, PatchType, PatchWeights};
 use crate::LimitError;
 use crate::evaluation::eval::FaceParam;
 use crate::evaluation::fvar_eval::FVarPoint;
@@ -103,8 +103,10 @@ pub struct PatchGrid {
 /// The points of one set of base positions ([`PatchTable::points_for`]).
 #[derive(Debug, Clone)]
 pub struct TablePoints {
-    points: Vec<DVec3>,
-    exact: Option<CapPoints>,
+    /// Refined vertices of all levels, then the local points.
+    pub(crate) points: Vec<DVec3>,
+    /// The exact end caps' own points, when the table has exact caps.
+    pub(crate) exact: Option<CapPoints>,
 }
 
 /// A feature-adaptive patch table of a Catmull-Clark or Loop mesh (OpenSubdiv's
@@ -122,14 +124,16 @@ pub struct PatchTable {
     level_offsets: Vec<u32>,
     /// Local points as weights of the refined vertices.
     local: StencilTable,
-    /// Refined vertices of all levels, then the local points.
-    points: Vec<DVec3>,
+    /// The points of the positions given last.
+    points: TablePoints,
     /// First root (ptex) index of each base face.
     ptex: Vec<u32>,
     /// The array and index of each patch, in global order.
     handles: Vec<(u32, u32)>,
     map: PatchMap,
     exact: Option<ExactCaps>,
+    /// The index of the exact array, when the table has one.
+    exact_array: Option<usize>,
     /// Face-varying channels ([`Self::add_face_varying`]).
     face_varying: Vec<FVarPatches>,
 }
@@ -150,14 +154,23 @@ impl PatchTable {
         rules: &Options,
         options: &PatchOptions,
     ) -> Result<PatchTable, LimitError> {
-        let reg = regularity(scheme)?;
-        if !(1..=MAX_ISOLATION).contains(&options.isolation) {
-            return Err(LimitError::Param(format!(
-                "isolation level {} is outside 1..={MAX_ISOLATION}",
-                options.isolation
-            )));
-        }
+        check_request(scheme, options)?;
         check_positions(base, positions)?;
+        let mut table = Self::without_points(base, scheme, rules, options)?;
+        table.points = table.points_for(positions)?;
+        Ok(table)
+    }
+
+    /// [`Self::new`] without points: the topology, patches and end caps, to be evaluated with
+    /// points from [`Self::points_for`] ([`crate::eval::LimitEvaluator`] keeps one table for
+    /// any number of point sets).
+    pub(crate) fn without_points(
+        base: &Topology,
+        scheme: &Scheme,
+        rules: &Options,
+        options: &PatchOptions,
+    ) -> Result<PatchTable, LimitError> {
+        let reg = check_request(scheme, options)?;
         let levels = refine_adaptive(base, scheme, rules, options, reg)?;
         let ptex = ptex_offsets(base, reg.face_size);
         let irregular_faces = (0..base.num_faces()).any(|f| base.face_size(f) != reg.face_size);
@@ -190,20 +203,20 @@ impl PatchTable {
             arrays,
             level_offsets,
             local,
-            points: Vec::new(),
+            points: TablePoints {
+                points: Vec::new(),
+                exact: None,
+            },
             ptex,
             handles,
             map,
             exact: None,
+            exact_array: None,
             face_varying: Vec::new(),
         };
-        table.points = table.compute_points(positions);
-        if let Some(a) = table.arrays.iter().position(|a| a.kind == PatchType::Exact) {
-            table.exact = Some(ExactCaps::new(
-                &table.arrays[a],
-                &table.cap_context(),
-                positions,
-            )?);
+        table.exact_array = table.arrays.iter().position(|a| a.kind == PatchType::Exact);
+        if let Some(a) = table.exact_array {
+            table.exact = Some(ExactCaps::new(&table.arrays[a], &table.cap_context(&[]))?);
         }
         Ok(table)
     }
@@ -242,13 +255,10 @@ impl PatchTable {
     pub fn points_for(&self, positions: &[DVec3]) -> Result<TablePoints, LimitError> {
         check_positions(&self.levels[0].topology, positions)?;
         let points = self.compute_points(positions);
-        let exact = self.exact.as_ref().map(|e| {
-            let cx = CapContext {
-                points: &points,
-                ..self.cap_context()
-            };
-            e.points_for(&cx, positions)
-        });
+        let exact = self
+            .exact
+            .as_ref()
+            .map(|e| e.points_for(&self.cap_context(&points), positions));
         Ok(TablePoints { points, exact })
     }
 
@@ -258,18 +268,16 @@ impl PatchTable {
     /// # Panics
     /// If `next` was computed by another table (a different point count).
     pub fn set_points(&mut self, next: TablePoints) {
-        self.points.copy_from_slice(&next.points);
-        if let (Some(exact), Some(points)) = (&mut self.exact, next.exact) {
-            exact.points = points;
-        }
+        self.points.points.copy_from_slice(&next.points);
+        self.points.exact = next.exact;
     }
 
-    /// What the exact caps read of the table.
-    fn cap_context(&self) -> CapContext<'_> {
+    /// What the exact caps read of the table, with its points `points`.
+    fn cap_context<'a>(&'a self, points: &'a [DVec3]) -> CapContext<'a> {
         CapContext {
             levels: &self.levels,
             level_offsets: &self.level_offsets,
-            points: &self.points,
+            points,
             scheme: &self.scheme,
             rules: &self.rules,
         }
@@ -293,6 +301,11 @@ impl PatchTable {
     /// holes under `BoundaryInterpolation::None`).
     pub fn base_topology(&self) -> &Topology {
         &self.levels[0].topology
+    }
+
+    /// The points of the positions given last (to evaluate with them).
+    pub(crate) fn own_points(&self) -> &TablePoints {
+        &self.points
     }
 
     /// The scheme.
@@ -328,7 +341,7 @@ impl PatchTable {
     /// The refined vertices of all levels, then the local points: what the control points
     /// index.
     pub fn points(&self) -> &[DVec3] {
-        &self.points
+        &self.points.points
     }
 
     /// The local points as weights of the refined vertices of all levels (OpenSubdiv's
@@ -403,13 +416,63 @@ impl PatchTable {
     /// Position and normal at `at` of exact end cap `i` (index in the exact array).
     pub(crate) fn exact_position_normal(
         &self,
+        pts: &TablePoints,
         i: usize,
-        param: PatchParam,
         at: FaceParam,
     ) -> Result<(DVec3, DVec3), LimitError> {
-        let exact = self.exact.as_ref().expect("exact end caps are set up");
-        let p = exact.evaluate(&self.cap_context(), i, param, at, Derivatives::First)?;
+        let p = self.exact_cap(pts, i, at, Derivatives::First)?;
         Ok((p.position, p.normal()))
+    }
+
+    /// Exact end cap `i` (index in the exact array) at `at` as weights of the points it
+    /// reads.
+    pub(crate) fn exact_cap_stencil(
+        &self,
+        i: usize,
+        at: FaceParam,
+    ) -> Result<CapStencil, LimitError> {
+        let exact = self.exact.as_ref().expect("exact end caps are set up");
+        let a = self.exact_array.expect("an exact array");
+        exact.stencil(&self.cap_context(&[]), i, self.arrays[a].params[i], at)
+    }
+
+    /// The index of the first point of level `level` among the table's points (the number
+    /// of refined vertices for one past the last level).
+    pub(crate) fn level_offset(&self, level: usize) -> u32 {
+        self.level_offsets[level]
+    }
+
+    /// The row of point `p` above the base level: its points, their weights, and the
+    /// index the points are counted from (a local point's row names refined vertices, a
+    /// refined vertex's the vertices of the level above it).
+    pub(crate) fn point_row(&self, p: u32) -> (&[u32], &[f64], u32) {
+        let refined = *self.level_offsets.last().expect("offsets");
+        if p >= refined {
+            let (indices, weights) = self.local.row((p - refined) as usize);
+            return (indices, weights, 0);
+        }
+        let level = self.level_offsets.partition_point(|&o| o <= p) - 1;
+        let rows = self.levels[level]
+            .rows
+            .as_ref()
+            .expect("a refined level has rows");
+        let (indices, weights) = rows.row((p - self.level_offsets[level]) as usize);
+        (indices, weights, self.level_offsets[level - 1])
+    }
+
+    /// Exact end cap `i` (index in the exact array) at `at`, up to the derivatives `d`.
+    fn exact_cap(
+        &self,
+        pts: &TablePoints,
+        i: usize,
+        at: FaceParam,
+        d: Derivatives,
+    ) -> Result<SurfacePoint, LimitError> {
+        let exact = self.exact.as_ref().expect("exact end caps are set up");
+        let cap_points = pts.exact.as_ref().expect("and their points");
+        let a = self.exact_array.expect("an exact array");
+        let param = self.arrays[a].params[i];
+        exact.evaluate(&self.cap_context(&pts.points), cap_points, i, param, at, d)
     }
 
     /// The surface at `at`: position and first and second derivatives with respect to the
@@ -418,8 +481,17 @@ impl PatchTable {
     /// # Errors
     /// As [`Self::find`].
     pub fn evaluate(&self, at: FaceParam) -> Result<SurfacePoint, LimitError> {
+        self.evaluate_on(&self.points, at)
+    }
+
+    /// [`Self::evaluate`] with points `pts` from [`Self::points_for`].
+    pub(crate) fn evaluate_on(
+        &self,
+        pts: &TablePoints,
+        at: FaceParam,
+    ) -> Result<SurfacePoint, LimitError> {
         let (a, i) = self.find(&at)?;
-        self.evaluate_in(a, i, at)
+        self.evaluate_in(pts, a, i, at)
     }
 
     /// The weights of patch `index` of array `array`'s control points at `(u, v)` of its
@@ -479,7 +551,7 @@ impl PatchTable {
             local_point_offsets: self.local.offsets(),
             local_point_indices: self.local.indices(),
             local_point_weights: self.local.weights(),
-            points: self.points.iter().map(|p| p.to_array()).collect(),
+            points: self.points.points.iter().map(|p| p.to_array()).collect(),
             face_varying: self.face_varying.iter().map(FVarPatches::layout).collect(),
         }
     }
@@ -515,13 +587,15 @@ impl PatchTable {
                 .zip(out.par_iter_mut())
                 .enumerate()
                 .with_min_len(4096)
-                .filter_map(|(i, (p, o))| match self.evaluate_first_at(*p) {
-                    Ok(v) => {
-                        *o = v;
-                        None
-                    }
-                    Err(e) => Some((i, e)),
-                })
+                .filter_map(
+                    |(i, (p, o))| match self.evaluate_first_on(&self.points, *p) {
+                        Ok(v) => {
+                            *o = v;
+                            None
+                        }
+                        Err(e) => Some((i, e)),
+                    },
+                )
                 .collect();
             return first_failure(failures);
         }
@@ -535,13 +609,15 @@ impl PatchTable {
             .zip(&places)
             .zip(sorted.par_iter_mut())
             .with_min_len(4096)
-            .filter_map(|((&i, p), o)| match self.evaluate_first_at(*p) {
-                Ok(v) => {
-                    *o = v;
-                    None
-                }
-                Err(e) => Some((i as usize, e)),
-            })
+            .filter_map(
+                |((&i, p), o)| match self.evaluate_first_on(&self.points, *p) {
+                    Ok(v) => {
+                        *o = v;
+                        None
+                    }
+                    Err(e) => Some((i as usize, e)),
+                },
+            )
             .collect();
         scatter(&order, &sorted, out);
         first_failure(failures)
@@ -549,7 +625,11 @@ impl PatchTable {
 
     /// Position and first derivatives at `at`: [`Self::evaluate`] without the second
     /// derivatives, and with the bicubic B-spline summed as a tensor product.
-    fn evaluate_first_at(&self, at: FaceParam) -> Result<[DVec3; 3], LimitError> {
+    pub(crate) fn evaluate_first_on(
+        &self,
+        pts: &TablePoints,
+        at: FaceParam,
+    ) -> Result<[DVec3; 3], LimitError> {
         let (a, i) = self.find(&at)?;
         let array = &self.arrays[a];
         let param = array.params[i];
@@ -557,7 +637,7 @@ impl PatchTable {
         if array.kind == PatchType::Regular && place.boundary == 0 {
             let (s, t) = param.normalize(at.u, at.v);
             let d1 = 1.0 / param.fraction();
-            let [p, du, dv] = bspline_first(array.patch_points(i), &self.points, s, t);
+            let [p, du, dv] = bspline_first(array.patch_points(i), &pts.points, s, t);
             return Ok([p, du * d1, dv * d1]);
         }
         if array.kind == PatchType::Loop && place.boundary == 0 {
@@ -566,10 +646,11 @@ impl PatchTable {
             if param.is_triangle_rotated() {
                 d1 = -d1;
             }
-            let [p, du, dv] = basis::box_spline_first(array.patch_points(i), &self.points, s, t);
+            let [p, du, dv] = basis::box_spline_first(array.patch_points(i), &pts.points, s, t);
             return Ok([p, du * d1, dv * d1]);
         }
-        self.evaluate(at).map(|s| [s.position, s.du, s.dv])
+        self.evaluate_in(pts, a, i, at)
+            .map(|s| [s.position, s.du, s.dv])
     }
 
     /// Every patch sampled on its own `rate × rate` grid of its domain (a triangle's in
@@ -602,7 +683,8 @@ impl PatchTable {
                         } else {
                             param.unnormalize(s, t)
                         };
-                        let p = self.evaluate_in(a, i, FaceParam { face, sub, u, v })?;
+                        let at = FaceParam { face, sub, u, v };
+                        let p = self.evaluate_in(&self.points, a, i, at)?;
                         grid.positions.push(p.position);
                         grid.normals.push(p.normal());
                     }
@@ -649,18 +731,22 @@ impl PatchTable {
     }
 
     /// Patch `i` of array `a` at `at` (which it covers).
-    fn evaluate_in(&self, a: usize, i: usize, at: FaceParam) -> Result<SurfacePoint, LimitError> {
+    fn evaluate_in(
+        &self,
+        pts: &TablePoints,
+        a: usize,
+        i: usize,
+        at: FaceParam,
+    ) -> Result<SurfacePoint, LimitError> {
         let array = &self.arrays[a];
         if array.kind == PatchType::Exact {
-            let exact = self.exact.as_ref().expect("exact end caps are set up");
-            let cx = self.cap_context();
-            return exact.evaluate(&cx, i, array.params[i], at, Derivatives::Second);
+            return self.exact_cap(pts, i, at, Derivatives::Second);
         }
         Ok(evaluate_patch(
             array.kind,
             array.params[i],
             array.patch_points(i),
-            &self.points,
+            &pts.points,
             at.u,
             at.v,
         ))
@@ -853,6 +939,18 @@ fn check_positions(base: &Topology, positions: &[DVec3]) -> Result<(), LimitErro
             base.num_vertices()
         )))
     }
+}
+
+/// The scheme's regular face and valence, once the scheme and isolation level are checked.
+fn check_request(scheme: &Scheme, options: &PatchOptions) -> Result<Regularity, LimitError> {
+    let reg = regularity(scheme)?;
+    if !(1..=MAX_ISOLATION).contains(&options.isolation) {
+        return Err(LimitError::Param(format!(
+            "isolation level {} is outside 1..={MAX_ISOLATION}",
+            options.isolation
+        )));
+    }
+    Ok(reg)
 }
 
 fn regularity(scheme: &Scheme) -> Result<Regularity, LimitError> {

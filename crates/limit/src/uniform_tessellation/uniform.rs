@@ -21,15 +21,14 @@
 //! bits.
 
 use glam::DVec3;
-use rayon::prelude::*;
 use subd_mesh::Topology;
 use subd_schemes::{Options, Scheme};
 
 use super::numbering::number_samples;
 use super::output::{Numbered, Tessellation};
 use crate::LimitError;
-use crate::evaluation::eval::{FaceParam, GatheredPatch, LimitEvaluator, PatchPoints};
-use crate::patch_table::PatchTable;
+use crate::limit_evaluator::{LimitEvaluator, PatchPoints};
+use crate::patch_table::{PatchTable, TablePoints};
 
 /// The largest rate accepted.
 pub const MAX_RATE: usize = 1024;
@@ -62,15 +61,7 @@ pub fn tessellate(
     points: &PatchPoints,
     rate: usize,
 ) -> Result<Tessellation, LimitError> {
-    let topo = evaluator.topology();
-    let loop_scheme = evaluator.scheme == Scheme::Loop;
-    check_rate(topo, loop_scheme, rate)?;
-    let Numbered {
-        params, mut out, ..
-    } = number_samples(topo, loop_scheme, rate as u32);
-    (out.positions, out.normals) = evaluate_samples(evaluator, points, &params)?;
-    out.params = params;
-    Ok(out)
+    sample_table(evaluator.table(), &points.table, rate)
 }
 
 /// The surface of a patch table sampled as [`tessellate`] samples the exact limit: the same
@@ -80,52 +71,25 @@ pub fn tessellate(
 /// # Errors
 /// As [`tessellate`].
 pub fn tessellate_patches(table: &PatchTable, rate: usize) -> Result<Tessellation, LimitError> {
+    sample_table(table, table.own_points(), rate)
+}
+
+/// The samples of a uniform tessellation at `rate`, evaluated on `table` with its points
+/// `points`.
+fn sample_table(
+    table: &PatchTable,
+    points: &TablePoints,
+    rate: usize,
+) -> Result<Tessellation, LimitError> {
     let topo = table.base_topology();
     let loop_scheme = *table.scheme() == Scheme::Loop;
     check_rate(topo, loop_scheme, rate)?;
     let Numbered {
         params, mut out, ..
     } = number_samples(topo, loop_scheme, rate as u32);
-    (out.positions, out.normals) = table.evaluate_grid_samples(&params, rate as u32)?;
+    (out.positions, out.normals) = table.evaluate_grid_samples(points, &params, rate as u32)?;
     out.params = params;
     Ok(out)
-}
-
-/// Samples per parallel job of [`evaluate_samples`]: many faces' worth, so that a face's
-/// run of samples is rarely split.
-const SAMPLE_CHUNK: usize = 4096;
-
-/// The position and normal at every sample, in parallel chunks, each keeping the control
-/// points of the face it evaluated last (a face's own samples are numbered together).
-fn evaluate_samples(
-    evaluator: &LimitEvaluator,
-    points: &PatchPoints,
-    params: &[FaceParam],
-) -> Result<(Vec<DVec3>, Vec<DVec3>), LimitError> {
-    let mut positions = subd_mesh::memory::zeroed::<DVec3>(params.len());
-    let mut normals = subd_mesh::memory::zeroed::<DVec3>(params.len());
-    let failed = positions
-        .par_chunks_mut(SAMPLE_CHUNK)
-        .zip(normals.par_chunks_mut(SAMPLE_CHUNK))
-        .zip(params.par_chunks(SAMPLE_CHUNK))
-        .any(|((p, n), at)| {
-            let mut patch = GatheredPatch::default();
-            for k in 0..at.len() {
-                match evaluator.evaluate_position_normal_in(points, at[k], &mut patch) {
-                    Ok(value) => (p[k], n[k]) = value,
-                    Err(_) => return true,
-                }
-            }
-            false
-        });
-    if failed {
-        // The first failing sample's error, not whichever a thread met first.
-        let first = params
-            .iter()
-            .find_map(|&at| evaluator.evaluate_position_normal(points, at).err());
-        return Err(first.expect("a sample failed"));
-    }
-    Ok((positions, normals))
 }
 
 /// Tessellates the limit surface of `positions` on `topology` at `rate`, as [`tessellate`]
