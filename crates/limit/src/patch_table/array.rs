@@ -25,6 +25,15 @@ impl PatchArray {
         }
     }
 
+    /// Makes room for `patches` more patches.
+    pub(crate) fn reserve(&mut self, patches: usize) {
+        let n = self.kind.num_control_points().unwrap_or(0);
+        self.faces.reserve(patches);
+        self.params.reserve(patches);
+        self.sharpness.reserve(patches);
+        self.control_points.reserve(n * patches);
+    }
+
     /// Appends a patch.
     pub(crate) fn push(
         &mut self,

@@ -36,9 +36,24 @@ pub(crate) struct Assembly<'a> {
     level_offsets: &'a [u32],
     options: &'a PatchOptions,
     reg: Regularity,
-    /// Local point rows over the refined vertices of all levels.
-    local_rows: Vec<Row>,
+    /// Local point rows over the refined vertices of all levels, as CSR arrays filled in
+    /// place (no row of its own per point).
+    local: LocalRows,
     shared: HashMap<ShareKey, u32>,
+}
+
+/// The local points' stencil rows as they are appended.
+struct LocalRows {
+    offsets: Vec<u32>,
+    indices: Vec<u32>,
+    weights: Vec<f64>,
+}
+
+/// A patch's points before the local ones are numbered: a regular patch's refined-vertex
+/// indices, or an end cap's points and what each is shared under.
+enum PatchPoints {
+    Regular([u32; 16], usize),
+    Cap(Vec<(CapPoint, Option<ShareKey>)>),
 }
 
 /// The arrays, each patch's (array, index) in global order, and the local points' stencils.
@@ -56,7 +71,11 @@ impl<'a> Assembly<'a> {
             level_offsets,
             options,
             reg,
-            local_rows: Vec::new(),
+            local: LocalRows {
+                offsets: vec![0],
+                indices: Vec::new(),
+                weights: Vec::new(),
+            },
             shared: HashMap::new(),
         }
     }
@@ -70,16 +89,35 @@ impl<'a> Assembly<'a> {
             PatchType::Regular
         };
         let mut arrays = [PatchArray::new_of(regular), PatchArray::new_of(caps)];
+        let in_caps = found
+            .iter()
+            .filter(|p| !p.regular && caps != regular)
+            .count();
+        arrays[0].reserve(found.len() - in_caps);
+        arrays[1].reserve(in_caps);
         let mut slots = Vec::with_capacity(found.len());
+        let mut cap_indices = Vec::with_capacity(20);
         for p in found {
             let a = usize::from(!p.regular && caps != regular);
-            let points = if p.regular {
-                self.regular_points(p)
-            } else {
-                self.end_cap_points(p)
-            };
+            let points = self.patch_points(p);
             slots.push((a, arrays[a].len()));
-            arrays[a].push((p.level, p.face), p.param, p.sharpness, &points);
+            let points: &[u32] = match points {
+                PatchPoints::Regular(points, n) => {
+                    let offset = self.level_offsets[p.level as usize];
+                    cap_indices.clear();
+                    cap_indices.extend(points[..n].iter().map(|&v| v + offset));
+                    &cap_indices
+                }
+                PatchPoints::Cap(points) => {
+                    cap_indices.clear();
+                    for (point, key) in points {
+                        let i = self.numbered(p.level, point, key);
+                        cap_indices.push(i);
+                    }
+                    &cap_indices
+                }
+            };
+            arrays[a].push((p.level, p.face), p.param, p.sharpness, points);
         }
         let keep: Vec<bool> = arrays.iter().map(|a| !a.is_empty()).collect();
         // Global order: arrays in order, patches in order within each.
@@ -93,28 +131,35 @@ impl<'a> Assembly<'a> {
             handles[g] = (renumber(a) as u32, k as u32);
         }
         let total = *self.level_offsets.last().expect("offsets") as usize;
-        let local = StencilTable::from_rows(total, &self.local_rows);
+        let LocalRows {
+            offsets,
+            indices,
+            weights,
+        } = self.local;
+        let local = StencilTable::from_csr(total, offsets, indices, weights);
         let arrays = arrays.into_iter().filter(|a| !a.is_empty()).collect();
         (arrays, handles, local)
     }
 
-    /// The 16 or 12 points of a regular patch, as refined-vertex indices.
-    fn regular_points(&self, p: &FoundPatch) -> Vec<u32> {
-        let level = &self.levels[p.level as usize];
-        let offset = self.level_offsets[p.level as usize];
+    /// A patch's points, before the local ones are numbered.
+    fn patch_points(&self, p: &FoundPatch) -> PatchPoints {
+        if !p.regular {
+            return PatchPoints::Cap(self.end_cap_points(p));
+        }
+        let t = &self.levels[p.level as usize].topology;
         let f = p.face as usize;
-        let local: Vec<u32> = if self.reg.face_size == 4 {
-            gather::quad_points(&level.topology, f, p.points_mask).to_vec()
+        if self.reg.face_size == 4 {
+            PatchPoints::Regular(gather::quad_points(t, f, p.points_mask), 16)
         } else {
-            gather::triangle_points(&level.topology, f, p.points_mask).to_vec()
-        };
-        local.into_iter().map(|v| v + offset).collect()
+            let mut points = [0; 16];
+            points[..12].copy_from_slice(&gather::triangle_points(t, f, p.points_mask));
+            PatchPoints::Regular(points, 12)
+        }
     }
 
-    /// The points of an end cap: local points (new ones appended, shared ones reused) as
-    /// indices past the refined vertices, and the level's vertices a B-spline end cap takes
-    /// as they are.
-    fn end_cap_points(&mut self, p: &FoundPatch) -> Vec<u32> {
+    /// The points of an end cap (rows over its level's vertices, or vertices of the level
+    /// a B-spline end cap takes as they are) and what each is shared under.
+    fn end_cap_points(&self, p: &FoundPatch) -> Vec<(CapPoint, Option<ShareKey>)> {
         let level = &self.levels[p.level as usize];
         let (t, tags, f) = (&level.topology, &level.tags, p.face as usize);
         let rules = CornerRules {
@@ -132,15 +177,16 @@ impl<'a> Assembly<'a> {
             EndCaps::Bilinear => local(end_caps::linear(t, tags, f, &rules)),
         };
         let keys = self.share_keys(p, points.len());
-        let offset = self.level_offsets[p.level as usize];
-        points
-            .into_iter()
-            .zip(keys)
-            .map(|(point, key)| match point {
-                CapPoint::Vertex(v) => v + offset,
-                CapPoint::Local(row) => self.local_point(p.level, row, key),
-            })
-            .collect()
+        points.into_iter().zip(keys).collect()
+    }
+
+    /// An end cap's point as an index into [refined vertices | local points]: a level
+    /// vertex, or a local point (new ones appended, shared ones reused).
+    fn numbered(&mut self, level: u8, point: CapPoint, key: Option<ShareKey>) -> u32 {
+        match point {
+            CapPoint::Vertex(v) => v + self.level_offsets[level as usize],
+            CapPoint::Local(row) => self.local_point(level, row, key),
+        }
     }
 
     /// The sharing key of each of an end cap's points (`None`: never shared). Gregory quads
@@ -193,9 +239,12 @@ impl<'a> Assembly<'a> {
             }
         }
         let offset = self.level_offsets[level as usize];
-        let i = self.local_rows.len() as u32;
-        self.local_rows
-            .push(row.into_iter().map(|(v, w)| (v + offset, w)).collect());
+        let i = (self.local.offsets.len() - 1) as u32;
+        for (v, w) in row {
+            self.local.indices.push(v + offset);
+            self.local.weights.push(w);
+        }
+        self.local.offsets.push(self.local.indices.len() as u32);
         if let Some(k) = key {
             self.shared.insert(k, i);
         }
