@@ -12,7 +12,7 @@
 
 use glam::DVec3;
 use rayon::prelude::*;
-use subd_mesh::tags::{CreaseMethod, SHARPNESS_INFINITE, SHARPNESS_SMOOTH};
+use subd_mesh::tags::{SHARPNESS_INFINITE, SHARPNESS_SMOOTH};
 use subd_schemes::{Options, Scheme};
 
 use super::array::PatchArray;
@@ -70,10 +70,7 @@ impl ExactCaps {
             .faces
             .par_iter()
             .with_min_len(64)
-            .map(|&(level, face)| {
-                let chaikin = cx.rules.crease_method == CreaseMethod::Chaikin;
-                cap_of(&cx.levels[level as usize], level, face, cx.scheme, chaikin)
-            })
+            .map(|&(level, face)| cap_of(&cx.levels[level as usize], level, face, cx.scheme))
             .collect();
         let whole = if caps.iter().any(|c| matches!(c, Cap::Whole)) {
             let base = &cx.levels[0].topology;
@@ -224,7 +221,7 @@ impl ExactCaps {
 
 /// How face `face` of `level` (an exact patch's) is evaluated: on the level when what its
 /// evaluation reads is whole there, else by the whole-mesh evaluator.
-fn cap_of(level: &PatchLevel, depth: u8, face: u32, scheme: &Scheme, chaikin: bool) -> Cap {
+fn cap_of(level: &PatchLevel, depth: u8, face: u32, scheme: &Scheme) -> Cap {
     let t = &level.topology;
     let f = face as usize;
     let regular = if *scheme == Scheme::Loop { 3 } else { 4 };
@@ -247,7 +244,7 @@ fn cap_of(level: &PatchLevel, depth: u8, face: u32, scheme: &Scheme, chaikin: bo
                     .iter()
                     .all(|&g| corners_whole(g as usize))
             });
-            if !ring_whole || (chaikin && semi_sharp_near(t, f)) {
+            if !ring_whole || semi_sharp_near(t, f) {
                 return Cap::Whole;
             }
             Piece::Local
@@ -262,12 +259,9 @@ fn cap_of(level: &PatchLevel, depth: u8, face: u32, scheme: &Scheme, chaikin: bo
 }
 
 /// Whether a semi-sharp edge or vertex (sharpness neither 0 nor infinite) lies on the faces
-/// around face `f`'s vertices. With Chaikin's creasing, local refinement from a sparse
-/// level next to one departs from the limit by up to 1e-10 (found on a random torus by the
-/// conformance run): a child edge's sharpness depends on every sharp edge at its parent
-/// vertex, which a sparse level's parent piece may not all hold, so a complete vertex can
-/// still carry an edge of the wrong sharpness. The whole-mesh evaluator, which starts two
-/// levels down the whole mesh, takes those caps.
+/// around face `f`'s vertices. Local refinement from a sparse level next to one departs
+/// from the limit by up to 1e-10 (found on a random torus by the conformance run, cause not
+/// yet found); the whole-mesh evaluator, which starts two levels down, takes those caps.
 fn semi_sharp_near(t: &subd_mesh::Topology, f: usize) -> bool {
     let semi = |s: f32| s > SHARPNESS_SMOOTH && s < SHARPNESS_INFINITE;
     t.face_vertices(f).iter().any(|&v| {
