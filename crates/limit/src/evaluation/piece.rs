@@ -256,15 +256,8 @@ pub(crate) fn eval_piece_to(
             let q = if a == 0.0 && b == 0.0 {
                 let c: Vec<DVec3> = cp.iter().map(|&i| pts[i as usize]).collect();
                 at_extraordinary_vertex(&c, n)?
-            } else if steps_to_regular(a.max(b)).0 <= DIRECT_STEPS {
-                // Within a step of the regular sub-patches the subdivision matrix applied to
-                // the points themselves costs about what the eigenbasis does, without its
-                // round-off (V⁻¹ is ill-conditioned at valence 3: 1e-12 in the derivatives).
-                let c = Projected::Points(cp.iter().map(|&i| pts[i as usize]).collect());
-                matrices.evaluate_projected_to(&c, a, b, d)
             } else {
-                let c = projected.expect("corner pieces are projected");
-                matrices.evaluate_projected_to(c, a, b, d)
+                corner_value(matrices, cp, pts, projected, (a, b), d)
             };
             Ok(pull_back(&q, j))
         }
@@ -321,6 +314,27 @@ pub(crate) fn eval_piece_to(
         }
         Piece::Refined | Piece::Local => unreachable!("refined pieces are resolved by the caller"),
         Piece::Unsupported(reason) => Err(LimitError::Unsupported { face, reason }),
+    }
+}
+
+/// A Catmull-Clark corner piece at `(a, b)` of its corner frame, away from the vertex.
+/// Within a step of the regular sub-patches the subdivision matrix applied to the points
+/// themselves costs about what the eigenbasis does, without its round-off (V⁻¹ is
+/// ill-conditioned at valence 3: 1e-12 in the derivatives).
+fn corner_value(
+    matrices: &CornerPatchMatrices,
+    cp: &[u32],
+    pts: &[DVec3],
+    projected: Option<&Projected>,
+    (a, b): (f64, f64),
+    d: Derivatives,
+) -> SurfacePoint {
+    if steps_to_regular(a.max(b)).0 <= DIRECT_STEPS {
+        let c = Projected::Points(cp.iter().map(|&i| pts[i as usize]).collect());
+        matrices.evaluate_projected_to(&c, a, b, d)
+    } else {
+        let c = projected.expect("corner pieces are projected");
+        matrices.evaluate_projected_to(c, a, b, d)
     }
 }
 

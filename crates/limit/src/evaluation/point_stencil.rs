@@ -237,14 +237,7 @@ impl WholeMeshEvaluator {
                 })?,
             };
             // Derivatives by the parameter map's scale, then level 2 back to the base.
-            let factors = [
-                1.0,
-                scale,
-                scale,
-                scale * scale,
-                scale * scale,
-                scale * scale,
-            ];
+            let factors = crate::evaluation::support::derivative_factors(scale);
             let mut base_pairs = Vec::with_capacity(pairs.len() * 16);
             for (v2, w) in pairs {
                 if w.iter().all(|&x| x == 0.0) {

@@ -57,3 +57,10 @@ pub(crate) fn linear_weights(
     }
     Ok(out)
 }
+
+/// The factors that take position and first and second derivatives through a parameter
+/// map of scale `scale`: 1, `scale` twice, `scale²` three times.
+pub(crate) fn derivative_factors(scale: f64) -> [f64; 6] {
+    let s2 = scale * scale;
+    [1.0, scale, scale, s2, s2, s2]
+}

@@ -202,14 +202,7 @@ impl ExactCaps {
                 })?
             }
         };
-        let factors = [
-            1.0,
-            scale,
-            scale,
-            scale * scale,
-            scale * scale,
-            scale * scale,
-        ];
+        let factors = crate::evaluation::support::derivative_factors(scale);
         for (_, w) in &mut pairs {
             for (x, f) in w.iter_mut().zip(factors) {
                 *x *= f;

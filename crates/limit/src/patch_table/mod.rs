@@ -44,6 +44,7 @@
 mod array;
 mod assembly;
 mod basis;
+mod batch_eval;
 mod box_fit;
 mod bspline_caps;
 mod classify;
