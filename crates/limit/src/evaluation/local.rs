@@ -26,6 +26,9 @@ use crate::LimitStencilTable;
 use crate::LimitError;
 use crate::evaluation::patch::SurfacePoint;
 
+mod shared;
+pub(crate) use shared::evaluate_many;
+
 /// Levels of local refinement before a point that still is not on a known patch is taken
 /// as its face's nearest corner (the distance is then below `2^-MAX_LOCAL_LEVELS` of the
 /// starting face's size, under the resolution of `f64` parameters). Only points closer than
@@ -447,6 +450,33 @@ pub(crate) fn evaluate(
     })
 }
 
+/// The options of a local descent: boundary edges are already infinitely sharp and holes
+/// already tagged; the cut's artificial boundary must not turn faces into holes.
+fn descent_options(options: &Options) -> Options {
+    Options {
+        boundary_interpolation: BoundaryInterpolation::EdgeOnly,
+        ..*options
+    }
+}
+
+/// The surface at `(u, v)` of `face` of a piece (its topology and rules), a known patch, for
+/// positions `pts` of its vertices, with derivatives scaled by `scale` (`f` names the
+/// starting face in errors).
+fn patch_value(
+    (topology, rules, face): (&Topology, &[Rule], usize),
+    pts: &[DVec3],
+    scheme: &Scheme,
+    (u, v, scale): (f64, f64, f64),
+    f: usize,
+) -> Result<SurfacePoint, LimitError> {
+    crate::evaluation::piece::direct_evaluation(topology, rules, pts, face, scheme, u, v)?
+        .map(|p| p.scaled(scale))
+        .ok_or(LimitError::Unsupported {
+            face: f,
+            reason: "local refinement ended off a patch",
+        })
+}
+
 /// [`evaluate`] as weights: the limit at (u, v) of face `f` of `t` (level `level` of a
 /// refinement) as (vertex of `t`,
 /// weights of position, ∂u, ∂v, ∂uu, ∂uv, ∂vv) pairs, from one descent that carries each
@@ -524,20 +554,10 @@ impl<P> Ending<P> {
     /// face the descent started from in errors).
     fn value(&self, pts: &[DVec3], scheme: &Scheme, f: usize) -> Result<SurfacePoint, LimitError> {
         match self {
-            Ending::Patch { nb, u, v, scale } => crate::evaluation::piece::direct_evaluation(
-                &nb.topology,
-                &nb.rules,
-                pts,
-                nb.face,
-                scheme,
-                *u,
-                *v,
-            )?
-            .map(|p| p.scaled(*scale))
-            .ok_or(LimitError::Unsupported {
-                face: f,
-                reason: "local refinement ended off a patch",
-            }),
+            Ending::Patch { nb, u, v, scale } => {
+                let piece = (&nb.topology, &nb.rules[..], nb.face);
+                patch_value(piece, pts, scheme, (*u, *v, *scale), f)
+            }
             Ending::Corner {
                 nb,
                 corner,
@@ -558,12 +578,7 @@ fn descend<P: Carried>(
     u: f64,
     v: f64,
 ) -> Result<Ending<P>, LimitError> {
-    // Boundary edges are already infinitely sharp and holes already tagged; the cut's
-    // artificial boundary must not turn faces into holes.
-    let options = Options {
-        boundary_interpolation: BoundaryInterpolation::EdgeOnly,
-        ..*options
-    };
+    let options = descent_options(options);
     let (mut u, mut v, mut scale) = (u, v, 1.0);
     for depth in 0..MAX_LOCAL_LEVELS {
         let r = nb.refine(scheme, &options, 1)?;

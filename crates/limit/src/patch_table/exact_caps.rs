@@ -154,6 +154,74 @@ impl ExactCaps {
     }
 }
 
+impl ExactCaps {
+    /// Cap `i`'s level and piece when it is one of Stam's corner pieces (Catmull-Clark or
+    /// Loop), whose values are fixed weights of its control points at each place.
+    pub(crate) fn corner_piece(&self, i: usize) -> Option<(usize, &Piece)> {
+        match &self.caps[i] {
+            Cap::OnLevel { level, piece, .. }
+                if matches!(piece, Piece::Corner { .. } | Piece::LoopCorner { .. }) =>
+            {
+                Some((*level as usize, piece))
+            }
+            _ => None,
+        }
+    }
+
+    /// [`Self::evaluate`] at every place of `ats` (all in patch `i`), each the same bits:
+    /// a cap refined locally shares its descent between the places
+    /// ([`crate::evaluation::local::evaluate_many`]).
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn evaluate_many(
+        &self,
+        cx: &CapContext<'_>,
+        cap_points: &CapPoints,
+        i: usize,
+        param: PatchParam,
+        ats: &[FaceParam],
+        d: Derivatives,
+    ) -> Result<Vec<SurfacePoint>, LimitError> {
+        let (level, face) = match &self.caps[i] {
+            Cap::OnLevel {
+                level,
+                face,
+                piece: Piece::Local,
+            } if ats.len() > 1 => (*level as usize, *face as usize),
+            _ => {
+                return ats
+                    .iter()
+                    .map(|&at| self.evaluate(cx, cap_points, i, param, at, d))
+                    .collect();
+            }
+        };
+        let triangle = *cx.scheme == Scheme::Loop;
+        let places: Vec<(f64, f64)> = ats
+            .iter()
+            .map(|at| {
+                let (s, t, _) = patch_local(param, triangle, at.u, at.v);
+                (s, t)
+            })
+            .collect();
+        // One patch, one map from its root: the same scale for every place.
+        let (_, _, scale) = patch_local(param, triangle, ats[0].u, ats[0].v);
+        let lv = &cx.levels[level];
+        let first = cx.level_offsets[level] as usize;
+        let end = cx.level_offsets[level + 1] as usize;
+        let values = crate::evaluation::local::evaluate_many(
+            &lv.topology,
+            &lv.rules,
+            level,
+            &cx.points[first..end],
+            face,
+            cx.scheme,
+            cx.rules,
+            &places,
+        )
+        .map_err(|e| on_base_face(e, ats[0].face))?;
+        Ok(values.into_iter().map(|p| p.scaled(scale)).collect())
+    }
+}
+
 /// The weights of an exact cap at a place: over one level's vertices, or (a cap the
 /// whole-mesh evaluator takes) over the base vertices already.
 pub(crate) enum CapStencil {
@@ -271,7 +339,7 @@ fn semi_sharp_near(t: &subd_mesh::Topology, f: usize) -> bool {
 
 /// The patch's own parameters at `(u, v)` of its root face, and the factor its derivatives
 /// take back to the root's (negative for a turned-around triangle).
-fn patch_local(param: PatchParam, triangle: bool, u: f64, v: f64) -> (f64, f64, f64) {
+pub(super) fn patch_local(param: PatchParam, triangle: bool, u: f64, v: f64) -> (f64, f64, f64) {
     let scale = 1.0 / param.fraction();
     if triangle {
         let (s, t) = param.normalize_triangle(u, v);

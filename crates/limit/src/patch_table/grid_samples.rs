@@ -12,7 +12,10 @@
 //!
 //! A B-spline patch on a boundary gathers its phantom points (`2B − I`) instead of folding
 //! them into the weights ([`super::basis`] folds the weights): the same sums, grouped
-//! differently. Exact end caps evaluate each sample on their own (`super::exact_caps`).
+//! differently. Exact end caps take their samples after the rest of a chunk's, cap by cap:
+//! Stam's corner pieces from weights tabulated the same way ([`super::cap_grid`]), the
+//! others by their own evaluation (`super::exact_caps`), a cap refined locally sharing its
+//! pieces between its samples.
 
 use std::collections::HashMap;
 
@@ -20,6 +23,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::basis;
+use super::cap_grid::CapGrids;
 use super::table::{PatchTable, TablePoints};
 use super::{PatchParam, PatchType};
 
@@ -32,7 +36,7 @@ const SAMPLE_CHUNK: usize = 4096;
 
 /// The largest grid (points of a root face) whose non-product basis is tabulated; beyond
 /// it (rates above 64) those patch types are evaluated sample by sample.
-const MAX_TABLE_POINTS: usize = 65 * 65;
+pub(super) const MAX_TABLE_POINTS: usize = 65 * 65;
 
 /// A cubic B-spline's four values and four derivatives at one grid coordinate.
 type CubicRow = [[f64; 4]; 2];
@@ -46,6 +50,8 @@ struct GridBasis {
     /// Position, ∂s and ∂t weights (`3 n` per grid point) of the other tabulated types, by
     /// (type, boundary mask, span).
     tables: HashMap<(PatchType, u8, u32), Vec<f64>>,
+    /// The exact caps' corner pieces on the same grids.
+    caps: CapGrids,
 }
 
 impl GridBasis {
@@ -70,7 +76,7 @@ impl GridBasis {
                 let boundary = if place.regular { place.boundary } else { 0 };
                 let m = spans[usize::from(place.non_quad)];
                 let key = (array.kind(), boundary, m);
-                if grid_points(array.kind(), m) <= MAX_TABLE_POINTS && !keys.contains(&key) {
+                if grid_points_of(array.kind(), m) <= MAX_TABLE_POINTS && !keys.contains(&key) {
                     keys.push(key);
                 }
             }
@@ -83,6 +89,7 @@ impl GridBasis {
             spans,
             cubic,
             tables,
+            caps: CapGrids::new(table, spans),
         }
     }
 }
@@ -96,9 +103,14 @@ fn is_triangle(kind: PatchType) -> bool {
 }
 
 /// Grid points of span `m` on a patch of type `kind`.
-fn grid_points(kind: PatchType, m: u32) -> usize {
+fn grid_points_of(kind: PatchType, m: u32) -> usize {
+    grid_points(is_triangle(kind), m)
+}
+
+/// Grid points of span `m` on a triangle or a quad.
+pub(super) fn grid_points(triangle: bool, m: u32) -> usize {
     let m = m as usize;
-    if is_triangle(kind) {
+    if triangle {
         (m + 1) * (m + 2) / 2
     } else {
         (m + 1) * (m + 1)
@@ -106,7 +118,7 @@ fn grid_points(kind: PatchType, m: u32) -> usize {
 }
 
 /// The index of grid point `(i, j)` of span `m`, row by row.
-fn grid_index(triangle: bool, m: u32, i: u32, j: u32) -> usize {
+pub(super) fn grid_index(triangle: bool, m: u32, i: u32, j: u32) -> usize {
     if triangle {
         (j * (2 * m + 3 - j) / 2 + i) as usize
     } else {
@@ -120,7 +132,7 @@ fn tabulate(kind: PatchType, boundary: u8, m: u32) -> Vec<f64> {
         .num_control_points()
         .expect("a tabulated type has points");
     let triangle = is_triangle(kind);
-    let mut out = vec![0.0; 3 * n * grid_points(kind, m)];
+    let mut out = vec![0.0; 3 * n * grid_points_of(kind, m)];
     for j in 0..=m {
         let last = if triangle { m - j } else { m };
         for i in 0..=last {
@@ -136,7 +148,7 @@ fn tabulate(kind: PatchType, boundary: u8, m: u32) -> Vec<f64> {
 }
 
 /// The grid step nearest `x · m`, when `x` is a grid coordinate (within rounding).
-fn grid_step(x: f64, m: u32) -> Option<u32> {
+pub(super) fn grid_step(x: f64, m: u32) -> Option<u32> {
     let y = x * f64::from(m);
     if !(-0.5..=f64::from(m) + 0.5).contains(&y) {
         return None;
@@ -193,33 +205,70 @@ impl PatchTable {
             .zip(params.par_chunks(SAMPLE_CHUNK))
             .any(|((p, n), at)| {
                 let mut gathered = Gathered::new();
+                // Samples on exact caps, as (cap, sample): evaluated per cap after the rest.
+                let mut on_caps = Vec::new();
                 for k in 0..at.len() {
                     match self.grid_sample(pts, &basis, at[k], &mut gathered) {
-                        Ok(value) => (p[k], n[k]) = value,
+                        Ok(Some(value)) => (p[k], n[k]) = value,
+                        Ok(None) => on_caps.push((gathered.handle.1, k)),
                         Err(_) => return true,
                     }
                 }
-                false
+                self.cap_samples(pts, &basis, at, &mut on_caps, p, n)
+                    .is_err()
             });
         if failed {
             // The first failing sample's error, not whichever a thread met first.
             let mut gathered = Gathered::new();
-            let first = params
-                .iter()
-                .find_map(|&at| self.grid_sample(pts, &basis, at, &mut gathered).err());
+            let first = params.iter().find_map(|&at| {
+                match self.grid_sample(pts, &basis, at, &mut gathered) {
+                    Ok(None) => self.exact_position_normal(pts, gathered.handle.1, at).err(),
+                    sample => sample.err(),
+                }
+            });
             return Err(first.unwrap_or_else(|| LimitError::Param("a sample failed".into())));
         }
         Ok((positions, normals))
     }
 
-    /// One sample's position and normal.
+    /// The samples `on_caps` ((exact cap, index in `at`)) of one chunk, each cap's together
+    /// (a cap refined locally shares its pieces between them), into `p` and `n`.
+    fn cap_samples(
+        &self,
+        pts: &TablePoints,
+        basis: &GridBasis,
+        at: &[FaceParam],
+        on_caps: &mut [(usize, usize)],
+        p: &mut [DVec3],
+        n: &mut [DVec3],
+    ) -> Result<(), LimitError> {
+        on_caps.sort_unstable();
+        let exact = self.exact_caps().map(|(_, a)| &self.arrays()[a]);
+        for run in on_caps.chunk_by(|a, b| a.0 == b.0) {
+            let cap = run[0].0;
+            let places: Vec<FaceParam> = run.iter().map(|&(_, k)| at[k]).collect();
+            let span = exact.map(|e| basis.spans[usize::from(e.params()[cap].place().non_quad)]);
+            let tabulated = span.and_then(|m| basis.caps.samples(self, pts, cap, &places, m));
+            let values = match tabulated {
+                Some(values) => values,
+                None => self.exact_position_normals(pts, cap, &places)?,
+            };
+            for (&(_, k), value) in run.iter().zip(values) {
+                (p[k], n[k]) = value;
+            }
+        }
+        Ok(())
+    }
+
+    /// One sample's position and normal; `None` for a sample on an exact cap (the cap is
+    /// `cur.handle.1`), which [`Self::cap_samples`] evaluates.
     fn grid_sample(
         &self,
         pts: &TablePoints,
         basis: &GridBasis,
         at: FaceParam,
         cur: &mut Gathered,
-    ) -> Result<(DVec3, DVec3), LimitError> {
+    ) -> Result<Option<(DVec3, DVec3)>, LimitError> {
         let root = self.root_of(&at);
         // A patch covering its whole root (depth 0) holds every sample of it: no search.
         if root != cur.root || !cur.whole {
@@ -233,9 +282,7 @@ impl PatchTable {
         let m = cur.span;
         let steps = grid_step(s, m).zip(grid_step(t, m));
         let (p, du, dv) = match (cur.kind, steps) {
-            (PatchType::Exact, _) => {
-                return self.exact_position_normal(pts, cur.handle.1, at);
-            }
+            (PatchType::Exact, _) => return Ok(None),
             (PatchType::Regular, Some((ks, kt))) => cubic_first(
                 &cur.points,
                 &basis.cubic[cur.row][ks as usize],
@@ -250,14 +297,23 @@ impl PatchTable {
                         let at = 3 * n * grid_index(cur.triangle, m, ks, kt);
                         tabulated_first(&w[at..at + 3 * n], cps, &pts.points)
                     }
-                    None => return self.evaluate_on(pts, at).map(|p| (p.position, p.normal())),
+                    None => return self.position_normal(pts, at).map(Some),
                 }
             }
-            _ => return self.evaluate_on(pts, at).map(|p| (p.position, p.normal())),
+            _ => return self.position_normal(pts, at).map(Some),
         };
         // Derivatives in the patch's own parameters: the map to the root's scales both by
         // the same factor (negated for a turned triangle), which leaves the normal as it is.
-        Ok((p, du.cross(dv).normalize_or_zero()))
+        Ok(Some((p, du.cross(dv).normalize_or_zero())))
+    }
+
+    /// Position and normal at `at`, found and evaluated on its own.
+    fn position_normal(
+        &self,
+        pts: &TablePoints,
+        at: FaceParam,
+    ) -> Result<(DVec3, DVec3), LimitError> {
+        self.evaluate_on(pts, at).map(|p| (p.position, p.normal()))
     }
 }
 
@@ -364,7 +420,7 @@ fn cubic_first(p: &[DVec3; 16], s: &CubicRow, t: &CubicRow) -> (DVec3, DVec3, DV
 
 /// Position and first derivatives from tabulated weights (`n` each for the position, ∂s
 /// and ∂t) of the points `cps`.
-fn tabulated_first(w: &[f64], cps: &[u32], points: &[DVec3]) -> (DVec3, DVec3, DVec3) {
+pub(super) fn tabulated_first(w: &[f64], cps: &[u32], points: &[DVec3]) -> (DVec3, DVec3, DVec3) {
     let n = cps.len();
     let (mut pos, mut du, mut dv) = (DVec3::ZERO, DVec3::ZERO, DVec3::ZERO);
     for (k, &cp) in cps.iter().enumerate() {

@@ -47,6 +47,7 @@ mod basis;
 mod batch_eval;
 mod box_fit;
 mod bspline_caps;
+mod cap_grid;
 mod classify;
 mod end_caps;
 mod exact_caps;

@@ -424,6 +424,28 @@ impl PatchTable {
         Ok((p.position, p.normal()))
     }
 
+    /// The exact end caps and the index of their array, when the table has them.
+    pub(crate) fn exact_caps(&self) -> Option<(&ExactCaps, usize)> {
+        self.exact.as_ref().zip(self.exact_array)
+    }
+
+    /// [`Self::exact_position_normal`] at every place of `ats` (all in cap `i`), the
+    /// places sharing what their evaluation can share.
+    pub(crate) fn exact_position_normals(
+        &self,
+        pts: &TablePoints,
+        i: usize,
+        ats: &[FaceParam],
+    ) -> Result<Vec<(DVec3, DVec3)>, LimitError> {
+        let exact = self.exact.as_ref().expect("exact end caps are set up");
+        let cap_points = pts.exact.as_ref().expect("and their points");
+        let a = self.exact_array.expect("an exact array");
+        let param = self.arrays[a].params[i];
+        let cx = self.cap_context(&pts.points);
+        let values = exact.evaluate_many(&cx, cap_points, i, param, ats, Derivatives::First)?;
+        Ok(values.iter().map(|p| (p.position, p.normal())).collect())
+    }
+
     /// Exact end cap `i` (index in the exact array) at `at` as weights of the points it
     /// reads.
     pub(crate) fn exact_cap_stencil(
