@@ -12,6 +12,7 @@ use super::{
 };
 use crate::LimitError;
 use crate::evaluation::patch::SurfacePoint;
+use crate::evaluation::piece::{Piece, eval_piece, piece_of, project};
 
 /// [`super::evaluate`] at many places `(u, v)` of face `f`, each value the same bits as
 /// its: the descent is shared while places lie in the same child face, so each
@@ -139,12 +140,14 @@ impl SharedDescent<'_> {
             }
             // A child that is a known patch is evaluated where it is: its ring is whole in
             // the refined piece (see the module's note), so cutting it out would change
-            // nothing it reads.
-            if crate::evaluation::piece::is_direct(t1, rules1, child, scheme)? {
-                let piece = (t1, rules1, child);
+            // nothing it reads. Its piece (and a corner piece's projection) serves all its
+            // places.
+            let piece = piece_of(t1, rules1, child, scheme)?;
+            if !matches!(piece, Piece::Refined | Piece::Local) {
+                let projected = project(&piece, &refined);
                 for p in group {
-                    let at = (p.u, p.v, p.scale);
-                    out[p.k] = patch_value(piece, &refined, scheme, at, self.face)?;
+                    let value = eval_piece(&piece, &refined, projected.as_ref(), child, p.u, p.v);
+                    out[p.k] = value?.scaled(p.scale);
                 }
                 continue;
             }
