@@ -45,6 +45,15 @@ struct ValueTag {
     semi_sharp: bool,
     /// Semi-sharp because the other value at its vertex is (the two-value plus modes).
     dep_sharp: bool,
+    /// What the patches read of the value's span at the base level (§2.3, the
+    /// "informational" tags), kept by vertex children and zero for edge children's values;
+    /// refinement never reads them: the faces the value spans, the infinitely sharp edges
+    /// inside the span, whether the span is disjoint (or the vertex non-manifold), and
+    /// whether the value was pinned as an infinitely sharp corner.
+    span_faces: u16,
+    span_inf_edges: u16,
+    disjoint: bool,
+    inf_sharp: bool,
 }
 
 impl ValueTag {
@@ -392,6 +401,11 @@ impl FaceVaryingRefinement {
             level: &self.levels[level],
             topology: refinement.topology(level),
             linear: self.mode == FVarLinearInterpolation::All,
+            regular_span: if *refinement.scheme() == crate::Scheme::Loop {
+                3
+            } else {
+                2
+            },
         }
     }
 
@@ -847,133 +861,15 @@ impl NextValues<'_> {
     }
 }
 
-/// The values of one level of a [`FaceVaryingRefinement`] as limit masks need them: which
-/// values each vertex has, whether they follow the geometry (matching) or are seam corners
-/// or seam creases, and a crease value's two end values (`Vtr::FVarLevel`'s state).
-///
-/// Values are named by their index at that level (at level 0, the channel's own indices).
-#[derive(Debug, Clone, Copy)]
-pub struct FVarLevelValues<'a> {
-    level: &'a ChannelLevel,
-    topology: &'a Topology,
-    linear: bool,
-}
-
-impl FVarLevelValues<'_> {
-    /// Whether the channel is linear everywhere (mode `all`): every value's limit is itself.
-    pub fn is_linear(&self) -> bool {
-        self.linear
-    }
-
-    /// Number of values of vertex `v` (its siblings).
-    pub fn num_vertex_values(&self, v: usize) -> usize {
-        self.level.count(v)
-    }
-
-    /// The `k`-th value of vertex `v`.
-    pub fn vertex_value(&self, v: usize, k: usize) -> u32 {
-        self.level.source(self.level.offset(v) + k)
-    }
-
-    /// Whether vertex `v`'s values follow the geometry's rules (one value, no seam, and
-    /// not pinned by the mode).
-    pub fn is_matching(&self, v: usize) -> bool {
-        !self.level.tags[self.level.offset(v)].mismatch
-    }
-
-    /// The value at corner `k` of face `f`.
-    pub fn corner_value(&self, f: usize, k: usize) -> u32 {
-        self.level.corner_source(self.topology, f, k)
-    }
-
-    /// The value at the far end of edge `e` from vertex `v`, seen from a vertex whose
-    /// values match (every edge there is continuous, so any of its faces gives it).
-    pub fn far_value(&self, e: usize, v: u32) -> u32 {
-        let [a, b] = self.level.edge_face_sources(self.topology, e, 0);
-        if self.topology.edge_vertices(e)[0] != v {
-            a
-        } else {
-            b
-        }
-    }
-
-    /// For a seam value `k` of a mismatched vertex `v` that is refined with the crease rule,
-    /// the values at the far ends of the two edges bounding its span; `None` for a value
-    /// pinned as a corner (including one still semi-sharp).
-    pub fn crease_ends(&self, v: usize, k: usize) -> Option<[u32; 2]> {
-        let slot = self.level.offset(v) + k;
-        let tag = self.level.tags[slot];
-        (tag.mismatch && !tag.is_corner())
-            .then(|| self.level.crease_end_sources(self.topology, v, slot))
-    }
-}
-
-/// How a face-varying value is refined at its level (`Vtr::FVarLevel`'s value tags, in the
-/// terms of the vertex rules).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum FVarValueKind {
-    /// The one value of a seamless vertex: it follows the vertex's own rule.
-    Matching,
-    /// Pinned by the mode or by infinitely sharp features: it stays put.
-    Corner,
-    /// On a seam: the crease rule along the two seam edges bounding its span.
-    Crease,
-    /// Pinned until the semi-sharp features around it decay, a crease after that.
-    SemiSharp,
-}
-
-impl FVarLevelValues<'_> {
-    /// Number of (vertex, value) pairs at this level. At refined levels that is the number of
-    /// values; at level 0 a channel value used at two vertices counts once at each.
-    pub fn num_slots(&self) -> usize {
-        self.level.num_values()
-    }
-
-    /// The slot of value `k` of vertex `v`: slots number the (vertex, value) pairs vertex by
-    /// vertex, and at refined levels a slot is the value's own index.
-    pub fn slot(&self, v: usize, k: usize) -> usize {
-        self.level.offset(v) + k
-    }
-
-    /// The slot at corner `k` of face `f`.
-    pub fn corner_slot(&self, f: usize, k: usize) -> usize {
-        self.level.corner_slot(self.topology, f, k)
-    }
-
-    /// The value (the channel's own index at level 0) of slot `slot`.
-    pub fn slot_value(&self, slot: usize) -> u32 {
-        self.level.source(slot)
-    }
-
-    /// How value `k` of vertex `v` is refined.
-    pub fn value_kind(&self, v: usize, k: usize) -> FVarValueKind {
-        self.level.kind(v, self.slot(v, k))
-    }
-}
-
-impl ChannelLevel {
-    /// How per-vertex value `slot` of vertex `v` is refined.
-    fn kind(&self, v: usize, slot: usize) -> FVarValueKind {
-        let tag = self.tags[slot];
-        if !self.tags[self.offset(v)].mismatch {
-            FVarValueKind::Matching
-        } else if tag.semi_sharp {
-            FVarValueKind::SemiSharp
-        } else if tag.crease {
-            FVarValueKind::Crease
-        } else {
-            FVarValueKind::Corner
-        }
-    }
-}
-
 mod base;
 mod child;
 mod state;
 #[cfg(test)]
 mod tests;
+mod values;
 
 pub use state::FVarLevelState;
+pub use values::{FVarLevelValues, FVarPatchTag, FVarValueKind};
 
 use base::*;
 pub(crate) use base::{base_corner_kinds, check_channel};

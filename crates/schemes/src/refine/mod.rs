@@ -16,7 +16,9 @@ mod tags;
 
 pub use counts::{LevelCounts, refined_counts};
 pub(crate) use counts::{last_level_bytes, topology_bytes};
-pub use fvar::{FVarLevelState, FVarLevelValues, FVarValueKind, FaceVaryingRefinement};
+pub use fvar::{
+    FVarLevelState, FVarLevelValues, FVarPatchTag, FVarValueKind, FaceVaryingRefinement,
+};
 pub(crate) use fvar::{base_corner_kinds, check_channel};
 pub use layout::ChildLayout;
 pub(crate) use osd::OsdRefinement;

@@ -423,12 +423,16 @@ pub(super) fn classify_vertex(
         dependent = (a.semi > 0) != (b.semi > 0);
     }
     for (k, s) in spans.iter().enumerate() {
-        let mut tag = ValueTag {
-            mismatch: true,
-            ..ValueTag::default()
-        };
         let inf_sharp =
             all_corners || s.inf > 0 || (s.size == 1 && flags.corners_sharp) || s.discts > 0;
+        let mut tag = ValueTag {
+            mismatch: true,
+            span_faces: s.size,
+            span_inf_edges: s.inf,
+            disjoint: s.discts > 0,
+            inf_sharp,
+            ..ValueTag::default()
+        };
         if !inf_sharp {
             if s.semi > 0 || is_semi_sharp(vs) {
                 tag.semi_sharp = true;

@@ -336,3 +336,131 @@ fn continuing_from_a_levels_state_is_the_next_level() {
         }
     }
 }
+
+/// A channel on `faces` (a list of quads or triangles of `t`) in which each face's island
+/// (`island(face)`) names its own value at every vertex it touches: seams wherever two
+/// islands meet.
+fn island_channel(
+    t: &Topology,
+    faces: &[u32],
+    n: usize,
+    island: impl Fn(usize) -> usize,
+) -> FVarChannel {
+    let mut index = std::collections::HashMap::new();
+    let indices: Vec<u32> = faces
+        .iter()
+        .enumerate()
+        .map(|(k, &v)| {
+            let fresh = index.len() as u32;
+            *index.entry((v, island(k / n))).or_insert(fresh)
+        })
+        .collect();
+    let values = (0..index.len()).map(|i| i as f64).collect();
+    FVarChannel::new(t, 1, values, indices).unwrap()
+}
+
+/// The patch tags of every value of vertex `v` at `level`.
+fn patch_tags(
+    r: &Refinement,
+    channel: &FVarChannel,
+    mode: FVarLinearInterpolation,
+    level: usize,
+    v: usize,
+) -> Vec<FVarPatchTag> {
+    let fr = FaceVaryingRefinement::new(r, channel, mode).unwrap();
+    let values = fr.level_values(r, level);
+    (0..values.num_vertex_values(v))
+        .map(|k| values.patch_tag(v, k))
+        .collect()
+}
+
+const REGULAR_CREASE: FVarPatchTag = FVarPatchTag {
+    non_manifold: false,
+    xordinary: false,
+    inf_sharp_edges: false,
+    inf_irregular: false,
+};
+
+/// The informational value tags of §2.3 on small layouts, each expectation read off the
+/// rules there (OpenSubdiv's `FVarLevel::completeTopologyFromFaceValues`): a straight seam
+/// through a regular vertex is two regular crease values, its ends on the boundary are
+/// one-face spans (smooth corners, irregular, in mode `none`; pinned, regular, with the
+/// corners sharp), a seam that ends inside is a dart (one value over four faces), and a
+/// value met again after another is non-manifold. Vertex children keep the tags, the values
+/// of a seam's edge children have none.
+#[test]
+fn patch_tags_follow_the_value_spans() {
+    use FVarLinearInterpolation as M;
+    let faces = [0, 1, 4, 3, 1, 2, 5, 4, 4, 5, 8, 7, 3, 4, 7, 6];
+    let t = TopologyBuilder::new(9).build(&[4; 4], &faces).unwrap();
+    let r = Refinement::new(&t, Scheme::CatmullClark, &Options::default(), 1).unwrap();
+    // Faces 0, 1 below the seam 3-4-5, faces 2, 3 above it.
+    let straight = island_channel(&t, &faces, 4, |f| usize::from(f >= 2));
+    for mode in [M::None, M::CornersOnly, M::CornersPlus1] {
+        assert_eq!(
+            patch_tags(&r, &straight, mode, 0, 4),
+            [REGULAR_CREASE; 2],
+            "{mode:?}"
+        );
+        assert_eq!(
+            patch_tags(&r, &straight, mode, 1, 4),
+            [REGULAR_CREASE; 2],
+            "{mode:?}"
+        );
+    }
+    let smooth_corner = FVarPatchTag {
+        xordinary: true,
+        inf_irregular: true,
+        ..REGULAR_CREASE
+    };
+    assert_eq!(patch_tags(&r, &straight, M::None, 0, 3), [smooth_corner; 2]);
+    assert_eq!(
+        patch_tags(&r, &straight, M::CornersOnly, 0, 3),
+        [REGULAR_CREASE; 2]
+    );
+    // The seam's edge child between vertices 4 and 5: two values, no informational bits,
+    // and the matching vertex 0 none either.
+    let layout = crate::ChildLayout::new(&t, &Scheme::CatmullClark, 1).unwrap();
+    let seam_edge = t.find_edge(4, 5).unwrap();
+    let edge_child = layout.edge_point(0, u64::from(seam_edge)) as usize;
+    assert_eq!(
+        patch_tags(&r, &straight, M::None, 1, edge_child),
+        [FVarPatchTag::default(); 2]
+    );
+    assert_eq!(
+        patch_tags(&r, &straight, M::None, 0, 0),
+        [FVarPatchTag::default()]
+    );
+    // A dart: only edge 1-4 is a seam (face 1's value at vertex 1 is its own), so vertex 4
+    // has one value spanning all four faces.
+    let mut dart_indices: Vec<u32> = faces.to_vec();
+    dart_indices[4] = 9;
+    let dart = FVarChannel::new(&t, 1, (0..10).map(f64::from).collect(), dart_indices).unwrap();
+    let dart_value = FVarPatchTag {
+        xordinary: true,
+        inf_irregular: true,
+        ..REGULAR_CREASE
+    };
+    for mode in [M::None, M::CornersPlus2] {
+        assert_eq!(patch_tags(&r, &dart, mode, 0, 4), [dart_value], "{mode:?}");
+    }
+    // Islands A B A B around vertex 4: A's value comes back, a disjoint span.
+    let alternating = island_channel(&t, &faces, 4, |f| f % 2);
+    let tags = patch_tags(&r, &alternating, M::None, 0, 4);
+    assert!(tags[0].non_manifold && !tags[0].xordinary, "{tags:?}");
+    assert!(tags[1..].iter().all(|g| !g.non_manifold), "{tags:?}");
+}
+
+/// Loop's regular boundary vertex has three faces: a straight seam through a valence-6
+/// vertex leaves two regular crease values (they would be irregular for quads).
+#[test]
+fn loop_patch_tags_count_three_faces_as_regular() {
+    let faces: Vec<u32> = (0..6u32)
+        .flat_map(|i| [0, 1 + i, 1 + (i + 1) % 6])
+        .collect();
+    let t = TopologyBuilder::new(7).build(&[3; 6], &faces).unwrap();
+    let r = Refinement::new(&t, Scheme::Loop, &Options::default(), 1).unwrap();
+    let straight = island_channel(&t, &faces, 3, |f| usize::from(f >= 3));
+    let tags = patch_tags(&r, &straight, FVarLinearInterpolation::None, 0, 0);
+    assert_eq!(tags, [REGULAR_CREASE; 2]);
+}
