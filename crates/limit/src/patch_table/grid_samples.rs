@@ -179,6 +179,11 @@ struct Gathered {
     row: usize,
     /// A B-spline patch's points, phantoms in place.
     points: [DVec3; 16],
+    /// The grid row `rows` holds (`u32::MAX`: none yet for this patch).
+    row_step: u32,
+    /// A B-spline patch's columns combined with one grid row's basis: position and ∂t
+    /// (the tensor product's inner sums, shared by the row's samples).
+    rows: [[DVec3; 4]; 2],
 }
 
 impl PatchTable {
@@ -283,11 +288,13 @@ impl PatchTable {
         let steps = grid_step(s, m).zip(grid_step(t, m));
         let (p, du, dv) = match (cur.kind, steps) {
             (PatchType::Exact, _) => return Ok(None),
-            (PatchType::Regular, Some((ks, kt))) => cubic_first(
-                &cur.points,
-                &basis.cubic[cur.row][ks as usize],
-                &basis.cubic[cur.row][kt as usize],
-            ),
+            (PatchType::Regular, Some((ks, kt))) => {
+                if cur.row_step != kt {
+                    cur.rows = cubic_rows(&cur.points, &basis.cubic[cur.row][kt as usize]);
+                    cur.row_step = kt;
+                }
+                cubic_across(&cur.rows, &basis.cubic[cur.row][ks as usize])
+            }
             (kind, Some((ks, kt))) if !cur.triangle || ks + kt <= m => {
                 let (a, i) = cur.handle;
                 let cps = self.arrays()[a].patch_points(i);
@@ -333,6 +340,8 @@ impl Gathered {
             span: 1,
             row: 0,
             points: [DVec3::ZERO; 16],
+            row_step: u32::MAX,
+            rows: [[DVec3::ZERO; 4]; 2],
         }
     }
 
@@ -362,6 +371,7 @@ impl Gathered {
         self.origin = (f64::from(place.u), f64::from(place.v));
         if self.kind == PatchType::Regular {
             self.points = bspline_points(param, array.patch_points(i), &pts.points);
+            self.row_step = u32::MAX;
         }
     }
 
@@ -403,19 +413,24 @@ fn bspline_points(param: PatchParam, cps: &[u32], points: &[DVec3]) -> [DVec3; 1
     p
 }
 
-/// A bicubic B-spline's position and first derivatives from its 16 points and the basis
-/// rows of its two parameters, summed row by row.
-fn cubic_first(p: &[DVec3; 16], s: &CubicRow, t: &CubicRow) -> (DVec3, DVec3, DVec3) {
-    let (mut pos, mut du, mut dv) = (DVec3::ZERO, DVec3::ZERO, DVec3::ZERO);
-    for r in 0..4 {
-        let row = &p[4 * r..4 * r + 4];
-        let x = s[0][0] * row[0] + s[0][1] * row[1] + s[0][2] * row[2] + s[0][3] * row[3];
-        let d = s[1][0] * row[0] + s[1][1] * row[1] + s[1][2] * row[2] + s[1][3] * row[3];
-        pos += t[0][r] * x;
-        du += t[0][r] * d;
-        dv += t[1][r] * x;
-    }
-    (pos, du, dv)
+/// The inner sums of a bicubic B-spline at one grid row: each column of its 16 points
+/// (row-major, 4 × 4) combined with the row parameter's values (position) and derivatives
+/// (∂t).
+fn cubic_rows(p: &[DVec3; 16], t: &CubicRow) -> [[DVec3; 4]; 2] {
+    let column =
+        |c: usize, w: &[f64; 4]| w[0] * p[c] + w[1] * p[4 + c] + w[2] * p[8 + c] + w[3] * p[12 + c];
+    [
+        std::array::from_fn(|c| column(c, &t[0])),
+        std::array::from_fn(|c| column(c, &t[1])),
+    ]
+}
+
+/// A bicubic B-spline's position and first derivatives at one sample of a grid row from the
+/// row's inner sums ([`cubic_rows`]) and the basis of its column parameter.
+fn cubic_across(rows: &[[DVec3; 4]; 2], s: &CubicRow) -> (DVec3, DVec3, DVec3) {
+    let [pos, dt] = rows;
+    let sum = |w: &[f64; 4], x: &[DVec3; 4]| w[0] * x[0] + w[1] * x[1] + w[2] * x[2] + w[3] * x[3];
+    (sum(&s[0], pos), sum(&s[1], pos), sum(&s[0], dt))
 }
 
 /// Position and first derivatives from tabulated weights (`n` each for the position, ∂s
