@@ -262,9 +262,16 @@ fn ensure_system_packages(packages: &[(&str, &str)]) -> Result<(), String> {
 
 fn run(cmd: &mut Command) -> Result<(), String> {
     eprintln!("xtask: running {cmd:?}");
+    let start = std::time::Instant::now();
     let status = cmd
         .status()
         .map_err(|e| format!("cannot run {cmd:?}: {e}"))?;
+    // Where CI's time goes, step by step.
+    eprintln!(
+        "xtask: {:?} took {:.0} s",
+        cmd.get_program(),
+        start.elapsed().as_secs_f64()
+    );
     if status.success() {
         Ok(())
     } else {

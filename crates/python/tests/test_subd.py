@@ -114,6 +114,14 @@ def same_uvs(got, want, name):
         assert np.array_equal(got.uv_indices, want.uv_indices), name
 
 
+# Catmull-Clark shapes whose texture coordinates reach their exact limit through a whole
+# refinement 6 to 9 levels deep (semi-sharp creases of that sharpness on hundreds of faces):
+# 10-25 s each through each door. The shapes with sharpness-5 creases (chaikin, cubes,
+# single crease, val2) take the same code.
+SLOW_UV_LIMITS = {"catmark_car.obj", "catmark_bishop.obj", "catmark_pawn.obj",
+                  "catmark_gregory_test7.obj"}
+
+
 @pytest.mark.skipif(not SUBD_BIN, reason="SUBD_BIN (the subd binary) not set")
 @pytest.mark.parametrize("scheme,mode", [("catmull-clark", "all"), ("loop", "none"),
                                          ("catmull-clark", "corners-plus2"),
@@ -121,8 +129,10 @@ def same_uvs(got, want, name):
 def test_refine_to_the_limit_with_uvs_equals_the_binary(tmp_path, scheme, mode):
     compared = with_uvs = 0
     extra = [] if mode is None else ["--fvar-interpolation", mode]
+    shapes = [s for s in sorted(SHAPES.glob("*.obj"))
+              if not (scheme == "catmull-clark" and s.name in SLOW_UV_LIMITS)]
     for got, want, name in binary_and_binding(
-        tmp_path, sorted(SHAPES.glob("*.obj")),
+        tmp_path, shapes,
         lambda obj: ["refine", "--scheme", scheme, "--levels", "1", "--limit", *extra],
         lambda mesh, obj: subd.refine(mesh, scheme, levels=1, limit=True,
                                       fvar_interpolation=mode),
