@@ -3,7 +3,7 @@
 Usage::
 
     python examples/python/dask_batch.py IN_DIR OUT_DIR --scheme S --levels N \\
-        [--format obj|ply|glb] [--workers W] [--threads-per-worker T] \\
+        [--format obj|ply|glb|usda|usdc|usdz] [--workers W] [--threads-per-worker T] \\
         [--scheduler ADDRESS] [--verbose]
 
     # 4 local worker processes, Catmull-Clark twice:
@@ -15,7 +15,7 @@ Usage::
         --levels 3 --scheduler tcp://host:8786
 
 Inputs are the files under IN_DIR, searched recursively, whose extension subd reads
-(.obj, .ply, .gltf, .glb, in any case), in sorted order; files under OUT_DIR are left out
+(.obj, .ply, .gltf, .glb, .usd, .usda, .usdc, .usdz, in any case), in sorted order; files under OUT_DIR are left out
 when OUT_DIR lies inside IN_DIR. Each input gives ``OUT_DIR/<stem>.<ext>``: ``ext`` is the
 input's own (a .gltf input gives .glb, which subd writes) unless ``--format`` names one.
 
@@ -73,10 +73,10 @@ from typing import Callable, Dict, List, Optional, Sequence, Tuple
 import subd
 from distributed import Client, LocalCluster, WorkerPlugin, as_completed
 
-INPUT_EXTENSIONS = (".obj", ".ply", ".gltf", ".glb")
+INPUT_EXTENSIONS = (".obj", ".ply", ".gltf", ".glb", ".usd", ".usda", ".usdc", ".usdz")
 """Extensions of the files taken as inputs (compared ignoring case)."""
 
-OUTPUT_FORMATS = ("obj", "ply", "glb")
+OUTPUT_FORMATS = ("obj", "ply", "glb", "usda", "usdc", "usdz")
 """Formats subd writes."""
 
 EXIT_OK = 0

@@ -29,6 +29,7 @@ mod scaling_bench;
 mod split_bench;
 mod tess_bench;
 mod tess_conformance;
+mod usd_conformance;
 
 #[derive(Parser)]
 #[command(name = "xtask", about = "subd project automation")]
@@ -279,6 +280,11 @@ fn run(cmd: &mut Command) -> Result<(), String> {
     }
 }
 
+/// The USD stages Pixar's USD wrote for the conformance rows (`tests/data/usd`).
+fn usd_stages() -> std::path::PathBuf {
+    workspace_root().join("tests/data/usd")
+}
+
 /// The workspace's root directory.
 fn workspace_root() -> std::path::PathBuf {
     std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -329,6 +335,9 @@ fn main() -> ExitCode {
                 }
                 rows.extend(fvar_conformance::shapes(&exe, &shapes)?);
                 rows.extend(fvar_conformance::random(&exe, random));
+                if !fvar_only {
+                    rows.extend(usd_conformance::stages(&exe, &usd_stages())?);
+                }
             }
             if against != Against::Opensubdiv && !fvar_only && !patches_only {
                 let geom = geom_ref::build_harness()?;

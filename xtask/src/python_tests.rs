@@ -20,6 +20,8 @@ pub(crate) const TEST_PACKAGES: &[&str] = &[
     "libigl",
     "trimesh",
     "dask[distributed]",
+    // Pixar's USD: the reference the USD tests hold subd's reader and writer to.
+    "usd-core",
 ];
 
 /// Builds and installs the package in `target/python-env`, then runs its tests.

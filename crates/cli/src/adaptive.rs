@@ -219,7 +219,7 @@ fn run_one(
     out: &mut dyn Write,
     err: &mut dyn Write,
 ) -> Result<(), Failure> {
-    let started = ADAPTIVE.start(&job.input, &job.output)?;
+    let started = ADAPTIVE.start_job(job)?;
     let levels = check_arguments(args)?;
     let opened = started.read(&args.rules, err)?;
     let (file, t_read) = (&opened.file, opened.read_seconds);
@@ -281,7 +281,7 @@ fn run_one(
     let uv = adaptive_uv(mesh, &request, surface, &result, err, job);
     spinner.message("writing");
     let t3 = Instant::now();
-    let written = write(job, &result, &options, uv.as_ref())?;
+    let written = write(job, &result, &options, uv.as_ref(), &file.output_options())?;
     print_warnings(err, &job.input, &written);
     spinner.finish();
     let t_write = t3.elapsed().as_secs_f64();
@@ -488,6 +488,7 @@ fn write(
     mesh: &AdaptiveMesh,
     options: &subd_schemes::Options,
     uv: Option<&crate::uv::RefinedUv>,
+    write_options: &subd_io::WriteOptions,
 ) -> Result<Vec<String>, Failure> {
     let fail = |e: subd_io::ViewError| bad(format!("{}: {e}", job.input.display()));
     let mut view = subd_io::MeshView::new(
@@ -506,6 +507,7 @@ fn write(
         crease_method: Some(options.crease_method),
         triangle_subdivision: Some(options.triangle_subdivision),
         fvar_interpolation: None,
+        scheme: None,
     };
     let mut warnings = Vec::new();
     let with_uv = crate::uv::with_uv(view.clone(), uv).map_err(fail)?;
@@ -515,6 +517,6 @@ fn write(
     } else {
         view = with_uv;
     }
-    subd_io::write_view(&job.output, &view, &subd_io::WriteOptions::default())?;
+    subd_io::write_view(&job.output, &view, write_options)?;
     Ok(warnings)
 }

@@ -20,13 +20,14 @@ use crate::failure::bad;
 use crate::{EXIT_BAD_INPUT, Failure};
 
 /// Extensions of the mesh files a directory input contributes.
-const MESH_EXTENSIONS: [&str; 4] = ["obj", "ply", "glb", "gltf"];
+const MESH_EXTENSIONS: [&str; 8] = ["obj", "ply", "glb", "gltf", "usd", "usda", "usdc", "usdz"];
 
 /// The input and output paths of a mesh command, single or batch.
 #[derive(Debug, Clone, Args)]
 pub(crate) struct Files {
     /// `IN OUT`; or, with --out-dir, any number of inputs: mesh files, or directories
-    /// searched recursively for .obj, .ply, .glb and .gltf files.
+    /// searched recursively for .obj, .ply, .glb, .gltf, .usd, .usda, .usdc and .usdz files.
+    /// Each mesh prim of a USD stage with several is an input of its own.
     #[arg(required = true, value_name = "IN... [OUT]")]
     paths: Vec<PathBuf>,
     /// Batch mode: write one output per input into DIR (created if missing), named after
@@ -47,6 +48,9 @@ pub(crate) enum OutputFormat {
     Obj,
     Ply,
     Glb,
+    Usda,
+    Usdc,
+    Usdz,
     /// Text, one line per vertex (`subd limit` only).
     Txt,
 }
@@ -65,6 +69,10 @@ impl OutputFormat {
             subd_io::Format::Obj => Some(OutputFormat::Obj),
             subd_io::Format::Ply => Some(OutputFormat::Ply),
             subd_io::Format::Glb => Some(OutputFormat::Glb),
+            // `.usd` is written as binary, as USD writes it.
+            subd_io::Format::Usda => Some(OutputFormat::Usda),
+            subd_io::Format::Usdc => Some(OutputFormat::Usdc),
+            subd_io::Format::Usdz => Some(OutputFormat::Usdz),
             subd_io::Format::Gltf => None,
         }
     }
@@ -75,6 +83,9 @@ impl OutputFormat {
             OutputFormat::Obj => "obj",
             OutputFormat::Ply => "ply",
             OutputFormat::Glb => "glb",
+            OutputFormat::Usda => "usda",
+            OutputFormat::Usdc => "usdc",
+            OutputFormat::Usdz => "usdz",
             OutputFormat::Txt => "txt",
         }
     }
@@ -88,6 +99,8 @@ pub(crate) struct Job {
     pub(crate) quiet: bool,
     /// Files processed at the same time as this one (they share the memory budget).
     pub(crate) concurrent: usize,
+    /// The mesh prim to read, for a USD stage with several (batch mode: one job each).
+    pub(crate) prim: Option<String>,
 }
 
 /// What batch mode needs to know about the command it drives.
@@ -99,8 +112,14 @@ pub(crate) struct Command {
 }
 
 /// Output formats of the commands that write meshes.
-pub(crate) const MESH_OUTPUTS: &[OutputFormat] =
-    &[OutputFormat::Obj, OutputFormat::Ply, OutputFormat::Glb];
+pub(crate) const MESH_OUTPUTS: &[OutputFormat] = &[
+    OutputFormat::Obj,
+    OutputFormat::Ply,
+    OutputFormat::Glb,
+    OutputFormat::Usda,
+    OutputFormat::Usdc,
+    OutputFormat::Usdz,
+];
 
 #[derive(Serialize)]
 struct FileError<'a> {
@@ -215,6 +234,7 @@ where
         output: output.clone(),
         quiet: false,
         concurrent: 1,
+        prim: None,
     };
     crate::refusal_alone(err, |err| one(&job, out, err))
 }
@@ -402,24 +422,60 @@ fn plan(files: &Files, dir: &Path, command: &Command) -> Result<Vec<Job>, Failur
             Some(f) => f.extension(),
             None => default_extension(&input),
         };
-        let stem = input.file_stem().unwrap_or(input.as_os_str());
-        let output = dir.join(stem).with_extension(extension);
-        if let Some(first) = seen.insert(output.clone(), input.clone()) {
-            return Err(bad(format!(
-                "{}: {} and {} would both write it (outputs are named after the input stem)",
-                output.display(),
-                first.display(),
-                input.display()
-            )));
+        for (prim, name) in items(&input) {
+            let output = dir.join(name).with_extension(extension);
+            if let Some(first) = seen.insert(output.clone(), input.clone()) {
+                return Err(bad(format!(
+                    "{}: {} and {} would both write it (outputs are named after the input stem)",
+                    output.display(),
+                    first.display(),
+                    input.display()
+                )));
+            }
+            jobs.push(Job {
+                input: input.clone(),
+                output,
+                quiet: true,
+                concurrent: 1,
+                prim,
+            });
         }
-        jobs.push(Job {
-            input,
-            output,
-            quiet: true,
-            concurrent: 1,
-        });
     }
     Ok(jobs)
+}
+
+/// The items of one input, with the names of their outputs: the file itself, named after
+/// its stem; or, for a USD stage with several mesh prims, each prim, named after the stem
+/// and the prim's path (`scene_World_Body`). A stage that cannot be opened is one item,
+/// which fails with the reader's message when it runs.
+fn items(input: &Path) -> Vec<(Option<String>, std::ffi::OsString)> {
+    let stem = input
+        .file_stem()
+        .unwrap_or(input.as_os_str())
+        .to_os_string();
+    let usd = matches!(
+        subd_io::Format::from_path(input),
+        Some(subd_io::Format::Usda | subd_io::Format::Usdc | subd_io::Format::Usdz)
+    );
+    let prims = if usd {
+        subd_io::usd::mesh_prims(input).unwrap_or_default()
+    } else {
+        Vec::new()
+    };
+    if prims.len() < 2 {
+        return vec![(None, stem)];
+    }
+    prims
+        .into_iter()
+        .map(|p| {
+            let mut name = stem.clone();
+            for part in p.path.split('/').filter(|s| !s.is_empty()) {
+                name.push("_");
+                name.push(part);
+            }
+            (Some(p.path), name)
+        })
+        .collect()
 }
 
 /// The output extension of an input when `--format` is not given: its own, with .gltf
@@ -433,6 +489,10 @@ fn default_extension(input: &Path) -> &'static str {
     match ext.as_deref() {
         Some("ply") => "ply",
         Some("glb" | "gltf") => "glb",
+        Some("usda") => "usda",
+        Some("usdc") => "usdc",
+        Some("usdz") => "usdz",
+        Some("usd") => "usd",
         _ => "obj",
     }
 }

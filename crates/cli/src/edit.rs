@@ -218,10 +218,12 @@ fn residual_reports(constraints: &[Constraint], res: &[f64]) -> Vec<ConstraintRe
         .collect()
 }
 
-/// Writes IN's topology, tags and texture coordinates with the edited control vertices.
+/// Writes IN's topology, tags and texture coordinates with the edited control vertices: a
+/// cage that a USD renderer subdivides with `scheme`.
 fn write_edited(
     job: &Job,
     file: &subd_io::MeshFile,
+    scheme: &Scheme,
     positions: &[DVec3],
     err: &mut dyn Write,
 ) -> Result<(), Failure> {
@@ -231,9 +233,10 @@ fn write_edited(
     // The edit moves control points only: texture coordinates stay as given.
     mesh.fvar = file.mesh.fvar.clone();
     let mut dropped = Vec::new();
+    crate::cage::name_scheme(&mut mesh.hints, scheme, &job.output, &mut dropped);
     crate::uv::fit_ply(&mut mesh, &job.output, &mut dropped);
     print_warnings(err, &job.input, &dropped);
-    subd_io::write_mesh(&job.output, &mesh, &subd_io::WriteOptions::default())?;
+    subd_io::write_mesh(&job.output, &mesh, &file.output_options())?;
     Ok(())
 }
 
@@ -243,7 +246,7 @@ fn run_one(
     out: &mut dyn Write,
     err: &mut dyn Write,
 ) -> Result<(), Failure> {
-    let started = EDIT.start(&job.input, &job.output)?;
+    let started = EDIT.start_job(job)?;
     let method = method(args)?;
     let constraints = read_constraints(&args.constraints)?;
     let opened = started.read(&args.rules, err)?;
@@ -267,7 +270,7 @@ fn run_one(
     let edit = &edited.edit;
 
     let t_write = Instant::now();
-    write_edited(job, file, &edit.positions, err)?;
+    write_edited(job, file, &scheme, &edit.positions, err)?;
     let t_write = t_write.elapsed().as_secs_f64();
 
     if args.json {
@@ -351,20 +354,21 @@ fn run_deform_one(
     out: &mut dyn Write,
     err: &mut dyn Write,
 ) -> Result<(), Failure> {
-    let started = DEFORM.start(&job.input, &job.output)?;
+    let started = DEFORM.start_job(job)?;
     let cs = subd_editing::spec::parse_deformation(&read_text(&args.constraints)?)
         .map_err(|e| bad(format!("{}: {e}", args.constraints.display())))?;
     let d =
         Deformation::new(&cs).map_err(|e| bad(format!("{}: {e}", args.constraints.display())))?;
     let opened = started.read_with(&subd_io::ReadOptions::default(), err)?;
     let started = opened.started;
+    let write_options = opened.file.output_options();
     let mut mesh = opened.file.mesh;
     let moved = d.apply(&mut mesh.positions);
     let max_err = d.max_constraint_error();
     let mut dropped = Vec::new();
     crate::uv::fit_ply(&mut mesh, &job.output, &mut dropped);
     print_warnings(err, &job.input, &dropped);
-    subd_io::write_mesh(&job.output, &mesh, &subd_io::WriteOptions::default())?;
+    subd_io::write_mesh(&job.output, &mesh, &write_options)?;
     if args.json {
         crate::print_json(
             out,

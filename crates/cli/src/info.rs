@@ -11,8 +11,16 @@ use crate::{Failure, print_warnings};
 
 #[derive(Debug, Args)]
 pub(crate) struct InfoArgs {
-    /// Input mesh (.obj or .ply). Faces whose windings disagree are accepted and counted.
+    /// Input mesh (.obj, .ply, .glb, .gltf, .usda, .usdc, .usdz, .usd). Faces whose windings
+    /// disagree are accepted and counted. A USD stage's mesh prims are listed; the report
+    /// is of its only one, or of --prim.
     input: PathBuf,
+    /// USD input: the mesh prim to report on.
+    #[arg(long, value_name = "PATH")]
+    prim: Option<String>,
+    /// USD input: the time code at which time-sampled attributes are read.
+    #[arg(long, value_name = "T")]
+    time: Option<f64>,
     /// Print one JSON object on stdout instead of text.
     #[arg(long)]
     json: bool,
@@ -21,9 +29,30 @@ pub(crate) struct InfoArgs {
 #[derive(Serialize)]
 struct InfoReport<'a> {
     file: String,
+    /// A USD stage's mesh prims.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    prims: Option<Vec<PrimReport>>,
+    /// The prim reported on and the stage's units (USD).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    stage: Option<StageReport>,
     #[serde(flatten)]
-    mesh: &'a MeshReport,
+    mesh: Option<&'a MeshReport>,
     warnings: &'a [String],
+}
+
+#[derive(Serialize)]
+struct PrimReport {
+    path: String,
+    faces: usize,
+    points: usize,
+    scheme: String,
+}
+
+#[derive(Serialize)]
+struct StageReport {
+    prim: String,
+    meters_per_unit: Option<f64>,
+    up_axis: Option<String>,
 }
 
 pub(crate) fn run(
@@ -36,15 +65,37 @@ pub(crate) fn run(
     // first one.
     let options = subd_io::ReadOptions {
         accept_inconsistent_orientation: true,
+        prim: args.prim.clone(),
+        time: args.time,
         ..subd_io::ReadOptions::default()
     };
-    let file = subd_io::read_mesh(&args.input, &options)?;
-    print_warnings(err, &args.input, &file.warnings);
-    let mesh = MeshReport::of(&file.mesh, file.orientation_conflicts);
+    let prims = usd_prims(&args.input)?;
+    // A stage with several mesh prims and no --prim: the list alone.
+    let listed_only = args.prim.is_none() && prims.as_ref().is_some_and(|p| p.len() > 1);
+    let file = if listed_only {
+        None
+    } else {
+        Some(subd_io::read_mesh(&args.input, &options)?)
+    };
+    if let Some(file) = &file {
+        print_warnings(err, &args.input, &file.warnings);
+    }
+    let mesh = file
+        .as_ref()
+        .map(|f| MeshReport::of(&f.mesh, f.orientation_conflicts));
     let report = InfoReport {
         file: args.input.display().to_string(),
-        mesh: &mesh,
-        warnings: &file.warnings,
+        prims,
+        stage: file
+            .as_ref()
+            .and_then(|f| f.stage.as_ref())
+            .map(|s| StageReport {
+                prim: s.prim.clone(),
+                meters_per_unit: s.meters_per_unit,
+                up_axis: s.up_axis.clone(),
+            }),
+        mesh: mesh.as_ref(),
+        warnings: file.as_ref().map_or(&[], |f| &f.warnings),
     };
     let written = if args.json {
         serde_json::to_writer(&mut *out, &report)
@@ -65,8 +116,58 @@ fn histogram(h: &std::collections::BTreeMap<usize, usize>) -> String {
         .join(" ")
 }
 
+/// The mesh prims of a USD input (`None` for the other formats).
+fn usd_prims(input: &std::path::Path) -> Result<Option<Vec<PrimReport>>, Failure> {
+    let usd = matches!(
+        subd_io::Format::from_path(input),
+        Some(subd_io::Format::Usda | subd_io::Format::Usdc | subd_io::Format::Usdz)
+    );
+    if !usd {
+        return Ok(None);
+    }
+    let prims = subd_io::usd::mesh_prims(input)?;
+    Ok(Some(
+        prims
+            .into_iter()
+            .map(|p| PrimReport {
+                path: p.path,
+                faces: p.faces,
+                points: p.points,
+                scheme: p.scheme,
+            })
+            .collect(),
+    ))
+}
+
 fn write_text(out: &mut dyn Write, report: &InfoReport) -> std::io::Result<()> {
-    let r = report.mesh;
+    writeln!(out, "file              {}", report.file)?;
+    for p in report.prims.iter().flatten() {
+        writeln!(
+            out,
+            "mesh prim         {} ({} faces, {} points, {})",
+            p.path, p.faces, p.points, p.scheme
+        )?;
+    }
+    if let Some(s) = &report.stage {
+        writeln!(out, "prim              {}", s.prim)?;
+        let units = s.meters_per_unit.map_or("unset".into(), |m| m.to_string());
+        writeln!(out, "meters per unit   {units}")?;
+        writeln!(
+            out,
+            "up axis           {}",
+            s.up_axis.as_deref().unwrap_or("unset")
+        )?;
+    }
+    match report.mesh {
+        Some(r) => write_mesh_text(out, r),
+        None => writeln!(
+            out,
+            "(several mesh prims: pick one with --prim for its report)"
+        ),
+    }
+}
+
+fn write_mesh_text(out: &mut dyn Write, r: &MeshReport) -> std::io::Result<()> {
     let s = &r.summary;
     let opt = |g: Option<i64>| {
         g.map_or(
@@ -74,7 +175,6 @@ fn write_text(out: &mut dyn Write, report: &InfoReport) -> std::io::Result<()> {
             |g| g.to_string(),
         )
     };
-    writeln!(out, "file              {}", report.file)?;
     writeln!(out, "vertices          {}", s.vertices)?;
     writeln!(out, "edges             {}", s.edges)?;
     writeln!(out, "faces             {}", s.faces)?;
@@ -132,6 +232,10 @@ fn write_text(out: &mut dyn Write, report: &InfoReport) -> std::io::Result<()> {
     }
     if let Some(m) = r.fvar_interpolation {
         writeln!(out, "fvar rule         {}", m.name())?;
+    }
+    if let Some(scheme) = r.scheme {
+        let name = serde_json::to_value(scheme).unwrap_or_default();
+        writeln!(out, "scheme            {}", name.as_str().unwrap_or(""))?;
     }
     writeln!(out, "components        {}", s.components)?;
     writeln!(out, "euler             {}", s.euler)?;

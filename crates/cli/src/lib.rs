@@ -17,6 +17,7 @@ mod adaptive;
 mod analyze;
 mod batch;
 mod budget;
+mod cage;
 mod curve;
 mod edit;
 mod eval;

@@ -101,7 +101,7 @@ fn run_one(
     out: &mut dyn Write,
     err: &mut dyn Write,
 ) -> Result<(), Failure> {
-    let started = LIMIT.start(&job.input, &job.output)?;
+    let started = LIMIT.start_job(job)?;
     let is_text = OutputFormat::of(&job.output) == Some(OutputFormat::Txt);
     let scheme = scheme_arg::with_tension(&args.scheme, args.tension, "--scheme")?;
     if args.acc.is_some() && scheme != Scheme::CatmullClark {
@@ -132,7 +132,16 @@ fn run_one(
         _ => None,
     };
     print_warnings(err, input, &uv_warnings);
-    write_limit(args, job, &limit, mesh, uv.as_ref(), is_text, err)?;
+    let write_options = opened.file.output_options();
+    write_limit(
+        args,
+        job,
+        &limit,
+        mesh,
+        uv.as_ref(),
+        (is_text, &write_options),
+        err,
+    )?;
     if let Some((path, json)) = acc {
         subd_io::atomic_write(path, |w| w.write_all(&json))?;
     }
@@ -204,7 +213,7 @@ fn write_limit(
     limit: &LimitPoints,
     input: &Mesh,
     uv: Option<&crate::uv::RefinedUv>,
-    is_text: bool,
+    (is_text, write_options): (bool, &subd_io::WriteOptions),
     err: &mut dyn Write,
 ) -> Result<(), Failure> {
     if is_text {
@@ -214,6 +223,8 @@ fn write_limit(
         let mut mesh = Mesh::new(input.topology.clone(), limit.positions.clone())
             .map_err(|e| bad(format!("{}: {e}", job.input.display())))?;
         mesh.hints = input.hints;
+        // Points on the limit surface: polygons, no longer a cage to subdivide.
+        mesh.hints.scheme = None;
         if let Some(uv) = uv {
             let in_file =
                 |e: subd_mesh::fvar::FVarError| bad(format!("{}: {e}", job.input.display()));
@@ -229,7 +240,7 @@ fn write_limit(
             crate::uv::fit_ply(&mut mesh, &job.output, &mut dropped);
             print_warnings(err, &job.input, &dropped);
         }
-        subd_io::write_mesh(&job.output, &mesh, &subd_io::WriteOptions::default())?;
+        subd_io::write_mesh(&job.output, &mesh, write_options)?;
     }
     Ok(())
 }

@@ -28,6 +28,13 @@ impl Command {
         batch::run(files, self, json, out, err, one)
     }
 
+    /// [`Command::start`] for a job, which may name the USD prim to read.
+    pub(crate) fn start_job(&self, job: &Job) -> Result<Started, Failure> {
+        let mut started = self.start(&job.input, &job.output)?;
+        started.prim = job.prim.clone();
+        Ok(started)
+    }
+
     /// Starts the command's timer and checks its output: it must not be the input, and its
     /// extension must be one of the command's formats.
     pub(crate) fn start(&self, input: &Path, output: &Path) -> Result<Started, Failure> {
@@ -43,6 +50,7 @@ impl Command {
         Ok(Started {
             input: input.to_path_buf(),
             started,
+            prim: None,
         })
     }
 }
@@ -64,6 +72,8 @@ fn extension_list(formats: &[OutputFormat]) -> String {
 pub(crate) struct Started {
     input: PathBuf,
     started: Instant,
+    /// The USD prim the batch picked for this job, over `--prim`.
+    prim: Option<String>,
 }
 
 /// A command's input, read.
@@ -90,7 +100,16 @@ impl Started {
         options: &subd_io::ReadOptions,
         err: &mut dyn Write,
     ) -> Result<Opened, Failure> {
-        let file = subd_io::read_mesh(&self.input, options)?;
+        let file = match &self.prim {
+            Some(prim) => {
+                let options = subd_io::ReadOptions {
+                    prim: Some(prim.clone()),
+                    ..options.clone()
+                };
+                subd_io::read_mesh(&self.input, &options)?
+            }
+            None => subd_io::read_mesh(&self.input, options)?,
+        };
         print_warnings(err, &self.input, &file.warnings);
         Ok(Opened {
             printed: file.warnings.len(),
@@ -121,7 +140,10 @@ mod tests {
 
     #[test]
     fn format_lists_read_as_prose() {
-        assert_eq!(extension_list(batch::MESH_OUTPUTS), ".obj, .ply or .glb");
+        assert_eq!(
+            extension_list(batch::MESH_OUTPUTS),
+            ".obj, .ply, .glb, .usda, .usdc or .usdz"
+        );
         assert_eq!(
             extension_list(&[OutputFormat::Txt, OutputFormat::Obj]),
             ".txt or .obj"

@@ -122,7 +122,7 @@ fn run_one(
     out: &mut dyn Write,
     err: &mut dyn Write,
 ) -> Result<(), Failure> {
-    let started = PIA.start(&job.input, &job.output)?;
+    let started = PIA.start_job(job)?;
     if args.tol.is_nan() || args.tol <= 0.0 {
         return Err(bad(format!(
             "--tol {}: must be a positive number",
@@ -173,6 +173,8 @@ fn run_one(
     let fitted = Fitted {
         mesh: &file.mesh,
         points: &result.points,
+        scheme: &scheme,
+        options: file.output_options(),
     };
 
     let t3 = Instant::now();
@@ -257,6 +259,10 @@ impl SolverArg {
 struct Fitted<'a> {
     mesh: &'a Mesh,
     points: &'a [subd_mesh::DVec3],
+    /// The scheme the points are the cage of.
+    scheme: &'a Scheme,
+    /// What the output keeps of the input (a USD prim's name and units).
+    options: subd_io::WriteOptions,
 }
 
 impl Fitted<'_> {
@@ -268,9 +274,10 @@ impl Fitted<'_> {
         mesh.hints = self.mesh.hints;
         mesh.fvar = self.mesh.fvar.clone();
         let mut dropped = Vec::new();
+        crate::cage::name_scheme(&mut mesh.hints, self.scheme, &job.output, &mut dropped);
         crate::uv::fit_ply(&mut mesh, &job.output, &mut dropped);
         print_warnings(err, &job.input, &dropped);
-        subd_io::write_mesh(&job.output, &mesh, &subd_io::WriteOptions::default())?;
+        subd_io::write_mesh(&job.output, &mesh, &self.options)?;
         Ok(())
     }
 }

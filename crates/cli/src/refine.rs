@@ -11,7 +11,6 @@ use subd_mesh::{BoundaryInterpolation, CreaseMethod, SchemeHints, TriangleSubdiv
 use subd_schemes::Scheme;
 use subd_schemes::peak::PeakModel;
 
-use crate::Failure;
 use crate::batch::{self, Files, Job};
 use crate::budget::Budget;
 use crate::failure::bad;
@@ -19,6 +18,7 @@ use crate::refined::{RefinementWithLimit, all_unit, normals_or_faces, output_lim
 use crate::rule_args::RuleArgs;
 use crate::scheme_arg;
 use crate::vertex_data::LambdaArgs;
+use crate::{Failure, print_warnings};
 
 #[derive(Debug, Args)]
 pub(crate) struct RefineArgs {
@@ -144,7 +144,14 @@ fn run_one(
         args.rules.triangles.is_some(),
     );
     hints.fvar_interpolation = uv.as_ref().map(|_| fvar_mode);
+    if args.levels == 0 && !args.limit {
+        // Level 0 is the cage itself, which a USD renderer subdivides.
+        let mut warnings = Vec::new();
+        crate::cage::name_scheme(&mut hints, refinement.scheme(), &job.output, &mut warnings);
+        print_warnings(err, &job.input, &warnings);
+    }
     let output = Output {
+        write_options: opened.file.output_options(),
         args,
         job,
         refinement: &refinement,
@@ -199,7 +206,7 @@ fn open(
     job: &Job,
     err: &mut dyn Write,
 ) -> Result<(crate::opening::Opened, Scheme), Failure> {
-    let started = REFINE.start(&job.input, &job.output)?;
+    let started = REFINE.start_job(job)?;
     let scheme = scheme_arg::with_tension(&args.scheme, args.tension, "--scheme")?;
     let opened = started.read(&args.rules, err)?;
     let vertices = opened.file.mesh.topology.num_vertices();
@@ -259,6 +266,8 @@ struct Output<'a> {
     base: &'a [subd_mesh::DVec3],
     uv: Option<&'a crate::uv::RefinedUv>,
     hints: SchemeHints,
+    /// What the output keeps of the input (a USD prim's name and units).
+    write_options: subd_io::WriteOptions,
     progress: &'a Progress,
 }
 
@@ -297,7 +306,7 @@ impl Output<'_> {
             .and_then(|v| v.with_tags(tags.creases, tags.corners))
             .and_then(|v| crate::uv::with_uv(v, self.uv))
             .map_err(|e| self.in_view(e))?;
-        let counts = write_level(self.job, view, self.hints, r.edges(levels))?;
+        let counts = self.write_level(view, r.edges(levels))?;
         Ok(Written {
             counts,
             positions_seconds,
@@ -346,7 +355,7 @@ impl Output<'_> {
             let n = filled.as_deref().unwrap_or(n);
             view = view.with_normals(n).map_err(|e| self.in_view(e))?;
         }
-        let counts = write_level(self.job, view, self.hints, r.edges(levels))?;
+        let counts = self.write_level(view, r.edges(levels))?;
         Ok(Written {
             counts,
             positions_seconds,
@@ -380,24 +389,25 @@ impl Output<'_> {
         .and_then(|v| crate::uv::with_uv(v, self.uv))
         .and_then(|v| v.with_normals(normals))
         .map_err(|e| self.in_view(e))?;
-        write_level(self.job, view, self.hints, r.edges(levels)).map(Some)
+        self.write_level(view, r.edges(levels)).map(Some)
     }
 }
 
-/// Writes the output level with its hints; its counts for the report.
-fn write_level(
-    job: &Job,
-    mut view: subd_io::MeshView<'_>,
-    hints: SchemeHints,
-    edges: Option<usize>,
-) -> Result<Counts, Failure> {
-    view.hints = hints;
-    subd_io::write_view(&job.output, &view, &subd_io::WriteOptions::default())?;
-    Ok(Counts {
-        vertices: view.num_vertices(),
-        edges,
-        faces: view.num_faces(),
-    })
+impl Output<'_> {
+    /// Writes the output level with its hints; its counts for the report.
+    fn write_level(
+        &self,
+        mut view: subd_io::MeshView<'_>,
+        edges: Option<usize>,
+    ) -> Result<Counts, Failure> {
+        view.hints = self.hints;
+        subd_io::write_view(&self.job.output, &view, &self.write_options)?;
+        Ok(Counts {
+            vertices: view.num_vertices(),
+            edges,
+            faces: view.num_faces(),
+        })
+    }
 }
 
 /// Refuses the request if its estimated peak memory is over the budget (see

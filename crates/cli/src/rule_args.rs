@@ -69,12 +69,26 @@ pub(crate) struct RuleArgs {
     /// Accept faces whose windings disagree across a shared edge (treated as non-manifold).
     #[arg(long)]
     pub(crate) accept_inconsistent_orientation: bool,
-    /// glTF input: read each mesh as stored, without its nodes' transforms.
+    /// glTF and USD input: read each mesh as stored, without its nodes' (prims') transforms.
     #[arg(long)]
     no_transform: bool,
+    /// USD input: the path of the mesh prim to read (default: the stage's only one).
+    #[arg(long, value_name = "PATH")]
+    pub(crate) prim: Option<String>,
+    /// USD input: the time code at which time-sampled attributes are read (default: their
+    /// default values).
+    #[arg(long, value_name = "T", value_parser = finite_time)]
+    time: Option<f64>,
     /// glTF input: weld vertices closer than this (default: only identical positions).
     #[arg(long, value_name = "D", value_parser = non_negative_distance)]
     weld_tolerance: Option<f64>,
+}
+
+fn finite_time(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(t) if t.is_finite() => Ok(t),
+        _ => Err("expected a finite time code".into()),
+    }
 }
 
 fn non_negative_distance(s: &str) -> Result<f64, String> {
@@ -131,6 +145,8 @@ impl RuleArgs {
             accept_inconsistent_orientation: self.accept_inconsistent_orientation,
             ignore_transforms: self.no_transform,
             weld_tolerance: self.weld_tolerance,
+            prim: self.prim.clone(),
+            time: self.time,
         }
     }
 }

@@ -97,7 +97,7 @@ pub(crate) fn run(
     let normals = normals_or_faces(&t.normals, &view);
     let normals = normals.as_deref().unwrap_or(&t.normals);
     let view = view.with_normals(normals).map_err(|e| in_file(&e))?;
-    subd_io::write_view(&args.output, &view, &subd_io::WriteOptions::default())?;
+    subd_io::write_view(&args.output, &view, &file.output_options())?;
     if args.json {
         let report = TessellateReport {
             input: args.input.display().to_string(),

@@ -423,6 +423,7 @@ impl TriangleSoup {
             extra_tags: Vec::new(),
             orientation_conflicts,
             face_levels: None,
+            stage: None,
         })
     }
 }

@@ -8,6 +8,9 @@
 //! * **glTF 2.0 binary** (`.glb`) out: positions, normals, triangle indices ([`glb`]).
 //! * **glTF 2.0** in (`.glb`, `.gltf`): every triangle primitive, node transforms applied,
 //!   vertices welded by position ([`gltf_input`]).
+//! * **USD** in and out (`.usda`, `.usdc`, `.usdz`, `.usd`): a `UsdGeomMesh` prim with
+//!   OpenSubdiv's rules as its attributes, composed stages, transforms, time samples
+//!   ([`usd`]).
 //!
 //! The format is chosen by the file extension. Every output goes through
 //! [`atomic_write`]: the data is written to a temporary file beside the target and renamed
@@ -28,6 +31,7 @@ pub mod obj;
 pub mod ply;
 mod records;
 mod text;
+pub mod usd;
 pub mod view;
 #[cfg(test)]
 mod write_reference_tests;
@@ -51,6 +55,12 @@ pub enum Format {
     Glb,
     /// glTF 2.0 JSON (read only).
     Gltf,
+    /// USD text (`.usda`).
+    Usda,
+    /// USD binary (`.usdc`, and `.usd`, which USD writes as binary and reads as either).
+    Usdc,
+    /// USD package (`.usdz`): one binary layer in a zip archive.
+    Usdz,
 }
 
 impl Format {
@@ -62,6 +72,9 @@ impl Format {
             "ply" => Some(Format::Ply),
             "glb" => Some(Format::Glb),
             "gltf" => Some(Format::Gltf),
+            "usda" => Some(Format::Usda),
+            "usdc" | "usd" => Some(Format::Usdc),
+            "usdz" => Some(Format::Usdz),
             _ => None,
         }
     }
@@ -89,6 +102,11 @@ pub struct ReadOptions {
     /// glTF: weld vertices within this distance of each other (default: only vertices at
     /// exactly the same position).
     pub weld_tolerance: Option<f64>,
+    /// USD: the path of the mesh prim to read (default: the stage's only one).
+    pub prim: Option<String>,
+    /// USD: the time code to read time-sampled attributes at (default: their default
+    /// values).
+    pub time: Option<f64>,
 }
 
 /// Options for writing.
@@ -98,6 +116,8 @@ pub struct WriteOptions {
     pub ply_encoding: PlyEncoding,
     /// Tag lines written verbatim at the end of an OBJ file (e.g. [`MeshFile::extra_tags`]).
     pub extra_obj_tags: Vec<String>,
+    /// USD: the prim name and the stage units to write (e.g. [`MeshFile::stage`]).
+    pub stage: Option<usd::StageInfo>,
 }
 
 /// A mesh read from a file, with what the reader noticed.
@@ -117,6 +137,19 @@ pub struct MeshFile {
     /// Per-face refinement levels: the PLY face property `level`, as `subd adaptive` writes
     /// it (`None` where the file has none).
     pub face_levels: Option<Vec<u8>>,
+    /// USD: the prim read and the stage's units (`None` for the other formats).
+    pub stage: Option<usd::StageInfo>,
+}
+
+impl MeshFile {
+    /// The options of an output made from this input: a USD output keeps its prim's name
+    /// and its stage's units.
+    pub fn output_options(&self) -> WriteOptions {
+        WriteOptions {
+            stage: self.stage.clone(),
+            ..WriteOptions::default()
+        }
+    }
 }
 
 /// Parses a mesh from bytes in the given format. A `.gltf` document whose buffers are
@@ -130,17 +163,29 @@ pub fn parse_mesh(
         Format::Obj => obj::parse_obj(bytes, options),
         Format::Ply => ply::parse_ply(bytes, options),
         Format::Glb | Format::Gltf => gltf_input::parse_gltf(bytes, None, options),
+        Format::Usda | Format::Usdc | Format::Usdz => usd::parse_usd(bytes, format, options),
     }
 }
 
-/// Reads a mesh file, choosing the format by extension (`.obj`, `.ply`, `.glb`, `.gltf`).
+/// Reads a mesh file, choosing the format by extension (`.obj`, `.ply`, `.glb`, `.gltf`,
+/// `.usda`, `.usdc`, `.usdz`, `.usd`). A USD stage is opened composed, so its references
+/// reach the files beside it.
 pub fn read_mesh(path: &Path, options: &ReadOptions) -> Result<MeshFile, IoError> {
     let Some(format) = Format::from_path(path) else {
         return Err(IoError::UnknownFormat {
             path: path.to_path_buf(),
-            expected: ".obj, .ply, .glb or .gltf",
+            expected: ".obj, .ply, .glb, .gltf, .usda, .usdc, .usdz or .usd",
         });
     };
+    if matches!(format, Format::Usda | Format::Usdc | Format::Usdz) {
+        if let Err(source) = std::fs::metadata(path) {
+            return Err(IoError::Read {
+                path: path.to_path_buf(),
+                source,
+            });
+        }
+        return usd::read_usd(path, options).map_err(|e| e.at(path));
+    }
     let bytes = std::fs::read(path).map_err(|source| IoError::Read {
         path: path.to_path_buf(),
         source,
@@ -176,6 +221,7 @@ pub fn encode_view(
         Format::Obj => obj::write_obj(w, view, &options.extra_obj_tags),
         Format::Ply => ply::write_ply(w, view, options.ply_encoding),
         Format::Glb => glb::write_glb(w, view),
+        Format::Usda | Format::Usdc | Format::Usdz => usd::write_usd(w, view, format, options),
         Format::Gltf => Err(std::io::Error::new(
             std::io::ErrorKind::Unsupported,
             "writing .gltf is not supported; use .glb",
@@ -183,7 +229,8 @@ pub fn encode_view(
     }
 }
 
-/// Writes a mesh file atomically, choosing the format by extension (`.obj`, `.ply`, `.glb`).
+/// Writes a mesh file atomically, choosing the format by extension (`.obj`, `.ply`, `.glb`,
+/// `.usda`, `.usdc`, `.usdz`, `.usd`).
 pub fn write_mesh(path: &Path, mesh: &Mesh, options: &WriteOptions) -> Result<(), IoError> {
     write_view(path, &MeshView::from_mesh(mesh), options)
 }
@@ -194,7 +241,7 @@ pub fn write_mesh(path: &Path, mesh: &Mesh, options: &WriteOptions) -> Result<()
 pub fn write_view(path: &Path, view: &MeshView<'_>, options: &WriteOptions) -> Result<(), IoError> {
     let format = Format::for_output(path).ok_or_else(|| IoError::UnknownFormat {
         path: path.to_path_buf(),
-        expected: ".obj, .ply or .glb",
+        expected: ".obj, .ply, .glb, .usda, .usdc, .usdz or .usd",
     })?;
     atomic_write(path, |w| encode_view(w, view, format, options))
 }

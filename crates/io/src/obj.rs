@@ -111,6 +111,7 @@ fn parse_obj_in_chunks(
         extra_tags,
         orientation_conflicts,
         face_levels: None,
+        stage: None,
     })
 }
 

@@ -395,6 +395,7 @@ pub fn parse_ply(bytes: &[u8], options: &ReadOptions) -> Result<MeshFile, ReadEr
         extra_tags: Vec::new(),
         orientation_conflicts,
         face_levels: (!face_levels.is_empty()).then_some(face_levels),
+        stage: None,
     })
 }
 

@@ -375,6 +375,8 @@ pub fn refined_hints(
             .triangle_subdivision
             .or(triangles_asked.then_some(options.triangle_subdivision)),
         fvar_interpolation: read.fvar_interpolation,
+        // A refined mesh: polygons, not a cage to subdivide.
+        scheme: None,
     }
 }
 

@@ -46,7 +46,9 @@ pub use build::{FaceEdges, TopologyBuilder};
 pub use error::{BuildWarning, TopologyError};
 pub use geometry::{Mesh, bounding_box, validate_positions};
 pub use glam::DVec3;
-pub use tags::{BoundaryInterpolation, CreaseMethod, SchemeHints, Tags, TriangleSubdivision};
+pub use tags::{
+    BoundaryInterpolation, CreaseMethod, FileScheme, SchemeHints, Tags, TriangleSubdivision,
+};
 pub use topology::{MAX_FACE_SIZE, Topology, TopologyParts};
 
 #[cfg(doctest)]

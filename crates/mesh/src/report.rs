@@ -58,6 +58,10 @@ pub struct MeshReport {
     pub fvar_channels: Vec<ChannelReport>,
     /// The mesh's face-varying interpolation tag, if any.
     pub fvar_interpolation: Option<FVarLinearInterpolation>,
+    /// The scheme the file names (USD's `subdivisionScheme`), if any; left out of the JSON
+    /// for files that name none.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub scheme: Option<crate::FileScheme>,
 }
 
 impl MeshReport {
@@ -87,6 +91,7 @@ impl MeshReport {
                 })
                 .collect(),
             fvar_interpolation: mesh.hints.fvar_interpolation,
+            scheme: mesh.hints.scheme,
         }
     }
 }

@@ -197,6 +197,22 @@ pub enum TriangleSubdivision {
     Smooth,
 }
 
+/// The subdivision scheme a mesh file names for its surface: USD's `subdivisionScheme`
+/// (the schemes USD shares with OpenSubdiv), kept as the file says it. The crates that know
+/// the schemes turn it into theirs (`subd_schemes::Scheme::from_file`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum FileScheme {
+    /// `catmullClark`.
+    CatmullClark,
+    /// `loop`.
+    Loop,
+    /// `bilinear`.
+    Bilinear,
+    /// `none`: a plain polygon mesh, not a subdivision surface.
+    Polygons,
+}
+
 /// Scheme options a mesh file asks for (the `t interpolateboundary`, `t creasemethod`,
 /// `t smoothtriangles` and `t facevaryinginterpolateboundary` tags of OpenSubdiv's shape
 /// files). `None` means the file is silent and
@@ -211,4 +227,6 @@ pub struct SchemeHints {
     pub triangle_subdivision: Option<TriangleSubdivision>,
     /// Requested face-varying interpolation (`t facevaryinginterpolateboundary 1/0/0 k`).
     pub fvar_interpolation: Option<crate::fvar::FVarLinearInterpolation>,
+    /// The scheme the file names (USD's `subdivisionScheme`; OBJ, PLY and glTF name none).
+    pub scheme: Option<FileScheme>,
 }

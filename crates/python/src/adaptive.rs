@@ -110,6 +110,7 @@ fn assembled(
         crease_method: Some(request.options.crease_method),
         triangle_subdivision: Some(request.options.triangle_subdivision),
         fvar_interpolation: uv.as_ref().map(|_| request.fvar_interpolation),
+        scheme: None,
     };
     if let Some(uv) = uv {
         let channel = FVarChannel::new(&mesh.topology, uv.components, uv.values, uv.indices)

@@ -96,17 +96,22 @@ impl RuleNames<'_> {
     }
 }
 
-/// Reads a mesh file (OBJ with OpenSubdiv's tags, PLY, glTF): the mesh and the reader's
-/// warnings.
+/// Reads a mesh file (OBJ with OpenSubdiv's tags, PLY, glTF, USD): the mesh and the
+/// reader's warnings.
 #[pyfunction]
-#[pyo3(signature = (path, accept_inconsistent_orientation = false, no_transform = false, weld_tolerance = None))]
+#[pyo3(signature = (path, accept_inconsistent_orientation = false, no_transform = false, weld_tolerance = None, prim = None, time = None))]
 pub(crate) fn read(
     py: Python<'_>,
     path: PathBuf,
     accept_inconsistent_orientation: bool,
     no_transform: bool,
     weld_tolerance: Option<f64>,
+    prim: Option<String>,
+    time: Option<f64>,
 ) -> PyResult<(CoreMesh, Vec<String>)> {
+    if time.is_some_and(|t| !t.is_finite()) {
+        return Err(PyValueError::new_err("time: expected a finite time code"));
+    }
     if weld_tolerance.is_some_and(|w| !(w.is_finite() && w >= 0.0)) {
         return Err(PyValueError::new_err(
             "weld_tolerance: expected a finite distance ≥ 0",
@@ -116,6 +121,8 @@ pub(crate) fn read(
         accept_inconsistent_orientation,
         ignore_transforms: no_transform,
         weld_tolerance,
+        prim,
+        time,
     };
     let file = pool::run(py, || subd_io::read_mesh(&path, &options))?.map_err(io_error)?;
     let mut core = CoreMesh::plain(file.mesh);

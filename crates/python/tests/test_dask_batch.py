@@ -122,7 +122,7 @@ def test_batch_on_two_local_workers_refines_the_good_files_and_reports_the_bad(t
     [
         ("clash", "would both write it"),
         ("same-dir", "OUT_DIR is IN_DIR"),
-        ("empty", "no .obj, .ply, .gltf, .glb files"),
+        ("empty", "no .obj, .ply, .gltf, .glb, .usd, .usda, .usdc, .usdz files"),
     ],
 )
 def test_refusals_exit_2_before_anything_runs(tmp_path, case, message):

@@ -162,6 +162,37 @@ impl Scheme {
         )
     }
 
+    /// The scheme a mesh file names (USD's `subdivisionScheme`); `None` for a file that
+    /// says its mesh is plain polygons (`none`).
+    ///
+    /// ```
+    /// use subd_mesh::FileScheme;
+    /// use subd_schemes::Scheme;
+    /// assert_eq!(Scheme::from_file(FileScheme::Loop), Some(Scheme::Loop));
+    /// assert_eq!(Scheme::from_file(FileScheme::Polygons), None);
+    /// assert_eq!(Scheme::DooSabin.file_scheme(), None);
+    /// ```
+    pub fn from_file(named: subd_mesh::FileScheme) -> Option<Scheme> {
+        match named {
+            subd_mesh::FileScheme::CatmullClark => Some(Scheme::CatmullClark),
+            subd_mesh::FileScheme::Loop => Some(Scheme::Loop),
+            subd_mesh::FileScheme::Bilinear => Some(Scheme::Bilinear),
+            subd_mesh::FileScheme::Polygons => None,
+        }
+    }
+
+    /// How a mesh file names this scheme, where it can: USD names Catmull-Clark, Loop and
+    /// Bilinear; the other schemes (and the two-phase scheme, whose λ no file carries) have
+    /// no name there.
+    pub fn file_scheme(&self) -> Option<subd_mesh::FileScheme> {
+        match self {
+            Scheme::CatmullClark => Some(subd_mesh::FileScheme::CatmullClark),
+            Scheme::Loop => Some(subd_mesh::FileScheme::Loop),
+            Scheme::Bilinear => Some(subd_mesh::FileScheme::Bilinear),
+            _ => None,
+        }
+    }
+
     /// The faces the scheme takes.
     pub fn input_faces(&self) -> FaceKind {
         match self {

@@ -81,6 +81,7 @@ fn streamed_last_level_files_equal_the_held_ones() {
             crease_method: Some(options.crease_method),
             triangle_subdivision: file.mesh.hints.triangle_subdivision,
             fvar_interpolation: None,
+            scheme: None,
         };
         for scheme in schemes {
             for levels in 1..=2 {

@@ -327,6 +327,7 @@ fn refine_output_equals_the_fully_built_level() {
             crease_method: Some(options.crease_method),
             triangle_subdivision: file.mesh.hints.triangle_subdivision,
             fvar_interpolation: None,
+            scheme: None,
         };
         // Texture coordinates refined beside, in the file's mode or corners-plus1.
         let mut textured = mesh.clone();

@@ -4,3 +4,4 @@ mod atomic_write;
 mod fuzz_regressions;
 mod gltf_input;
 mod mesh_view;
+mod usd;

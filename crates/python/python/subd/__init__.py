@@ -246,7 +246,8 @@ class Mesh:
         return self._core.num_edges
 
     def write(self, path: Union[str, os.PathLike]) -> None:
-        """Writes the mesh: OBJ (with crease tags), PLY or glTF binary, by the extension."""
+        """Writes the mesh by the extension: OBJ (with crease tags), PLY, glTF binary, or USD
+        (.usda, .usdc, .usdz, .usd: one Mesh prim with its scheme, rules and tags)."""
         self._core.write(os.fspath(path))
 
     def __repr__(self) -> str:
@@ -300,18 +301,29 @@ def read(
     accept_inconsistent_orientation: bool = False,
     no_transform: bool = False,
     weld_tolerance: Optional[float] = None,
+    prim: Optional[str] = None,
+    time: Optional[float] = None,
 ) -> Mesh:
     """Reads an OBJ (with OpenSubdiv's crease, corner and hole tags, texture coordinates),
-    PLY or glTF file. What the reader repaired or left out comes as :class:`SubdWarning`.
+    PLY, glTF or USD (.usda, .usdc, .usdz, .usd) file. What the reader repaired or left out
+    comes as :class:`SubdWarning`.
 
     The options are the CLI's: ``accept_inconsistent_orientation`` takes an edge two faces
     use in the same direction (non-manifold, as OpenSubdiv does) instead of raising;
-    glTF only: ``no_transform`` reads each mesh as stored rather than placed by its nodes,
-    ``weld_tolerance`` welds vertices closer than it (default: identical positions only).
+    glTF and USD: ``no_transform`` reads each mesh as stored rather than placed by its
+    nodes (prims); glTF only: ``weld_tolerance`` welds vertices closer than it (default:
+    identical positions only); USD only: ``prim`` is the path of the mesh prim to read
+    (default: the stage's only one) and ``time`` the time code at which time-sampled
+    attributes are read (default: their default values). A USD mesh's scheme and rules
+    (``subdivisionScheme``, ``interpolateBoundary``, creases, corners, holes,
+    ``primvars:st``) are the mesh's, as for OBJ tags.
     """
     weld = None if weld_tolerance is None else _threshold(weld_tolerance, "weld_tolerance")
+    if prim is not None and not isinstance(prim, str):
+        raise TypeError(f"prim: expected a prim path such as '/World/Body', got {type(prim).__name__}")
+    at = None if time is None else float(time)
     core, messages = _subd.read(os.fspath(path), bool(accept_inconsistent_orientation),
-                                bool(no_transform), weld)
+                                bool(no_transform), weld, prim, at)
     _warn(messages)
     return Mesh._wrap(core)
 

@@ -124,6 +124,8 @@ def read(
     accept_inconsistent_orientation: bool = ...,
     no_transform: bool = ...,
     weld_tolerance: Optional[float] = ...,
+    prim: Optional[str] = ...,
+    time: Optional[float] = ...,
 ) -> Tuple[_CoreMesh, List[str]]: ...
 def refine(
     mesh: _CoreMesh,
