@@ -29,6 +29,7 @@ mod scaling_bench;
 mod split_bench;
 mod tess_bench;
 mod tess_conformance;
+mod usd_bench;
 mod usd_conformance;
 
 #[derive(Parser)]
@@ -141,6 +142,10 @@ enum Task {
         /// InterpolateFaceVarying).
         #[arg(long)]
         fvar_only: bool,
+        /// Only the USD benchmark: a 1M-face mesh read and written as .usdc against binary
+        /// PLY, and Pixar's USD reading it from Python.
+        #[arg(long)]
+        usd_only: bool,
         /// Only the Python benchmark: the package's Loop level 3 against trimesh, libigl and
         /// PyMeshLab, conversions included (installs them in `target/python-env`).
         #[arg(long)]
@@ -368,6 +373,7 @@ fn main() -> ExitCode {
             patches_only,
             fvar_only,
             python_only,
+            usd_only,
             scaling,
             threads,
         } => {
@@ -389,6 +395,8 @@ fn main() -> ExitCode {
             let fvar = || fvar_bench::run(levels, repeats, rounds.max(1));
             if python_only {
                 python_tests::run_python_bench(&workspace_root(), repeats)
+            } else if usd_only {
+                usd_bench::run(&workspace_root(), repeats)
             } else if scaling {
                 ensure_system_packages(REFERENCE_PACKAGES)
                     .and_then(|_| scaling_bench::run(repeats, &threads))
@@ -426,6 +434,7 @@ fn main() -> ExitCode {
                                 .and_then(|_| batch())
                                 .and_then(|_| tess())
                                 .and_then(|_| fvar())
+                                .and_then(|_| usd_bench::run(&workspace_root(), repeats))
                         }
                     })
             }

@@ -27,9 +27,9 @@ const DEFAULT_LEVELS: usize = 4;
 
 #[derive(Debug, Args)]
 pub(crate) struct AdaptiveArgs {
-    /// Subdivision scheme.
+    /// Subdivision scheme (default: the scheme the input names, USD's subdivisionScheme).
     #[arg(long, value_parser = scheme_arg::parser(scheme_arg::evaluated))]
-    scheme: Scheme,
+    scheme: Option<Scheme>,
     /// Seed 002's flatness: refine every face that is not dead, a vertex being dead when the
     /// largest angle between its faces' normals is below DEG degrees.
     #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
@@ -168,7 +168,7 @@ fn check_arguments(args: &AdaptiveArgs) -> Result<usize, Failure> {
 fn request_of(
     args: &AdaptiveArgs,
     mesh: &subd_mesh::Mesh,
-    options: &subd_schemes::Options,
+    (scheme, options): (&Scheme, &subd_schemes::Options),
     levels: usize,
 ) -> Result<AdaptiveRequest, Failure> {
     let base = &mesh.topology;
@@ -183,7 +183,7 @@ fn request_of(
             .transpose()
     };
     Ok(AdaptiveRequest {
-        scheme: args.scheme.clone(),
+        scheme: scheme.clone(),
         options: *options,
         levels,
         limit: args.limit,
@@ -225,13 +225,18 @@ fn run_one(
     let (file, t_read) = (&opened.file, opened.read_seconds);
     let mesh = &file.mesh;
     let base = &mesh.topology;
-    let scheme = args.scheme.clone();
+    let scheme = scheme_arg::given_or_named(
+        args.scheme.as_ref(),
+        &mesh.hints,
+        scheme_arg::evaluated,
+        &job.input,
+    )?;
     let options = args.rules.options(&mesh.hints);
     let input_err = |e: AdaptiveError| bad(format!("{}: {e}", job.input.display()));
     let diagonal = mesh
         .bounding_box()
         .map_or(0.0, |(lo, hi)| (hi - lo).length());
-    let request = request_of(args, mesh, &options, levels)?;
+    let request = request_of(args, mesh, (&scheme, &options), levels)?;
     let selection = Criteria::new(mesh, &request, diagonal).map_err(input_err)?;
 
     let spinner = Spinner::new(args.json || job.quiet, "refining");

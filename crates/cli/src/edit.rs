@@ -34,9 +34,11 @@ pub(crate) struct EditArgs {
     /// How the control vertices change.
     #[arg(long, value_enum, default_value = "least-squares")]
     method: EditMethodArg,
-    /// Scheme of the limit surface (the energy method needs catmull-clark).
-    #[arg(long, value_parser = scheme_arg::parser(scheme_arg::evaluated), default_value = "catmull-clark")]
-    scheme: Scheme,
+    /// Scheme of the limit surface (the energy method needs catmull-clark; default: the
+    /// scheme the input names, USD's subdivisionScheme, if catmull-clark or loop, else
+    /// catmull-clark).
+    #[arg(long, value_parser = scheme_arg::parser(scheme_arg::evaluated))]
+    scheme: Option<Scheme>,
     /// Energy method: the seed's penalty form with this weight (relative to
     /// mean diag Q / mean diag AᵀA) instead of the exact solve.
     #[arg(long, conflicts_with = "exact")]
@@ -251,7 +253,12 @@ fn run_one(
     let constraints = read_constraints(&args.constraints)?;
     let opened = started.read(&args.rules, err)?;
     let (file, t_read) = (&opened.file, opened.read_seconds);
-    let scheme = args.scheme.clone();
+    let named = file.mesh.hints.scheme.and_then(Scheme::from_file);
+    let scheme = args
+        .scheme
+        .clone()
+        .or(named.filter(scheme_arg::evaluated))
+        .unwrap_or(Scheme::CatmullClark);
     let options = args.rules.options(&file.mesh.hints);
     let topo = &file.mesh.topology;
     let named = |e: subd_editing::EditError| match e {

@@ -18,9 +18,9 @@ use crate::{Failure, print_warnings};
 
 #[derive(Debug, Args)]
 pub(crate) struct EvalArgs {
-    /// Subdivision scheme.
+    /// Subdivision scheme (default: the scheme the input names, USD's subdivisionScheme).
     #[arg(long, value_parser = scheme_arg::parser(scheme_arg::evaluated))]
-    scheme: Scheme,
+    scheme: Option<Scheme>,
     #[command(flatten)]
     rules: RuleArgs,
     #[command(flatten)]
@@ -109,7 +109,12 @@ pub(crate) fn run(
     refuse_overwrite(&args.input, &args.output)?;
     let file = subd_io::read_mesh(&args.input, &args.rules.read_options())?;
     print_warnings(err, &args.input, &file.warnings);
-    let scheme = args.scheme.clone();
+    let scheme = scheme_arg::given_or_named(
+        args.scheme.as_ref(),
+        &file.mesh.hints,
+        scheme_arg::evaluated,
+        &args.input,
+    )?;
     let options = args.rules.options(&file.mesh.hints);
     let topo = &file.mesh.topology;
     // On the patch table: the exact limit's (exact end caps) unless other patches are

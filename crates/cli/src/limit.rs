@@ -22,9 +22,10 @@ pub(crate) struct LimitArgs {
     /// Subdivision scheme: the limit of its limit masks (Catmull-Clark, Loop), of seed 000's
     /// formula (2) (two-phase, closed quad meshes), of each vertex's vertex face one level down
     /// (Doo-Sabin), of Kobbelt's masks (√3), or the vertices themselves with normals from the
-    /// eigenvectors (the butterflies).
+    /// eigenvectors (the butterflies). Default: the scheme the input names (USD's
+    /// subdivisionScheme).
     #[arg(long, value_parser = scheme_arg::parser(scheme_arg::with_limit))]
-    scheme: Scheme,
+    scheme: Option<Scheme>,
     #[command(flatten)]
     lambda: LambdaArgs,
     #[command(flatten)]
@@ -103,14 +104,16 @@ fn run_one(
 ) -> Result<(), Failure> {
     let started = LIMIT.start_job(job)?;
     let is_text = OutputFormat::of(&job.output) == Some(OutputFormat::Txt);
-    let scheme = scheme_arg::with_tension(&args.scheme, args.tension, "--scheme")?;
+    let opened = started.read(&args.rules, err)?;
+    let (mesh, input) = (&opened.file.mesh, &job.input);
+    let given = args.scheme.as_ref();
+    let scheme = scheme_arg::given_or_named(given, &mesh.hints, scheme_arg::with_limit, input)?;
+    let scheme = scheme_arg::with_tension(&scheme, args.tension, "--scheme")?;
     if args.acc.is_some() && scheme != Scheme::CatmullClark {
         return Err(bad(
             "--acc: ACC patches approximate catmull-clark surfaces only".into(),
         ));
     }
-    let opened = started.read(&args.rules, err)?;
-    let (mesh, input) = (&opened.file.mesh, &job.input);
     let in_file = |e: &dyn std::fmt::Display| bad(format!("{}: {e}", input.display()));
     let topo = &mesh.topology;
     let options = args.rules.options(&mesh.hints);

@@ -39,9 +39,9 @@ impl From<EndCapsArg> for EndCaps {
 
 #[derive(Debug, Args)]
 pub(crate) struct PatchesArgs {
-    /// Subdivision scheme.
+    /// Subdivision scheme (default: the scheme the input names, USD's subdivisionScheme).
     #[arg(long, value_parser = scheme_arg::parser(scheme_arg::evaluated))]
-    scheme: Scheme,
+    scheme: Option<Scheme>,
     #[command(flatten)]
     rules: RuleArgs,
     /// Levels of feature-adaptive refinement around irregular features (1 to 10).
@@ -102,10 +102,16 @@ pub(crate) fn run(
     let file = subd_io::read_mesh(&args.input, &args.rules.read_options())?;
     print_warnings(err, &args.input, &file.warnings);
     let rules = args.rules.options(&file.mesh.hints);
+    let scheme = scheme_arg::given_or_named(
+        args.scheme.as_ref(),
+        &file.mesh.hints,
+        scheme_arg::evaluated,
+        &args.input,
+    )?;
     let mut table = PatchTable::new(
         &file.mesh.topology,
         &file.mesh.positions,
-        &args.scheme,
+        &scheme,
         &rules,
         &args.options(),
     )

@@ -40,9 +40,10 @@ pub(crate) enum SolverArg {
 
 #[derive(Debug, Args)]
 pub(crate) struct PiaArgs {
-    /// Scheme whose limit surface interpolates.
+    /// Scheme whose limit surface interpolates (default: the scheme the input names, USD's
+    /// subdivisionScheme).
     #[arg(long, value_parser = scheme_arg::parser(scheme_arg::interpolated))]
-    scheme: Scheme,
+    scheme: Option<Scheme>,
     #[command(flatten)]
     lambda: LambdaArgs,
     /// Only these vertices move (a file of 0-based indices); the others keep their
@@ -134,7 +135,14 @@ fn run_one(
     let topo = &file.mesh.topology;
     let nv = topo.num_vertices();
     let options = args.rules.options(&file.mesh.hints);
-    let scheme = scheme_arg::with_lambda(&args.scheme, &args.lambda, &job.input, nv)?;
+    let given = args.scheme.as_ref();
+    let named = scheme_arg::given_or_named(
+        given,
+        &file.mesh.hints,
+        scheme_arg::interpolated,
+        &job.input,
+    )?;
+    let scheme = scheme_arg::with_lambda(&named, &args.lambda, &job.input, nv)?;
     let name = scheme.name();
     let moving = moving_vertices(args, nv)?;
     let solver = args.solver.solver();

@@ -22,9 +22,10 @@ use crate::{Failure, print_warnings};
 
 #[derive(Debug, Args)]
 pub(crate) struct RefineArgs {
-    /// Subdivision scheme (a parameter may follow a colon: butterfly:0.05, two-phase:0.6).
+    /// Subdivision scheme (a parameter may follow a colon: butterfly:0.05, two-phase:0.6;
+    /// default: the scheme the input names, USD's subdivisionScheme).
     #[arg(long, value_parser = scheme_arg::parser(scheme_arg::all))]
-    scheme: Scheme,
+    scheme: Option<Scheme>,
     /// Number of uniform refinement levels (0 to 15; for two-phase, level 1 is phase 1).
     #[arg(long)]
     levels: usize,
@@ -207,8 +208,11 @@ fn open(
     err: &mut dyn Write,
 ) -> Result<(crate::opening::Opened, Scheme), Failure> {
     let started = REFINE.start_job(job)?;
-    let scheme = scheme_arg::with_tension(&args.scheme, args.tension, "--scheme")?;
     let opened = started.read(&args.rules, err)?;
+    let hints = &opened.file.mesh.hints;
+    let scheme =
+        scheme_arg::given_or_named(args.scheme.as_ref(), hints, scheme_arg::all, &job.input)?;
+    let scheme = scheme_arg::with_tension(&scheme, args.tension, "--scheme")?;
     let vertices = opened.file.mesh.topology.num_vertices();
     let scheme = scheme_arg::with_lambda(&scheme, &args.lambda, &job.input, vertices)?;
     check_memory(args, job, &opened.file, &scheme)?;

@@ -8,6 +8,7 @@ use std::path::Path;
 
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use clap::error::ErrorKind;
+use subd_mesh::SchemeHints;
 use subd_schemes::Scheme;
 
 use crate::Failure;
@@ -97,6 +98,39 @@ impl SchemeParser {
             .iter()
             .map(|s| PossibleValue::new(s.name()).help(s.summary()))
             .collect()
+    }
+}
+
+/// The scheme a command runs on `input`: `--scheme` when given, else the one the file
+/// names (USD's `subdivisionScheme`) if the command takes it (`accepts`).
+pub(crate) fn given_or_named(
+    given: Option<&Scheme>,
+    hints: &SchemeHints,
+    accepts: fn(&Scheme) -> bool,
+    input: &Path,
+) -> Result<Scheme, Failure> {
+    if let Some(s) = given {
+        return Ok(s.clone());
+    }
+    let named = hints.scheme.ok_or_else(|| {
+        bad(format!(
+            "{}: no --scheme given, and the file names no subdivision scheme",
+            input.display()
+        ))
+    })?;
+    let scheme = Scheme::from_file(named).ok_or_else(|| {
+        bad(format!(
+            "{}: the file names no subdivision scheme (subdivisionScheme none): give --scheme",
+            input.display()
+        ))
+    })?;
+    if accepts(&scheme) {
+        Ok(scheme)
+    } else {
+        Err(bad(format!(
+            "{}: the file's scheme {scheme} is not one this command takes: give --scheme",
+            input.display()
+        )))
     }
 }
 

@@ -20,9 +20,9 @@ use crate::scheme_arg;
 
 #[derive(Debug, Args)]
 pub(crate) struct TessellateArgs {
-    /// Subdivision scheme.
+    /// Subdivision scheme (default: the scheme the input names, USD's subdivisionScheme).
     #[arg(long, value_parser = scheme_arg::parser(scheme_arg::evaluated))]
-    scheme: Scheme,
+    scheme: Option<Scheme>,
     /// Segments per base edge (even when a Catmull-Clark face is not a quad: each of its quad
     /// sub-faces takes half).
     #[arg(long)]
@@ -77,7 +77,12 @@ pub(crate) fn run(
     let in_file = |e: &dyn std::fmt::Display| bad(format!("{}: {e}", args.input.display()));
     let t1 = Instant::now();
     let options = args.rules.options(&file.mesh.hints);
-    let scheme = args.scheme.clone();
+    let scheme = scheme_arg::given_or_named(
+        args.scheme.as_ref(),
+        &file.mesh.hints,
+        scheme_arg::evaluated,
+        &args.input,
+    )?;
     let t_setup = t1.elapsed().as_secs_f64();
     let t2 = Instant::now();
     // Refinement and the last level's limit masks at a rate that is a power of two, the

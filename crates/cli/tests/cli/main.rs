@@ -18,6 +18,7 @@ mod pia;
 mod refine;
 mod render;
 mod tessellate;
+mod usd;
 mod uv;
 
 fn subd(args: &[&str]) -> (i32, String, String) {

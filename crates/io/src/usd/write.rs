@@ -153,6 +153,13 @@ fn mesh_attributes(view: &MeshView<'_>) -> io::Result<Vec<Attr>> {
         attrs.push(a);
     }
     if let Some(uv) = view.uv() {
+        let single = |x: f64| x.abs() <= f64::from(f32::MAX);
+        if let Some(i) = (0..uv.len()).find(|&i| !uv.uv(i).into_iter().all(single)) {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidData,
+                format!("texture coordinate {i} is beyond single precision, which USD's st holds"),
+            ));
+        }
         let values = (0..uv.len())
             .map(|i| {
                 let [u, v] = uv.uv(i);
@@ -280,11 +287,23 @@ fn tag_attributes(view: &MeshView<'_>) -> io::Result<Vec<Attr>> {
     Ok(attrs)
 }
 
+/// Every position, checked to fit USD's single-precision `point3f` (a larger coordinate
+/// would be written as infinity, which no reader takes back).
 fn all_points(view: &MeshView<'_>) -> io::Result<Vec<DVec3>> {
-    match view.positions() {
-        Some(p) => Ok(p.to_vec()),
-        None => Ok(view.point_window(0..view.num_vertices())?.points().to_vec()),
+    let points = match view.positions() {
+        Some(p) => p.to_vec(),
+        None => view.point_window(0..view.num_vertices())?.points().to_vec(),
+    };
+    if let Some(v) = points
+        .iter()
+        .position(|p| p.abs().max_element() > f64::from(f32::MAX))
+    {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidData,
+            format!("vertex {v} has a coordinate beyond single precision, which USD's points hold"),
+        ));
     }
+    Ok(points)
 }
 
 fn all_faces(view: &MeshView<'_>) -> io::Result<(Vec<i32>, Vec<i32>)> {

@@ -268,6 +268,21 @@ fn bad_stages_name_the_prim_and_the_attribute() {
     );
 }
 
+/// A coordinate past `f32`'s range would become infinity in `point3f`: refused, naming the
+/// vertex, rather than written as a file that cannot be read back.
+#[test]
+fn coordinates_beyond_single_precision_are_refused() {
+    let points = [DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1e39, 0.0)];
+    let view = subd_io::MeshView::new(&points, &[0, 3], &[0, 1, 2], &[]).unwrap();
+    let mut out = Vec::new();
+    let err =
+        subd_io::encode_view(&mut out, &view, Format::Usdc, &WriteOptions::default()).unwrap_err();
+    assert!(
+        err.to_string()
+            .contains("vertex 2 has a coordinate beyond single precision")
+    );
+}
+
 #[test]
 fn corrupt_binary_files_are_errors() {
     let mesh = subd_io::read_mesh(
