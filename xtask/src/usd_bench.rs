@@ -8,41 +8,11 @@ use std::process::Command;
 use std::time::Instant;
 
 use subd_io::{ReadOptions, WriteOptions};
-use subd_mesh::{DVec3, Mesh, TopologyBuilder};
 
 use crate::bench::median;
 
 /// Quads per side of the benchmark torus: 1000 × 1000 = 1M faces.
 const SIDE: usize = 1000;
-
-/// A closed torus of `SIDE` × `SIDE` quads.
-fn torus() -> Result<Mesh, String> {
-    let n = SIDE;
-    let mut sizes = Vec::with_capacity(n * n);
-    let mut faces = Vec::with_capacity(4 * n * n);
-    let id = |i: usize, j: usize| ((i % n) * n + j % n) as u32;
-    for i in 0..n {
-        for j in 0..n {
-            sizes.push(4);
-            faces.extend([id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
-        }
-    }
-    let tau = std::f64::consts::TAU;
-    let positions = (0..n * n)
-        .map(|k| {
-            let (u, v) = (
-                (k / n) as f64 * tau / n as f64,
-                (k % n) as f64 * tau / n as f64,
-            );
-            let r = 3.0 + v.cos();
-            DVec3::new(r * u.cos(), r * u.sin(), v.sin())
-        })
-        .collect();
-    let topology = TopologyBuilder::new(n * n)
-        .build(&sizes, &faces)
-        .map_err(|e| e.to_string())?;
-    Mesh::new(topology, positions).map_err(|e| e.to_string())
-}
 
 /// Median seconds of `repeats` runs of `f`.
 fn timed(repeats: usize, mut f: impl FnMut() -> Result<(), String>) -> Result<f64, String> {
@@ -95,7 +65,7 @@ print(statistics.median(times))
 }
 
 pub(crate) fn run(root: &Path, repeats: usize) -> Result<(), String> {
-    let mesh = torus()?;
+    let mesh = subd_mesh::primitives::torus(SIDE as u32, SIDE as u32, 3.0, 1.0);
     let dir: PathBuf = root.join("target/xtask/bench/usd");
     std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
     println!(

@@ -225,12 +225,7 @@ fn run_one(
     let (file, t_read) = (&opened.file, opened.read_seconds);
     let mesh = &file.mesh;
     let base = &mesh.topology;
-    let scheme = scheme_arg::given_or_named(
-        args.scheme.as_ref(),
-        &mesh.hints,
-        scheme_arg::evaluated,
-        &job.input,
-    )?;
+    let scheme = scheme_arg::evaluated_or_named(args.scheme.as_ref(), &mesh.hints, &job.input)?;
     let options = args.rules.options(&mesh.hints);
     let input_err = |e: AdaptiveError| bad(format!("{}: {e}", job.input.display()));
     let diagonal = mesh

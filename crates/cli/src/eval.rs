@@ -109,12 +109,8 @@ pub(crate) fn run(
     refuse_overwrite(&args.input, &args.output)?;
     let file = subd_io::read_mesh(&args.input, &args.rules.read_options())?;
     print_warnings(err, &args.input, &file.warnings);
-    let scheme = scheme_arg::given_or_named(
-        args.scheme.as_ref(),
-        &file.mesh.hints,
-        scheme_arg::evaluated,
-        &args.input,
-    )?;
+    let scheme =
+        scheme_arg::evaluated_or_named(args.scheme.as_ref(), &file.mesh.hints, &args.input)?;
     let options = args.rules.options(&file.mesh.hints);
     let topo = &file.mesh.topology;
     // On the patch table: the exact limit's (exact end caps) unless other patches are

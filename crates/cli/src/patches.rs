@@ -102,12 +102,8 @@ pub(crate) fn run(
     let file = subd_io::read_mesh(&args.input, &args.rules.read_options())?;
     print_warnings(err, &args.input, &file.warnings);
     let rules = args.rules.options(&file.mesh.hints);
-    let scheme = scheme_arg::given_or_named(
-        args.scheme.as_ref(),
-        &file.mesh.hints,
-        scheme_arg::evaluated,
-        &args.input,
-    )?;
+    let scheme =
+        scheme_arg::evaluated_or_named(args.scheme.as_ref(), &file.mesh.hints, &args.input)?;
     let mut table = PatchTable::new(
         &file.mesh.topology,
         &file.mesh.positions,

@@ -135,9 +135,8 @@ fn run_one(
     let topo = &file.mesh.topology;
     let nv = topo.num_vertices();
     let options = args.rules.options(&file.mesh.hints);
-    let given = args.scheme.as_ref();
     let named = scheme_arg::given_or_named(
-        given,
+        args.scheme.as_ref(),
         &file.mesh.hints,
         scheme_arg::interpolated,
         &job.input,
@@ -147,7 +146,6 @@ fn run_one(
     let moving = moving_vertices(args, nv)?;
     let solver = args.solver.solver();
     let at_input = |e: subd_pia::PiaError| bad(format!("{}: {e}", job.input.display()));
-
     let spinner = Spinner::new(args.json || job.quiet, "limit stencils");
     let t0 = Instant::now();
     let pia = Pia::new(topo, &scheme, &options).map_err(at_input)?;

@@ -134,6 +134,15 @@ pub(crate) fn given_or_named(
     }
 }
 
+/// [`given_or_named`] for the commands that evaluate the limit exactly ([`evaluated`]).
+pub(crate) fn evaluated_or_named(
+    given: Option<&Scheme>,
+    hints: &SchemeHints,
+    input: &Path,
+) -> Result<Scheme, Failure> {
+    given_or_named(given, hints, evaluated, input)
+}
+
 /// `scheme` with the butterfly's `--tension`; the flag applies to the butterfly only (named
 /// `flag` in the message).
 pub(crate) fn with_tension(

@@ -77,12 +77,8 @@ pub(crate) fn run(
     let in_file = |e: &dyn std::fmt::Display| bad(format!("{}: {e}", args.input.display()));
     let t1 = Instant::now();
     let options = args.rules.options(&file.mesh.hints);
-    let scheme = scheme_arg::given_or_named(
-        args.scheme.as_ref(),
-        &file.mesh.hints,
-        scheme_arg::evaluated,
-        &args.input,
-    )?;
+    let scheme =
+        scheme_arg::evaluated_or_named(args.scheme.as_ref(), &file.mesh.hints, &args.input)?;
     let t_setup = t1.elapsed().as_secs_f64();
     let t2 = Instant::now();
     // Refinement and the last level's limit masks at a rate that is a power of two, the
