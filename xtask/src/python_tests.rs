@@ -30,7 +30,8 @@ pub(crate) fn run_python_tests(root: &Path) -> Result<(), String> {
     let package = root.join("crates/python");
     let subd_bin: PathBuf = root.join("target/release/subd");
     run(Command::new(&python)
-        .args(["-m", "pytest", "-q"])
+        // The slowest tests are listed, to see where the CI budget goes.
+        .args(["-m", "pytest", "-q", "--durations=25"])
         .arg(package.join("tests"))
         .env("SUBD_BIN", subd_bin))
 }
