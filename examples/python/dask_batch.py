@@ -2,7 +2,7 @@
 
 Usage::
 
-    python examples/python/dask_batch.py IN_DIR OUT_DIR --scheme S --levels N \\
+    python examples/python/dask_batch.py IN_DIR OUT_DIR [--scheme S] --levels N \\
         [--format obj|ply|glb|usda|usdc|usdz] [--workers W] [--threads-per-worker T] \\
         [--scheduler ADDRESS] [--verbose]
 
@@ -15,9 +15,14 @@ Usage::
         --levels 3 --scheduler tcp://host:8786
 
 Inputs are the files under IN_DIR, searched recursively, whose extension subd reads
-(.obj, .ply, .gltf, .glb, .usd, .usda, .usdc, .usdz, in any case), in sorted order; files under OUT_DIR are left out
-when OUT_DIR lies inside IN_DIR. Each input gives ``OUT_DIR/<stem>.<ext>``: ``ext`` is the
-input's own (a .gltf input gives .glb, which subd writes) unless ``--format`` names one.
+(.obj, .ply, .gltf, .glb, .usd, .usda, .usdc, .usdz, in any case), in sorted order; files
+under OUT_DIR are left out when OUT_DIR lies inside IN_DIR. Each input gives
+``OUT_DIR/<stem>.<ext>``: ``ext`` is the input's own (a .gltf input gives .glb, which subd
+writes) unless ``--format`` names one. A USD stage with several mesh prims gives one task
+per prim, named after the stem and the prim's path (``scene.usda``'s ``/World/Body``:
+``scene_World_Body.usda``), as the CLI's batch mode (``--out-dir``) names them. Without
+``--scheme`` each mesh is refined with the scheme its file names (USD's
+``subdivisionScheme``), else Catmull-Clark.
 
 Outputs are named by stem alone, so two inputs that would write the same output (``a/x.obj``
 and ``b/x.obj``; compared ignoring case, since a case-insensitive file system would
@@ -83,11 +88,12 @@ EXIT_OK = 0
 EXIT_SOME_FAILED = 1
 EXIT_BAD_ARGUMENTS = 2
 
-Job = Tuple[str, str]
-"""An (input path, output path) pair, both absolute."""
+Job = Tuple[str, str, Optional[str]]
+"""An (input path, output path, mesh prim) triple, both paths absolute; the prim is the USD
+mesh prim to read, None for the file's only mesh."""
 
 Record = Dict[str, object]
-"""A task's outcome: ``input``, ``output``, ``faces_in``, ``faces_out``, ``seconds``,
+"""A task's outcome: ``input``, ``output``, ``prim``, ``faces_in``, ``faces_out``, ``seconds``,
 ``error`` (the message, None on success) and ``error_type`` (the exception's class name)."""
 
 
@@ -106,12 +112,27 @@ def find_meshes(in_dir: Path, exclude: Optional[Path] = None) -> List[Path]:
     return sorted(found)
 
 
-def output_path(src: Path, out_dir: Path, fmt: Optional[str] = None) -> Path:
-    """``out_dir/<stem>.<ext>``: ``ext`` is ``fmt``, else the input's (.gltf gives .glb)."""
+def output_path(src: Path, out_dir: Path, fmt: Optional[str] = None,
+                prim: Optional[str] = None) -> Path:
+    """``out_dir/<name>.<ext>``: ``name`` is the stem, followed by the parts of ``prim``'s
+    path where there is one; ``ext`` is ``fmt``, else the input's (.gltf gives .glb)."""
     ext = fmt or src.suffix.lower().lstrip(".")
     if ext == "gltf":
         ext = "glb"
-    return out_dir / f"{src.stem}.{ext}"
+    name = "_".join([src.stem] + [part for part in (prim or "").split("/") if part])
+    return out_dir / f"{name}.{ext}"
+
+
+def prims_of(src: Path) -> List[Optional[str]]:
+    """The items of one input: each mesh prim of a USD stage with several, else the file
+    (None). A stage that cannot be opened is one item, which fails when its task runs."""
+    if not src.suffix.lower().startswith(".usd"):
+        return [None]
+    try:
+        prims = [p["path"] for p in subd.mesh_prims(src)]
+    except (subd.SubdError, ValueError, OSError):
+        return [None]
+    return prims if len(prims) > 1 else [None]
 
 
 def plan(in_dir, out_dir, fmt: Optional[str] = None) -> List[Job]:
@@ -129,13 +150,15 @@ def plan(in_dir, out_dir, fmt: Optional[str] = None) -> List[Job]:
         raise PlanError(f"{in_dir}: no {', '.join(INPUT_EXTENSIONS)} files under it")
     jobs, first, clashes = [], {}, []
     for src in inputs:
-        dst = output_path(src, out_dir, fmt)
-        key = str(dst).casefold()
-        if key in first:
-            clashes.append(f"{dst}: {first[key]} and {src} would both write it")
-        else:
-            first[key] = src
-        jobs.append((str(src), str(dst)))
+        for prim in prims_of(src):
+            dst = output_path(src, out_dir, fmt, prim)
+            key = str(dst).casefold()
+            item = src if prim is None else f"{src} {prim}"
+            if key in first:
+                clashes.append(f"{dst}: {first[key]} and {item} would both write it")
+            else:
+                first[key] = item
+            jobs.append((str(src), str(dst), prim))
     if clashes:
         raise PlanError("; ".join(clashes) + " (outputs are named after the input's stem)")
     return jobs
@@ -153,19 +176,21 @@ class SubdThreads(WorkerPlugin):
         subd.set_num_threads(self.threads)
 
 
-def refine_one(src: str, dst: str, scheme: str, levels: int) -> Record:
-    """Reads ``src``, refines it and writes ``dst`` (creating its directory): the task each
-    worker runs.
+def refine_one(src: str, dst: str, scheme: Optional[str], levels: int,
+               prim: Optional[str] = None) -> Record:
+    """Reads ``src`` (its mesh prim ``prim``, for a USD stage with several), refines it
+    with ``scheme`` (None: the one the file names, else Catmull-Clark) and writes ``dst``
+    (creating its directory): the task each worker runs.
 
     subd's own errors (a file that does not parse, a mesh the scheme refuses), any other
     ``ValueError`` and ``OSError`` (unreadable input, unwritable output) are returned in
     the record; anything else is a bug and propagates, with its traceback, to the client.
     """
     start = time.perf_counter()
-    record: Record = {"input": src, "output": dst, "faces_in": None, "faces_out": None,
-                      "seconds": None, "error": None, "error_type": None}
+    record: Record = {"input": src, "output": dst, "prim": prim, "faces_in": None,
+                      "faces_out": None, "seconds": None, "error": None, "error_type": None}
     try:
-        mesh = subd.read(src)
+        mesh = subd.read(src, prim=prim)
         record["faces_in"] = mesh.num_faces
         fine = subd.refine(mesh, scheme, levels)
         os.makedirs(os.path.dirname(dst), exist_ok=True)
@@ -179,7 +204,8 @@ def refine_one(src: str, dst: str, scheme: str, levels: int) -> Record:
 
 def failed_record(job: Job, error: BaseException) -> Record:
     """The record of a task that did not return one (it raised, or its worker died)."""
-    return {"input": job[0], "output": job[1], "faces_in": None, "faces_out": None,
+    return {"input": job[0], "output": job[1], "prim": job[2], "faces_in": None,
+            "faces_out": None,
             "seconds": None, "error": str(error) or repr(error),
             "error_type": type(error).__name__}
 
@@ -187,7 +213,7 @@ def failed_record(job: Job, error: BaseException) -> Record:
 def refine_all(
     client,
     jobs: Sequence[Job],
-    scheme: str,
+    scheme: Optional[str],
     levels: int,
     threads: int = 1,
     report: Optional[Callable[[Record], None]] = None,
@@ -201,9 +227,11 @@ def refine_all(
     worker gives a failed record: the batch always finishes.
     """
     client.register_plugin(SubdThreads(threads))
-    srcs, dsts = [j[0] for j in jobs], [j[1] for j in jobs]
+    srcs, dsts, prims = [j[0] for j in jobs], [j[1] for j in jobs], [j[2] for j in jobs]
     # pure=False: the tasks write files, so two equal calls are not one.
-    futures = client.map(refine_one, srcs, dsts, scheme=scheme, levels=levels, pure=False)
+    # Keywords would be given whole to every task: the per-job prims go by position.
+    n = len(jobs)
+    futures = client.map(refine_one, srcs, dsts, [scheme] * n, [levels] * n, prims, pure=False)
     index = {f.key: i for i, f in enumerate(futures)}
     records: List[Optional[Record]] = [None] * len(futures)
     for future in as_completed(futures):
@@ -220,9 +248,12 @@ def refine_all(
 
 
 def error_line(record: Record) -> str:
-    """``subd: <path>: <message>`` on one line; a message that starts with the path (a
-    parse error's ``<path>:<line>: ...``) is not prefixed with it again."""
+    """``subd: <path>: <message>`` on one line (``<path> <prim>`` for a prim of a stage with
+    several); a message that starts with the path (a parse error's ``<path>:<line>: ...``)
+    is not prefixed with it again."""
     src, message = str(record["input"]), " ".join(str(record["error"]).split())
+    if record.get("prim"):
+        return f"subd: {src} {record['prim']}: {message}"
     if message.startswith(src + ":"):
         return f"subd: {message}"
     return f"subd: {src}: {message}"
@@ -257,7 +288,8 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
     )
     p.add_argument("in_dir", metavar="IN_DIR", type=Path)
     p.add_argument("out_dir", metavar="OUT_DIR", type=Path, help="created if missing")
-    p.add_argument("--scheme", required=True, choices=subd.SCHEMES)
+    p.add_argument("--scheme", choices=subd.SCHEMES,
+                   help="default: the scheme each file names (USD), else catmull-clark")
     p.add_argument("--levels", required=True, type=int)
     p.add_argument("--format", choices=OUTPUT_FORMATS,
                    help="output format (default: the input's; .gltf gives .glb)")

@@ -19,7 +19,13 @@ fuzz_target!(|data: &[u8]| {
     if let Ok(file) = parse_mesh(bytes, format, &opts) {
         for again_as in [Format::Usda, Format::Usdc, Format::Usdz] {
             let mut out = Vec::new();
-            encode_mesh(&mut out, &file.mesh, again_as, &WriteOptions::default()).unwrap();
+            if let Err(e) = encode_mesh(&mut out, &file.mesh, again_as, &WriteOptions::default())
+            {
+                // Double-precision points or UVs (or a transform) can leave single precision,
+                // which USD's points and st hold: the one refusal allowed.
+                assert!(e.to_string().contains("beyond single precision"), "{e}");
+                return;
+            }
             let again = parse_mesh(&out, again_as, &opts).expect("written USD must read back");
             assert_eq!(
                 again.mesh.topology.all_face_vertices(),

@@ -321,11 +321,19 @@ fn main() -> ExitCode {
         } => ensure_system_packages(REFERENCE_PACKAGES).and_then(|_| {
             let mut rows = Vec::new();
             let patch_rows = |exe: &std::path::Path| -> Result<Vec<_>, String> {
-                let mut rows = patch_conformance::shapes(exe, &shapes)?;
-                rows.extend(patch_conformance::real_meshes(exe)?);
-                rows.extend(patch_conformance::random(exe, random_patches));
-                rows.extend(patch_fvar_conformance::shapes(exe, &shapes)?);
-                rows.extend(patch_fvar_conformance::random(exe, random_fvar_patches));
+                let mut rows = timed("patch shapes", || patch_conformance::shapes(exe, &shapes))?;
+                rows.extend(timed("patch meshes", || {
+                    patch_conformance::real_meshes(exe)
+                })?);
+                rows.extend(timed("patch random", || {
+                    patch_conformance::random(exe, random_patches)
+                }));
+                rows.extend(timed("fvar patch shapes", || {
+                    patch_fvar_conformance::shapes(exe, &shapes)
+                })?);
+                rows.extend(timed("fvar patch random", || {
+                    patch_fvar_conformance::random(exe, random_fvar_patches)
+                }));
                 Ok(rows)
             };
             if patches_only {
@@ -335,19 +343,29 @@ fn main() -> ExitCode {
                 let exe = osd::build_harness()?;
                 rows.extend(patch_rows(&exe)?);
                 if !fvar_only {
-                    rows.extend(conformance::shapes(&exe, &shapes)?);
-                    rows.extend(conformance::random(&exe, random));
+                    rows.extend(timed("shapes", || conformance::shapes(&exe, &shapes))?);
+                    rows.extend(timed("random", || conformance::random(&exe, random)));
                 }
-                rows.extend(fvar_conformance::shapes(&exe, &shapes)?);
-                rows.extend(fvar_conformance::random(&exe, random));
+                rows.extend(timed("fvar shapes", || {
+                    fvar_conformance::shapes(&exe, &shapes)
+                })?);
+                rows.extend(timed("fvar random", || {
+                    fvar_conformance::random(&exe, random)
+                }));
                 if !fvar_only {
-                    rows.extend(usd_conformance::stages(&exe, &usd_stages())?);
+                    rows.extend(timed("usd", || {
+                        usd_conformance::stages(&exe, &usd_stages())
+                    })?);
                 }
             }
             if against != Against::Opensubdiv && !fvar_only && !patches_only {
                 let geom = geom_ref::build_harness()?;
-                rows.extend(geom_conformance::shapes(&geom, &shapes)?);
-                rows.extend(geom_conformance::random(&geom, random));
+                rows.extend(timed("geom shapes", || {
+                    geom_conformance::shapes(&geom, &shapes)
+                })?);
+                rows.extend(timed("geom random", || {
+                    geom_conformance::random(&geom, random)
+                }));
             }
             if conformance::report(&rows) {
                 Ok(())
@@ -471,6 +489,7 @@ fn main() -> ExitCode {
                     "ply".to_string(),
                     "edit_constraints".to_string(),
                     "gltf".to_string(),
+                    "usd".to_string(),
                 ],
             };
             targets.iter().try_for_each(|t| {
@@ -496,4 +515,15 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// `f()`, with the seconds it took on stderr (to see where CI's budget goes).
+fn timed<T>(what: &str, f: impl FnOnce() -> T) -> T {
+    let start = std::time::Instant::now();
+    let out = f();
+    eprintln!(
+        "xtask: conformance {what} took {:.0} s",
+        start.elapsed().as_secs_f64()
+    );
+    out
 }

@@ -25,6 +25,8 @@
 //! ```
 
 pub mod error;
+#[cfg(feature = "fuzzing")]
+pub mod fuzzing;
 pub mod glb;
 pub mod gltf_input;
 pub mod obj;

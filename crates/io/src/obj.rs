@@ -78,15 +78,33 @@ pub fn parse_obj(bytes: &[u8], options: &ReadOptions) -> Result<MeshFile, ReadEr
 /// [`parse_obj`] with the statements read in parallel chunks of about `chunk_bytes`; input
 /// the chunks refuse is read again serially, so that the first error in file order is the
 /// one reported, worded as the serial reader words it.
-fn parse_obj_in_chunks(
+pub(crate) fn parse_obj_in_chunks(
     bytes: &[u8],
     options: &ReadOptions,
     chunk_bytes: usize,
 ) -> Result<MeshFile, ReadError> {
-    let mut st = match chunks::read_statements(bytes, chunk_bytes) {
+    let st = match chunks::read_statements(bytes, chunk_bytes) {
         Ok(st) => st,
         Err(chunks::Failed) => read_statements(bytes)?,
     };
+    mesh_from_statements(st, options)
+}
+
+/// [`parse_obj`] with the statements read by the serial reader alone: what the chunked
+/// reader must agree with (the fuzz target holds it to that).
+#[cfg(feature = "fuzzing")]
+pub(crate) fn parse_obj_serially(
+    bytes: &[u8],
+    options: &ReadOptions,
+) -> Result<MeshFile, ReadError> {
+    mesh_from_statements(read_statements(bytes)?, options)
+}
+
+/// The mesh, tags and UVs the statements give.
+fn mesh_from_statements(
+    mut st: ObjStatements,
+    options: &ReadOptions,
+) -> Result<MeshFile, ReadError> {
     check_face_indices(&st)?;
     let (mut topology, orientation_conflicts) = build_topology(&mut st, options)?;
     let mut hints = SchemeHints::default();

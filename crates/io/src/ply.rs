@@ -350,6 +350,30 @@ fn parse_hint(line: usize, words: &[&str], hints: &mut SchemeHints) -> Result<()
 
 /// Parses a PLY file. ASCII errors carry the line; binary errors name the element.
 pub fn parse_ply(bytes: &[u8], options: &ReadOptions) -> Result<MeshFile, ReadError> {
+    parse_ply_with(
+        bytes,
+        options,
+        BinaryReading::Parallel(binary::VERTICES_PER_TASK),
+    )
+}
+
+/// How binary vertex and face elements are read.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum BinaryReading {
+    /// By the fast decoders ([`binary`]), vertices in parallel tasks of this many.
+    Parallel(usize),
+    /// By the per-value reader alone: what the fast decoders must agree with (the fuzz
+    /// target and the tests hold them to that).
+    #[cfg_attr(not(any(test, feature = "fuzzing")), allow(dead_code))]
+    PerValue,
+}
+
+/// [`parse_ply`] with binary elements read as `reading` says.
+pub(crate) fn parse_ply_with(
+    bytes: &[u8],
+    options: &ReadOptions,
+    reading: BinaryReading,
+) -> Result<MeshFile, ReadError> {
     let header = parse_header(bytes)?;
     let data = &bytes[header.body_offset..];
     let mut body = match header.encoding {
@@ -365,7 +389,7 @@ pub fn parse_ply(bytes: &[u8], options: &ReadOptions) -> Result<MeshFile, ReadEr
             big_endian: header.encoding == Encoding::Be,
         },
     };
-    let d = read_elements(&header, &mut body)?;
+    let d = read_elements(&header, &mut body, reading)?;
     check_faces(&d)?;
     let nv = d.positions.len();
     let (mut topology, build_warnings) = TopologyBuilder::new(nv)
@@ -416,7 +440,11 @@ struct PlyData {
 }
 
 /// Reads every element instance of the body (see the module docs for the roles).
-fn read_elements(header: &Header, body: &mut Body<'_>) -> Result<PlyData, ReadError> {
+fn read_elements(
+    header: &Header,
+    body: &mut Body<'_>,
+    reading: BinaryReading,
+) -> Result<PlyData, ReadError> {
     let mut r = ElementReader {
         d: PlyData {
             positions: Vec::new(),
@@ -443,7 +471,9 @@ fn read_elements(header: &Header, body: &mut Body<'_>) -> Result<PlyData, ReadEr
             Some(Role::Face { .. }) => r.d.face_sizes.reserve(el.count),
             _ => {}
         }
-        if binary::read_element(&mut r, el, role, body) {
+        if let BinaryReading::Parallel(vertices_per_task) = reading
+            && binary::read_element(&mut r, el, role, body, vertices_per_task)
+        {
             continue;
         }
         for k in 0..el.count {

@@ -73,7 +73,7 @@ pub(crate) fn adaptive(
             .and_then(|a| assembled(a, &request))
     })?
     .map_err(mesh_error)?;
-    Ok(adapted)
+    Ok((adapted.0.made_from(mesh), adapted.1))
 }
 
 /// Indices as the criteria take them, a negative one named.

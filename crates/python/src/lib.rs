@@ -31,6 +31,7 @@ fn _subd(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<refiner::CoreRefiner>()?;
     m.add_class::<patches::CorePatchTable>()?;
     m.add_function(wrap_pyfunction!(ops::read, m)?)?;
+    m.add_function(wrap_pyfunction!(ops::mesh_prims, m)?)?;
     m.add_function(wrap_pyfunction!(ops::refine, m)?)?;
     m.add_function(wrap_pyfunction!(ops::limit, m)?)?;
     m.add_function(wrap_pyfunction!(ops::info, m)?)?;

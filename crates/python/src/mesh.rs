@@ -29,6 +29,9 @@ pub(crate) struct CoreMesh {
     pub(crate) face_levels: Option<Vec<u8>>,
     /// Edges used in the same direction by two faces, as the reader counted them.
     pub(crate) orientation_conflicts: usize,
+    /// The USD prim it was read from and its stage's units (kept by what is made from it,
+    /// and written back by a USD output).
+    pub(crate) stage: Option<subd_io::usd::StageInfo>,
 }
 
 /// What the arrays of a mesh are read from, built or not.
@@ -49,7 +52,14 @@ impl CoreMesh {
             normals: None,
             face_levels: None,
             orientation_conflicts: 0,
+            stage: None,
         }
+    }
+
+    /// This mesh, made from `source`: it keeps the USD prim and units `source` was read with.
+    pub(crate) fn made_from(mut self, source: &CoreMesh) -> CoreMesh {
+        self.stage = source.stage.clone();
+        self
     }
 
     /// A refinement's result, its topology left for later.
@@ -60,6 +70,7 @@ impl CoreMesh {
             pending: Mutex::new(Some(refined)),
             face_levels: None,
             orientation_conflicts: 0,
+            stage: None,
         }
     }
 
@@ -482,10 +493,35 @@ impl CoreMesh {
         Ok(self.mesh(py)?.topology.num_edges())
     }
 
-    /// Writes the mesh (OBJ with crease tags, PLY, glTF binary by the extension), with its
-    /// normals where it has them. The file appears whole or not at all.
+    /// The USD prim the mesh (or the mesh it was made from) was read from, and its stage's
+    /// units: `(prim path, metersPerUnit or None, upAxis or None)`, or None for other files.
+    #[getter]
+    fn stage(&self) -> Option<(String, Option<f64>, Option<String>)> {
+        self.stage
+            .as_ref()
+            .map(|s| (s.prim.clone(), s.meters_per_unit, s.up_axis.clone()))
+    }
+
+    /// The scheme the file names for the mesh (USD's `subdivisionScheme`: `catmull-clark`,
+    /// `loop`, `bilinear`, or `none` for plain polygons), or None when it names none.
+    #[getter]
+    fn file_scheme(&self, py: Python<'_>) -> PyResult<Option<&'static str>> {
+        use subd_mesh::FileScheme;
+        Ok(self.mesh(py)?.hints.scheme.map(|s| match s {
+            FileScheme::CatmullClark => "catmull-clark",
+            FileScheme::Loop => "loop",
+            FileScheme::Bilinear => "bilinear",
+            FileScheme::Polygons => "none",
+        }))
+    }
+
+    /// Writes the mesh (OBJ with crease tags, PLY, glTF binary, USD by the extension), with
+    /// its normals where it has them. The file appears whole or not at all.
     fn write(&self, py: Python<'_>, path: std::path::PathBuf) -> PyResult<()> {
-        let options = subd_io::WriteOptions::default();
+        let options = subd_io::WriteOptions {
+            stage: self.stage.clone(),
+            ..subd_io::WriteOptions::default()
+        };
         let mesh = self.mesh(py)?;
         pool::run(py, || match &self.normals {
             None => subd_io::write_mesh(&path, mesh, &options),

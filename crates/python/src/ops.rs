@@ -127,7 +127,22 @@ pub(crate) fn read(
     let file = pool::run(py, || subd_io::read_mesh(&path, &options))?.map_err(io_error)?;
     let mut core = CoreMesh::plain(file.mesh);
     core.orientation_conflicts = file.orientation_conflicts;
+    core.stage = file.stage;
     Ok((core, file.warnings))
+}
+
+/// The mesh prims of the USD stage at `path` (composed, in traversal order): each one's
+/// path, faces, points and `subdivisionScheme` token.
+#[pyfunction]
+pub(crate) fn mesh_prims(
+    py: Python<'_>,
+    path: PathBuf,
+) -> PyResult<Vec<(String, usize, usize, String)>> {
+    let prims = pool::run(py, || subd_io::usd::mesh_prims(&path))?.map_err(io_error)?;
+    Ok(prims
+        .into_iter()
+        .map(|p| (p.path, p.faces, p.points, p.scheme))
+        .collect())
 }
 
 /// The mesh refined `levels` times with `scheme` (the mesh's own rule options unless
@@ -164,7 +179,7 @@ pub(crate) fn refine(
     };
     let mut refined = pool::run(py, || refine_mesh(base, &request))?.map_err(mesh_error)?;
     let warnings = std::mem::take(&mut refined.warnings);
-    Ok((CoreMesh::refined(refined), warnings))
+    Ok((CoreMesh::refined(refined).made_from(mesh), warnings))
 }
 
 /// A refinement request checked: the scheme, the options for `mesh` and the output's size.

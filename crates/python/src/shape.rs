@@ -32,6 +32,15 @@ fn reshaped(base: &Mesh, positions: Vec<DVec3>) -> Result<Mesh, String> {
     Ok(mesh)
 }
 
+/// The control cage of `scheme` with the base's topology at `positions`: it names the scheme
+/// (as `subd pia` and `subd edit` do), so that a USD output is subdivided by a renderer into
+/// the same limit surface; a scheme USD cannot name leaves the cage plain polygons.
+fn cage(base: &Mesh, positions: Vec<DVec3>, scheme: &Scheme) -> Result<Mesh, String> {
+    let mut mesh = reshaped(base, positions)?;
+    mesh.hints.scheme = scheme.file_scheme();
+    Ok(mesh)
+}
+
 /// Vertex indices as `u32`, each named when negative or past the mesh's `nv` vertices.
 fn vertex_list(indices: &[i64], nv: usize, what: &str) -> PyResult<Vec<u32>> {
     indices
@@ -179,8 +188,8 @@ pub(crate) fn pia(
             max_iter,
         },
     };
-    let (mesh, report) = pool::run(py, || interpolate(base, &request))?.map_err(mesh_error)?;
-    Ok((mesh.map(CoreMesh::plain), report))
+    let (solved, report) = pool::run(py, || interpolate(base, &request))?.map_err(mesh_error)?;
+    Ok((solved.map(|m| CoreMesh::plain(m).made_from(mesh)), report))
 }
 
 /// Sets up and solves the interpolation, then measures the result with a limit table built
@@ -225,7 +234,7 @@ fn interpolate(base: &Mesh, r: &PiaRequest) -> Result<(Option<Mesh>, String), St
     });
     // A solve that did not converge may hold points that are not finite: no mesh of them.
     let mesh = converged
-        .then(|| reshaped(base, result.points))
+        .then(|| cage(base, result.points, &r.scheme))
         .transpose()?;
     Ok((mesh, report.to_string()))
 }
@@ -328,12 +337,16 @@ pub(crate) fn edit(
     let (edited, moved) = pool::run(py, || -> Result<(MeshEdit, Mesh), String> {
         let e = subd_editing::edit_mesh(base, &scheme, &options, &constraints, method, measure)
             .map_err(|e| e.to_string())?;
-        let moved = reshaped(base, e.edit.positions.clone())?;
+        let moved = cage(base, e.edit.positions.clone(), &scheme)?;
         Ok((e, moved))
     })?
     .map_err(mesh_error)?;
     let report = edit_report(&edited, &scheme, base.topology.num_vertices(), &constraints);
-    Ok((CoreMesh::plain(moved), edited.warnings, report))
+    Ok((
+        CoreMesh::plain(moved).made_from(mesh),
+        edited.warnings,
+        report,
+    ))
 }
 
 /// What `subd edit --json` reports of an edit, less the files and the reading and writing.
@@ -397,5 +410,5 @@ pub(crate) fn deform(
         "moved": count,
         "max_constraint_error": deformation.max_constraint_error(),
     });
-    Ok((CoreMesh::plain(moved), report.to_string()))
+    Ok((CoreMesh::plain(moved).made_from(mesh), report.to_string()))
 }

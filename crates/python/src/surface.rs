@@ -108,7 +108,7 @@ pub(crate) fn tessellate(
         Ok((out, t.normals))
     })?
     .map_err(mesh_error)?;
-    let mut core = CoreMesh::plain(out);
+    let mut core = CoreMesh::plain(out).made_from(mesh);
     core.normals = Some(normals);
     Ok(core)
 }

@@ -10,12 +10,15 @@ import sys
 import numpy as np
 import pytest
 
+import shutil
+
 import subd
 
 pytest.importorskip("distributed")
 
 ROOT = pathlib.Path(__file__).resolve().parents[3]
 EXAMPLE = ROOT / "examples" / "python" / "dask_batch.py"
+STAGES = ROOT / "tests" / "data" / "usd"
 
 CUBE_V = np.array(
     [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]],
@@ -115,6 +118,37 @@ def test_batch_on_two_local_workers_refines_the_good_files_and_reports_the_bad(t
     m = re.fullmatch(r"(\d+) refined, (\d+) failed, (\d+) faces out, ([\d.]+) s", summary)
     assert m, run.stdout
     assert (int(m[1]), int(m[2]), int(m[3])) == (18, 2, total)
+
+
+def test_each_mesh_prim_of_a_stage_is_a_task_refined_with_its_scheme(tmp_path):
+    in_dir, out_dir = (tmp_path / "in").resolve(), (tmp_path / "out").resolve()
+    in_dir.mkdir()
+    shutil.copy(STAGES / "meshes.usda", in_dir / "scene.usda")
+    subd.Mesh(CUBE_V, CUBE_F).write(in_dir / "cube.obj")
+    run = run_example(in_dir, out_dir, "--levels", 1, "--workers", 1)
+    # /World/Flat names no subdivision scheme (`none`): that task fails, named, as the CLI's.
+    assert run.returncode == 1, run.stderr
+    [failed] = [line for line in run.stderr.splitlines() if line.startswith("subd: ")]
+    assert failed.startswith(f"subd: {in_dir / 'scene.usda'} /World/Flat: "), failed
+    assert "names no subdivision scheme" in failed
+    prims = [p["path"] for p in subd.mesh_prims(in_dir / "scene.usda")]
+    assert len(prims) == 4 and "/World/Flat" in prims
+    names = {"cube.obj": (in_dir / "cube.obj", None)}
+    for prim in prims:
+        if prim != "/World/Flat":
+            names["scene" + prim.replace("/", "_") + ".usda"] = (in_dir / "scene.usda", prim)
+    assert sorted(p.name for p in out_dir.iterdir()) == sorted(names)
+    for name, (src, prim) in names.items():
+        mesh = subd.read(src, prim=prim)
+        # Each prim with the scheme its stage names (Catmull-Clark, Loop, ...).
+        want = subd.refine(mesh, mesh.file_scheme or "catmull-clark", levels=1)
+        got = subd.read(out_dir / name)
+        assert np.array_equal(got.face_vertices, want.face_vertices), name
+        # USD stores single-precision points.
+        assert np.abs(got.vertices - want.vertices).max() <= 1e-5 * max(
+            1.0, np.abs(want.vertices).max()), name
+        if prim is not None:
+            assert got.stage[0].rsplit("/", 1)[1] == prim.rsplit("/", 1)[1], name
 
 
 @pytest.mark.parametrize(

@@ -576,8 +576,13 @@ def test_a_refined_meshs_topology_is_built_once_under_concurrent_use(pool):
 def test_adaptive_equals_the_binary(tmp_path, flags, kwargs):
     compared = with_uvs = 0
     scheme = lambda obj: "loop" if obj.name.startswith("loop") else "catmull-clark"  # noqa: E731
+    # With --limit, catmark_pole360 (one vertex of valence 360) is left out: each point's
+    # exact limit takes a local refinement of the whole 720-face pole (~200 s per door);
+    # the other extraordinary vertices take the same code.
+    shapes = [s for s in sorted(SHAPES.glob("*.obj"))[::4]
+              if not (kwargs.get("limit") and s.stem == "catmark_pole360")]
     for got, want, name in binary_and_binding(
-        tmp_path, sorted(SHAPES.glob("*.obj"))[::4],
+        tmp_path, shapes,
         lambda obj: ["adaptive", "--scheme", scheme(obj), *flags],
         lambda mesh, obj: subd.adaptive(mesh, scheme(obj), **kwargs),
     ):

@@ -150,6 +150,7 @@ for prim in stage.Traverse():
     st = UsdGeom.PrimvarsAPI(prim).GetPrimvar("st")
     normals = m.GetNormalsAttr()
     out.append({
+        "path": str(prim.GetPath()),
         "valid": ok, "why": why,
         "counts": list(m.GetFaceVertexCountsAttr().Get()),
         "indices": list(m.GetFaceVertexIndicesAttr().Get()),
@@ -242,6 +243,35 @@ def test_python_writes_usd_that_pxr_reads(tmp_path):
         assert np.array_equal(np.array(m["points"]), f32(mesh.vertices))
         again = subd.read(path)
         assert np.array_equal(again.creases[1], mesh.creases[1])
+
+
+def test_python_keeps_the_prim_units_and_scheme_through_its_functions(tmp_path):
+    """What is made from a USD mesh keeps its prim's name and its stage's units; the scheme
+    defaults to the file's; a cage from pia names the scheme it is the cage of."""
+    strip = subd.read(STAGES / "meshes.usda", prim="/World/Strip")
+    assert strip.file_scheme == "loop"
+    assert strip.stage == ("/World/Strip", 0.01, "Z")
+    refined = subd.refine(strip, levels=2)
+    by_name = subd.refine(strip, "loop", levels=2)
+    assert np.array_equal(refined.vertices, by_name.vertices)
+    assert not np.array_equal(refined.vertices,
+                              subd.refine(strip, "catmull-clark", levels=2).vertices)
+    assert refined.stage == strip.stage
+    out = tmp_path / "refined.usda"
+    refined.write(out)
+    [m], diagnostics = pxr_reads(out)
+    assert diagnostics == ""
+    assert m["path"].endswith("/Strip") and m["scheme"] == "none"
+    assert m["meters_per_unit"] == 0.01 and m["up_axis"] == "Z"
+    cage = subd.pia(strip)
+    assert cage.stage == strip.stage and cage.file_scheme == "loop"
+    cage.write(tmp_path / "cage.usdc")
+    [m], diagnostics = pxr_reads(tmp_path / "cage.usdc")
+    assert diagnostics == "" and m["scheme"] == "loop" and m["path"].endswith("/Strip")
+    # A mesh from arrays names no scheme, and the default stays Catmull-Clark.
+    quad = subd.Mesh([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], [[0, 1, 2, 3]])
+    assert quad.file_scheme is None and quad.stage is None
+    assert subd.refine(quad).num_faces == 4
 
 
 @pytest.mark.skipif(not SUBD_BIN, reason="SUBD_BIN (the subd binary) not set")

@@ -12,7 +12,7 @@ use subd_mesh::DVec3;
 use super::{Body, Element, ElementReader, Property, Role, Scalar, scalar_value};
 
 /// Vertices per parallel task.
-const VERTICES_PER_TASK: usize = 1 << 14;
+pub(super) const VERTICES_PER_TASK: usize = 1 << 14;
 
 /// Reads every instance of `el` when this module handles it, and returns whether it did
 /// (having changed nothing when it did not).
@@ -21,6 +21,7 @@ pub(super) fn read_element(
     el: &Element,
     role: Option<Role>,
     body: &mut Body<'_>,
+    vertices_per_task: usize,
 ) -> bool {
     let Body::Binary {
         data,
@@ -32,7 +33,9 @@ pub(super) fn read_element(
     };
     let rest = &data[*pos..];
     let read = match role {
-        Some(Role::Vertex(xyz)) => read_vertices(r, el, xyz, rest, *big_endian),
+        Some(Role::Vertex(xyz)) => {
+            read_vertices(r, el, xyz, rest, *big_endian, vertices_per_task.max(1))
+        }
         Some(Role::Face { list, level }) => read_faces(r, el, list, level, rest, *big_endian),
         _ => None,
     };
@@ -68,6 +71,7 @@ fn read_vertices(
     [x, y, z]: [usize; 3],
     data: &[u8],
     big_endian: bool,
+    per_task: usize,
 ) -> Option<usize> {
     let (fields, stride) = scalar_offsets(&el.props)?;
     if stride == 0 {
@@ -80,8 +84,8 @@ fn read_vertices(
     let first = r.d.positions.len();
     r.d.positions.resize(first + el.count, DVec3::ZERO);
     let finite = r.d.positions[first..]
-        .par_chunks_mut(VERTICES_PER_TASK)
-        .zip(bytes.par_chunks(VERTICES_PER_TASK * stride))
+        .par_chunks_mut(per_task)
+        .zip(bytes.par_chunks(per_task * stride))
         .all(|(out, records)| {
             out.iter_mut()
                 .zip(records.chunks_exact(stride))
@@ -92,7 +96,7 @@ fn read_vertices(
         });
     let uv_finite = finite
         && match r.uv_props {
-            Some([u, v]) => read_texcoords(&mut r.texcoords, bytes, stride, |rec| {
+            Some([u, v]) => read_texcoords(&mut r.texcoords, bytes, stride, per_task, |rec| {
                 [value(rec, fields[u]), value(rec, fields[v])]
             }),
             None => true,
@@ -110,13 +114,14 @@ fn read_texcoords(
     texcoords: &mut Vec<f64>,
     bytes: &[u8],
     stride: usize,
+    per_task: usize,
     uv: impl Fn(&[u8]) -> [f64; 2] + Sync,
 ) -> bool {
     let first = texcoords.len();
     texcoords.resize(first + 2 * (bytes.len() / stride), 0.0);
     let finite = texcoords[first..]
-        .par_chunks_mut(2 * VERTICES_PER_TASK)
-        .zip(bytes.par_chunks(VERTICES_PER_TASK * stride))
+        .par_chunks_mut(2 * per_task)
+        .zip(bytes.par_chunks(per_task * stride))
         .all(|(out, records)| {
             out.chunks_exact_mut(2)
                 .zip(records.chunks_exact(stride))
@@ -420,5 +425,46 @@ mod tests {
                 .unwrap_err()
                 .contains("binary data ends inside face 2499")
         );
+    }
+
+    /// Vertices decoded in tasks of one, three or all of them give what the per-value reader
+    /// gives, bit for bit, and the same errors where a late value is bad.
+    #[test]
+    fn tiny_tasks_give_the_per_value_result() {
+        use super::super::{BinaryReading, parse_ply_with};
+        let (positions, offsets, vertices, uv, levels) = grid(40);
+        let view = MeshView::new(&positions, &offsets, &vertices, &[])
+            .and_then(|v| v.with_uv(&uv, 2, &vertices))
+            .and_then(|v| v.with_face_levels(&levels))
+            .unwrap();
+        let mut good = Vec::new();
+        let options = WriteOptions {
+            ply_encoding: PlyEncoding::BinaryLittleEndian,
+            ..WriteOptions::default()
+        };
+        encode_view(&mut good, &view, Format::Ply, &options).unwrap();
+        let mut bad = good.clone();
+        // The last vertex's last value (its v, a double) becomes infinite.
+        let header_end = bad.windows(11).position(|w| w == b"end_header\n").unwrap() + 11;
+        let last_v = header_end + positions.len() * 40 - 8;
+        bad[last_v..last_v + 8].copy_from_slice(&f64::INFINITY.to_le_bytes());
+        let read = |bytes: &[u8], reading| {
+            parse_ply_with(bytes, &ReadOptions::default(), reading).map_err(|e| e.to_string())
+        };
+        for bytes in [&good, &bad] {
+            let serial = read(bytes, BinaryReading::PerValue);
+            for per_task in [1, 3, 1 << 14] {
+                let fast = read(bytes, BinaryReading::Parallel(per_task));
+                match (&fast, &serial) {
+                    (Ok(f), Ok(s)) => {
+                        assert_eq!(f.mesh, s.mesh);
+                        assert_eq!(f.face_levels, s.face_levels);
+                    }
+                    (Err(f), Err(s)) => assert_eq!(f, s),
+                    _ => panic!("fast {:?} but per-value {:?}", fast.err(), serial.err()),
+                }
+            }
+        }
+        assert!(read(&bad, BinaryReading::PerValue).is_err());
     }
 }

@@ -18,7 +18,7 @@ from __future__ import annotations
 import json
 import os
 import warnings
-from typing import Optional, Sequence, Tuple, Union
+from typing import List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -62,6 +62,7 @@ __all__ = [
     "info",
     "get_num_threads",
     "limit",
+    "mesh_prims",
     "pia",
     "read",
     "refine",
@@ -245,9 +246,25 @@ class Mesh:
     def num_edges(self) -> int:
         return self._core.num_edges
 
+    @property
+    def file_scheme(self) -> Optional[str]:
+        """The scheme the mesh's file names (USD's ``subdivisionScheme``): ``"catmull-clark"``,
+        ``"loop"``, ``"bilinear"``, ``"none"`` (plain polygons), or None where it names none
+        (OBJ, PLY, glTF, arrays). The functions that take a ``scheme`` use it when given
+        none (else Catmull-Clark); :func:`pia` and :func:`edit` name theirs in their cage."""
+        return self._core.file_scheme
+
+    @property
+    def stage(self) -> Optional[Tuple[str, Optional[float], Optional[str]]]:
+        """``(prim path, metersPerUnit, upAxis)`` of the USD prim the mesh, or the mesh it was
+        made from, was read from (units None where the stage authors none); None for other
+        files. A USD output names its prim after the path and writes the units back."""
+        return self._core.stage
+
     def write(self, path: Union[str, os.PathLike]) -> None:
         """Writes the mesh by the extension: OBJ (with crease tags), PLY, glTF binary, or USD
-        (.usda, .usdc, .usdz, .usd: one Mesh prim with its scheme, rules and tags)."""
+        (.usda, .usdc, .usdz, .usd: one Mesh prim with its scheme, rules and tags, named after
+        the prim it was read from, with that stage's units; see :attr:`stage`)."""
         self._core.write(os.fspath(path))
 
     def __repr__(self) -> str:
@@ -328,6 +345,15 @@ def read(
     return Mesh._wrap(core)
 
 
+def mesh_prims(path: Union[str, os.PathLike]) -> List[dict]:
+    """The mesh prims of a USD stage (composed, in traversal order), as ``subd info`` lists
+    them: dicts of ``path``, ``faces``, ``points`` and ``scheme`` (the
+    ``subdivisionScheme`` token, ``catmullClark`` where not authored). Read one with
+    ``read(path, prim=...)``. Raises :class:`FormatError` when the file is no stage."""
+    return [{"path": p, "faces": f, "points": n, "scheme": s}
+            for p, f, n, s in _subd.mesh_prims(os.fspath(path))]
+
+
 def info(mesh: Mesh) -> dict:
     """What ``subd info --json`` reports: counts, face-size and valence histograms,
     boundaries, non-manifold elements, components, Euler characteristic and genus,
@@ -339,7 +365,10 @@ def info(mesh: Mesh) -> dict:
     return report
 
 
-def _scheme_name(scheme: str, tension: Optional[float], lam: Optional[float]) -> str:
+def _scheme_name(scheme: Optional[str], tension: Optional[float], lam: Optional[float],
+                 mesh: Optional["Mesh"] = None) -> str:
+    if scheme is None:
+        scheme = _file_scheme(mesh)
     if not isinstance(scheme, str):
         raise TypeError(f"scheme: expected a name such as 'catmull-clark', got {type(scheme).__name__}")
     if tension is not None and lam is not None:
@@ -352,9 +381,18 @@ def _scheme_name(scheme: str, tension: Optional[float], lam: Optional[float]) ->
     return f"{scheme}:{float(parameter)!r}"
 
 
+def _file_scheme(mesh: Optional["Mesh"]) -> str:
+    """The scheme a mesh's file names (USD's ``subdivisionScheme``), else Catmull-Clark."""
+    named = None if mesh is None else mesh._core.file_scheme
+    if named == "none":
+        raise ValueError("the mesh's file names no subdivision scheme (subdivisionScheme "
+                         "none): give scheme=")
+    return "catmull-clark" if named is None else named
+
+
 def refine(
     mesh: Mesh,
-    scheme: str = "catmull-clark",
+    scheme: Optional[str] = None,
     levels: int = 1,
     *,
     limit: bool = False,
@@ -365,7 +403,9 @@ def refine(
     tension: Optional[float] = None,
     lam: Optional[float] = None,
 ) -> Mesh:
-    """The mesh refined ``levels`` times with ``scheme`` (one of :data:`SCHEMES`).
+    """The mesh refined ``levels`` times with ``scheme`` (one of :data:`SCHEMES`; by default
+    the one the mesh's file names, :attr:`Mesh.file_scheme`, else Catmull-Clark, as every
+    function here that takes a ``scheme``).
 
     With ``limit=True`` the vertices are moved to the exact limit surface and the result
     has unit ``normals``. The rule options take the CLI's names and default to the mesh's
@@ -382,7 +422,7 @@ def refine(
     """
     _check_mesh(mesh)
     levels = _count(levels, "levels")
-    name = _scheme_name(scheme, tension, lam)
+    name = _scheme_name(scheme, tension, lam, mesh)
     rules = _rule_names(boundary, crease_method, triangles, fvar_interpolation)
     core, messages = _subd.refine(mesh._core, name, levels, bool(limit), *rules)
     _warn(messages)
@@ -391,7 +431,7 @@ def refine(
 
 def adaptive(
     mesh: Mesh,
-    scheme: str = "catmull-clark",
+    scheme: Optional[str] = None,
     *,
     flatness: Optional[float] = None,
     max_distance: Optional[float] = None,
@@ -431,7 +471,7 @@ def adaptive(
     verts = (None if select_vertices is None
              else _index_array(select_vertices, "select_vertices").reshape(-1))
     rules = _rule_names(boundary, crease_method, triangles, fvar_interpolation)
-    core, messages = _subd.adaptive(mesh._core, _scheme_name(scheme, None, None), levels,
+    core, messages = _subd.adaptive(mesh._core, _scheme_name(scheme, None, None, mesh), levels,
                                     bool(limit), thresholds, faces, verts, *rules)
     _warn(messages)
     return Mesh._wrap(core)
@@ -566,7 +606,7 @@ class Refiner:
     def __init__(
         self,
         mesh: Mesh,
-        scheme: str = "catmull-clark",
+        scheme: Optional[str] = None,
         levels: int = 1,
         *,
         boundary: Optional[str] = None,
@@ -577,7 +617,7 @@ class Refiner:
     ) -> None:
         _check_mesh(mesh)
         self.levels = _count(levels, "levels")
-        name = _scheme_name(scheme, tension, lam)
+        name = _scheme_name(scheme, tension, lam, mesh)
         rules = _rule_names(boundary, crease_method, triangles)[:3]
         self._core = _subd._CoreRefiner(mesh._core, name, self.levels, *rules)
 
@@ -656,7 +696,7 @@ class PatchTable:
     def __init__(
         self,
         mesh: Mesh,
-        scheme: str = "catmull-clark",
+        scheme: Optional[str] = None,
         *,
         isolation: int = 10,
         end_caps: str = "gregory",
@@ -677,7 +717,7 @@ class PatchTable:
                              "(one of gregory, bspline, bilinear, exact)")
         rules = _rule_names(boundary, crease_method, triangles, fvar_interpolation)
         self._scheme, self._end_caps, self._isolation = (
-            _scheme_name(scheme, None, None), end_caps, isolation)
+            _scheme_name(scheme, None, None, mesh), end_caps, isolation)
         self._core = _subd._CorePatchTable(
             mesh._core, self._scheme, isolation, end_caps,
             bool(single_crease), bool(inf_sharp), bool(legacy_sharp_corners), *rules)
@@ -788,10 +828,10 @@ class PatchTable:
         self._core.update_uv(np.ascontiguousarray(a))
 
 
-def limit(mesh: Mesh, scheme: str = "catmull-clark") -> Tuple[np.ndarray, np.ndarray]:
+def limit(mesh: Mesh, scheme: Optional[str] = None) -> Tuple[np.ndarray, np.ndarray]:
     """(positions, normals), both (n, 3) float64: the exact limit of every vertex."""
     _check_mesh(mesh)
-    return _subd.limit(mesh._core, _scheme_name(scheme, None, None))
+    return _subd.limit(mesh._core, _scheme_name(scheme, None, None, mesh))
 
 
 def evaluate(
@@ -819,17 +859,17 @@ def evaluate(
     vv = _float_array(v, "v").reshape(-1)
     if s.size == 1 and f.size != 1:
         s = np.full_like(f, int(s[0]))
-    out = _subd.evaluate(mesh._core, _scheme_name(scheme, None, None), f, s, uu, vv,
+    out = _subd.evaluate(mesh._core, _scheme_name(scheme, None, None, mesh), f, s, uu, vv,
                          bool(derivatives))
     return tuple(out)
 
 
-def tessellate(mesh: Mesh, scheme: str = "catmull-clark", rate: int = 4) -> Mesh:
+def tessellate(mesh: Mesh, scheme: Optional[str] = None, rate: int = 4) -> Mesh:
     """The limit surface sampled ``rate`` times along every edge: a watertight mesh of
     quads (Catmull-Clark) or triangles (Loop) with unit ``normals``."""
     _check_mesh(mesh)
     rate = _count(rate, "rate")
-    return Mesh._wrap(_subd.tessellate(mesh._core, _scheme_name(scheme, None, None), rate))
+    return Mesh._wrap(_subd.tessellate(mesh._core, _scheme_name(scheme, None, None, mesh), rate))
 
 
 def _count(n, what: str) -> int:

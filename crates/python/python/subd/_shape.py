@@ -128,7 +128,7 @@ def _with_report(mesh: Mesh, report: dict, return_report: bool):
 
 def pia(
     mesh: Mesh,
-    scheme: str = "catmull-clark",
+    scheme: Optional[str] = None,
     *,
     moving=None,
     fixed=None,
@@ -164,7 +164,7 @@ def pia(
     and after each, an array) and ``seconds``.
     """
     _check_mesh(mesh)
-    name = _scheme_name(scheme, None, None)
+    name = _scheme_name(scheme, None, None, mesh)
     n = mesh.num_vertices
     chosen = _vertex_set(moving, "moving", n)
     kept = _vertex_set(fixed, "fixed", n)
@@ -196,7 +196,7 @@ def edit(
     constraints,
     *,
     method: str = "least-squares",
-    scheme: str = "catmull-clark",
+    scheme: Optional[str] = None,
     penalty: Optional[float] = None,
     exact: bool = False,
     membrane: float = 0.0,
@@ -233,7 +233,7 @@ def edit(
     """
     _check_mesh(mesh)
     text = _constraints_json(constraints)
-    name = _scheme_name(scheme, None, None)
+    name = _scheme_name(scheme, None, None, mesh)
     if isinstance(region_rings, str) and region_rings == "all":
         rings = None
     elif isinstance(region_rings, str):

@@ -16,7 +16,7 @@ class ConvergenceError(SubdError, RuntimeError):
 @overload
 def pia(
     mesh: Mesh,
-    scheme: str = ...,
+    scheme: Optional[str] = ...,
     *,
     moving: Optional[_Vertices] = ...,
     fixed: Optional[_Vertices] = ...,
@@ -33,7 +33,7 @@ def pia(
 @overload
 def pia(
     mesh: Mesh,
-    scheme: str = ...,
+    scheme: Optional[str] = ...,
     *,
     moving: Optional[_Vertices] = ...,
     fixed: Optional[_Vertices] = ...,
@@ -53,7 +53,7 @@ def edit(
     constraints: _Constraints,
     *,
     method: str = ...,
-    scheme: str = ...,
+    scheme: Optional[str] = ...,
     penalty: Optional[float] = ...,
     exact: bool = ...,
     membrane: float = ...,
@@ -69,7 +69,7 @@ def edit(
     constraints: _Constraints,
     *,
     method: str = ...,
-    scheme: str = ...,
+    scheme: Optional[str] = ...,
     penalty: Optional[float] = ...,
     exact: bool = ...,
     membrane: float = ...,
