@@ -1,9 +1,11 @@
 //! A [`MeshView`] as a layer with one `Mesh` prim, encoded as `.usda`, `.usdc` or `.usdz`.
 
+use std::borrow::Cow;
 use std::io::{self, Cursor, Write};
 
 use openusd::sdf::{self, ChildrenKey, FieldKey, SpecType, Specifier, Value, Variability};
 use openusd::{gf, usda, usdc, usdz};
+use rayon::prelude::*;
 use subd_mesh::{BoundaryInterpolation, DVec3, FileScheme};
 
 use super::StageInfo;
@@ -24,13 +26,16 @@ pub(crate) fn write_usd(
     let stage = options.stage.clone().unwrap_or_default();
     let name = prim_name(&stage.prim);
     let data = mesh_layer(view, &name, &stage)?;
+    // The arrays' raw size (points, normals, counts, indices, st and its indices): the crate
+    // file is rarely larger, so its buffer is allocated once.
+    let raw = 24 * view.num_vertices() + 4 * view.num_faces() + 16 * view.num_face_vertices();
     match format {
         Format::Usda => usda::TextWriter::write(&data, &mut &mut *w).map_err(io::Error::other),
-        Format::Usdc => w.write_all(&crate_bytes(&data)?),
+        Format::Usdc => w.write_all(&crate_bytes(&data, raw)?),
         Format::Usdz => {
             let mut archive = usdz::ArchiveWriter::new(Cursor::new(Vec::new()));
             archive
-                .add_layer(&format!("{name}.usdc"), &crate_bytes(&data)?)
+                .add_layer(&format!("{name}.usdc"), &crate_bytes(&data, raw)?)
                 .map_err(io::Error::other)?;
             let bytes = archive.finish().map_err(io::Error::other)?.into_inner();
             w.write_all(&bytes)
@@ -39,8 +44,8 @@ pub(crate) fn write_usd(
     }
 }
 
-fn crate_bytes(data: &sdf::Data) -> io::Result<Vec<u8>> {
-    let mut out = Cursor::new(Vec::new());
+fn crate_bytes(data: &sdf::Data, capacity: usize) -> io::Result<Vec<u8>> {
+    let mut out = Cursor::new(Vec::with_capacity(capacity));
     usdc::CrateWriter::write(data, &mut out).map_err(io::Error::other)?;
     Ok(out.into_inner())
 }
@@ -288,15 +293,16 @@ fn tag_attributes(view: &MeshView<'_>) -> io::Result<Vec<Attr>> {
 }
 
 /// Every position, checked to fit USD's single-precision `point3f` (a larger coordinate
-/// would be written as infinity, which no reader takes back).
-fn all_points(view: &MeshView<'_>) -> io::Result<Vec<DVec3>> {
+/// would be written as infinity, which no reader takes back); borrowed where the view holds
+/// them.
+fn all_points<'a>(view: &'a MeshView<'_>) -> io::Result<Cow<'a, [DVec3]>> {
     let points = match view.positions() {
-        Some(p) => p.to_vec(),
-        None => view.point_window(0..view.num_vertices())?.points().to_vec(),
+        Some(p) => Cow::Borrowed(p),
+        None => Cow::Owned(view.point_window(0..view.num_vertices())?.points().to_vec()),
     };
     if let Some(v) = points
-        .iter()
-        .position(|p| p.abs().max_element() > f64::from(f32::MAX))
+        .par_iter()
+        .position_first(|p| p.abs().max_element() > f64::from(f32::MAX))
     {
         return Err(io::Error::new(
             io::ErrorKind::InvalidData,
@@ -307,20 +313,24 @@ fn all_points(view: &MeshView<'_>) -> io::Result<Vec<DVec3>> {
 }
 
 fn all_faces(view: &MeshView<'_>) -> io::Result<(Vec<i32>, Vec<i32>)> {
-    let n = view.num_faces();
-    let faces = view.face_window(0..n)?;
-    let mut counts = Vec::with_capacity(n);
-    let mut indices = Vec::with_capacity(view.num_face_vertices());
-    for f in 0..n {
-        let face = faces.face(f);
-        counts.push(face.len() as i32);
-        indices.extend(face.iter().map(|&v| v as i32));
-    }
     if view.num_vertices() > i32::MAX as usize {
         return Err(io::Error::other(
             "more vertices than USD's int indices hold",
         ));
     }
+    let n = view.num_faces();
+    let faces = view.face_window(0..n)?;
+    let counts = (0..n)
+        .into_par_iter()
+        .map(|f| faces.face(f).len() as i32)
+        .collect();
+    // Vertex indices fit `i32` (checked above).
+    let indices = match view.all_face_vertices() {
+        Some(all) => all.par_iter().map(|&v| v as i32).collect(),
+        None => (0..n)
+            .flat_map(|f| faces.face(f).iter().map(|&v| v as i32))
+            .collect(),
+    };
     Ok((counts, indices))
 }
 
@@ -331,7 +341,7 @@ fn to_ints(v: &[u32]) -> io::Result<Vec<i32>> {
 }
 
 fn vec3f(p: &[DVec3]) -> Vec<gf::Vec3f> {
-    p.iter()
+    p.par_iter()
         .map(|p| gf::Vec3f {
             x: p.x as f32,
             y: p.y as f32,

@@ -107,68 +107,63 @@ where
 
     let is_64_bit = mem::size_of::<T>() == 8;
 
-    // Compute deltas.
-    let mut deltas = Vec::with_capacity(count);
-    let mut prev = 0_i64;
-    for v in values {
-        let cur: i64 = (*v).as_();
-        deltas.push(cur.wrapping_sub(prev));
-        prev = cur;
-    }
+    // The deltas, made again for each pass rather than held (subd: two arrays of millions
+    // of entries were most of the allocation of a mesh's crate file).
+    let deltas = || {
+        values.iter().scan(0_i64, |prev, v| {
+            let cur: i64 = (*v).as_();
+            let d = cur.wrapping_sub(*prev);
+            *prev = cur;
+            Some(d)
+        })
+    };
 
     // Pick the most frequent delta as the common value.
-    let common = most_common(&deltas);
+    let common = most_common(deltas());
 
     // Classify each delta.
-    let codes: Vec<u8> = deltas
-        .iter()
-        .map(|&d| {
-            if d == common {
-                COMMON
-            } else if is_64_bit {
-                if fits_in_i16(d) {
-                    SMALL
-                } else if fits_in_i32(d) {
-                    MEDIUM
-                } else {
-                    LARGE
-                }
-            } else if fits_in_i8(d) {
+    let code_of = |d: i64| {
+        if d == common {
+            COMMON
+        } else if is_64_bit {
+            if fits_in_i16(d) {
                 SMALL
-            } else if fits_in_i16(d) {
+            } else if fits_in_i32(d) {
                 MEDIUM
             } else {
                 LARGE
             }
-        })
-        .collect();
+        } else if fits_in_i8(d) {
+            SMALL
+        } else if fits_in_i16(d) {
+            MEDIUM
+        } else {
+            LARGE
+        }
+    };
 
-    // Assemble output.
-    let mut out = Vec::new();
+    // Assemble output: the common value, the code table, then the payload (sized for the
+    // widest payload, so it never grows).
+    let num_code_bytes = (count * 2).div_ceil(8);
+    let header = if is_64_bit { 8 } else { 4 };
+    let mut out = Vec::with_capacity(header + num_code_bytes + count * mem::size_of::<T>());
     if is_64_bit {
         out.extend_from_slice(&common.to_le_bytes());
     } else {
         out.extend_from_slice(&(common as i32).to_le_bytes());
     }
-
-    let num_code_bytes = (count * 2).div_ceil(8);
-    let mut code_table = vec![0_u8; num_code_bytes];
-    for (i, code) in codes.iter().enumerate() {
-        let byte_idx = i / 4;
-        let slot = i % 4;
-        code_table[byte_idx] |= (code & 0b11) << (2 * slot);
-    }
-    out.extend_from_slice(&code_table);
-
-    for (code, delta) in codes.iter().zip(deltas.iter()) {
-        match (*code, is_64_bit) {
+    out.resize(header + num_code_bytes, 0);
+    for (i, delta) in deltas().enumerate() {
+        let code = code_of(delta);
+        out[header + i / 4] |= (code & 0b11) << (2 * (i % 4));
+        match (code, is_64_bit) {
             (COMMON, _) => {}
-            (SMALL, true) => out.extend_from_slice(&(*delta as i16).to_le_bytes()),
-            (SMALL, false) => out.extend_from_slice(&(*delta as i8).to_le_bytes()),
-            (MEDIUM, true) => out.extend_from_slice(&(*delta as i32).to_le_bytes()),
-            (MEDIUM, false) => out.extend_from_slice(&(*delta as i16).to_le_bytes()),
-            (LARGE, true) => out.extend_from_slice(&(*delta).to_le_bytes()),
-            (LARGE, false) => out.extend_from_slice(&(*delta as i32).to_le_bytes()),
+            (SMALL, true) => out.extend_from_slice(&(delta as i16).to_le_bytes()),
+            (SMALL, false) => out.extend_from_slice(&(delta as i8).to_le_bytes()),
+            (MEDIUM, true) => out.extend_from_slice(&(delta as i32).to_le_bytes()),
+            (MEDIUM, false) => out.extend_from_slice(&(delta as i16).to_le_bytes()),
+            (LARGE, true) => out.extend_from_slice(&delta.to_le_bytes()),
+            (LARGE, false) => out.extend_from_slice(&(delta as i32).to_le_bytes()),
             _ => unreachable!(),
         }
     }
@@ -176,15 +171,30 @@ where
     out
 }
 
-fn most_common(deltas: &[i64]) -> i64 {
+fn most_common(deltas: impl Iterator<Item = i64>) -> i64 {
+    // Deltas of index arrays are mostly small: those are counted in a table, only the
+    // others in a map (subd: hashing every one of millions of deltas was most of the
+    // time a mesh's crate file took to write). The answer is the one counting all of them
+    // in the map gives.
+    const SPAN: i64 = 1 << 12;
+    let mut dense = vec![0_usize; 2 * SPAN as usize];
     let mut counts: HashMap<i64, usize> = HashMap::new();
-    for &d in deltas {
-        *counts.entry(d).or_insert(0) += 1;
+    for d in deltas {
+        if (-SPAN..SPAN).contains(&d) {
+            dense[(d + SPAN) as usize] += 1;
+        } else {
+            *counts.entry(d).or_insert(0) += 1;
+        }
     }
+    let small = dense
+        .iter()
+        .enumerate()
+        .filter(|&(_, &c)| c > 0)
+        .map(|(i, &c)| (i as i64 - SPAN, c));
     // Tie-break by smallest value so the output is byte-deterministic across
     // runs regardless of `HashMap` iteration order.
     let mut best: Option<(i64, usize)> = None;
-    for (value, count) in counts {
+    for (value, count) in small.chain(counts) {
         match best {
             None => best = Some((value, count)),
             Some((bv, bc)) if count > bc || (count == bc && value < bv) => {
