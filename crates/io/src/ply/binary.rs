@@ -278,6 +278,17 @@ mod tests {
         (positions, offsets, vertices, uv, levels)
     }
 
+    /// `view` written as PLY in `ply_encoding`.
+    fn encoded(view: &MeshView<'_>, ply_encoding: PlyEncoding) -> Vec<u8> {
+        let mut out = Vec::new();
+        let options = WriteOptions {
+            ply_encoding,
+            ..WriteOptions::default()
+        };
+        encode_view(&mut out, view, Format::Ply, &options).unwrap();
+        out
+    }
+
     fn read(bytes: &[u8]) -> crate::MeshFile {
         parse_mesh(bytes, Format::Ply, &ReadOptions::default()).unwrap()
     }
@@ -291,17 +302,8 @@ mod tests {
             .and_then(|v| v.with_uv(&uv, 2, &vertices))
             .and_then(|v| v.with_face_levels(&levels))
             .unwrap();
-        let encode = |ply_encoding| {
-            let mut out = Vec::new();
-            let options = WriteOptions {
-                ply_encoding,
-                ..WriteOptions::default()
-            };
-            encode_view(&mut out, &view, Format::Ply, &options).unwrap();
-            out
-        };
-        let binary = read(&encode(PlyEncoding::BinaryLittleEndian));
-        let ascii = read(&encode(PlyEncoding::Ascii));
+        let binary = read(&encoded(&view, PlyEncoding::BinaryLittleEndian));
+        let ascii = read(&encoded(&view, PlyEncoding::Ascii));
         let bits = |f: &crate::MeshFile| {
             f.mesh
                 .positions
@@ -437,12 +439,7 @@ mod tests {
             .and_then(|v| v.with_uv(&uv, 2, &vertices))
             .and_then(|v| v.with_face_levels(&levels))
             .unwrap();
-        let mut good = Vec::new();
-        let options = WriteOptions {
-            ply_encoding: PlyEncoding::BinaryLittleEndian,
-            ..WriteOptions::default()
-        };
-        encode_view(&mut good, &view, Format::Ply, &options).unwrap();
+        let good = encoded(&view, PlyEncoding::BinaryLittleEndian);
         let mut bad = good.clone();
         // The last vertex's last value (its v, a double) becomes infinite.
         let header_end = bad.windows(11).position(|w| w == b"end_header\n").unwrap() + 11;
