@@ -4,27 +4,64 @@
 
 use std::path::Path;
 
-use subd_mesh::SchemeHints;
+use subd_mesh::Mesh;
 use subd_schemes::Scheme;
 
-/// Names `scheme` in `hints`. Where a USD output cannot name it (Doo-Sabin, √3, the
-/// butterflies, the two-phase scheme), the cage is written as plain polygons
-/// (`subdivisionScheme = "none"`) and `warnings` says so.
-pub(crate) fn name_scheme(
-    hints: &mut SchemeHints,
+use crate::Failure;
+
+/// Whether `output` is a USD file, whose `subdivisionScheme` names Catmull-Clark, Loop and
+/// Bilinear only.
+fn is_usd(output: &Path) -> bool {
+    matches!(
+        subd_io::Format::for_output(output),
+        Some(subd_io::Format::Usda | subd_io::Format::Usdc | subd_io::Format::Usdz)
+    )
+}
+
+/// The warning for a cage of `scheme` written refined to `output`.
+fn refined_warning(scheme: &Scheme, output: &Path) -> String {
+    format!(
+        "{}: USD has no name for the {scheme} scheme: the cage is written refined {} levels, as plain polygons (subdivisionScheme none)",
+        output.display(),
+        subd_limit::refined_mesh::UNNAMED_CAGE_LEVELS
+    )
+}
+
+/// The levels `subd refine --levels 0` writes: the cage itself, unless the output is USD
+/// and cannot name `scheme` (Doo-Sabin, √3, the butterflies, two-phase); then the cage
+/// refined [`subd_limit::refined_mesh::UNNAMED_CAGE_LEVELS`] levels, and `warnings` says
+/// so.
+pub(crate) fn levels_for_refine(
+    levels: usize,
+    limit: bool,
+    scheme: Option<&Scheme>,
+    output: &Path,
+    warnings: &mut Vec<String>,
+) -> usize {
+    match scheme {
+        Some(s) if levels == 0 && !limit && s.file_scheme().is_none() && is_usd(output) => {
+            warnings.push(refined_warning(s, output));
+            subd_limit::refined_mesh::UNNAMED_CAGE_LEVELS
+        }
+        _ => levels,
+    }
+}
+
+/// `mesh`, the cage of `scheme`, as `output` holds it: naming the scheme, or, where a USD
+/// output cannot name it, refined to plain polygons (and `warnings` says so).
+pub(crate) fn for_output(
+    mut mesh: Mesh,
     scheme: &Scheme,
     output: &Path,
     warnings: &mut Vec<String>,
-) {
-    hints.scheme = scheme.file_scheme();
-    let usd = matches!(
-        subd_io::Format::for_output(output),
-        Some(subd_io::Format::Usda | subd_io::Format::Usdc | subd_io::Format::Usdz)
-    );
-    if hints.scheme.is_none() && usd {
-        warnings.push(format!(
-            "{}: USD has no name for the {scheme} scheme: the cage is written as plain polygons (subdivisionScheme none), which a renderer does not subdivide",
-            output.display()
-        ));
+) -> Result<Mesh, Failure> {
+    mesh.hints.scheme = scheme.file_scheme();
+    if mesh.hints.scheme.is_some() || !is_usd(output) {
+        return Ok(mesh);
     }
+    let (refined, left_out) = subd_limit::refined_mesh::refined_unnamed_cage(&mesh, scheme)
+        .map_err(|e| crate::failure::bad(format!("{}: {e}", output.display())))?;
+    warnings.push(refined_warning(scheme, output));
+    warnings.extend(left_out);
+    Ok(refined)
 }

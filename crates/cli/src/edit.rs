@@ -235,7 +235,7 @@ fn write_edited(
     // The edit moves control points only: texture coordinates stay as given.
     mesh.fvar = file.mesh.fvar.clone();
     let mut dropped = Vec::new();
-    crate::cage::name_scheme(&mut mesh.hints, scheme, &job.output, &mut dropped);
+    let mut mesh = crate::cage::for_output(mesh, scheme, &job.output, &mut dropped)?;
     crate::uv::fit_ply(&mut mesh, &job.output, &mut dropped);
     print_warnings(err, &job.input, &dropped);
     subd_io::write_mesh(&job.output, &mesh, &file.output_options())?;

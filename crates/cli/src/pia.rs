@@ -280,7 +280,7 @@ impl Fitted<'_> {
         mesh.hints = self.mesh.hints;
         mesh.fvar = self.mesh.fvar.clone();
         let mut dropped = Vec::new();
-        crate::cage::name_scheme(&mut mesh.hints, self.scheme, &job.output, &mut dropped);
+        let mut mesh = crate::cage::for_output(mesh, self.scheme, &job.output, &mut dropped)?;
         crate::uv::fit_ply(&mut mesh, &job.output, &mut dropped);
         print_warnings(err, &job.input, &dropped);
         subd_io::write_mesh(&job.output, &mesh, &self.options)?;

@@ -20,7 +20,7 @@ use crate::scheme_arg;
 use crate::vertex_data::LambdaArgs;
 use crate::{Failure, print_warnings};
 
-#[derive(Debug, Args)]
+#[derive(Debug, Clone, Args)]
 pub(crate) struct RefineArgs {
     /// Subdivision scheme (a parameter may follow a colon: butterfly:0.05, two-phase:0.6;
     /// default: the scheme the input names, USD's subdivisionScheme).
@@ -104,7 +104,24 @@ pub(crate) fn run(
     err: &mut dyn Write,
 ) -> Result<(), Failure> {
     REFINE.run(&args.files, args.json, out, err, |job, out, err| {
-        run_one(args, job, out, err)
+        let mut warnings = Vec::new();
+        let scheme = args.scheme.as_ref();
+        let levels = crate::cage::levels_for_refine(
+            args.levels,
+            args.limit,
+            scheme,
+            &job.output,
+            &mut warnings,
+        );
+        print_warnings(err, &job.input, &warnings);
+        if levels == args.levels {
+            return run_one(args, job, out, err);
+        }
+        let refined = RefineArgs {
+            levels,
+            ..args.clone()
+        };
+        run_one(&refined, job, out, err)
     })
 }
 
@@ -146,10 +163,9 @@ fn run_one(
     );
     hints.fvar_interpolation = uv.as_ref().map(|_| fvar_mode);
     if args.levels == 0 && !args.limit {
-        // Level 0 is the cage itself, which a USD renderer subdivides.
-        let mut warnings = Vec::new();
-        crate::cage::name_scheme(&mut hints, refinement.scheme(), &job.output, &mut warnings);
-        print_warnings(err, &job.input, &warnings);
+        // Level 0 is the cage itself, which a USD renderer subdivides (the scheme is one
+        // USD names: `run` refines the others' cages).
+        hints.scheme = refinement.scheme().file_scheme();
     }
     let output = Output {
         write_options: opened.file.output_options(),

@@ -47,7 +47,7 @@ pub(crate) enum TriangleArg {
 }
 
 /// The rule options a command shares: defaults from the file's tags, overridden here.
-#[derive(Debug, Args)]
+#[derive(Debug, Clone, Args)]
 pub(crate) struct RuleArgs {
     /// Boundary interpolation (default: the file's `t interpolateboundary` tag, else
     /// edge-only).

@@ -15,7 +15,7 @@ use crate::Failure;
 use crate::failure::bad;
 
 /// The two-phase scheme's shape parameter.
-#[derive(Debug, Args)]
+#[derive(Debug, Clone, Args)]
 pub(crate) struct LambdaArgs {
     /// Two-phase scheme: the same λ for every vertex, in (7/20, 1].
     #[arg(long, conflicts_with = "lambda_file")]

@@ -141,8 +141,8 @@ pub mod refined_mesh {
     //! A whole mesh refined in one call, optionally to the exact limit, texture coordinates
     //! included.
     pub use crate::whole_mesh::{
-        LimitedRefinement, MeshRefinement, RefinedMesh, RefinedUv, limit_uv, output_limit,
-        refine_mesh, refined_hints, refined_uv, split_limit_uv,
+        LimitedRefinement, MeshRefinement, RefinedMesh, RefinedUv, UNNAMED_CAGE_LEVELS, limit_uv,
+        output_limit, refine_mesh, refined_hints, refined_unnamed_cage, refined_uv, split_limit_uv,
     };
 }
 

@@ -424,3 +424,25 @@ pub fn refine_mesh(mesh: &Mesh, request: &MeshRefinement) -> Result<RefinedMesh,
         warnings,
     })
 }
+
+/// Levels by which a control cage is refined when its scheme has no name in the output
+/// format (USD names Catmull-Clark, Loop and Bilinear only): two levels give each face 16
+/// (9 for √3), close enough to the limit surface for a viewer, which shows a `none` mesh
+/// as it is.
+pub const UNNAMED_CAGE_LEVELS: usize = 2;
+
+/// A control cage as a file that cannot name its scheme must hold it: the cage
+/// refined [`UNNAMED_CAGE_LEVELS`] levels of `scheme` with its own rules, texture
+/// coordinates carried where the scheme carries them, as plain polygons. The warnings say
+/// what was left out.
+pub fn refined_unnamed_cage(
+    cage: &Mesh,
+    scheme: &Scheme,
+) -> Result<(Mesh, Vec<String>), LimitError> {
+    let request = MeshRefinement::new(scheme.clone(), cage, UNNAMED_CAGE_LEVELS);
+    let refined = refine_mesh(cage, &request)?;
+    let warnings = refined.warnings.clone();
+    let (mut mesh, _) = refined.into_mesh()?;
+    mesh.hints.scheme = Some(subd_mesh::FileScheme::Polygons);
+    Ok((mesh, warnings))
+}

@@ -8,6 +8,7 @@ use pyo3::prelude::*;
 use subd_limit::refined_mesh::RefinedMesh;
 use subd_mesh::fvar::FVarChannel;
 use subd_mesh::{DVec3, Mesh, TopologyBuilder};
+use subd_schemes::Scheme;
 
 use crate::arrays::{
     columns, contiguous, copied1, filled1, filled2, flat_ints, flat_rows, index, points,
@@ -32,6 +33,9 @@ pub(crate) struct CoreMesh {
     /// The USD prim it was read from and its stage's units (kept by what is made from it,
     /// and written back by a USD output).
     pub(crate) stage: Option<subd_io::usd::StageInfo>,
+    /// The scheme this mesh is the control cage of, where USD cannot name it (two-phase,
+    /// Doo-Sabin, √3, the butterflies): a USD output holds the cage refined instead.
+    pub(crate) unnamed_cage: Option<Scheme>,
 }
 
 /// What the arrays of a mesh are read from, built or not.
@@ -53,12 +57,19 @@ impl CoreMesh {
             face_levels: None,
             orientation_conflicts: 0,
             stage: None,
+            unnamed_cage: None,
         }
     }
 
     /// This mesh, made from `source`: it keeps the USD prim and units `source` was read with.
     pub(crate) fn made_from(mut self, source: &CoreMesh) -> CoreMesh {
         self.stage = source.stage.clone();
+        self
+    }
+
+    /// This mesh as the control cage of `scheme` (its hints name the scheme where a file can).
+    pub(crate) fn cage_of(mut self, scheme: &Scheme) -> CoreMesh {
+        self.unnamed_cage = scheme.file_scheme().is_none().then(|| scheme.clone());
         self
     }
 
@@ -71,6 +82,7 @@ impl CoreMesh {
             face_levels: None,
             orientation_conflicts: 0,
             stage: None,
+            unnamed_cage: None,
         }
     }
 
@@ -516,13 +528,21 @@ impl CoreMesh {
     }
 
     /// Writes the mesh (OBJ with crease tags, PLY, glTF binary, USD by the extension), with
-    /// its normals where it has them. The file appears whole or not at all.
-    fn write(&self, py: Python<'_>, path: std::path::PathBuf) -> PyResult<()> {
+    /// its normals where it has them. The file appears whole or not at all. Returns the
+    /// warnings: a USD file holds the cage of a scheme it cannot name refined, and says so.
+    fn write(&self, py: Python<'_>, path: std::path::PathBuf) -> PyResult<Vec<String>> {
         let options = subd_io::WriteOptions {
             stage: self.stage.clone(),
             ..subd_io::WriteOptions::default()
         };
         let mesh = self.mesh(py)?;
+        let usd = matches!(
+            subd_io::Format::for_output(&path),
+            Some(subd_io::Format::Usda | subd_io::Format::Usdc | subd_io::Format::Usdz)
+        );
+        if let (Some(scheme), true) = (&self.unnamed_cage, usd) {
+            return pool::run(py, || write_unnamed_cage(&path, mesh, scheme, &options))?;
+        }
         pool::run(py, || match &self.normals {
             None => subd_io::write_mesh(&path, mesh, &options),
             Some(n) => {
@@ -535,6 +555,27 @@ impl CoreMesh {
                 subd_io::write_view(&path, &view, &options)
             }
         })?
-        .map_err(io_error)
+        .map_err(io_error)?;
+        Ok(Vec::new())
     }
+}
+
+/// Writes `cage`, the control cage of `scheme`, which USD cannot name: refined to plain
+/// polygons, as `subd pia` writes it; the warnings say so and what was left out.
+fn write_unnamed_cage(
+    path: &std::path::Path,
+    cage: &Mesh,
+    scheme: &Scheme,
+    options: &subd_io::WriteOptions,
+) -> PyResult<Vec<String>> {
+    let (refined, left_out) = subd_limit::refined_mesh::refined_unnamed_cage(cage, scheme)
+        .map_err(|e| mesh_error(e.to_string()))?;
+    subd_io::write_mesh(path, &refined, options).map_err(io_error)?;
+    let mut warnings = vec![format!(
+        "{}: USD has no name for the {scheme} scheme: the cage is written refined {} levels, as plain polygons (subdivisionScheme none)",
+        path.display(),
+        subd_limit::refined_mesh::UNNAMED_CAGE_LEVELS
+    )];
+    warnings.extend(left_out);
+    Ok(warnings)
 }

@@ -189,7 +189,8 @@ pub(crate) fn pia(
         },
     };
     let (solved, report) = pool::run(py, || interpolate(base, &request))?.map_err(mesh_error)?;
-    Ok((solved.map(|m| CoreMesh::plain(m).made_from(mesh)), report))
+    let cage_of = |m| CoreMesh::plain(m).made_from(mesh).cage_of(&request.scheme);
+    Ok((solved.map(cage_of), report))
 }
 
 /// Sets up and solves the interpolation, then measures the result with a limit table built
@@ -343,7 +344,7 @@ pub(crate) fn edit(
     .map_err(mesh_error)?;
     let report = edit_report(&edited, &scheme, base.topology.num_vertices(), &constraints);
     Ok((
-        CoreMesh::plain(moved).made_from(mesh),
+        CoreMesh::plain(moved).made_from(mesh).cage_of(&scheme),
         edited.warnings,
         report,
     ))

@@ -268,6 +268,17 @@ def test_python_keeps_the_prim_units_and_scheme_through_its_functions(tmp_path):
     cage.write(tmp_path / "cage.usdc")
     [m], diagnostics = pxr_reads(tmp_path / "cage.usdc")
     assert diagnostics == "" and m["scheme"] == "loop" and m["path"].endswith("/Strip")
+    # USD cannot name two-phase: its cage is written refined two levels, with a warning.
+    grid = subd.read(SHAPES / "catmark_cube.obj")
+    two_phase = subd.pia(grid, "two-phase", lam=0.5)
+    assert two_phase.file_scheme is None
+    with pytest.warns(subd.SubdWarning, match="USD has no name for the two-phase scheme"):
+        two_phase.write(tmp_path / "two_phase.usda")
+    [m], diagnostics = pxr_reads(tmp_path / "two_phase.usda")
+    want = subd.refine(two_phase, "two-phase", levels=2, lam=0.5)
+    assert diagnostics == "" and m["scheme"] == "none"
+    assert m["indices"] == want.face_vertices.tolist()
+    assert np.array_equal(np.array(m["points"]), f32(want.vertices))
     # A mesh from arrays names no scheme, and the default stays Catmull-Clark.
     quad = subd.Mesh([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], [[0, 1, 2, 3]])
     assert quad.file_scheme is None and quad.stage is None

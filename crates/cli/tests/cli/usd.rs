@@ -1,7 +1,7 @@
 //! USD through the commands: the scheme a stage names, prims picked and batched, cages that
 //! keep their scheme, refusals that name the prim.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use super::{Scratch, subd};
 
@@ -164,6 +164,19 @@ fn a_cage_keeps_its_scheme_and_a_nameless_one_is_warned_about() {
     let (code, info, err) = subd(&["info", "--json", path(&ds)]);
     assert_eq!(code, 0, "{err}");
     assert!(info.contains("\"scheme\":\"polygons\""), "{info}");
+    // It holds the cage refined two levels: what `refine --levels 2` writes as OBJ.
+    let obj = s.0.join("ds2.obj");
+    let flags = ["refine", "--scheme", "doo-sabin", "--levels", "2"];
+    let (code, _, err) = subd(&[&flags[..], &[path(&cube), path(&obj)]].concat());
+    assert_eq!(code, 0, "{err}");
+    let read = |p: &Path| subd_io::read_mesh(p, &subd_io::ReadOptions::default()).unwrap();
+    let (usd, obj) = (read(&ds).mesh, read(&obj).mesh);
+    let faces = |m: &subd_mesh::Mesh| m.topology.all_face_vertices().to_vec();
+    assert_eq!(faces(&usd), faces(&obj));
+    for (a, b) in usd.positions.iter().zip(&obj.positions) {
+        // The OBJ holds 17 significant digits, the .usdc single precision.
+        assert!((*a - *b).abs().max_element() < 1e-6, "{a} {b}");
+    }
 }
 
 #[test]

@@ -264,8 +264,12 @@ class Mesh:
     def write(self, path: Union[str, os.PathLike]) -> None:
         """Writes the mesh by the extension: OBJ (with crease tags), PLY, glTF binary, or USD
         (.usda, .usdc, .usdz, .usd: one Mesh prim with its scheme, rules and tags, named after
-        the prim it was read from, with that stage's units; see :attr:`stage`)."""
-        self._core.write(os.fspath(path))
+        the prim it was read from, with that stage's units; see :attr:`stage`).
+
+        The result of :func:`pia` or :func:`edit` is a control cage and names its scheme; a
+        USD file cannot name two-phase, Doo-Sabin, √3 or the butterflies, so it holds such a
+        cage refined two levels as plain polygons, with a :class:`SubdWarning`."""
+        _warn(self._core.write(os.fspath(path)))
 
     def __repr__(self) -> str:
         return f"subd.Mesh({self.num_vertices} vertices, {self.num_faces} faces)"
