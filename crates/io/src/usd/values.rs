@@ -3,6 +3,7 @@
 
 use openusd::sdf::Value;
 use openusd::{sdf, tf, usd};
+use rayon::prelude::*;
 use subd_mesh::DVec3;
 
 use crate::error::ReadError;
@@ -73,21 +74,22 @@ impl PrimValues<'_> {
 
     /// An `int[]` attribute, each value checked non-negative.
     pub(crate) fn indices(&self, attr: &str) -> Result<Option<Vec<u32>>, ReadError> {
-        let ints: Vec<i64> = match self.value(attr)? {
-            None => return Ok(None),
-            Some(Value::IntVec(v)) => v.into_iter().map(i64::from).collect(),
-            Some(Value::Int64Vec(v)) => v,
-            Some(Value::UintVec(v)) => v.into_iter().map(i64::from).collect(),
-            Some(other) => return Err(self.mismatch(attr, "int[]", &other)),
-        };
-        ints.iter()
-            .enumerate()
-            .map(|(i, &x)| {
-                u32::try_from(x)
-                    .map_err(|_| self.error(attr, format!("value [{i}] = {x} is not an index")))
-            })
-            .collect::<Result<Vec<u32>, _>>()
-            .map(Some)
+        let not_index =
+            |i: usize, x: i64| Err(self.error(attr, format!("value [{i}] = {x} is not an index")));
+        match self.value(attr)? {
+            None => Ok(None),
+            Some(Value::IntVec(v)) => match v.iter().position(|&x| x < 0) {
+                Some(i) => not_index(i, v[i].into()),
+                // Same size: the array is reused in place, not copied.
+                None => Ok(Some(v.into_iter().map(|x| x as u32).collect())),
+            },
+            Some(Value::UintVec(v)) => Ok(Some(v)),
+            Some(Value::Int64Vec(v)) => match v.iter().position(|&x| u32::try_from(x).is_err()) {
+                Some(i) => not_index(i, v[i]),
+                None => Ok(Some(v.into_iter().map(|x| x as u32).collect())),
+            },
+            Some(other) => Err(self.mismatch(attr, "int[]", &other)),
+        }
     }
 
     /// A `float[]` (or `double[]`, `half[]`) attribute.
@@ -107,7 +109,7 @@ impl PrimValues<'_> {
         Ok(Some(match self.value(attr)? {
             None => return Ok(None),
             Some(Value::Vec3fVec(v)) => v
-                .iter()
+                .par_iter()
                 .map(|a| p(a.x.into(), a.y.into(), a.z.into()))
                 .collect(),
             Some(Value::Vec3dVec(v)) => v.iter().map(|a| p(a.x, a.y, a.z)).collect(),

@@ -300,10 +300,11 @@ fn all_points<'a>(view: &'a MeshView<'_>) -> io::Result<Cow<'a, [DVec3]>> {
         Some(p) => Cow::Borrowed(p),
         None => Cow::Owned(view.point_window(0..view.num_vertices())?.points().to_vec()),
     };
-    if let Some(v) = points
-        .par_iter()
-        .position_first(|p| p.abs().max_element() > f64::from(f32::MAX))
-    {
+    let beyond = |p: &DVec3| p.abs().max_element() > f64::from(f32::MAX);
+    // Chunks, then the index only where one holds such a point: a per-point parallel
+    // search costs more than the check itself.
+    let any_beyond = points.par_chunks(1 << 15).any(|c| c.iter().any(beyond));
+    if let Some(v) = any_beyond.then(|| points.iter().position(beyond)).flatten() {
         return Err(io::Error::new(
             io::ErrorKind::InvalidData,
             format!("vertex {v} has a coordinate beyond single precision, which USD's points hold"),

@@ -302,3 +302,59 @@ fn corrupt_binary_files_are_errors() {
         assert!(parse_mesh(&bytes[..bytes.len() / 2], format, &ReadOptions::default()).is_err());
     }
 }
+
+/// A `.usdc` codes large integer arrays in two halves on two threads (the vendored
+/// `openusd`'s `encode_ints`): a grid whose vertices are renumbered so that its index
+/// deltas take every width the coding has (8, 16 and 32 bits, and the common one), with
+/// more indices than the parallel threshold and a length that is not a multiple of four,
+/// reads back with every index and position.
+#[test]
+fn large_index_arrays_survive_the_parallel_integer_coding() {
+    let (nx, ny) = (301, 300); // 90,300 quads, 361,200 indices
+    let nv = (nx + 1) * (ny + 1);
+    // Swap vertices at distances of every size (a small linear congruential generator:
+    // the test needs spread, not statistics).
+    let mut renumber: Vec<u32> = (0..nv as u32).collect();
+    let mut state = 0x2545_f491_4f6c_dd1d_u64;
+    let mut next = |bound: usize| {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1);
+        (state >> 33) as usize % bound
+    };
+    for k in 0..nv / 3 {
+        let reach = [50, 20_000, nv][k % 3];
+        let a = next(nv);
+        let b = (a + 1 + next(reach)).min(nv - 1);
+        renumber.swap(a, b);
+    }
+    let mut positions = vec![DVec3::ZERO; nv];
+    for j in 0..=ny {
+        for i in 0..=nx {
+            positions[renumber[j * (nx + 1) + i] as usize] = DVec3::new(i as f64, j as f64, 0.5);
+        }
+    }
+    let mut offsets = vec![0_u32];
+    let mut corners = Vec::new();
+    for j in 0..ny {
+        for i in 0..nx {
+            let v = |di: usize, dj: usize| renumber[(j + dj) * (nx + 1) + i + di];
+            corners.extend([v(0, 0), v(1, 0), v(1, 1), v(0, 1)]);
+            offsets.push(corners.len() as u32);
+        }
+    }
+    // One triangle more, so that the index count is not a multiple of four.
+    corners.extend([renumber[0], renumber[1], renumber[nx + 2]]);
+    offsets.push(corners.len() as u32);
+    assert!(corners.len() > 1 << 18 && corners.len() % 4 != 0);
+    let view = subd_io::MeshView::new(&positions, &offsets, &corners, &[]).unwrap();
+    let mut bytes = Vec::new();
+    subd_io::encode_view(&mut bytes, &view, Format::Usdc, &WriteOptions::default()).unwrap();
+    let options = ReadOptions {
+        accept_inconsistent_orientation: true,
+        ..ReadOptions::default()
+    };
+    let back = parse_mesh(&bytes, Format::Usdc, &options).unwrap().mesh;
+    assert_eq!(back.topology.all_face_vertices(), &corners[..]);
+    assert_eq!(back.positions, positions);
+}

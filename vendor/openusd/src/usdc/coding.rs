@@ -85,6 +85,12 @@ where
     Ok(output)
 }
 
+/// subd: arrays at least this long are coded in two halves on two threads. The halves
+/// split at a multiple of four values, so that each half's code bytes are whole; the
+/// second half's first delta is taken from the last value of the first. The bytes are
+/// those of one pass.
+const PARALLEL_MIN: usize = 1 << 18;
+
 /// Encode a sequence of integers using the crate file delta/common-value
 /// coding scheme. Inverse of [`decode_ints`].
 ///
@@ -92,13 +98,9 @@ where
 /// 1. Common value (i32 for 32-bit T, i64 for 64-bit T)
 /// 2. Code bytes: 2 bits per integer, packed 4 per byte, little-endian
 /// 3. Payload: variable-width deltas (COMMON omits, SMALL/MEDIUM/LARGE vary by bit-width)
-// One arm per (code, width) pair of the crate integer encoding, matching the
-// layout the reader expects. Merging the arms that happen to emit the same
-// width would break that row-per-case correspondence.
-#[allow(clippy::match_same_arms)]
 pub fn encode_ints<T>(values: &[T]) -> Vec<u8>
 where
-    T: PrimInt + 'static + AsPrimitive<i64>,
+    T: PrimInt + 'static + AsPrimitive<i64> + Sync,
 {
     let count = values.len();
     if count == 0 {
@@ -106,22 +108,82 @@ where
     }
 
     let is_64_bit = mem::size_of::<T>() == 8;
-
-    // The deltas, made again for each pass rather than held (subd: two arrays of millions
-    // of entries were most of the allocation of a mesh's crate file).
-    let deltas = || {
-        values.iter().scan(0_i64, |prev, v| {
-            let cur: i64 = (*v).as_();
-            let d = cur.wrapping_sub(*prev);
-            *prev = cur;
-            Some(d)
-        })
-    };
+    let split = if count >= PARALLEL_MIN { (count / 2) & !3 } else { count };
+    let (first, second) = values.split_at(split);
+    let before_second: i64 = if split > 0 { values[split - 1].as_() } else { 0 };
 
     // Pick the most frequent delta as the common value.
-    let common = most_common(deltas());
+    let parallel = !second.is_empty();
+    let (mut counts, second_counts) = join(
+        parallel,
+        || DeltaCounts::of(deltas(first, 0)),
+        || DeltaCounts::of(deltas(second, before_second)),
+    );
+    counts.merge(second_counts);
+    let common = counts.most_common();
 
-    // Classify each delta.
+    // Assemble output: the common value, the code table, then the payload.
+    let header = if is_64_bit { 8 } else { 4 };
+    let ((codes, payload), (second_codes, second_payload)) = join(
+        parallel,
+        || code_deltas(first.len(), deltas(first, 0), common, is_64_bit),
+        || code_deltas(second.len(), deltas(second, before_second), common, is_64_bit),
+    );
+    let size = header + codes.len() + second_codes.len() + payload.len() + second_payload.len();
+    let mut out = Vec::with_capacity(size);
+    if is_64_bit {
+        out.extend_from_slice(&common.to_le_bytes());
+    } else {
+        out.extend_from_slice(&(common as i32).to_le_bytes());
+    }
+    for part in [&codes, &second_codes, &payload, &second_payload] {
+        out.extend_from_slice(part);
+    }
+    out
+}
+
+/// `a()` and `b()`, `b` on a second thread when `parallel`.
+fn join<R: Send>(
+    parallel: bool,
+    a: impl FnOnce() -> R,
+    b: impl FnOnce() -> R + Send,
+) -> (R, R) {
+    if !parallel {
+        return (a(), b());
+    }
+    std::thread::scope(|s| {
+        let other = s.spawn(b);
+        let mine = a();
+        (mine, other.join().expect("integer coding does not panic"))
+    })
+}
+
+/// The deltas of `values`, the first taken from `before`: made again for each pass rather
+/// than held (subd: two arrays of millions of entries were most of the allocation of a
+/// mesh's crate file).
+fn deltas<T>(values: &[T], before: i64) -> impl Iterator<Item = i64> + '_
+where
+    T: PrimInt + 'static + AsPrimitive<i64>,
+{
+    values.iter().scan(before, |prev, v| {
+        let cur: i64 = (*v).as_();
+        let d = cur.wrapping_sub(*prev);
+        *prev = cur;
+        Some(d)
+    })
+}
+
+/// The code bytes (two bits per delta, four deltas a byte) and the payload of `deltas`.
+// One arm per (code, width) pair of the crate integer encoding, matching the
+// layout the reader expects. Merging the arms that happen to emit the same
+// width would break that row-per-case correspondence.
+#[allow(clippy::match_same_arms)]
+fn code_deltas(
+    count: usize,
+    mut deltas: impl Iterator<Item = i64>,
+    common: i64,
+    is_64_bit: bool,
+) -> (Vec<u8>, Vec<u8>) {
     let code_of = |d: i64| {
         if d == common {
             COMMON
@@ -141,69 +203,85 @@ where
             LARGE
         }
     };
-
-    // Assemble output: the common value, the code table, then the payload (sized for the
-    // widest payload, so it never grows).
-    let num_code_bytes = (count * 2).div_ceil(8);
-    let header = if is_64_bit { 8 } else { 4 };
-    let mut out = Vec::with_capacity(header + num_code_bytes + count * mem::size_of::<T>());
-    if is_64_bit {
-        out.extend_from_slice(&common.to_le_bytes());
-    } else {
-        out.extend_from_slice(&(common as i32).to_le_bytes());
-    }
-    out.resize(header + num_code_bytes, 0);
-    for (i, delta) in deltas().enumerate() {
-        let code = code_of(delta);
-        out[header + i / 4] |= (code & 0b11) << (2 * (i % 4));
-        match (code, is_64_bit) {
-            (COMMON, _) => {}
-            (SMALL, true) => out.extend_from_slice(&(delta as i16).to_le_bytes()),
-            (SMALL, false) => out.extend_from_slice(&(delta as i8).to_le_bytes()),
-            (MEDIUM, true) => out.extend_from_slice(&(delta as i32).to_le_bytes()),
-            (MEDIUM, false) => out.extend_from_slice(&(delta as i16).to_le_bytes()),
-            (LARGE, true) => out.extend_from_slice(&delta.to_le_bytes()),
-            (LARGE, false) => out.extend_from_slice(&(delta as i32).to_le_bytes()),
-            _ => unreachable!(),
+    let mut codes = Vec::with_capacity(count.div_ceil(4));
+    let mut payload = Vec::new();
+    // Four deltas make one code byte, written once.
+    for _ in 0..count.div_ceil(4) {
+        let mut byte = 0_u8;
+        for (slot, delta) in deltas.by_ref().take(4).enumerate() {
+            let code = code_of(delta);
+            byte |= code << (2 * slot);
+            match (code, is_64_bit) {
+                (COMMON, _) => {}
+                (SMALL, true) => payload.extend_from_slice(&(delta as i16).to_le_bytes()),
+                (SMALL, false) => payload.extend_from_slice(&(delta as i8).to_le_bytes()),
+                (MEDIUM, true) => payload.extend_from_slice(&(delta as i32).to_le_bytes()),
+                (MEDIUM, false) => payload.extend_from_slice(&(delta as i16).to_le_bytes()),
+                (LARGE, true) => payload.extend_from_slice(&delta.to_le_bytes()),
+                (LARGE, false) => payload.extend_from_slice(&(delta as i32).to_le_bytes()),
+                _ => unreachable!(),
+            }
         }
+        codes.push(byte);
     }
-
-    out
+    (codes, payload)
 }
 
-fn most_common(deltas: impl Iterator<Item = i64>) -> i64 {
-    // Deltas of index arrays are mostly small: those are counted in a table, only the
-    // others in a map (subd: hashing every one of millions of deltas was most of the
-    // time a mesh's crate file took to write). The answer is the one counting all of them
-    // in the map gives.
+/// How often each delta occurs. Deltas of index arrays are mostly small: those are counted
+/// in a table, only the others in a map (subd: hashing every one of millions of deltas was
+/// most of the time a mesh's crate file took to write). The answer is the one counting all
+/// of them in the map gives.
+struct DeltaCounts {
+    dense: Vec<usize>,
+    sparse: HashMap<i64, usize>,
+}
+
+impl DeltaCounts {
     const SPAN: i64 = 1 << 12;
-    let mut dense = vec![0_usize; 2 * SPAN as usize];
-    let mut counts: HashMap<i64, usize> = HashMap::new();
-    for d in deltas {
-        if (-SPAN..SPAN).contains(&d) {
-            dense[(d + SPAN) as usize] += 1;
-        } else {
-            *counts.entry(d).or_insert(0) += 1;
-        }
-    }
-    let small = dense
-        .iter()
-        .enumerate()
-        .filter(|&(_, &c)| c > 0)
-        .map(|(i, &c)| (i as i64 - SPAN, c));
-    // Tie-break by smallest value so the output is byte-deterministic across
-    // runs regardless of `HashMap` iteration order.
-    let mut best: Option<(i64, usize)> = None;
-    for (value, count) in small.chain(counts) {
-        match best {
-            None => best = Some((value, count)),
-            Some((bv, bc)) if count > bc || (count == bc && value < bv) => {
-                best = Some((value, count));
+
+    fn of(deltas: impl Iterator<Item = i64>) -> Self {
+        let mut dense = vec![0_usize; 2 * Self::SPAN as usize];
+        let mut sparse: HashMap<i64, usize> = HashMap::new();
+        for d in deltas {
+            if (-Self::SPAN..Self::SPAN).contains(&d) {
+                dense[(d + Self::SPAN) as usize] += 1;
+            } else {
+                *sparse.entry(d).or_insert(0) += 1;
             }
-            _ => {}
+        }
+        DeltaCounts { dense, sparse }
+    }
+
+    fn merge(&mut self, other: DeltaCounts) {
+        for (mine, theirs) in self.dense.iter_mut().zip(other.dense) {
+            *mine += theirs;
+        }
+        for (d, c) in other.sparse {
+            *self.sparse.entry(d).or_insert(0) += c;
         }
     }
-    best.map_or(0, |(v, _)| v)
+
+    fn most_common(self) -> i64 {
+        let small = self
+            .dense
+            .iter()
+            .enumerate()
+            .filter(|&(_, &c)| c > 0)
+            .map(|(i, &c)| (i as i64 - Self::SPAN, c));
+        // Tie-break by smallest value so the output is byte-deterministic across
+        // runs regardless of `HashMap` iteration order.
+        let mut best: Option<(i64, usize)> = None;
+        for (value, count) in small.chain(self.sparse) {
+            match best {
+                None => best = Some((value, count)),
+                Some((bv, bc)) if count > bc || (count == bc && value < bv) => {
+                    best = Some((value, count));
+                }
+                _ => {}
+            }
+        }
+        best.map_or(0, |(v, _)| v)
+    }
 }
 
 fn fits_in_i8(v: i64) -> bool {

@@ -163,7 +163,9 @@ impl<'w, W: Write + Seek> Packer<'w, W> {
             let fieldset_idx = self.fieldsets.len() as u32;
             if let Some(field_names) = data.list_fields(path) {
                 for name in field_names {
-                    let value = data.get_field(path, &name)?.into_owned();
+                    // subd: the value is read where it lies, not copied (a copy of every
+                    // array of a large mesh was a fifth of the time its crate file took).
+                    let value = data.get_field(path, &name)?;
                     let rep = self.write_field_value(&name, &value)?;
                     let token = if name == sdf::ChildrenKey::PropertyChildren.as_str() {
                         super::CRATE_PROPERTY_CHILDREN.to_owned()
@@ -775,7 +777,7 @@ impl<'w, W: Write + Seek> Packer<'w, W> {
     /// it as compressed (see [`MIN_COMPRESSED_ARRAY_SIZE`](super::MIN_COMPRESSED_ARRAY_SIZE)).
     fn write_array_ints<T>(&mut self, ty: Type, v: &[T]) -> Result<ValueRep, FormatError>
     where
-        T: Pod + PrimInt + 'static + AsPrimitive<i64>,
+        T: Pod + PrimInt + 'static + AsPrimitive<i64> + Sync,
     {
         let off = self.pos()?;
         self.write_count(v.len() as u64)?;
