@@ -236,6 +236,13 @@ const REFERENCE_PACKAGES: &[(&str, &str)] = &[
     ),
 ];
 
+/// System packages the tests need: a Vulkan adapter for subd-gpu's tests (Mesa's software
+/// driver, lavapipe, where the machine has no GPU).
+const TEST_PACKAGES: &[(&str, &str)] = &[(
+    "/usr/share/vulkan/icd.d/lvp_icd.x86_64.json",
+    "mesa-vulkan-drivers",
+)];
+
 fn is_root() -> bool {
     Command::new("id")
         .arg("-u")
@@ -305,11 +312,14 @@ fn cargo() -> Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Task::Test { extra } => run(cargo()
-            .args(["test", "--workspace", "--release"])
-            .arg("--")
-            .args(&extra))
-        .and_then(|_| python_tests::run_python_tests(&workspace_root())),
+        Task::Test { extra } => ensure_system_packages(TEST_PACKAGES)
+            .and_then(|_| {
+                run(cargo()
+                    .args(["test", "--workspace", "--release"])
+                    .arg("--")
+                    .args(&extra))
+            })
+            .and_then(|_| python_tests::run_python_tests(&workspace_root())),
         Task::Conformance {
             shapes,
             random,

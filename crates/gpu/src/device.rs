@@ -1,0 +1,280 @@
+//! The device: one adapter, its device and queue, and the moves of f32 columns between the
+//! host and the device.
+
+use std::sync::mpsc;
+
+use wgpu::util::DeviceExt;
+
+use crate::GpuError;
+
+/// An adapter as `subd info --devices` lists it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct AdapterSummary {
+    /// The adapter's name (e.g. "NVIDIA H100", "llvmpipe (LLVM 15.0.6, 256 bits)").
+    pub name: String,
+    /// The backend: Vulkan, Metal or Dx12.
+    pub backend: String,
+    /// Discrete, integrated, virtual, CPU (software) or other.
+    pub device_type: String,
+    /// The driver and its version, as the adapter reports them.
+    pub driver: String,
+    /// Whether the adapter offers 64-bit floats in shaders.
+    pub shader_f64: bool,
+}
+
+impl AdapterSummary {
+    fn of(adapter: &wgpu::Adapter) -> AdapterSummary {
+        let info = adapter.get_info();
+        AdapterSummary {
+            name: info.name,
+            backend: format!("{:?}", info.backend),
+            device_type: format!("{:?}", info.device_type),
+            driver: format!("{} {}", info.driver, info.driver_info)
+                .trim()
+                .to_string(),
+            shader_f64: adapter.features().contains(wgpu::Features::SHADER_F64),
+        }
+    }
+}
+
+/// The native backends (Vulkan, Metal, DX12), no GL: compute shaders with storage buffers.
+fn instance() -> wgpu::Instance {
+    let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+    desc.backends = wgpu::Backends::VULKAN | wgpu::Backends::METAL | wgpu::Backends::DX12;
+    wgpu::Instance::new(desc)
+}
+
+/// Every adapter this machine offers, best first as wgpu orders them.
+pub fn list_adapters() -> Vec<AdapterSummary> {
+    let instance = instance();
+    let adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all()));
+    adapters.iter().map(AdapterSummary::of).collect()
+}
+
+/// The arithmetic of the stencil sums. Values in device buffers are f32 either way.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Precision {
+    /// f64 weights and sums (adapters with `SHADER_F64`): every result within about one
+    /// f32 rounding of the f64 result, however long its stencil.
+    F64,
+    /// f32 weights and sums (every adapter): the error grows with a stencil's length, a
+    /// few f32 roundings per level's row (e.g. 5 units in the last place on a table composed
+    /// over three levels of Catmull-Clark).
+    F32,
+}
+
+/// A device to run subd's compute shaders on, with its queue.
+#[derive(Debug)]
+pub struct Gpu {
+    pub(crate) device: wgpu::Device,
+    pub(crate) queue: wgpu::Queue,
+    adapter: AdapterSummary,
+    pub(crate) limits: wgpu::Limits,
+    precision: Precision,
+    pub(crate) pipelines: crate::stencils::StencilPipeline,
+}
+
+impl Gpu {
+    /// The system's preferred high-performance adapter, with the largest buffers it allows,
+    /// summing in f64 where the adapter has it ([`Precision`]).
+    ///
+    /// # Errors
+    /// [`GpuError::NoAdapter`] where the machine has none, [`GpuError::Device`] where it
+    /// refuses a device.
+    pub fn new() -> Result<Gpu, GpuError> {
+        Gpu::with_precision(None)
+    }
+
+    /// As [`Self::new`], with the precision chosen: `Some(Precision::F32)` on any adapter
+    /// (faster where f64 is slow), `Some(Precision::F64)` only where the adapter has it.
+    ///
+    /// # Errors
+    /// As [`Self::new`]; [`GpuError::Device`] when f64 is asked of an adapter without it.
+    pub fn with_precision(precision: Option<Precision>) -> Result<Gpu, GpuError> {
+        let instance = instance();
+        let options = wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::HighPerformance,
+            ..Default::default()
+        };
+        let adapter = pollster::block_on(instance.request_adapter(&options))
+            .map_err(|e| GpuError::NoAdapter(e.to_string()))?;
+        let summary = AdapterSummary::of(&adapter);
+        let precision = match (precision, summary.shader_f64) {
+            (Some(Precision::F64), false) => {
+                return Err(GpuError::Device {
+                    adapter: summary.name,
+                    message: "it has no 64-bit floats in shaders (SHADER_F64)".into(),
+                });
+            }
+            (Some(p), _) => p,
+            (None, true) => Precision::F64,
+            (None, false) => Precision::F32,
+        };
+        let required_features = match precision {
+            Precision::F64 => wgpu::Features::SHADER_F64,
+            Precision::F32 => wgpu::Features::empty(),
+        };
+        // Storage buffers as large as the adapter allows: a refined level's columns and
+        // tables are the largest arrays subd hands the device.
+        let limits = adapter.limits();
+        let desc = wgpu::DeviceDescriptor {
+            label: Some("subd"),
+            required_limits: limits.clone(),
+            required_features,
+            ..Default::default()
+        };
+        let (device, queue) =
+            pollster::block_on(adapter.request_device(&desc)).map_err(|e| GpuError::Device {
+                adapter: summary.name.clone(),
+                message: e.to_string(),
+            })?;
+        let pipelines = crate::stencils::StencilPipeline::new(&device, precision);
+        Ok(Gpu {
+            device,
+            queue,
+            adapter: summary,
+            limits,
+            precision,
+            pipelines,
+        })
+    }
+
+    /// The arithmetic of the stencil sums.
+    pub fn precision(&self) -> Precision {
+        self.precision
+    }
+
+    /// The adapter this device is on.
+    pub fn adapter(&self) -> &AdapterSummary {
+        &self.adapter
+    }
+
+    /// The underlying `wgpu` device and queue, for a renderer that draws from subd's
+    /// buffers or records its own work beside subd's.
+    pub fn device_and_queue(&self) -> (&wgpu::Device, &wgpu::Queue) {
+        (&self.device, &self.queue)
+    }
+
+    /// Checks a storage buffer of `bytes` against the device's limits.
+    pub(crate) fn check_size(&self, what: &'static str, bytes: u64) -> Result<(), GpuError> {
+        let limit = self
+            .limits
+            .max_storage_buffer_binding_size
+            .min(self.limits.max_buffer_size);
+        if bytes > limit {
+            return Err(GpuError::TooLarge { what, bytes, limit });
+        }
+        Ok(())
+    }
+
+    /// A storage buffer holding `data` (at least 4 bytes: a binding may not be empty).
+    pub(crate) fn storage<T: bytemuck::Pod>(
+        &self,
+        what: &'static str,
+        data: &[T],
+        usage: wgpu::BufferUsages,
+    ) -> Result<wgpu::Buffer, GpuError> {
+        let bytes: &[u8] = bytemuck::cast_slice(data);
+        self.check_size(what, bytes.len() as u64)?;
+        let padding = [0_u8; 4];
+        let contents = if bytes.is_empty() {
+            &padding[..]
+        } else {
+            bytes
+        };
+        self.allocating(what, || {
+            self.device
+                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some(what),
+                    contents,
+                    usage: wgpu::BufferUsages::STORAGE | usage,
+                })
+        })
+    }
+
+    /// An uninitialised storage buffer of `bytes` (at least 4).
+    pub(crate) fn storage_of_size(
+        &self,
+        what: &'static str,
+        bytes: u64,
+        usage: wgpu::BufferUsages,
+    ) -> Result<wgpu::Buffer, GpuError> {
+        self.check_size(what, bytes)?;
+        self.allocating(what, || {
+            self.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(what),
+                size: bytes.max(4).next_multiple_of(4),
+                usage: wgpu::BufferUsages::STORAGE | usage,
+                mapped_at_creation: false,
+            })
+        })
+    }
+
+    /// Runs `allocate`, turning the device's out-of-memory or validation error into a
+    /// [`GpuError`] instead of wgpu's default (a panic).
+    fn allocating(
+        &self,
+        what: &'static str,
+        allocate: impl FnOnce() -> wgpu::Buffer,
+    ) -> Result<wgpu::Buffer, GpuError> {
+        let memory = self.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+        let validation = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let buffer = allocate();
+        let invalid = pollster::block_on(validation.pop());
+        let oom = pollster::block_on(memory.pop());
+        if oom.is_some() {
+            return Err(GpuError::OutOfMemory { what });
+        }
+        if let Some(e) = invalid {
+            return Err(GpuError::Failed(format!("allocating {what}: {e}")));
+        }
+        Ok(buffer)
+    }
+
+    /// Copies `bytes` bytes of `buffer` back to the host as f32 values, waiting for the
+    /// device to finish the work submitted before.
+    pub(crate) fn read_f32(&self, buffer: &wgpu::Buffer, bytes: u64) -> Result<Vec<f32>, GpuError> {
+        if bytes == 0 {
+            return Ok(Vec::new());
+        }
+        let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("read-back"),
+            size: bytes,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, bytes);
+        self.queue.submit([encoder.finish()]);
+        let slice = staging.slice(..);
+        let (sent, received) = mpsc::channel();
+        slice.map_async(wgpu::MapMode::Read, move |r| {
+            // The receiver waits below; it cannot be gone.
+            let _ = sent.send(r);
+        });
+        self.wait()?;
+        received
+            .recv()
+            .map_err(|e| GpuError::Failed(e.to_string()))?
+            .map_err(|e| GpuError::Failed(format!("reading back: {e}")))?;
+        let values = {
+            let view = slice
+                .get_mapped_range()
+                .map_err(|e| GpuError::Failed(format!("reading back: {e}")))?;
+            bytemuck::cast_slice::<u8, f32>(&view).to_vec()
+        };
+        staging.unmap();
+        Ok(values)
+    }
+
+    /// Waits for the work submitted so far.
+    ///
+    /// # Errors
+    /// [`GpuError::Failed`] when the device is lost or the wait fails.
+    pub fn wait(&self) -> Result<(), GpuError> {
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map(|_| ())
+            .map_err(|e| GpuError::Failed(e.to_string()))
+    }
+}

@@ -1,0 +1,323 @@
+//! Stencil tables on the device: uploaded once, applied to columns of f32 values as often
+//! as the source values change (every frame, for an animated cage).
+
+use subd_mesh::DVec3;
+use subd_schemes::StencilTable;
+
+use crate::{Gpu, GpuError, Precision};
+
+/// Threads per workgroup of the stencil shader (`@workgroup_size` in `stencils.wgsl`).
+const WORKGROUP: u32 = 64;
+
+/// The compute pipeline of `stencils.wgsl`, made once per device.
+#[derive(Debug)]
+pub(crate) struct StencilPipeline {
+    pipeline: wgpu::ComputePipeline,
+}
+
+impl StencilPipeline {
+    pub(crate) fn new(device: &wgpu::Device, precision: Precision) -> StencilPipeline {
+        let real = match precision {
+            Precision::F64 => "f64",
+            Precision::F32 => "f32",
+        };
+        let source = format!(
+            "alias Real = {real};\n{}",
+            include_str!("shaders/stencils.wgsl")
+        );
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("stencils.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(source.into()),
+        });
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("apply stencils"),
+            layout: None,
+            module: &module,
+            entry_point: Some("apply"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        StencilPipeline { pipeline }
+    }
+}
+
+/// Rows of `width` interleaved f32 columns in a device buffer: row `i`'s column `c` is the
+/// f32 at index `i * width + c` (positions are `width` 3: x, y, z). The buffer is a
+/// storage buffer that may also be copied from and to and bound as a vertex buffer, so a
+/// renderer can draw from it directly.
+#[derive(Debug)]
+pub struct GpuColumns {
+    buffer: wgpu::Buffer,
+    rows: usize,
+    width: usize,
+}
+
+impl GpuColumns {
+    /// The device buffer (layout above).
+    pub fn buffer(&self) -> &wgpu::Buffer {
+        &self.buffer
+    }
+
+    /// Number of rows.
+    pub fn rows(&self) -> usize {
+        self.rows
+    }
+
+    /// f32 values per row.
+    pub fn width(&self) -> usize {
+        self.width
+    }
+
+    fn bytes(&self) -> u64 {
+        (self.rows * self.width * 4) as u64
+    }
+}
+
+/// How a column buffer may be used besides storage.
+fn column_usage() -> wgpu::BufferUsages {
+    wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::VERTEX
+}
+
+impl Gpu {
+    /// Uploads rows of `width` f32 values (`values.len()` a multiple of `width`).
+    ///
+    /// # Errors
+    /// [`GpuError::Mismatch`] for a length that is not whole rows; the device's size and
+    /// memory errors.
+    pub fn upload_columns(&self, values: &[f32], width: usize) -> Result<GpuColumns, GpuError> {
+        if width == 0 || !values.len().is_multiple_of(width) {
+            return Err(GpuError::Mismatch(format!(
+                "{} values are not whole rows of {width}",
+                values.len()
+            )));
+        }
+        Ok(GpuColumns {
+            buffer: self.storage("columns", values, column_usage())?,
+            rows: values.len() / width,
+            width,
+        })
+    }
+
+    /// Uploads points as rows of three f32 values.
+    ///
+    /// # Errors
+    /// The device's size and memory errors.
+    pub fn upload_points(&self, points: &[DVec3]) -> Result<GpuColumns, GpuError> {
+        self.upload_columns(&f32_rows(points), 3)
+    }
+
+    /// Rows of `width` f32 values, their contents undefined until written.
+    ///
+    /// # Errors
+    /// The device's size and memory errors.
+    pub fn columns(&self, rows: usize, width: usize) -> Result<GpuColumns, GpuError> {
+        let bytes = (rows as u64).saturating_mul(width as u64).saturating_mul(4);
+        Ok(GpuColumns {
+            buffer: self.storage_of_size("columns", bytes, column_usage())?,
+            rows,
+            width,
+        })
+    }
+
+    /// Replaces the values of `columns` (same number of rows and width), as a frame does
+    /// with its new cage.
+    ///
+    /// # Errors
+    /// [`GpuError::Mismatch`] where `values` is not `columns`' size.
+    pub fn write_columns(&self, columns: &GpuColumns, values: &[f32]) -> Result<(), GpuError> {
+        if values.len() != columns.rows * columns.width {
+            return Err(GpuError::Mismatch(format!(
+                "{} values given for {} rows of {}",
+                values.len(),
+                columns.rows,
+                columns.width
+            )));
+        }
+        if !values.is_empty() {
+            self.queue
+                .write_buffer(&columns.buffer, 0, bytemuck::cast_slice(values));
+        }
+        Ok(())
+    }
+
+    /// Reads `columns` back to the host (waiting for the work submitted before).
+    ///
+    /// # Errors
+    /// [`GpuError::Failed`] when the device fails.
+    pub fn read_columns(&self, columns: &GpuColumns) -> Result<Vec<f32>, GpuError> {
+        self.read_f32(&columns.buffer, columns.bytes())
+    }
+
+    /// Reads rows of three columns back as points.
+    ///
+    /// # Errors
+    /// [`GpuError::Mismatch`] where the width is not 3; [`GpuError::Failed`] when the
+    /// device fails.
+    pub fn read_points(&self, columns: &GpuColumns) -> Result<Vec<DVec3>, GpuError> {
+        if columns.width != 3 {
+            return Err(GpuError::Mismatch(format!(
+                "points are rows of 3 values, not {}",
+                columns.width
+            )));
+        }
+        let values = self.read_columns(columns)?;
+        Ok(values
+            .chunks_exact(3)
+            .map(|p| DVec3::new(p[0].into(), p[1].into(), p[2].into()))
+            .collect())
+    }
+}
+
+/// Points as interleaved f32 values.
+pub(crate) fn f32_rows(points: &[DVec3]) -> Vec<f32> {
+    points
+        .iter()
+        .flat_map(|p| [p.x as f32, p.y as f32, p.z as f32])
+        .collect()
+}
+
+/// A [`StencilTable`] on the device, its weights in the device's [`Precision`].
+#[derive(Debug)]
+pub struct GpuStencilTable {
+    offsets: wgpu::Buffer,
+    indices: wgpu::Buffer,
+    weights: wgpu::Buffer,
+    rows: usize,
+    sources: usize,
+}
+
+impl GpuStencilTable {
+    /// Uploads `table`.
+    ///
+    /// # Errors
+    /// [`GpuError::TooLarge`] for a table past the device's buffer limits;
+    /// [`GpuError::OutOfMemory`].
+    pub fn new(gpu: &Gpu, table: &StencilTable) -> Result<GpuStencilTable, GpuError> {
+        let none = wgpu::BufferUsages::empty();
+        let weights = match gpu.precision() {
+            Precision::F64 => gpu.storage("stencil weights", table.weights(), none)?,
+            Precision::F32 => {
+                let w: Vec<f32> = table.weights().iter().map(|&w| w as f32).collect();
+                gpu.storage("stencil weights", &w, none)?
+            }
+        };
+        Ok(GpuStencilTable {
+            offsets: gpu.storage("stencil offsets", table.offsets(), none)?,
+            indices: gpu.storage("stencil indices", table.indices(), none)?,
+            weights,
+            rows: table.num_rows(),
+            sources: table.num_sources(),
+        })
+    }
+
+    /// Number of rows (destination values).
+    pub fn num_rows(&self) -> usize {
+        self.rows
+    }
+
+    /// Number of source rows it reads.
+    pub fn num_sources(&self) -> usize {
+        self.sources
+    }
+
+    /// Binds `src` and `dst` to the table: a dispatch to record as often as `src` changes,
+    /// with no allocation after this.
+    ///
+    /// # Errors
+    /// [`GpuError::Mismatch`] where `src` has not [`Self::num_sources`] rows, `dst` not
+    /// [`Self::num_rows`], or their widths differ.
+    pub fn bind(
+        &self,
+        gpu: &Gpu,
+        src: &GpuColumns,
+        dst: &GpuColumns,
+    ) -> Result<StencilDispatch, GpuError> {
+        self.check(src, dst)?;
+        let groups = (self.rows as u32).div_ceil(WORKGROUP);
+        let max = gpu.limits.max_compute_workgroups_per_dimension;
+        let grid = (groups.min(max), groups.div_ceil(max));
+        let params = [self.rows as u32, src.width as u32, grid.0 * WORKGROUP, 0];
+        let uniform = wgpu::util::DeviceExt::create_buffer_init(
+            &gpu.device,
+            &wgpu::util::BufferInitDescriptor {
+                label: Some("stencil parameters"),
+                contents: bytemuck::cast_slice(&params),
+                usage: wgpu::BufferUsages::UNIFORM,
+            },
+        );
+        let buffers = [
+            &uniform,
+            &self.offsets,
+            &self.indices,
+            &self.weights,
+            &src.buffer,
+            &dst.buffer,
+        ];
+        let entries: Vec<wgpu::BindGroupEntry<'_>> = buffers
+            .iter()
+            .enumerate()
+            .map(|(i, b)| wgpu::BindGroupEntry {
+                binding: i as u32,
+                resource: b.as_entire_binding(),
+            })
+            .collect();
+        let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("stencils"),
+            layout: &gpu.pipelines.pipeline.get_bind_group_layout(0),
+            entries: &entries,
+        });
+        let empty = self.rows == 0 || src.width == 0;
+        Ok(StencilDispatch {
+            bind_group,
+            grid: if empty { (0, 0) } else { grid },
+            _parameters: uniform,
+        })
+    }
+
+    /// `dst = table · src`, submitted now.
+    ///
+    /// # Errors
+    /// As [`Self::bind`].
+    pub fn apply(&self, gpu: &Gpu, src: &GpuColumns, dst: &GpuColumns) -> Result<(), GpuError> {
+        let dispatch = self.bind(gpu, src, dst)?;
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        dispatch.record(gpu, &mut encoder);
+        gpu.queue.submit([encoder.finish()]);
+        Ok(())
+    }
+
+    fn check(&self, src: &GpuColumns, dst: &GpuColumns) -> Result<(), GpuError> {
+        if src.rows != self.sources || dst.rows != self.rows || src.width != dst.width {
+            return Err(GpuError::Mismatch(format!(
+                "a table from {} rows to {} applied to {} rows of {} into {} rows of {}",
+                self.sources, self.rows, src.rows, src.width, dst.rows, dst.width
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// A stencil table bound to its source and destination columns (see
+/// [`GpuStencilTable::bind`]).
+#[derive(Debug)]
+pub struct StencilDispatch {
+    bind_group: wgpu::BindGroup,
+    /// Workgroups in x and y; (0, 0) when there is nothing to do.
+    grid: (u32, u32),
+    _parameters: wgpu::Buffer,
+}
+
+impl StencilDispatch {
+    /// Records the table's application into `encoder` (nothing runs until the encoder's
+    /// commands are submitted). Dispatches recorded one after another in one encoder run
+    /// in order, each seeing the writes of those before (a level reads the one above).
+    pub fn record(&self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder) {
+        if self.grid.0 == 0 {
+            return;
+        }
+        let mut pass = encoder.begin_compute_pass(&Default::default());
+        pass.set_pipeline(&gpu.pipelines.pipeline);
+        pass.set_bind_group(0, &self.bind_group, &[]);
+        pass.dispatch_workgroups(self.grid.0, self.grid.1, 1);
+    }
+}

@@ -1,0 +1,192 @@
+//! The device's refinement against the CPU's: every OpenSubdiv shape, each level's points
+//! within 1e-6 of the shape's bounding-box diagonal of the CPU's f64 points (computed from
+//! the masks directly, not through the stencil tables the device applies).
+
+use std::path::PathBuf;
+
+use subd_gpu::{Gpu, GpuError, GpuRefiner, GpuStencilTable, LevelTables, Precision};
+use subd_mesh::DVec3;
+use subd_schemes::{Options, Refinement, Scheme};
+
+/// The device, or None outside CI where the machine has no adapter (said loudly). In CI
+/// (`CI` set) a missing adapter fails the test: CI installs Mesa's lavapipe.
+fn gpu() -> Option<Gpu> {
+    gpu_with(None)
+}
+
+fn gpu_with(precision: Option<Precision>) -> Option<Gpu> {
+    match Gpu::with_precision(precision) {
+        Ok(g) => Some(g),
+        Err(e) if std::env::var_os("CI").is_some() => panic!("CI needs a GPU adapter: {e}"),
+        Err(e) => {
+            eprintln!("SKIPPED: no GPU adapter ({e}); install mesa-vulkan-drivers");
+            None
+        }
+    }
+}
+
+fn shapes() -> Vec<(PathBuf, Scheme)> {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/meshes/osd");
+    let mut out: Vec<(PathBuf, Scheme)> = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(|e| {
+            let path = e.unwrap().path();
+            let name = path.file_name()?.to_str()?.to_string();
+            let scheme = match name.split('_').next()? {
+                "catmark" => Scheme::CatmullClark,
+                "loop" => Scheme::Loop,
+                "bilinear" => Scheme::Bilinear,
+                _ => return None,
+            };
+            name.ends_with(".obj").then_some((path, scheme))
+        })
+        .collect();
+    out.sort_by(|a, b| a.0.cmp(&b.0));
+    out
+}
+
+fn diagonal(points: &[DVec3]) -> f64 {
+    let (lo, hi) = subd_mesh::bounding_box(points.iter().copied()).unwrap();
+    (hi - lo).length().max(1e-300)
+}
+
+fn max_distance(a: &[DVec3], b: &[DVec3]) -> f64 {
+    assert_eq!(a.len(), b.len());
+    a.iter()
+        .zip(b)
+        .map(|(p, q)| p.distance(*q))
+        .fold(0.0, f64::max)
+}
+
+/// With f64 sums (the default where the adapter has them, as lavapipe and datacentre GPUs
+/// do), every level and a table composed over three levels within 1e-6 of the diagonal.
+/// With f32 sums the long rows cost more: a face point of valence 360, and a composed
+/// table's rows, lose a rounding per block of entries, and each level's f32 values are
+/// rounded again: within 1.5e-6 (measured on lavapipe: 1.04e-6 per level on the valence-360
+/// pole, 1.05e-6 composed).
+#[test]
+fn every_shape_refines_on_the_device_as_on_the_cpu() {
+    let Some(gpu) = gpu() else { return };
+    eprintln!("adapter: {:?}", gpu.adapter());
+    let f64_sums = gpu.precision() == Precision::F64;
+    if f64_sums {
+        refine_every_shape(&gpu, 1e-6, 1e-6);
+    } else if std::env::var_os("CI").is_some() {
+        panic!("CI's adapter (lavapipe) has 64-bit floats; this one has not");
+    } else {
+        eprintln!("SKIPPED: f64 sums (the adapter has no SHADER_F64)");
+    }
+    let f32_sums = gpu_with(Some(Precision::F32)).expect("the adapter opened before");
+    refine_every_shape(&f32_sums, 1.5e-6, 1.5e-6);
+}
+
+fn refine_every_shape(gpu: &Gpu, level_tolerance: f64, composed_tolerance: f64) {
+    let options = subd_io::ReadOptions {
+        accept_inconsistent_orientation: true,
+        ..Default::default()
+    };
+    let (mut checked, mut worst) = (0, [0.0_f64; 2]);
+    for (path, scheme) in shapes() {
+        let mesh = subd_io::read_mesh(&path, &options).unwrap().mesh;
+        let rules = Options::from_hints(&mesh.hints);
+        let Ok(refinement) = Refinement::new(&mesh.topology, scheme, &rules, 3) else {
+            continue; // a shape the scheme does not take (Loop on quads)
+        };
+        let cpu = refinement.refine_points(&mesh.positions);
+        let diagonal = diagonal(&mesh.positions);
+        let per_level = GpuRefiner::new(gpu, &refinement, 3, LevelTables::PerLevel).unwrap();
+        per_level.update_points(gpu, &mesh.positions).unwrap();
+        for (level, want) in cpu.iter().enumerate() {
+            let got = gpu.read_points(per_level.level(level).unwrap()).unwrap();
+            let d = max_distance(&got, want) / diagonal;
+            let at = format!("{}: level {level}", path.display());
+            assert!(d <= level_tolerance, "{at}: {d:e} of the diagonal");
+            worst[0] = worst[0].max(d);
+        }
+        let composed = GpuRefiner::new(gpu, &refinement, 3, LevelTables::Composed).unwrap();
+        composed.update_points(gpu, &mesh.positions).unwrap();
+        let got = gpu.read_points(composed.last()).unwrap();
+        let d = max_distance(&got, &cpu[3]) / diagonal;
+        assert!(
+            d <= composed_tolerance,
+            "{}: composed: {d:e}",
+            path.display()
+        );
+        worst[1] = worst[1].max(d);
+        checked += 1;
+    }
+    eprintln!(
+        "{:?}: worst per level {:e}, composed {:e}",
+        gpu.precision(),
+        worst[0],
+        worst[1]
+    );
+    assert!(checked > 50, "only {checked} shapes refined");
+}
+
+/// A new cage is a new frame: the same refiner, new base values, new levels.
+#[test]
+fn an_update_recomputes_every_level() {
+    let Some(gpu) = gpu() else { return };
+    let quads = subd_mesh::TopologyBuilder::new(6)
+        .build(&[4, 4], &[0, 1, 4, 3, 1, 2, 5, 4])
+        .unwrap();
+    let refinement = Refinement::new(&quads, Scheme::CatmullClark, &Options::default(), 2).unwrap();
+    let refiner = GpuRefiner::new(&gpu, &refinement, 3, LevelTables::PerLevel).unwrap();
+    for frame in 0..3 {
+        let lift = f64::from(frame);
+        let cage: Vec<DVec3> = (0..6)
+            .map(|i| DVec3::new(f64::from(i % 3), f64::from(i / 3), lift * f64::from(i % 2)))
+            .collect();
+        refiner.update_points(&gpu, &cage).unwrap();
+        let got = gpu.read_points(refiner.last()).unwrap();
+        let want = refinement.points_at(&cage, 2);
+        assert!(
+            max_distance(&got, &want) <= 1e-6 * diagonal(&cage),
+            "frame {frame}"
+        );
+    }
+}
+
+/// Any width: texture coordinates (2) and colours (4) through a table.
+#[test]
+fn tables_apply_to_columns_of_any_width() {
+    let Some(gpu) = gpu() else { return };
+    let tri = subd_mesh::TopologyBuilder::new(4)
+        .build(&[3, 3], &[0, 1, 2, 0, 2, 3])
+        .unwrap();
+    let refinement = Refinement::new(&tri, Scheme::Loop, &Options::default(), 1).unwrap();
+    let table = refinement.stencils(1);
+    let on_device = GpuStencilTable::new(&gpu, table).unwrap();
+    for width in [1, 2, 4, 7] {
+        let values: Vec<f64> = (0..4 * width).map(|i| (i as f64 * 0.37).sin()).collect();
+        let mut want = vec![0.0; table.num_rows() * width];
+        table.apply(&values, width, &mut want);
+        let as_f32: Vec<f32> = values.iter().map(|&v| v as f32).collect();
+        let src = gpu.upload_columns(&as_f32, width).unwrap();
+        let dst = gpu.columns(table.num_rows(), width).unwrap();
+        on_device.apply(&gpu, &src, &dst).unwrap();
+        let got = gpu.read_columns(&dst).unwrap();
+        for (g, w) in got.iter().zip(&want) {
+            assert!((f64::from(*g) - w).abs() < 1e-6, "width {width}: {g} {w}");
+        }
+    }
+}
+
+#[test]
+fn mismatched_and_oversized_buffers_are_errors() {
+    let Some(gpu) = gpu() else { return };
+    let quad = subd_mesh::TopologyBuilder::new(4)
+        .build(&[4], &[0, 1, 2, 3])
+        .unwrap();
+    let refinement = Refinement::new(&quad, Scheme::CatmullClark, &Options::default(), 1).unwrap();
+    let table = GpuStencilTable::new(&gpu, refinement.stencils(1)).unwrap();
+    let src = gpu.columns(3, 3).unwrap();
+    let dst = gpu.columns(table.num_rows(), 3).unwrap();
+    let e = table.apply(&gpu, &src, &dst).unwrap_err();
+    assert!(matches!(e, GpuError::Mismatch(_)), "{e}");
+    assert!(e.to_string().contains("applied to 3 rows"), "{e}");
+    let e = gpu.columns(1 << 40, 3).unwrap_err();
+    assert!(matches!(e, GpuError::TooLarge { .. }), "{e}");
+    assert!(gpu.upload_columns(&[1.0; 5], 3).is_err());
+}
