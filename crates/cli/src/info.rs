@@ -14,7 +14,11 @@ pub(crate) struct InfoArgs {
     /// Input mesh (.obj, .ply, .glb, .gltf, .usda, .usdc, .usdz, .usd). Faces whose windings
     /// disagree are accepted and counted. A USD stage's mesh prims are listed; the report
     /// is of its only one, or of --prim.
-    input: PathBuf,
+    #[arg(required_unless_present = "devices")]
+    input: Option<PathBuf>,
+    /// List the GPU adapters subd can use (Vulkan, Metal, DX12) instead of reading a mesh.
+    #[arg(long, conflicts_with_all = ["input", "prim", "time"])]
+    devices: bool,
     /// USD input: the mesh prim to report on.
     #[arg(long, value_name = "PATH")]
     prim: Option<String>,
@@ -60,6 +64,10 @@ pub(crate) fn run(
     out: &mut dyn Write,
     err: &mut dyn Write,
 ) -> Result<(), Failure> {
+    let Some(input) = &args.input else {
+        print_devices(args.json, out);
+        return Ok(());
+    };
     // `info` is the diagnostic command: it accepts orientation conflicts (as OpenSubdiv does,
     // making the edge non-manifold) so that it can report them instead of stopping at the
     // first one.
@@ -69,22 +77,22 @@ pub(crate) fn run(
         time: args.time,
         ..subd_io::ReadOptions::default()
     };
-    let prims = usd_prims(&args.input)?;
+    let prims = usd_prims(input)?;
     // A stage with several mesh prims and no --prim: the list alone.
     let listed_only = args.prim.is_none() && prims.as_ref().is_some_and(|p| p.len() > 1);
     let file = if listed_only {
         None
     } else {
-        Some(subd_io::read_mesh(&args.input, &options)?)
+        Some(subd_io::read_mesh(input, &options)?)
     };
     if let Some(file) = &file {
-        print_warnings(err, &args.input, &file.warnings);
+        print_warnings(err, input, &file.warnings);
     }
     let mesh = file
         .as_ref()
         .map(|f| MeshReport::of(&f.mesh, f.orientation_conflicts));
     let report = InfoReport {
-        file: args.input.display().to_string(),
+        file: input.display().to_string(),
         prims,
         stage: file
             .as_ref()
@@ -241,4 +249,45 @@ fn write_mesh_text(out: &mut dyn Write, r: &MeshReport) -> std::io::Result<()> {
     writeln!(out, "euler             {}", s.euler)?;
     writeln!(out, "genus             {}", opt(s.genus))?;
     Ok(())
+}
+
+#[derive(Serialize)]
+struct DeviceReport {
+    name: String,
+    backend: String,
+    device_type: String,
+    driver: String,
+    shader_f64: bool,
+}
+
+/// `--devices`: the GPU adapters, one line each (or a JSON list); none is not an error.
+fn print_devices(json: bool, out: &mut dyn Write) {
+    let adapters: Vec<DeviceReport> = subd_gpu::list_adapters()
+        .into_iter()
+        .map(|a| DeviceReport {
+            name: a.name,
+            backend: a.backend,
+            device_type: a.device_type,
+            driver: a.driver,
+            shader_f64: a.shader_f64,
+        })
+        .collect();
+    if json {
+        crate::print_json(out, &adapters);
+        return;
+    }
+    if adapters.is_empty() {
+        let _ = writeln!(
+            out,
+            "no GPU adapter (on Linux, Mesa's software Vulkan driver, Debian's mesa-vulkan-drivers, provides one)"
+        );
+    }
+    for a in &adapters {
+        let f64_note = if a.shader_f64 { ", f64" } else { "" };
+        let _ = writeln!(
+            out,
+            "{} ({}, {}{f64_note}; driver {})",
+            a.name, a.backend, a.device_type, a.driver
+        );
+    }
 }

@@ -6,7 +6,9 @@
 //! * [`GpuStencilTable`]: a [`subd_schemes::StencilTable`] uploaded once and applied to
 //!   columns as often as they change;
 //! * [`GpuRefiner`]: a refinement's levels recomputed on the device from new base values
-//!   with one submission, per level or through one composed table.
+//!   with one submission, per level or through one composed table;
+//! * [`GpuLimitStencils`]: a level's limit positions and tangents
+//!   ([`subd_limit::LimitStencilTable`]).
 //!
 //! Values are f32 on the device (every adapter has it); stencil weights and sums are f64
 //! where the adapter has 64-bit floats, else f32 ([`Precision`]). Results stay on the device
@@ -33,10 +35,12 @@
 
 mod device;
 mod error;
+mod limit;
 mod refiner;
 mod stencils;
 
 pub use device::{AdapterSummary, Gpu, Precision, list_adapters};
 pub use error::GpuError;
+pub use limit::{GpuLimit, GpuLimitStencils};
 pub use refiner::{GpuRefiner, LevelTables};
 pub use stencils::{GpuColumns, GpuStencilTable, StencilDispatch};

@@ -190,3 +190,76 @@ fn mismatched_and_oversized_buffers_are_errors() {
     assert!(matches!(e, GpuError::TooLarge { .. }), "{e}");
     assert!(gpu.upload_columns(&[1.0; 5], 3).is_err());
 }
+
+/// A level's limit on the device: level 2 refined there, then its limit stencils. The
+/// positions and normals against the CPU's limit of the same level taken by its masks
+/// without tables (`level_limit_points`), the tangents (whose direction convention is the
+/// tables') against the CPU's f64 application of the same tables: positions within 1e-6 of
+/// the diagonal, tangents within 1e-6 of it times their row's absolute weight sum, normals
+/// as close as tangents that close allow.
+#[test]
+fn limits_on_the_device_are_the_cpus() {
+    let Some(gpu) = gpu() else { return };
+    let options = subd_io::ReadOptions {
+        accept_inconsistent_orientation: true,
+        ..Default::default()
+    };
+    let mut checked = 0;
+    for (path, scheme) in shapes() {
+        if scheme == Scheme::Bilinear {
+            continue; // its limit is the mesh itself: no limit stencils
+        }
+        let mesh = subd_io::read_mesh(&path, &options).unwrap().mesh;
+        let rules = Options::from_hints(&mesh.hints);
+        let Ok(refinement) = Refinement::new(&mesh.topology, scheme.clone(), &rules, 2) else {
+            continue;
+        };
+        let level2 = refinement.points_at(&mesh.positions, 2);
+        let kept = subd_limit::Tangents::Kept;
+        let want = subd_limit::level_limit_points(&refinement, 2, &rules, &level2, kept).unwrap();
+        let table = subd_limit::limit_stencils(refinement.topology(2), &scheme, &rules).unwrap();
+        let by_table = table.apply(&level2);
+        let limit = subd_gpu::GpuLimitStencils::new(&gpu, &table).unwrap();
+        let refiner = GpuRefiner::new(&gpu, &refinement, 3, LevelTables::PerLevel).unwrap();
+        refiner.update_points(&gpu, &mesh.positions).unwrap();
+        let out = limit.outputs(&gpu, 3).unwrap();
+        limit.apply(&gpu, refiner.last(), &out).unwrap();
+        let tolerance = 1e-6 * diagonal(&mesh.positions);
+        let read = |c| gpu.read_points(c).unwrap();
+        let (p, t1, t2) = (
+            read(&out.positions),
+            read(&out.tangent1),
+            read(&out.tangent2),
+        );
+        let at = path.display();
+        let d = max_distance(&p, &want.positions);
+        assert!(d <= tolerance, "{at}: positions: {d:e}");
+        // A tangent row's weights sum to zero and reach several units: it scales the f32
+        // rounding of the level's points by its weights' absolute sum.
+        for (got, want, rows, what) in [
+            (&t1, &by_table.tangent1, &table.tangent1, "tangent 1"),
+            (&t2, &by_table.tangent2, &table.tangent2, "tangent 2"),
+        ] {
+            for v in 0..got.len() {
+                let reach: f64 = rows.row(v).1.iter().map(|w| w.abs()).sum();
+                let d = got[v].distance(want[v]);
+                assert!(d <= tolerance * reach.max(1.0), "{at}: {what} {v}: {d:e}");
+            }
+        }
+        // A normal is as accurate as its tangents relative to their cross product: a
+        // tangent off by e turns it by at most about e (|t1| + |t2|) / |t1 × t2|.
+        for (v, n) in want.normals.iter().enumerate() {
+            let cross = t1[v].cross(t2[v]);
+            let turn = tolerance * (t1[v].length() + t2[v].length()) / cross.length();
+            if n.is_finite() && n.length() > 0.5 {
+                let got = cross.normalize_or_zero();
+                assert!(
+                    got.distance(*n) <= 2.0 * turn,
+                    "{at}: normal {v}: {got} {n}"
+                );
+            }
+        }
+        checked += 1;
+    }
+    assert!(checked > 40, "only {checked} shapes");
+}

@@ -448,3 +448,20 @@ fn a_refused_input_prints_the_refusal_alone() {
     );
     assert!(dir.join("warned.obj").exists());
 }
+
+/// `subd info --devices` lists the GPU adapters (CI has Mesa's lavapipe, a Vulkan one) or
+/// says there is none; it takes no mesh.
+#[test]
+fn info_lists_the_gpu_adapters() {
+    let (code, out, err) = subd(&["info", "--devices", "--json"]);
+    assert_eq!(code, 0, "{err}");
+    let adapters: Vec<serde_json::Value> = serde_json::from_str(&out).unwrap();
+    if std::env::var_os("CI").is_some() {
+        assert!(adapters.iter().any(|a| a["backend"] == "Vulkan"), "{out}");
+    }
+    let (code, text, err) = subd(&["info", "--devices"]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(text.lines().count(), adapters.len().max(1), "{text}");
+    let (code, _, err) = subd(&["info", "--devices", "some.obj"]);
+    assert_eq!(code, 2, "{err}");
+}
