@@ -112,6 +112,10 @@ enum Task {
         /// Only the evaluation benchmark.
         #[arg(long)]
         eval_only: bool,
+        /// Only the GPU benchmark (subd-gpu's stencils on the preferred adapter against the
+        /// CPU on all cores, `crates/gpu/examples/gpu_bench.rs`).
+        #[arg(long)]
+        gpu: bool,
         /// Only the PIA benchmark (solvers on the quad bench mesh, Loop on a scan).
         #[arg(long)]
         pia_only: bool,
@@ -392,6 +396,7 @@ fn main() -> ExitCode {
             refine_only,
             open,
             eval_only,
+            gpu,
             pia_only,
             adaptive_only,
             editing_only,
@@ -421,7 +426,19 @@ fn main() -> ExitCode {
             let batch = || batch_bench::run_batch(rounds.max(1), &shapes);
             let tess = || tess_bench::run(repeats);
             let fvar = || fvar_bench::run(levels, repeats, rounds.max(1));
-            if python_only {
+            if gpu {
+                run(cargo()
+                    .args([
+                        "run",
+                        "--release",
+                        "-p",
+                        "subd-gpu",
+                        "--example",
+                        "gpu_bench",
+                        "--",
+                    ])
+                    .args(["100000", &levels.to_string(), &repeats.to_string()]))
+            } else if python_only {
                 python_tests::run_python_bench(&workspace_root(), repeats)
             } else if usd_only {
                 usd_bench::run(&workspace_root(), repeats)

@@ -42,5 +42,5 @@ mod stencils;
 pub use device::{AdapterSummary, Gpu, Precision, list_adapters};
 pub use error::GpuError;
 pub use limit::{GpuLimit, GpuLimitStencils};
-pub use refiner::{GpuRefiner, LevelTables};
+pub use refiner::{GpuFaceVarying, GpuRefiner, LevelTables};
 pub use stencils::{GpuColumns, GpuStencilTable, StencilDispatch};

@@ -79,12 +79,25 @@ impl GpuRefiner {
     /// [`GpuError::Mismatch`] where `base` is not one row per base vertex.
     pub fn update(&self, gpu: &Gpu, base: &[f32]) -> Result<(), GpuError> {
         gpu.write_columns(&self.levels[0], base)?;
-        let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        for d in &self.dispatches {
-            d.record(gpu, &mut encoder);
-        }
-        gpu.queue.submit([encoder.finish()]);
+        self.recompute(gpu);
         Ok(())
+    }
+
+    /// Submits the recomputation of every level from the base values already in
+    /// [`Self::level`]`(0)`'s buffer (written there by the caller's own work, a skinning
+    /// shader say).
+    pub fn recompute(&self, gpu: &Gpu) {
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        self.record(gpu, &mut encoder);
+        gpu.queue.submit([encoder.finish()]);
+    }
+
+    /// Records the recomputation of every level into `encoder`, after whatever the caller
+    /// recorded there before (the levels' dispatches see its writes to the base buffer).
+    pub fn record(&self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder) {
+        for d in &self.dispatches {
+            d.record(gpu, encoder);
+        }
     }
 
     /// [`Self::update`] with points (width 3).
@@ -105,5 +118,59 @@ impl GpuRefiner {
     /// The values of the last level.
     pub fn last(&self) -> &GpuColumns {
         self.levels.last().expect("the base is always kept")
+    }
+}
+
+/// A face-varying channel (texture coordinates) of a refinement on the device: its last
+/// level's values recomputed from new base values through one composed table
+/// ([`subd_schemes::FaceVarying::composed`], OpenSubdiv's interpolation modes and the
+/// split schemes' alike).
+#[derive(Debug)]
+pub struct GpuFaceVarying {
+    base: GpuColumns,
+    last: GpuColumns,
+    _table: GpuStencilTable,
+    dispatch: StencilDispatch,
+}
+
+impl GpuFaceVarying {
+    /// Uploads the table from `channel`'s base values to its last level, for values of
+    /// `width` numbers each (2 for texture coordinates).
+    ///
+    /// # Errors
+    /// The device's size and memory errors.
+    pub fn new(
+        gpu: &Gpu,
+        channel: &subd_schemes::FaceVarying<'_>,
+        width: usize,
+    ) -> Result<GpuFaceVarying, GpuError> {
+        let table = channel.composed(channel.num_levels());
+        let base = gpu.columns(table.num_sources(), width)?;
+        let last = gpu.columns(table.num_rows(), width)?;
+        let on_device = GpuStencilTable::new(gpu, &table)?;
+        let dispatch = on_device.bind(gpu, &base, &last)?;
+        Ok(GpuFaceVarying {
+            base,
+            last,
+            _table: on_device,
+            dispatch,
+        })
+    }
+
+    /// Writes new base values and submits the recomputation of the last level's.
+    ///
+    /// # Errors
+    /// [`GpuError::Mismatch`] where `base` is not one row per base value.
+    pub fn update(&self, gpu: &Gpu, base: &[f32]) -> Result<(), GpuError> {
+        gpu.write_columns(&self.base, base)?;
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        self.dispatch.record(gpu, &mut encoder);
+        gpu.queue.submit([encoder.finish()]);
+        Ok(())
+    }
+
+    /// The last level's values.
+    pub fn last(&self) -> &GpuColumns {
+        &self.last
     }
 }

@@ -191,7 +191,7 @@ fn mismatched_and_oversized_buffers_are_errors() {
     assert!(gpu.upload_columns(&[1.0; 5], 3).is_err());
 }
 
-/// A level's limit on the device: level 2 refined there, then its limit stencils. The
+/// A level's limit on the device: level 1 refined there, then its limit stencils. The
 /// positions and normals against the CPU's limit of the same level taken by its masks
 /// without tables (`level_limit_points`), the tangents (whose direction convention is the
 /// tables') against the CPU's f64 application of the same tables: positions within 1e-6 of
@@ -211,14 +211,19 @@ fn limits_on_the_device_are_the_cpus() {
         }
         let mesh = subd_io::read_mesh(&path, &options).unwrap().mesh;
         let rules = Options::from_hints(&mesh.hints);
-        let Ok(refinement) = Refinement::new(&mesh.topology, scheme.clone(), &rules, 2) else {
+        let Ok(refinement) = Refinement::new(&mesh.topology, scheme.clone(), &rules, 1) else {
             continue;
         };
-        let level2 = refinement.points_at(&mesh.positions, 2);
+        if refinement.num_vertices(1) > 2000 {
+            // The CPU's limit tables of the largest shapes (car, bishop, pawn) take seconds
+            // each; on the device they are the same shader over more rows.
+            continue;
+        }
+        let level = refinement.points_at(&mesh.positions, 1);
         let kept = subd_limit::Tangents::Kept;
-        let want = subd_limit::level_limit_points(&refinement, 2, &rules, &level2, kept).unwrap();
-        let table = subd_limit::limit_stencils(refinement.topology(2), &scheme, &rules).unwrap();
-        let by_table = table.apply(&level2);
+        let want = subd_limit::level_limit_points(&refinement, 1, &rules, &level, kept).unwrap();
+        let table = subd_limit::limit_stencils(refinement.topology(1), &scheme, &rules).unwrap();
+        let by_table = table.apply(&level);
         let limit = subd_gpu::GpuLimitStencils::new(&gpu, &table).unwrap();
         let refiner = GpuRefiner::new(&gpu, &refinement, 3, LevelTables::PerLevel).unwrap();
         refiner.update_points(&gpu, &mesh.positions).unwrap();
@@ -262,4 +267,57 @@ fn limits_on_the_device_are_the_cpus() {
         checked += 1;
     }
     assert!(checked > 40, "only {checked} shapes");
+}
+
+/// Texture coordinates on the device: every OSD shape with UVs, refined two levels with
+/// each of its scheme's interpolation modes, against the CPU's level-by-level refinement
+/// of the values (`refine_values`), within 1e-6 of the UVs' bounding-box diagonal.
+#[test]
+fn texture_coordinates_on_the_device_are_the_cpus() {
+    use subd_mesh::fvar::FVarLinearInterpolation as Mode;
+    let Some(gpu) = gpu() else { return };
+    let options = subd_io::ReadOptions {
+        accept_inconsistent_orientation: true,
+        ..Default::default()
+    };
+    let mut checked = 0;
+    for (path, scheme) in shapes() {
+        let mesh = subd_io::read_mesh(&path, &options).unwrap().mesh;
+        let Some(uv) = mesh.fvar.first() else {
+            continue;
+        };
+        let rules = Options::from_hints(&mesh.hints);
+        let Ok(refinement) = Refinement::new(&mesh.topology, scheme, &rules, 2) else {
+            continue;
+        };
+        let values = uv.values();
+        let (lo, hi) =
+            values
+                .chunks_exact(2)
+                .fold(([f64::MAX; 2], [f64::MIN; 2]), |(lo, hi), v| {
+                    (
+                        [lo[0].min(v[0]), lo[1].min(v[1])],
+                        [hi[0].max(v[0]), hi[1].max(v[1])],
+                    )
+                });
+        let tolerance = 1e-6 * (hi[0] - lo[0]).hypot(hi[1] - lo[1]).max(1e-300);
+        for mode in [Mode::None, Mode::CornersPlus1, Mode::All] {
+            let fv = refinement.face_varying(uv, mode).unwrap();
+            let want = fv.refine_values(values, 2);
+            let on_device = subd_gpu::GpuFaceVarying::new(&gpu, &fv, 2).unwrap();
+            let as_f32: Vec<f32> = values.iter().map(|&x| x as f32).collect();
+            on_device.update(&gpu, &as_f32).unwrap();
+            let got = gpu.read_columns(on_device.last()).unwrap();
+            assert_eq!(got.len(), want[2].len());
+            for (g, w) in got.iter().zip(&want[2]) {
+                let d = (f64::from(*g) - w).abs();
+                assert!(d <= tolerance, "{}: {mode:?}: {g} {w}", path.display());
+            }
+        }
+        checked += 1;
+    }
+    assert!(
+        checked >= 5,
+        "only {checked} shapes with texture coordinates"
+    );
 }

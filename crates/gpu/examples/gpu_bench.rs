@@ -1,0 +1,104 @@
+//! The GPU's stencil evaluation against the CPU's refinement, one run:
+//!
+//! ```text
+//! cargo run --release -p subd-gpu --example gpu_bench -- [QUADS] [LEVELS] [REPEATS]
+//! ```
+//!
+//! A closed quad torus of about QUADS faces (default 100,000), Catmull-Clark to LEVELS
+//! (default 3). Times, medians of REPEATS (default 7): uploading the stencil tables, one
+//! frame's compute (every level from a new cage, the cage already written), writing the
+//! cage, reading the last level back; and the CPU computing the same level from the cage
+//! on all its cores (`Refinement::points_at`). `cargo xtask bench --gpu` runs it.
+
+use std::time::Instant;
+
+use subd_gpu::{Gpu, GpuRefiner, LevelTables};
+use subd_schemes::{Options, Refinement, Scheme};
+
+fn median(mut t: Vec<f64>) -> f64 {
+    t.sort_by(f64::total_cmp);
+    t[t.len() / 2]
+}
+
+fn timed(repeats: usize, mut f: impl FnMut()) -> f64 {
+    median(
+        (0..repeats.max(1))
+            .map(|_| {
+                let t = Instant::now();
+                f();
+                t.elapsed().as_secs_f64()
+            })
+            .collect(),
+    )
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<usize> = std::env::args()
+        .skip(1)
+        .filter_map(|a| a.parse().ok())
+        .collect();
+    let quads = args.first().copied().unwrap_or(100_000);
+    let levels = args.get(1).copied().unwrap_or(3);
+    let repeats = args.get(2).copied().unwrap_or(7);
+    let side = (quads as f64).sqrt().round().max(3.0) as u32;
+    let cage = subd_mesh::primitives::torus(side, side, 1.0, 0.3);
+    let refinement = Refinement::new(
+        &cage.topology,
+        Scheme::CatmullClark,
+        &Options::default(),
+        levels,
+    )?;
+    let vertices = refinement.num_vertices(levels);
+    for l in 1..=levels {
+        refinement.stencils(l); // built before the timing: the tables are the input here
+    }
+    let gpu = Gpu::new()?;
+    let adapter = gpu.adapter();
+    println!(
+        "device: {} ({}, {}); sums {:?}",
+        adapter.name,
+        adapter.backend,
+        adapter.device_type,
+        gpu.precision()
+    );
+    println!(
+        "cage: {} quads, Catmull-Clark level {levels}: {vertices} vertices, {} faces; medians of {repeats}",
+        cage.topology.num_faces(),
+        refinement.faces(levels).0.len() - 1
+    );
+    let t = Instant::now();
+    let refiner = GpuRefiner::new(&gpu, &refinement, 3, LevelTables::PerLevel)?;
+    gpu.wait()?;
+    let upload = t.elapsed().as_secs_f64();
+    refiner.update_points(&gpu, &cage.positions)?;
+    gpu.wait()?;
+    let frame = timed(repeats, || {
+        refiner.recompute(&gpu);
+        gpu.wait().expect("the device stays");
+    });
+    let write = timed(repeats, || {
+        refiner
+            .update_points(&gpu, &cage.positions)
+            .expect("same size");
+        gpu.wait().expect("the device stays");
+    }) - frame;
+    let read = timed(repeats, || {
+        gpu.read_points(refiner.last()).expect("read back");
+    });
+    let cpu = timed(repeats, || {
+        refinement.points_at(&cage.positions, levels);
+    });
+    let threads = std::thread::available_parallelism().map_or(1, usize::from);
+    println!("tables upload        {upload:9.4} s");
+    println!("cage write           {:9.4} s", write.max(0.0));
+    println!(
+        "frame (all levels)   {frame:9.4} s   {:.3e} vertices/s",
+        vertices as f64 / frame
+    );
+    println!("read back last level {read:9.4} s");
+    println!(
+        "CPU, {threads} threads      {cpu:9.4} s   GPU frame is {:.2}x the CPU's speed",
+        cpu / frame
+    );
+    Ok(())
+}
