@@ -453,10 +453,7 @@ fn items(input: &Path) -> Vec<(Option<String>, std::ffi::OsString)> {
         .file_stem()
         .unwrap_or(input.as_os_str())
         .to_os_string();
-    let usd = matches!(
-        subd_io::Format::from_path(input),
-        Some(subd_io::Format::Usda | subd_io::Format::Usdc | subd_io::Format::Usdz)
-    );
+    let usd = subd_io::Format::from_path(input).is_some_and(subd_io::Format::is_usd);
     let prims = if usd {
         subd_io::usd::mesh_prims(input).unwrap_or_default()
     } else {

@@ -9,21 +9,17 @@ use subd_schemes::Scheme;
 
 use crate::Failure;
 
-/// Whether `output` is a USD file, whose `subdivisionScheme` names Catmull-Clark, Loop and
-/// Bilinear only.
+/// Whether `output` is a USD file.
 fn is_usd(output: &Path) -> bool {
-    matches!(
-        subd_io::Format::for_output(output),
-        Some(subd_io::Format::Usda | subd_io::Format::Usdc | subd_io::Format::Usdz)
-    )
+    subd_io::Format::for_output(output).is_some_and(subd_io::Format::is_usd)
 }
 
 /// The warning for a cage of `scheme` written refined to `output`.
 fn refined_warning(scheme: &Scheme, output: &Path) -> String {
     format!(
-        "{}: USD has no name for the {scheme} scheme: the cage is written refined {} levels, as plain polygons (subdivisionScheme none)",
+        "{}: {}",
         output.display(),
-        subd_limit::refined_mesh::UNNAMED_CAGE_LEVELS
+        subd_limit::refined_mesh::unnamed_cage_warning(scheme)
     )
 }
 

@@ -126,10 +126,7 @@ fn histogram(h: &std::collections::BTreeMap<usize, usize>) -> String {
 
 /// The mesh prims of a USD input (`None` for the other formats).
 fn usd_prims(input: &std::path::Path) -> Result<Option<Vec<PrimReport>>, Failure> {
-    let usd = matches!(
-        subd_io::Format::from_path(input),
-        Some(subd_io::Format::Usda | subd_io::Format::Usdc | subd_io::Format::Usdz)
-    );
+    let usd = subd_io::Format::from_path(input).is_some_and(subd_io::Format::is_usd);
     if !usd {
         return Ok(None);
     }

@@ -45,6 +45,16 @@ fn shapes() -> Vec<(PathBuf, Scheme)> {
     out
 }
 
+/// A shape as the OSD regression suite has it (some have faces wound against their
+/// neighbours, which OpenSubdiv accepts).
+fn read_shape(path: &std::path::Path) -> subd_mesh::Mesh {
+    let options = subd_io::ReadOptions {
+        accept_inconsistent_orientation: true,
+        ..Default::default()
+    };
+    subd_io::read_mesh(path, &options).unwrap().mesh
+}
+
 fn diagonal(points: &[DVec3]) -> f64 {
     let (lo, hi) = subd_mesh::bounding_box(points.iter().copied()).unwrap();
     (hi - lo).length().max(1e-300)
@@ -81,13 +91,9 @@ fn every_shape_refines_on_the_device_as_on_the_cpu() {
 }
 
 fn refine_every_shape(gpu: &Gpu, level_tolerance: f64, composed_tolerance: f64) {
-    let options = subd_io::ReadOptions {
-        accept_inconsistent_orientation: true,
-        ..Default::default()
-    };
     let (mut checked, mut worst) = (0, [0.0_f64; 2]);
     for (path, scheme) in shapes() {
-        let mesh = subd_io::read_mesh(&path, &options).unwrap().mesh;
+        let mesh = read_shape(&path);
         let rules = Options::from_hints(&mesh.hints);
         let Ok(refinement) = Refinement::new(&mesh.topology, scheme, &rules, 3) else {
             continue; // a shape the scheme does not take (Loop on quads)
@@ -200,16 +206,12 @@ fn mismatched_and_oversized_buffers_are_errors() {
 #[test]
 fn limits_on_the_device_are_the_cpus() {
     let Some(gpu) = gpu() else { return };
-    let options = subd_io::ReadOptions {
-        accept_inconsistent_orientation: true,
-        ..Default::default()
-    };
     let mut checked = 0;
     for (path, scheme) in shapes() {
         if scheme == Scheme::Bilinear {
             continue; // its limit is the mesh itself: no limit stencils
         }
-        let mesh = subd_io::read_mesh(&path, &options).unwrap().mesh;
+        let mesh = read_shape(&path);
         let rules = Options::from_hints(&mesh.hints);
         let Ok(refinement) = Refinement::new(&mesh.topology, scheme.clone(), &rules, 1) else {
             continue;
@@ -276,13 +278,9 @@ fn limits_on_the_device_are_the_cpus() {
 fn texture_coordinates_on_the_device_are_the_cpus() {
     use subd_mesh::fvar::FVarLinearInterpolation as Mode;
     let Some(gpu) = gpu() else { return };
-    let options = subd_io::ReadOptions {
-        accept_inconsistent_orientation: true,
-        ..Default::default()
-    };
     let mut checked = 0;
     for (path, scheme) in shapes() {
-        let mesh = subd_io::read_mesh(&path, &options).unwrap().mesh;
+        let mesh = read_shape(&path);
         let Some(uv) = mesh.fvar.first() else {
             continue;
         };

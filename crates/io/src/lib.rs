@@ -87,6 +87,12 @@ impl Format {
         !matches!(self, Format::Gltf)
     }
 
+    /// Whether this is one of USD's formats (`.usda`, `.usdc`, `.usdz`), whose
+    /// `subdivisionScheme` names Catmull-Clark, Loop and Bilinear only.
+    pub fn is_usd(self) -> bool {
+        matches!(self, Format::Usda | Format::Usdc | Format::Usdz)
+    }
+
     /// The format named by an output path's extension, if subd writes it.
     pub fn for_output(path: &Path) -> Option<Format> {
         Format::from_path(path).filter(|f| f.can_write())

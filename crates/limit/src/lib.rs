@@ -143,6 +143,7 @@ pub mod refined_mesh {
     pub use crate::whole_mesh::{
         LimitedRefinement, MeshRefinement, RefinedMesh, RefinedUv, UNNAMED_CAGE_LEVELS, limit_uv,
         output_limit, refine_mesh, refined_hints, refined_unnamed_cage, refined_uv, split_limit_uv,
+        unnamed_cage_warning,
     };
 }
 

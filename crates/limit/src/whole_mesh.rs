@@ -431,6 +431,14 @@ pub fn refine_mesh(mesh: &Mesh, request: &MeshRefinement) -> Result<RefinedMesh,
 /// as it is.
 pub const UNNAMED_CAGE_LEVELS: usize = 2;
 
+/// What a writer says when it holds a cage of `scheme` refined because the file cannot
+/// name the scheme (the caller puts the file's name in front).
+pub fn unnamed_cage_warning(scheme: &Scheme) -> String {
+    format!(
+        "USD has no name for the {scheme} scheme: the cage is written refined {UNNAMED_CAGE_LEVELS} levels, as plain polygons (subdivisionScheme none)"
+    )
+}
+
 /// A control cage as a file that cannot name its scheme must hold it: the cage
 /// refined [`UNNAMED_CAGE_LEVELS`] levels of `scheme` with its own rules, texture
 /// coordinates carried where the scheme carries them, as plain polygons. The warnings say

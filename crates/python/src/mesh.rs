@@ -536,10 +536,7 @@ impl CoreMesh {
             ..subd_io::WriteOptions::default()
         };
         let mesh = self.mesh(py)?;
-        let usd = matches!(
-            subd_io::Format::for_output(&path),
-            Some(subd_io::Format::Usda | subd_io::Format::Usdc | subd_io::Format::Usdz)
-        );
+        let usd = subd_io::Format::for_output(&path).is_some_and(subd_io::Format::is_usd);
         if let (Some(scheme), true) = (&self.unnamed_cage, usd) {
             return pool::run(py, || write_unnamed_cage(&path, mesh, scheme, &options))?;
         }
@@ -572,9 +569,9 @@ fn write_unnamed_cage(
         .map_err(|e| mesh_error(e.to_string()))?;
     subd_io::write_mesh(path, &refined, options).map_err(io_error)?;
     let mut warnings = vec![format!(
-        "{}: USD has no name for the {scheme} scheme: the cage is written refined {} levels, as plain polygons (subdivisionScheme none)",
+        "{}: {}",
         path.display(),
-        subd_limit::refined_mesh::UNNAMED_CAGE_LEVELS
+        subd_limit::refined_mesh::unnamed_cage_warning(scheme)
     )];
     warnings.extend(left_out);
     Ok(warnings)
