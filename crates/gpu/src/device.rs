@@ -72,6 +72,7 @@ pub struct Gpu {
     pub(crate) limits: wgpu::Limits,
     precision: Precision,
     pub(crate) pipelines: crate::stencils::StencilPipeline,
+    pub(crate) patch_pipelines: crate::patches::PatchPipelines,
 }
 
 impl Gpu {
@@ -129,6 +130,7 @@ impl Gpu {
                 message: e.to_string(),
             })?;
         let pipelines = crate::stencils::StencilPipeline::new(&device, precision);
+        let patch_pipelines = crate::patches::PatchPipelines::new(&device, precision);
         Ok(Gpu {
             device,
             queue,
@@ -136,6 +138,7 @@ impl Gpu {
             limits,
             precision,
             pipelines,
+            patch_pipelines,
         })
     }
 
@@ -155,6 +158,50 @@ impl Gpu {
         (&self.device, &self.queue)
     }
 
+    /// The workgroups (x, y) of a dispatch of `invocations` invocations in workgroups of
+    /// `workgroup`, and the invocations per line of that grid: a grid is two-dimensional
+    /// where one dimension cannot hold every workgroup. (0, 0) for no work.
+    pub(crate) fn dispatch_grid(&self, invocations: usize, workgroup: u32) -> ((u32, u32), u32) {
+        let groups = (invocations as u32).div_ceil(workgroup);
+        let max = self.limits.max_compute_workgroups_per_dimension;
+        let grid = (groups.min(max), groups.div_ceil(max));
+        if invocations == 0 {
+            return ((0, 0), grid.0 * workgroup);
+        }
+        (grid, grid.0 * workgroup)
+    }
+
+    /// A uniform buffer holding `words`.
+    pub(crate) fn uniform(&self, what: &'static str, words: &[u32]) -> wgpu::Buffer {
+        self.device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(what),
+                contents: bytemuck::cast_slice(words),
+                usage: wgpu::BufferUsages::UNIFORM,
+            })
+    }
+
+    /// A bind group of `pipeline`'s group 0 with `buffers` at their bindings.
+    pub(crate) fn bind_group(
+        &self,
+        what: &'static str,
+        pipeline: &wgpu::ComputePipeline,
+        buffers: &[(u32, &wgpu::Buffer)],
+    ) -> wgpu::BindGroup {
+        let entries: Vec<wgpu::BindGroupEntry<'_>> = buffers
+            .iter()
+            .map(|&(binding, b)| wgpu::BindGroupEntry {
+                binding,
+                resource: b.as_entire_binding(),
+            })
+            .collect();
+        self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some(what),
+            layout: &pipeline.get_bind_group_layout(0),
+            entries: &entries,
+        })
+    }
+
     /// Checks a storage buffer of `bytes` against the device's limits.
     pub(crate) fn check_size(&self, what: &'static str, bytes: u64) -> Result<(), GpuError> {
         let limit = self
@@ -167,7 +214,8 @@ impl Gpu {
         Ok(())
     }
 
-    /// A storage buffer holding `data` (at least 4 bytes: a binding may not be empty).
+    /// A storage buffer holding `data` (at least 8 bytes: a binding may not be empty, nor
+    /// shorter than one element, f64 included).
     pub(crate) fn storage<T: bytemuck::Pod>(
         &self,
         what: &'static str,
@@ -176,7 +224,7 @@ impl Gpu {
     ) -> Result<wgpu::Buffer, GpuError> {
         let bytes: &[u8] = bytemuck::cast_slice(data);
         self.check_size(what, bytes.len() as u64)?;
-        let padding = [0_u8; 4];
+        let padding = [0_u8; 8];
         let contents = if bytes.is_empty() {
             &padding[..]
         } else {
@@ -234,6 +282,16 @@ impl Gpu {
     /// Copies `bytes` bytes of `buffer` back to the host as f32 values, waiting for the
     /// device to finish the work submitted before.
     pub(crate) fn read_f32(&self, buffer: &wgpu::Buffer, bytes: u64) -> Result<Vec<f32>, GpuError> {
+        self.read_back(buffer, bytes)
+    }
+
+    /// Copies `bytes` bytes of `buffer` back to the host as values of `T`, waiting for the
+    /// device to finish the work submitted before.
+    pub(crate) fn read_back<T: bytemuck::Pod>(
+        &self,
+        buffer: &wgpu::Buffer,
+        bytes: u64,
+    ) -> Result<Vec<T>, GpuError> {
         if bytes == 0 {
             return Ok(Vec::new());
         }
@@ -261,7 +319,7 @@ impl Gpu {
             let view = slice
                 .get_mapped_range()
                 .map_err(|e| GpuError::Failed(format!("reading back: {e}")))?;
-            bytemuck::cast_slice::<u8, f32>(&view).to_vec()
+            bytemuck::cast_slice::<u8, T>(&view).to_vec()
         };
         staging.unmap();
         Ok(values)

@@ -38,6 +38,12 @@ pub enum GpuError {
     /// Arrays that do not fit together (a table applied to data with the wrong row count).
     #[error("{0}")]
     Mismatch(String),
+    /// Something the device path does not do (a table with exact end caps).
+    #[error("not on the GPU: {0}")]
+    Unsupported(String),
+    /// The host-side work before a dispatch failed (a place off the surface).
+    #[error(transparent)]
+    Limit(#[from] subd_limit::LimitError),
     /// The device was lost, or a command failed validation (a bug in subd if it happens).
     #[error("the device failed: {0}")]
     Failed(String),

@@ -8,7 +8,10 @@
 //! * [`GpuRefiner`]: a refinement's levels recomputed on the device from new base values
 //!   with one submission, per level or through one composed table;
 //! * [`GpuLimitStencils`]: a level's limit positions and tangents
-//!   ([`subd_limit::LimitStencilTable`]).
+//!   ([`subd_limit::LimitStencilTable`]);
+//! * [`GpuPatchTable`]: a [`subd_limit::patches::PatchTable`]'s points recomputed from new
+//!   base positions, its patches evaluated at batches of places ([`GpuPatchCoords`]) and
+//!   on a uniform grid of every patch ([`GpuTessellation`]).
 //!
 //! Values are f32 on the device (every adapter has it); stencil weights and sums are f64
 //! where the adapter has 64-bit floats, else f32 ([`Precision`]). Results stay on the device
@@ -36,11 +39,13 @@
 mod device;
 mod error;
 mod limit;
+mod patches;
 mod refiner;
 mod stencils;
 
 pub use device::{AdapterSummary, Gpu, Precision, list_adapters};
 pub use error::GpuError;
 pub use limit::{GpuLimit, GpuLimitStencils};
+pub use patches::{GpuPatchCoords, GpuPatchTable, GpuPatchValues, GpuTessellation, PatchDispatch};
 pub use refiner::{GpuFaceVarying, GpuRefiner, LevelTables};
 pub use stencils::{GpuColumns, GpuStencilTable, StencilDispatch};

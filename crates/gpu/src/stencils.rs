@@ -47,9 +47,9 @@ impl StencilPipeline {
 /// renderer can draw from it directly.
 #[derive(Debug)]
 pub struct GpuColumns {
-    buffer: wgpu::Buffer,
-    rows: usize,
-    width: usize,
+    pub(crate) buffer: wgpu::Buffer,
+    pub(crate) rows: usize,
+    pub(crate) width: usize,
 }
 
 impl GpuColumns {
@@ -68,7 +68,7 @@ impl GpuColumns {
         self.width
     }
 
-    fn bytes(&self) -> u64 {
+    pub(crate) fn bytes(&self) -> u64 {
         (self.rows * self.width * 4) as u64
     }
 }
@@ -233,45 +233,42 @@ impl GpuStencilTable {
         dst: &GpuColumns,
     ) -> Result<StencilDispatch, GpuError> {
         self.check(src, dst)?;
-        let groups = (self.rows as u32).div_ceil(WORKGROUP);
-        let max = gpu.limits.max_compute_workgroups_per_dimension;
-        let grid = (groups.min(max), groups.div_ceil(max));
-        let params = [self.rows as u32, src.width as u32, grid.0 * WORKGROUP, 0];
-        let uniform = wgpu::util::DeviceExt::create_buffer_init(
-            &gpu.device,
-            &wgpu::util::BufferInitDescriptor {
-                label: Some("stencil parameters"),
-                contents: bytemuck::cast_slice(&params),
-                usage: wgpu::BufferUsages::UNIFORM,
-            },
-        );
+        Ok(self.dispatch(gpu, src, dst))
+    }
+
+    /// [`Self::bind`] for a source holding the table's source rows first and more after
+    /// them (a patch table's points, whose first level a table reads).
+    pub(crate) fn bind_prefix(
+        &self,
+        gpu: &Gpu,
+        src: &GpuColumns,
+        dst: &GpuColumns,
+    ) -> Result<StencilDispatch, GpuError> {
+        if src.rows < self.sources || dst.rows != self.rows || src.width != dst.width {
+            return Err(self.mismatch(src, dst));
+        }
+        Ok(self.dispatch(gpu, src, dst))
+    }
+
+    fn dispatch(&self, gpu: &Gpu, src: &GpuColumns, dst: &GpuColumns) -> StencilDispatch {
+        let rows = if src.width == 0 { 0 } else { self.rows };
+        let (grid, per_line) = gpu.dispatch_grid(rows, WORKGROUP);
+        let params = [self.rows as u32, src.width as u32, per_line, 0];
+        let uniform = gpu.uniform("stencil parameters", &params);
         let buffers = [
-            &uniform,
-            &self.offsets,
-            &self.indices,
-            &self.weights,
-            &src.buffer,
-            &dst.buffer,
+            (0, &uniform),
+            (1, &self.offsets),
+            (2, &self.indices),
+            (3, &self.weights),
+            (4, &src.buffer),
+            (5, &dst.buffer),
         ];
-        let entries: Vec<wgpu::BindGroupEntry<'_>> = buffers
-            .iter()
-            .enumerate()
-            .map(|(i, b)| wgpu::BindGroupEntry {
-                binding: i as u32,
-                resource: b.as_entire_binding(),
-            })
-            .collect();
-        let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("stencils"),
-            layout: &gpu.pipelines.pipeline.get_bind_group_layout(0),
-            entries: &entries,
-        });
-        let empty = self.rows == 0 || src.width == 0;
-        Ok(StencilDispatch {
+        let bind_group = gpu.bind_group("stencils", &gpu.pipelines.pipeline, &buffers);
+        StencilDispatch {
             bind_group,
-            grid: if empty { (0, 0) } else { grid },
+            grid,
             _parameters: uniform,
-        })
+        }
     }
 
     /// `dst = table · src`, submitted now.
@@ -288,12 +285,16 @@ impl GpuStencilTable {
 
     fn check(&self, src: &GpuColumns, dst: &GpuColumns) -> Result<(), GpuError> {
         if src.rows != self.sources || dst.rows != self.rows || src.width != dst.width {
-            return Err(GpuError::Mismatch(format!(
-                "a table from {} rows to {} applied to {} rows of {} into {} rows of {}",
-                self.sources, self.rows, src.rows, src.width, dst.rows, dst.width
-            )));
+            return Err(self.mismatch(src, dst));
         }
         Ok(())
+    }
+
+    fn mismatch(&self, src: &GpuColumns, dst: &GpuColumns) -> GpuError {
+        GpuError::Mismatch(format!(
+            "a table from {} rows to {} applied to {} rows of {} into {} rows of {}",
+            self.sources, self.rows, src.rows, src.width, dst.rows, dst.width
+        ))
     }
 }
 

@@ -124,9 +124,9 @@ pub mod patches {
     //! end caps besides OpenSubdiv's. See [`PatchTable`].
     pub use crate::evaluation::fvar_eval::FVarPoint;
     pub use crate::patch_table::{
-        EndCaps, FVarPatches, FVarPatchesLayout, MAX_ISOLATION, PatchArray, PatchArrayLayout,
-        PatchCensus, PatchGrid, PatchMap, PatchOptions, PatchParam, PatchPlace, PatchTable,
-        PatchTableLayout, PatchType, PatchWeights, TablePoints,
+        BasisBlend, EndCaps, FVarPatches, FVarPatchesLayout, MAX_ISOLATION, MONOMIALS, PatchArray,
+        PatchArrayLayout, PatchBasisPolynomials, PatchCensus, PatchGrid, PatchMap, PatchOptions,
+        PatchParam, PatchPlace, PatchTable, PatchTableLayout, PatchType, PatchWeights, TablePoints,
     };
 }
 

@@ -282,34 +282,52 @@ const GREGORY_NET: [(usize, usize); 20] = [
     (1, 2),
 ];
 
+/// The share of each corner's `Fp` point in its interior Bézier point at `(s, t)` of a
+/// Gregory quad (`Fm` has the rest); a corner's own sum is 0 exactly there, where `Fp`'s
+/// share is 0.
+pub(crate) fn gregory_fp_shares(s: f64, t: f64) -> [f64; 4] {
+    let recip = |x: f64| if x <= 0.0 { 1.0 } else { 1.0 / x };
+    [
+        s * recip(s + t),
+        t * recip((1.0 - s) + t),
+        (1.0 - s) * recip((1.0 - s) + (1.0 - t)),
+        (1.0 - t) * recip(s + (1.0 - t)),
+    ]
+}
+
+/// Gregory patch weights of the 20 points at `(s, t)` with every blend 1: the Bézier net's
+/// Bernstein products, each interior pair weighted as its shared net point.
+pub(crate) fn gregory_net(s: f64, t: f64) -> Weights<20> {
+    let (bs, ds, dss) = bernstein(s);
+    let (bt, dt, dtt) = bernstein(t);
+    let mut w = [[0.0; 20]; 6];
+    for (k, &(col, row)) in GREGORY_NET.iter().enumerate() {
+        w[0][k] = bs[col] * bt[row];
+        w[1][k] = ds[col] * bt[row];
+        w[2][k] = bs[col] * dt[row];
+        w[3][k] = dss[col] * bt[row];
+        w[4][k] = ds[col] * dt[row];
+        w[5][k] = bs[col] * dtt[row];
+    }
+    w
+}
+
 /// Gregory patch weights of the 20 points at `(s, t)`: the Bézier net whose interior
 /// points blend each corner's `Fp` and `Fm` rationally (`Fp` towards the corner's `Ep`
 /// edge). Derivatives hold the blend constant, as OpenSubdiv's evaluation does (the
 /// Bézier net at `(s, t)` differentiated).
 pub(crate) fn gregory(s: f64, t: f64) -> Weights<20> {
-    let (bs, ds, dss) = bernstein(s);
-    let (bt, dt, dtt) = bernstein(t);
-    let recip = |x: f64| if x <= 0.0 { 1.0 } else { 1.0 / x };
-    // The Fp share of each corner's interior point; a corner's own sum is 0 exactly there.
-    let fp = [
-        s * recip(s + t),
-        t * recip((1.0 - s) + t),
-        (1.0 - s) * recip((1.0 - s) + (1.0 - t)),
-        (1.0 - t) * recip(s + (1.0 - t)),
-    ];
-    let mut w = [[0.0; 20]; 6];
-    for (k, &(col, row)) in GREGORY_NET.iter().enumerate() {
+    let fp = gregory_fp_shares(s, t);
+    let mut w = gregory_net(s, t);
+    for k in 0..20 {
         let blend = match k % 5 {
             3 => fp[k / 5],
             4 => 1.0 - fp[k / 5],
-            _ => 1.0,
+            _ => continue,
         };
-        w[0][k] = blend * bs[col] * bt[row];
-        w[1][k] = blend * ds[col] * bt[row];
-        w[2][k] = blend * bs[col] * dt[row];
-        w[3][k] = blend * dss[col] * bt[row];
-        w[4][k] = blend * ds[col] * dt[row];
-        w[5][k] = blend * bs[col] * dtt[row];
+        for row in &mut w {
+            row[k] *= blend;
+        }
     }
     w
 }
@@ -382,7 +400,25 @@ const GREGORY_TRIANGLE_NET: [usize; 18] =
 /// `w/(w + u)` at corners 0, 1, 2; all `Fp` where the sum vanishes, as OpenSubdiv chooses).
 /// Derivatives hold the blend constant, as OpenSubdiv's evaluation does.
 pub(crate) fn gregory_triangle(s: f64, t: f64) -> Weights<18> {
-    let b = bezier_triangle(s, t);
+    let pairs = gregory_triangle_shares(s, t);
+    let mut out = gregory_triangle_net(s, t);
+    for k in 0..15 {
+        let blend = match k % 5 {
+            3 => pairs[k / 5][0],
+            4 => pairs[k / 5][1],
+            _ => continue,
+        };
+        for row in &mut out {
+            row[k] *= blend;
+        }
+    }
+    out
+}
+
+/// The (`Fp`, `Fm`) shares of each corner's interior point of a Gregory triangle at
+/// `(s, t)`: `u/(u + v)`, `v/(v + w)`, `w/(w + u)` for `Fp` at corners 0, 1, 2, and all
+/// `Fp` where the sum vanishes.
+pub(crate) fn gregory_triangle_shares(s: f64, t: f64) -> [[f64; 2]; 3] {
     let (u, v, w) = (s, t, 1.0 - s - t);
     let shares = |x: f64, y: f64| {
         if x + y > 0.0 {
@@ -391,16 +427,16 @@ pub(crate) fn gregory_triangle(s: f64, t: f64) -> Weights<18> {
             [1.0, 0.0]
         }
     };
-    let pairs = [shares(u, v), shares(v, w), shares(w, u)];
+    [shares(u, v), shares(v, w), shares(w, u)]
+}
+
+/// Gregory triangle weights of the 18 points at `(s, t)` with every blend 1.
+pub(crate) fn gregory_triangle_net(s: f64, t: f64) -> Weights<18> {
+    let b = bezier_triangle(s, t);
     let mut out = [[0.0; 18]; 6];
     for (k, &q) in GREGORY_TRIANGLE_NET.iter().enumerate() {
-        let blend = match (k < 15, k % 5) {
-            (true, 3) => pairs[k / 5][0],
-            (true, 4) => pairs[k / 5][1],
-            _ => 1.0,
-        };
         for (o, row) in out.iter_mut().zip(&b) {
-            o[k] = blend * row[q];
+            o[k] = row[q];
         }
     }
     out

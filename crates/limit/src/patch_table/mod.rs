@@ -44,6 +44,7 @@
 mod array;
 mod assembly;
 mod basis;
+mod basis_polynomials;
 mod batch_eval;
 mod box_fit;
 mod bspline_caps;
@@ -66,6 +67,7 @@ mod table;
 mod table_stencil;
 
 pub use array::PatchArray;
+pub use basis_polynomials::{BasisBlend, MONOMIALS, PatchBasisPolynomials};
 pub use face_varying::{FVarPatches, FVarPatchesLayout};
 pub use kind::PatchType;
 pub use map::PatchMap;

@@ -74,6 +74,13 @@ impl PatchParam {
         }
     }
 
+    /// The boundary mask the patch's basis folds: the boundary of a regular patch, none for
+    /// an end cap (whose points stand in for the missing ones).
+    pub fn basis_boundary(self) -> u8 {
+        let p = self.place();
+        if p.regular { p.boundary } else { 0 }
+    }
+
     /// The fraction of the root domain one side of the patch spans: `2^-(depth − nonquad)`.
     pub fn fraction(self) -> f64 {
         let p = self.place();

@@ -29,12 +29,11 @@ pub(crate) fn patch_weights(kind: PatchType, param: PatchParam, u: f64, v: f64) 
     } else {
         param.normalize(u, v)
     };
-    let place = param.place();
     let mut d1 = 1.0 / param.fraction();
     if triangle && param.is_triangle_rotated() {
         d1 = -d1;
     }
-    let mut w = basis::weights(kind, s, t, if place.regular { place.boundary } else { 0 });
+    let mut w = basis::weights(kind, s, t, param.basis_boundary());
     let d2 = d1 * d1;
     for (row, scale) in w.iter_mut().zip([1.0, d1, d1, d2, d2, d2]) {
         for x in row.iter_mut() {

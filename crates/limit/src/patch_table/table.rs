@@ -297,6 +297,17 @@ impl PatchTable {
         points
     }
 
+    /// The stencils of each refined level from the level above it (level 1 first): with
+    /// [`Self::local_point_stencils`], what recomputes [`Self::points`] from new base
+    /// positions, level by level (a GPU does it so).
+    pub fn level_stencils(&self) -> Vec<&StencilTable> {
+        self.levels
+            .iter()
+            .skip(1)
+            .map(|l| l.rows.as_ref().expect("a refined level has rows"))
+            .collect()
+    }
+
     /// The base level as the table sees it (OpenSubdiv's tags applied: boundary faces are
     /// holes under `BoundaryInterpolation::None`).
     pub fn base_topology(&self) -> &Topology {
