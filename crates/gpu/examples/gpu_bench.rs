@@ -8,11 +8,16 @@
 //! (default 3). Times, medians of REPEATS (default 7): uploading the stencil tables, one
 //! frame's compute (every level from a new cage, the cage already written), writing the
 //! cage, reading the last level back; and the CPU computing the same level from the cage
-//! on all its cores (`Refinement::points_at`). `cargo xtask bench --gpu` runs it.
+//! on all its cores (`Refinement::points_at`). Then the cage's patch table (OpenSubdiv's
+//! default options) tessellated at rate 8 on the device (every patch's 9 × 9 samples:
+//! positions and derivatives), against the CPU's tessellation of the same table on all
+//! its cores (`tessellate_patches`, the same number of samples). `cargo xtask bench --gpu`
+//! runs it.
 
 use std::time::Instant;
 
-use subd_gpu::{Gpu, GpuRefiner, LevelTables};
+use subd_gpu::{Gpu, GpuPatchTable, GpuRefiner, LevelTables};
+use subd_limit::patches::{PatchOptions, PatchTable};
 use subd_schemes::{Options, Refinement, Scheme};
 
 fn median(mut t: Vec<f64>) -> f64 {
@@ -99,6 +104,61 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!(
         "CPU, {threads} threads      {cpu:9.4} s   GPU frame is {:.2}x the CPU's speed",
         cpu / frame
+    );
+    patch_tessellation(&gpu, &cage, repeats)
+}
+
+/// The cage's patch table tessellated at rate 8 on the device and on the CPU.
+fn patch_tessellation(
+    gpu: &Gpu,
+    cage: &subd_mesh::Mesh,
+    repeats: usize,
+) -> Result<(), Box<dyn std::error::Error>> {
+    const RATE: usize = 8;
+    let table = PatchTable::new(
+        &cage.topology,
+        &cage.positions,
+        &Scheme::CatmullClark,
+        &Options::default(),
+        &PatchOptions::default(),
+    )?;
+    let t = Instant::now();
+    let on_device = GpuPatchTable::new(gpu, &table)?;
+    let tessellation = on_device.tessellation(gpu, RATE)?;
+    gpu.wait()?;
+    let upload = t.elapsed().as_secs_f64();
+    let samples = tessellation.values.rows();
+    let update = timed(repeats, || {
+        on_device
+            .update_points(gpu, &cage.positions)
+            .expect("same size");
+        gpu.wait().expect("the device stays");
+    });
+    let compute = timed(repeats, || {
+        tessellation.evaluate(gpu);
+        gpu.wait().expect("the device stays");
+    });
+    let read = timed(repeats, || {
+        gpu.read_points(&tessellation.values.positions)
+            .expect("read back");
+    });
+    let cpu = timed(repeats, || {
+        subd_limit::tessellation::tessellate_patches(&table, RATE).expect("a built table");
+    });
+    println!(
+        "patches: {} patches at rate {RATE}: {samples} samples",
+        on_device.num_patches()
+    );
+    println!("table upload + grid   {upload:9.4} s");
+    println!("points update         {update:9.4} s");
+    println!(
+        "tessellation compute  {compute:9.4} s   {:.3e} samples/s",
+        samples as f64 / compute
+    );
+    println!("read back positions   {read:9.4} s");
+    println!(
+        "CPU tessellate_patches {cpu:8.4} s   GPU compute is {:.2}x the CPU's speed",
+        cpu / compute
     );
     Ok(())
 }

@@ -1,7 +1,7 @@
 //! The device: one adapter, its device and queue, and the moves of f32 columns between the
 //! host and the device.
 
-use std::sync::mpsc;
+use std::sync::{Arc, Mutex, mpsc};
 
 use wgpu::util::DeviceExt;
 
@@ -37,6 +37,19 @@ impl AdapterSummary {
     }
 }
 
+/// Routes the device's loss and its uncaught errors to a [`Health`] instead of wgpu's
+/// default panic.
+fn watch(device: &wgpu::Device) -> Arc<Health> {
+    let health = Arc::new(Health::default());
+    let lost = Arc::clone(&health);
+    device.set_device_lost_callback(move |reason, message| {
+        lost.fail(format!("the device was lost ({reason:?}): {message}"));
+    });
+    let uncaught = Arc::clone(&health);
+    device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| uncaught.fail(e.to_string())));
+    health
+}
+
 /// The native backends (Vulkan, Metal, DX12), no GL: compute shaders with storage buffers.
 fn instance() -> wgpu::Instance {
     let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
@@ -63,6 +76,29 @@ pub enum Precision {
     F32,
 }
 
+/// What the device's callbacks saw: its loss, or an error no error scope caught (wgpu's
+/// default for those is a panic; subd reports them from [`Gpu::check`] and [`Gpu::wait`]).
+#[derive(Debug, Default)]
+struct Health {
+    failure: Mutex<Option<String>>,
+}
+
+impl Health {
+    /// Keeps the first failure: later ones usually follow from it.
+    fn fail(&self, message: String) {
+        let mut failure = self.failure.lock().unwrap_or_else(|e| e.into_inner());
+        failure.get_or_insert(message);
+    }
+
+    fn check(&self) -> Result<(), GpuError> {
+        let failure = self.failure.lock().unwrap_or_else(|e| e.into_inner());
+        match failure.as_ref() {
+            Some(message) => Err(GpuError::Failed(message.clone())),
+            None => Ok(()),
+        }
+    }
+}
+
 /// A device to run subd's compute shaders on, with its queue.
 #[derive(Debug)]
 pub struct Gpu {
@@ -73,6 +109,7 @@ pub struct Gpu {
     precision: Precision,
     pub(crate) pipelines: crate::stencils::StencilPipeline,
     pub(crate) patch_pipelines: crate::patches::PatchPipelines,
+    health: Arc<Health>,
 }
 
 impl Gpu {
@@ -129,8 +166,10 @@ impl Gpu {
                 adapter: summary.name.clone(),
                 message: e.to_string(),
             })?;
+        let health = watch(&device);
         let pipelines = crate::stencils::StencilPipeline::new(&device, precision);
         let patch_pipelines = crate::patches::PatchPipelines::new(&device, precision);
+        health.check()?;
         Ok(Gpu {
             device,
             queue,
@@ -139,6 +178,7 @@ impl Gpu {
             precision,
             pipelines,
             patch_pipelines,
+            health,
         })
     }
 
@@ -328,11 +368,21 @@ impl Gpu {
     /// Waits for the work submitted so far.
     ///
     /// # Errors
-    /// [`GpuError::Failed`] when the device is lost or the wait fails.
+    /// [`GpuError::Failed`] when the device is lost, a command failed, or the wait fails.
     pub fn wait(&self) -> Result<(), GpuError> {
         self.device
             .poll(wgpu::PollType::wait_indefinitely())
-            .map(|_| ())
-            .map_err(|e| GpuError::Failed(e.to_string()))
+            .map_err(|e| GpuError::Failed(e.to_string()))?;
+        self.check()
+    }
+
+    /// Whether the device still works: [`GpuError::Failed`] once it was lost (a driver
+    /// reset, a removed GPU) or a command failed; every later call fails alike, and the
+    /// caller opens a new [`Gpu`] (or goes on on the CPU).
+    ///
+    /// # Errors
+    /// As said.
+    pub fn check(&self) -> Result<(), GpuError> {
+        self.health.check()
     }
 }

@@ -168,6 +168,7 @@ pub struct GpuTessellation {
     /// Number of triangles.
     pub triangles: usize,
     dispatch: PatchDispatch,
+    _weights: wgpu::Buffer,
 }
 
 impl GpuTessellation {
@@ -216,6 +217,8 @@ pub struct GpuPatchTable {
     /// The device index of each array's first patch.
     array_first: Vec<u32>,
     patches: usize,
+    /// The basis of each class (kind and boundary mask).
+    bases: Vec<PatchBasisPolynomials>,
     /// Loop's triangles, not Catmull-Clark's quads.
     triangles: bool,
 }
@@ -223,6 +226,7 @@ pub struct GpuPatchTable {
 /// The table's patches as `patches.wgsl` reads them.
 struct PatchWords {
     words: Vec<u32>,
+    bases: Vec<PatchBasisPolynomials>,
     coefficients: Vec<f64>,
     cps_base: u32,
     classes_base: u32,
@@ -277,6 +281,7 @@ fn patch_words(table: &PatchTable) -> Result<PatchWords, GpuError> {
     }
     Ok(PatchWords {
         words,
+        bases: class_list,
         coefficients,
         cps_base,
         classes_base,
@@ -343,6 +348,7 @@ impl GpuPatchTable {
             classes_base: layout.classes_base,
             array_first: layout.array_first,
             patches: table.arrays().iter().map(|a| a.len()).sum(),
+            bases: layout.bases,
             triangles: *table.scheme() == subd_schemes::Scheme::Loop,
         })
     }
@@ -462,7 +468,8 @@ impl GpuPatchTable {
                 out.rows()
             )));
         }
-        Ok(self.dispatch(gpu, Entry::Evaluate, coords.count, 0, Some(coords), out))
+        let inputs = [(2, &self.coefficients), (4, &coords.buffer)];
+        Ok(self.dispatch(gpu, Entry::Evaluate, coords.count, 0, &inputs, out))
     }
 
     /// Evaluates the places `coords` into `out`, submitted now.
@@ -510,14 +517,10 @@ impl GpuPatchTable {
         let indices = gpu.storage_of_size("tessellation indices", triangles as u64 * 12, usage)?;
         let index_dispatch = self.index_dispatch(gpu, rate, cells as usize, &indices);
         index_dispatch.submit(gpu);
-        let dispatch = self.dispatch(
-            gpu,
-            Entry::Tessellate,
-            samples as usize,
-            rate,
-            None,
-            &values,
-        );
+        let weights = self.grid_weights(gpu, rate)?;
+        let inputs = [(9, &weights)];
+        let samples = samples as usize;
+        let dispatch = self.dispatch(gpu, Entry::Tessellate, samples, rate, &inputs, &values);
         dispatch.submit(gpu);
         Ok(GpuTessellation {
             rate,
@@ -525,6 +528,7 @@ impl GpuPatchTable {
             indices,
             triangles,
             dispatch,
+            _weights: weights,
         })
     }
 
@@ -533,28 +537,22 @@ impl GpuPatchTable {
         self.triangles
     }
 
-    /// `entry` (evaluate or tessellate) over `count` places bound to the table, `coords`
-    /// (evaluate) and `out`.
+    /// `entry` (evaluate or tessellate) over `count` places into `out`; `inputs` the
+    /// entry's own buffers with their bindings (the places and bases, or the grid's
+    /// weights).
     fn dispatch(
         &self,
         gpu: &Gpu,
         entry: Entry,
         count: usize,
         rate: usize,
-        coords: Option<&GpuPatchCoords>,
+        inputs: &[(u32, &wgpu::Buffer)],
         out: &GpuPatchValues,
     ) -> PatchDispatch {
         let (grid, per_line) = gpu.dispatch_grid(count, WORKGROUP);
         let uniform = gpu.uniform("patch parameters", &self.params(count, per_line, rate));
-        let mut buffers = vec![
-            (0, &uniform),
-            (1, &self.words),
-            (2, &self.coefficients),
-            (3, &self.points.buffer),
-        ];
-        if let Some(c) = coords {
-            buffers.push((4, &c.buffer));
-        }
+        let mut buffers = vec![(0, &uniform), (1, &self.words), (3, &self.points.buffer)];
+        buffers.extend_from_slice(inputs);
         buffers.extend([
             (5, &out.positions.buffer),
             (6, &out.du.buffer),
@@ -571,6 +569,36 @@ impl GpuPatchTable {
             grid,
             entry,
             _parameters: uniform,
+        }
+    }
+
+    /// The weights (position, ∂s, ∂t) of every class's control points at every sample of
+    /// a `rate` grid, in the device's precision: the same for every patch of a class, so a
+    /// sample is one weighted sum of its patch's points.
+    fn grid_weights(&self, gpu: &Gpu, rate: usize) -> Result<wgpu::Buffer, GpuError> {
+        let side = rate + 1;
+        let mut weights = Vec::with_capacity(self.bases.len() * side * side * 60);
+        for basis in &self.bases {
+            for y in 0..side {
+                for x in 0..side {
+                    let (mut s, mut t) = (x as f64 / rate as f64, y as f64 / rate as f64);
+                    if basis.is_triangle() && s + t > 1.0 {
+                        (s, t) = (s / (s + t), t / (s + t));
+                    }
+                    let w = basis.weights(s, t);
+                    for k in 0..20 {
+                        weights.extend((0..3).map(|d| w[d].get(k).copied().unwrap_or(0.0)));
+                    }
+                }
+            }
+        }
+        let none = wgpu::BufferUsages::empty();
+        match gpu.precision() {
+            Precision::F64 => gpu.storage("tessellation weights", &weights, none),
+            Precision::F32 => {
+                let w: Vec<f32> = weights.iter().map(|&x| x as f32).collect();
+                gpu.storage("tessellation weights", &w, none)
+            }
         }
     }
 

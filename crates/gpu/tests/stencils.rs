@@ -319,3 +319,31 @@ fn texture_coordinates_on_the_device_are_the_cpus() {
         "only {checked} shapes with texture coordinates"
     );
 }
+
+/// A lost device (here destroyed, as a driver reset or a removed GPU would lose it) is an
+/// error from every later call, never a panic or a hang; a new `Gpu` works again.
+#[test]
+fn a_lost_device_is_an_error_not_a_panic() {
+    let Some(gpu) = gpu() else { return };
+    let path = shapes().into_iter().next().expect("a shape").0;
+    let mesh = read_shape(&path);
+    let refinement = Refinement::new(
+        &mesh.topology,
+        Scheme::CatmullClark,
+        &Options::from_hints(&mesh.hints),
+        2,
+    )
+    .unwrap();
+    let refiner = GpuRefiner::new(&gpu, &refinement, 3, LevelTables::PerLevel).unwrap();
+    refiner.update_points(&gpu, &mesh.positions).unwrap();
+    assert!(gpu.wait().is_ok());
+    gpu.device_and_queue().0.destroy();
+    let _ = refiner.update_points(&gpu, &mesh.positions);
+    let err = gpu.wait().unwrap_err();
+    assert!(matches!(err, GpuError::Failed(_)), "{err}");
+    assert!(err.to_string().contains("lost"), "{err}");
+    assert!(gpu.read_points(refiner.last()).is_err());
+    assert!(gpu.check().is_err());
+    let again = Gpu::new().expect("a new device");
+    assert!(again.check().is_ok());
+}

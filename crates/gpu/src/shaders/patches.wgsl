@@ -34,6 +34,9 @@ struct Params {
 @group(0) @binding(6) var<storage, read_write> out_du: array<f32>;
 @group(0) @binding(7) var<storage, read_write> out_dv: array<f32>;
 @group(0) @binding(8) var<storage, read_write> out_indices: array<u32>;
+// Tessellation: per class and grid sample, per control point, the weights of position,
+// ∂s and ∂t (the same for every patch of a class, computed once per rate).
+@group(0) @binding(9) var<storage, read> grid_weights: array<Real>;
 
 const CLASS_WORDS: u32 = 22u;
 
@@ -197,7 +200,7 @@ fn evaluate(@builtin(global_invocation_id) id: vec3<u32>) {
 }
 
 // Sample x + (rate + 1) y of each patch's grid: (x, y) / rate of its own domain, points
-// past a triangle's hypotenuse folded onto it.
+// past a triangle's hypotenuse folded onto it; the basis there is `grid_weights`'.
 @compute @workgroup_size(64)
 fn tessellate(@builtin(global_invocation_id) id: vec3<u32>) {
     let q = invocation(id);
@@ -207,17 +210,20 @@ fn tessellate(@builtin(global_invocation_id) id: vec3<u32>) {
     let side = params.rate + 1u;
     let p = q / (side * side);
     let r = q % (side * side);
-    var s = Real(r % side) / Real(params.rate);
-    var t = Real(r / side) / Real(params.rate);
-    let triangle = is_triangle(p);
-    if (triangle && s + t > Real(1.0)) {
-        let sum = s + t;
-        s = s / sum;
-        t = t / sum;
+    let first = words[4u * p];
+    let basis = words[4u * p + 1u];
+    let n = words[params.classes_base + basis * CLASS_WORDS];
+    let at = (basis * side * side + r) * 60u;
+    var out = Sample(vec3<Real>(Real(0.0)), vec3<Real>(Real(0.0)), vec3<Real>(Real(0.0)));
+    for (var k = 0u; k < n; k++) {
+        let x = point(words[params.cps_base + first + k]);
+        out.position += grid_weights[at + 3u * k] * x;
+        out.ds += grid_weights[at + 3u * k + 1u] * x;
+        out.dt += grid_weights[at + 3u * k + 2u] * x;
     }
     let field1 = words[4u * p + 3u];
     let inv = inverse_fraction(field1);
-    store(q, evaluate_patch(p, s, t), select(inv, -inv, triangle && is_rotated(field1)));
+    store(q, out, select(inv, -inv, is_triangle(p) && is_rotated(field1)));
 }
 
 // Cell (x, y) of each patch's grid: a quad cell's two triangles (a, b, c), (a, c, d) of
