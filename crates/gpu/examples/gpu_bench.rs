@@ -11,12 +11,14 @@
 //! on all its cores (`Refinement::points_at`). Then the cage's patch table (OpenSubdiv's
 //! default options) tessellated at rate 8 on the device (every patch's 9 × 9 samples:
 //! positions and derivatives), against the CPU's tessellation of the same table on all
-//! its cores (`tessellate_patches`, the same number of samples). `cargo xtask bench --gpu`
-//! runs it.
+//! its cores (`tessellate_patches`, the same number of samples). Last, the cage refined
+//! uniformly to LEVELS + 1 on the device, topology and points (`GpuUniformRefinement`),
+//! against the CPU's `Refinement::new` + `points_at` on all its cores. `cargo xtask bench
+//! --gpu` runs it.
 
 use std::time::Instant;
 
-use subd_gpu::{Gpu, GpuPatchTable, GpuRefiner, LevelTables};
+use subd_gpu::{Gpu, GpuPatchTable, GpuRefiner, GpuUniformRefinement, LevelTables};
 use subd_limit::patches::{PatchOptions, PatchTable};
 use subd_schemes::{Options, Refinement, Scheme};
 
@@ -105,7 +107,60 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "CPU, {threads} threads      {cpu:9.4} s   GPU frame is {:.2}x the CPU's speed",
         cpu / frame
     );
-    patch_tessellation(&gpu, &cage, repeats)
+    patch_tessellation(&gpu, &cage, repeats)?;
+    uniform_refinement(&gpu, &cage, levels + 1, repeats)
+}
+
+/// The cage refined `levels` levels on the device, topology and points, and on the CPU.
+fn uniform_refinement(
+    gpu: &Gpu,
+    cage: &subd_mesh::Mesh,
+    levels: usize,
+    repeats: usize,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let scheme = Scheme::CatmullClark;
+    let rules = Options::default();
+    let t = Instant::now();
+    let on_device = GpuUniformRefinement::new(
+        gpu,
+        &cage.topology,
+        &scheme,
+        &rules,
+        &cage.positions,
+        levels,
+    )?;
+    gpu.wait()?;
+    let first = t.elapsed().as_secs_f64();
+    let faces = on_device.num_faces(levels);
+    let compute = timed(repeats, || {
+        on_device.recompute(gpu);
+        gpu.wait().expect("the device stays");
+    });
+    let read = timed(repeats, || {
+        on_device
+            .read_face_vertices(gpu, levels)
+            .expect("read back");
+        gpu.read_points(on_device.points(levels).expect("refined"))
+            .expect("read back");
+    });
+    let cpu = timed(repeats, || {
+        let r = subd_schemes::Refinement::new(&cage.topology, scheme.clone(), &rules, levels)
+            .expect("a closed quad mesh");
+        r.points_at(&cage.positions, levels);
+    });
+    println!("uniform refinement to level {levels}: {faces} faces");
+    println!("upload + first refinement {first:9.4} s");
+    println!(
+        "refinement compute        {compute:9.4} s   {:.3e} faces/s",
+        faces as f64 / compute
+    );
+    println!("read back faces + points  {read:9.4} s");
+    println!(
+        "CPU Refinement::new + points_at {cpu:9.4} s   {:.3e} faces/s; GPU compute is {:.2}x",
+        faces as f64 / cpu,
+        cpu / compute
+    );
+    Ok(())
 }
 
 /// The cage's patch table tessellated at rate 8 on the device and on the CPU.

@@ -109,6 +109,7 @@ pub struct Gpu {
     precision: Precision,
     pub(crate) pipelines: crate::stencils::StencilPipeline,
     pub(crate) patch_pipelines: crate::patches::PatchPipelines,
+    pub(crate) uniform_pipelines: crate::uniform::UniformPipelines,
     health: Arc<Health>,
 }
 
@@ -169,6 +170,7 @@ impl Gpu {
         let health = watch(&device);
         let pipelines = crate::stencils::StencilPipeline::new(&device, precision);
         let patch_pipelines = crate::patches::PatchPipelines::new(&device, precision);
+        let uniform_pipelines = crate::uniform::UniformPipelines::new(&device, precision);
         health.check()?;
         Ok(Gpu {
             device,
@@ -178,6 +180,7 @@ impl Gpu {
             precision,
             pipelines,
             patch_pipelines,
+            uniform_pipelines,
             health,
         })
     }

@@ -42,6 +42,7 @@ mod limit;
 mod patches;
 mod refiner;
 mod stencils;
+mod uniform;
 
 pub use device::{AdapterSummary, Gpu, Precision, list_adapters};
 pub use error::GpuError;
@@ -49,3 +50,4 @@ pub use limit::{GpuLimit, GpuLimitStencils};
 pub use patches::{GpuPatchCoords, GpuPatchTable, GpuPatchValues, GpuTessellation, PatchDispatch};
 pub use refiner::{GpuFaceVarying, GpuRefiner, LevelTables};
 pub use stencils::{GpuColumns, GpuStencilTable, StencilDispatch};
+pub use uniform::GpuUniformRefinement;

@@ -150,6 +150,19 @@ pub fn crease_pair(count: usize, is_sharp: impl Fn(usize) -> bool) -> (usize, us
     (first, last)
 }
 
+/// Loop's smooth vertex weights (edge weight, vertex weight) for valence `n`
+/// (`Sdc::Scheme<SCHEME_LOOP>::assignSmoothMaskForVertex`).
+pub fn loop_smooth_weights(n: usize) -> (f64, f64) {
+    if n == 6 {
+        return (0.0625, 0.625);
+    }
+    let inv = 1.0 / n as f64;
+    let cos_t = (std::f64::consts::PI * 2.0 * inv).cos();
+    let beta = 0.25 * cos_t + 0.375;
+    let e = (0.625 - beta * beta) * inv;
+    (e, 1.0 - e * n as f64)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

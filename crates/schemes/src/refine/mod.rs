@@ -881,18 +881,7 @@ impl Mask {
     }
 }
 
-/// Loop's smooth vertex weights (edge weight, vertex weight) for valence `n`
-/// (`Sdc::Scheme<SCHEME_LOOP>::assignSmoothMaskForVertex`).
-fn loop_smooth_weights(n: usize) -> (f64, f64) {
-    if n == 6 {
-        return (0.0625, 0.625);
-    }
-    let inv = 1.0 / n as f64;
-    let cos_t = (std::f64::consts::PI * 2.0 * inv).cos();
-    let beta = 0.25 * cos_t + 0.375;
-    let e = (0.625 - beta * beta) * inv;
-    (e, 1.0 - e * n as f64)
-}
+pub(crate) use crate::rules::loop_smooth_weights;
 
 /// [`rules::fractional_weight`] over the edges of parent vertex `v`, without allocating.
 fn fractional_weight_at(p: &Topology, v: usize, ps: f32, cs: f32, method: CreaseMethod) -> f32 {

@@ -1,0 +1,540 @@
+//! Uniform refinement on the device, topology and points, level by level (`uniform.wgsl`):
+//! for closed, smooth, manifold Catmull-Clark and Loop meshes, where every relation of a
+//! child level follows from its parent's by index arithmetic and every point by the smooth
+//! masks. Other meshes (boundaries, creases, holes, non-manifold parts) refine on the
+//! device through the CPU's stencil tables ([`crate::GpuRefiner`]).
+
+use subd_mesh::{DVec3, Topology};
+use subd_schemes::{Options, Scheme};
+
+use crate::stencils::f32_rows;
+use crate::{Gpu, GpuColumns, GpuError, Precision};
+
+const WORKGROUP: u32 = 64;
+
+/// The stages of one level, in the order they run.
+const STAGES: [&str; 7] = [
+    "corners",
+    "twins",
+    "child_faces",
+    "edge_halves",
+    "face_points",
+    "edge_points",
+    "vertex_points",
+];
+
+/// The compute pipelines of `uniform.wgsl`, one per stage.
+#[derive(Debug)]
+pub(crate) struct UniformPipelines {
+    stages: Vec<wgpu::ComputePipeline>,
+}
+
+impl UniformPipelines {
+    pub(crate) fn new(device: &wgpu::Device, precision: Precision) -> UniformPipelines {
+        let real = match precision {
+            Precision::F64 => "f64",
+            Precision::F32 => "f32",
+        };
+        let source = format!(
+            "alias Real = {real};\n{}",
+            include_str!("shaders/uniform.wgsl")
+        );
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("uniform.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(source.into()),
+        });
+        let stages = STAGES
+            .iter()
+            .map(|entry| {
+                device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                    label: Some(entry),
+                    layout: None,
+                    module: &module,
+                    entry_point: Some(entry),
+                    compilation_options: Default::default(),
+                    cache: None,
+                })
+            })
+            .collect();
+        UniformPipelines { stages }
+    }
+}
+
+/// Element counts of a level.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Counts {
+    vertices: u64,
+    faces: u64,
+    edges: u64,
+    corners: u64,
+}
+
+impl Counts {
+    fn of(t: &Topology) -> Counts {
+        Counts {
+            vertices: t.num_vertices() as u64,
+            faces: t.num_faces() as u64,
+            edges: t.num_edges() as u64,
+            corners: t.num_face_vertices() as u64,
+        }
+    }
+
+    /// The child's counts: Catmull-Clark a quad per corner, Loop four triangles per face.
+    fn child(self, loop_scheme: bool) -> Counts {
+        let c = self;
+        if loop_scheme {
+            Counts {
+                vertices: c.vertices + c.edges,
+                faces: 4 * c.faces,
+                edges: 3 * c.faces + 2 * c.edges,
+                corners: 12 * c.faces,
+            }
+        } else {
+            Counts {
+                vertices: c.vertices + c.faces + c.edges,
+                faces: c.corners,
+                edges: c.corners + 2 * c.edges,
+                corners: 4 * c.corners,
+            }
+        }
+    }
+}
+
+/// One level on the device.
+#[derive(Debug)]
+struct DeviceLevel {
+    counts: Counts,
+    /// Vertices per face where all faces have as many, else 0.
+    face_size: u32,
+    face_vertices: wgpu::Buffer,
+    face_edges: wgpu::Buffer,
+    edge_vertices: wgpu::Buffer,
+    points: GpuColumns,
+}
+
+/// A level as a parent: where its edges' corners, a corner of each vertex and each
+/// corner's twin are found.
+#[derive(Debug)]
+struct Walks {
+    edge_corners: wgpu::Buffer,
+    vertex_corner: wgpu::Buffer,
+    twin: wgpu::Buffer,
+}
+
+/// One dispatch of a stage.
+#[derive(Debug)]
+struct Pass {
+    stage: usize,
+    bind_group: wgpu::BindGroup,
+    grid: (u32, u32),
+    _parameters: wgpu::Buffer,
+}
+
+/// A closed smooth mesh refined uniformly on the device, every level's topology and
+/// points kept there: faces as [`Self::face_vertices`] (u32, the CPU's vertex numbering and
+/// face order bit for bit, usable as an index buffer: quads for Catmull-Clark, triangles
+/// for Loop) and points as [`Self::points`].
+#[derive(Debug)]
+pub struct GpuUniformRefinement {
+    levels: Vec<DeviceLevel>,
+    _walks: Vec<Walks>,
+    _base: [wgpu::Buffer; 3],
+    passes: Vec<Pass>,
+}
+
+/// Why `base` cannot be refined on the device with `scheme` and `rules`, if it cannot.
+fn check_input(
+    base: &Topology,
+    scheme: &Scheme,
+    rules: &Options,
+    positions: &[DVec3],
+) -> Result<(), GpuError> {
+    if !matches!(scheme, Scheme::CatmullClark | Scheme::Loop) {
+        return Err(GpuError::Unsupported(format!(
+            "uniform refinement with {scheme} (Catmull-Clark and Loop only)"
+        )));
+    }
+    if positions.len() != base.num_vertices() {
+        return Err(GpuError::Mismatch(format!(
+            "{} positions for {} vertices",
+            positions.len(),
+            base.num_vertices()
+        )));
+    }
+    if *scheme == Scheme::Loop && base.num_face_vertices() != 3 * base.num_faces() {
+        return Err(GpuError::Mismatch("Loop refines triangles only".into()));
+    }
+    let smooth_triangles = rules.triangle_subdivision == subd_mesh::TriangleSubdivision::Smooth;
+    if *scheme == Scheme::CatmullClark
+        && smooth_triangles
+        && (0..base.num_faces()).any(|f| base.face_size(f) == 3)
+    {
+        return Err(GpuError::Unsupported(
+            "Catmull-Clark's smooth-triangle rule (TRI_SUB_SMOOTH) on the device".into(),
+        ));
+    }
+    if !base.is_closed_and_smooth() {
+        return Err(GpuError::Unsupported(
+            "refining the topology of a mesh with boundaries, creases, corners, holes or non-manifold parts (the device refines closed smooth meshes; GpuRefiner applies the CPU's stencil tables to any mesh)".into(),
+        ));
+    }
+    Ok(())
+}
+
+impl GpuUniformRefinement {
+    /// Uploads `base` and `positions` and refines `levels` levels of `scheme` with `rules`
+    /// on the device (submitted now; read the results when needed). On a closed smooth mesh
+    /// the rules that matter are the smooth masks and, for Catmull-Clark with triangles,
+    /// the triangle rule: the plain one runs on the device, the smooth-triangle one does not.
+    ///
+    /// # Errors
+    /// [`GpuError::Unsupported`] for a scheme other than Catmull-Clark and Loop, a mesh
+    /// that is not closed and smooth ([`Topology::is_closed_and_smooth`]) or the
+    /// smooth-triangle rule;
+    /// [`GpuError::Mismatch`] for positions that are not one per vertex, or Loop on
+    /// faces that are not triangles; [`GpuError::TooLarge`] where a level passes the
+    /// device's buffers or 32-bit indices; the device's memory errors.
+    pub fn new(
+        gpu: &Gpu,
+        base: &Topology,
+        scheme: &Scheme,
+        rules: &Options,
+        positions: &[DVec3],
+        levels: usize,
+    ) -> Result<GpuUniformRefinement, GpuError> {
+        check_input(base, scheme, rules, positions)?;
+        let loop_scheme = *scheme == Scheme::Loop;
+        let mut counts = vec![Counts::of(base)];
+        for l in 0..levels {
+            let child = counts[l].child(loop_scheme);
+            if 2 * child.edges.max(child.corners) >= u64::from(u32::MAX) {
+                return Err(GpuError::TooLarge {
+                    what: "a refined level (32-bit indices)",
+                    bytes: 8 * child.edges.max(child.corners),
+                    limit: u64::from(u32::MAX) * 4,
+                });
+            }
+            counts.push(child);
+        }
+        let (level0, base_buffers) = upload_base(gpu, base, positions, loop_scheme)?;
+        let mut out = GpuUniformRefinement {
+            levels: vec![level0],
+            _walks: Vec::new(),
+            _base: base_buffers,
+            passes: Vec::new(),
+        };
+        for &child in &counts[1..] {
+            out.add_level(gpu, child, if loop_scheme { 3 } else { 4 }, loop_scheme)?;
+        }
+        out.recompute(gpu);
+        Ok(out)
+    }
+
+    /// Refines every level again from the base (the timing of a refinement: topology and
+    /// points), submitted now.
+    pub fn recompute(&self, gpu: &Gpu) {
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        self.record(gpu, &mut encoder);
+        gpu.queue.submit([encoder.finish()]);
+    }
+
+    /// Records the refinement of every level into `encoder`.
+    pub fn record(&self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder) {
+        for pass in &self.passes {
+            if pass.grid.0 == 0 {
+                continue;
+            }
+            let mut compute = encoder.begin_compute_pass(&Default::default());
+            compute.set_pipeline(&gpu.uniform_pipelines.stages[pass.stage]);
+            compute.set_bind_group(0, &pass.bind_group, &[]);
+            compute.dispatch_workgroups(pass.grid.0, pass.grid.1, 1);
+        }
+    }
+
+    /// Writes new base positions and refines again (the topology is recomputed too: it is
+    /// the same).
+    ///
+    /// # Errors
+    /// [`GpuError::Mismatch`] where `positions` is not one per base vertex.
+    pub fn update_points(&self, gpu: &Gpu, positions: &[DVec3]) -> Result<(), GpuError> {
+        gpu.write_columns(&self.levels[0].points, &f32_rows(positions))?;
+        self.recompute(gpu);
+        Ok(())
+    }
+
+    /// Number of levels refined.
+    pub fn num_levels(&self) -> usize {
+        self.levels.len() - 1
+    }
+
+    /// The face vertices of `level` (u32, the level's faces one after another; every face
+    /// of a refined level has [`Self::face_size`] vertices).
+    pub fn face_vertices(&self, level: usize) -> Option<&wgpu::Buffer> {
+        self.levels.get(level).map(|l| &l.face_vertices)
+    }
+
+    /// Vertices per face of `level` (0 for a base level of mixed faces).
+    pub fn face_size(&self, level: usize) -> usize {
+        self.levels.get(level).map_or(0, |l| l.face_size as usize)
+    }
+
+    /// Number of faces of `level`.
+    pub fn num_faces(&self, level: usize) -> usize {
+        self.levels
+            .get(level)
+            .map_or(0, |l| l.counts.faces as usize)
+    }
+
+    /// The points of `level` (rows of three f32).
+    pub fn points(&self, level: usize) -> Option<&GpuColumns> {
+        self.levels.get(level).map(|l| &l.points)
+    }
+
+    /// Reads the face vertices of `level` back.
+    ///
+    /// # Errors
+    /// [`GpuError::Mismatch`] for a level not refined; [`GpuError::Failed`] when the device
+    /// fails.
+    pub fn read_face_vertices(&self, gpu: &Gpu, level: usize) -> Result<Vec<u32>, GpuError> {
+        let l = self
+            .levels
+            .get(level)
+            .ok_or_else(|| GpuError::Mismatch(format!("no level {level}")))?;
+        gpu.read_back(&l.face_vertices, l.counts.corners * 4)
+    }
+}
+
+/// The base level on the device, and its buffers every level's passes bind: face offsets,
+/// per-corner face and next corner, Loop's vertex weights per valence.
+fn upload_base(
+    gpu: &Gpu,
+    base: &Topology,
+    positions: &[DVec3],
+    loop_scheme: bool,
+) -> Result<(DeviceLevel, [wgpu::Buffer; 3]), GpuError> {
+    let nf = base.num_faces();
+    let mut corner_face = Vec::with_capacity(2 * base.num_face_vertices());
+    let mut next = Vec::with_capacity(base.num_face_vertices());
+    let mut face_edges = Vec::with_capacity(base.num_face_vertices());
+    let offsets = base.face_offsets();
+    for (f, range) in offsets.windows(2).enumerate() {
+        let (start, n) = (range[0], range[1] - range[0]);
+        for k in 0..n {
+            corner_face.push(f as u32);
+            next.push(start + (k + 1) % n);
+        }
+        face_edges.extend_from_slice(base.face_edges(f));
+    }
+    corner_face.extend(next);
+    let edge_vertices: Vec<u32> = (0..base.num_edges())
+        .flat_map(|e| base.edge_vertices(e))
+        .collect();
+    let sizes = (0..nf).map(|f| base.face_size(f) as u32);
+    let first = sizes.clone().next().unwrap_or(0);
+    let face_size = if sizes.clone().all(|s| s == first) {
+        first
+    } else {
+        0
+    };
+    let max_valence = (0..base.num_vertices())
+        .map(|v| base.valence(v))
+        .max()
+        .unwrap_or(0)
+        .max(6);
+    let weights: Vec<f64> = (0..=max_valence)
+        .flat_map(|n| {
+            let (e, own) = if n == 0 {
+                (0.0, 1.0)
+            } else {
+                subd_schemes::rules::loop_smooth_weights(n)
+            };
+            [e, own]
+        })
+        .collect();
+    let weights = match (loop_scheme, gpu.precision()) {
+        (false, _) => gpu.storage("loop weights", &[0u32; 2], wgpu::BufferUsages::empty())?,
+        (true, Precision::F64) => {
+            gpu.storage("loop weights", &weights, wgpu::BufferUsages::empty())?
+        }
+        (true, Precision::F32) => {
+            let w: Vec<f32> = weights.iter().map(|&x| x as f32).collect();
+            gpu.storage("loop weights", &w, wgpu::BufferUsages::empty())?
+        }
+    };
+    let none = wgpu::BufferUsages::empty();
+    let level = DeviceLevel {
+        counts: Counts::of(base),
+        face_size,
+        face_vertices: gpu.storage("face vertices", base.all_face_vertices(), index_usage())?,
+        face_edges: gpu.storage("face edges", &face_edges, none)?,
+        edge_vertices: gpu.storage("edge vertices", &edge_vertices, none)?,
+        points: gpu.upload_points(positions)?,
+    };
+    let shared = [
+        gpu.storage("face offsets", offsets, none)?,
+        gpu.storage("corner faces", &corner_face, none)?,
+        weights,
+    ];
+    Ok((level, shared))
+}
+
+/// Face vertices are an index buffer a renderer draws from, and read back on request.
+fn index_usage() -> wgpu::BufferUsages {
+    wgpu::BufferUsages::INDEX | wgpu::BufferUsages::COPY_SRC
+}
+
+impl GpuUniformRefinement {
+    /// Allocates the child of the last level (`child` counts, `face_size` vertices per
+    /// face) and adds the passes that compute it.
+    fn add_level(
+        &mut self,
+        gpu: &Gpu,
+        child: Counts,
+        face_size: u32,
+        loop_scheme: bool,
+    ) -> Result<(), GpuError> {
+        let none = wgpu::BufferUsages::empty();
+        let parent = self.levels.last().expect("the base is there");
+        let c = parent.counts;
+        let walks = Walks {
+            edge_corners: gpu.storage_of_size("edge corners", 8 * c.edges, none)?,
+            vertex_corner: gpu.storage_of_size("vertex corners", 4 * c.vertices, none)?,
+            twin: gpu.storage_of_size("twins", 4 * c.corners, none)?,
+        };
+        let next = DeviceLevel {
+            counts: child,
+            face_size,
+            face_vertices: gpu.storage_of_size(
+                "face vertices",
+                4 * child.corners,
+                index_usage(),
+            )?,
+            face_edges: gpu.storage_of_size("face edges", 4 * child.corners, none)?,
+            edge_vertices: gpu.storage_of_size("edge vertices", 8 * child.edges, none)?,
+            points: gpu.columns(child.vertices as usize, 3)?,
+        };
+        let stages = stage_bindings(&self._base, parent, &walks, &next, loop_scheme);
+        let c = parent.counts;
+        let p = parent;
+        let mut passes = Vec::new();
+        for (stage, count, buffers) in stages {
+            let (grid, per_line) = gpu.dispatch_grid(count as usize, WORKGROUP);
+            let params = [
+                c.vertices as u32,
+                c.faces as u32,
+                c.edges as u32,
+                c.corners as u32,
+                p.face_size,
+                u32::from(loop_scheme),
+                count as u32,
+                per_line,
+            ];
+            let uniform = gpu.uniform("refinement parameters", &params);
+            let mut all = vec![(0, &uniform)];
+            all.extend(buffers);
+            let pipeline = &gpu.uniform_pipelines.stages[stage];
+            passes.push(Pass {
+                stage,
+                bind_group: gpu.bind_group(STAGES[stage], pipeline, &all),
+                grid,
+                _parameters: uniform,
+            });
+        }
+        self.passes.extend(passes);
+        self._walks.push(walks);
+        self.levels.push(next);
+        Ok(())
+    }
+}
+
+/// A stage's bindings: its index, its invocations, its buffers by binding.
+type StageBindings<'a> = (usize, u64, Vec<(u32, &'a wgpu::Buffer)>);
+
+/// The seven stages computing `next` from `p` (their order in [`STAGES`]), with the
+/// buffers each reads and writes.
+fn stage_bindings<'a>(
+    base: &'a [wgpu::Buffer; 3],
+    p: &'a DeviceLevel,
+    walks: &'a Walks,
+    next: &'a DeviceLevel,
+    loop_scheme: bool,
+) -> [StageBindings<'a>; 7] {
+    let [offsets, corner_info, weights] = base;
+    let c = p.counts;
+    [
+        (
+            0,
+            c.corners,
+            vec![
+                (3, &p.face_vertices),
+                (4, &p.face_edges),
+                (5, &p.edge_vertices),
+                (6, &walks.edge_corners),
+                (7, &walks.vertex_corner),
+            ],
+        ),
+        (
+            1,
+            c.corners,
+            vec![
+                (3, &p.face_vertices),
+                (4, &p.face_edges),
+                (5, &p.edge_vertices),
+                (16, &walks.edge_corners),
+                (8, &walks.twin),
+            ],
+        ),
+        (
+            2,
+            c.faces,
+            vec![
+                (1, offsets),
+                (3, &p.face_vertices),
+                (4, &p.face_edges),
+                (5, &p.edge_vertices),
+                (10, &next.face_vertices),
+                (11, &next.face_edges),
+                (12, &next.edge_vertices),
+            ],
+        ),
+        (
+            3,
+            c.edges,
+            vec![(5, &p.edge_vertices), (12, &next.edge_vertices)],
+        ),
+        (
+            4,
+            if loop_scheme { 0 } else { c.faces },
+            vec![
+                (1, offsets),
+                (3, &p.face_vertices),
+                (9, &p.points.buffer),
+                (13, &next.points.buffer),
+            ],
+        ),
+        (
+            5,
+            c.edges,
+            vec![
+                (16, &walks.edge_corners),
+                (3, &p.face_vertices),
+                (2, corner_info),
+                (9, &p.points.buffer),
+                (13, &next.points.buffer),
+            ],
+        ),
+        (
+            6,
+            c.vertices,
+            vec![
+                (17, &walks.vertex_corner),
+                (3, &p.face_vertices),
+                (2, corner_info),
+                (15, &walks.twin),
+                (9, &p.points.buffer),
+                (13, &next.points.buffer),
+                (14, weights),
+            ],
+        ),
+    ]
+}

@@ -1,0 +1,185 @@
+//! Uniform refinement of topology and points on the device against the CPU's: every
+//! closed smooth OpenSubdiv Catmull-Clark and Loop shape (and a torus), three levels, the
+//! face vertices bit for bit and the points within 1e-6 of the bounding-box diagonal of the
+//! CPU's f64 points.
+
+use std::path::PathBuf;
+
+use subd_gpu::{Gpu, GpuError, GpuUniformRefinement};
+use subd_mesh::{DVec3, Mesh};
+use subd_schemes::{Options, Refinement, Scheme};
+
+fn gpu() -> Option<Gpu> {
+    match Gpu::new() {
+        Ok(g) => Some(g),
+        Err(e) if std::env::var_os("CI").is_some() => panic!("CI needs a GPU adapter: {e}"),
+        Err(e) => {
+            eprintln!("SKIPPED: no GPU adapter ({e}); install mesa-vulkan-drivers");
+            None
+        }
+    }
+}
+
+fn shapes() -> Vec<(String, Scheme, Mesh)> {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/meshes/osd");
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "obj"))
+        .collect();
+    paths.sort();
+    let options = subd_io::ReadOptions {
+        accept_inconsistent_orientation: true,
+        ..Default::default()
+    };
+    let mut out: Vec<(String, Scheme, Mesh)> = paths
+        .into_iter()
+        .filter_map(|path| {
+            let name = path.file_name()?.to_str()?.to_string();
+            let scheme = match name.split('_').next()? {
+                "catmark" => Scheme::CatmullClark,
+                "loop" => Scheme::Loop,
+                _ => return None,
+            };
+            let mesh = subd_io::read_mesh(&path, &options).unwrap().mesh;
+            Some((name, scheme, mesh))
+        })
+        .collect();
+    out.push((
+        "torus 12 x 9".into(),
+        Scheme::CatmullClark,
+        subd_mesh::primitives::torus(12, 9, 1.0, 0.3),
+    ));
+    out
+}
+
+fn diagonal(points: &[DVec3]) -> f64 {
+    let (lo, hi) = subd_mesh::bounding_box(points.iter().copied()).unwrap();
+    (hi - lo).length().max(1e-300)
+}
+
+#[test]
+fn closed_smooth_shapes_refine_on_the_device_as_on_the_cpu() {
+    let Some(gpu) = gpu() else { return };
+    let (mut checked, mut refused, mut worst) = (Vec::new(), 0, 0.0_f64);
+    for (name, scheme, mesh) in shapes() {
+        let topology = &mesh.topology;
+        let rules = Options::from_hints(&mesh.hints);
+        let Ok(refinement) = Refinement::new(topology, scheme.clone(), &rules, 3) else {
+            continue; // Loop on quads
+        };
+        let on_device =
+            match GpuUniformRefinement::new(&gpu, topology, &scheme, &rules, &mesh.positions, 3) {
+                Ok(r) => r,
+                Err(GpuError::Unsupported(why)) => {
+                    // Refused only where the mesh is not closed and smooth, or asks for
+                    // the smooth-triangle rule.
+                    let smooth_triangles =
+                        rules.triangle_subdivision == subd_mesh::TriangleSubdivision::Smooth;
+                    let expected = !topology.is_closed_and_smooth() || smooth_triangles;
+                    assert!(expected, "{name} was refused: {why}");
+                    refused += 1;
+                    continue;
+                }
+                Err(e) => panic!("{name}: {e}"),
+            };
+        let cpu = refinement.refine_points(&mesh.positions);
+        let tolerance = 1e-6 * diagonal(&mesh.positions);
+        for (level, cpu_level) in cpu.iter().enumerate().skip(1) {
+            let want = refinement.topology(level).all_face_vertices();
+            let got = on_device.read_face_vertices(&gpu, level).unwrap();
+            assert!(got == want, "{name}: level {level}: face vertices differ");
+            let points = gpu.read_points(on_device.points(level).unwrap()).unwrap();
+            assert_eq!(points.len(), cpu_level.len(), "{name}: level {level}");
+            for (k, (p, q)) in points.iter().zip(cpu_level).enumerate() {
+                let d = p.distance(*q);
+                assert!(d <= tolerance, "{name}: level {level}: vertex {k}: {d:e}");
+                worst = worst.max(d / tolerance * 1e-6);
+            }
+        }
+        checked.push(name);
+    }
+    eprintln!(
+        "{} shapes refined on the device ({}), {refused} refused; worst {worst:e} of the diagonal",
+        checked.len(),
+        checked.join(", ")
+    );
+    assert!(checked.len() >= 8, "only {} shapes", checked.len());
+}
+
+/// The base positions change, the topology stays: a new frame, the same faces.
+#[test]
+fn new_positions_refine_again() {
+    let Some(gpu) = gpu() else { return };
+    let torus = subd_mesh::primitives::torus(8, 6, 1.0, 0.3);
+    let scheme = Scheme::CatmullClark;
+    let refinement =
+        Refinement::new(&torus.topology, scheme.clone(), &Options::default(), 2).unwrap();
+    let r = GpuUniformRefinement::new(
+        &gpu,
+        &torus.topology,
+        &scheme,
+        &Options::default(),
+        &torus.positions,
+        2,
+    )
+    .unwrap();
+    let moved: Vec<DVec3> = torus
+        .positions
+        .iter()
+        .map(|p| *p * 2.0 + DVec3::X)
+        .collect();
+    r.update_points(&gpu, &moved).unwrap();
+    let want = refinement.points_at(&moved, 2);
+    let got = gpu.read_points(r.points(2).unwrap()).unwrap();
+    let tolerance = 1e-6 * diagonal(&moved);
+    assert!(
+        got.iter()
+            .zip(&want)
+            .all(|(p, q)| p.distance(*q) <= tolerance)
+    );
+    assert_eq!(
+        r.read_face_vertices(&gpu, 2).unwrap(),
+        refinement.topology(2).all_face_vertices()
+    );
+}
+
+#[test]
+fn what_the_device_does_not_refine_is_an_error() {
+    let Some(gpu) = gpu() else { return };
+    let o = Options::default();
+    let quad = subd_mesh::TopologyBuilder::new(4)
+        .build(&[4], &[0, 1, 2, 3])
+        .unwrap();
+    let corners = [DVec3::ZERO, DVec3::X, DVec3::ONE, DVec3::Y];
+    let open = GpuUniformRefinement::new(&gpu, &quad, &Scheme::CatmullClark, &o, &corners, 1);
+    assert!(matches!(open, Err(GpuError::Unsupported(_))));
+    let torus = subd_mesh::primitives::torus(4, 4, 1.0, 0.3);
+    let sqrt3 = GpuUniformRefinement::new(
+        &gpu,
+        &torus.topology,
+        &Scheme::Sqrt3,
+        &o,
+        &torus.positions,
+        1,
+    );
+    assert!(matches!(sqrt3, Err(GpuError::Unsupported(_))));
+    let few = GpuUniformRefinement::new(
+        &gpu,
+        &torus.topology,
+        &Scheme::CatmullClark,
+        &o,
+        &corners,
+        1,
+    );
+    assert!(matches!(few, Err(GpuError::Mismatch(_))));
+    let quads = GpuUniformRefinement::new(
+        &gpu,
+        &torus.topology,
+        &Scheme::Loop,
+        &o,
+        &torus.positions,
+        1,
+    );
+    assert!(matches!(quads, Err(GpuError::Mismatch(_))));
+}
