@@ -44,6 +44,9 @@ pub enum GpuError {
     /// The host-side work before a dispatch failed (a place off the surface).
     #[error(transparent)]
     Limit(#[from] subd_limit::LimitError),
+    /// The CPU's refinement, whose tables the device applies, refused the mesh.
+    #[error(transparent)]
+    Refine(#[from] subd_schemes::RefineError),
     /// The device was lost, or a command failed validation (a bug in subd if it happens).
     #[error("the device failed: {0}")]
     Failed(String),

@@ -1,14 +1,14 @@
-//! Uniform refinement on the device, topology and points, level by level (`uniform.wgsl`):
-//! for closed, smooth, manifold Catmull-Clark and Loop meshes, where every relation of a
-//! child level follows from its parent's by index arithmetic and every point by the smooth
-//! masks. Other meshes (boundaries, creases, holes, non-manifold parts) refine on the
-//! device through the CPU's stencil tables ([`crate::GpuRefiner`]).
+//! Uniform refinement on the device, level by level (`uniform.wgsl`): the topology of any
+//! Catmull-Clark or Loop mesh, every relation of a child level following from its parent's
+//! by index arithmetic; the points of closed, smooth, manifold meshes by the smooth masks
+//! on the device, those of the others (boundaries, creases, corners, holes, non-manifold
+//! parts: OpenSubdiv's full rules) through the CPU's stencil tables of each level.
 
 use subd_mesh::{DVec3, Topology};
 use subd_schemes::{Options, Scheme};
 
 use crate::stencils::f32_rows;
-use crate::{Gpu, GpuColumns, GpuError, Precision};
+use crate::{Gpu, GpuColumns, GpuError, GpuStencilTable, Precision, StencilDispatch};
 
 const WORKGROUP: u32 = 64;
 
@@ -130,25 +130,33 @@ struct Pass {
     _parameters: wgpu::Buffer,
 }
 
-/// A closed smooth mesh refined uniformly on the device, every level's topology and
-/// points kept there: faces as [`Self::face_vertices`] (u32, the CPU's vertex numbering and
-/// face order bit for bit, usable as an index buffer: quads for Catmull-Clark, triangles
-/// for Loop) and points as [`Self::points`].
+/// A mesh refined uniformly on the device, every level's topology and points kept there:
+/// faces as [`Self::face_vertices`] (u32, the CPU's vertex numbering and face order bit for
+/// bit, usable as an index buffer: quads for Catmull-Clark, triangles for Loop) and points
+/// as [`Self::points`].
 #[derive(Debug)]
 pub struct GpuUniformRefinement {
     levels: Vec<DeviceLevel>,
     _walks: Vec<Walks>,
     _base: [wgpu::Buffer; 3],
     passes: Vec<Pass>,
+    /// Where the points do not come from the device's masks: each level's stencil table
+    /// from the CPU's refinement, applied level to level.
+    stencils: Vec<(GpuStencilTable, StencilDispatch)>,
 }
 
-/// Why `base` cannot be refined on the device with `scheme` and `rules`, if it cannot.
-fn check_input(
-    base: &Topology,
-    scheme: &Scheme,
-    rules: &Options,
-    positions: &[DVec3],
-) -> Result<(), GpuError> {
+/// Whether the device's smooth masks give `base`'s points: a closed smooth mesh, without
+/// Catmull-Clark's smooth-triangle rule on its triangles.
+fn points_by_masks(base: &Topology, scheme: &Scheme, rules: &Options) -> bool {
+    let smooth_triangles = rules.triangle_subdivision == subd_mesh::TriangleSubdivision::Smooth;
+    let triangle_rule = *scheme == Scheme::CatmullClark
+        && smooth_triangles
+        && (0..base.num_faces()).any(|f| base.face_size(f) == 3);
+    !triangle_rule && base.is_closed_and_smooth()
+}
+
+/// Why `base` cannot be refined on the device with `scheme`, if it cannot.
+fn check_input(base: &Topology, scheme: &Scheme, positions: &[DVec3]) -> Result<(), GpuError> {
     if !matches!(scheme, Scheme::CatmullClark | Scheme::Loop) {
         return Err(GpuError::Unsupported(format!(
             "uniform refinement with {scheme} (Catmull-Clark and Loop only)"
@@ -164,33 +172,20 @@ fn check_input(
     if *scheme == Scheme::Loop && base.num_face_vertices() != 3 * base.num_faces() {
         return Err(GpuError::Mismatch("Loop refines triangles only".into()));
     }
-    let smooth_triangles = rules.triangle_subdivision == subd_mesh::TriangleSubdivision::Smooth;
-    if *scheme == Scheme::CatmullClark
-        && smooth_triangles
-        && (0..base.num_faces()).any(|f| base.face_size(f) == 3)
-    {
-        return Err(GpuError::Unsupported(
-            "Catmull-Clark's smooth-triangle rule (TRI_SUB_SMOOTH) on the device".into(),
-        ));
-    }
-    if !base.is_closed_and_smooth() {
-        return Err(GpuError::Unsupported(
-            "refining the topology of a mesh with boundaries, creases, corners, holes or non-manifold parts (the device refines closed smooth meshes; GpuRefiner applies the CPU's stencil tables to any mesh)".into(),
-        ));
-    }
     Ok(())
 }
 
 impl GpuUniformRefinement {
     /// Uploads `base` and `positions` and refines `levels` levels of `scheme` with `rules`
-    /// on the device (submitted now; read the results when needed). On a closed smooth mesh
-    /// the rules that matter are the smooth masks and, for Catmull-Clark with triangles,
-    /// the triangle rule: the plain one runs on the device, the smooth-triangle one does not.
+    /// on the device (submitted now; read the results when needed). The topology is
+    /// refined on the device for every mesh; the points by the device's smooth masks where
+    /// the mesh is closed and smooth ([`Topology::is_closed_and_smooth`], and not
+    /// Catmull-Clark's smooth-triangle rule on triangles), else by each level's stencil
+    /// table, which the CPU computes here once ([`Self::points_by_masks`] says which).
     ///
     /// # Errors
-    /// [`GpuError::Unsupported`] for a scheme other than Catmull-Clark and Loop, a mesh
-    /// that is not closed and smooth ([`Topology::is_closed_and_smooth`]) or the
-    /// smooth-triangle rule;
+    /// [`GpuError::Unsupported`] for a scheme other than Catmull-Clark and Loop;
+    /// [`GpuError::Refine`] where the CPU's refinement refuses the mesh;
     /// [`GpuError::Mismatch`] for positions that are not one per vertex, or Loop on
     /// faces that are not triangles; [`GpuError::TooLarge`] where a level passes the
     /// device's buffers or 32-bit indices; the device's memory errors.
@@ -202,7 +197,8 @@ impl GpuUniformRefinement {
         positions: &[DVec3],
         levels: usize,
     ) -> Result<GpuUniformRefinement, GpuError> {
-        check_input(base, scheme, rules, positions)?;
+        check_input(base, scheme, positions)?;
+        let masks = points_by_masks(base, scheme, rules);
         let loop_scheme = *scheme == Scheme::Loop;
         let mut counts = vec![Counts::of(base)];
         for l in 0..levels {
@@ -222,12 +218,23 @@ impl GpuUniformRefinement {
             _walks: Vec::new(),
             _base: base_buffers,
             passes: Vec::new(),
+            stencils: Vec::new(),
         };
         for &child in &counts[1..] {
-            out.add_level(gpu, child, if loop_scheme { 3 } else { 4 }, loop_scheme)?;
+            let face_size = if loop_scheme { 3 } else { 4 };
+            out.add_level(gpu, child, face_size, loop_scheme, masks)?;
+        }
+        if !masks {
+            out.stencils = level_stencils(gpu, base, scheme, rules, levels, &out.levels)?;
         }
         out.recompute(gpu);
         Ok(out)
+    }
+
+    /// Whether the device's smooth masks compute the points (a closed smooth mesh), not
+    /// the CPU's stencil tables.
+    pub fn points_by_masks(&self) -> bool {
+        self.stencils.is_empty()
     }
 
     /// Refines every level again from the base (the timing of a refinement: topology and
@@ -248,6 +255,9 @@ impl GpuUniformRefinement {
             compute.set_pipeline(&gpu.uniform_pipelines.stages[pass.stage]);
             compute.set_bind_group(0, &pass.bind_group, &[]);
             compute.dispatch_workgroups(pass.grid.0, pass.grid.1, 1);
+        }
+        for (_, dispatch) in &self.stencils {
+            dispatch.record(gpu, encoder);
         }
     }
 
@@ -378,6 +388,26 @@ fn upload_base(
     Ok((level, shared))
 }
 
+/// Each level's stencil table from the CPU's refinement, bound to the levels' point
+/// buffers: the points of a mesh the device's masks do not cover.
+fn level_stencils(
+    gpu: &Gpu,
+    base: &Topology,
+    scheme: &Scheme,
+    rules: &Options,
+    levels: usize,
+    on_device: &[DeviceLevel],
+) -> Result<Vec<(GpuStencilTable, StencilDispatch)>, GpuError> {
+    let refinement = subd_schemes::Refinement::new(base, scheme.clone(), rules, levels)?;
+    (1..=levels)
+        .map(|l| {
+            let table = GpuStencilTable::new(gpu, refinement.stencils(l))?;
+            let dispatch = table.bind(gpu, &on_device[l - 1].points, &on_device[l].points)?;
+            Ok((table, dispatch))
+        })
+        .collect()
+}
+
 /// Face vertices are an index buffer a renderer draws from, and read back on request.
 fn index_usage() -> wgpu::BufferUsages {
     wgpu::BufferUsages::INDEX | wgpu::BufferUsages::COPY_SRC
@@ -392,6 +422,7 @@ impl GpuUniformRefinement {
         child: Counts,
         face_size: u32,
         loop_scheme: bool,
+        masks: bool,
     ) -> Result<(), GpuError> {
         let none = wgpu::BufferUsages::empty();
         let parent = self.levels.last().expect("the base is there");
@@ -417,7 +448,9 @@ impl GpuUniformRefinement {
         let c = parent.counts;
         let p = parent;
         let mut passes = Vec::new();
-        for (stage, count, buffers) in stages {
+        // Without the masks only the topology's stages run.
+        let topology_only = |&(stage, _, _): &StageBindings<'_>| masks || stage == 2 || stage == 3;
+        for (stage, count, buffers) in stages.into_iter().filter(topology_only) {
             let (grid, per_line) = gpu.dispatch_grid(count as usize, WORKGROUP);
             let params = [
                 c.vertices as u32,

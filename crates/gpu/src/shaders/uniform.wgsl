@@ -1,6 +1,6 @@
-// One level of uniform Catmull-Clark or Loop refinement of a closed, smooth, manifold mesh on
-// the device: the child level's topology (face vertices, face edges, edge vertices, numbered
-// as subd-schemes and OpenSubdiv number them) and its points.
+// One level of uniform Catmull-Clark or Loop refinement on the device: the child level's
+// topology (face vertices, face edges, edge vertices, numbered as subd-schemes and
+// OpenSubdiv number them) of any mesh, and the points of a closed, smooth, manifold one.
 //
 // A face corner is a halfedge: corner h of face f runs from its vertex to the face's next
 // vertex along edge face_edges[h]. `corners` and `twins` find, per edge, its two corners
@@ -83,9 +83,19 @@ fn store_child(i: u32, p: vec3<Real>) {
     child_points[3u * i + 2u] = f32(p.z);
 }
 
-// Which end (0, 1) of edge e is vertex v (the mesh has no degenerate edges).
+// Which end (0, 1) of edge e is vertex v (the point walks have no degenerate edges).
 fn end_at(e: u32, v: u32) -> u32 {
     return select(1u, 0u, edge_vertices[2u * e] == v);
+}
+
+// Which end of edge e a face corner at vertex v uses, the corner `leaving` along e or
+// arriving by it: for a degenerate edge (both ends v) the leaving side takes end 0 and the
+// arriving side end 1, as subd-schemes numbers them.
+fn corner_end(e: u32, v: u32, leaving: bool) -> u32 {
+    if (edge_vertices[2u * e] == edge_vertices[2u * e + 1u]) {
+        return select(1u, 0u, leaving);
+    }
+    return end_at(e, v);
 }
 
 // Per corner: its edge's slot for it (by the end it starts at), and its vertex's corner
@@ -169,8 +179,8 @@ fn catmark_faces(f: u32) {
         let em1 = face_edges[base + km1];
         child_edge_vertices[2u * (base + k)] = fp;
         child_edge_vertices[2u * (base + k) + 1u] = ep0 + e;
-        let a = hb + 2u * e + end_at(e, v);
-        let b = hb + 2u * em1 + end_at(em1, v);
+        let a = hb + 2u * e + corner_end(e, v, true);
+        let b = hb + 2u * em1 + corner_end(em1, v, false);
         let ik = base + k;
         let ikm1 = base + km1;
         let vs = vec4<u32>(v, ep0 + e, fp, ep0 + em1);
@@ -205,8 +215,8 @@ fn loop_faces(f: u32) {
     }
     for (var k = 0u; k < 3u; k++) {
         // The half of edge k at its start corner, and at its end corner.
-        s[k] = hb + 2u * e[k] + end_at(e[k], v[k]);
-        t[k] = hb + 2u * e[k] + end_at(e[k], v[(k + 1u) % 3u]);
+        s[k] = hb + 2u * e[k] + corner_end(e[k], v[k], true);
+        t[k] = hb + 2u * e[k] + corner_end(e[k], v[(k + 1u) % 3u], false);
     }
     let nv = params.nv;
     let i = 3u * f;
