@@ -11,7 +11,9 @@
 //!   ([`subd_limit::LimitStencilTable`]);
 //! * [`GpuPatchTable`]: a [`subd_limit::patches::PatchTable`]'s points recomputed from new
 //!   base positions, its patches evaluated at batches of places ([`GpuPatchCoords`]) and
-//!   on a uniform grid of every patch ([`GpuTessellation`]).
+//!   on a uniform grid of every patch ([`GpuTessellation`]);
+//! * [`GpuUniformRefinement`]: a Catmull-Clark or Loop mesh refined uniformly on the
+//!   device, topology (face vertices bit for bit the CPU's) and points, level by level.
 //!
 //! Values are f32 on the device (every adapter has it); stencil weights and sums are f64
 //! where the adapter has 64-bit floats, else f32 ([`Precision`]). Results stay on the device
