@@ -20,6 +20,11 @@ fn subd_error(py: Python<'_>, name: &str, message: String) -> PyErr {
     }
 }
 
+/// The package's exception `name` with `message`, raised from the modules beside this one.
+pub(crate) fn named_error(name: &str, message: String) -> PyErr {
+    Python::attach(|py| subd_error(py, name, message))
+}
+
 /// `subd.MeshError`: an invalid mesh, tag or option, naming the element.
 pub(crate) fn mesh_error(message: impl std::fmt::Display) -> PyErr {
     Python::attach(|py| subd_error(py, "MeshError", message.to_string()))

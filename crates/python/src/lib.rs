@@ -15,6 +15,7 @@ mod adaptive;
 mod analysis;
 mod arrays;
 mod curve;
+mod device;
 mod errors;
 mod mesh;
 mod ops;

@@ -1,5 +1,10 @@
 //! `subd._subd._CorePatchTable`: a mesh's feature-adaptive patch table (OpenSubdiv's
-//! `PatchTable`), its arrays, its local-point stencils, vectorised evaluation and `update`.
+//! `PatchTable`), its arrays, its local-point stencils, vectorised evaluation and `update`,
+//! the evaluation optionally on the GPU.
+
+use std::sync::Arc;
+
+use subd_gpu::{Gpu, GpuPatchTable, GpuPatchValues};
 
 use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
@@ -10,6 +15,7 @@ use subd_limit::patches::{EndCaps, PatchOptions, PatchTable};
 use subd_mesh::DVec3;
 
 use crate::arrays::{contiguous, copied1, filled1, points, view2};
+use crate::device::{choose, device_error};
 use crate::errors::mesh_error;
 use crate::mesh::CoreMesh;
 use crate::ops::{RuleNames, scheme};
@@ -19,6 +25,10 @@ use crate::pool;
 #[pyclass(name = "_CorePatchTable", module = "subd._subd")]
 pub(crate) struct CorePatchTable {
     table: PatchTable,
+    /// The table on the GPU, where it is evaluated there.
+    device: Option<(Arc<Gpu>, GpuPatchTable)>,
+    /// Why `device="auto"` evaluates on the CPU, if it does.
+    device_warning: Option<String>,
 }
 
 /// One array's parts: type name, control points `(n, k)`, parameters `(n, 2)` (OpenSubdiv's
@@ -36,7 +46,8 @@ impl CorePatchTable {
     #[new]
     /// Texture coordinates of the mesh become face-varying channel 0, refined with
     /// `fvar_interpolation` (else the mesh's own mode, else corners-plus1).
-    #[pyo3(signature = (mesh, scheme_name, isolation, end_caps, single_crease, inf_sharp, legacy_sharp_corners, boundary = None, crease_method = None, triangles = None, fvar_interpolation = None))]
+    /// `evaluate` runs on `device` ("cpu", "gpu" or "auto").
+    #[pyo3(signature = (mesh, scheme_name, isolation, end_caps, single_crease, inf_sharp, legacy_sharp_corners, boundary = None, crease_method = None, triangles = None, fvar_interpolation = None, device = "cpu"))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -51,7 +62,9 @@ impl CorePatchTable {
         crease_method: Option<&str>,
         triangles: Option<&str>,
         fvar_interpolation: Option<&str>,
+        device: &str,
     ) -> PyResult<CorePatchTable> {
+        let (gpu, mut device_warning) = choose(device)?;
         let scheme = scheme(scheme_name)?;
         let end_caps: EndCaps = end_caps.parse().map_err(PyValueError::new_err)?;
         let base = mesh.mesh(py)?;
@@ -79,7 +92,34 @@ impl CorePatchTable {
             Ok::<_, subd_limit::LimitError>(table)
         })?
         .map_err(mesh_error)?;
-        Ok(CorePatchTable { table })
+        let on_device = match gpu {
+            None => None,
+            Some(gpu) => match py.detach(|| GpuPatchTable::new(&gpu, &table)) {
+                Ok(t) => Some((gpu, t)),
+                Err(e) if device == "auto" => {
+                    device_warning = Some(format!("device=\"auto\": {e}; evaluating on the CPU"));
+                    None
+                }
+                Err(e) => return Err(device_error(e)),
+            },
+        };
+        Ok(CorePatchTable {
+            table,
+            device: on_device,
+            device_warning,
+        })
+    }
+
+    /// Where `evaluate` runs: "gpu" or "cpu".
+    #[getter]
+    fn device(&self) -> &'static str {
+        if self.device.is_some() { "gpu" } else { "cpu" }
+    }
+
+    /// Why `device="auto"` evaluates on the CPU, if it does.
+    #[getter]
+    fn device_warning(&self) -> Option<String> {
+        self.device_warning.clone()
     }
 
     /// The census as JSON text (the Python layer makes it a dict).
@@ -173,6 +213,16 @@ impl CorePatchTable {
         derivatives: bool,
     ) -> PyResult<Vec<Bound<'py, PyArray2<f64>>>> {
         let at = places(&faces, &subs, &u, &v)?;
+        if let Some((gpu, on_device)) = &self.device {
+            if derivatives {
+                return Err(PyValueError::new_err(
+                    "derivatives=True: second derivatives are evaluated on the CPU (build the table with device=\"cpu\")",
+                ));
+            }
+            let table = &self.table;
+            let columns = py.detach(|| evaluate_on_device(gpu, on_device, table, &at))?;
+            return columns.iter().map(|c| points(py, c)).collect();
+        }
         let table = &self.table;
         let columns: Vec<Vec<DVec3>> = pool::run(py, || -> Result<Vec<Vec<DVec3>>, String> {
             use rayon::prelude::*;
@@ -320,8 +370,35 @@ impl CorePatchTable {
         let table = &self.table;
         let next = pool::run(py, || table.points_for(&base))?.map_err(mesh_error)?;
         self.table.set_points(next);
+        if let Some((gpu, on_device)) = &self.device {
+            py.detach(|| on_device.update_points(gpu, &base))
+                .map_err(device_error)?;
+        }
         Ok(())
     }
+}
+
+/// Positions, du and dv at `at` on the device: the places located on the host by the
+/// table's patch map, evaluated there, read back as f64.
+fn evaluate_on_device(
+    gpu: &Gpu,
+    on_device: &GpuPatchTable,
+    table: &PatchTable,
+    at: &[FaceParam],
+) -> PyResult<Vec<Vec<DVec3>>> {
+    let coords = match on_device.coords(gpu, table, at) {
+        Ok(c) => c,
+        Err(subd_gpu::GpuError::Limit(e)) => return Err(mesh_error(e)),
+        Err(e) => return Err(device_error(e)),
+    };
+    let out = GpuPatchValues::new(gpu, at.len()).map_err(device_error)?;
+    on_device
+        .evaluate(gpu, &coords, &out)
+        .map_err(device_error)?;
+    [&out.positions, &out.du, &out.dv]
+        .into_iter()
+        .map(|c| gpu.read_points(c).map_err(device_error))
+        .collect()
 }
 
 /// The evaluation places `(faces[i], subs[i], u[i], v[i])`, checked for equal lengths and

@@ -1,6 +1,11 @@
 //! `subd._subd._CoreRefiner`: a mesh's topology refined once, applied to any number of
-//! position sets (animation frames) or other per-vertex columns, and its stencils as a
-//! sparse matrix.
+//! position sets (animation frames) or other per-vertex columns, on the CPU or the GPU,
+//! and its stencils as a sparse matrix.
+
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex};
+
+use subd_gpu::{Gpu, GpuRefiner, LevelTables};
 
 use numpy::{PyArray1, PyArray2, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
@@ -9,6 +14,7 @@ use subd_mesh::DVec3;
 use subd_schemes::Refinement;
 
 use crate::arrays::{contiguous, copied1, filled1, flat_rows, points};
+use crate::device::{choose, device_error};
 use crate::errors::mesh_error;
 use crate::mesh::CoreMesh;
 use crate::ops::{RuleNames, request};
@@ -19,13 +25,49 @@ use crate::pool;
 pub(crate) struct CoreRefiner {
     refinement: Refinement,
     levels: usize,
+    /// The GPU and its refiners by column count, where the refiner runs there.
+    device: Option<DeviceRefiners>,
+    /// Why `device="auto"` runs on the CPU.
+    device_warning: Option<String>,
+}
+
+/// The level stencils on the device, one refiner per column count (made on first use).
+struct DeviceRefiners {
+    gpu: Arc<Gpu>,
+    by_width: Mutex<HashMap<usize, Arc<GpuRefiner>>>,
+}
+
+impl DeviceRefiners {
+    /// `values` (rows of `k`) refined to the last level on the device, as f64.
+    fn apply(&self, refinement: &Refinement, values: &[f64], k: usize) -> PyResult<Vec<f64>> {
+        let refiner = {
+            let mut held = self.by_width.lock().unwrap_or_else(|e| e.into_inner());
+            match held.get(&k) {
+                Some(r) => Arc::clone(r),
+                None => {
+                    let r = GpuRefiner::new(&self.gpu, refinement, k, LevelTables::PerLevel)
+                        .map_err(device_error)?;
+                    Arc::clone(held.entry(k).or_insert(Arc::new(r)))
+                }
+            }
+        };
+        let as_f32: Vec<f32> = values.iter().map(|&x| x as f32).collect();
+        refiner.update(&self.gpu, &as_f32).map_err(device_error)?;
+        let out = self
+            .gpu
+            .read_columns(refiner.last())
+            .map_err(device_error)?;
+        Ok(out.into_iter().map(f64::from).collect())
+    }
 }
 
 #[pymethods]
 impl CoreRefiner {
-    /// Refines `mesh`'s topology `levels` times with `scheme_name` and the rule options.
+    /// Refines `mesh`'s topology `levels` times with `scheme_name` and the rule options;
+    /// `apply` runs on `device` ("cpu", "gpu" or "auto").
     #[new]
-    #[pyo3(signature = (mesh, scheme_name, levels, boundary = None, crease_method = None, triangles = None))]
+    #[pyo3(signature = (mesh, scheme_name, levels, boundary = None, crease_method = None, triangles = None, device = "cpu"))]
+    #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
         mesh: &CoreMesh,
@@ -34,7 +76,9 @@ impl CoreRefiner {
         boundary: Option<&str>,
         crease_method: Option<&str>,
         triangles: Option<&str>,
+        device: &str,
     ) -> PyResult<CoreRefiner> {
+        let (gpu, device_warning) = choose(device)?;
         let rules = RuleNames {
             boundary,
             crease_method,
@@ -46,7 +90,28 @@ impl CoreRefiner {
         let topology = &base.topology;
         let refinement = pool::run(py, || Refinement::new(topology, scheme, &options, levels))?
             .map_err(mesh_error)?;
-        Ok(CoreRefiner { refinement, levels })
+        let device = gpu.map(|gpu| DeviceRefiners {
+            gpu,
+            by_width: Mutex::new(HashMap::new()),
+        });
+        Ok(CoreRefiner {
+            refinement,
+            levels,
+            device,
+            device_warning,
+        })
+    }
+
+    /// Where `apply` runs: "gpu" or "cpu".
+    #[getter]
+    fn device(&self) -> &'static str {
+        if self.device.is_some() { "gpu" } else { "cpu" }
+    }
+
+    /// Why `device="auto"` runs on the CPU, if it does.
+    #[getter]
+    fn device_warning(&self) -> Option<String> {
+        self.device_warning.clone()
     }
 
     /// Number of vertices of the base level.
@@ -76,6 +141,11 @@ impl CoreRefiner {
             )));
         }
         let src = contiguous(&values, "values")?;
+        if let Some(device) = &self.device {
+            let refinement = &self.refinement;
+            let out = py.detach(|| device.apply(refinement, src, k))?;
+            return flat_rows(py, &out, k);
+        }
         if k == 3 {
             let base: Vec<DVec3> = src.chunks_exact(3).map(DVec3::from_slice).collect();
             let out = pool::run(py, || self.refinement.points_at(&base, self.levels))?;

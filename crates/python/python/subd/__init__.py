@@ -35,6 +35,11 @@ class FormatError(SubdError, ValueError):
     """A file that cannot be read; the message names the file and line."""
 
 
+class DeviceError(SubdError, RuntimeError):
+    """The GPU path failed: no adapter, a lost device, a mesh past the device's buffer
+    limits, or something the device does not do (a patch table with exact end caps)."""
+
+
 class SubdWarning(UserWarning):
     """Something subd left out or changed and went on (a reader's repair, texture
     coordinates a scheme cannot carry)."""
@@ -48,6 +53,7 @@ SCHEMES: Tuple[str, ...] = tuple(_subd.SCHEMES)
 __all__ = [
     "SCHEMES",
     "ConvergenceError",
+    "DeviceError",
     "FormatError",
     "Mesh",
     "MeshError",
@@ -603,6 +609,13 @@ class Refiner:
     :func:`refine`'s positions for those vertices. ``stencil_matrix(level=None)`` gives the
     weights from the base vertices to a level as a ``scipy.sparse.csr_matrix`` when SciPy
     is installed, else as ``(indptr, indices, weights)``.
+
+    ``device="gpu"`` runs ``apply`` on the GPU (subd-gpu: the level stencils uploaded once
+    per column count, values in f32, sums in f64 where the adapter has them): within 1e-6
+    of the values' range of the CPU's; :class:`DeviceError` without an adapter.
+    ``device="auto"`` takes the GPU where there is one, else the CPU with a
+    :class:`SubdWarning`. ``device`` says which ran. The results come back as numpy arrays;
+    the device buffers stay inside (wgpu's buffers cannot be handed to Python safely).
     """
 
     __slots__ = ("_core", "levels")
@@ -618,12 +631,20 @@ class Refiner:
         triangles: Optional[str] = None,
         tension: Optional[float] = None,
         lam: Optional[float] = None,
+        device: str = "cpu",
     ) -> None:
         _check_mesh(mesh)
         self.levels = _count(levels, "levels")
         name = _scheme_name(scheme, tension, lam, mesh)
         rules = _rule_names(boundary, crease_method, triangles)[:3]
-        self._core = _subd._CoreRefiner(mesh._core, name, self.levels, *rules)
+        self._core = _subd._CoreRefiner(mesh._core, name, self.levels, *rules, device=device)
+        if self._core.device_warning:
+            _warn([self._core.device_warning])
+
+    @property
+    def device(self) -> str:
+        """Where ``apply`` runs: ``"gpu"`` or ``"cpu"``."""
+        return self._core.device
 
     @property
     def num_vertices(self) -> int:
@@ -693,6 +714,11 @@ class PatchTable:
       ``generateFVarTables`` with its default linear patches, refined with
       ``fvar_interpolation``): ``face_varying`` (views of the arrays),
       ``evaluate_uv(faces, u, v, sub=None)`` and ``update_uv(uvs)``.
+    * ``device="gpu"``: the table also on the GPU (subd-gpu), where ``evaluate`` computes
+      positions and first derivatives (``derivatives=True`` stays on the CPU: a
+      ``ValueError``) and ``update`` recomputes the points too; f32 values, within 1e-6 of
+      the mesh's size of the CPU's. Exact end caps have no fixed basis for the device:
+      :class:`DeviceError` (``device="auto"``: the CPU, with a :class:`SubdWarning`).
     """
 
     __slots__ = ("_core", "_scheme", "_end_caps", "_isolation")
@@ -711,6 +737,7 @@ class PatchTable:
         crease_method: Optional[str] = None,
         triangles: Optional[str] = None,
         fvar_interpolation: Optional[str] = None,
+        device: str = "cpu",
     ) -> None:
         _check_mesh(mesh)
         isolation = _count(isolation, "isolation")
@@ -724,7 +751,15 @@ class PatchTable:
             _scheme_name(scheme, None, None, mesh), end_caps, isolation)
         self._core = _subd._CorePatchTable(
             mesh._core, self._scheme, isolation, end_caps,
-            bool(single_crease), bool(inf_sharp), bool(legacy_sharp_corners), *rules)
+            bool(single_crease), bool(inf_sharp), bool(legacy_sharp_corners), *rules,
+            device=device)
+        if self._core.device_warning:
+            _warn([self._core.device_warning])
+
+    @property
+    def device(self) -> str:
+        """Where ``evaluate`` runs: ``"gpu"`` or ``"cpu"``."""
+        return self._core.device
 
     def census(self) -> dict:
         """Patches by type, depth and boundary mask, and the local points (as ``subd
