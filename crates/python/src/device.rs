@@ -41,6 +41,11 @@ pub(crate) fn choose(device: &str) -> PyResult<(Option<Arc<Gpu>>, Option<String>
     }
 }
 
+/// What `device="auto"` says when the GPU fails and the CPU takes over.
+pub(crate) fn fallback_warning(e: &GpuError) -> String {
+    format!("device=\"auto\": {e}; running on the CPU")
+}
+
 /// `subd.DeviceError`: the GPU path failed (no adapter, a lost device, a buffer past its
 /// limits, something it does not do).
 pub(crate) fn device_error(e: GpuError) -> PyErr {

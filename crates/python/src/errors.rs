@@ -25,6 +25,15 @@ pub(crate) fn named_error(name: &str, message: String) -> PyErr {
     Python::attach(|py| subd_error(py, name, message))
 }
 
+/// Emits `message` as a `subd.SubdWarning` (where a Python warning filter makes warnings
+/// errors, that error).
+pub(crate) fn warn(py: Python<'_>, message: &str) -> PyResult<()> {
+    let class = py.import("subd")?.getattr("SubdWarning")?;
+    let text =
+        std::ffi::CString::new(message.replace('\0', " ")).expect("no NUL left in the message");
+    PyErr::warn(py, &class, &text, 2)
+}
+
 /// `subd.MeshError`: an invalid mesh, tag or option, naming the element.
 pub(crate) fn mesh_error(message: impl std::fmt::Display) -> PyErr {
     Python::attach(|py| subd_error(py, "MeshError", message.to_string()))

@@ -15,8 +15,8 @@ use subd_limit::patches::{EndCaps, PatchOptions, PatchTable};
 use subd_mesh::DVec3;
 
 use crate::arrays::{contiguous, copied1, filled1, points, view2};
-use crate::device::{choose, device_error};
-use crate::errors::mesh_error;
+use crate::device::{choose, device_error, fallback_warning};
+use crate::errors::{mesh_error, warn};
 use crate::mesh::CoreMesh;
 use crate::ops::{RuleNames, scheme};
 use crate::pool;
@@ -29,6 +29,8 @@ pub(crate) struct CorePatchTable {
     device: Option<(Arc<Gpu>, GpuPatchTable)>,
     /// Why `device="auto"` evaluates on the CPU, if it does.
     device_warning: Option<String>,
+    /// `device="auto"`: a failure on the GPU falls back to the CPU with a warning.
+    auto: bool,
 }
 
 /// One array's parts: type name, control points `(n, k)`, parameters `(n, 2)` (OpenSubdiv's
@@ -107,6 +109,7 @@ impl CorePatchTable {
             table,
             device: on_device,
             device_warning,
+            auto: device == "auto",
         })
     }
 
@@ -220,8 +223,12 @@ impl CorePatchTable {
                 ));
             }
             let table = &self.table;
-            let columns = py.detach(|| evaluate_on_device(gpu, on_device, table, &at))?;
-            return columns.iter().map(|c| points(py, c)).collect();
+            match py.detach(|| evaluate_on_device(gpu, on_device, table, &at)) {
+                Ok(columns) => return columns.iter().map(|c| points(py, c)).collect(),
+                Err(subd_gpu::GpuError::Limit(e)) => return Err(mesh_error(e)),
+                Err(e) if self.auto => warn(py, &fallback_warning(&e))?,
+                Err(e) => return Err(device_error(e)),
+            }
         }
         let table = &self.table;
         let columns: Vec<Vec<DVec3>> = pool::run(py, || -> Result<Vec<Vec<DVec3>>, String> {
@@ -371,8 +378,14 @@ impl CorePatchTable {
         let next = pool::run(py, || table.points_for(&base))?.map_err(mesh_error)?;
         self.table.set_points(next);
         if let Some((gpu, on_device)) = &self.device {
-            py.detach(|| on_device.update_points(gpu, &base))
-                .map_err(device_error)?;
+            match py.detach(|| on_device.update_points(gpu, &base)) {
+                Ok(()) => {}
+                Err(e) if self.auto => {
+                    warn(py, &fallback_warning(&e))?;
+                    self.device = None;
+                }
+                Err(e) => return Err(device_error(e)),
+            }
         }
         Ok(())
     }
@@ -385,19 +398,13 @@ fn evaluate_on_device(
     on_device: &GpuPatchTable,
     table: &PatchTable,
     at: &[FaceParam],
-) -> PyResult<Vec<Vec<DVec3>>> {
-    let coords = match on_device.coords(gpu, table, at) {
-        Ok(c) => c,
-        Err(subd_gpu::GpuError::Limit(e)) => return Err(mesh_error(e)),
-        Err(e) => return Err(device_error(e)),
-    };
-    let out = GpuPatchValues::new(gpu, at.len()).map_err(device_error)?;
-    on_device
-        .evaluate(gpu, &coords, &out)
-        .map_err(device_error)?;
+) -> Result<Vec<Vec<DVec3>>, subd_gpu::GpuError> {
+    let coords = on_device.coords(gpu, table, at)?;
+    let out = GpuPatchValues::new(gpu, at.len())?;
+    on_device.evaluate(gpu, &coords, &out)?;
     [&out.positions, &out.du, &out.dv]
         .into_iter()
-        .map(|c| gpu.read_points(c).map_err(device_error))
+        .map(|c| gpu.read_points(c))
         .collect()
 }
 

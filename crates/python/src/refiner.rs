@@ -5,7 +5,7 @@
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex};
 
-use subd_gpu::{Gpu, GpuRefiner, LevelTables};
+use subd_gpu::{Gpu, GpuError, GpuRefiner, LevelTables};
 
 use numpy::{PyArray1, PyArray2, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
@@ -14,8 +14,8 @@ use subd_mesh::DVec3;
 use subd_schemes::Refinement;
 
 use crate::arrays::{contiguous, copied1, filled1, flat_rows, points};
-use crate::device::{choose, device_error};
-use crate::errors::mesh_error;
+use crate::device::{choose, device_error, fallback_warning};
+use crate::errors::{mesh_error, warn};
 use crate::mesh::CoreMesh;
 use crate::ops::{RuleNames, request};
 use crate::pool;
@@ -29,6 +29,8 @@ pub(crate) struct CoreRefiner {
     device: Option<DeviceRefiners>,
     /// Why `device="auto"` runs on the CPU.
     device_warning: Option<String>,
+    /// `device="auto"`: a failure on the GPU falls back to the CPU with a warning.
+    auto: bool,
 }
 
 /// The level stencils on the device, one refiner per column count (made on first use).
@@ -39,24 +41,25 @@ struct DeviceRefiners {
 
 impl DeviceRefiners {
     /// `values` (rows of `k`) refined to the last level on the device, as f64.
-    fn apply(&self, refinement: &Refinement, values: &[f64], k: usize) -> PyResult<Vec<f64>> {
+    fn apply(
+        &self,
+        refinement: &Refinement,
+        values: &[f64],
+        k: usize,
+    ) -> Result<Vec<f64>, GpuError> {
         let refiner = {
             let mut held = self.by_width.lock().unwrap_or_else(|e| e.into_inner());
             match held.get(&k) {
                 Some(r) => Arc::clone(r),
                 None => {
-                    let r = GpuRefiner::new(&self.gpu, refinement, k, LevelTables::PerLevel)
-                        .map_err(device_error)?;
+                    let r = GpuRefiner::new(&self.gpu, refinement, k, LevelTables::PerLevel)?;
                     Arc::clone(held.entry(k).or_insert(Arc::new(r)))
                 }
             }
         };
         let as_f32: Vec<f32> = values.iter().map(|&x| x as f32).collect();
-        refiner.update(&self.gpu, &as_f32).map_err(device_error)?;
-        let out = self
-            .gpu
-            .read_columns(refiner.last())
-            .map_err(device_error)?;
+        refiner.update(&self.gpu, &as_f32)?;
+        let out = self.gpu.read_columns(refiner.last())?;
         Ok(out.into_iter().map(f64::from).collect())
     }
 }
@@ -78,6 +81,7 @@ impl CoreRefiner {
         triangles: Option<&str>,
         device: &str,
     ) -> PyResult<CoreRefiner> {
+        let device_name = device;
         let (gpu, device_warning) = choose(device)?;
         let rules = RuleNames {
             boundary,
@@ -99,6 +103,7 @@ impl CoreRefiner {
             levels,
             device,
             device_warning,
+            auto: device_name == "auto",
         })
     }
 
@@ -143,8 +148,11 @@ impl CoreRefiner {
         let src = contiguous(&values, "values")?;
         if let Some(device) = &self.device {
             let refinement = &self.refinement;
-            let out = py.detach(|| device.apply(refinement, src, k))?;
-            return flat_rows(py, &out, k);
+            match py.detach(|| device.apply(refinement, src, k)) {
+                Ok(out) => return flat_rows(py, &out, k),
+                Err(e) if self.auto => warn(py, &fallback_warning(&e))?,
+                Err(e) => return Err(device_error(e)),
+            }
         }
         if k == 3 {
             let base: Vec<DVec3> = src.chunks_exact(3).map(DVec3::from_slice).collect();

@@ -122,3 +122,26 @@ def test_without_an_adapter_gpu_fails_and_auto_warns():
     out = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True,
                          text=True)
     assert out.returncode == 0 and "ok" in out.stdout, out.stderr
+
+
+@needs_adapter
+def test_auto_falls_back_to_the_cpu_when_the_device_cannot():
+    """device="auto": values too wide for the device's buffers (lavapipe binds at most
+    128 MB) run on the CPU with a SubdWarning, where device="gpu" raises DeviceError."""
+    mesh = subd.read(SHAPES / "catmark_cube.obj")  # 8 vertices; 386 at level 3
+    k = 90_000  # level 3 in f32: 386 * 90,000 * 4 bytes = 139 MB
+    values = np.random.default_rng(2).random((8, k))
+    auto = subd.Refiner(mesh, "catmull-clark", 3, device="auto")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        got = auto.apply(values)
+    want = subd.Refiner(mesh, "catmull-clark", 3).apply(values)
+    if os.environ.get("CI"):
+        assert caught, "CI's lavapipe binds less than the level needs"
+    if caught:
+        assert "running on the CPU" in str(caught[0].message)
+        assert np.array_equal(got, want)
+        with pytest.raises(subd.DeviceError, match="limit"):
+            subd.Refiner(mesh, "catmull-clark", 3, device="gpu").apply(values)
+    else:
+        assert np.abs(got - want).max() <= 1e-6

@@ -614,7 +614,8 @@ class Refiner:
     per column count, values in f32, sums in f64 where the adapter has them): within 1e-6
     of the values' range of the CPU's; :class:`DeviceError` without an adapter.
     ``device="auto"`` takes the GPU where there is one, else the CPU with a
-    :class:`SubdWarning`. ``device`` says which ran. The results come back as numpy arrays;
+    :class:`SubdWarning`, and falls back the same way when the device fails later (values
+    past its buffer limits, a lost device). ``device`` says which was chosen. The results come back as numpy arrays;
     the device buffers stay inside (wgpu's buffers cannot be handed to Python safely).
     """
 
