@@ -1,10 +1,14 @@
 //! Uniform refinement on the device, level by level (`uniform.wgsl`): the topology of any
 //! Catmull-Clark or Loop mesh, every relation of a child level following from its parent's
-//! by index arithmetic; the points of closed, smooth, manifold meshes by the smooth masks
-//! on the device, those of the others (boundaries, creases, corners, holes, non-manifold
-//! parts: OpenSubdiv's full rules) through the CPU's stencil tables of each level.
+//! by index arithmetic; the points of manifold meshes whose sharpness is all or nothing
+//! (boundaries, infinitely sharp creases and corners, smooth elsewhere) by OpenSubdiv's
+//! smooth, crease and corner masks on the device, those of the others (semi-sharp creases,
+//! holes, non-manifold parts, the smooth-triangle rule) through the CPU's stencil tables of
+//! each level.
 
-use subd_mesh::{DVec3, Topology};
+use subd_mesh::tags::is_infinite;
+use subd_mesh::{BoundaryInterpolation, DVec3, Topology};
+use subd_schemes::rules::Rule;
 use subd_schemes::{Options, Scheme};
 
 use crate::stencils::f32_rows;
@@ -13,7 +17,7 @@ use crate::{Gpu, GpuColumns, GpuError, GpuStencilTable, Precision, StencilDispat
 const WORKGROUP: u32 = 64;
 
 /// The stages of one level, in the order they run.
-const STAGES: [&str; 7] = [
+const STAGES: [&str; 8] = [
     "corners",
     "twins",
     "child_faces",
@@ -21,6 +25,7 @@ const STAGES: [&str; 7] = [
     "face_points",
     "edge_points",
     "vertex_points",
+    "child_rules",
 ];
 
 /// The compute pipelines of `uniform.wgsl`, one per stage.
@@ -109,6 +114,10 @@ struct DeviceLevel {
     face_vertices: wgpu::Buffer,
     face_edges: wgpu::Buffer,
     edge_vertices: wgpu::Buffer,
+    /// Per edge 1 where it is infinitely sharp (boundaries included).
+    edge_sharp: wgpu::Buffer,
+    /// Per vertex its rule: 0 smooth or dart, 1 crease, 2 corner.
+    vertex_rules: wgpu::Buffer,
     points: GpuColumns,
 }
 
@@ -145,14 +154,61 @@ pub struct GpuUniformRefinement {
     stencils: Vec<(GpuStencilTable, StencilDispatch)>,
 }
 
-/// Whether the device's smooth masks give `base`'s points: a closed smooth mesh, without
-/// Catmull-Clark's smooth-triangle rule on its triangles.
+/// Whether the device's masks give `base`'s points: a manifold mesh without holes whose
+/// creases and corners are all infinitely sharp (boundaries too, unless boundary
+/// interpolation is `None`), without Catmull-Clark's smooth-triangle rule on triangles.
 fn points_by_masks(base: &Topology, scheme: &Scheme, rules: &Options) -> bool {
     let smooth_triangles = rules.triangle_subdivision == subd_mesh::TriangleSubdivision::Smooth;
     let triangle_rule = *scheme == Scheme::CatmullClark
         && smooth_triangles
         && (0..base.num_faces()).any(|f| base.face_size(f) == 3);
-    !triangle_rule && base.is_closed_and_smooth()
+    let all_or_nothing = |s: f32| s == 0.0 || is_infinite(s);
+    let edges_ok = (0..base.num_edges()).all(|e| {
+        let faces = base.edge_faces(e).len();
+        !base.is_degenerate_edge(e)
+            && (faces == 2
+                || (faces == 1 && rules.boundary_interpolation != BoundaryInterpolation::None))
+            && all_or_nothing(base.edge_sharpness(e))
+    });
+    let vertices_ok = (0..base.num_vertices()).all(|v| {
+        !base.is_non_manifold_vertex(v)
+            && !base.is_isolated_vertex(v)
+            && all_or_nothing(base.vertex_sharpness(v))
+    });
+    let holes = (0..base.num_faces()).any(|f| base.is_hole(f));
+    !triangle_rule && !holes && edges_ok && vertices_ok
+}
+
+/// The base level's sharp edges and vertex rules as OpenSubdiv tags them: boundary edges
+/// infinitely sharp, one-face corners too under edge-and-corner interpolation, then each
+/// vertex's rule by its sharpness and sharp edges.
+fn base_tags(base: &Topology, rules: &Options) -> (Vec<u32>, Vec<u32>) {
+    let sharp: Vec<u32> = (0..base.num_edges())
+        .map(|e| u32::from(base.is_boundary_edge(e) || is_infinite(base.edge_sharpness(e))))
+        .collect();
+    let corner_rule = rules.boundary_interpolation == BoundaryInterpolation::EdgeAndCorner;
+    let vertex_rules = (0..base.num_vertices())
+        .map(|v| {
+            let one_face_corner =
+                corner_rule && base.vertex_faces(v).len() == 1 && base.valence(v) == 2;
+            let s = if one_face_corner {
+                f32::INFINITY
+            } else {
+                base.vertex_sharpness(v)
+            };
+            let sharp_edges = base
+                .vertex_edges(v)
+                .iter()
+                .filter(|&&e| sharp[e as usize] != 0)
+                .count();
+            match Rule::determine(s, sharp_edges) {
+                Rule::Smooth | Rule::Dart => 0,
+                Rule::Crease => 1,
+                Rule::Corner => 2,
+            }
+        })
+        .collect();
+    (sharp, vertex_rules)
 }
 
 /// Why `base` cannot be refined on the device with `scheme`, if it cannot.
@@ -178,9 +234,10 @@ fn check_input(base: &Topology, scheme: &Scheme, positions: &[DVec3]) -> Result<
 impl GpuUniformRefinement {
     /// Uploads `base` and `positions` and refines `levels` levels of `scheme` with `rules`
     /// on the device (submitted now; read the results when needed). The topology is
-    /// refined on the device for every mesh; the points by the device's smooth masks where
-    /// the mesh is closed and smooth ([`Topology::is_closed_and_smooth`], and not
-    /// Catmull-Clark's smooth-triangle rule on triangles), else by each level's stencil
+    /// refined on the device for every mesh; the points by the device's masks where the
+    /// mesh is manifold, has no holes, and its creases and corners (boundaries included,
+    /// with edge-only or edge-and-corner interpolation) are all infinitely sharp, without
+    /// Catmull-Clark's smooth-triangle rule on triangles; else by each level's stencil
     /// table, which the CPU computes here once ([`Self::points_by_masks`] says which).
     ///
     /// # Errors
@@ -212,7 +269,7 @@ impl GpuUniformRefinement {
             }
             counts.push(child);
         }
-        let (level0, base_buffers) = upload_base(gpu, base, positions, loop_scheme)?;
+        let (level0, base_buffers) = upload_base(gpu, base, rules, positions, loop_scheme)?;
         let mut out = GpuUniformRefinement {
             levels: vec![level0],
             _walks: Vec::new(),
@@ -231,8 +288,7 @@ impl GpuUniformRefinement {
         Ok(out)
     }
 
-    /// Whether the device's smooth masks compute the points (a closed smooth mesh), not
-    /// the CPU's stencil tables.
+    /// Whether the device's masks compute the points, not the CPU's stencil tables.
     pub fn points_by_masks(&self) -> bool {
         self.stencils.is_empty()
     }
@@ -247,6 +303,10 @@ impl GpuUniformRefinement {
 
     /// Records the refinement of every level into `encoder`.
     pub fn record(&self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder) {
+        // Each run finds the corners of every edge again: no slot may hold an old one.
+        for walks in &self._walks {
+            encoder.clear_buffer(&walks.edge_corners, 0, None);
+        }
         for pass in &self.passes {
             if pass.grid.0 == 0 {
                 continue;
@@ -319,12 +379,14 @@ impl GpuUniformRefinement {
 fn upload_base(
     gpu: &Gpu,
     base: &Topology,
+    rules: &Options,
     positions: &[DVec3],
     loop_scheme: bool,
 ) -> Result<(DeviceLevel, [wgpu::Buffer; 3]), GpuError> {
     let nf = base.num_faces();
-    let mut corner_face = Vec::with_capacity(2 * base.num_face_vertices());
+    let mut corner_face = Vec::with_capacity(3 * base.num_face_vertices());
     let mut next = Vec::with_capacity(base.num_face_vertices());
+    let mut prev = Vec::with_capacity(base.num_face_vertices());
     let mut face_edges = Vec::with_capacity(base.num_face_vertices());
     let offsets = base.face_offsets();
     for (f, range) in offsets.windows(2).enumerate() {
@@ -332,10 +394,13 @@ fn upload_base(
         for k in 0..n {
             corner_face.push(f as u32);
             next.push(start + (k + 1) % n);
+            prev.push(start + (k + n - 1) % n);
         }
         face_edges.extend_from_slice(base.face_edges(f));
     }
     corner_face.extend(next);
+    corner_face.extend(prev);
+    let (edge_sharp, vertex_rules) = base_tags(base, rules);
     let edge_vertices: Vec<u32> = (0..base.num_edges())
         .flat_map(|e| base.edge_vertices(e))
         .collect();
@@ -378,6 +443,8 @@ fn upload_base(
         face_vertices: gpu.storage("face vertices", base.all_face_vertices(), index_usage())?,
         face_edges: gpu.storage("face edges", &face_edges, none)?,
         edge_vertices: gpu.storage("edge vertices", &edge_vertices, none)?,
+        edge_sharp: gpu.storage("sharp edges", &edge_sharp, none)?,
+        vertex_rules: gpu.storage("vertex rules", &vertex_rules, none)?,
         points: gpu.upload_points(positions)?,
     };
     let shared = [
@@ -428,7 +495,11 @@ impl GpuUniformRefinement {
         let parent = self.levels.last().expect("the base is there");
         let c = parent.counts;
         let walks = Walks {
-            edge_corners: gpu.storage_of_size("edge corners", 8 * c.edges, none)?,
+            edge_corners: gpu.storage_of_size(
+                "edge corners",
+                8 * c.edges,
+                wgpu::BufferUsages::COPY_DST,
+            )?,
             vertex_corner: gpu.storage_of_size("vertex corners", 4 * c.vertices, none)?,
             twin: gpu.storage_of_size("twins", 4 * c.corners, none)?,
         };
@@ -442,6 +513,8 @@ impl GpuUniformRefinement {
             )?,
             face_edges: gpu.storage_of_size("face edges", 4 * child.corners, none)?,
             edge_vertices: gpu.storage_of_size("edge vertices", 8 * child.edges, none)?,
+            edge_sharp: gpu.storage_of_size("sharp edges", 4 * child.edges, none)?,
+            vertex_rules: gpu.storage_of_size("vertex rules", 4 * child.vertices, none)?,
             points: gpu.columns(child.vertices as usize, 3)?,
         };
         let stages = stage_bindings(&self._base, parent, &walks, &next, loop_scheme);
@@ -491,30 +564,30 @@ fn stage_bindings<'a>(
     walks: &'a Walks,
     next: &'a DeviceLevel,
     loop_scheme: bool,
-) -> [StageBindings<'a>; 7] {
+) -> [StageBindings<'a>; 8] {
     let [offsets, corner_info, weights] = base;
     let c = p.counts;
+    let (fv, fe, ev) = (&p.face_vertices, &p.face_edges, &p.edge_vertices);
+    let (points, child_points) = (&p.points.buffer, &next.points.buffer);
+    let (sharp, child_sharp) = (&p.edge_sharp, &next.edge_sharp);
     [
         (
             0,
             c.corners,
-            vec![
-                (3, &p.face_vertices),
-                (4, &p.face_edges),
-                (5, &p.edge_vertices),
-                (6, &walks.edge_corners),
-                (7, &walks.vertex_corner),
-            ],
+            vec![(3, fv), (4, fe), (5, ev), (6, &walks.edge_corners)],
         ),
         (
             1,
             c.corners,
             vec![
-                (3, &p.face_vertices),
-                (4, &p.face_edges),
-                (5, &p.edge_vertices),
+                (3, fv),
+                (4, fe),
+                (5, ev),
                 (16, &walks.edge_corners),
                 (8, &walks.twin),
+                (7, &walks.vertex_corner),
+                (2, corner_info),
+                (18, sharp),
             ],
         ),
         (
@@ -522,38 +595,41 @@ fn stage_bindings<'a>(
             c.faces,
             vec![
                 (1, offsets),
-                (3, &p.face_vertices),
-                (4, &p.face_edges),
-                (5, &p.edge_vertices),
+                (3, fv),
+                (4, fe),
+                (5, ev),
                 (10, &next.face_vertices),
                 (11, &next.face_edges),
                 (12, &next.edge_vertices),
+                (19, child_sharp),
             ],
         ),
         (
             3,
             c.edges,
-            vec![(5, &p.edge_vertices), (12, &next.edge_vertices)],
+            vec![
+                (5, ev),
+                (12, &next.edge_vertices),
+                (18, sharp),
+                (19, child_sharp),
+            ],
         ),
         (
             4,
             if loop_scheme { 0 } else { c.faces },
-            vec![
-                (1, offsets),
-                (3, &p.face_vertices),
-                (9, &p.points.buffer),
-                (13, &next.points.buffer),
-            ],
+            vec![(1, offsets), (3, fv), (9, points), (13, child_points)],
         ),
         (
             5,
             c.edges,
             vec![
                 (16, &walks.edge_corners),
-                (3, &p.face_vertices),
+                (3, fv),
                 (2, corner_info),
-                (9, &p.points.buffer),
-                (13, &next.points.buffer),
+                (9, points),
+                (13, child_points),
+                (18, sharp),
+                (5, ev),
             ],
         ),
         (
@@ -561,13 +637,19 @@ fn stage_bindings<'a>(
             c.vertices,
             vec![
                 (17, &walks.vertex_corner),
-                (3, &p.face_vertices),
+                (3, fv),
                 (2, corner_info),
                 (15, &walks.twin),
-                (9, &p.points.buffer),
-                (13, &next.points.buffer),
+                (9, points),
+                (13, child_points),
                 (14, weights),
+                (20, &p.vertex_rules),
             ],
+        ),
+        (
+            7,
+            next.counts.vertices,
+            vec![(20, &p.vertex_rules), (18, sharp), (21, &next.vertex_rules)],
         ),
     ]
 }

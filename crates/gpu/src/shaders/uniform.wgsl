@@ -1,12 +1,18 @@
 // One level of uniform Catmull-Clark or Loop refinement on the device: the child level's
 // topology (face vertices, face edges, edge vertices, numbered as subd-schemes and
-// OpenSubdiv number them) of any mesh, and the points of a closed, smooth, manifold one.
+// OpenSubdiv number them) of any mesh, and the points of a manifold one whose sharpness is
+// all or nothing: boundaries and infinitely sharp creases and corners (OpenSubdiv's crease
+// and corner masks), smooth elsewhere.
 //
 // A face corner is a halfedge: corner h of face f runs from its vertex to the face's next
-// vertex along edge face_edges[h]. `corners` and `twins` find, per edge, its two corners
-// and, per corner, the other corner of its edge (the mesh is closed and consistently
-// oriented, so every edge has two, running opposite ways); a vertex's ring is then walked
-// corner to corner, next(twin(h)), without vertex-face lists.
+// vertex along edge face_edges[h]. `corners` and `twins` find, per edge, its corners (two
+// inside, running opposite ways; one on a boundary) and, per corner, the other corner of
+// its edge; a vertex's ring is then walked corner to corner, next(twin(h)), without
+// vertex-face lists, from the corner that arrives by a boundary edge where there is one.
+//
+// Vertex rules: 0 smooth (and dart), 1 crease, 2 corner. With infinite sharpness they
+// pass to the children unchanged: a vertex's child keeps its rule, an edge's child is a
+// crease when the edge is sharp, a face's child is smooth.
 //
 // `Real` (f64 or f32) is defined by the Rust side in front of this text.
 
@@ -45,6 +51,17 @@ struct Params {
 @group(0) @binding(15) var<storage, read> twin_in: array<u32>;
 @group(0) @binding(16) var<storage, read> edge_corners_in: array<u32>;
 @group(0) @binding(17) var<storage, read> vertex_corner_in: array<u32>;
+// Per edge 1 where it is (infinitely) sharp; per vertex its rule.
+@group(0) @binding(18) var<storage, read> edge_sharp: array<u32>;
+@group(0) @binding(19) var<storage, read_write> child_edge_sharp: array<u32>;
+@group(0) @binding(20) var<storage, read> vertex_rules: array<u32>;
+@group(0) @binding(21) var<storage, read_write> child_vertex_rules: array<u32>;
+
+// No corner: a twin across a boundary edge.
+const NONE: u32 = 0x7fffffffu;
+// A twin's flag: the corner's own edge is sharp. A vertex corner's flag: it arrives by a
+// boundary edge.
+const FLAG: u32 = 0x80000000u;
 
 fn invocation(id: vec3<u32>) -> u32 {
     return id.x + id.y * params.rows_per_line;
@@ -63,6 +80,14 @@ fn next_of(h: u32) -> u32 {
         return h - h % s + (h % s + 1u) % s;
     }
     return corner_info[params.nh + h];
+}
+
+fn prev_of(h: u32) -> u32 {
+    if (params.face_size != 0u) {
+        let s = params.face_size;
+        return h - h % s + (h % s + s - 1u) % s;
+    }
+    return corner_info[2u * params.nh + h];
 }
 
 fn point(i: u32) -> vec3<Real> {
@@ -98,8 +123,8 @@ fn corner_end(e: u32, v: u32, leaving: bool) -> u32 {
     return end_at(e, v);
 }
 
-// Per corner: its edge's slot for it (by the end it starts at), and its vertex's corner
-// (the largest, so that every run writes the same one).
+// Per corner: its edge's slot for it (by the end it starts at), as h + 1 (0: no corner;
+// the slots are cleared before each run).
 @compute @workgroup_size(64)
 fn corners(@builtin(global_invocation_id) id: vec3<u32>) {
     let h = invocation(id);
@@ -107,11 +132,17 @@ fn corners(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let e = face_edges[h];
-    let v = face_vertices[h];
-    edge_corners[2u * e + end_at(e, v)] = h;
-    atomicMax(&vertex_corner[v], h);
+    edge_corners[2u * e + end_at(e, face_vertices[h])] = h + 1u;
 }
 
+// Whether edge e has a corner in only one face.
+fn is_boundary(e: u32) -> bool {
+    return edge_corners_in[2u * e] == 0u || edge_corners_in[2u * e + 1u] == 0u;
+}
+
+// Per corner its twin (NONE across a boundary), flagged where its edge is sharp; and its
+// vertex's first corner: one arriving by a boundary edge where there is one, else the
+// largest (every run picks the same).
 @compute @workgroup_size(64)
 fn twins(@builtin(global_invocation_id) id: vec3<u32>) {
     let h = invocation(id);
@@ -119,7 +150,12 @@ fn twins(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let e = face_edges[h];
-    twin[h] = edge_corners_in[2u * e + 1u - end_at(e, face_vertices[h])];
+    let v = face_vertices[h];
+    let other = edge_corners_in[2u * e + 1u - end_at(e, v)];
+    let t = select(other - 1u, NONE, other == 0u);
+    twin[h] = t | select(0u, FLAG, edge_sharp[e] != 0u);
+    let arriving = face_edges[prev_of(h)];
+    atomicMax(&vertex_corner[v], h | select(0u, FLAG, is_boundary(arriving)));
 }
 
 // The halves of parent edges: H(e, k) = (E, V_k), after the face-interior child edges.
@@ -141,6 +177,7 @@ fn edge_halves(@builtin(global_invocation_id) id: vec3<u32>) {
     for (var k = 0u; k < 2u; k++) {
         child_edge_vertices[2u * (first + 2u * e + k)] = edge_point;
         child_edge_vertices[2u * (first + 2u * e + k) + 1u] = edge_vertices[2u * e + k];
+        child_edge_sharp[first + 2u * e + k] = edge_sharp[e];
     }
 }
 
@@ -179,6 +216,7 @@ fn catmark_faces(f: u32) {
         let em1 = face_edges[base + km1];
         child_edge_vertices[2u * (base + k)] = fp;
         child_edge_vertices[2u * (base + k) + 1u] = ep0 + e;
+        child_edge_sharp[base + k] = 0u;
         let a = hb + 2u * e + corner_end(e, v, true);
         let b = hb + 2u * em1 + corner_end(em1, v, false);
         let ik = base + k;
@@ -233,6 +271,9 @@ fn loop_faces(f: u32) {
     for (var k = 0u; k < 6u; k++) {
         child_edge_vertices[6u * f + k] = ends[k];
     }
+    for (var k = 0u; k < 3u; k++) {
+        child_edge_sharp[3u * f + k] = 0u;
+    }
 }
 
 @compute @workgroup_size(64)
@@ -263,55 +304,82 @@ fn face_points(@builtin(global_invocation_id) id: vec3<u32>) {
     store_child(params.nv + f, sum / Real(range.y - range.x));
 }
 
-// Edge points: Catmull-Clark (V0 + V1 + F0 + F1) / 4 with the child face points; Loop
-// 3/8 (V0 + V1) + 1/8 (the two opposite vertices).
+// Edge points: a sharp edge's midpoint; else Catmull-Clark (V0 + V1 + F0 + F1) / 4 with
+// the child face points, Loop 3/8 (V0 + V1) + 1/8 (the two opposite vertices).
 @compute @workgroup_size(64)
 fn edge_points(@builtin(global_invocation_id) id: vec3<u32>) {
     let e = invocation(id);
     if (e >= params.ne) {
         return;
     }
-    let h0 = edge_corners_in[2u * e];
-    let h1 = edge_corners_in[2u * e + 1u];
-    let ends = point(face_vertices[h0]) + point(face_vertices[h1]);
+    let child = select(params.nv + e, params.nv + params.nf + e, params.scheme == 0u);
+    let ends = point(edge_vertices[2u * e]) + point(edge_vertices[2u * e + 1u]);
+    if (edge_sharp[e] != 0u) {
+        store_child(child, Real(0.5) * ends);
+        return;
+    }
+    let h0 = edge_corners_in[2u * e] - 1u;
+    let h1 = edge_corners_in[2u * e + 1u] - 1u;
     if (params.scheme == 0u) {
         let faces = child_point(params.nv + face_of(h0)) + child_point(params.nv + face_of(h1));
-        store_child(params.nv + params.nf + e, Real(0.25) * (ends + faces));
+        store_child(child, Real(0.25) * (ends + faces));
         return;
     }
     // The corner before h in its triangle holds the vertex opposite h's edge.
-    let o0 = face_vertices[next_of(next_of(h0))];
-    let o1 = face_vertices[next_of(next_of(h1))];
-    store_child(params.nv + e, Real(0.375) * ends + Real(0.125) * (point(o0) + point(o1)));
+    let o0 = face_vertices[prev_of(h0)];
+    let o1 = face_vertices[prev_of(h1)];
+    store_child(child, Real(0.375) * ends + Real(0.125) * (point(o0) + point(o1)));
 }
 
-// Vertex points, the ring walked corner to corner: Catmull-Clark
-// ((n - 2) V + (Σ neighbours + Σ child face points) / n) / n; Loop (1 - n β) V + β Σ
-// neighbours.
+// Vertex points, the ring walked corner to corner: a corner stays; a crease is
+// (E0 + 6 V + E1) / 8 over its two sharp edges' other ends; a smooth vertex is
+// Catmull-Clark's ((n - 2) V + (Σ neighbours + Σ child face points) / n) / n or Loop's
+// (1 - n β) V + β Σ neighbours.
 @compute @workgroup_size(64)
 fn vertex_points(@builtin(global_invocation_id) id: vec3<u32>) {
     let v = invocation(id);
     if (v >= params.nv) {
         return;
     }
-    let h0 = vertex_corner_in[v];
+    let own = point(v);
+    let rule = vertex_rules[v];
+    if (rule == 2u) {
+        store_child(v, own);
+        return;
+    }
+    let start = vertex_corner_in[v];
+    let h0 = start & NONE;
     var h = h0;
     var n = 0u;
     var neighbours = vec3<Real>(Real(0.0));
+    var sharp = vec3<Real>(Real(0.0));
     var faces = vec3<Real>(Real(0.0));
-    // A closed manifold's ring closes; the bound only keeps a broken input from hanging.
+    // A ring closes or ends at a boundary; the bound only keeps a broken input from hanging.
     loop {
-        neighbours += point(face_vertices[next_of(h)]);
+        let across = twin_in[h];
+        let x = point(face_vertices[next_of(h)]);
+        neighbours += x;
+        if ((across & FLAG) != 0u) {
+            sharp += x;
+        }
         if (params.scheme == 0u) {
             faces += child_point(params.nv + face_of(h));
         }
         n++;
-        h = next_of(twin_in[h]);
-        if (h == h0 || n >= 65536u) {
+        if ((across & NONE) == NONE || n >= 65536u) {
+            // A boundary vertex: the edge its first corner arrives by is sharp too.
+            sharp += point(face_vertices[prev_of(h0)]);
+            break;
+        }
+        h = next_of(across & NONE);
+        if (h == h0) {
             break;
         }
     }
-    let own = point(v);
+    if (rule == 1u) {
+        store_child(v, Real(0.125) * sharp + Real(0.75) * own);
+        return;
+    }
     if (params.scheme == 0u) {
         let rn = Real(1.0) / Real(n);
         store_child(v, (Real(n) - Real(2.0)) * rn * own + rn * rn * (neighbours + faces));
@@ -320,4 +388,24 @@ fn vertex_points(@builtin(global_invocation_id) id: vec3<u32>) {
     let beta = loop_weights[2u * n];
     let centre = loop_weights[2u * n + 1u];
     store_child(v, centre * own + beta * neighbours);
+}
+
+// The rules of the child level: a vertex's child keeps its rule, an edge's child is a
+// crease where the edge is sharp, a face's child is smooth.
+@compute @workgroup_size(64)
+fn child_rules(@builtin(global_invocation_id) id: vec3<u32>) {
+    let c = invocation(id);
+    if (c >= params.count) {
+        return;
+    }
+    if (c < params.nv) {
+        child_vertex_rules[c] = vertex_rules[c];
+        return;
+    }
+    let edges = select(params.nv, params.nv + params.nf, params.scheme == 0u);
+    if (c < edges) {
+        child_vertex_rules[c] = 0u;
+        return;
+    }
+    child_vertex_rules[c] = select(0u, 1u, edge_sharp[c - edges] != 0u);
 }
