@@ -197,9 +197,9 @@ fn split_values_limit<'a>(
     Ok(limit.iter().flat_map(|p| [p.x, p.y]).collect())
 }
 
-/// The limit of a base mesh's texture coordinates under a split scheme (see
-/// [`split_values_limit`]), one value per (vertex, value); the values as given, with a
-/// warning pushed, where Doo-Sabin or √3 cannot carry their seams.
+/// The limit of a base mesh's texture coordinates under a split scheme, one value per
+/// (vertex, value); the values as given, with a warning pushed, where Doo-Sabin or √3
+/// cannot carry their seams.
 pub fn split_limit_uv(
     topology: &Topology,
     (scheme, stencils): (&Scheme, &LimitStencilTable),

@@ -286,7 +286,7 @@ pub(crate) fn on_base_face(e: LimitError, face: usize) -> LimitError {
 
 /// The vertex of level `level` of `r` at the dyadic parameter (u, v) of base face `face` (a
 /// quad for Catmull-Clark, a triangle for Loop), following the child faces that hold the
-/// point as [`LimitEvaluator::evaluate`] does; `None` when (u, v) is not a corner at that
+/// point as [`LimitEvaluator::evaluate`](crate::eval::LimitEvaluator::evaluate) does; `None` when (u, v) is not a corner at that
 /// level (not a multiple of 2^-level) or the face is not a quad or triangle.
 pub fn dyadic_vertex(r: &Refinement, level: usize, face: usize, u: f64, v: f64) -> Option<usize> {
     let loop_scheme = *r.scheme() == Scheme::Loop;
@@ -300,7 +300,7 @@ pub fn dyadic_vertex(r: &Refinement, level: usize, face: usize, u: f64, v: f64) 
 
 /// The face of level `level` (at least 1 for a Catmull-Clark face that is not a quad) of `r`
 /// whose corner is at `at`, and that corner, following the child faces that hold the point as
-/// [`LimitEvaluator::evaluate`] does (a sub-face of a face that is not a quad is its level-1
+/// [`LimitEvaluator::evaluate`](crate::eval::LimitEvaluator::evaluate) does (a sub-face of a face that is not a quad is its level-1
 /// child); `None` when `at` is not a corner at that level.
 pub fn dyadic_corner(r: &Refinement, level: usize, at: FaceParam) -> Option<(usize, usize)> {
     let loop_scheme = *r.scheme() == Scheme::Loop;

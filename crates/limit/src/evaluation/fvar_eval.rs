@@ -1,10 +1,10 @@
 //! Face-varying values (UVs) on the limit surface at any (face, u, v), beside the positions
-//! of [`LimitEvaluator`], with the parameterisation of [`crate::eval`].
+//! of [`LimitEvaluator`](crate::eval::LimitEvaluator), with the parameterisation of [`crate::eval`].
 //!
 //! **Method.** A channel refined by [`FaceVaryingRefinement`] is the refinement of a mesh of
 //! its own: one vertex per (vertex, value) pair, the faces of the geometry, seams as
 //! boundaries. Tagged so that its vertex rules are the channel's, that mesh's limit surface
-//! *is* the channel's limit, and [`LimitEvaluator`] evaluates it exactly:
+//! *is* the channel's limit, and [`LimitEvaluator`](crate::eval::LimitEvaluator) evaluates it exactly:
 //! * a value that matches its neighbours (OpenSubdiv's "matching" value) follows its
 //!   vertex's rule, so it keeps the vertex's sharpness and the sharpness of its edges, which
 //!   are all continuous; where that rule pins the vertex because it is a boundary corner
@@ -59,8 +59,8 @@ impl FVarPoint {
     }
 }
 
-/// Evaluates one face-varying channel on the limit surface of a [`LimitEvaluator`]'s mesh
-/// (made by [`LimitEvaluator::face_varying`]).
+/// Evaluates one face-varying channel on the limit surface of a [`LimitEvaluator`](crate::eval::LimitEvaluator)'s mesh
+/// (made by [`LimitEvaluator::face_varying`](crate::eval::LimitEvaluator::face_varying)).
 ///
 /// ```
 /// use subd_mesh::TopologyBuilder;
@@ -377,7 +377,7 @@ impl FVarEvaluator {
     /// The channel's limit value at `at` and its first derivatives.
     ///
     /// # Errors
-    /// As [`LimitEvaluator::evaluate`] for the point.
+    /// As [`LimitEvaluator::evaluate`](crate::eval::LimitEvaluator::evaluate) for the point.
     pub fn evaluate(
         &self,
         values: &FVarPatchValues,

@@ -1,6 +1,6 @@
 //! The limit surface as linear functions of the base control vertices.
 //!
-//! Every evaluation [`LimitEvaluator`] makes is linear in the control points, and the limit
+//! Every evaluation [`LimitEvaluator`](crate::eval::LimitEvaluator) makes is linear in the control points, and the limit
 //! surface over a face depends only on the vertices of the faces around it (every rule of
 //! these schemes, creases and their decay included, reads one ring). So the weights of the
 //! control vertices at a point are read off the evaluator itself: evaluate with unit vectors
@@ -9,7 +9,7 @@
 //! [`PointStencil`]: sparse rows of position and derivatives, exact to rounding, the
 //! building block of constraint rows (seed 003 §3).
 //!
-//! [`LimitEvaluator::face_patches`] exposes the same structure per face: the pieces the
+//! [`LimitEvaluator::face_patches`](crate::eval::LimitEvaluator::face_patches) exposes the same structure per face: the pieces the
 //! evaluator uses (bicubic B-splines, Stam corner patches), with their control points as
 //! rows over the base vertices, for quadratic forms such as the thin-plate energy.
 
@@ -132,7 +132,7 @@ pub enum PatchForm {
     /// vertex at one of its corners.
     Corner(Arc<CornerPatchMatrices>),
     /// Neither (Loop's pieces, pieces refined locally next to irregular sharp features): use
-    /// [`LimitEvaluator::stencil`] at points of its domain.
+    /// [`LimitEvaluator::stencil`](crate::eval::LimitEvaluator::stencil) at points of its domain.
     Other,
 }
 
@@ -198,10 +198,10 @@ fn merge_row(mut row: Vec<(u32, f64)>) -> Vec<(u32, f64)> {
 
 impl WholeMeshEvaluator {
     /// The limit surface at `at` as weights over the base control vertices: position and
-    /// derivatives, equal (to rounding) to [`LimitEvaluator::evaluate`] for any points.
+    /// derivatives, equal (to rounding) to [`LimitEvaluator::evaluate`](crate::eval::LimitEvaluator::evaluate) for any points.
     ///
     /// # Errors
-    /// As [`LimitEvaluator::evaluate`].
+    /// As [`LimitEvaluator::evaluate`](crate::eval::LimitEvaluator::evaluate).
     pub fn stencil(&self, at: FaceParam) -> Result<PointStencil, LimitError> {
         self.check(&at)?;
         SCRATCH.with(|cell| {

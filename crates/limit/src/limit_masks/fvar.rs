@@ -31,7 +31,7 @@ const CREASE_END: f64 = 1.0 / 6.0;
 const CREASE_CENTRE: f64 = 2.0 / 3.0;
 
 /// Limit stencils of every value of `level` (at least 1) of a channel refined with
-/// `refinement`, over the values of that level (see the [module docs](self)).
+/// `refinement`, over the values of that level (see the module [`crate::fvar`]).
 ///
 /// # Errors
 /// [`LimitError::Param`] for level 0 (its values are the channel's own, which a vertex may
