@@ -328,6 +328,15 @@ impl Gpu {
         self.read_back(buffer, bytes)
     }
 
+    /// Reads the first `bytes` bytes of a buffer of u32 values (an index buffer subd
+    /// made) back to the host, waiting for the work submitted before.
+    ///
+    /// # Errors
+    /// [`GpuError::Failed`] when the device fails.
+    pub fn read_u32(&self, buffer: &wgpu::Buffer, bytes: u64) -> Result<Vec<u32>, GpuError> {
+        self.read_back(buffer, bytes)
+    }
+
     /// Copies `bytes` bytes of `buffer` back to the host as values of `T`, waiting for the
     /// device to finish the work submitted before.
     pub(crate) fn read_back<T: bytemuck::Pod>(

@@ -17,7 +17,7 @@ use crate::{Gpu, GpuColumns, GpuError, GpuStencilTable, Precision, StencilDispat
 const WORKGROUP: u32 = 64;
 
 /// The stages of one level, in the order they run.
-const STAGES: [&str; 8] = [
+const STAGES: [&str; 9] = [
     "corners",
     "twins",
     "child_faces",
@@ -26,6 +26,8 @@ const STAGES: [&str; 8] = [
     "edge_points",
     "vertex_points",
     "child_rules",
+    // Not a stage of a level: a level's quads as triangles, on request.
+    "quad_triangles",
 ];
 
 /// The compute pipelines of `uniform.wgsl`, one per stage.
@@ -358,6 +360,48 @@ impl GpuUniformRefinement {
     /// The points of `level` (rows of three f32).
     pub fn points(&self, level: usize) -> Option<&GpuColumns> {
         self.levels.get(level).map(|l| &l.points)
+    }
+
+    /// The faces of refined `level` as a triangle list (u32, three per triangle) a renderer
+    /// draws directly: Loop's triangles as they are, Catmull-Clark's quads `(a, b, c, d)` as
+    /// `(a, b, c)`, `(a, c, d)`, computed on the device now (the topology does not change
+    /// with the points, so one list serves every frame).
+    ///
+    /// # Errors
+    /// [`GpuError::Mismatch`] for a level not refined, or the base level of mixed faces;
+    /// the device's size and memory errors.
+    pub fn triangle_indices(&self, gpu: &Gpu, level: usize) -> Result<wgpu::Buffer, GpuError> {
+        let l = self
+            .levels
+            .get(level)
+            .filter(|l| l.face_size == 3 || l.face_size == 4)
+            .ok_or_else(|| {
+                GpuError::Mismatch(format!(
+                    "level {level} is not a level of triangles or quads"
+                ))
+            })?;
+        let faces = l.counts.faces;
+        let triangles = if l.face_size == 4 { 2 * faces } else { faces };
+        let usage =
+            wgpu::BufferUsages::INDEX | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
+        let out = gpu.storage_of_size("triangle indices", 12 * triangles, usage)?;
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        if l.face_size == 3 {
+            encoder.copy_buffer_to_buffer(&l.face_vertices, 0, &out, 0, 12 * triangles);
+        } else {
+            let (grid, per_line) = gpu.dispatch_grid(faces as usize, WORKGROUP);
+            let params = [0, 0, 0, 0, 4, 0, faces as u32, per_line];
+            let uniform = gpu.uniform("triangle parameters", &params);
+            let pipeline = &gpu.uniform_pipelines.stages[8];
+            let buffers = [(0, &uniform), (3, &l.face_vertices), (22, &out)];
+            let bind_group = gpu.bind_group("quad triangles", pipeline, &buffers);
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, &bind_group, &[]);
+            pass.dispatch_workgroups(grid.0, grid.1, 1);
+        }
+        gpu.queue.submit([encoder.finish()]);
+        Ok(out)
     }
 
     /// Reads the face vertices of `level` back.

@@ -81,6 +81,20 @@ fn every_shape_refines_on_the_device_as_on_the_cpu() {
             let want = refinement.topology(level).all_face_vertices();
             let got = on_device.read_face_vertices(&gpu, level).unwrap();
             assert!(got == want, "{name}: level {level}: face vertices differ");
+            if level == 3 {
+                // The triangle list a renderer draws: quads split (a, b, c), (a, c, d).
+                let list = on_device.triangle_indices(&gpu, level).unwrap();
+                let bytes = (want.len() * if scheme == Scheme::Loop { 4 } else { 6 }) as u64;
+                let got: Vec<u32> = gpu.read_u32(&list, bytes).unwrap();
+                let split: Vec<u32> = if scheme == Scheme::Loop {
+                    want.to_vec()
+                } else {
+                    want.chunks_exact(4)
+                        .flat_map(|q| [q[0], q[1], q[2], q[0], q[2], q[3]])
+                        .collect()
+                };
+                assert!(got == split, "{name}: triangle list");
+            }
             let points = gpu.read_points(on_device.points(level).unwrap()).unwrap();
             assert_eq!(points.len(), cpu_level.len(), "{name}: level {level}");
             for (k, (p, q)) in points.iter().zip(cpu_level).enumerate() {
@@ -136,6 +150,11 @@ fn new_positions_refine_again() {
         r.read_face_vertices(&gpu, 2).unwrap(),
         refinement.topology(2).all_face_vertices()
     );
+    // A level that was not refined has no triangles.
+    assert!(matches!(
+        r.triangle_indices(&gpu, 3),
+        Err(GpuError::Mismatch(_))
+    ));
 }
 
 #[test]

@@ -57,6 +57,9 @@ struct Params {
 @group(0) @binding(20) var<storage, read> vertex_rules: array<u32>;
 @group(0) @binding(21) var<storage, read_write> child_vertex_rules: array<u32>;
 
+// A level's quads as triangles (a, b, c), (a, c, d), for drawing.
+@group(0) @binding(22) var<storage, read_write> triangles: array<u32>;
+
 // No corner: a twin across a boundary edge.
 const NONE: u32 = 0x7fffffffu;
 // A twin's flag: the corner's own edge is sharp. A vertex corner's flag: it arrives by a
@@ -408,4 +411,21 @@ fn child_rules(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     child_vertex_rules[c] = select(0u, 1u, edge_sharp[c - edges] != 0u);
+}
+
+// Quad f of a level (`face_vertices`, `count` quads) as the triangles (a, b, c), (a, c, d).
+@compute @workgroup_size(64)
+fn quad_triangles(@builtin(global_invocation_id) id: vec3<u32>) {
+    let f = invocation(id);
+    if (f >= params.count) {
+        return;
+    }
+    let a = face_vertices[4u * f];
+    let b = face_vertices[4u * f + 1u];
+    let c = face_vertices[4u * f + 2u];
+    let d = face_vertices[4u * f + 3u];
+    let out = array<u32, 6>(a, b, c, a, c, d);
+    for (var k = 0u; k < 6u; k++) {
+        triangles[6u * f + k] = out[k];
+    }
 }
