@@ -332,8 +332,15 @@ impl Gpu {
     /// made) back to the host, waiting for the work submitted before.
     ///
     /// # Errors
+    /// [`GpuError::Mismatch`] for a length past the buffer or not whole u32 values;
     /// [`GpuError::Failed`] when the device fails.
     pub fn read_u32(&self, buffer: &wgpu::Buffer, bytes: u64) -> Result<Vec<u32>, GpuError> {
+        if bytes > buffer.size() || !bytes.is_multiple_of(4) {
+            return Err(GpuError::Mismatch(format!(
+                "{bytes} bytes read from a buffer of {} (whole u32 values within it)",
+                buffer.size()
+            )));
+        }
         self.read_back(buffer, bytes)
     }
 

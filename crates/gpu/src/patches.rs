@@ -497,12 +497,21 @@ impl GpuPatchTable {
         if rate == 0 {
             return Err(GpuError::Mismatch("a tessellation rate of 0".into()));
         }
-        let samples = self.patches as u64 * (rate as u64 + 1).pow(2);
-        let cells = self.patches as u64 * (rate as u64).pow(2);
+        let side = rate as u64 + 1;
+        let samples = side
+            .checked_mul(side)
+            .and_then(|n| n.checked_mul(self.patches as u64))
+            .unwrap_or(u64::MAX);
+        let cells = (rate as u64 * rate as u64).saturating_mul(self.patches as u64);
+        // The grid's weights (per class and sample, 60 numbers) are built on the host first.
+        let weight_bytes = (self.bases.len() as u64)
+            .saturating_mul(side.saturating_mul(side))
+            .saturating_mul(60 * 8);
+        gpu.check_size("tessellation weights", weight_bytes)?;
         if samples > u64::from(u32::MAX) {
             return Err(GpuError::TooLarge {
                 what: "tessellation samples (32-bit indices)",
-                bytes: samples * 4,
+                bytes: samples.saturating_mul(4),
                 limit: u64::from(u32::MAX) * 4,
             });
         }

@@ -154,6 +154,8 @@ pub struct GpuUniformRefinement {
     /// Where the points do not come from the device's masks: each level's stencil table
     /// from the CPU's refinement, applied level to level.
     stencils: Vec<(GpuStencilTable, StencilDispatch)>,
+    /// Whether the device's masks compute the points.
+    masks: bool,
 }
 
 /// Whether the device's masks give `base`'s points: a manifold mesh without holes whose
@@ -278,6 +280,7 @@ impl GpuUniformRefinement {
             _base: base_buffers,
             passes: Vec::new(),
             stencils: Vec::new(),
+            masks,
         };
         for &child in &counts[1..] {
             let face_size = if loop_scheme { 3 } else { 4 };
@@ -292,7 +295,7 @@ impl GpuUniformRefinement {
 
     /// Whether the device's masks compute the points, not the CPU's stencil tables.
     pub fn points_by_masks(&self) -> bool {
-        self.stencils.is_empty()
+        self.masks
     }
 
     /// Refines every level again from the base (the timing of a refinement: topology and
@@ -308,6 +311,7 @@ impl GpuUniformRefinement {
         // Each run finds the corners of every edge again: no slot may hold an old one.
         for walks in &self._walks {
             encoder.clear_buffer(&walks.edge_corners, 0, None);
+            encoder.clear_buffer(&walks.vertex_corner, 0, None);
         }
         for pass in &self.passes {
             if pass.grid.0 == 0 {
@@ -544,7 +548,11 @@ impl GpuUniformRefinement {
                 8 * c.edges,
                 wgpu::BufferUsages::COPY_DST,
             )?,
-            vertex_corner: gpu.storage_of_size("vertex corners", 4 * c.vertices, none)?,
+            vertex_corner: gpu.storage_of_size(
+                "vertex corners",
+                4 * c.vertices,
+                wgpu::BufferUsages::COPY_DST,
+            )?,
             twin: gpu.storage_of_size("twins", 4 * c.corners, none)?,
         };
         let next = DeviceLevel {
@@ -600,7 +608,7 @@ impl GpuUniformRefinement {
 /// A stage's bindings: its index, its invocations, its buffers by binding.
 type StageBindings<'a> = (usize, u64, Vec<(u32, &'a wgpu::Buffer)>);
 
-/// The seven stages computing `next` from `p` (their order in [`STAGES`]), with the
+/// The eight stages computing `next` from `p` (their order in [`STAGES`]), with the
 /// buffers each reads and writes.
 fn stage_bindings<'a>(
     base: &'a [wgpu::Buffer; 3],

@@ -349,4 +349,14 @@ fn what_the_device_cannot_do_is_an_error() {
         on_device.tessellation(&gpu, 0),
         Err(GpuError::Mismatch(_))
     ));
+    // A rate whose grid cannot exist is refused before anything is built for it.
+    for rate in [1 << 20, usize::MAX / 2] {
+        let err = on_device.tessellation(&gpu, rate).unwrap_err();
+        assert!(matches!(err, GpuError::TooLarge { .. }), "{err}");
+    }
+    // A read past a buffer is an error, and the device goes on working.
+    let small = on_device.tessellation(&gpu, 1).unwrap();
+    let err = gpu.read_u32(&small.indices, 1 << 40).unwrap_err();
+    assert!(matches!(err, GpuError::Mismatch(_)), "{err}");
+    assert!(gpu.check().is_ok());
 }

@@ -216,10 +216,11 @@ impl CorePatchTable {
         derivatives: bool,
     ) -> PyResult<Vec<Bound<'py, PyArray2<f64>>>> {
         let at = places(&faces, &subs, &u, &v)?;
-        if let Some((gpu, on_device)) = &self.device {
+        if let Some((gpu, on_device)) = self.device.as_ref().filter(|_| !(derivatives && self.auto))
+        {
             if derivatives {
                 return Err(PyValueError::new_err(
-                    "derivatives=True: second derivatives are evaluated on the CPU (build the table with device=\"cpu\")",
+                    "derivatives=True: second derivatives are evaluated on the CPU (build the table with device=\"cpu\" or \"auto\")",
                 ));
             }
             let table = &self.table;
@@ -376,7 +377,7 @@ impl CorePatchTable {
         // no Python thread reads a view of them while they change.
         let table = &self.table;
         let next = pool::run(py, || table.points_for(&base))?.map_err(mesh_error)?;
-        self.table.set_points(next);
+        // The device first: where it fails with device="gpu" neither copy has moved.
         if let Some((gpu, on_device)) = &self.device {
             match py.detach(|| on_device.update_points(gpu, &base)) {
                 Ok(()) => {}
@@ -387,6 +388,7 @@ impl CorePatchTable {
                 Err(e) => return Err(device_error(e)),
             }
         }
+        self.table.set_points(next);
         Ok(())
     }
 }

@@ -33,10 +33,11 @@ pub(crate) struct CoreRefiner {
     auto: bool,
 }
 
-/// The level stencils on the device, one refiner per column count (made on first use).
+/// The level stencils on the device, one refiner per column count (made on first use),
+/// each used by one call at a time: its buffers hold that call's values until read back.
 struct DeviceRefiners {
     gpu: Arc<Gpu>,
-    by_width: Mutex<HashMap<usize, Arc<GpuRefiner>>>,
+    by_width: Mutex<HashMap<usize, Arc<Mutex<GpuRefiner>>>>,
 }
 
 impl DeviceRefiners {
@@ -53,11 +54,13 @@ impl DeviceRefiners {
                 Some(r) => Arc::clone(r),
                 None => {
                     let r = GpuRefiner::new(&self.gpu, refinement, k, LevelTables::PerLevel)?;
-                    Arc::clone(held.entry(k).or_insert(Arc::new(r)))
+                    Arc::clone(held.entry(k).or_insert(Arc::new(Mutex::new(r))))
                 }
             }
         };
         let as_f32: Vec<f32> = values.iter().map(|&x| x as f32).collect();
+        // Held from the write to the read-back: another thread's values would overwrite them.
+        let refiner = refiner.lock().unwrap_or_else(|e| e.into_inner());
         refiner.update(&self.gpu, &as_f32)?;
         let out = self.gpu.read_columns(refiner.last())?;
         Ok(out.into_iter().map(f64::from).collect())

@@ -79,6 +79,12 @@ def test_patch_table_on_the_gpu_evaluates_as_on_the_cpu(shape, scheme):
     assert np.abs(got - want).max() <= 1e-6 * _size(moved)
     with pytest.raises(ValueError, match="second derivatives"):
         gpu.evaluate(faces, u, v, derivatives=True)
+    # device="auto" answers second derivatives on the CPU instead.
+    auto = subd.PatchTable(mesh, scheme, isolation=3, device="auto")
+    auto.update(moved)
+    second = auto.evaluate(faces, u, v, derivatives=True)
+    assert len(second) == 6
+    assert np.abs(second[3] - cpu.evaluate(faces, u, v, derivatives=True)[3]).max() == 0.0
 
 
 @needs_adapter

@@ -33,7 +33,7 @@ struct Params {
 
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> face_offsets: array<u32>;
-// Per corner its face, then per corner the next corner of its face (level 0 only).
+// Per corner its face, then its face's next corner, then its previous (level 0 only).
 @group(0) @binding(2) var<storage, read> corner_info: array<u32>;
 @group(0) @binding(3) var<storage, read> face_vertices: array<u32>;
 @group(0) @binding(4) var<storage, read> face_edges: array<u32>;
