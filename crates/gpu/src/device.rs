@@ -37,6 +37,38 @@ impl AdapterSummary {
     }
 }
 
+/// The compute pipelines of the WGSL `shader` (named `label`) at `entries`, with its
+/// `Real` type the device's precision (f64 or f32), each with the layout the shader implies.
+pub(crate) fn compute_pipelines(
+    device: &wgpu::Device,
+    precision: Precision,
+    label: &'static str,
+    shader: &str,
+    entries: &[&'static str],
+) -> Vec<wgpu::ComputePipeline> {
+    let real = match precision {
+        Precision::F64 => "f64",
+        Precision::F32 => "f32",
+    };
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(label),
+        source: wgpu::ShaderSource::Wgsl(format!("alias Real = {real};\n{shader}").into()),
+    });
+    entries
+        .iter()
+        .map(|entry| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: None,
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        })
+        .collect()
+}
+
 /// Routes the device's loss and its uncaught errors to a [`Health`] instead of wgpu's
 /// default panic.
 fn watch(device: &wgpu::Device) -> Arc<Health> {
@@ -281,6 +313,23 @@ impl Gpu {
                     usage: wgpu::BufferUsages::STORAGE | usage,
                 })
         })
+    }
+
+    /// A storage buffer of real numbers in the device's [`Precision`]: `values` as they
+    /// are (f64) or rounded once to f32.
+    pub(crate) fn storage_real(
+        &self,
+        what: &'static str,
+        values: &[f64],
+    ) -> Result<wgpu::Buffer, GpuError> {
+        let none = wgpu::BufferUsages::empty();
+        match self.precision {
+            Precision::F64 => self.storage(what, values, none),
+            Precision::F32 => {
+                let rounded: Vec<f32> = values.iter().map(|&x| x as f32).collect();
+                self.storage(what, &rounded, none)
+            }
+        }
     }
 
     /// An uninitialised storage buffer of `bytes` (at least 4).

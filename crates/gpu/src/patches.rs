@@ -27,32 +27,16 @@ pub(crate) struct PatchPipelines {
 
 impl PatchPipelines {
     pub(crate) fn new(device: &wgpu::Device, precision: Precision) -> PatchPipelines {
-        let real = match precision {
-            Precision::F64 => "f64",
-            Precision::F32 => "f32",
-        };
-        let source = format!(
-            "alias Real = {real};\n{}",
-            include_str!("shaders/patches.wgsl")
-        );
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("patches.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(source.into()),
-        });
-        let pipeline = |entry: &'static str| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry),
-                layout: None,
-                module: &module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        };
+        let shader = include_str!("shaders/patches.wgsl");
+        let entries = ["evaluate", "tessellate", "grid_indices"];
+        let [evaluate, tessellate, grid_indices]: [wgpu::ComputePipeline; 3] =
+            crate::device::compute_pipelines(device, precision, "patches.wgsl", shader, &entries)
+                .try_into()
+                .expect("one pipeline per entry");
         PatchPipelines {
-            evaluate: pipeline("evaluate"),
-            tessellate: pipeline("tessellate"),
-            grid_indices: pipeline("grid_indices"),
+            evaluate,
+            tessellate,
+            grid_indices,
         }
     }
 }
@@ -316,8 +300,8 @@ impl GpuPatchTable {
         }
         let total = table.points().len();
         let points = gpu.upload_points(table.points())?;
-        let mut cpu_tables: Vec<_> = table.level_stencils().into_iter().cloned().collect();
-        cpu_tables.push(table.local_point_stencils().clone());
+        let mut cpu_tables = table.level_stencils();
+        cpu_tables.push(table.local_point_stencils());
         let mut parts = counts[1..]
             .iter()
             .map(|&n| gpu.columns(n, 3))
@@ -325,17 +309,11 @@ impl GpuPatchTable {
         parts.push(gpu.columns(total - level_offsets[counts.len()], 3)?);
         let tables = cpu_tables
             .iter()
-            .map(|t| GpuStencilTable::new(gpu, t))
+            .map(|&t| GpuStencilTable::new(gpu, t))
             .collect::<Result<Vec<_>, _>>()?;
         let dispatches = level_dispatches(gpu, &tables, &points, &parts)?;
         let none = wgpu::BufferUsages::empty();
-        let coefficients = match gpu.precision() {
-            Precision::F64 => gpu.storage("patch bases", &layout.coefficients, none)?,
-            Precision::F32 => {
-                let c: Vec<f32> = layout.coefficients.iter().map(|&x| x as f32).collect();
-                gpu.storage("patch bases", &c, none)?
-            }
-        };
+        let coefficients = gpu.storage_real("patch bases", &layout.coefficients)?;
         Ok(GpuPatchTable {
             points,
             level_offsets,
@@ -517,7 +495,7 @@ impl GpuPatchTable {
         }
         let values = GpuPatchValues::new(gpu, samples as usize)?;
         let triangles = 2 * cells as usize; // quads: two per cell; triangle patches: rate²
-        let triangles = if self.triangles() {
+        let triangles = if self.triangles {
             triangles / 2
         } else {
             triangles
@@ -539,11 +517,6 @@ impl GpuPatchTable {
             dispatch,
             _weights: weights,
         })
-    }
-
-    /// Whether the patches are triangles (Loop).
-    fn triangles(&self) -> bool {
-        self.triangles
     }
 
     /// `entry` (evaluate or tessellate) over `count` places into `out`; `inputs` the
@@ -601,14 +574,7 @@ impl GpuPatchTable {
                 }
             }
         }
-        let none = wgpu::BufferUsages::empty();
-        match gpu.precision() {
-            Precision::F64 => gpu.storage("tessellation weights", &weights, none),
-            Precision::F32 => {
-                let w: Vec<f32> = weights.iter().map(|&x| x as f32).collect();
-                gpu.storage("tessellation weights", &w, none)
-            }
-        }
+        gpu.storage_real("tessellation weights", &weights)
     }
 
     /// The triangle list of the `rate` grids (`cells` cells in all) into `indices`.

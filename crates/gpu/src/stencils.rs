@@ -17,27 +17,17 @@ pub(crate) struct StencilPipeline {
 
 impl StencilPipeline {
     pub(crate) fn new(device: &wgpu::Device, precision: Precision) -> StencilPipeline {
-        let real = match precision {
-            Precision::F64 => "f64",
-            Precision::F32 => "f32",
-        };
-        let source = format!(
-            "alias Real = {real};\n{}",
-            include_str!("shaders/stencils.wgsl")
+        let shader = include_str!("shaders/stencils.wgsl");
+        let mut pipelines = crate::device::compute_pipelines(
+            device,
+            precision,
+            "stencils.wgsl",
+            shader,
+            &["apply"],
         );
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("stencils.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(source.into()),
-        });
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("apply stencils"),
-            layout: None,
-            module: &module,
-            entry_point: Some("apply"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
-        StencilPipeline { pipeline }
+        StencilPipeline {
+            pipeline: pipelines.remove(0),
+        }
     }
 }
 
@@ -194,13 +184,7 @@ impl GpuStencilTable {
     /// [`GpuError::OutOfMemory`].
     pub fn new(gpu: &Gpu, table: &StencilTable) -> Result<GpuStencilTable, GpuError> {
         let none = wgpu::BufferUsages::empty();
-        let weights = match gpu.precision() {
-            Precision::F64 => gpu.storage("stencil weights", table.weights(), none)?,
-            Precision::F32 => {
-                let w: Vec<f32> = table.weights().iter().map(|&w| w as f32).collect();
-                gpu.storage("stencil weights", &w, none)?
-            }
-        };
+        let weights = gpu.storage_real("stencil weights", table.weights())?;
         Ok(GpuStencilTable {
             offsets: gpu.storage("stencil offsets", table.offsets(), none)?,
             indices: gpu.storage("stencil indices", table.indices(), none)?,

@@ -38,32 +38,16 @@ pub(crate) struct UniformPipelines {
 
 impl UniformPipelines {
     pub(crate) fn new(device: &wgpu::Device, precision: Precision) -> UniformPipelines {
-        let real = match precision {
-            Precision::F64 => "f64",
-            Precision::F32 => "f32",
-        };
-        let source = format!(
-            "alias Real = {real};\n{}",
-            include_str!("shaders/uniform.wgsl")
-        );
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("uniform.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(source.into()),
-        });
-        let stages = STAGES
-            .iter()
-            .map(|entry| {
-                device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                    label: Some(entry),
-                    layout: None,
-                    module: &module,
-                    entry_point: Some(entry),
-                    compilation_options: Default::default(),
-                    cache: None,
-                })
-            })
-            .collect();
-        UniformPipelines { stages }
+        let shader = include_str!("shaders/uniform.wgsl");
+        UniformPipelines {
+            stages: crate::device::compute_pipelines(
+                device,
+                precision,
+                "uniform.wgsl",
+                shader,
+                &STAGES,
+            ),
+        }
     }
 }
 
@@ -474,16 +458,8 @@ fn upload_base(
             [e, own]
         })
         .collect();
-    let weights = match (loop_scheme, gpu.precision()) {
-        (false, _) => gpu.storage("loop weights", &[0u32; 2], wgpu::BufferUsages::empty())?,
-        (true, Precision::F64) => {
-            gpu.storage("loop weights", &weights, wgpu::BufferUsages::empty())?
-        }
-        (true, Precision::F32) => {
-            let w: Vec<f32> = weights.iter().map(|&x| x as f32).collect();
-            gpu.storage("loop weights", &w, wgpu::BufferUsages::empty())?
-        }
-    };
+    // Catmull-Clark binds the table too (it reads none of it).
+    let weights = gpu.storage_real("loop weights", if loop_scheme { &weights } else { &[0.0] })?;
     let none = wgpu::BufferUsages::empty();
     let level = DeviceLevel {
         counts: Counts::of(base),

@@ -3,61 +3,29 @@
 //! places on every face and on the uniform grid of every patch, compared with
 //! `PatchTable::evaluate` and `PatchTable::patch_grid` in f64.
 
-use std::path::{Path, PathBuf};
+mod common;
 
-use subd_gpu::{Gpu, GpuError, GpuPatchTable, GpuPatchValues};
+use std::path::PathBuf;
+
+use common::{diagonal, gpu, osd_shapes, read_shape};
+
+use subd_gpu::{GpuError, GpuPatchTable, GpuPatchValues};
 use subd_limit::eval::FaceParam;
 use subd_limit::patches::{EndCaps, PatchOptions, PatchTable};
 use subd_mesh::{DVec3, Mesh};
 use subd_schemes::{Options, Scheme};
 
-/// The device, or None outside CI where the machine has no adapter (said loudly).
-fn gpu() -> Option<Gpu> {
-    match Gpu::new() {
-        Ok(g) => Some(g),
-        Err(e) if std::env::var_os("CI").is_some() => panic!("CI needs a GPU adapter: {e}"),
-        Err(e) => {
-            eprintln!("SKIPPED: no GPU adapter ({e}); install mesa-vulkan-drivers");
-            None
-        }
-    }
-}
-
 /// The Catmull-Clark and Loop shapes of the OSD suite with at most `max_vertices`.
 fn shapes(max_vertices: usize) -> Vec<(PathBuf, Scheme, Mesh)> {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/meshes/osd");
-    let mut paths: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "obj"))
-        .collect();
-    paths.sort();
-    paths
+    osd_shapes()
         .into_iter()
-        .filter_map(|path| {
-            let name = path.file_name()?.to_str()?.to_string();
-            let scheme = match name.split('_').next()? {
-                "catmark" => Scheme::CatmullClark,
-                "loop" => Scheme::Loop,
-                _ => return None,
-            };
+        .filter(|(_, scheme)| *scheme != Scheme::Bilinear)
+        .map(|(path, scheme)| {
             let mesh = read_shape(&path);
-            (mesh.positions.len() <= max_vertices).then_some((path, scheme, mesh))
+            (path, scheme, mesh)
         })
+        .filter(|(_, _, mesh)| mesh.positions.len() <= max_vertices)
         .collect()
-}
-
-fn read_shape(path: &Path) -> Mesh {
-    let options = subd_io::ReadOptions {
-        accept_inconsistent_orientation: true,
-        ..Default::default()
-    };
-    subd_io::read_mesh(path, &options).unwrap().mesh
-}
-
-fn diagonal(points: &[DVec3]) -> f64 {
-    let (lo, hi) = subd_mesh::bounding_box(points.iter().copied()).unwrap();
-    (hi - lo).length().max(1e-300)
 }
 
 /// A cage moved off its rest pose: every vertex pushed along a smooth field, so the

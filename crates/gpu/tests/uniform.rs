@@ -4,46 +4,20 @@
 //! points (the device's own masks on the shapes whose sharpness is all or nothing, the
 //! CPU's stencil tables on the others).
 
-use std::path::PathBuf;
+mod common;
 
-use subd_gpu::{Gpu, GpuError, GpuUniformRefinement};
+use common::{diagonal, gpu, osd_shapes, read_shape};
+use subd_gpu::{GpuError, GpuUniformRefinement};
 use subd_mesh::{DVec3, Mesh};
 use subd_schemes::{Options, Refinement, Scheme};
 
-fn gpu() -> Option<Gpu> {
-    match Gpu::new() {
-        Ok(g) => Some(g),
-        Err(e) if std::env::var_os("CI").is_some() => panic!("CI needs a GPU adapter: {e}"),
-        Err(e) => {
-            eprintln!("SKIPPED: no GPU adapter ({e}); install mesa-vulkan-drivers");
-            None
-        }
-    }
-}
-
 fn shapes() -> Vec<(String, Scheme, Mesh)> {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/meshes/osd");
-    let mut paths: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "obj"))
-        .collect();
-    paths.sort();
-    let options = subd_io::ReadOptions {
-        accept_inconsistent_orientation: true,
-        ..Default::default()
-    };
-    let mut out: Vec<(String, Scheme, Mesh)> = paths
+    let mut out: Vec<(String, Scheme, Mesh)> = osd_shapes()
         .into_iter()
-        .filter_map(|path| {
-            let name = path.file_name()?.to_str()?.to_string();
-            let scheme = match name.split('_').next()? {
-                "catmark" => Scheme::CatmullClark,
-                "loop" => Scheme::Loop,
-                _ => return None,
-            };
-            let mesh = subd_io::read_mesh(&path, &options).unwrap().mesh;
-            Some((name, scheme, mesh))
+        .filter(|(_, scheme)| *scheme != Scheme::Bilinear)
+        .map(|(path, scheme)| {
+            let name = path.file_name().unwrap().to_string_lossy().into_owned();
+            (name, scheme, read_shape(&path))
         })
         .collect();
     out.push((
@@ -52,11 +26,6 @@ fn shapes() -> Vec<(String, Scheme, Mesh)> {
         subd_mesh::primitives::torus(12, 9, 1.0, 0.3),
     ));
     out
-}
-
-fn diagonal(points: &[DVec3]) -> f64 {
-    let (lo, hi) = subd_mesh::bounding_box(points.iter().copied()).unwrap();
-    (hi - lo).length().max(1e-300)
 }
 
 #[test]

@@ -99,7 +99,7 @@ impl CorePatchTable {
             Some(gpu) => match py.detach(|| GpuPatchTable::new(&gpu, &table)) {
                 Ok(t) => Some((gpu, t)),
                 Err(e) if device == "auto" => {
-                    device_warning = Some(format!("device=\"auto\": {e}; evaluating on the CPU"));
+                    device_warning = Some(fallback_warning(&e));
                     None
                 }
                 Err(e) => return Err(device_error(e)),
