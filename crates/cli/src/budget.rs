@@ -83,6 +83,14 @@ fn address_space_headroom() -> Option<u64> {
     Some(soft.saturating_sub(used_kib * 1024))
 }
 
+/// The process's peak resident memory (`VmHWM` of `/proc/self/status`), in bytes.
+pub(crate) fn peak_resident_bytes() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
+}
+
 /// A size such as `800M`, `4G`, `1.5GiB` or a plain number of bytes (units are binary:
 /// K = 1024).
 pub(crate) fn parse_size(s: &str) -> Result<u64, String> {

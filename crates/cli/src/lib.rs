@@ -19,6 +19,7 @@ mod batch;
 mod budget;
 mod cage;
 mod curve;
+mod depth_first;
 mod edit;
 mod eval;
 mod failure;

@@ -9,7 +9,7 @@ use clap::Args;
 use serde::Serialize;
 use subd_mesh::{BoundaryInterpolation, CreaseMethod, SchemeHints, TriangleSubdivision};
 use subd_schemes::Scheme;
-use subd_schemes::peak::PeakModel;
+use subd_schemes::peak::{DepthFirstPeak, PeakModel};
 
 use crate::batch::{self, Files, Job};
 use crate::budget::Budget;
@@ -47,9 +47,25 @@ pub(crate) struct RefineArgs {
     /// (OBJ `vn`, PLY `nx ny nz`, glTF `NORMAL`): the limit masks of the output level.
     #[arg(long)]
     limit: bool,
+    /// Refine depth-first: chunks of base faces taken to the last level one at a time and
+    /// written in place, so that the memory does not grow with the level (Catmull-Clark,
+    /// Loop or Bilinear to binary PLY, without texture coordinates, holes or creases sharp
+    /// past the last level). Chosen by itself when the level at a time would not fit the
+    /// memory budget.
+    #[arg(long)]
+    depth_first: bool,
     /// Print a JSON report (counts, timings) on stdout.
     #[arg(long)]
     json: bool,
+}
+
+/// How the output level is made.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Plan {
+    /// Level by level, the last one streamed to the file where it can be.
+    LevelAtATime,
+    /// Depth-first, in chunks of about this many last-level faces.
+    DepthFirst(u64),
 }
 
 #[derive(Serialize)]
@@ -86,6 +102,12 @@ struct RefineReport {
     triangle_subdivision: Option<TriangleSubdivision>,
     /// Whether the vertices were moved to the limit surface.
     limit: bool,
+    /// Whether the level was made depth-first (chunks of base faces, no level held whole).
+    depth_first: bool,
+    /// The process's peak resident memory so far, in bytes (Linux's `VmHWM`; absent
+    /// elsewhere).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    peak_memory: Option<u64>,
     input_counts: Counts,
     output_counts: Counts,
     seconds: Timings,
@@ -133,8 +155,20 @@ fn run_one(
     out: &mut dyn Write,
     err: &mut dyn Write,
 ) -> Result<(), Failure> {
-    let (mut opened, scheme) = open(args, job, err)?;
+    let (mut opened, scheme, plan) = open(args, job, err)?;
     let options = args.rules.options(&opened.file.mesh.hints);
+    if let Plan::DepthFirst(faces_per_chunk) = plan {
+        return run_depth_first(
+            args,
+            job,
+            opened,
+            &scheme,
+            &options,
+            faces_per_chunk,
+            out,
+            err,
+        );
+    }
     let progress = Progress::new(args.levels, args.json || job.quiet);
     let t0 = Instant::now();
     let base = &opened.file.mesh.topology;
@@ -194,6 +228,8 @@ fn run_one(
             crease_method: osd.then_some(options.crease_method),
             triangle_subdivision: osd.then_some(options.triangle_subdivision),
             limit: args.limit,
+            depth_first: false,
+            peak_memory: crate::budget::peak_resident_bytes(),
             input_counts,
             output_counts: written.counts,
             seconds: Timings {
@@ -201,6 +237,77 @@ fn run_one(
                 topology: t_topology,
                 positions: written.positions_seconds,
                 write: written.write_seconds,
+                total: opened.elapsed(),
+            },
+            warnings: opened.file.warnings.clone(),
+        };
+        crate::print_json(out, &report);
+    }
+    Ok(())
+}
+
+/// One file depth-first ([`crate::depth_first`]): no level is built whole, so the report's
+/// `positions` time covers refining and writing together.
+#[allow(clippy::too_many_arguments)]
+fn run_depth_first(
+    args: &RefineArgs,
+    job: &Job,
+    mut opened: crate::opening::Opened,
+    scheme: &Scheme,
+    options: &subd_schemes::Options,
+    faces_per_chunk: u64,
+    out: &mut dyn Write,
+    err: &mut dyn Write,
+) -> Result<(), Failure> {
+    opened.print_new_warnings(&job.input, err);
+    let t0 = Instant::now();
+    let mesh = &opened.file.mesh;
+    let hints = subd_limit::refined_mesh::refined_hints(
+        scheme,
+        options,
+        &mesh.hints,
+        args.rules.triangles.is_some(),
+    );
+    let request = crate::depth_first::Request {
+        base: &mesh.topology,
+        positions: &mesh.positions,
+        scheme,
+        options,
+        levels: args.levels,
+        faces_per_chunk,
+        hints,
+        input: &job.input,
+        output: &job.output,
+    };
+    let counts = crate::depth_first::write(&request)?;
+    if args.json {
+        let report = RefineReport {
+            input: job.input.display().to_string(),
+            output: job.output.display().to_string(),
+            scheme: scheme.name(),
+            levels: args.levels,
+            tension: None,
+            boundary_interpolation: Some(options.boundary_interpolation),
+            crease_method: Some(options.crease_method),
+            triangle_subdivision: Some(options.triangle_subdivision),
+            limit: false,
+            depth_first: true,
+            peak_memory: crate::budget::peak_resident_bytes(),
+            input_counts: Counts {
+                vertices: mesh.topology.num_vertices(),
+                edges: Some(mesh.topology.num_edges()),
+                faces: mesh.topology.num_faces(),
+            },
+            output_counts: Counts {
+                vertices: counts.vertices as usize,
+                edges: Some(counts.edges as usize),
+                faces: counts.faces as usize,
+            },
+            seconds: Timings {
+                read: opened.read_seconds,
+                topology: 0.0,
+                positions: t0.elapsed().as_secs_f64(),
+                write: 0.0,
                 total: opened.elapsed(),
             },
             warnings: opened.file.warnings.clone(),
@@ -222,7 +329,7 @@ fn open(
     args: &RefineArgs,
     job: &Job,
     err: &mut dyn Write,
-) -> Result<(crate::opening::Opened, Scheme), Failure> {
+) -> Result<(crate::opening::Opened, Scheme, Plan), Failure> {
     let started = REFINE.start_job(job)?;
     let opened = started.read(&args.rules, err)?;
     let hints = &opened.file.mesh.hints;
@@ -231,8 +338,8 @@ fn open(
     let scheme = scheme_arg::with_tension(&scheme, args.tension, "--scheme")?;
     let vertices = opened.file.mesh.topology.num_vertices();
     let scheme = scheme_arg::with_lambda(&scheme, &args.lambda, &job.input, vertices)?;
-    check_memory(args, job, &opened.file, &scheme)?;
-    Ok((opened, scheme))
+    let plan = plan_memory(args, job, &opened.file, &scheme)?;
+    Ok((opened, scheme, plan))
 }
 
 /// The texture coordinates of the output level, if the input has them. PLY holds one per
@@ -430,26 +537,56 @@ impl Output<'_> {
     }
 }
 
-/// Refuses the request if its estimated peak memory is over the budget (see
-/// [`crate::budget`]).
-fn check_memory(
+/// How the output is made, within the memory budget (see [`crate::budget`]): depth-first
+/// when asked or when the level at a time would not fit and the output allows it; the
+/// request refused if its estimated peak is over the budget either way.
+fn plan_memory(
     args: &RefineArgs,
     job: &Job,
     file: &subd_io::MeshFile,
     scheme: &Scheme,
-) -> Result<(), Failure> {
+) -> Result<Plan, Failure> {
     let base = &file.mesh.topology;
     let counts = subd_schemes::refined_counts(base, scheme, args.levels);
     let model = PeakModel::of(scheme);
     let file_bytes = std::fs::metadata(&job.input).map_or(0, |m| m.len());
     let glb = subd_io::Format::for_output(&job.output) == Some(subd_io::Format::Glb);
     let budget = Budget::detect(args.max_memory).map(|b| b.share(job.concurrent));
-    crate::budget::check_refinement(
-        &job.input,
-        &counts,
-        |last| model.peak(file_bytes, last, glb, args.limit),
-        budget,
-    )
+    let level_at_a_time = |last| model.peak(file_bytes, last, glb, args.limit);
+    let fits = budget.is_none_or(|b| level_at_a_time(counts[args.levels]) <= b.bytes);
+    let last = counts[args.levels];
+    if glb {
+        crate::depth_first::check_glb_fits(&job.input, args.levels, last)?;
+    }
+    let why_not =
+        crate::depth_first::unsupported(scheme, args.levels, args.limit, &job.output, file);
+    let large = last.faces >= crate::depth_first::BY_ITSELF_FROM_FACES;
+    match why_not {
+        Some(why) if args.depth_first => Err(bad(format!(
+            "{}: --depth-first cannot make this output: {why}",
+            job.input.display()
+        ))),
+        None if args.depth_first || !fits || large => {
+            let threads = rayon::current_num_threads();
+            let bytes = budget.map_or(u64::MAX, |b| b.bytes);
+            let peak = DepthFirstPeak::fitting(bytes, file_bytes, threads);
+            match budget.filter(|b| peak.bytes > b.bytes) {
+                Some(b) => Err(bad(format!(
+                    "{}: refining {} levels depth-first needs about {}, over the budget of {} ({})",
+                    job.input.display(),
+                    args.levels,
+                    subd_mesh::memory::human_bytes(peak.bytes),
+                    subd_mesh::memory::human_bytes(b.bytes),
+                    b.source,
+                ))),
+                None => Ok(Plan::DepthFirst(peak.faces_per_chunk)),
+            }
+        }
+        _ => {
+            crate::budget::check_refinement(&job.input, &counts, level_at_a_time, budget)?;
+            Ok(Plan::LevelAtATime)
+        }
+    }
 }
 
 /// A progress bar on a terminal for refinements deep enough to take a while; nothing when

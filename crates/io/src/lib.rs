@@ -267,6 +267,27 @@ pub fn atomic_write(
         path: path.to_path_buf(),
         source,
     };
+    let mut tmp = temp_beside(path)?;
+    {
+        let mut buf = std::io::BufWriter::with_capacity(1 << 20, tmp.as_file_mut());
+        write(&mut buf).map_err(err)?;
+        buf.flush().map_err(err)?;
+    }
+    tmp.persist(path).map_err(|e| err(e.error))?;
+    Ok(())
+}
+
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;
+
+/// An empty temporary file in `path`'s directory, to be renamed over `path` when complete
+/// ([`atomic_write`]).
+pub(crate) fn temp_beside(path: &Path) -> Result<tempfile::NamedTempFile, IoError> {
+    let err = |source| IoError::Write {
+        path: path.to_path_buf(),
+        source,
+    };
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
@@ -281,19 +302,8 @@ pub fn atomic_write(
         use std::os::unix::fs::PermissionsExt;
         builder.permissions(std::fs::Permissions::from_mode(0o666));
     }
-    let mut tmp = builder.tempfile_in(dir).map_err(err)?;
-    {
-        let mut buf = std::io::BufWriter::with_capacity(1 << 20, tmp.as_file_mut());
-        write(&mut buf).map_err(err)?;
-        buf.flush().map_err(err)?;
-    }
-    tmp.persist(path).map_err(|e| err(e.error))?;
-    Ok(())
+    builder.tempfile_in(dir).map_err(err)
 }
-
-#[cfg(doctest)]
-#[doc = include_str!("../README.md")]
-struct ReadmeDoctests;
 
 /// `mesh` with the texture coordinates a reader found, if any (made for its topology).
 pub(crate) fn with_texcoords(

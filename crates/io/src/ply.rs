@@ -26,8 +26,10 @@ use crate::view::MeshView;
 use crate::{MeshFile, ReadOptions};
 
 mod binary;
+mod placed;
 mod write;
 
+pub use placed::PlacedPly;
 pub use write::{holds_texcoords, write_ply};
 
 /// PLY encoding to write.

@@ -85,8 +85,8 @@ use thiserror::Error;
 
 pub use face_varying::FaceVarying;
 pub use refine::{
-    ChildLayout, FVarLevelState, FVarLevelValues, FVarPatchTag, FVarValueKind, FaceStream,
-    FaceVaryingRefinement, LevelCounts, PointStream, refined_counts,
+    ChildLayout, ChunkLevel, DepthFirst, FVarLevelState, FVarLevelValues, FVarPatchTag,
+    FVarValueKind, FaceStream, FaceVaryingRefinement, LevelCounts, PointStream, refined_counts,
 };
 pub use refinement::Refinement;
 pub use rules::Rule;

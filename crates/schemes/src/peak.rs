@@ -31,6 +31,39 @@ const GLB_PER_VERTEX: u64 = 24;
 /// face around a vertex), per output vertex.
 const STREAMED_GLB_PER_VERTEX: u64 = 50;
 
+/// Bytes a depth-first chunk holds per face of the last level it makes: the piece's levels
+/// (its one-ring included), the last level's points and uniform indices, the encoded
+/// records. Measured with `/usr/bin/time -f %M` (BENCHMARKS.md, "Depth-first"), rounded up.
+const DEPTH_FIRST_PER_CHUNK_FACE: u64 = 400;
+/// The fewest and most last-level faces a depth-first chunk is sized for: fewer makes the
+/// pieces' one-rings most of the work, more gains nothing.
+const DEPTH_FIRST_CHUNK_FACES: (u64, u64) = (1 << 14, 1 << 18);
+
+/// A depth-first refinement's memory ([`crate::DepthFirst`]): `threads` chunks held at once,
+/// whatever the level.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct DepthFirstPeak {
+    /// Last-level faces per chunk.
+    pub faces_per_chunk: u64,
+    /// The estimated peak, in bytes.
+    pub bytes: u64,
+}
+
+impl DepthFirstPeak {
+    /// The largest chunks (within bounds) whose peak fits `budget` bytes with `threads`
+    /// chunks at once, from a file of `file_bytes`; the smallest chunks where none fit.
+    pub fn fitting(budget: u64, file_bytes: u64, threads: usize) -> DepthFirstPeak {
+        let fixed = FIXED_BYTES.saturating_add(PER_INPUT_BYTE.saturating_mul(file_bytes));
+        let per_chunk = DEPTH_FIRST_PER_CHUNK_FACE.saturating_mul(threads.max(1) as u64);
+        let (least, most) = DEPTH_FIRST_CHUNK_FACES;
+        let faces_per_chunk = (budget.saturating_sub(fixed) / per_chunk).clamp(least, most);
+        DepthFirstPeak {
+            faces_per_chunk,
+            bytes: fixed.saturating_add(per_chunk.saturating_mul(faces_per_chunk)),
+        }
+    }
+}
+
 impl PeakModel {
     /// The measured bytes per output vertex of `scheme` (the two-phase scheme is
     /// Catmull-Clark's after level 1; the split schemes hold every level and stream
@@ -67,6 +100,20 @@ mod tests {
 
     /// The estimate is affine in the output vertices and the file size, and each option
     /// adds what it holds.
+    /// A depth-first chunk is sized to the budget, within bounds, and the estimate does not
+    /// grow with the level.
+    #[test]
+    fn depth_first_chunks_fit_the_budget() {
+        let roomy = DepthFirstPeak::fitting(64 << 30, 0, 2);
+        assert_eq!(roomy.faces_per_chunk, DEPTH_FIRST_CHUNK_FACES.1);
+        let tight = DepthFirstPeak::fitting(FIXED_BYTES + 2 * 400 * 50_000, 0, 2);
+        assert_eq!(tight.faces_per_chunk, 50_000);
+        assert_eq!(tight.bytes, FIXED_BYTES + 2 * 400 * 50_000);
+        let none = DepthFirstPeak::fitting(1 << 20, 0, 16);
+        assert_eq!(none.faces_per_chunk, DEPTH_FIRST_CHUNK_FACES.0);
+        assert!(none.bytes > 1 << 20);
+    }
+
     #[test]
     fn the_estimate_adds_what_each_output_holds() {
         let last = |vertices| LevelCounts {

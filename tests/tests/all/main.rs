@@ -4,6 +4,7 @@
 mod acc;
 mod adaptive;
 mod curves;
+mod depth_first;
 mod editing;
 mod front_door;
 mod fvar_eval;

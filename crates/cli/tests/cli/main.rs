@@ -9,6 +9,7 @@ mod analyze;
 mod batch;
 mod budget;
 mod curve;
+mod depth_first;
 mod edit;
 mod eval;
 mod input;

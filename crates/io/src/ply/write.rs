@@ -57,8 +57,8 @@ pub fn write_ply(
     encoding: PlyEncoding,
 ) -> std::io::Result<()> {
     let out = PlyOutput::of(mesh)?;
-    write_header_start(w, mesh, encoding)?;
-    out.write_element_declarations(w)?;
+    write_header_start(w, &mesh.hints, encoding)?;
+    out.declarations().write(w)?;
     match encoding {
         PlyEncoding::Ascii => out.write_ascii_body(w),
         PlyEncoding::BinaryLittleEndian => out.write_binary_body(w),
@@ -80,8 +80,6 @@ struct PlyOutput<'a> {
     holes: Vec<usize>,
     /// Face sizes need a `uint` count (binary): a face has more than 255 vertices.
     wide_lists: bool,
-    /// `int`, or `uint` for vertex indices beyond `i32`.
-    index_ty: &'static str,
 }
 
 impl<'a> PlyOutput<'a> {
@@ -97,54 +95,22 @@ impl<'a> PlyOutput<'a> {
             corners: mesh.corners(),
             holes,
             wide_lists: mesh.max_face_size() > 255,
-            index_ty: if mesh.num_vertices() > i32::MAX as usize {
-                "uint"
-            } else {
-                "int"
-            },
         })
     }
 
-    /// The header from the elements on: vertex, face and tag elements, `end_header`.
-    fn write_element_declarations(&self, w: &mut dyn Write) -> std::io::Result<()> {
-        let index_ty = self.index_ty;
-        writeln!(w, "element vertex {}", self.mesh.num_vertices())?;
-        for c in ["x", "y", "z"] {
-            writeln!(w, "property double {c}")?;
+    /// What the header declares.
+    fn declarations(&self) -> Declarations {
+        Declarations {
+            num_vertices: self.mesh.num_vertices() as u64,
+            num_faces: self.mesh.num_faces() as u64,
+            normals: self.normals.is_some(),
+            uv: self.uv.is_some(),
+            wide_lists: self.wide_lists,
+            levels: self.levels.is_some(),
+            creases: self.creases.len(),
+            corners: self.corners.len(),
+            holes: self.holes.len(),
         }
-        if self.normals.is_some() {
-            for c in ["nx", "ny", "nz"] {
-                writeln!(w, "property double {c}")?;
-            }
-        }
-        if self.uv.is_some() {
-            writeln!(w, "property double u\nproperty double v")?;
-        }
-        writeln!(w, "element face {}", self.mesh.num_faces())?;
-        writeln!(
-            w,
-            "property list {} {index_ty} vertex_indices",
-            if self.wide_lists { "uint" } else { "uchar" }
-        )?;
-        if self.levels.is_some() {
-            writeln!(w, "property uchar level")?;
-        }
-        if !self.creases.is_empty() {
-            writeln!(w, "element crease {}", self.creases.len())?;
-            writeln!(
-                w,
-                "property {index_ty} v0\nproperty {index_ty} v1\nproperty float sharpness"
-            )?;
-        }
-        if !self.corners.is_empty() {
-            writeln!(w, "element corner {}", self.corners.len())?;
-            writeln!(w, "property {index_ty} vertex\nproperty float sharpness")?;
-        }
-        if !self.holes.is_empty() {
-            writeln!(w, "element hole {}", self.holes.len())?;
-            writeln!(w, "property int face")?;
-        }
-        writeln!(w, "end_header")
     }
 
     fn write_ascii_body(&self, w: &mut dyn Write) -> std::io::Result<()> {
@@ -277,9 +243,9 @@ impl<'a> PlyOutput<'a> {
 
 /// The header up to the elements: magic, format, and the comments that carry the mesh's
 /// scheme hints.
-fn write_header_start(
+pub(super) fn write_header_start(
     w: &mut dyn Write,
-    mesh: &MeshView<'_>,
+    hints: &SchemeHints,
     encoding: PlyEncoding,
 ) -> std::io::Result<()> {
     writeln!(w, "ply")?;
@@ -292,10 +258,10 @@ fn write_header_start(
         }
     )?;
     writeln!(w, "comment written by subd {}", env!("CARGO_PKG_VERSION"))?;
-    if let Some(b) = mesh.hints.boundary_interpolation {
+    if let Some(b) = hints.boundary_interpolation {
         writeln!(w, "comment subd interpolateboundary {}", b.to_shape_tag())?;
     }
-    if let Some(c) = mesh.hints.crease_method {
+    if let Some(c) = hints.crease_method {
         let s = if c == CreaseMethod::Chaikin {
             "chaikin"
         } else {
@@ -303,14 +269,14 @@ fn write_header_start(
         };
         writeln!(w, "comment subd creasemethod {s}")?;
     }
-    if let Some(m) = mesh.hints.fvar_interpolation {
+    if let Some(m) = hints.fvar_interpolation {
         writeln!(
             w,
             "comment subd facevaryinginterpolateboundary {}",
             m.to_shape_tag()
         )?;
     }
-    if let Some(t) = mesh.hints.triangle_subdivision {
+    if let Some(t) = hints.triangle_subdivision {
         let s = if t == TriangleSubdivision::Smooth {
             "smooth"
         } else {
@@ -319,4 +285,70 @@ fn write_header_start(
         writeln!(w, "comment subd smoothtriangles {s}")?;
     }
     Ok(())
+}
+
+/// `int` vertex indices, or `uint` past `i32`.
+fn index_type(num_vertices: u64) -> &'static str {
+    if num_vertices > i32::MAX as u64 {
+        "uint"
+    } else {
+        "int"
+    }
+}
+
+/// The elements a PLY header declares, from `element vertex` to `end_header`.
+pub(super) struct Declarations {
+    pub(super) num_vertices: u64,
+    pub(super) num_faces: u64,
+    pub(super) normals: bool,
+    pub(super) uv: bool,
+    /// Face sizes as `uint` (binary): a face has more than 255 vertices.
+    pub(super) wide_lists: bool,
+    pub(super) levels: bool,
+    pub(super) creases: usize,
+    pub(super) corners: usize,
+    pub(super) holes: usize,
+}
+
+impl Declarations {
+    pub(super) fn write(&self, w: &mut dyn Write) -> std::io::Result<()> {
+        let index_ty = index_type(self.num_vertices);
+        writeln!(w, "element vertex {}", self.num_vertices)?;
+        for c in ["x", "y", "z"] {
+            writeln!(w, "property double {c}")?;
+        }
+        if self.normals {
+            for c in ["nx", "ny", "nz"] {
+                writeln!(w, "property double {c}")?;
+            }
+        }
+        if self.uv {
+            writeln!(w, "property double u\nproperty double v")?;
+        }
+        writeln!(w, "element face {}", self.num_faces)?;
+        writeln!(
+            w,
+            "property list {} {index_ty} vertex_indices",
+            if self.wide_lists { "uint" } else { "uchar" }
+        )?;
+        if self.levels {
+            writeln!(w, "property uchar level")?;
+        }
+        if self.creases > 0 {
+            writeln!(w, "element crease {}", self.creases)?;
+            writeln!(
+                w,
+                "property {index_ty} v0\nproperty {index_ty} v1\nproperty float sharpness"
+            )?;
+        }
+        if self.corners > 0 {
+            writeln!(w, "element corner {}", self.corners)?;
+            writeln!(w, "property {index_ty} vertex\nproperty float sharpness")?;
+        }
+        if self.holes > 0 {
+            writeln!(w, "element hole {}", self.holes)?;
+            writeln!(w, "property int face")?;
+        }
+        writeln!(w, "end_header")
+    }
 }

@@ -4,6 +4,7 @@
 //! [`StencilTable`].
 
 mod counts;
+mod depth_first;
 mod fused;
 mod fvar;
 mod layout;
@@ -16,6 +17,7 @@ mod tags;
 
 pub use counts::{LevelCounts, refined_counts};
 pub(crate) use counts::{last_level_bytes, topology_bytes};
+pub use depth_first::{ChunkLevel, DepthFirst};
 pub use fvar::{
     FVarLevelState, FVarLevelValues, FVarPatchTag, FVarValueKind, FaceVaryingRefinement,
 };

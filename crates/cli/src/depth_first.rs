@@ -1,0 +1,156 @@
+//! `subd refine`'s depth-first output: the last level made a chunk of base faces at a time
+//! (`subd_schemes::DepthFirst`) and each chunk's records written at their places in a
+//! binary PLY file (`subd_io::ply::PlacedPly`), so that no level is held whole and the
+//! peak memory does not grow with the level. The file is byte for byte the one the level
+//! at a time writes.
+
+use std::path::Path;
+
+use subd_io::{IoError, MeshFile};
+use subd_mesh::tags::is_infinite;
+use subd_mesh::{DVec3, SchemeHints, Topology};
+use subd_schemes::{DepthFirst, LevelCounts, Options, RefineError, Scheme};
+
+use crate::Failure;
+use crate::failure::bad;
+
+/// Why `levels` levels of `file` under `scheme` cannot be written depth-first to `output`
+/// (`None` when they can): what the output would hold beyond positions and faces of one
+/// size is made level by level.
+pub(crate) fn unsupported(
+    scheme: &Scheme,
+    levels: usize,
+    limit: bool,
+    output: &Path,
+    file: &MeshFile,
+) -> Option<&'static str> {
+    let tags = file.mesh.topology.tags();
+    let lasting = |s: &f32| is_infinite(*s) || *s > levels as f32;
+    if !matches!(
+        scheme,
+        Scheme::CatmullClark | Scheme::Loop | Scheme::Bilinear
+    ) {
+        Some("it takes Catmull-Clark, Loop or Bilinear")
+    } else if levels == 0 {
+        Some("there is no level to refine")
+    } else if limit {
+        Some("--limit moves the whole level")
+    } else if subd_io::Format::for_output(output) != Some(subd_io::Format::Ply) {
+        Some("it writes binary PLY (.ply) only")
+    } else if !file.mesh.fvar.is_empty() {
+        Some("texture coordinates are carried level by level")
+    } else if tags.num_holes() > 0 {
+        Some("holes are carried level by level")
+    } else if tags.edge_sharpness().iter().any(lasting)
+        || tags.vertex_sharpness().iter().any(lasting)
+    {
+        Some("creases or corners sharp past the last level are written as tags")
+    } else {
+        None
+    }
+}
+
+/// Output levels of at least this many faces are made depth-first where they can be, even
+/// when the level at a time fits: from there on it is the faster of the two (BENCHMARKS.md,
+/// "Depth-first refinement"), and its memory stays flat.
+pub(crate) const BY_ITSELF_FROM_FACES: u64 = 1 << 24;
+
+/// Refuses, before any work, a `.glb` output past glTF's 4 GiB binary limit: its `f32`
+/// positions and normals and `u32` triangle indices (a quad is two triangles).
+pub(crate) fn check_glb_fits(
+    input: &Path,
+    levels: usize,
+    last: LevelCounts,
+) -> Result<(), Failure> {
+    let triangles = last.face_vertices.saturating_sub(2 * last.faces);
+    let bytes = 24u64
+        .saturating_mul(last.vertices)
+        .saturating_add(12u64.saturating_mul(triangles));
+    if bytes <= u32::MAX as u64 {
+        return Ok(());
+    }
+    Err(bad(format!(
+        "{}: level {levels} ({} vertices, {} faces) needs about {} as .glb, past glTF's 4 GiB limit on a binary file; write .ply or .obj",
+        input.display(),
+        last.vertices,
+        last.faces,
+        subd_mesh::memory::human_bytes(bytes),
+    )))
+}
+
+/// What writing the last level depth-first needs.
+pub(crate) struct Request<'a> {
+    pub(crate) base: &'a Topology,
+    pub(crate) positions: &'a [DVec3],
+    pub(crate) scheme: &'a Scheme,
+    pub(crate) options: &'a Options,
+    pub(crate) levels: usize,
+    pub(crate) faces_per_chunk: u64,
+    pub(crate) hints: SchemeHints,
+    pub(crate) input: &'a Path,
+    pub(crate) output: &'a Path,
+}
+
+/// A chunk's failure: refining its piece, or writing its records.
+enum ChunkError {
+    Refine(RefineError),
+    Io(IoError),
+}
+
+impl From<RefineError> for ChunkError {
+    fn from(e: RefineError) -> Self {
+        ChunkError::Refine(e)
+    }
+}
+
+impl From<IoError> for ChunkError {
+    fn from(e: IoError) -> Self {
+        ChunkError::Io(e)
+    }
+}
+
+/// Refines and writes the last level chunk by chunk, all threads at work; its counts.
+pub(crate) fn write(request: &Request<'_>) -> Result<LevelCounts, Failure> {
+    let in_input = |e: RefineError| bad(format!("{}: {e}", request.input.display()));
+    subd_mesh::memory::reuse_freed_memory();
+    // PLY's limits are checked before any work.
+    let last =
+        subd_schemes::refined_counts(request.base, request.scheme, request.levels)[request.levels];
+    let size = if *request.scheme == Scheme::Loop {
+        3
+    } else {
+        4
+    };
+    let ply = subd_io::ply::PlacedPly::create(
+        request.output,
+        &request.hints,
+        last.vertices,
+        last.faces,
+        size,
+    )?;
+    let df = DepthFirst::new(
+        request.base,
+        request.scheme.clone(),
+        request.options,
+        request.levels,
+        request.faces_per_chunk,
+    )
+    .map_err(in_input)?;
+    let counts = df.counts();
+    let threads = rayon::current_num_threads();
+    let written = df.for_each_chunk(request.positions, threads, |chunk| {
+        for (first, range) in chunk.point_runs() {
+            ply.write_points(first, &chunk.points()[range])?;
+        }
+        for (first, range) in chunk.face_runs(size) {
+            ply.write_faces(first, &chunk.face_vertices()[range])?;
+        }
+        Ok::<(), ChunkError>(())
+    });
+    match written {
+        Ok(()) => ply.finish()?,
+        Err(ChunkError::Refine(e)) => return Err(in_input(e)),
+        Err(ChunkError::Io(e)) => return Err(e.into()),
+    }
+    Ok(counts)
+}
