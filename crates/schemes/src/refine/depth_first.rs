@@ -129,7 +129,8 @@ impl DepthFirst {
     ///
     /// # Errors
     /// What [`Refinement::new`] refuses in `base`; [`RefineError::Unsupported`] for another
-    /// scheme (the two-phase scheme and the split schemes); [`RefineError::TooLarge`] when the
+    /// scheme (the two-phase scheme and the split schemes) or no level;
+    /// [`RefineError::TooManyLevels`] past [`crate::MAX_LEVELS`]; [`RefineError::TooLarge`] when the
     /// last level has more than 2^32 vertices (its faces could not name them in 32 bits).
     pub fn new(
         base: &Topology,
@@ -146,6 +147,12 @@ impl DepthFirst {
             return Err(RefineError::Unsupported {
                 scheme: scheme.to_string(),
                 what: "depth-first refinement takes Catmull-Clark, Loop or Bilinear, one level or more",
+            });
+        }
+        if levels > crate::MAX_LEVELS {
+            return Err(RefineError::TooManyLevels {
+                levels,
+                max: crate::MAX_LEVELS,
             });
         }
         let layout = ChildLayout::new(base, &scheme, levels).expect("a quad or triangle split");
@@ -531,5 +538,39 @@ impl DepthFirst {
             Some(e) => Err(e),
             None => Ok(()),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use subd_mesh::TopologyBuilder;
+
+    /// What cannot be planned is an error naming why, never a panic or an overflow.
+    #[test]
+    fn plans_out_of_reach_are_errors() {
+        let quad = TopologyBuilder::new(4).build(&[4], &[0, 1, 2, 3]).unwrap();
+        let opts = Options::default();
+        let plan = |scheme: Scheme, levels| DepthFirst::new(&quad, scheme, &opts, levels, 1);
+        assert!(matches!(
+            plan(Scheme::CatmullClark, 64),
+            Err(RefineError::TooManyLevels { levels: 64, .. })
+        ));
+        assert!(matches!(
+            plan(Scheme::CatmullClark, 0),
+            Err(RefineError::Unsupported { .. })
+        ));
+        assert!(matches!(
+            plan(Scheme::Sqrt3, 2),
+            Err(RefineError::Unsupported { .. })
+        ));
+        assert!(matches!(
+            plan(Scheme::Loop, 1),
+            Err(RefineError::NotTriangle { face: 0, .. })
+        ));
+        // One quad to level 15: 2^30 faces, 2^30 + 2^16 + ... vertices, within 2^32.
+        let deep = plan(Scheme::CatmullClark, 15).unwrap();
+        assert_eq!(deep.counts().faces, 1 << 30);
+        assert_eq!(deep.counts().vertices, ((1u64 << 15) + 1).pow(2));
     }
 }
