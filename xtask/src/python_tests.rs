@@ -9,7 +9,8 @@ use crate::run;
 
 /// What the tests import besides `subd` (from PyPI): the runner, property tests, SciPy
 /// (the stencil matrices come back as its CSR matrices), libigl (an independent Loop),
-/// trimesh (the benchmark's other Loop) and Dask's distributed scheduler (the batch
+/// trimesh (the benchmark's other Loop, and `Mesh.to_trimesh`'s other side), PyVista (with
+/// VTK: `Mesh.to_pyvista`'s other side) and Dask's distributed scheduler (the batch
 /// example).
 pub(crate) const TEST_PACKAGES: &[&str] = &[
     "maturin",
@@ -19,6 +20,7 @@ pub(crate) const TEST_PACKAGES: &[&str] = &[
     "scipy",
     "libigl",
     "trimesh",
+    "pyvista",
     "dask[distributed]",
     // Pixar's USD: the reference the USD tests hold subd's reader and writer to.
     "usd-core",

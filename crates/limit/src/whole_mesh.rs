@@ -332,6 +332,16 @@ impl RefinedMesh {
         self.refinement.faces(self.level)
     }
 
+    /// The faces of the last level a range at a time (or written whole into a buffer of
+    /// another index type), from the level above without holding the level's face lists;
+    /// `None` where the scheme does not stream them (the split schemes) or nothing was
+    /// refined.
+    pub fn face_stream(&self) -> Option<subd_schemes::FaceStream<'_>> {
+        (self.level > 0)
+            .then(|| self.refinement.face_stream())
+            .flatten()
+    }
+
     /// The texture coordinates of the last level, if carried.
     pub fn uv(&self) -> Option<&RefinedUv> {
         self.uv.as_ref()
@@ -343,7 +353,9 @@ impl RefinedMesh {
     }
 
     /// The refined mesh with its full topology (built now if it is not yet) and its limit
-    /// normals.
+    /// normals. The positions are moved, not copied: the mesh's positions are the buffer
+    /// [`Self::positions`] pointed at (what lets a binding hand out a view of them before
+    /// the topology is built).
     pub fn into_mesh(self) -> Result<(Mesh, Option<Vec<DVec3>>), LimitError> {
         let topology = self.refinement.into_topology(self.level);
         let mut out = Mesh::new(topology, self.positions)?;

@@ -1,7 +1,8 @@
-//! Arrays handed to Python: allocated by numpy (so they own their data, `OWNDATA` set, and
-//! outlive the mesh they came from) and filled in place, in parallel on the package's pool
-//! with the GIL released: the library's values are converted once, with no intermediate
-//! vector.
+//! Arrays handed to Python. Where the library's buffer has numpy's type (positions,
+//! normals) the array is a read-only view of it that keeps its mesh alive ([`view2`]);
+//! otherwise it is allocated by numpy (owning its data) and filled in place, in parallel on
+//! the package's pool with the GIL released, the values converted once with no
+//! intermediate vector (indices in the [`IndexType`] asked for).
 
 use numpy::ndarray::Dimension;
 use numpy::{
@@ -128,15 +129,6 @@ pub(crate) fn flat_rows<'py>(
     flat(py, values, k, |x| x)
 }
 
-/// Indices (`k` per row) as an `(n, k)` int64 array.
-pub(crate) fn flat_ints<'py>(
-    py: Python<'py>,
-    values: &[u32],
-    k: usize,
-) -> PyResult<Bound<'py, PyArray2<i64>>> {
-    flat(py, values, k, i64::from)
-}
-
 /// The elements of a C-contiguous array, or a `ValueError` naming the argument `what`.
 pub(crate) fn contiguous<'a, T: Element, D: Dimension>(
     a: &'a PyReadonlyArray<'_, T, D>,
@@ -185,4 +177,127 @@ pub(crate) unsafe fn view2<'py, T: Element>(
     let array = unsafe { PyArray2::borrow_from_array(&view, owner) };
     array.readwrite().make_nonwriteable();
     Ok(array)
+}
+
+/// The integer type face indices are handed out in (`index_dtype` in Python): numpy's
+/// int64 by default, as trimesh and libigl take them; int32 or uint32 for half the memory.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum IndexType {
+    I64,
+    I32,
+    U32,
+}
+
+impl IndexType {
+    /// The type numpy names `name` (`"int64"`, `"int32"`, `"uint32"`).
+    pub(crate) fn named(name: &str) -> PyResult<IndexType> {
+        match name {
+            "int64" => Ok(IndexType::I64),
+            "int32" => Ok(IndexType::I32),
+            "uint32" => Ok(IndexType::U32),
+            _ => Err(PyValueError::new_err(format!(
+                "index_dtype: {name} is not int64, int32 or uint32"
+            ))),
+        }
+    }
+
+    /// Refuses int32 for indices that reach past its range (`bound` elements indexed).
+    pub(crate) fn check_holds(self, bound: usize) -> PyResult<()> {
+        if self == IndexType::I32 && bound > i32::MAX as usize + 1 {
+            return Err(crate::errors::mesh_error(format!(
+                "index_dtype int32 cannot index {bound} vertices: take int64 or uint32"
+            )));
+        }
+        Ok(())
+    }
+
+    /// A new read-only `(n,)` array of this type, numpy's own, `write` filling it on the
+    /// pool with indices converted as the type needs (the GIL released).
+    pub(crate) fn filled<'py>(
+        self,
+        py: Python<'py>,
+        n: usize,
+        write: impl Fn(&mut dyn IndexSink) + Send + Sync,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        fn make<'py, T: Element + Copy + Send + Sync>(
+            py: Python<'py>,
+            n: usize,
+            fill: impl FnOnce(&mut [T]) + Send,
+        ) -> PyResult<Bound<'py, PyAny>> {
+            let array = PyArray1::<T>::zeros(py, n, false);
+            {
+                let mut rw = array.readwrite();
+                let out = rw.as_slice_mut().expect("a new array is contiguous");
+                pool::run(py, || fill(out))?;
+                rw.make_nonwriteable();
+            }
+            Ok(array.into_any())
+        }
+        match self {
+            IndexType::I64 => make(py, n, |out: &mut [i64]| write(&mut Sink(out))),
+            IndexType::I32 => make(py, n, |out: &mut [i32]| write(&mut Sink(out))),
+            IndexType::U32 => make(py, n, |out: &mut [u32]| write(&mut Sink(out))),
+        }
+    }
+
+    /// `values` as a new read-only array of this type.
+    pub(crate) fn copied<'py>(
+        self,
+        py: Python<'py>,
+        values: &[u32],
+    ) -> PyResult<Bound<'py, PyAny>> {
+        self.filled(py, values.len(), |sink| sink.convert_from(values))
+    }
+}
+
+/// Where indices are written in whatever type the caller asked for.
+pub(crate) trait IndexSink {
+    /// `values` converted into the whole buffer, in parallel.
+    fn convert_from(&mut self, values: &[u32]);
+    /// The faces of a refinement's last level written into the whole buffer.
+    fn faces_from(&mut self, stream: &subd_schemes::FaceStream<'_>);
+}
+
+/// An index buffer of one type.
+struct Sink<'a, T>(&'a mut [T]);
+
+/// The conversion from the library's `u32` (checked against the type's range by
+/// [`IndexType::check_holds`] before any writing).
+trait FromIndex: Copy + Send + Sync {
+    fn from_index(v: u32) -> Self;
+}
+
+impl FromIndex for i64 {
+    fn from_index(v: u32) -> Self {
+        i64::from(v)
+    }
+}
+
+impl FromIndex for i32 {
+    fn from_index(v: u32) -> Self {
+        v as i32
+    }
+}
+
+impl FromIndex for u32 {
+    fn from_index(v: u32) -> Self {
+        v
+    }
+}
+
+impl<T: FromIndex> IndexSink for Sink<'_, T> {
+    fn convert_from(&mut self, values: &[u32]) {
+        self.0
+            .par_chunks_mut(4 * CHUNK_ROWS)
+            .zip(values.par_chunks(4 * CHUNK_ROWS))
+            .for_each(|(out, v)| {
+                for (o, &x) in out.iter_mut().zip(v) {
+                    *o = T::from_index(x);
+                }
+            });
+    }
+
+    fn faces_from(&mut self, stream: &subd_schemes::FaceStream<'_>) {
+        stream.write_all(self.0, T::from_index);
+    }
 }

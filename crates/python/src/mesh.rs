@@ -11,7 +11,7 @@ use subd_mesh::{DVec3, Mesh, TopologyBuilder};
 use subd_schemes::Scheme;
 
 use crate::arrays::{
-    columns, contiguous, copied1, filled1, filled2, flat_ints, flat_rows, index, points,
+    IndexType, columns, contiguous, copied1, filled1, filled2, flat_rows, index, view2,
 };
 use crate::errors::{io_error, mesh_error};
 use crate::pool;
@@ -38,11 +38,9 @@ pub(crate) struct CoreMesh {
     pub(crate) unnamed_cage: Option<Scheme>,
 }
 
-/// What the arrays of a mesh are read from, built or not.
+/// The face offsets and texture coordinates of a mesh, built or not.
 pub(crate) struct Faces<'a> {
-    pub(crate) positions: &'a [DVec3],
     pub(crate) offsets: &'a [u32],
-    pub(crate) face_vertices: &'a [u32],
     /// Texture coordinates: values (two numbers each) and one index per face-vertex.
     pub(crate) uv: Option<(&'a [f64], &'a [u32])>,
 }
@@ -123,39 +121,71 @@ impl CoreMesh {
         }
     }
 
-    /// `read` applied to the mesh's faces, positions and texture coordinates, from the
-    /// refinement's result where its topology is not built.
-    pub(crate) fn with_faces<T>(&self, py: Python<'_>, read: impl FnOnce(Faces<'_>) -> T) -> T {
-        fn of_mesh(m: &Mesh) -> Faces<'_> {
-            Faces {
-                positions: &m.positions,
-                offsets: m.topology.face_offsets(),
-                face_vertices: m.topology.all_face_vertices(),
-                uv: m.uv().map(|c| (c.values(), c.indices())),
-            }
-        }
+    /// `read` applied to what the mesh holds now: the refinement's result where its
+    /// topology is not built, else the mesh.
+    fn with_held<T>(&self, py: Python<'_>, read: impl FnOnce(Held<'_>) -> T) -> T {
         if let Some(m) = self.built.get() {
-            return read(of_mesh(m));
+            return read(Held::Built(m));
         }
         let pending = self.lock_pending(py);
         match pending.as_ref() {
-            Some(r) => {
-                let (offsets, face_vertices) = r.faces();
-                read(Faces {
-                    positions: r.positions(),
-                    offsets,
-                    face_vertices,
-                    uv: r.uv().map(|u| (&u.values[..], &u.indices[..])),
-                })
-            }
+            Some(r) => read(Held::Pending(r)),
             // Taken by `mesh`, which set the mesh before letting go of the lock.
-            None => read(of_mesh(
+            None => read(Held::Built(
                 self.built
                     .get()
                     .expect("built before the lock was released"),
             )),
         }
     }
+
+    /// `read` applied to the mesh's face offsets and texture coordinates, from the
+    /// refinement's result where its topology is not built.
+    pub(crate) fn with_faces<T>(&self, py: Python<'_>, read: impl FnOnce(Faces<'_>) -> T) -> T {
+        self.with_held(py, |held| match held {
+            Held::Pending(r) => read(Faces {
+                offsets: r.faces().0,
+                uv: r.uv().map(|u| (&u.values[..], &u.indices[..])),
+            }),
+            Held::Built(m) => read(Faces {
+                offsets: m.topology.face_offsets(),
+                uv: m.uv().map(|c| (c.values(), c.indices())),
+            }),
+        })
+    }
+
+    /// `read` applied to the positions alone (a refinement's result makes no face list for
+    /// them).
+    fn with_positions<T>(&self, py: Python<'_>, read: impl FnOnce(&[DVec3]) -> T) -> T {
+        self.with_held(py, |held| match held {
+            Held::Pending(r) => read(r.positions()),
+            Held::Built(m) => read(&m.positions),
+        })
+    }
+
+    /// Number of faces and, when they all have the same number of corners, that number
+    /// (from a refinement's face stream where it has one, without a face list).
+    fn face_counts(&self, py: Python<'_>) -> (usize, Option<usize>) {
+        fn of_offsets(offsets: &[u32]) -> (usize, Option<usize>) {
+            let mut sizes = offsets.windows(2).map(|w| w[1] - w[0]);
+            let k = sizes.next().unwrap_or(3);
+            let uniform = sizes.all(|s| s == k).then_some(k as usize);
+            (offsets.len() - 1, uniform)
+        }
+        self.with_held(py, |held| match held {
+            Held::Pending(r) => match r.face_stream() {
+                Some(s) => (s.num_faces(), Some(s.face_size())),
+                None => of_offsets(r.faces().0),
+            },
+            Held::Built(m) => of_offsets(m.topology.face_offsets()),
+        })
+    }
+}
+
+/// What a mesh holds: a refinement's result whose topology is not built yet, or the mesh.
+enum Held<'a> {
+    Pending(&'a RefinedMesh),
+    Built(&'a Mesh),
 }
 
 /// The arrays a mesh is made of, as the Python layer passes them (C-contiguous, exact
@@ -360,21 +390,45 @@ impl CoreMesh {
         Ok(CoreMesh::plain(mesh))
     }
 
-    /// Vertex positions, `(n, 3)` float64.
+    /// Vertex positions, `(n, 3)` float64: a read-only view of the mesh's own buffer (no
+    /// copy; the array keeps the mesh alive).
     #[getter]
-    fn vertices<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        self.with_faces(py, |f| points(py, f.positions))
+    fn vertices<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let owner = slf.clone().into_any();
+        slf.get().with_positions(slf.py(), |positions| {
+            // SAFETY: the positions are this mesh's, never changed nor freed while it lives:
+            // a built mesh is never changed (the class is frozen) and building a pending one
+            // moves the buffer into it (`RefinedMesh::into_mesh`).
+            #[allow(unsafe_code)]
+            unsafe {
+                view2(bytemuck::cast_slice::<DVec3, f64>(positions), 3, owner)
+            }
+        })
     }
 
-    /// Unit limit normals, `(n, 3)` float64, or `None`.
+    /// Unit limit normals, `(n, 3)` float64 (a read-only view, as `vertices`), or `None`.
     #[getter]
-    fn normals<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyArray2<f64>>>> {
-        self.normals.as_deref().map(|n| points(py, n)).transpose()
+    fn normals<'py>(slf: &Bound<'py, Self>) -> PyResult<Option<Bound<'py, PyArray2<f64>>>> {
+        let owner = slf.clone().into_any();
+        slf.get()
+            .normals
+            .as_deref()
+            // SAFETY: the normals are a field of this frozen mesh, set once when it was made.
+            .map(|n| {
+                #[allow(unsafe_code)]
+                unsafe {
+                    view2(bytemuck::cast_slice::<DVec3, f64>(n), 3, owner)
+                }
+            })
+            .transpose()
     }
 
     /// Number of corners of every face, `(m,)` int64.
     #[getter]
     fn face_sizes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<i64>>> {
+        if let (n, Some(k)) = self.face_counts(py) {
+            return filled1(py, n, |_| k as i64);
+        }
         self.with_faces(py, |f| {
             let offsets = f.offsets;
             filled1(py, offsets.len() - 1, |i| {
@@ -383,25 +437,30 @@ impl CoreMesh {
         })
     }
 
-    /// Vertex indices of every face, one face after the other, int64.
-    #[getter]
-    fn face_vertices<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<i64>>> {
-        self.with_faces(py, |f| {
-            let fv = f.face_vertices;
-            filled1(py, fv.len(), |i| i64::from(fv[i]))
+    /// Vertex indices of every face, one face after the other, in `index_dtype` (`"int64"`,
+    /// `"int32"` or `"uint32"`), read-only.
+    fn face_vertices<'py>(
+        &self,
+        py: Python<'py>,
+        index_dtype: &str,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let ty = IndexType::named(index_dtype)?;
+        ty.check_holds(self.num_vertices(py))?;
+        self.with_held(py, |held| match held {
+            Held::Pending(r) => match r.face_stream() {
+                Some(stream) => {
+                    let n = stream.num_faces() * stream.face_size();
+                    ty.filled(py, n, |sink| sink.faces_from(&stream))
+                }
+                None => ty.copied(py, r.faces().1),
+            },
+            Held::Built(m) => ty.copied(py, m.topology.all_face_vertices()),
         })
     }
 
-    /// The faces as an `(m, k)` int64 array when every face has `k` corners, else `None`.
-    fn uniform_faces<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyArray2<i64>>>> {
-        self.with_faces(py, |f| {
-            let sizes = || f.offsets.windows(2).map(|w| w[1] - w[0]);
-            let k = sizes().next().unwrap_or(3) as usize;
-            if sizes().any(|s| s as usize != k) {
-                return Ok(None);
-            }
-            flat_ints(py, f.face_vertices, k).map(Some)
-        })
+    /// The number of corners every face has, or `None` when faces differ.
+    fn uniform_face_size(&self, py: Python<'_>) -> Option<usize> {
+        self.face_counts(py).1
     }
 
     /// Texture coordinates, `(u, 2)` float64, or `None`.
@@ -412,12 +471,19 @@ impl CoreMesh {
         })
     }
 
-    /// One texture-coordinate index per face-vertex, int64, or `None`.
-    #[getter]
-    fn uv_indices<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyArray1<i64>>>> {
+    /// One texture-coordinate index per face-vertex in `index_dtype`, or `None`.
+    fn uv_indices<'py>(
+        &self,
+        py: Python<'py>,
+        index_dtype: &str,
+    ) -> PyResult<Option<Bound<'py, PyAny>>> {
+        let ty = IndexType::named(index_dtype)?;
         self.with_faces(py, |f| {
-            f.uv.map(|(_, x)| filled1(py, x.len(), |i| i64::from(x[i])))
-                .transpose()
+            f.uv.map(|(values, x)| {
+                ty.check_holds(values.len() / 2)?;
+                ty.copied(py, x)
+            })
+            .transpose()
         })
     }
 
@@ -479,24 +545,34 @@ impl CoreMesh {
     /// Indices of the faces that are holes, int64.
     #[getter]
     fn holes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<i64>>> {
-        let t = &self.mesh(py)?.topology;
-        let h: Vec<i64> = (0..t.num_faces())
-            .filter(|&f| t.is_hole(f))
-            .map(|f| f as i64)
-            .collect();
+        // A refinement's result names its holes from the level above, without its topology.
+        let streamed = self.with_held(py, |held| match held {
+            Held::Pending(r) => r.face_stream().map(|s| s.hole_faces()),
+            Held::Built(_) => None,
+        });
+        let h: Vec<i64> = match streamed {
+            Some(faces) => faces.into_iter().map(|f| f as i64).collect(),
+            None => {
+                let t = &self.mesh(py)?.topology;
+                (0..t.num_faces())
+                    .filter(|&f| t.is_hole(f))
+                    .map(|f| f as i64)
+                    .collect()
+            }
+        };
         copied1(py, &h)
     }
 
     /// Number of vertices.
     #[getter]
     fn num_vertices(&self, py: Python<'_>) -> usize {
-        self.with_faces(py, |f| f.positions.len())
+        self.with_positions(py, <[DVec3]>::len)
     }
 
     /// Number of faces.
     #[getter]
     fn num_faces(&self, py: Python<'_>) -> usize {
-        self.with_faces(py, |f| f.offsets.len() - 1)
+        self.face_counts(py).0
     }
 
     /// Number of edges.

@@ -6,13 +6,13 @@ use std::path::PathBuf;
 use numpy::PyArray2;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use subd_limit::refined_mesh::{MeshRefinement, refine_mesh};
+use subd_limit::refined_mesh::{MeshRefinement, RefinedMesh, refine_mesh};
 use subd_mesh::Mesh;
 use subd_mesh::fvar::FVarLinearInterpolation;
 use subd_mesh::report::MeshReport;
 use subd_schemes::{Options, Scheme};
 
-use crate::arrays::points;
+use crate::arrays::{IndexType, points};
 use crate::errors::{io_error, mesh_error};
 use crate::mesh::CoreMesh;
 use crate::pool;
@@ -149,10 +149,10 @@ pub(crate) fn mesh_prims(
 /// named), its vertices and texture coordinates moved to the limit surface, with unit
 /// normals, when `limit`: the mesh and what was left out (warnings).
 #[pyfunction]
-#[pyo3(signature = (mesh, scheme_name, levels, limit = false, boundary = None, crease_method = None, triangles = None, fvar_interpolation = None))]
+#[pyo3(signature = (mesh, scheme_name, levels, limit = false, boundary = None, crease_method = None, triangles = None, fvar_interpolation = None, index_dtype = "int64"))]
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn refine(
-    py: Python<'_>,
+pub(crate) fn refine<'py>(
+    py: Python<'py>,
     mesh: &CoreMesh,
     scheme_name: &str,
     levels: usize,
@@ -161,7 +161,9 @@ pub(crate) fn refine(
     crease_method: Option<&str>,
     triangles: Option<&str>,
     fvar_interpolation: Option<&str>,
-) -> PyResult<(CoreMesh, Vec<String>)> {
+    index_dtype: &str,
+) -> PyResult<(CoreMesh, Vec<String>, Option<Bound<'py, PyAny>>)> {
+    let index_type = IndexType::named(index_dtype)?;
     let rules = RuleNames {
         boundary,
         crease_method,
@@ -179,7 +181,26 @@ pub(crate) fn refine(
     };
     let mut refined = pool::run(py, || refine_mesh(base, &request))?.map_err(mesh_error)?;
     let warnings = std::mem::take(&mut refined.warnings);
-    Ok((CoreMesh::refined(refined).made_from(mesh), warnings))
+    let faces = last_faces(py, &refined, index_type)?;
+    Ok((CoreMesh::refined(refined).made_from(mesh), warnings, faces))
+}
+
+/// The face-vertex indices of a refinement's last level written once, straight into the
+/// array Python keeps (`index_type`), from the level above: no `u32` face list is made
+/// unless something else asks for one. `None` where the scheme does not stream its faces.
+fn last_faces<'py>(
+    py: Python<'py>,
+    refined: &RefinedMesh,
+    index_type: IndexType,
+) -> PyResult<Option<Bound<'py, PyAny>>> {
+    let Some(stream) = refined.face_stream() else {
+        return Ok(None);
+    };
+    index_type.check_holds(refined.positions().len())?;
+    let n = stream.num_faces() * stream.face_size();
+    index_type
+        .filled(py, n, |sink| sink.faces_from(&stream))
+        .map(Some)
 }
 
 /// A refinement request checked: the scheme, the options for `mesh` and the output's size.

@@ -1,6 +1,7 @@
 """Tests of the Python package against independent computations: the `subd` binary's files
 (the Rust library through its CLI), libigl's Loop, closed forms, and OBJ tags."""
 
+import gc
 import json
 import os
 import pathlib
@@ -57,15 +58,53 @@ def test_cube_refines_to_the_closed_form_counts_and_keeps_symmetry():
     assert np.allclose(fine.vertices.mean(axis=0), [0.5, 0.5, 0.5], atol=1e-14)
 
 
-def test_outputs_are_contiguous_writable_copies():
+def test_properties_are_the_same_read_only_arrays_without_copies():
     fine = subd.refine(subd.Mesh(CUBE_V, CUBE_F), "catmull-clark", 1)
-    for a, dtype in [(fine.vertices, np.float64), (fine.face_vertices, np.int64),
-                     (fine.face_sizes, np.int64)]:
-        assert a.dtype == dtype and a.flags["C_CONTIGUOUS"] and a.flags["WRITEABLE"]
-    # Each property is the caller's own array: writing to it leaves the mesh alone.
+    for name, dtype in [("vertices", np.float64), ("face_vertices", np.int64),
+                        ("face_sizes", np.int64), ("faces", np.int64)]:
+        a = getattr(fine, name)
+        assert a.dtype == dtype and a.flags["C_CONTIGUOUS"], name
+        assert getattr(fine, name) is a, f"{name}: a new array on a second access"
+        with pytest.raises(ValueError):
+            a[0] = 0  # the mesh's own: read-only
+    # The positions are a view of the library's buffer, which the array keeps alive.
     v = fine.vertices
-    v[:] = 0.0
-    assert fine.vertices.max() > 0.5
+    assert not v.flags["OWNDATA"] and v.base is not None
+    address = v.__array_interface__["data"][0]
+    assert fine.num_edges == 48  # builds the topology: the positions are moved, not copied
+    assert subd.Mesh._wrap(fine._core).vertices.__array_interface__["data"][0] == address
+    # faces is a view of face_vertices.
+    assert np.shares_memory(fine.faces, fine.face_vertices)
+    # The view outlives the mesh object it came from, with the same values.
+    del fine
+    want = subd.refine(subd.Mesh(CUBE_V, CUBE_F), "catmull-clark", 1).vertices
+    assert v.shape == (26, 3) and np.array_equal(v, want)
+
+
+@pytest.mark.parametrize("dtype", [np.int64, np.int32, np.uint32])
+def test_index_dtype_gives_the_same_faces_in_that_type(dtype):
+    cube = subd.Mesh(CUBE_V, CUBE_F)
+    want = subd.refine(cube, "catmull-clark", 2).faces
+    fine = subd.refine(cube, "catmull-clark", 2, index_dtype=dtype)
+    assert fine.index_dtype == np.dtype(dtype) and fine.faces.dtype == np.dtype(dtype)
+    assert fine.face_vertices.dtype == np.dtype(dtype)
+    assert np.array_equal(fine.faces.astype(np.int64), want)
+    # The type is kept by what is made from the mesh, and can be changed afterwards.
+    again = subd.refine(fine, "catmull-clark", 1)
+    assert again.faces.dtype == np.dtype(dtype)
+    again.index_dtype = np.int64
+    assert again.faces.dtype == np.int64
+    assert np.array_equal(again.faces, subd.refine(cube, "catmull-clark", 3).faces)
+    # A mesh built from arrays, and one read, take it too.
+    assert subd.Mesh(CUBE_V, CUBE_F, index_dtype=dtype).faces.dtype == np.dtype(dtype)
+
+
+def test_index_dtype_refuses_what_is_not_an_index_type():
+    for bad in (np.float64, np.int16, "nonsense", None):
+        with pytest.raises(TypeError, match="index_dtype"):
+            subd.Mesh(CUBE_V, CUBE_F, index_dtype=bad)
+    with pytest.raises(TypeError, match="index_dtype"):
+        subd.refine(subd.Mesh(CUBE_V, CUBE_F), "catmull-clark", 1, index_dtype=np.int8)
 
 
 @pytest.mark.skipif(not SUBD_BIN, reason="SUBD_BIN (the subd binary) not set")
@@ -196,12 +235,21 @@ def test_info_equals_the_binarys_report():
     assert (cube["euler"], cube["genus"], cube["face_sizes"]) == (2, 0, {4: 6})
 
 
-def test_outputs_are_owned_by_numpy():
+def test_outputs_are_contiguous_and_outlive_their_mesh():
     fine = subd.refine(subd.Mesh(CUBE_V, CUBE_F, uvs=np.zeros((1, 2)),
                                  uv_indices=np.zeros(24, int)), "catmull-clark", 2, limit=True)
-    for a in [fine.vertices, fine.normals, fine.faces, fine.face_vertices, fine.face_sizes,
-              fine.uvs, fine.uv_indices, *fine.creases, *subd.limit(fine, "catmull-clark")]:
-        assert a.flags["OWNDATA"] and a.flags["C_CONTIGUOUS"], a.shape
+    arrays = [fine.vertices, fine.normals, fine.faces, fine.face_vertices, fine.face_sizes,
+              fine.uvs, fine.uv_indices, *fine.creases, *subd.limit(fine, "catmull-clark")]
+    copies = [a.copy() for a in arrays]
+    for a in arrays:
+        assert a.flags["C_CONTIGUOUS"], a.shape
+    # Views (positions, normals, faces) keep what they view alive; the rest are numpy's own.
+    assert not fine.vertices.flags["OWNDATA"] and not fine.normals.flags["OWNDATA"]
+    assert fine.face_sizes.flags["OWNDATA"] and fine.uvs.flags["OWNDATA"]
+    del fine
+    gc.collect()
+    for a, c in zip(arrays, copies):
+        assert np.array_equal(a, c), a.shape
 
 
 def torus(n=12, m=8):

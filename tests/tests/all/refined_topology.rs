@@ -320,6 +320,13 @@ fn last_level_streams_equal_the_held_level() {
                     "{what} face size"
                 );
                 assert_eq!(got_faces, vertices, "{what} faces");
+                // The whole level written at once into a buffer of another index type.
+                let mut wide = vec![-1i64; vertices.len()];
+                faces.write_all(&mut wide, i64::from);
+                assert!(
+                    wide.iter().zip(vertices).all(|(&w, &v)| w == i64::from(v)),
+                    "{what} faces written whole"
+                );
                 let holes: Vec<usize> = (0..n).filter(|&f| held.holes(levels)[f]).collect();
                 with_holes += usize::from(!holes.is_empty());
                 assert_eq!(faces.hole_faces(), holes, "{what} holes");
@@ -341,4 +348,34 @@ fn last_level_streams_equal_the_held_level() {
         "{from_grandparent} from the grandparent"
     );
     assert!(with_holes > 3, "{with_holes} with holes");
+}
+
+/// `refine_mesh`'s result hands its faces out whole in another index type equal to the
+/// built mesh's, and building the topology moves its positions rather than copying them
+/// (the Python binding's views of them stay valid).
+#[test]
+fn refined_mesh_streams_faces_and_moves_positions() {
+    use subd_limit::refined_mesh::{MeshRefinement, refine_mesh};
+    for (name, file) in small_shapes(400) {
+        let scheme = if all_faces_of_size(&file.mesh.topology, 3) {
+            Scheme::Loop
+        } else {
+            Scheme::CatmullClark
+        };
+        for levels in 1..=2 {
+            let request = MeshRefinement::new(scheme.clone(), &file.mesh, levels);
+            let refined = refine_mesh(&file.mesh, &request).unwrap();
+            let stream = refined.face_stream().expect("an OpenSubdiv scheme streams");
+            let mut wide = vec![0i32; refined.faces().1.len()];
+            stream.write_all(&mut wide, |v| i32::try_from(v).unwrap());
+            let before = refined.positions().as_ptr();
+            let (mesh, _) = refined.into_mesh().unwrap();
+            assert_eq!(mesh.positions.as_ptr(), before, "{name} L{levels}");
+            let built = mesh.topology.all_face_vertices();
+            assert!(
+                wide.iter().zip(built).all(|(&w, &b)| w as u32 == b) && wide.len() == built.len(),
+                "{name} L{levels} faces"
+            );
+        }
+    }
 }

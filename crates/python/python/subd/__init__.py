@@ -46,6 +46,7 @@ class SubdWarning(UserWarning):
 
 
 from . import _subd  # noqa: E402  (the exceptions above must exist first: Rust raises them)
+from . import _interop  # noqa: E402
 
 SCHEMES: Tuple[str, ...] = tuple(_subd.SCHEMES)
 """The scheme names :func:`refine` and :func:`limit` take."""
@@ -99,6 +100,20 @@ def _index_array(values, what: str) -> np.ndarray:
     raise MeshError(f"{what}: expected integers, got dtype {a.dtype}")
 
 
+_INDEX_DTYPES = ("int64", "int32", "uint32")
+
+
+def _index_dtype_name(dtype) -> str:
+    """The name of an ``index_dtype`` argument (int64, int32 or uint32), or TypeError."""
+    try:
+        name = np.dtype(dtype).name
+    except TypeError:
+        name = None
+    if name not in _INDEX_DTYPES:
+        raise TypeError(f"index_dtype: expected np.int64, np.int32 or np.uint32, got {dtype!r}")
+    return name
+
+
 def _float_array(values, what: str) -> np.ndarray:
     """``values`` as a C-contiguous float64 array."""
     a = np.asarray(values)
@@ -142,9 +157,18 @@ class Mesh:
     accept_inconsistent_orientation : bool
         Take an edge two faces use in the same direction (as OpenSubdiv does, making it
         non-manifold) instead of raising :class:`MeshError`, as :func:`read` does.
+    index_dtype : numpy dtype, optional
+        The integer type of the face (and texture-coordinate) indices the mesh hands out:
+        ``np.int64`` (default, as trimesh and libigl take them), ``np.int32`` or
+        ``np.uint32`` (half the memory). See :attr:`index_dtype`.
+
+    A mesh is immutable: its properties are read-only arrays, the same array on every
+    access, without copies where the library's buffer has numpy's type (:attr:`vertices`
+    and :attr:`normals` are views of it, which keep the mesh alive). Make a new mesh from
+    changed copies (``mesh.vertices.copy()``).
     """
 
-    __slots__ = ("_core",)
+    __slots__ = ("_core", "_arrays", "_index_dtype")
 
     def __init__(
         self,
@@ -157,7 +181,10 @@ class Mesh:
         uvs=None,
         uv_indices=None,
         accept_inconsistent_orientation: bool = False,
+        index_dtype=np.int64,
     ) -> None:
+        self._arrays = {}
+        self._index_dtype = _index_dtype_name(index_dtype)
         v = _float_array(vertices, "vertices")
         if v.ndim != 2 or v.shape[1] != 3:
             if not (v.size == 0 and v.ndim in (1, 2)):
@@ -174,71 +201,122 @@ class Mesh:
         )
 
     @classmethod
-    def _wrap(cls, core) -> "Mesh":
+    def _wrap(cls, core, index_dtype: str = "int64", face_vertices=None) -> "Mesh":
+        """A mesh around ``core``, with its face-vertex indices when they were made already."""
         mesh = cls.__new__(cls)
         mesh._core = core
+        mesh._arrays = {}
+        mesh._index_dtype = index_dtype
+        if face_vertices is not None:
+            mesh._arrays["face_vertices"] = face_vertices
         return mesh
+
+    def _kept(self, key: str, make):
+        """The array (or tuple of arrays) ``make()`` gives, made once and kept read-only."""
+        value = self._arrays.get(key)
+        if value is None:
+            value = make()
+            for a in value if isinstance(value, tuple) else (value,):
+                if isinstance(a, np.ndarray):
+                    a.flags.writeable = False
+            self._arrays[key] = value
+        return value
+
+    @property
+    def index_dtype(self) -> np.dtype:
+        """The integer type of :attr:`faces`, :attr:`face_vertices` and :attr:`uv_indices`:
+        ``int64`` (default), ``int32`` or ``uint32``. Settable; the arrays are made afresh in
+        the new type (``int32`` raises :class:`MeshError` past 2^31 vertices)."""
+        return np.dtype(self._index_dtype)
+
+    @index_dtype.setter
+    def index_dtype(self, dtype) -> None:
+        name = _index_dtype_name(dtype)
+        if name != self._index_dtype:
+            for key in ("face_vertices", "faces", "uv_indices"):
+                self._arrays.pop(key, None)
+            self._index_dtype = name
 
     @property
     def vertices(self) -> np.ndarray:
-        """Vertex positions, (n, 3) float64."""
-        return self._core.vertices
+        """Vertex positions, (n, 3) float64: a read-only view of the mesh's own buffer."""
+        return self._kept("vertices", lambda: self._core.vertices)
 
     @property
     def normals(self) -> Optional[np.ndarray]:
-        """Unit limit normals, (n, 3) float64, after ``refine(..., limit=True)``; else None."""
-        return self._core.normals
+        """Unit limit normals, (n, 3) float64 (a read-only view), after
+        ``refine(..., limit=True)``; else None."""
+        if "normals" not in self._arrays:
+            self._arrays["normals"] = self._core.normals
+        return self._arrays["normals"]
 
     @property
     def face_sizes(self) -> np.ndarray:
         """Number of corners of every face, (m,) int64."""
-        return self._core.face_sizes
+        return self._kept("face_sizes", lambda: self._core.face_sizes)
 
     @property
     def face_vertices(self) -> np.ndarray:
-        """Vertex indices of every face, one face after the other, (sum of sizes,) int64."""
-        return self._core.face_vertices
+        """Vertex indices of every face, one face after the other, (sum of sizes,), in
+        :attr:`index_dtype`."""
+        return self._kept("face_vertices", lambda: self._core.face_vertices(self._index_dtype))
 
     @property
     def faces(self) -> np.ndarray:
-        """Faces as an (m, k) int64 array when every face has k corners."""
-        faces = self._core.uniform_faces()
+        """Faces as an (m, k) array in :attr:`index_dtype` when every face has k corners (a
+        view of :attr:`face_vertices`)."""
+        faces = self._arrays.get("faces")
         if faces is None:
-            raise ValueError(
-                "faces of several sizes: use face_sizes and face_vertices (the flat pair)"
-            )
+            k = self._core.uniform_face_size()
+            if k is None:
+                raise ValueError(
+                    "faces of several sizes: use face_sizes and face_vertices (the flat pair)"
+                )
+            faces = self._kept("faces", lambda: self.face_vertices.reshape(-1, k))
         return faces
 
     @property
     def uvs(self) -> Optional[np.ndarray]:
         """Texture coordinates, (u, 2) float64, or None."""
-        return self._core.uvs
+        if "uvs" not in self._arrays:
+            self._arrays["uvs"] = self._core.uvs
+            if self._arrays["uvs"] is not None:
+                self._arrays["uvs"].flags.writeable = False
+        return self._arrays["uvs"]
 
     @property
     def uv_indices(self) -> Optional[np.ndarray]:
-        """One index into :attr:`uvs` per face corner, face after face, int64; or None."""
-        return self._core.uv_indices
+        """One index into :attr:`uvs` per face corner, face after face, in
+        :attr:`index_dtype`; or None."""
+        if "uv_indices" not in self._arrays:
+            self._arrays["uv_indices"] = self._core.uv_indices(self._index_dtype)
+        return self._arrays["uv_indices"]
 
     @property
     def face_levels(self) -> Optional[np.ndarray]:
         """The refinement level of every face of an :func:`adaptive` result (uint8), else
         None."""
-        return self._core.face_levels
+        if "face_levels" not in self._arrays:
+            levels = self._core.face_levels
+            if levels is not None:
+                levels.flags.writeable = False
+            self._arrays["face_levels"] = levels
+        return self._arrays["face_levels"]
 
     @property
     def creases(self) -> Tuple[np.ndarray, np.ndarray]:
         """(edges (k, 2) int64, sharpness (k,) float64) of the edges with sharpness > 0."""
-        return self._core.creases
+        return self._kept("creases", lambda: self._core.creases)
 
     @property
     def corners(self) -> Tuple[np.ndarray, np.ndarray]:
         """(vertices (c,) int64, sharpness (c,) float64) of the vertices with sharpness > 0."""
-        return self._core.corners
+        return self._kept("corners", lambda: self._core.corners)
 
     @property
     def holes(self) -> np.ndarray:
         """Indices of the faces that are holes, int64."""
-        return self._core.holes
+        return self._kept("holes", lambda: self._core.holes)
 
     @property
     def num_vertices(self) -> int:
@@ -276,6 +354,32 @@ class Mesh:
         USD file cannot name two-phase, Doo-Sabin, √3 or the butterflies, so it holds such a
         cage refined two levels as plain polygons, with a :class:`SubdWarning`."""
         _warn(self._core.write(os.fspath(path)))
+
+    @classmethod
+    def from_trimesh(cls, mesh, **options) -> "Mesh":
+        """A mesh of a ``trimesh.Trimesh``: its vertices, faces and (where its visual has them,
+        one per vertex) texture coordinates. ``options`` are the constructor's (``creases``,
+        ``index_dtype``, ...)."""
+        return _interop.from_trimesh(cls, mesh, **options)
+
+    def to_trimesh(self):
+        """The mesh as a ``trimesh.Trimesh`` (needs trimesh): faces other than triangles
+        fanned from their first corner, texture coordinates as trimesh keeps them (one per
+        vertex: vertices split at seams), limit normals as its vertex normals, holes left
+        out. trimesh has no creases: they are left behind."""
+        return _interop.to_trimesh(self)
+
+    @classmethod
+    def from_pyvista(cls, data, **options) -> "Mesh":
+        """A mesh of a ``pyvista.PolyData`` (another dataset: its surface): its points,
+        polygons and active texture coordinates. ``options`` are the constructor's."""
+        return _interop.from_pyvista(cls, data, **options)
+
+    def to_pyvista(self):
+        """The mesh as a ``pyvista.PolyData`` (needs pyvista): every polygon as it is,
+        texture coordinates as its active ones (vertices split at seams), limit normals as
+        point data ``Normals``, holes left out. VTK has no creases: they are left behind."""
+        return _interop.to_pyvista(self)
 
     def __repr__(self) -> str:
         return f"subd.Mesh({self.num_vertices} vertices, {self.num_faces} faces)"
@@ -330,6 +434,7 @@ def read(
     weld_tolerance: Optional[float] = None,
     prim: Optional[str] = None,
     time: Optional[float] = None,
+    index_dtype=np.int64,
 ) -> Mesh:
     """Reads an OBJ (with OpenSubdiv's crease, corner and hole tags, texture coordinates),
     PLY, glTF or USD (.usda, .usdc, .usdz, .usd) file. What the reader repaired or left out
@@ -343,8 +448,10 @@ def read(
     (default: the stage's only one) and ``time`` the time code at which time-sampled
     attributes are read (default: their default values). A USD mesh's scheme and rules
     (``subdivisionScheme``, ``interpolateBoundary``, creases, corners, holes,
-    ``primvars:st``) are the mesh's, as for OBJ tags.
+    ``primvars:st``) are the mesh's, as for OBJ tags. ``index_dtype`` is the mesh's
+    :attr:`Mesh.index_dtype`.
     """
+    dtype = _index_dtype_name(index_dtype)
     weld = None if weld_tolerance is None else _threshold(weld_tolerance, "weld_tolerance")
     if prim is not None and not isinstance(prim, str):
         raise TypeError(f"prim: expected a prim path such as '/World/Body', got {type(prim).__name__}")
@@ -352,7 +459,7 @@ def read(
     core, messages = _subd.read(os.fspath(path), bool(accept_inconsistent_orientation),
                                 bool(no_transform), weld, prim, at)
     _warn(messages)
-    return Mesh._wrap(core)
+    return Mesh._wrap(core, dtype)
 
 
 def mesh_prims(path: Union[str, os.PathLike]) -> List[dict]:
@@ -412,6 +519,7 @@ def refine(
     fvar_interpolation: Optional[str] = None,
     tension: Optional[float] = None,
     lam: Optional[float] = None,
+    index_dtype=None,
 ) -> Mesh:
     """The mesh refined ``levels`` times with ``scheme`` (one of :data:`SCHEMES`; by default
     the one the mesh's file names, :attr:`Mesh.file_scheme`, else Catmull-Clark, as every
@@ -429,14 +537,20 @@ def refine(
     ``"corners-plus1"`` (default, unless the mesh's file names one), ``"corners-plus2"``,
     ``"boundaries"`` or ``"all"``. Where Doo-Sabin or √3 cannot carry their seams they are
     left out with a :class:`SubdWarning`.
+
+    The result's :attr:`Mesh.index_dtype` is ``index_dtype`` (default: the input's); for
+    Catmull-Clark, Loop and Bilinear its face indices are written once, straight into the
+    array :attr:`Mesh.faces` returns.
     """
     _check_mesh(mesh)
     levels = _count(levels, "levels")
     name = _scheme_name(scheme, tension, lam, mesh)
     rules = _rule_names(boundary, crease_method, triangles, fvar_interpolation)
-    core, messages = _subd.refine(mesh._core, name, levels, bool(limit), *rules)
+    dtype = mesh._index_dtype if index_dtype is None else _index_dtype_name(index_dtype)
+    core, messages, face_vertices = _subd.refine(mesh._core, name, levels, bool(limit), *rules,
+                                                 dtype)
     _warn(messages)
-    return Mesh._wrap(core)
+    return Mesh._wrap(core, dtype, face_vertices)
 
 
 def adaptive(

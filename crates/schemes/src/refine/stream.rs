@@ -158,6 +158,47 @@ impl<'a> FaceStream<'a> {
         }
     }
 
+    /// Writes the vertices of every face into `out` ([`Self::face_size`] per face), each
+    /// index converted by `convert`, in parallel: the whole level written once into the
+    /// buffer that keeps it (a numpy array of another index type, say), with no list of
+    /// `u32` in between.
+    ///
+    /// # Panics
+    /// If `out` does not hold exactly [`Self::num_faces`] × [`Self::face_size`] indices.
+    pub fn write_all<T: Send>(&self, out: &mut [T], convert: impl Fn(u32) -> T + Sync) {
+        let k = self.face_size();
+        assert_eq!(
+            out.len(),
+            k * self.num_faces(),
+            "{} indices for {} faces of {k}",
+            out.len(),
+            self.num_faces()
+        );
+        // The output of every run of source faces, cut off the front of `out` in order.
+        let sources = self.from.num_faces();
+        let mut tasks = Vec::with_capacity(sources.div_ceil(FACES_PER_TASK));
+        let mut rest = out;
+        for start in (0..sources).step_by(FACES_PER_TASK) {
+            let end = (start + FACES_PER_TASK).min(sources);
+            let len = k * (self.first_child(end) - self.first_child(start));
+            let (mine, after) = rest.split_at_mut(len);
+            tasks.push((start..end, mine));
+            rest = after;
+        }
+        tasks.into_par_iter().for_each(|(faces, out)| {
+            let mut block = Vec::new();
+            let mut at = 0;
+            for f in faces {
+                block.clear();
+                self.push_children(f, &mut block);
+                for (slot, &v) in out[at..at + block.len()].iter_mut().zip(&block) {
+                    *slot = convert(v);
+                }
+                at += block.len();
+            }
+        });
+    }
+
     /// The faces that are holes: the children of hole faces, in order.
     pub fn hole_faces(&self) -> Vec<usize> {
         let p = self.from;
