@@ -114,6 +114,41 @@ struct RefineReport {
     warnings: Vec<String>,
 }
 
+impl RefineReport {
+    /// The report of refining `job` with `scheme` and `options` (OpenSubdiv's rule options
+    /// for its schemes only), the counts and times given; the peak memory read now.
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        args: &RefineArgs,
+        job: &Job,
+        scheme: &Scheme,
+        options: &subd_schemes::Options,
+        depth_first: bool,
+        (input_counts, output_counts): (Counts, Counts),
+        seconds: Timings,
+        warnings: Vec<String>,
+    ) -> RefineReport {
+        let osd = scheme.is_opensubdiv();
+        RefineReport {
+            input: job.input.display().to_string(),
+            output: job.output.display().to_string(),
+            scheme: scheme.name(),
+            levels: args.levels,
+            tension: scheme.tension(),
+            boundary_interpolation: osd.then_some(options.boundary_interpolation),
+            crease_method: osd.then_some(options.crease_method),
+            triangle_subdivision: osd.then_some(options.triangle_subdivision),
+            limit: args.limit,
+            depth_first,
+            peak_memory: crate::budget::peak_resident_bytes(),
+            input_counts,
+            output_counts,
+            seconds,
+            warnings,
+        }
+    }
+}
+
 /// `subd refine` writes meshes.
 const REFINE: batch::Command = batch::Command {
     name: "refine",
@@ -218,29 +253,22 @@ fn run_one(
     };
     progress.finish();
     if args.json {
-        let report = RefineReport {
-            input: job.input.display().to_string(),
-            output: job.output.display().to_string(),
-            scheme: refinement.scheme().name(),
-            levels: args.levels,
-            tension: refinement.scheme().tension(),
-            boundary_interpolation: osd.then_some(options.boundary_interpolation),
-            crease_method: osd.then_some(options.crease_method),
-            triangle_subdivision: osd.then_some(options.triangle_subdivision),
-            limit: args.limit,
-            depth_first: false,
-            peak_memory: crate::budget::peak_resident_bytes(),
-            input_counts,
-            output_counts: written.counts,
-            seconds: Timings {
+        let report = RefineReport::new(
+            args,
+            job,
+            refinement.scheme(),
+            &options,
+            false,
+            (input_counts, written.counts),
+            Timings {
                 read: opened.read_seconds,
                 topology: t_topology,
                 positions: written.positions_seconds,
                 write: written.write_seconds,
                 total: opened.elapsed(),
             },
-            warnings: opened.file.warnings.clone(),
-        };
+            opened.file.warnings.clone(),
+        );
         crate::print_json(out, &report);
     }
     Ok(())
@@ -281,37 +309,35 @@ fn run_depth_first(
     };
     let counts = crate::depth_first::write(&request)?;
     if args.json {
-        let report = RefineReport {
-            input: job.input.display().to_string(),
-            output: job.output.display().to_string(),
-            scheme: scheme.name(),
-            levels: args.levels,
-            tension: None,
-            boundary_interpolation: Some(options.boundary_interpolation),
-            crease_method: Some(options.crease_method),
-            triangle_subdivision: Some(options.triangle_subdivision),
-            limit: false,
-            depth_first: true,
-            peak_memory: crate::budget::peak_resident_bytes(),
-            input_counts: Counts {
-                vertices: mesh.topology.num_vertices(),
-                edges: Some(mesh.topology.num_edges()),
-                faces: mesh.topology.num_faces(),
-            },
-            output_counts: Counts {
-                vertices: counts.vertices as usize,
-                edges: Some(counts.edges as usize),
-                faces: counts.faces as usize,
-            },
-            seconds: Timings {
-                read: opened.read_seconds,
-                topology: 0.0,
-                positions: t0.elapsed().as_secs_f64(),
-                write: 0.0,
-                total: opened.elapsed(),
-            },
-            warnings: opened.file.warnings.clone(),
+        let input_counts = Counts {
+            vertices: mesh.topology.num_vertices(),
+            edges: Some(mesh.topology.num_edges()),
+            faces: mesh.topology.num_faces(),
         };
+        let output_counts = Counts {
+            vertices: counts.vertices as usize,
+            edges: Some(counts.edges as usize),
+            faces: counts.faces as usize,
+        };
+        // Refining and writing go together, chunk by chunk: one time for both.
+        let seconds = Timings {
+            read: opened.read_seconds,
+            topology: 0.0,
+            positions: t0.elapsed().as_secs_f64(),
+            write: 0.0,
+            total: opened.elapsed(),
+        };
+        let warnings = opened.file.warnings.clone();
+        let report = RefineReport::new(
+            args,
+            job,
+            scheme,
+            options,
+            true,
+            (input_counts, output_counts),
+            seconds,
+            warnings,
+        );
         crate::print_json(out, &report);
     }
     Ok(())
