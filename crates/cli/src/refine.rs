@@ -14,7 +14,7 @@ use subd_schemes::peak::{DepthFirstPeak, PeakModel};
 use crate::batch::{self, Files, Job};
 use crate::budget::Budget;
 use crate::failure::bad;
-use crate::refined::{RefinementWithLimit, all_unit, normals_or_faces, output_limit};
+use crate::refined::{RefinementWithLimit, all_unit, last_level_limit, normals_or_faces};
 use crate::rule_args::RuleArgs;
 use crate::scheme_arg;
 use crate::vertex_data::LambdaArgs;
@@ -474,14 +474,12 @@ impl Output<'_> {
     fn held(&self, options: &subd_schemes::Options) -> Result<Written, Failure> {
         let (r, levels) = (self.refinement, self.args.levels);
         let t1 = Instant::now();
-        let mut positions = r.last_positions(self.base);
-        let normals = if self.args.limit {
+        let (positions, normals) = if self.args.limit {
             let limit =
-                output_limit(r, levels, options, &positions).map_err(|e| in_file(self.job, &e))?;
-            positions = limit.positions;
-            Some(limit.normals)
+                last_level_limit(r, options, self.base).map_err(|e| in_file(self.job, &e))?;
+            (limit.positions, Some(limit.normals))
         } else {
-            None
+            (r.last_positions(self.base), None)
         };
         self.progress.step("positions");
         let positions_seconds = t1.elapsed().as_secs_f64();

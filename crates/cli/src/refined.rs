@@ -3,7 +3,9 @@
 //! exact limit of its output level (both from `subd_limit::refined_mesh`), and the normals
 //! a writer gets where the limit defines none.
 
-pub(crate) use subd_limit::refined_mesh::{LimitedRefinement as RefinementWithLimit, output_limit};
+pub(crate) use subd_limit::refined_mesh::{
+    LimitedRefinement as RefinementWithLimit, last_level_limit,
+};
 
 /// Whether every normal is a unit vector (the limit defines every tangent plane).
 pub(crate) fn all_unit(normals: &[subd_mesh::DVec3]) -> bool {

@@ -12,7 +12,7 @@ use subd_schemes::Scheme;
 
 use crate::failure::{bad, refuse_overwrite};
 use crate::raster::{Camera, Canvas, Rgb, shade};
-use crate::refined::{RefinementWithLimit, normals_or_faces, output_limit};
+use crate::refined::{RefinementWithLimit, last_level_limit, normals_or_faces};
 use crate::rule_args::RuleArgs;
 use crate::scheme_arg;
 use crate::{Failure, print_warnings};
@@ -306,14 +306,12 @@ fn refined_surface(
     let refinement =
         RefinementWithLimit::new(&file.mesh.topology, scheme.clone(), &options, levels)
             .map_err(|e| e.to_string())?;
-    let mut positions = refinement.last_positions(&file.mesh.positions);
-    let limit_normals = if args.limit {
-        let limit =
-            output_limit(&refinement, levels, &options, &positions).map_err(|e| e.to_string())?;
-        positions = limit.positions;
-        Some(limit.normals)
+    let (positions, limit_normals) = if args.limit {
+        let limit = last_level_limit(&refinement, &options, &file.mesh.positions)
+            .map_err(|e| e.to_string())?;
+        (limit.positions, Some(limit.normals))
     } else {
-        None
+        (refinement.last_positions(&file.mesh.positions), None)
     };
     let (offsets, vertices) = refinement.faces(levels);
     let holes = refinement.holes(levels).into_owned();

@@ -141,9 +141,9 @@ pub mod refined_mesh {
     //! A whole mesh refined in one call, optionally to the exact limit, texture coordinates
     //! included.
     pub use crate::whole_mesh::{
-        LimitedRefinement, MeshRefinement, RefinedMesh, RefinedUv, UNNAMED_CAGE_LEVELS, limit_uv,
-        output_limit, refine_mesh, refined_hints, refined_unnamed_cage, refined_uv, split_limit_uv,
-        unnamed_cage_warning,
+        LimitedRefinement, MeshRefinement, RefinedMesh, RefinedUv, UNNAMED_CAGE_LEVELS,
+        last_level_limit, limit_uv, output_limit, refine_mesh, refined_hints, refined_unnamed_cage,
+        refined_uv, split_limit_uv, unnamed_cage_warning,
     };
 }
 

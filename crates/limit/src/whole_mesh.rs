@@ -88,6 +88,26 @@ impl LimitedRefinement {
     }
 }
 
+/// The exact limit (positions and unit normals; no tangents) of the vertices of
+/// `refinement`'s last level, from `base`, the base mesh's points: the same surface as
+/// [`output_limit`] of the last level's points. On Catmull-Clark, a child of a regular quad
+/// of the level above is read off that quad's B-spline patch from the level above's points,
+/// so where every quad is regular the last level's own points are never made (what
+/// `subd refine --limit` and `subd.refine(limit=True)` take).
+pub fn last_level_limit(
+    refinement: &LimitedRefinement,
+    options: &Options,
+    base: &[DVec3],
+) -> Result<LimitPoints, LimitError> {
+    let levels = refinement.num_levels();
+    if crate::limit_masks::regular_patches::applies(refinement) {
+        let above = refinement.points_at(base, levels - 1);
+        return crate::limit_masks::regular_patches::last_level_limit(refinement, &above);
+    }
+    let positions = refinement.last_positions(base);
+    output_limit(refinement, levels, options, &positions)
+}
+
 /// The exact limit (positions and normals) of the vertices of `level`, from the limit
 /// masks of that level's own topology: what Blender calls "use limit surface".
 pub fn output_limit(
@@ -410,13 +430,12 @@ pub fn refine_mesh(mesh: &Mesh, request: &MeshRefinement) -> Result<RefinedMesh,
         request.limit,
         &mut warnings,
     )?;
-    let mut positions = refinement.last_positions(&mesh.positions);
-    let mut normals = None;
-    if request.limit {
-        let limit = output_limit(&refinement, levels, &request.options, &positions)?;
-        positions = limit.positions;
-        normals = Some(limit.normals);
-    }
+    let (positions, normals) = if request.limit {
+        let limit = last_level_limit(&refinement, &request.options, &mesh.positions)?;
+        (limit.positions, Some(limit.normals))
+    } else {
+        (refinement.last_positions(&mesh.positions), None)
+    };
     let asked = request.options.triangle_subdivision;
     let triangles_asked = asked != Options::from_hints(&mesh.hints).triangle_subdivision;
     let mut hints = refined_hints(

@@ -312,6 +312,26 @@ impl Refinement {
         out
     }
 
+    /// The points of `level` from `above`, the points of the level before it (one step of
+    /// [`Self::points_at`], bit for bit).
+    ///
+    /// # Panics
+    /// If `level` is 0 or not refined, or `above` does not have one point per vertex of
+    /// the level before.
+    pub fn next_level_points(&self, level: usize, above: &[DVec3]) -> Vec<DVec3> {
+        assert!(
+            (1..=self.num_levels()).contains(&level),
+            "level {level} is not refined"
+        );
+        assert_eq!(
+            above.len(),
+            self.num_vertices(level - 1),
+            "one point per vertex of level {}",
+            level - 1
+        );
+        self.family.next_points(level, above)
+    }
+
     /// Positions of `level` alone from base positions, each level dropped once the next is
     /// computed: [`Self::refine_points`]`(base)[level]` in less memory.
     ///

@@ -64,3 +64,59 @@ fn level_limit_equals_the_tables_of_the_level() {
     }
     assert!(compared > 150, "only {compared} levels compared");
 }
+
+/// `last_level_limit`, which reads the children of regular quads off the level above's
+/// B-spline patches (the rest by the masks of the last level), against `output_limit` of
+/// the last level's points (every vertex by its own ring's masks), on every Catmull-Clark
+/// shape, levels 1 to 3: positions to 4e-15 of the bounding box, unit normals to 1e-12.
+#[test]
+fn last_level_limit_from_the_patches_above_equals_the_masks() {
+    use subd_limit::refined_mesh::{LimitedRefinement, last_level_limit, output_limit};
+    let (mut compared, mut all_regular) = (0, 0);
+    for s in surface_shapes() {
+        if s.scheme != subd_schemes::Scheme::CatmullClark
+            || s.mesh.topology.num_face_vertices() << 6 > 60_000
+        {
+            continue;
+        }
+        let diag = diagonal(&s.mesh.positions);
+        for levels in 1..=3 {
+            let r = LimitedRefinement::new(&s.mesh.topology, s.scheme.clone(), &s.options, levels)
+                .unwrap();
+            let last = r.last_positions(&s.mesh.positions);
+            let (reference, ours) = match (
+                output_limit(&r, levels, &s.options, &last),
+                last_level_limit(&r, &s.options, &s.mesh.positions),
+            ) {
+                (Ok(a), Ok(b)) => (a, b),
+                (Err(a), Err(b)) => {
+                    assert_eq!(a.to_string(), b.to_string(), "{} L{levels}", s.name);
+                    continue;
+                }
+                (a, b) => panic!("{} L{levels}: {:?} vs {:?}", s.name, a.err(), b.err()),
+            };
+            assert_eq!(reference.positions.len(), ours.positions.len());
+            for v in 0..reference.positions.len() {
+                let d = (reference.positions[v] - ours.positions[v]).length() / diag;
+                assert!(
+                    d <= 4e-15,
+                    "{} L{levels} vertex {v}: position {d:e}",
+                    s.name
+                );
+                let (a, b) = (reference.normals[v], ours.normals[v]);
+                let same = (a - b).length() < 1e-12
+                    || (a == DVec3::ZERO && b == DVec3::ZERO)
+                    || (a.is_nan() && b.is_nan());
+                assert!(same, "{} L{levels} vertex {v}: normal {a} vs {b}", s.name);
+            }
+            // Bit for bit where the patches were not taken: the same masks.
+            all_regular += usize::from(reference.positions != ours.positions);
+            compared += 1;
+        }
+    }
+    assert!(compared > 60, "only {compared} levels compared");
+    assert!(
+        all_regular > 20,
+        "the patches were taken on only {all_regular} levels"
+    );
+}

@@ -6,6 +6,7 @@ pub(crate) mod child_limit;
 pub(crate) mod eigen;
 pub(crate) mod fvar;
 pub(crate) mod masks;
+pub(crate) mod regular_patches;
 pub(crate) mod smooth_closed;
 pub(crate) mod spectrum;
 pub(crate) mod table;
