@@ -93,6 +93,12 @@ impl CoreMesh {
         // could starve the pool work of the thread that holds it.
         py.detach(|| -> PyResult<()> {
             let mut pending = self.pending.lock().unwrap_or_else(PoisonError::into_inner);
+            // Checked before the result is consumed: a failure inside `into_mesh` would free
+            // the positions that `vertices` views may point at (a refinement's faces and
+            // texture coordinates are consistent by construction; only its values can fail).
+            if let Some(r) = pending.as_ref() {
+                subd_mesh::validate_positions(r.positions()).map_err(mesh_error)?;
+            }
             if let Some(r) = pending.take() {
                 let (mesh, _normals) = pool::install(|| r.into_mesh())?.map_err(mesh_error)?;
                 // Set before the lock is released: a reader that finds nothing pending
