@@ -240,6 +240,17 @@ impl IndexType {
         }
     }
 
+    /// The faces of a refinement's last level, written once from `stream` into a new
+    /// read-only array of this type.
+    pub(crate) fn faces<'py>(
+        self,
+        py: Python<'py>,
+        stream: &subd_schemes::FaceStream<'_>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let n = stream.num_faces() * stream.face_size();
+        self.filled(py, n, |sink| sink.faces_from(stream))
+    }
+
     /// `values` as a new read-only array of this type.
     pub(crate) fn copied<'py>(
         self,

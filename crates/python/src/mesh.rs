@@ -454,10 +454,7 @@ impl CoreMesh {
         ty.check_holds(self.num_vertices(py))?;
         self.with_held(py, |held| match held {
             Held::Pending(r) => match r.face_stream() {
-                Some(stream) => {
-                    let n = stream.num_faces() * stream.face_size();
-                    ty.filled(py, n, |sink| sink.faces_from(&stream))
-                }
+                Some(stream) => ty.faces(py, &stream),
                 None => ty.copied(py, r.faces().1),
             },
             Held::Built(m) => ty.copied(py, m.topology.all_face_vertices()),

@@ -197,10 +197,7 @@ fn last_faces<'py>(
         return Ok(None);
     };
     index_type.check_holds(refined.positions().len())?;
-    let n = stream.num_faces() * stream.face_size();
-    index_type
-        .filled(py, n, |sink| sink.faces_from(&stream))
-        .map(Some)
+    index_type.faces(py, &stream).map(Some)
 }
 
 /// A refinement request checked: the scheme, the options for `mesh` and the output's size.

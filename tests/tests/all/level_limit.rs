@@ -12,6 +12,27 @@ fn diagonal(p: &[DVec3]) -> f64 {
     subd_pia::bbox_diagonal(p).max(1e-300)
 }
 
+/// Positions of `ours` within `tolerance.0` × `diag` of `reference`'s and unit normals within
+/// `tolerance.1`; normals that are zero (parallel tangents) or undefined agree as such.
+fn assert_same_limit(
+    reference: &subd_limit::LimitPoints,
+    ours: &subd_limit::LimitPoints,
+    diag: f64,
+    (position, normal): (f64, f64),
+    what: &str,
+) {
+    assert_eq!(reference.positions.len(), ours.positions.len(), "{what}");
+    for v in 0..reference.positions.len() {
+        let d = (reference.positions[v] - ours.positions[v]).length() / diag;
+        assert!(d <= position, "{what} vertex {v}: position {d:e}");
+        let (a, b) = (reference.normals[v], ours.normals[v]);
+        let same = (a - b).length() < normal
+            || (a == DVec3::ZERO && b == DVec3::ZERO)
+            || (a.is_nan() && b.is_nan());
+        assert!(same, "{what} vertex {v}: normal {a} vs {b}");
+    }
+}
+
 /// Positions agree to 2e-15 of the bounding box (a few units in the last place) and unit normals to 1e-13 (the sums run in
 /// another order where the level's rings are read off the level above); normals that are
 /// zero (parallel tangents) or undefined agree as such.
@@ -42,23 +63,8 @@ fn level_limit_equals_the_tables_of_the_level() {
                 }
                 (a, b) => panic!("{} level {level}: {:?} vs {:?}", s.name, a.err(), b.err()),
             };
-            for v in 0..reference.positions.len() {
-                let d = (reference.positions[v] - ours.positions[v]).length() / diag;
-                assert!(
-                    d <= 2e-15,
-                    "{} level {level} vertex {v}: position {d:e}",
-                    s.name
-                );
-                let (a, b) = (reference.normals[v], ours.normals[v]);
-                let same = (a - b).length() < 1e-13
-                    || (a == DVec3::ZERO && b == DVec3::ZERO)
-                    || (a.is_nan() && b.is_nan());
-                assert!(
-                    same,
-                    "{} level {level} vertex {v}: normal {a} vs {b}",
-                    s.name
-                );
-            }
+            let what = format!("{} level {level}", s.name);
+            assert_same_limit(&reference, &ours, diag, (2e-15, 1e-13), &what);
             compared += 1;
         }
     }
@@ -95,20 +101,8 @@ fn last_level_limit_from_the_patches_above_equals_the_masks() {
                 }
                 (a, b) => panic!("{} L{levels}: {:?} vs {:?}", s.name, a.err(), b.err()),
             };
-            assert_eq!(reference.positions.len(), ours.positions.len());
-            for v in 0..reference.positions.len() {
-                let d = (reference.positions[v] - ours.positions[v]).length() / diag;
-                assert!(
-                    d <= 4e-15,
-                    "{} L{levels} vertex {v}: position {d:e}",
-                    s.name
-                );
-                let (a, b) = (reference.normals[v], ours.normals[v]);
-                let same = (a - b).length() < 1e-12
-                    || (a == DVec3::ZERO && b == DVec3::ZERO)
-                    || (a.is_nan() && b.is_nan());
-                assert!(same, "{} L{levels} vertex {v}: normal {a} vs {b}", s.name);
-            }
+            let what = format!("{} L{levels}", s.name);
+            assert_same_limit(&reference, &ours, diag, (4e-15, 1e-12), &what);
             // Bit for bit where the patches were not taken: the same masks.
             all_regular += usize::from(reference.positions != ours.positions);
             compared += 1;

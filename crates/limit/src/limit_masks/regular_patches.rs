@@ -13,7 +13,7 @@ use rayon::prelude::*;
 use subd_mesh::Topology;
 use subd_schemes::{Refinement, Rule, Scheme};
 
-use crate::evaluation::patch::bspline_basis;
+use crate::evaluation::patch::eval_bicubic_first;
 use crate::limit_masks::child_limit::{self, ChildLimit};
 use crate::limit_masks::table::Ring;
 use crate::{LimitError, LimitPoints};
@@ -61,12 +61,11 @@ pub(crate) fn last_level_limit(
         tangent2: Vec::new(),
         normals: subd_mesh::memory::with_capacity(n),
     };
-    let basis = basis_at_children();
     (0..n)
         .into_par_iter()
         .with_min_len(CHUNK)
         .map_init(Ring::default, |ring, v| match numbering.owner(t, v) {
-            (f, at) if f != usize::MAX && grids.regular(f) => grids.limit(f, at, above, &basis),
+            (f, at) if f != usize::MAX && grids.regular(f) => grids.limit(f, at, above),
             _ => {
                 let (children, points) = general.as_ref().expect("made for irregular faces");
                 let [p, _, _, normal] = children.limit(ring, v, points);
@@ -140,15 +139,6 @@ struct Grids {
     all_regular: bool,
 }
 
-/// The uniform cubic B-spline basis and its derivative at 0, ½ and 1, the parameters of a
-/// quad's children.
-fn basis_at_children() -> [([f64; 4], [f64; 4]); 3] {
-    [0.0, 0.5, 1.0].map(|t| {
-        let (b, d, _) = bspline_basis(t);
-        (b, d)
-    })
-}
-
 impl Grids {
     fn new(t: &Topology, rules: &[Rule]) -> Grids {
         let regular: Vec<bool> = (0..t.num_vertices())
@@ -179,33 +169,16 @@ impl Grids {
     }
 
     /// Limit position and unit normal at `at` on face `f`'s patch, from the level's
-    /// `points`, with `basis` from [`basis_at_children`].
-    fn limit(
-        &self,
-        f: usize,
-        at: At,
-        points: &[DVec3],
-        basis: &[([f64; 4], [f64; 4]); 3],
-    ) -> (DVec3, DVec3) {
-        let grid = &self.points[f];
-        // Parameters as indices of 0, ½, 1.
+    /// `points`.
+    fn limit(&self, f: usize, at: At, points: &[DVec3]) -> (DVec3, DVec3) {
         let (u, v) = match at {
-            At::Corner(k) => [(0, 0), (2, 0), (2, 2), (0, 2)][k],
-            At::Side(k) => [(1, 0), (2, 1), (1, 2), (0, 1)][k],
-            At::Centre => (1, 1),
+            At::Corner(k) => [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)][k],
+            At::Side(k) => [(0.5, 0.0), (1.0, 0.5), (0.5, 1.0), (0.0, 0.5)][k],
+            At::Centre => (0.5, 0.5),
         };
-        let ((bu, du), (bv, dv)) = (&basis[u], &basis[v]);
-        let (mut p, mut pu, mut pv) = (DVec3::ZERO, DVec3::ZERO, DVec3::ZERO);
-        for j in 0..4 {
-            let row = |i: usize| points[grid[4 * j + i] as usize];
-            let (r0, r1, r2, r3) = (row(0), row(1), row(2), row(3));
-            let r = bu[0] * r0 + bu[1] * r1 + bu[2] * r2 + bu[3] * r3;
-            let ru = du[0] * r0 + du[1] * r1 + du[2] * r2 + du[3] * r3;
-            p += bv[j] * r;
-            pu += bv[j] * ru;
-            pv += dv[j] * r;
-        }
-        (p, pu.cross(pv).normalize_or_zero())
+        let grid = self.points[f].map(|i| points[i as usize]);
+        let (p, du, dv) = eval_bicubic_first(&grid, u, v);
+        (p, du.cross(dv).normalize_or_zero())
     }
 }
 
