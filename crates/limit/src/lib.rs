@@ -166,10 +166,10 @@ pub mod split_eigen {
 }
 
 pub mod split_limit {
-    //! Limit stencils of the split schemes.
+    //! Limit stencils of the split schemes, and their limit points without stencils.
     pub use crate::split_limits::split_limit::{
-        MAX_LEVELS, Neighbourhoods, SplitLimitPoints, SplitLimitStencils, split_limit_stencils,
-        split_limit_stencils_in, split_limit_table,
+        MAX_LEVELS, Neighbourhoods, SplitLimitPoints, SplitLimitStencils, split_limit_points,
+        split_limit_stencils, split_limit_stencils_in, split_limit_table,
     };
 }
 
@@ -358,7 +358,10 @@ pub fn limit_stencils(
     }
 }
 
-/// [`limit_stencils`] applied to `positions`.
+/// [`limit_stencils`] applied to `positions`; for the split schemes the masks are applied
+/// to the points as they are found, without building the stencils
+/// ([`split_limit::split_limit_points`]: the same values, up to rounding where a mask is
+/// found below the base level).
 ///
 /// # Errors
 /// As [`limit_stencils`].
@@ -368,7 +371,11 @@ pub fn limit_points(
     options: &Options,
     positions: &[glam::DVec3],
 ) -> Result<LimitPoints, LimitError> {
-    Ok(limit_stencils(topology, scheme, options)?.apply(positions))
+    match scheme {
+        Scheme::TwoPhase(_) => Ok(limit_stencils(topology, scheme, options)?.apply(positions)),
+        s if s.is_opensubdiv() => Ok(limit_stencils(topology, scheme, options)?.apply(positions)),
+        s => split_limits::split_limit::split_limit_points(topology, s, positions),
+    }
 }
 
 /// The exact limit (positions, tangents, normals) of every vertex of `level` of

@@ -120,8 +120,10 @@ pub fn output_limit(
     if scheme.is_opensubdiv() || level < refinement.num_levels() {
         return crate::level_limit_points(refinement, level, options, positions, Tangents::Dropped);
     }
-    // A split scheme's last level: the stencils its texture coordinates share.
-    Ok(refinement.last_limit()?.apply(positions))
+    // A split scheme's last level: its masks applied to the points as they are found (the
+    // stencils are built only where texture coordinates take their limit through them).
+    let last = refinement.topology(level);
+    crate::split_limits::split_limit::split_limit_points(last, refinement.scheme(), positions)
 }
 
 /// Refined texture coordinates: `components` numbers per value, one value index per

@@ -656,3 +656,73 @@ fn split_limits_of_local_pieces_match_the_whole_mesh() {
     }
     assert!(compared > 50, "only {compared} meshes compared");
 }
+
+/// `split_limit_points` (each mask applied to the points of the level where it is found)
+/// against the stencil tables of `split_limit_table` applied to the same points (the rows
+/// composed back to the base): on every OpenSubdiv shape each split scheme refines, and an
+/// irregular grid with a boundary, at the base and one level down. Positions agree to 1e-14
+/// of the bounding box and unit normals to 1e-11 (the deeper masks' sums run in another
+/// order), undefined normals are undefined on both sides, a mesh without a limit fails with
+/// the same message, and the vertices settled at the base level are equal bit for bit.
+#[test]
+fn split_limit_points_equal_the_tables_applied() {
+    use subd_limit::split_limit::{split_limit_points, split_limit_table};
+    let mut meshes: Vec<(String, Topology, Vec<DVec3>)> = subd_tests::osd_meshes()
+        .into_iter()
+        .filter_map(|path| {
+            let file = subd_io::read_mesh(&path, &subd_io::ReadOptions::default()).ok()?;
+            let name = path.file_stem()?.to_string_lossy().to_string();
+            Some((name, file.mesh.topology, file.mesh.positions))
+        })
+        .collect();
+    let (t, p) = irregular_grid(30);
+    meshes.push(("irregular grid".into(), t, p));
+    let (mut compared, mut same_bits, mut vertices) = (0, 0, 0);
+    let schemes = [
+        Scheme::DooSabin,
+        Scheme::Sqrt3,
+        Scheme::BUTTERFLY,
+        Scheme::ModifiedButterfly,
+    ];
+    for (name, t, p) in &meshes {
+        for scheme in &schemes {
+            let Ok(r) = Refinement::new(t, scheme.clone(), &Options::default(), 1) else {
+                continue;
+            };
+            let p1 = r.refine_points(p).pop().unwrap();
+            let diag = subd_pia::bbox_diagonal(p).max(1e-300);
+            for (level, (t, p)) in [(t, p), (r.topology(1), &p1)].into_iter().enumerate() {
+                let what = format!("{name} {scheme:?} level {level}");
+                let (table, ours) = match (
+                    split_limit_table(t, scheme).map(|table| table.apply(p)),
+                    split_limit_points(t, scheme, p),
+                ) {
+                    (Ok(a), Ok(b)) => (a, b),
+                    (Err(a), Err(b)) => {
+                        assert_eq!(a.to_string(), b.to_string(), "{what}");
+                        continue;
+                    }
+                    (a, b) => panic!("{what}: {:?} vs {:?}", a.err(), b.err()),
+                };
+                for v in 0..p.len() {
+                    let d = (table.positions[v] - ours.positions[v]).length() / diag;
+                    assert!(d <= 1e-14, "{what} vertex {v}: position {d:e}");
+                    let (a, b) = (table.normals[v], ours.normals[v]);
+                    let same = (a - b).length() < 1e-11
+                        || (a == DVec3::ZERO && b == DVec3::ZERO)
+                        || (a.is_nan() && b.is_nan());
+                    assert!(same, "{what} vertex {v}: normal {a} vs {b}");
+                    same_bits += usize::from(table.positions[v] == ours.positions[v]);
+                }
+                vertices += p.len();
+                compared += 1;
+            }
+        }
+    }
+    assert!(compared > 100, "only {compared} levels compared");
+    // Most vertices are settled at the base level, where the sums are the table's.
+    assert!(
+        same_bits * 10 > vertices * 9,
+        "{same_bits} of {vertices} positions bit for bit"
+    );
+}

@@ -28,6 +28,7 @@
 //! [`split_limit_table`] gives the same rows as the [`LimitStencilTable`] every scheme's
 //! limit takes ([`crate::limit_stencils`]).
 
+use std::borrow::Cow;
 use std::collections::HashMap;
 use std::f64::consts::TAU;
 
@@ -45,7 +46,7 @@ use crate::split_limits::split_eigen::{
     FeatureCentre, FeatureMasks, LocalMasks, expand_row, feature_ball, feature_masks,
     feature_matrix, local_masks, row_between,
 };
-use crate::{LimitError, LimitStencilTable};
+use crate::{LimitError, LimitPoints, LimitStencilTable};
 
 /// The deepest level searched for a regular ball around an interior vertex.
 pub const MAX_LEVELS: usize = 4;
@@ -121,16 +122,7 @@ impl SplitLimitStencils {
     /// [`LimitError::NoLimit`] naming the first vertex without a limit.
     pub fn into_table(self, scheme: &Scheme) -> Result<LimitStencilTable, LimitError> {
         if let Some(v) = self.position_known.iter().position(|known| !known) {
-            let why = if scheme.split() == Split::Dual {
-                "an interior vertex of valence 2 has no vertex face"
-            } else {
-                "its neighbourhood never became one with a known limit mask (a dart or boundary vertex whose refined neighbourhood stays irregular)"
-            };
-            return Err(LimitError::NoLimit {
-                vertex: v,
-                scheme: scheme.name(),
-                why,
-            });
+            return Err(no_limit(v, scheme));
         }
         let [tangent1, tangent2] = self.tangents;
         Ok(LimitStencilTable {
@@ -178,15 +170,14 @@ pub fn split_limit_stencils_in(
 ) -> Result<SplitLimitStencils, LimitError> {
     let nv = base.num_vertices();
     let refiner = Refiner { base, scheme, how };
-    let refinement = |levels| refiner.whole(levels).map(|r| r.r);
-    let mut position: Vec<Option<Row>> = vec![None; nv];
-    let mut tangents: Vec<Option<[Row; 2]>> = vec![None; nv];
-    if scheme.split() == Split::Dual {
-        let r = refinement(1)?;
-        doo_sabin_rows(base, &r, &mut position, &mut tangents);
-    } else {
-        vertex_rows(base, scheme, &refiner, &mut position, &mut tangents)?;
-    }
+    let mut found = Found::Rows {
+        position: vec![None; nv],
+        tangents: vec![None; nv],
+    };
+    find_limits(&refiner, &mut found)?;
+    let Found::Rows { position, tangents } = found else {
+        unreachable!("rows asked for")
+    };
     let table = |rows: Vec<Row>| {
         StencilTable::build(nv, nv, |v, sink| {
             for &(s, w) in &rows[v] {
@@ -215,13 +206,209 @@ pub fn split_limit_stencils_in(
     })
 }
 
-/// Doo-Sabin: centroid and first Fourier mode of each vertex's vertex face.
-fn doo_sabin_rows(
+/// The exact limit (positions, tangents, normals) of every vertex of `base` under a split
+/// scheme, from `points`, without stencil tables: the values of
+/// [`split_limit_table`]`(base, scheme)?.apply(points)`, with each mask applied to the
+/// points of the level where it is found instead of being composed back into a row over the
+/// base. A vertex whose mask applies at the base level (most of them) gets the table's
+/// value bit for bit; one whose mask applies further down gets it up to rounding (the
+/// piece's points refined level by level rather than its rows composed). This is what
+/// `refine --limit`, `limit` and `subd.refine(limit=True)` take for those schemes; the
+/// stencils are built only where texture coordinates share them.
+///
+/// ```
+/// use subd_mesh::{DVec3, TopologyBuilder};
+/// use subd_schemes::Scheme;
+/// use subd_limit::split_limit::{split_limit_points, split_limit_table};
+///
+/// // An octahedron, every vertex of valence 4.
+/// let faces = [0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4, 2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 3, 5];
+/// let octahedron = TopologyBuilder::new(6).build(&[3; 8], &faces).unwrap();
+/// let p = [DVec3::X, -DVec3::X, DVec3::Y, -DVec3::Y, DVec3::Z, -DVec3::Z];
+/// let direct = split_limit_points(&octahedron, &Scheme::Sqrt3, &p).unwrap();
+/// let by_table = split_limit_table(&octahedron, &Scheme::Sqrt3).unwrap().apply(&p);
+/// for v in 0..6 {
+///     assert!((direct.positions[v] - by_table.positions[v]).length() < 1e-14);
+///     assert!((direct.normals[v] - by_table.normals[v]).length() < 1e-12);
+/// }
+/// ```
+///
+/// # Errors
+/// As [`split_limit_table`].
+///
+/// # Panics
+/// If `points` does not hold one point per vertex of `base`.
+pub fn split_limit_points(
     base: &Topology,
-    r: &Refinement,
-    position: &mut [Option<Row>],
-    tangents: &mut [Option<[Row; 2]>],
-) {
+    scheme: &Scheme,
+    points: &[DVec3],
+) -> Result<LimitPoints, LimitError> {
+    assert_eq!(points.len(), base.num_vertices(), "one point per vertex");
+    Refinement::new(base, scheme.clone(), &Options::default(), 0)?;
+    let nv = base.num_vertices();
+    let refiner = Refiner {
+        base,
+        scheme,
+        how: Neighbourhoods::Local,
+    };
+    let mut found = Found::Points {
+        base: points,
+        position: vec![None; nv],
+        tangents: vec![None; nv],
+    };
+    find_limits(&refiner, &mut found)?;
+    let Found::Points {
+        position, tangents, ..
+    } = found
+    else {
+        unreachable!("points asked for")
+    };
+    if let Some(v) = position.iter().position(Option::is_none) {
+        return Err(no_limit(v, scheme));
+    }
+    let nan = DVec3::splat(f64::NAN);
+    let (mut tangent1, mut tangent2, mut normals) = (
+        Vec::with_capacity(nv),
+        Vec::with_capacity(nv),
+        Vec::with_capacity(nv),
+    );
+    for t in &tangents {
+        let (a, b, n) = match t {
+            Some([a, b]) => (*a, *b, a.cross(*b).normalize_or_zero()),
+            None => (nan, nan, nan),
+        };
+        tangent1.push(a);
+        tangent2.push(b);
+        normals.push(n);
+    }
+    Ok(LimitPoints {
+        positions: position.into_iter().map(|p| p.expect("checked")).collect(),
+        tangent1,
+        tangent2,
+        normals,
+    })
+}
+
+/// Where the masks' findings go: rows over the base vertices (for the stencil tables), or
+/// the values themselves, taken from the base points as each vertex is settled.
+enum Found<'p> {
+    Rows {
+        position: Vec<Option<Row>>,
+        tangents: Vec<Option<[Row; 2]>>,
+    },
+    Points {
+        base: &'p [DVec3],
+        position: Vec<Option<DVec3>>,
+        tangents: Vec<Option<[DVec3; 2]>>,
+    },
+}
+
+impl Found<'_> {
+    /// Whether vertex `v` has its position.
+    fn has_position(&self, v: usize) -> bool {
+        match self {
+            Found::Rows { position, .. } => position[v].is_some(),
+            Found::Points { position, .. } => position[v].is_some(),
+        }
+    }
+
+    /// The base points, when values rather than rows are asked for.
+    fn points(&self) -> Option<&[DVec3]> {
+        match self {
+            Found::Rows { .. } => None,
+            Found::Points { base, .. } => Some(base),
+        }
+    }
+
+    /// Sets vertex `v`'s position row (applied to the base points for values).
+    fn set_position(&mut self, v: usize, row: Row) {
+        match self {
+            Found::Rows { position, .. } => position[v] = Some(row),
+            Found::Points { base, position, .. } => position[v] = Some(apply_row(&row, base)),
+        }
+    }
+
+    /// Sets vertex `v`'s two tangent rows.
+    fn set_tangents(&mut self, v: usize, rows: [Row; 2]) {
+        match self {
+            Found::Rows { tangents, .. } => tangents[v] = Some(rows),
+            Found::Points { base, tangents, .. } => {
+                tangents[v] = Some([apply_row(&rows[0], base), apply_row(&rows[1], base)]);
+            }
+        }
+    }
+
+    /// Records what the masks found at vertex `v`.
+    fn set(&mut self, v: usize, at: AtVertex) {
+        match (self, at) {
+            (found, AtVertex::Rows(p, t)) => {
+                if let Some(p) = p {
+                    found.set_position(v, p);
+                }
+                if let Some(t) = t {
+                    found.set_tangents(v, t);
+                }
+            }
+            (
+                Found::Points {
+                    position, tangents, ..
+                },
+                AtVertex::Values(p, t),
+            ) => {
+                if p.is_some() {
+                    position[v] = p;
+                }
+                if t.is_some() {
+                    tangents[v] = t;
+                }
+            }
+            (Found::Rows { .. }, AtVertex::Values(..)) => unreachable!("rows were asked for"),
+        }
+    }
+}
+
+/// The masks' findings at one vertex: position and tangent rows, or their values.
+enum AtVertex {
+    Rows(Option<Row>, Option<[Row; 2]>),
+    Values(Option<DVec3>, Option<[DVec3; 2]>),
+}
+
+/// `Σ w p[s]` over a row, summed as [`StencilTable::apply_points`] sums its rows.
+fn apply_row(row: &[(u32, f64)], p: &[DVec3]) -> DVec3 {
+    let mut acc = DVec3::ZERO;
+    for &(s, w) in row {
+        acc += w * p[s as usize];
+    }
+    acc
+}
+
+/// The error naming vertex `v`, which has no limit under `scheme`.
+fn no_limit(v: usize, scheme: &Scheme) -> LimitError {
+    let why = if scheme.split() == Split::Dual {
+        "an interior vertex of valence 2 has no vertex face"
+    } else {
+        "its neighbourhood never became one with a known limit mask (a dart or boundary vertex whose refined neighbourhood stays irregular)"
+    };
+    LimitError::NoLimit {
+        vertex: v,
+        scheme: scheme.name(),
+        why,
+    }
+}
+
+/// The limit of every vertex of the refiner's base, as `found` asks for it.
+fn find_limits(refiner: &Refiner<'_>, found: &mut Found<'_>) -> Result<(), LimitError> {
+    if refiner.scheme.split() == Split::Dual {
+        let r = refiner.whole(1)?.r;
+        doo_sabin_rows(refiner.base, &r, found);
+        Ok(())
+    } else {
+        vertex_rows(refiner.base, refiner.scheme, refiner, found)
+    }
+}
+
+/// Doo-Sabin: centroid and first Fourier mode of each vertex's vertex face.
+fn doo_sabin_rows(base: &Topology, r: &Refinement, found: &mut Found<'_>) {
     let level1 = r.topology(1);
     let stencils = r.stencils(1);
     for (v, face) in doo_sabin::vertex_face_indices(base).into_iter().enumerate() {
@@ -236,11 +423,14 @@ fn doo_sabin_rows(
                 .collect()
         };
         let centroid: Row = corners.iter().map(|&c| (c, 1.0 / m as f64)).collect();
-        position[v] = Some(to_base(&centroid, stencils));
-        tangents[v] = Some([
-            to_base(&mode(f64::cos), stencils),
-            to_base(&mode(f64::sin), stencils),
-        ]);
+        found.set_position(v, to_base(&centroid, stencils));
+        found.set_tangents(
+            v,
+            [
+                to_base(&mode(f64::cos), stencils),
+                to_base(&mode(f64::sin), stencils),
+            ],
+        );
     }
 }
 
@@ -272,6 +462,18 @@ impl Refined {
         match &self.piece {
             None => v,
             Some((of_base, _)) => of_base[v as usize],
+        }
+    }
+
+    /// The points of the refinement's `level`, from the points of the whole base.
+    fn points_at<'p>(&self, base: &'p [DVec3], level: usize) -> Cow<'p, [DVec3]> {
+        match &self.piece {
+            None if level == 0 => Cow::Borrowed(base),
+            None => Cow::Owned(self.r.points_at(base, level)),
+            Some((_, to_base)) => {
+                let own: Vec<DVec3> = to_base.iter().map(|&b| base[b as usize]).collect();
+                Cow::Owned(self.r.points_at(&own, level))
+            }
         }
     }
 
@@ -393,8 +595,7 @@ fn vertex_rows(
     base: &Topology,
     scheme: &Scheme,
     refiner: &Refiner<'_>,
-    position: &mut [Option<Row>],
-    tangents: &mut [Option<[Row; 2]>],
+    found: &mut Found<'_>,
 ) -> Result<(), LimitError> {
     let nv = base.num_vertices();
     let features = Features::new(base);
@@ -403,7 +604,7 @@ fn vertex_rows(
     for v in 0..nv as u32 {
         let vi = v as usize;
         if base.vertex_faces(vi).is_empty() || scheme.is_interpolating() {
-            position[vi] = Some(vec![(v, 1.0)]);
+            found.set_position(vi, vec![(v, 1.0)]);
         }
         if base.vertex_faces(vi).is_empty() {
             continue;
@@ -416,9 +617,9 @@ fn vertex_rows(
             }
             if scheme.split() == Split::Sqrt3 {
                 if features.is_corner(vi) {
-                    position[vi] = Some(vec![(v, 1.0)]);
+                    found.set_position(vi, vec![(v, 1.0)]);
                 } else if features.is_curve_vertex(vi) {
-                    position[vi] = Some(sqrt3_curve_limit(base, &features, v, refiner)?);
+                    found.set_position(vi, sqrt3_curve_limit(base, &features, v, refiner)?);
                 }
                 // A dart (one crease edge ending inside the surface): no mask here.
             }
@@ -426,8 +627,8 @@ fn vertex_rows(
         }
         pending.push(v);
     }
-    interior_rows(base, scheme, refiner, pending, position, tangents)?;
-    feature_rows(scheme, refiner, &feature_pending, position, tangents)
+    interior_rows(base, scheme, refiner, pending, found)?;
+    feature_rows(scheme, refiner, &feature_pending, found)
 }
 
 /// Interior vertices: the masks of their valence at the first level (0 to [`MAX_LEVELS`])
@@ -437,8 +638,7 @@ fn interior_rows(
     scheme: &Scheme,
     refiner: &Refiner<'_>,
     mut pending: Vec<u32>,
-    position: &mut [Option<Row>],
-    tangents: &mut [Option<[Row; 2]>],
+    found: &mut Found<'_>,
 ) -> Result<(), LimitError> {
     let mut masks: HashMap<usize, (LocalMasks, usize)> = HashMap::new();
     pending.retain(|&v| (3..=64).contains(&base.valence(v as usize)));
@@ -458,57 +658,93 @@ fn interior_rows(
             .max()
             .unwrap_or(0);
         let refined = refiner.around_last_level(&pending, level, radius)?;
+        let points = found.points().map(|p| refined.points_at(p, level));
         let t = refined.r.topology(level);
-        let features = Features::new(t);
-        let masks = &masks;
-        // The vertex's rows, or `None` while its ball is not regular yet.
-        let rows_of = |v: u32, composed: &mut ComposedRows| {
-            let (m, size) = &masks[&base.valence(v as usize)];
-            let lv = refined.vertex(v);
-            let ball = LocalMasks::ball(t, lv, m.radius);
-            if !regular_ball(t, &features, lv, &ball, *size) {
-                return None;
-            }
-            let mut row = |w: &[f64]| -> Row {
-                let r: Row = ball
-                    .iter()
-                    .zip(w)
-                    .filter(|(_, w)| **w != 0.0)
-                    .map(|(&u, &w)| (u, w))
-                    .collect();
-                refined.base_row(r, level, composed)
-            };
-            let limit = (!scheme.is_interpolating()).then(|| row(&m.limit));
-            let tangent_rows = m.tangents.as_ref().map(|[a, b]| [row(a), row(b)]);
-            Some((limit, tangent_rows))
+        let at_level = LevelMasks {
+            base,
+            interpolating: scheme.is_interpolating(),
+            masks: &masks,
+            refined: &refined,
+            level,
+            topology: t,
+            features: Features::new(t),
+            points: points.as_deref(),
         };
         // Vertices in chunks, each composing the rows it reads (a row two chunks read is
-        // composed twice, the same way): the rows do not depend on the chunks.
-        let found: Vec<Vec<_>> = pending
+        // composed twice, the same way): the rows do not depend on the chunks. Values need
+        // no composing.
+        let results: Vec<Vec<Option<AtVertex>>> = pending
             .par_chunks(ROWS_CHUNK)
             .map(|chunk| {
-                let mut composed = ComposedRows::new(&refined.r);
-                chunk.iter().map(|&v| rows_of(v, &mut composed)).collect()
+                let mut composed = points.is_none().then(|| ComposedRows::new(&refined.r));
+                chunk
+                    .iter()
+                    .map(|&v| at_level.at(v, composed.as_mut()))
+                    .collect()
             })
             .collect();
         let mut still = Vec::new();
-        for (&v, rows) in pending.iter().zip(found.into_iter().flatten()) {
-            match rows {
+        for (&v, at) in pending.iter().zip(results.into_iter().flatten()) {
+            match at {
                 None => still.push(v),
-                Some((limit, tangent_rows)) => {
-                    if limit.is_some() {
-                        position[v as usize] = limit;
-                    }
-                    if tangent_rows.is_some() {
-                        tangents[v as usize] = tangent_rows;
-                    }
-                }
+                Some(at) => found.set(v as usize, at),
             }
         }
         pending = still;
         level += 1;
     }
     Ok(())
+}
+
+/// The interior masks at one level of a refinement around the pending vertices.
+struct LevelMasks<'a> {
+    base: &'a Topology,
+    interpolating: bool,
+    masks: &'a HashMap<usize, (LocalMasks, usize)>,
+    refined: &'a Refined,
+    level: usize,
+    topology: &'a Topology,
+    features: Features,
+    /// The level's points, when values rather than rows are asked for.
+    points: Option<&'a [DVec3]>,
+}
+
+impl LevelMasks<'_> {
+    /// Base vertex `v`'s limit and tangents, as rows (through `composed`) or values; `None`
+    /// while its ball is not regular yet.
+    fn at(&self, v: u32, composed: Option<&mut ComposedRows>) -> Option<AtVertex> {
+        let (m, size) = &self.masks[&self.base.valence(v as usize)];
+        let t = self.topology;
+        let lv = self.refined.vertex(v);
+        let ball = LocalMasks::ball(t, lv, m.radius);
+        if !regular_ball(t, &self.features, lv, &ball, *size) {
+            return None;
+        }
+        let entries = |w: &'_ [f64]| {
+            ball.iter()
+                .zip(w)
+                .filter(|(_, w)| **w != 0.0)
+                .map(|(&u, &w)| (u, w))
+                .collect::<Row>()
+        };
+        let limit = (!self.interpolating).then_some(&m.limit);
+        if let (Some(points), None) = (self.points, &composed) {
+            // As `apply_row` sums the entries, without collecting them.
+            let value = |w: &Vec<f64>| {
+                ball.iter()
+                    .zip(w)
+                    .filter(|(_, w)| **w != 0.0)
+                    .fold(DVec3::ZERO, |acc, (&u, &w)| acc + w * points[u as usize])
+            };
+            let tangents = m.tangents.as_ref().map(|[a, b]| [value(a), value(b)]);
+            return Some(AtVertex::Values(limit.map(value), tangents));
+        }
+        let composed = composed.expect("rows compose through the refinement");
+        let mut row = |w: &Vec<f64>| self.refined.base_row(entries(w), self.level, composed);
+        let limit = limit.map(&mut row);
+        let tangents = m.tangents.as_ref().map(|[a, b]| [row(a), row(b)]);
+        Some(AtVertex::Rows(limit, tangents))
+    }
 }
 
 /// Pending vertices per parallel task of [`interior_rows`].
@@ -552,8 +788,7 @@ fn feature_rows(
     scheme: &Scheme,
     refiner: &Refiner<'_>,
     vertices: &[u32],
-    position: &mut [Option<Row>],
-    tangents: &mut [Option<[Row; 2]>],
+    found: &mut Found<'_>,
 ) -> Result<(), LimitError> {
     if vertices.is_empty() {
         return Ok(());
@@ -607,11 +842,11 @@ fn feature_rows(
                     .collect();
                 refined.base_row(r, level, &mut composed)
             };
-            if position[v as usize].is_none() {
-                position[v as usize] = Some(row(&m.limit));
+            if !found.has_position(v as usize) {
+                found.set_position(v as usize, row(&m.limit));
             }
             if let Some([a, b]) = &m.tangents {
-                tangents[v as usize] = Some([row(a), row(b)]);
+                found.set_tangents(v as usize, [row(a), row(b)]);
             }
         }
         pending = still;
