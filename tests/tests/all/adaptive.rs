@@ -362,3 +362,87 @@ fn adaptive_uvs_are_the_limits_of_uniform_refinement_values() {
     }
     assert!(checked > 5000, "only {checked} corners checked");
 }
+
+/// The crack count of `mesh` computed another way: a hash map of each uniform edge's
+/// face sides against the faces it has, and of each diagonal's (unordered vertex pair)
+/// sides, which must be two.
+fn mismatches_by_hashing(mesh: &subd_adaptive::AdaptiveMesh) -> usize {
+    use std::collections::HashMap;
+    use subd_adaptive::EdgeOrigin;
+    let mut uniform: HashMap<(u8, u64), (usize, u32)> = HashMap::new();
+    let mut diagonals: HashMap<(u32, u32), usize> = HashMap::new();
+    for f in 0..mesh.num_faces() {
+        let face = mesh.face(f);
+        for (i, &a) in face.iter().enumerate() {
+            let b = face[(i + 1) % face.len()];
+            match mesh.edge_origins[mesh.face_offsets[f] as usize + i] {
+                EdgeOrigin::Uniform {
+                    level,
+                    index,
+                    faces,
+                } => uniform.entry((level, index)).or_insert((0, faces)).0 += 1,
+                EdgeOrigin::Diagonal => *diagonals.entry((a.min(b), a.max(b))).or_insert(0) += 1,
+            }
+        }
+    }
+    uniform
+        .values()
+        .filter(|(n, faces)| *n != *faces as usize)
+        .count()
+        + diagonals.values().filter(|&&n| n % 2 != 0).count()
+}
+
+/// The conformity check finds cracks: with the last face of an adaptive mesh dropped, its
+/// inner sides are each one side short; with one side's uniform edge index moved past what
+/// the packed sort holds (so the check takes its unpacked path), that side and its
+/// partner are off. Both counts equal a hash map's, on every shape.
+#[test]
+fn the_conformity_check_counts_cracks() {
+    let (mut cracked, mut unpacked) = (0, 0);
+    for s in shapes() {
+        let pick = RandomSelection::new(5, 0.35).unwrap();
+        let Ok(a) = AdaptiveRefinement::new(
+            &s.mesh.topology,
+            &s.mesh.positions,
+            &s.scheme,
+            &s.options,
+            &[&pick],
+            2,
+        ) else {
+            continue;
+        };
+        let mut mesh = a.mesh(Positions::Refined).unwrap();
+        assert_eq!(mesh.conformity().mismatched_edges, 0, "{}", s.name);
+        // The last face dropped.
+        let mut dropped = mesh.clone();
+        dropped.face_offsets.pop();
+        let end = *dropped.face_offsets.last().unwrap() as usize;
+        dropped.face_vertices.truncate(end);
+        dropped.edge_origins.truncate(end);
+        dropped.face_levels.pop();
+        let expected = mismatches_by_hashing(&dropped);
+        assert_eq!(
+            dropped.conformity().mismatched_edges,
+            expected,
+            "{}",
+            s.name
+        );
+        cracked += usize::from(expected > 0);
+        // One uniform side moved out of the packed range.
+        if let Some(subd_adaptive::EdgeOrigin::Uniform { index, .. }) = mesh
+            .edge_origins
+            .iter_mut()
+            .find(|o| matches!(o, subd_adaptive::EdgeOrigin::Uniform { faces: 2, .. }))
+        {
+            *index += 1 << 53;
+            let expected = mismatches_by_hashing(&mesh);
+            assert_eq!(mesh.conformity().mismatched_edges, expected, "{}", s.name);
+            assert_eq!(expected, 2, "{}", s.name);
+            unpacked += 1;
+        }
+    }
+    assert!(
+        cracked > 30 && unpacked > 30,
+        "{cracked} cracked, {unpacked} unpacked"
+    );
+}
