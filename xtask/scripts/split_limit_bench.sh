@@ -31,7 +31,7 @@ with open("open_bunny.obj", "w") as o:
     o.writelines("f %d %d %d\n" % tuple(t + 1) for t in index[keep])
 PY
 run() { # scheme levels binary [--limit]
-  /usr/bin/time -f "%e s %M KB" "$3" refine --scheme "$1" --levels "$2" $4 open_bunny.obj out.ply --json \
+  /usr/bin/time -f "%e s %M KB" "$3" refine --scheme "$1" --levels "$2" ${4:-} open_bunny.obj out.ply --json \
     > report.json 2> time.txt
   echo "$1 L$2 $3 ${4:-plain}: positions $(grep -o '"positions":[0-9.]*' report.json | cut -d: -f2) s, $(tail -1 time.txt)"
 }

@@ -551,6 +551,113 @@ impl Refiner<'_> {
         self.piece(vertices, levels, rings)
     }
 
+    /// The level `level` for the masks of `pending` when values are asked for: the base at
+    /// level 0; for the butterflies below level 1, one step of a piece cut out of the level
+    /// above (`above`) around the vertices still pending, so that each level refines only
+    /// their neighbourhood, not the base's again; otherwise a piece of the base refined
+    /// `level` deep ([`Self::around_last_level`]).
+    ///
+    /// Each butterfly level is kept exact within `E = max(radius + 1, 6)` rings of the
+    /// pending vertices, the masks' balls and their rings included. One step is exact within
+    /// `E` rings when the level above is within `C = ⌈E/2⌉ + 2` ([`Self::around_last_level`]'s
+    /// step), and a piece cut `C` rings around them reads the faces touching those rings,
+    /// exact where the level above is within `C + 1 = ⌈E/2⌉ + 3 ≤ E` (as `E ≥ 6`, and `E`
+    /// does not grow as the pending vertices become fewer).
+    fn level_for_points(
+        &self,
+        above: Option<PointsLevel>,
+        pending: &[u32],
+        level: usize,
+        radius: usize,
+        base_points: &[DVec3],
+    ) -> Result<PointsLevel, LimitError> {
+        let chained = self.scheme.split() == Split::Triangle && self.how == Neighbourhoods::Local;
+        let exact = if chained {
+            (radius + 1).max(6)
+        } else {
+            radius + 1
+        };
+        if level == 0 {
+            return Ok(PointsLevel {
+                refined: None,
+                numbering: Vec::new(),
+                points: Vec::new(),
+            });
+        }
+        match above {
+            Some(above) if chained && above.refined.is_some() => {
+                self.step_below(&above, pending, exact.div_ceil(2) + 2)
+            }
+            _ => {
+                let refined = self.around_last_level(pending, level, exact - 1)?;
+                let points = refined.points_at(base_points, level).into_owned();
+                let numbering = refined
+                    .piece
+                    .map(|(of_base, _)| of_base)
+                    .unwrap_or_default();
+                Ok(PointsLevel {
+                    refined: Some((refined.r, level)),
+                    numbering,
+                    points,
+                })
+            }
+        }
+    }
+
+    /// One step of the faces of `above`'s level touching the vertices within `rings` of the
+    /// pending vertices (all of that level where that is every face, or where the cut would
+    /// pinch a vertex), with its points.
+    fn step_below(
+        &self,
+        above: &PointsLevel,
+        pending: &[u32],
+        rings: usize,
+    ) -> Result<PointsLevel, LimitError> {
+        let (r_above, at) = above.refined.as_ref().expect("a refined level above");
+        let t = r_above.topology(*at);
+        let seeds: Vec<u32> = pending.iter().map(|&v| above.vertex(v)).collect();
+        let faces = without_pinches(
+            t,
+            &faces_touching(t, &vertices_within_rings(t, &seeds, rings)),
+        );
+        let step = |t: &Topology| {
+            Refinement::new(t, self.scheme.clone(), &Options::default(), 1)
+                .map_err(|e| LimitError::Analysis(e.to_string()))
+        };
+        let sub = (faces.len() < t.num_faces()).then(|| cut(t, &faces));
+        let (r, of_above, points) = match sub.as_ref().map(|sub| (step(&sub.topology), sub)) {
+            Some((Ok(r), sub)) => {
+                let own: Vec<DVec3> = sub
+                    .vertices
+                    .iter()
+                    .map(|&u| above.points[u as usize])
+                    .collect();
+                let mut of_above = vec![NONE; t.num_vertices()];
+                for (i, &u) in sub.vertices.iter().enumerate() {
+                    of_above[u as usize] = i as u32;
+                }
+                (r, Some(of_above), own)
+            }
+            _ => (step(t)?, None, above.points.clone()),
+        };
+        let points = r.points_at(&points, 1);
+        let numbering = (0..self.base.num_vertices() as u32)
+            .map(|v| {
+                let u = above.vertex(v);
+                match (&of_above, u) {
+                    (_, NONE) => NONE,
+                    (Some(of_above), u) => of_above[u as usize],
+                    (None, u) => u,
+                }
+            })
+            .collect();
+        Ok(PointsLevel {
+            refined: Some((r, 1)),
+            numbering,
+            points,
+        })
+    }
+
     /// The faces touching the vertices within `rings` base rings of `vertices`, refined
     /// `levels` deep; the whole base where that is every face, or where the piece cannot be
     /// refined.
@@ -650,6 +757,8 @@ fn interior_rows(
             e.insert((m, size));
         }
     }
+    let interpolating = scheme.is_interpolating();
+    let mut above: Option<PointsLevel> = None;
     let mut level = 0;
     while !pending.is_empty() && level <= MAX_LEVELS {
         let radius = pending
@@ -657,34 +766,44 @@ fn interior_rows(
             .map(|&v| masks[&base.valence(v as usize)].0.radius)
             .max()
             .unwrap_or(0);
-        let refined = refiner.around_last_level(&pending, level, radius)?;
-        let points = found.points().map(|p| refined.points_at(p, level));
-        let t = refined.r.topology(level);
-        let at_level = LevelMasks {
-            base,
-            interpolating: scheme.is_interpolating(),
-            masks: &masks,
-            refined: &refined,
-            level,
-            topology: t,
-            features: Features::new(t),
-            points: points.as_deref(),
+        let results = if let Some(base_points) = found.points() {
+            let at =
+                refiner.level_for_points(above.take(), &pending, level, radius, base_points)?;
+            let t = at.topology(base);
+            let at_level = LevelMasks {
+                base,
+                interpolating,
+                masks: &masks,
+                topology: t,
+                features: Features::new(t),
+                numbering: at.numbering(),
+                source: Source::Points(at.points(base_points)),
+            };
+            let results = masks_in_chunks(&pending, |v, _| at_level.at(v, None), || None);
+            above = Some(at);
+            results
+        } else {
+            let refined = refiner.around_last_level(&pending, level, radius)?;
+            let t = refined.r.topology(level);
+            let at_level = LevelMasks {
+                base,
+                interpolating,
+                masks: &masks,
+                topology: t,
+                features: Features::new(t),
+                numbering: refined.piece.as_ref().map(|(of_base, _)| &of_base[..]),
+                source: Source::Rows(&refined, level),
+            };
+            // Each chunk composes the rows it reads (a row two chunks read is composed
+            // twice, the same way): the rows do not depend on the chunks.
+            masks_in_chunks(
+                &pending,
+                |v, composed| at_level.at(v, composed),
+                || Some(ComposedRows::new(&refined.r)),
+            )
         };
-        // Vertices in chunks, each composing the rows it reads (a row two chunks read is
-        // composed twice, the same way): the rows do not depend on the chunks. Values need
-        // no composing.
-        let results: Vec<Vec<Option<AtVertex>>> = pending
-            .par_chunks(ROWS_CHUNK)
-            .map(|chunk| {
-                let mut composed = points.is_none().then(|| ComposedRows::new(&refined.r));
-                chunk
-                    .iter()
-                    .map(|&v| at_level.at(v, composed.as_mut()))
-                    .collect()
-            })
-            .collect();
         let mut still = Vec::new();
-        for (&v, at) in pending.iter().zip(results.into_iter().flatten()) {
+        for (&v, at) in pending.iter().zip(results) {
             match at {
                 None => still.push(v),
                 Some(at) => found.set(v as usize, at),
@@ -696,17 +815,39 @@ fn interior_rows(
     Ok(())
 }
 
+/// `at(v, scratch)` for every pending vertex, in parallel chunks with a scratch each.
+fn masks_in_chunks<'r>(
+    pending: &[u32],
+    at: impl Fn(u32, Option<&mut ComposedRows<'r>>) -> Option<AtVertex> + Sync,
+    scratch: impl Fn() -> Option<ComposedRows<'r>> + Sync,
+) -> Vec<Option<AtVertex>> {
+    let chunks: Vec<Vec<Option<AtVertex>>> = pending
+        .par_chunks(ROWS_CHUNK)
+        .map(|chunk| {
+            let mut composed = scratch();
+            chunk.iter().map(|&v| at(v, composed.as_mut())).collect()
+        })
+        .collect();
+    chunks.into_iter().flatten().collect()
+}
+
+/// Where a level's masks take their values from: the rows of a refinement's level
+/// (composed back to the base), or the level's points.
+enum Source<'a> {
+    Rows(&'a Refined, usize),
+    Points(&'a [DVec3]),
+}
+
 /// The interior masks at one level of a refinement around the pending vertices.
 struct LevelMasks<'a> {
     base: &'a Topology,
     interpolating: bool,
     masks: &'a HashMap<usize, (LocalMasks, usize)>,
-    refined: &'a Refined,
-    level: usize,
     topology: &'a Topology,
     features: Features,
-    /// The level's points, when values rather than rows are asked for.
-    points: Option<&'a [DVec3]>,
+    /// The level's vertex of each base vertex; `None` where they are the same.
+    numbering: Option<&'a [u32]>,
+    source: Source<'a>,
 }
 
 impl LevelMasks<'_> {
@@ -715,35 +856,79 @@ impl LevelMasks<'_> {
     fn at(&self, v: u32, composed: Option<&mut ComposedRows>) -> Option<AtVertex> {
         let (m, size) = &self.masks[&self.base.valence(v as usize)];
         let t = self.topology;
-        let lv = self.refined.vertex(v);
+        let lv = self.numbering.map_or(v, |n| n[v as usize]);
         let ball = LocalMasks::ball(t, lv, m.radius);
         if !regular_ball(t, &self.features, lv, &ball, *size) {
             return None;
         }
-        let entries = |w: &'_ [f64]| {
-            ball.iter()
-                .zip(w)
-                .filter(|(_, w)| **w != 0.0)
-                .map(|(&u, &w)| (u, w))
-                .collect::<Row>()
-        };
         let limit = (!self.interpolating).then_some(&m.limit);
-        if let (Some(points), None) = (self.points, &composed) {
-            // As `apply_row` sums the entries, without collecting them.
-            let value = |w: &Vec<f64>| {
-                ball.iter()
-                    .zip(w)
-                    .filter(|(_, w)| **w != 0.0)
-                    .fold(DVec3::ZERO, |acc, (&u, &w)| acc + w * points[u as usize])
-            };
-            let tangents = m.tangents.as_ref().map(|[a, b]| [value(a), value(b)]);
-            return Some(AtVertex::Values(limit.map(value), tangents));
+        match self.source {
+            Source::Points(points) => {
+                // As `apply_row` sums the entries, without collecting them.
+                let value = |w: &Vec<f64>| {
+                    ball.iter()
+                        .zip(w)
+                        .filter(|(_, w)| **w != 0.0)
+                        .fold(DVec3::ZERO, |acc, (&u, &w)| acc + w * points[u as usize])
+                };
+                let tangents = m.tangents.as_ref().map(|[a, b]| [value(a), value(b)]);
+                Some(AtVertex::Values(limit.map(value), tangents))
+            }
+            Source::Rows(refined, level) => {
+                let composed = composed.expect("rows compose through the refinement");
+                let mut row = |w: &Vec<f64>| {
+                    let entries: Row = ball
+                        .iter()
+                        .zip(w)
+                        .filter(|(_, w)| **w != 0.0)
+                        .map(|(&u, &w)| (u, w))
+                        .collect();
+                    refined.base_row(entries, level, composed)
+                };
+                let limit = limit.map(&mut row);
+                let tangents = m.tangents.as_ref().map(|[a, b]| [row(a), row(b)]);
+                Some(AtVertex::Rows(limit, tangents))
+            }
         }
-        let composed = composed.expect("rows compose through the refinement");
-        let mut row = |w: &Vec<f64>| self.refined.base_row(entries(w), self.level, composed);
-        let limit = limit.map(&mut row);
-        let tangents = m.tangents.as_ref().map(|[a, b]| [row(a), row(b)]);
-        Some(AtVertex::Rows(limit, tangents))
+    }
+}
+
+/// A level the masks are read at when values are asked for: the base itself, or a piece
+/// refined to the level (from the base, or one step from the piece of the level above),
+/// with its points.
+struct PointsLevel {
+    /// The piece's refinement and the level of it the masks read; `None` at the base.
+    refined: Option<(Refinement, usize)>,
+    /// The level's vertex of each base vertex ([`NONE`] outside the piece); empty where
+    /// they are the same.
+    numbering: Vec<u32>,
+    /// The level's points (empty at the base, whose points are given).
+    points: Vec<DVec3>,
+}
+
+impl PointsLevel {
+    fn topology<'t>(&'t self, base: &'t Topology) -> &'t Topology {
+        match &self.refined {
+            Some((r, level)) => r.topology(*level),
+            None => base,
+        }
+    }
+
+    fn numbering(&self) -> Option<&[u32]> {
+        (!self.numbering.is_empty()).then_some(&self.numbering[..])
+    }
+
+    fn points<'p>(&'p self, base: &'p [DVec3]) -> &'p [DVec3] {
+        if self.refined.is_some() {
+            &self.points
+        } else {
+            base
+        }
+    }
+
+    /// The level's vertex of base vertex `v`.
+    fn vertex(&self, v: u32) -> u32 {
+        self.numbering().map_or(v, |n| n[v as usize])
     }
 }
 
