@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use serde::Serialize;
-use subd_limit::{LimitPoints, LimitStencilTable, levels_for_exact_limit};
+use subd_limit::{LimitPoints, levels_for_exact_limit};
 use subd_mesh::Mesh;
 use subd_schemes::Scheme;
 
@@ -118,9 +118,8 @@ fn run_one(
     let topo = &mesh.topology;
     let options = args.rules.options(&mesh.hints);
     let scheme = scheme_arg::with_lambda(&scheme, &args.lambda, input, topo.num_vertices())?;
-    // One set of stencils for the positions and the texture coordinates.
-    let table = subd_limit::limit_stencils(topo, &scheme, &options).map_err(|e| in_file(&e))?;
-    let limit = table.apply(&mesh.positions);
+    let limit = subd_limit::limit_points(topo, &scheme, &options, &mesh.positions)
+        .map_err(|e| in_file(&e))?;
     // ACC first, so that a mesh it does not cover fails before any file is written.
     let acc = match &args.acc {
         Some(path) => Some((path, acc_json(path, topo, &mesh.positions, input)?)),
@@ -129,7 +128,7 @@ fn run_one(
     let mut uv_warnings = Vec::new();
     let uv = match mesh.uv() {
         Some(c) if !is_text => Some(
-            limit_uv(args, mesh, (&scheme, &options, &table), c, &mut uv_warnings)
+            limit_uv(args, mesh, (&scheme, &options), c, &mut uv_warnings)
                 .map_err(|e| in_file(&e))?,
         ),
         _ => None,
@@ -181,14 +180,17 @@ fn acc_json(
 fn limit_uv(
     args: &LimitArgs,
     mesh: &Mesh,
-    (scheme, options, table): (&Scheme, &subd_schemes::Options, &LimitStencilTable),
+    (scheme, options): (&Scheme, &subd_schemes::Options),
     channel: &subd_mesh::fvar::FVarChannel,
     warnings: &mut Vec<String>,
 ) -> Result<crate::uv::RefinedUv, String> {
     let mode = args.rules.fvar_mode(&mesh.hints);
     let topo = &mesh.topology;
     if !scheme.is_opensubdiv() {
-        crate::uv::split_limit_uv(topo, (scheme, table), channel, mode, warnings)
+        // The split schemes' texture coordinates take their limit through the stencils the
+        // positions' masks write as rows.
+        let table = subd_limit::limit_stencils(topo, scheme, options).map_err(|e| e.to_string())?;
+        crate::uv::split_limit_uv(topo, (scheme, &table), channel, mode, warnings)
             .map_err(|e| e.to_string())
     } else {
         crate::uv::limit_uv(topo, &scheme.at_level(1), options, channel, mode)
