@@ -1,8 +1,9 @@
 //! `subd refine`'s depth-first output: the last level made a chunk of base faces at a time
-//! (`subd_schemes::DepthFirst`) and each chunk's records written at their places in a
-//! binary PLY file (`subd_io::ply::PlacedPly`), so that no level is held whole and the
-//! peak memory does not grow with the level. The file is byte for byte the one the level
-//! at a time writes.
+//! (`subd_schemes::DepthFirst`) and each chunk's records written at their places: in a
+//! binary PLY file itself (`subd_io::ply::PlacedPly`), or for OBJ and ASCII PLY in a
+//! scratch file of fixed-size records then encoded in order (`subd_io::PlacedMesh`), so
+//! that no level is held whole and the peak memory does not grow with the level. The file
+//! is byte for byte the one the level at a time writes.
 
 use std::path::Path;
 
@@ -35,8 +36,11 @@ pub(crate) fn unsupported(
         Some("there is no level to refine")
     } else if limit {
         Some("--limit moves the whole level")
-    } else if subd_io::Format::for_output(output) != Some(subd_io::Format::Ply) {
-        Some("it writes binary PLY (.ply) only")
+    } else if !matches!(
+        subd_io::Format::for_output(output),
+        Some(subd_io::Format::Ply | subd_io::Format::Obj)
+    ) {
+        Some("it writes PLY (.ply) or OBJ (.obj) only")
     } else if !file.mesh.fvar.is_empty() {
         Some("texture coordinates are carried level by level")
     } else if tags.num_holes() > 0 {
@@ -50,9 +54,11 @@ pub(crate) fn unsupported(
     }
 }
 
-/// Output levels of at least this many faces are made depth-first where they can be, even
-/// when the level at a time fits: from there on it is the faster of the two (BENCHMARKS.md,
-/// "Depth-first refinement"), and its memory stays flat.
+/// Binary PLY output levels of at least this many faces are made depth-first where they
+/// can be, even when the level at a time fits: from there on it is the faster of the two
+/// (BENCHMARKS.md, "Depth-first refinement"), and its memory stays flat. OBJ, whose records
+/// go through a scratch file, is made depth-first only when asked or when the level does not
+/// fit.
 pub(crate) const BY_ITSELF_FROM_FACES: u64 = 1 << 24;
 
 /// Refuses, before any work, a `.glb` output past glTF's 4 GiB binary limit: its `f32`
@@ -89,6 +95,59 @@ pub(crate) struct Request<'a> {
     pub(crate) hints: SchemeHints,
     pub(crate) input: &'a Path,
     pub(crate) output: &'a Path,
+    pub(crate) write_options: subd_io::WriteOptions,
+}
+
+/// Where a chunk's records go: into a binary little-endian PLY file at their places, or
+/// into the scratch file of any other output.
+enum Placed {
+    Ply(subd_io::ply::PlacedPly),
+    Scratch(subd_io::PlacedMesh),
+}
+
+impl Placed {
+    fn create(request: &Request<'_>, last: LevelCounts, size: usize) -> Result<Placed, IoError> {
+        let binary_ply = subd_io::Format::for_output(request.output) == Some(subd_io::Format::Ply)
+            && request.write_options.ply_encoding == subd_io::PlyEncoding::BinaryLittleEndian;
+        Ok(if binary_ply {
+            Placed::Ply(subd_io::ply::PlacedPly::create(
+                request.output,
+                &request.hints,
+                last.vertices,
+                last.faces,
+                size,
+            )?)
+        } else {
+            Placed::Scratch(subd_io::PlacedMesh::create(
+                request.output,
+                request.hints,
+                last.vertices,
+                last.faces,
+                size,
+            )?)
+        })
+    }
+
+    fn write_points(&self, first: u64, points: &[DVec3]) -> Result<(), IoError> {
+        match self {
+            Placed::Ply(p) => p.write_points(first, points),
+            Placed::Scratch(m) => m.write_points(first, points),
+        }
+    }
+
+    fn write_faces(&self, first: u64, corners: &[u32]) -> Result<(), IoError> {
+        match self {
+            Placed::Ply(p) => p.write_faces(first, corners),
+            Placed::Scratch(m) => m.write_faces(first, corners),
+        }
+    }
+
+    fn finish(self, options: &subd_io::WriteOptions) -> Result<(), IoError> {
+        match self {
+            Placed::Ply(p) => p.finish(),
+            Placed::Scratch(m) => m.finish(options),
+        }
+    }
 }
 
 /// A chunk's failure: refining its piece, or writing its records.
@@ -121,13 +180,7 @@ pub(crate) fn write(request: &Request<'_>) -> Result<LevelCounts, Failure> {
     } else {
         4
     };
-    let ply = subd_io::ply::PlacedPly::create(
-        request.output,
-        &request.hints,
-        last.vertices,
-        last.faces,
-        size,
-    )?;
+    let placed = Placed::create(request, last, size)?;
     let df = DepthFirst::new(
         request.base,
         request.scheme.clone(),
@@ -140,15 +193,15 @@ pub(crate) fn write(request: &Request<'_>) -> Result<LevelCounts, Failure> {
     let threads = rayon::current_num_threads();
     let written = df.for_each_chunk(request.positions, threads, |chunk| {
         for (first, range) in chunk.point_runs() {
-            ply.write_points(first, &chunk.points()[range])?;
+            placed.write_points(first, &chunk.points()[range])?;
         }
         for (first, range) in chunk.face_runs(size) {
-            ply.write_faces(first, &chunk.face_vertices()[range])?;
+            placed.write_faces(first, &chunk.face_vertices()[range])?;
         }
         Ok::<(), ChunkError>(())
     });
     match written {
-        Ok(()) => ply.finish()?,
+        Ok(()) => placed.finish(&request.write_options)?,
         Err(ChunkError::Refine(e)) => return Err(in_input(e)),
         Err(ChunkError::Io(e)) => return Err(e.into()),
     }

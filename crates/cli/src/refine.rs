@@ -48,10 +48,10 @@ pub(crate) struct RefineArgs {
     #[arg(long)]
     limit: bool,
     /// Refine depth-first: chunks of base faces taken to the last level one at a time and
-    /// written in place, so that the memory does not grow with the level (Catmull-Clark,
-    /// Loop or Bilinear to binary PLY, without texture coordinates, holes or creases sharp
-    /// past the last level). Chosen by itself when the level at a time would not fit the
-    /// memory budget.
+    /// written in place (OBJ: into a scratch file beside it, then encoded in order), so
+    /// that the memory does not grow with the level (Catmull-Clark, Loop or Bilinear to PLY
+    /// or OBJ, without texture coordinates, holes or creases sharp past the last level).
+    /// Chosen by itself when the level at a time would not fit the memory budget.
     #[arg(long)]
     depth_first: bool,
     /// Print a JSON report (counts, timings) on stdout.
@@ -306,6 +306,7 @@ fn run_depth_first(
         hints,
         input: &job.input,
         output: &job.output,
+        write_options: opened.file.output_options(),
     };
     let counts = crate::depth_first::write(&request)?;
     if args.json {
@@ -584,7 +585,10 @@ fn plan_memory(
     }
     let why_not =
         crate::depth_first::unsupported(scheme, args.levels, args.limit, &job.output, file);
-    let large = last.faces >= crate::depth_first::BY_ITSELF_FROM_FACES;
+    // Only where the records go straight into the file (binary PLY): through a scratch
+    // file (OBJ) depth-first is the slower of the two, taken when the level does not fit.
+    let in_place = subd_io::Format::for_output(&job.output) == Some(subd_io::Format::Ply);
+    let large = in_place && last.faces >= crate::depth_first::BY_ITSELF_FROM_FACES;
     match why_not {
         Some(why) if args.depth_first => Err(bad(format!(
             "{}: --depth-first cannot make this output: {why}",

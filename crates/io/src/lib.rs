@@ -30,6 +30,7 @@ pub mod fuzzing;
 pub mod glb;
 pub mod gltf_input;
 pub mod obj;
+mod placed;
 pub mod ply;
 mod records;
 mod text;
@@ -42,6 +43,7 @@ use std::io::Write;
 use std::path::Path;
 
 pub use error::{IoError, ReadError};
+pub use placed::PlacedMesh;
 pub use ply::PlyEncoding;
 use subd_mesh::Mesh;
 pub use view::{FaceSource, MeshView, PointSource, Points, TexCoords, ViewError};

@@ -26,7 +26,7 @@ use crate::view::MeshView;
 use crate::{MeshFile, ReadOptions};
 
 mod binary;
-mod placed;
+pub(crate) mod placed;
 mod write;
 
 pub use placed::PlacedPly;

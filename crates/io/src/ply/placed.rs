@@ -195,7 +195,7 @@ thread_local! {
 }
 
 /// PLY's limits: 32-bit vertex indices, a `uchar` face size.
-fn check_fits(path: &Path, num_vertices: u64, face_size: usize) -> Result<(), IoError> {
+pub(crate) fn check_fits(path: &Path, num_vertices: u64, face_size: usize) -> Result<(), IoError> {
     let message = if num_vertices > 1 << 32 {
         format!(
             "{num_vertices} vertices: PLY names vertices with 32-bit indices (at most 2^32 = 4294967296); refine fewer levels or split the input"
@@ -212,18 +212,48 @@ fn check_fits(path: &Path, num_vertices: u64, face_size: usize) -> Result<(), Io
 }
 
 #[cfg(unix)]
-fn write_all_at(file: &std::fs::File, bytes: &[u8], offset: u64) -> std::io::Result<()> {
+pub(crate) fn write_all_at(file: &std::fs::File, bytes: &[u8], offset: u64) -> std::io::Result<()> {
     std::os::unix::fs::FileExt::write_all_at(file, bytes, offset)
 }
 
 #[cfg(windows)]
-fn write_all_at(file: &std::fs::File, mut bytes: &[u8], mut offset: u64) -> std::io::Result<()> {
+pub(crate) fn write_all_at(
+    file: &std::fs::File,
+    mut bytes: &[u8],
+    mut offset: u64,
+) -> std::io::Result<()> {
     while !bytes.is_empty() {
         let n = std::os::windows::fs::FileExt::seek_write(file, bytes, offset)?;
         if n == 0 {
             return Err(std::io::ErrorKind::WriteZero.into());
         }
         bytes = &bytes[n..];
+        offset += n as u64;
+    }
+    Ok(())
+}
+
+#[cfg(unix)]
+pub(crate) fn read_exact_at(
+    file: &std::fs::File,
+    out: &mut [u8],
+    offset: u64,
+) -> std::io::Result<()> {
+    std::os::unix::fs::FileExt::read_exact_at(file, out, offset)
+}
+
+#[cfg(windows)]
+pub(crate) fn read_exact_at(
+    file: &std::fs::File,
+    mut out: &mut [u8],
+    mut offset: u64,
+) -> std::io::Result<()> {
+    while !out.is_empty() {
+        let n = std::os::windows::fs::FileExt::seek_read(file, out, offset)?;
+        if n == 0 {
+            return Err(std::io::ErrorKind::UnexpectedEof.into());
+        }
+        out = &mut out[n..];
         offset += n as u64;
     }
     Ok(())
