@@ -22,22 +22,25 @@ pub(crate) struct ComposedRows<'r> {
     /// `rows[l - 1]`: the composed rows of the vertices of level `l` asked for so far.
     rows: Vec<HashMap<u32, Row>>,
     /// Where each level-0 vertex sits in the row being summed (valid where `stamp` holds
-    /// the current row's number), as `then`'s row sink keeps it.
+    /// the current row's number), as `then`'s row sink keeps it; made on the first row
+    /// composed (a chunk of vertices whose masks apply at level 0 composes none).
     stamp: Vec<u32>,
     pos: Vec<u32>,
     current: u32,
+    /// Vertices of level 0.
+    sources: usize,
 }
 
 impl<'r> ComposedRows<'r> {
     /// No row composed yet.
     pub(crate) fn new(r: &'r Refinement) -> Self {
-        let n = r.num_vertices(0);
         ComposedRows {
             r,
             rows: (0..r.num_levels()).map(|_| HashMap::new()).collect(),
-            stamp: vec![u32::MAX; n],
-            pos: vec![0; n],
+            stamp: Vec::new(),
+            pos: Vec::new(),
             current: 0,
+            sources: r.num_vertices(0),
         }
     }
 
@@ -68,6 +71,10 @@ impl<'r> ComposedRows<'r> {
 
     /// A stamp no entry holds yet (on wrapping round, the stamps are cleared once).
     fn next_stamp(&mut self) -> u32 {
+        if self.stamp.is_empty() {
+            self.stamp = vec![u32::MAX; self.sources];
+            self.pos = vec![0; self.sources];
+        }
         self.current = self.current.wrapping_add(1);
         if self.current == u32::MAX {
             self.stamp.fill(u32::MAX);
