@@ -319,12 +319,14 @@ impl AdaptiveMesh {
                 EdgeOrigin::Diagonal => None,
             })
         };
-        let fits =
-            uniform().all(|(level, index, faces)| level < 16 && index < 1 << 52 && faces < 255);
-        if fits {
-            let packed: Vec<u64> = uniform()
-                .map(|(l, i, f)| (u64::from(l) << 60) | (i << 8) | u64::from(f))
-                .collect();
+        // One pass: `None` as soon as a value does not fit.
+        let packed: Option<Vec<u64>> = uniform()
+            .map(|(l, i, f)| {
+                (l < 16 && i < 1 << 52 && f < 255)
+                    .then(|| (u64::from(l) << 60) | (i << 8) | u64::from(f))
+            })
+            .collect();
+        if let Some(packed) = packed {
             return runs_off(packed, |run| run.len() as u64 != run[0] & 0xff);
         }
         let mut uses: Vec<(u8, u64, u32)> = uniform().collect();

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use serde::Serialize;
-use subd_limit::{LimitPoints, levels_for_exact_limit};
+use subd_limit::{LimitPoints, LimitStencilTable, levels_for_exact_limit};
 use subd_mesh::Mesh;
 use subd_schemes::Scheme;
 
@@ -118,8 +118,18 @@ fn run_one(
     let topo = &mesh.topology;
     let options = args.rules.options(&mesh.hints);
     let scheme = scheme_arg::with_lambda(&scheme, &args.lambda, input, topo.num_vertices())?;
-    let limit = subd_limit::limit_points(topo, &scheme, &options, &mesh.positions)
+    // A split scheme's texture coordinates take their limit through the stencils the
+    // positions' masks write as rows: built once for both; otherwise the masks are applied
+    // to the points as they are found.
+    let uv_table = (mesh.uv().is_some() && !is_text && !scheme.is_opensubdiv())
+        .then(|| subd_limit::limit_stencils(topo, &scheme, &options))
+        .transpose()
         .map_err(|e| in_file(&e))?;
+    let limit = match &uv_table {
+        Some(table) => table.apply(&mesh.positions),
+        None => subd_limit::limit_points(topo, &scheme, &options, &mesh.positions)
+            .map_err(|e| in_file(&e))?,
+    };
     // ACC first, so that a mesh it does not cover fails before any file is written.
     let acc = match &args.acc {
         Some(path) => Some((path, acc_json(path, topo, &mesh.positions, input)?)),
@@ -128,8 +138,14 @@ fn run_one(
     let mut uv_warnings = Vec::new();
     let uv = match mesh.uv() {
         Some(c) if !is_text => Some(
-            limit_uv(args, mesh, (&scheme, &options), c, &mut uv_warnings)
-                .map_err(|e| in_file(&e))?,
+            limit_uv(
+                args,
+                mesh,
+                (&scheme, &options, uv_table.as_ref()),
+                c,
+                &mut uv_warnings,
+            )
+            .map_err(|e| in_file(&e))?,
         ),
         _ => None,
     };
@@ -180,17 +196,15 @@ fn acc_json(
 fn limit_uv(
     args: &LimitArgs,
     mesh: &Mesh,
-    (scheme, options): (&Scheme, &subd_schemes::Options),
+    (scheme, options, table): (&Scheme, &subd_schemes::Options, Option<&LimitStencilTable>),
     channel: &subd_mesh::fvar::FVarChannel,
     warnings: &mut Vec<String>,
 ) -> Result<crate::uv::RefinedUv, String> {
     let mode = args.rules.fvar_mode(&mesh.hints);
     let topo = &mesh.topology;
     if !scheme.is_opensubdiv() {
-        // The split schemes' texture coordinates take their limit through the stencils the
-        // positions' masks write as rows.
-        let table = subd_limit::limit_stencils(topo, scheme, options).map_err(|e| e.to_string())?;
-        crate::uv::split_limit_uv(topo, (scheme, &table), channel, mode, warnings)
+        let table = table.expect("the split schemes' stencils are built for their UVs");
+        crate::uv::split_limit_uv(topo, (scheme, table), channel, mode, warnings)
             .map_err(|e| e.to_string())
     } else {
         crate::uv::limit_uv(topo, &scheme.at_level(1), options, channel, mode)

@@ -113,12 +113,16 @@ impl PlacedMesh {
         if first + points.len() as u64 > self.num_vertices {
             return Err(self.beyond("vertex", first + points.len() as u64 - 1));
         }
+        let offset = POINT_BYTES * first;
+        if cfg!(target_endian = "little") {
+            return self.write_at(offset, bytemuck::cast_slice(points));
+        }
         let bytes: Vec<u8> = points
             .iter()
             .flat_map(|p| p.to_array())
             .flat_map(f64::to_le_bytes)
             .collect();
-        self.write_at(POINT_BYTES * first, &bytes)
+        self.write_at(offset, &bytes)
     }
 
     /// Writes faces `first..`, one per `face_size` entries of `corners` (vertex indices).
@@ -132,8 +136,12 @@ impl PlacedMesh {
         if corners.len() % n != 0 || first + faces > self.num_faces {
             return Err(self.beyond("face", first + faces));
         }
+        let offset = self.face_start + 4 * n as u64 * first;
+        if cfg!(target_endian = "little") {
+            return self.write_at(offset, bytemuck::cast_slice(corners));
+        }
         let bytes: Vec<u8> = corners.iter().flat_map(|v| v.to_le_bytes()).collect();
-        self.write_at(self.face_start + 4 * n as u64 * first, &bytes)
+        self.write_at(offset, &bytes)
     }
 
     /// Encodes the records (every one should have been written: what was not reads as
@@ -209,8 +217,16 @@ impl PointSource for Records<'_> {
     }
 
     fn fill(&self, first: usize, out: &mut [DVec3]) {
+        let offset = POINT_BYTES * first as u64;
+        if cfg!(target_endian = "little") {
+            // The records are the points' own bytes: read straight into them.
+            if !self.read(offset, bytemuck::cast_slice_mut(out)) {
+                out.fill(DVec3::NAN);
+            }
+            return;
+        }
         let mut bytes = vec![0u8; out.len() * POINT_BYTES as usize];
-        if !self.read(POINT_BYTES * first as u64, &mut bytes) {
+        if !self.read(offset, &mut bytes) {
             out.fill(DVec3::NAN);
             return;
         }
@@ -232,8 +248,16 @@ impl FaceSource for Records<'_> {
 
     fn fill(&self, faces: Range<usize>, out: &mut Vec<u32>) {
         let n = self.mesh.face_size;
-        let mut bytes = vec![0u8; faces.len() * n * 4];
         let offset = self.mesh.face_start + (4 * n * faces.start) as u64;
+        if cfg!(target_endian = "little") {
+            let start = out.len();
+            out.resize(start + faces.len() * n, 0);
+            if !self.read(offset, bytemuck::cast_slice_mut(&mut out[start..])) {
+                out[start..].fill(u32::MAX);
+            }
+            return;
+        }
+        let mut bytes = vec![0u8; faces.len() * n * 4];
         if !self.read(offset, &mut bytes) {
             out.extend(std::iter::repeat_n(u32::MAX, faces.len() * n));
             return;

@@ -120,8 +120,12 @@ pub fn output_limit(
     if scheme.is_opensubdiv() || level < refinement.num_levels() {
         return crate::level_limit_points(refinement, level, options, positions, Tangents::Dropped);
     }
-    // A split scheme's last level: its masks applied to the points as they are found (the
-    // stencils are built only where texture coordinates take their limit through them).
+    // A split scheme's last level: the stencils where texture coordinates built them
+    // already (both callers carry those first), so the masks are found once; otherwise
+    // the masks applied to the points as they are found, without stencils.
+    if let Some(Ok(table)) = refinement.last_limit.get() {
+        return Ok(table.apply(positions));
+    }
     let last = refinement.topology(level);
     crate::split_limits::split_limit::split_limit_points(last, refinement.scheme(), positions)
 }

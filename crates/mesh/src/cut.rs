@@ -26,6 +26,18 @@ pub struct SubMesh {
     pub complete: Vec<bool>,
 }
 
+impl SubMesh {
+    /// The cut vertex of each of the source's `source_vertices` vertices ([`NONE`] for one
+    /// outside the cut): the inverse of [`Self::vertices`].
+    pub fn vertex_of_source(&self, source_vertices: usize) -> Vec<u32> {
+        let mut of_source = vec![NONE; source_vertices];
+        for (i, &v) in self.vertices.iter().enumerate() {
+            of_source[v as usize] = i as u32;
+        }
+        of_source
+    }
+}
+
 /// Cuts `faces` (indices into `src`, each once) out of `src`. Vertices and edges are numbered
 /// by first appearance in `faces`; face-edges, edge-faces, vertex-faces and vertex-edges are
 /// the source's, filtered to the cut, in the source's order. A manifold vertex that lost

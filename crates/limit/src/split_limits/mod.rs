@@ -2,5 +2,6 @@
 //! subdivision matrices analysed in Fourier blocks, and the limit stencils from them.
 
 pub(crate) mod composed_rows;
+pub(crate) mod pieces;
 pub(crate) mod split_eigen;
 pub(crate) mod split_limit;
