@@ -103,9 +103,11 @@ fn depth_first_files_equal_the_level_at_a_time() {
     }
 }
 
-/// The peak resident memory of a depth-first run to `output` (in `dir`), from its report.
-fn peak(dir: &Scratch, input: &str, levels: &str, output: &str) -> u64 {
+/// The peak resident memory of a depth-first run to `output` (in `dir`) under a budget of
+/// `budget_mib` MiB, from its report.
+fn peak(dir: &Scratch, input: &str, levels: &str, output: &str, budget_mib: u64) -> u64 {
     let out_path = dir.0.join(output);
+    let budget = format!("{budget_mib}M");
     let (code, out, err) = subd(&[
         "refine",
         input,
@@ -116,7 +118,7 @@ fn peak(dir: &Scratch, input: &str, levels: &str, output: &str) -> u64 {
         levels,
         "--depth-first",
         "--max-memory",
-        "100M",
+        &budget,
         "--json",
     ]);
     assert_eq!(code, 0, "{err}");
@@ -126,7 +128,7 @@ fn peak(dir: &Scratch, input: &str, levels: &str, output: &str) -> u64 {
         .expect("peak_memory in the report")
 }
 
-/// L5 and L6 of one mesh (6.6M and 26M quads, many chunks each) peak within 10% of each
+/// L5 and L6 of one mesh (6.6M and 26M quads, many chunks each) peak within 20% of each
 /// other: chunks sized by the budget, not by the level.
 #[test]
 #[cfg(target_os = "linux")]
@@ -134,38 +136,40 @@ fn depth_first_memory_is_flat_in_the_level() {
     let dir = Scratch::new("depth-first-flat");
     let torus = dir.file("torus.obj", torus_obj(80, 80).as_bytes());
     let torus = torus.to_str().unwrap();
-    assert_flat_peaks(&dir, torus, ["5", "6"], "out.ply");
+    assert_flat_peaks(&dir, torus, ["5", "6"], "out.ply", 100);
 }
 
-/// The peaks of two levels of `input` written depth-first to `output` are within 10% of
-/// each other, and the deeper one within the 100M budget.
-fn assert_flat_peaks(dir: &Scratch, input: &str, levels: [&str; 2], output: &str) {
+/// The peaks of two levels of `input` written depth-first to `output` (the second four
+/// times the first) are within 20% of each other, and the deeper one within the budget.
+/// The allowance is for the allocator and the chunks' count, which grows with the level
+/// (a few MB either way on a 2-core machine); a level at a time grows with the level.
+fn assert_flat_peaks(dir: &Scratch, input: &str, levels: [&str; 2], output: &str, budget_mib: u64) {
     let (a, b) = (
-        peak(dir, input, levels[0], output),
-        peak(dir, input, levels[1], output),
+        peak(dir, input, levels[0], output, budget_mib),
+        peak(dir, input, levels[1], output, budget_mib),
     );
     let ratio = b as f64 / a as f64;
     assert!(
-        (0.9..=1.1).contains(&ratio),
+        (0.8..=1.2).contains(&ratio),
         "{output}: peaks {a} and {b} bytes: ratio {ratio}"
     );
     assert!(
-        b <= 100 << 20,
-        "{output}: peak {b} bytes over --max-memory 100M"
+        b <= budget_mib << 20,
+        "{output}: peak {b} bytes over --max-memory {budget_mib}M"
     );
 }
 
 /// The same for OBJ, whose records go through a scratch file and are encoded in order a
 /// window at a time: L4 and L5 of a 1,600-quad torus (410k and 1.6M quads; the OBJ of L5
-/// is ~150 MB) peak within 10% of each other, under the budget, and no scratch file is
-/// left.
+/// is ~150 MB) peak within 20% of each other, under a budget of 40M (the level at a time
+/// peaks at ~55 MB for L5), and no scratch file is left.
 #[test]
 #[cfg(target_os = "linux")]
 fn depth_first_obj_memory_is_flat_in_the_level() {
     let dir = Scratch::new("depth-first-flat-obj");
     let torus = dir.file("torus.obj", torus_obj(40, 40).as_bytes());
     let torus = torus.to_str().unwrap();
-    assert_flat_peaks(&dir, torus, ["4", "5"], "out.obj");
+    assert_flat_peaks(&dir, torus, ["4", "5"], "out.obj", 40);
     let names: Vec<String> = std::fs::read_dir(&dir.0)
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
