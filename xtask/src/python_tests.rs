@@ -5,7 +5,8 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use crate::run;
+use crate::system::env_python;
+use crate::system::run;
 
 /// What the tests import besides `subd` (from PyPI): the runner, property tests, SciPy
 /// (the stencil matrices come back as its CSR matrices), libigl (an independent Loop),
@@ -44,7 +45,7 @@ pub(crate) fn run_python_tests(root: &Path) -> Result<(), String> {
 pub(crate) fn run_python_bench(root: &Path, repeats: usize) -> Result<(), String> {
     // PyMeshLab ships wheels for few platforms: the table says so where it is missing.
     let python = python_env(root, &["pymeshlab"])?;
-    let scan = crate::pia_bench::bunny()?;
+    let scan = crate::meshes::bunny()?;
     let json = root.join("target/xtask/bench/python_loop.json");
     run(Command::new(&python)
         .arg(root.join("crates/python/bench/loop_bench.py"))
@@ -52,12 +53,6 @@ pub(crate) fn run_python_bench(root: &Path, repeats: usize) -> Result<(), String
         .arg(scan)
         .args(["--repeats", &repeats.max(1).to_string(), "--json"])
         .arg(json))
-}
-
-/// The interpreter of the test environment `target/python-env` (there once `cargo xtask
-/// test` has made it).
-pub(crate) fn env_python(root: &Path) -> PathBuf {
-    root.join("target/python-env/bin/python")
 }
 
 /// The environment `target/python-env` with the test packages, `optional` ones where they

@@ -6,7 +6,7 @@
 //! points only, so no new vertex is made and every vertex stays a vertex of uniform
 //! refinement:
 //!
-//! * Loop (seed 002 §2.3): one split edge — bisect the triangle from the edge point to the
+//! * Loop (Sun et al. 2012 §2.3): one split edge — bisect the triangle from the edge point to the
 //!   opposite corner; two — a triangle at the corner between them and the remaining quad
 //!   cut along the diagonal that gives the larger smallest angle. (Three split edges are
 //!   refined by the closure.)

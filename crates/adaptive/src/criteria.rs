@@ -149,7 +149,7 @@ fn angle_between(a: DVec3, b: DVec3) -> f64 {
     a.dot(b).clamp(-1.0, 1.0).acos()
 }
 
-/// Seed 002 §2.2's flatness: `ε(v)` is the largest angle between the normals of two faces
+/// Sun et al. 2012 §2.2's flatness: `ε(v)` is the largest angle between the normals of two faces
 /// at `v`. A vertex with `ε(v) < ε_T` is dead, an edge between two dead vertices is dead,
 /// and a face with two or more dead edges is dead; every other face is refined.
 #[derive(Clone, Copy, Debug)]
@@ -178,7 +178,7 @@ impl Flatness {
 }
 
 /// The smallest dot product between the unit normals of two faces at each vertex (1 where
-/// fewer than two faces have a normal): the cosine of seed 002's `ε(v)`.
+/// fewer than two faces have a normal): the cosine of Sun et al.'s `ε(v)`.
 fn min_normal_dots(t: &Topology, p: &[DVec3]) -> Vec<f64> {
     let normals = face_normals(t, p);
     (0..t.num_vertices())
@@ -226,7 +226,7 @@ impl Criterion for Flatness {
     }
 }
 
-/// User selection (seed 002 §2.1): every descendant of the chosen base faces is refined.
+/// User selection (Sun et al. 2012 §2.1): every descendant of the chosen base faces is refined.
 #[derive(Clone, Debug)]
 pub struct FaceSelection {
     base_faces: Vec<bool>,
@@ -243,7 +243,7 @@ impl FaceSelection {
         })
     }
 
-    /// The base faces with two or more of the chosen `vertices` (seed 002 §2.1: "any
+    /// The base faces with two or more of the chosen `vertices` (Sun et al. 2012 §2.1: "any
     /// triangle with at least two selected vertices is refined").
     ///
     /// # Errors

@@ -5,7 +5,7 @@
 //! hold at once:
 //!
 //! 1. **Selection**: the criteria's union ([`crate::criteria`]).
-//! 2. **Red-green closure** (seed 002 §2.3): a face that would be left with more edges split
+//! 2. **Red-green closure** (Sun et al. 2012 §2.3): a face that would be left with more edges split
 //!    by finer neighbours than a transition pattern covers is refined itself — a triangle
 //!    with three split edges; a quad with three or four; a Catmull-Clark base face that is
 //!    not a quad with any.

@@ -12,7 +12,7 @@
 //!   bit for bit — with creases, semi-sharp decay, corners, boundaries, holes and non-manifold
 //!   input treated as uniform refinement treats them. Each element carries its uniform index
 //!   ([`AdaptiveMesh::vertex_uniform`]). Selecting every face gives uniform refinement.
-//!   Seed 002 instead leaves "dead" vertices where they are while their neighbours move on:
+//!   Sun et al. 2012 instead leaves "dead" vertices where they are while their neighbours move on:
 //!   its adaptive surface is not the Loop surface of the input, and two selections give two
 //!   different surfaces. Here the selection decides only how finely the one subdivision
 //!   surface is sampled, so results of different criteria can be compared, mixed, and
@@ -21,7 +21,7 @@
 //!   patterns (a triangle or quad split from the leaf's corners and the edge points of its split edges): every edge has as many faces as it has in uniform refinement,
 //!   so a closed input gives a closed, manifold output with no hanging vertex
 //!   ([`AdaptiveMesh::conformity`] checks it).
-//! * [`criteria`]: seed 002's flatness with its dead vertex / edge / face rules, user face
+//! * [`criteria`]: Sun et al.'s flatness with its dead vertex / edge / face rules, user face
 //!   or vertex selection, Gaussian curvature, dihedral angle and distance to the exact limit
 //!   surface, each one type behind the [`Criterion`] trait; they compose by union, under a
 //!   level cap.

@@ -24,7 +24,7 @@ pub struct AdaptiveRequest {
     pub levels: usize,
     /// Every vertex at its exact limit position, with limit normals.
     pub limit: bool,
-    /// Seed 002's flatness, in degrees ([`Flatness`]).
+    /// Sun et al.'s flatness, in degrees ([`Flatness`]).
     pub flatness: Option<f64>,
     /// Largest distance to the limit surface, relative to the bounding-box diagonal
     /// ([`LimitDistance`]).

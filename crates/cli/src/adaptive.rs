@@ -12,7 +12,7 @@ use subd_adaptive::{
     AdaptiveError, AdaptiveMesh, AdaptiveRefinement, Conformity, LimitSurface, Positions,
 };
 use subd_mesh::{BoundaryInterpolation, CreaseMethod, SchemeHints, TriangleSubdivision};
-use subd_schemes::Scheme;
+use subd_schemes::{Capability, Scheme};
 
 use crate::batch::{self, Files, Job};
 use crate::failure::bad;
@@ -28,9 +28,9 @@ const DEFAULT_LEVELS: usize = 4;
 #[derive(Debug, Args)]
 pub(crate) struct AdaptiveArgs {
     /// Subdivision scheme (default: the scheme the input names, USD's subdivisionScheme).
-    #[arg(long, value_parser = scheme_arg::parser(scheme_arg::evaluated))]
+    #[arg(long, value_parser = scheme_arg::parser(Capability::Adaptive))]
     scheme: Option<Scheme>,
-    /// Seed 002's flatness: refine every face that is not dead, a vertex being dead when the
+    /// Sun et al.'s flatness: refine every face that is not dead, a vertex being dead when the
     /// largest angle between its faces' normals is below DEG degrees.
     #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
     flatness: Option<f64>,
@@ -223,9 +223,13 @@ fn run_one(
     let levels = check_arguments(args)?;
     let opened = started.read(&args.rules, err)?;
     let (file, t_read) = (&opened.file, opened.read_seconds);
-    let mesh = &file.mesh;
-    let base = &mesh.topology;
-    let scheme = scheme_arg::evaluated_or_named(args.scheme.as_ref(), &mesh.hints, &job.input)?;
+    let (mesh, base) = (&file.mesh, &file.mesh.topology);
+    let scheme = scheme_arg::given_or_named(
+        args.scheme.as_ref(),
+        &mesh.hints,
+        Capability::Adaptive,
+        &job.input,
+    )?;
     let options = args.rules.options(&mesh.hints);
     let input_err = |e: AdaptiveError| bad(format!("{}: {e}", job.input.display()));
     let diagonal = mesh

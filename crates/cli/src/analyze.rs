@@ -7,8 +7,8 @@ use clap::{Args, ValueEnum};
 use subd_limit::spectrum::{
     RingSpectrum, SplitSpectrumReport, SurfaceSpectrum, VALENCES, surface_spectrum,
 };
-use subd_schemes::Scheme;
 use subd_schemes::analysis::{Lattice, analyze, analyze_bivariate, check_total};
+use subd_schemes::{Capability, Scheme};
 
 use crate::Failure;
 use crate::failure::bad;
@@ -46,7 +46,7 @@ pub(crate) struct AnalyzeArgs {
     max_levels: usize,
     /// Instead of a mask: the eigenvalue test of this surface scheme's local subdivision
     /// matrix at an interior vertex of valence --valence.
-    #[arg(long, value_parser = scheme_arg::parser(scheme_arg::analysed), requires = "valence")]
+    #[arg(long, value_parser = scheme_arg::parser(Capability::Analyse), requires = "valence")]
     surface: Option<Scheme>,
     /// Valence for --surface (the number of sides of the centre face for doo-sabin).
     #[arg(long)]

@@ -1,5 +1,5 @@
-//! `subd edit`: move the limit surface to meet constraints (seed 003), and `subd deform`:
-//! simple constrained deformation of a mesh at any level (seed 002 §3).
+//! `subd edit`: move the limit surface to meet constraints (Li et al. 2008), and `subd deform`:
+//! simple constrained deformation of a mesh at any level (Sun et al. 2012 §3).
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -10,7 +10,7 @@ use serde::Serialize;
 use subd_editing::energy::EnergyOptions;
 use subd_editing::{Constraint, Deformation, DependentGroup, Method};
 use subd_mesh::{DVec3, Mesh};
-use subd_schemes::Scheme;
+use subd_schemes::{Capability, Scheme};
 
 use crate::batch::{self, Files, Job};
 use crate::failure::bad;
@@ -37,7 +37,7 @@ pub(crate) struct EditArgs {
     /// Scheme of the limit surface (the energy method needs catmull-clark; default: the
     /// scheme the input names, USD's subdivisionScheme, if catmull-clark or loop, else
     /// catmull-clark).
-    #[arg(long, value_parser = scheme_arg::parser(scheme_arg::evaluated))]
+    #[arg(long, value_parser = scheme_arg::parser(Capability::Edit))]
     scheme: Option<Scheme>,
     /// Energy method: the seed's penalty form with this weight (relative to
     /// mean diag Q / mean diag AᵀA) instead of the exact solve.
@@ -257,7 +257,7 @@ fn run_one(
     let scheme = args
         .scheme
         .clone()
-        .or(named.filter(scheme_arg::evaluated))
+        .or(named.filter(|s| s.supports(Capability::Edit)))
         .unwrap_or(Scheme::CatmullClark);
     let options = args.rules.options(&file.mesh.hints);
     let topo = &file.mesh.topology;

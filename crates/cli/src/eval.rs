@@ -9,7 +9,7 @@ use clap::Args;
 use serde::Serialize;
 use subd_limit::eval::{FaceParam, LimitEvaluator};
 use subd_limit::patches::{PatchOptions, PatchTable};
-use subd_schemes::Scheme;
+use subd_schemes::{Capability, Scheme};
 
 use crate::failure::{bad, refuse_overwrite};
 use crate::rule_args::RuleArgs;
@@ -19,7 +19,7 @@ use crate::{Failure, print_warnings};
 #[derive(Debug, Args)]
 pub(crate) struct EvalArgs {
     /// Subdivision scheme (default: the scheme the input names, USD's subdivisionScheme).
-    #[arg(long, value_parser = scheme_arg::parser(scheme_arg::evaluated))]
+    #[arg(long, value_parser = scheme_arg::parser(Capability::Evaluate))]
     scheme: Option<Scheme>,
     #[command(flatten)]
     rules: RuleArgs,
@@ -109,8 +109,12 @@ pub(crate) fn run(
     refuse_overwrite(&args.input, &args.output)?;
     let file = subd_io::read_mesh(&args.input, &args.rules.read_options())?;
     print_warnings(err, &args.input, &file.warnings);
-    let scheme =
-        scheme_arg::evaluated_or_named(args.scheme.as_ref(), &file.mesh.hints, &args.input)?;
+    let scheme = scheme_arg::given_or_named(
+        args.scheme.as_ref(),
+        &file.mesh.hints,
+        Capability::Evaluate,
+        &args.input,
+    )?;
     let options = args.rules.options(&file.mesh.hints);
     let topo = &file.mesh.topology;
     // On the patch table: the exact limit's (exact end caps) unless other patches are

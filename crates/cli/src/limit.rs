@@ -8,7 +8,7 @@ use clap::Args;
 use serde::Serialize;
 use subd_limit::{LimitPoints, LimitStencilTable, levels_for_exact_limit};
 use subd_mesh::Mesh;
-use subd_schemes::Scheme;
+use subd_schemes::{Capability, Scheme};
 
 use crate::batch::{self, Files, Job, OutputFormat};
 use crate::failure::bad;
@@ -19,12 +19,12 @@ use crate::{Failure, print_warnings};
 
 #[derive(Debug, Args)]
 pub(crate) struct LimitArgs {
-    /// Subdivision scheme: the limit of its limit masks (Catmull-Clark, Loop), of seed 000's
+    /// Subdivision scheme: the limit of its limit masks (Catmull-Clark, Loop), of Lin et al.'s
     /// formula (2) (two-phase, closed quad meshes), of each vertex's vertex face one level down
     /// (Doo-Sabin), of Kobbelt's masks (√3), or the vertices themselves with normals from the
     /// eigenvectors (the butterflies). Default: the scheme the input names (USD's
     /// subdivisionScheme).
-    #[arg(long, value_parser = scheme_arg::parser(scheme_arg::with_limit))]
+    #[arg(long, value_parser = scheme_arg::parser(Capability::Limit))]
     scheme: Option<Scheme>,
     #[command(flatten)]
     lambda: LambdaArgs,
@@ -107,7 +107,7 @@ fn run_one(
     let opened = started.read(&args.rules, err)?;
     let (mesh, input) = (&opened.file.mesh, &job.input);
     let given = args.scheme.as_ref();
-    let scheme = scheme_arg::given_or_named(given, &mesh.hints, scheme_arg::with_limit, input)?;
+    let scheme = scheme_arg::given_or_named(given, &mesh.hints, Capability::Limit, input)?;
     let scheme = scheme_arg::with_tension(&scheme, args.tension, "--scheme")?;
     if args.acc.is_some() && scheme != Scheme::CatmullClark {
         return Err(bad(

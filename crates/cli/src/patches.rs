@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
 use subd_limit::patches::{EndCaps, MAX_ISOLATION, PatchOptions, PatchTable};
-use subd_schemes::Scheme;
+use subd_schemes::{Capability, Scheme};
 
 use crate::failure::{bad, refuse_overwrite};
 use crate::rule_args::RuleArgs;
@@ -40,7 +40,7 @@ impl From<EndCapsArg> for EndCaps {
 #[derive(Debug, Args)]
 pub(crate) struct PatchesArgs {
     /// Subdivision scheme (default: the scheme the input names, USD's subdivisionScheme).
-    #[arg(long, value_parser = scheme_arg::parser(scheme_arg::evaluated))]
+    #[arg(long, value_parser = scheme_arg::parser(Capability::Evaluate))]
     scheme: Option<Scheme>,
     #[command(flatten)]
     rules: RuleArgs,
@@ -102,8 +102,12 @@ pub(crate) fn run(
     let file = subd_io::read_mesh(&args.input, &args.rules.read_options())?;
     print_warnings(err, &args.input, &file.warnings);
     let rules = args.rules.options(&file.mesh.hints);
-    let scheme =
-        scheme_arg::evaluated_or_named(args.scheme.as_ref(), &file.mesh.hints, &args.input)?;
+    let scheme = scheme_arg::given_or_named(
+        args.scheme.as_ref(),
+        &file.mesh.hints,
+        Capability::Evaluate,
+        &args.input,
+    )?;
     let mut table = PatchTable::new(
         &file.mesh.topology,
         &file.mesh.positions,

@@ -9,7 +9,7 @@ use clap::{Args, ValueEnum};
 use serde::Serialize;
 use subd_mesh::Mesh;
 use subd_pia::{Method, Moving, Pia, PiaOptions, Solver};
-use subd_schemes::Scheme;
+use subd_schemes::{Capability, Scheme};
 
 use crate::batch::{self, Files, Job};
 use crate::failure::bad;
@@ -42,7 +42,7 @@ pub(crate) enum SolverArg {
 pub(crate) struct PiaArgs {
     /// Scheme whose limit surface interpolates (default: the scheme the input names, USD's
     /// subdivisionScheme).
-    #[arg(long, value_parser = scheme_arg::parser(scheme_arg::interpolated))]
+    #[arg(long, value_parser = scheme_arg::parser(Capability::Interpolate))]
     scheme: Option<Scheme>,
     #[command(flatten)]
     lambda: LambdaArgs,
@@ -138,7 +138,7 @@ fn run_one(
     let named = scheme_arg::given_or_named(
         args.scheme.as_ref(),
         &file.mesh.hints,
-        scheme_arg::interpolated,
+        Capability::Interpolate,
         &job.input,
     )?;
     let scheme = scheme_arg::with_lambda(&named, &args.lambda, &job.input, nv)?;

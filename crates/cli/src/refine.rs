@@ -8,8 +8,8 @@ use std::time::Instant;
 use clap::Args;
 use serde::Serialize;
 use subd_mesh::{BoundaryInterpolation, CreaseMethod, SchemeHints, TriangleSubdivision};
-use subd_schemes::Scheme;
 use subd_schemes::peak::{DepthFirstPeak, PeakModel};
+use subd_schemes::{Capability, Scheme};
 
 use crate::batch::{self, Files, Job};
 use crate::budget::Budget;
@@ -24,7 +24,7 @@ use crate::{Failure, print_warnings};
 pub(crate) struct RefineArgs {
     /// Subdivision scheme (a parameter may follow a colon: butterfly:0.05, two-phase:0.6;
     /// default: the scheme the input names, USD's subdivisionScheme).
-    #[arg(long, value_parser = scheme_arg::parser(scheme_arg::all))]
+    #[arg(long, value_parser = scheme_arg::parser(Capability::Refine))]
     scheme: Option<Scheme>,
     /// Number of uniform refinement levels (0 to 15; for two-phase, level 1 is phase 1).
     #[arg(long)]
@@ -361,7 +361,7 @@ fn open(
     let opened = started.read(&args.rules, err)?;
     let hints = &opened.file.mesh.hints;
     let scheme =
-        scheme_arg::given_or_named(args.scheme.as_ref(), hints, scheme_arg::all, &job.input)?;
+        scheme_arg::given_or_named(args.scheme.as_ref(), hints, Capability::Refine, &job.input)?;
     let scheme = scheme_arg::with_tension(&scheme, args.tension, "--scheme")?;
     let vertices = opened.file.mesh.topology.num_vertices();
     let scheme = scheme_arg::with_lambda(&scheme, &args.lambda, &job.input, vertices)?;

@@ -8,7 +8,7 @@ use std::time::Instant;
 use clap::Args;
 use serde::Serialize;
 use subd_mesh::DVec3;
-use subd_schemes::Scheme;
+use subd_schemes::{Capability, Scheme};
 
 use crate::failure::{bad, refuse_overwrite};
 use crate::raster::{Camera, Canvas, Rgb, shade};
@@ -43,7 +43,7 @@ const POINT: Rgb = [200, 20, 40];
 pub(crate) struct RenderArgs {
     /// Refine with this scheme before drawing (default: draw IN as it is; with --limit:
     /// loop for an all-triangle mesh, else catmull-clark).
-    #[arg(long, value_parser = scheme_arg::parser(scheme_arg::all))]
+    #[arg(long, value_parser = scheme_arg::parser(Capability::Refine))]
     scheme: Option<Scheme>,
     /// Levels of refinement (default 3 when refining).
     #[arg(long)]
@@ -252,9 +252,10 @@ fn patches_surface(
     scheme: &Scheme,
 ) -> Result<Surface, String> {
     use subd_limit::patches::{PatchOptions, PatchTable};
-    if !scheme_arg::evaluated(scheme) {
+    if !scheme.supports(Capability::Evaluate) {
         return Err(format!(
-            "--patches needs catmull-clark or loop, not {scheme}"
+            "--patches needs {}, not {scheme}",
+            Scheme::list_with(Capability::Evaluate)
         ));
     }
     let options = PatchOptions {

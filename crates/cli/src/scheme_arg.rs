@@ -9,47 +9,19 @@ use std::path::Path;
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use clap::error::ErrorKind;
 use subd_mesh::SchemeHints;
-use subd_schemes::Scheme;
+use subd_schemes::{Capability, Scheme};
 
 use crate::Failure;
 use crate::failure::bad;
 use crate::vertex_data::LambdaArgs;
 
-/// Every surface scheme (`refine`, `render`).
-pub(crate) fn all(_: &Scheme) -> bool {
-    true
-}
-
-/// Schemes with a limit surface other than the mesh itself (`limit`): all but Bilinear.
-pub(crate) fn with_limit(s: &Scheme) -> bool {
-    *s != Scheme::Bilinear
-}
-
-/// Schemes whose limit is evaluated exactly at any (face, u, v) (`eval`, `tessellate`,
-/// `edit`, `deform`, `adaptive`).
-pub(crate) fn evaluated(s: &Scheme) -> bool {
-    matches!(s, Scheme::CatmullClark | Scheme::Loop)
-}
-
-/// Schemes whose limit surface interpolates through PIA (`pia`).
-pub(crate) fn interpolated(s: &Scheme) -> bool {
-    matches!(s, Scheme::CatmullClark | Scheme::Loop | Scheme::TwoPhase(_))
-}
-
-/// Schemes with a local subdivision matrix at a valence (`analyze --surface`): all with a
-/// limit but the two-phase scheme, whose λ varies per vertex.
-pub(crate) fn analysed(s: &Scheme) -> bool {
-    with_limit(s) && !matches!(s, Scheme::TwoPhase(_))
-}
-
-/// A clap value parser giving a [`Scheme`], accepting the schemes `accepts` takes (every
-/// name of [`Scheme::NAMES`] it is true for).
-pub(crate) fn parser(accepts: fn(&Scheme) -> bool) -> SchemeParser {
+/// A clap value parser giving a [`Scheme`], accepting the schemes with `capability` (the
+/// library's list, [`Scheme::names_with`]).
+pub(crate) fn parser(capability: Capability) -> SchemeParser {
     SchemeParser {
-        accepted: Scheme::NAMES
+        accepted: Scheme::names_with(capability)
             .iter()
             .filter_map(|name| name.parse::<Scheme>().ok())
-            .filter(accepts)
             .collect(),
     }
 }
@@ -102,11 +74,11 @@ impl SchemeParser {
 }
 
 /// The scheme a command runs on `input`: `--scheme` when given, else the one the file
-/// names (USD's `subdivisionScheme`) if the command takes it (`accepts`).
+/// names (USD's `subdivisionScheme`) if it has the `capability` the command needs.
 pub(crate) fn given_or_named(
     given: Option<&Scheme>,
     hints: &SchemeHints,
-    accepts: fn(&Scheme) -> bool,
+    capability: Capability,
     input: &Path,
 ) -> Result<Scheme, Failure> {
     if let Some(s) = given {
@@ -124,23 +96,15 @@ pub(crate) fn given_or_named(
             input.display()
         ))
     })?;
-    if accepts(&scheme) {
+    if scheme.supports(capability) {
         Ok(scheme)
     } else {
         Err(bad(format!(
-            "{}: the file's scheme {scheme} is not one this command takes: give --scheme",
-            input.display()
+            "{}: the file's scheme {scheme} is not one this command takes ({capability} needs {}): give --scheme",
+            input.display(),
+            Scheme::list_with(capability)
         )))
     }
-}
-
-/// [`given_or_named`] for the commands that evaluate the limit exactly ([`evaluated`]).
-pub(crate) fn evaluated_or_named(
-    given: Option<&Scheme>,
-    hints: &SchemeHints,
-    input: &Path,
-) -> Result<Scheme, Failure> {
-    given_or_named(given, hints, evaluated, input)
 }
 
 /// `scheme` with the butterfly's `--tension`; the flag applies to the butterfly only (named
@@ -187,7 +151,7 @@ pub(crate) fn with_lambda(
 mod tests {
     use super::*;
 
-    fn parse(accepted: fn(&Scheme) -> bool, text: &str) -> Result<Scheme, String> {
+    fn parse(accepted: Capability, text: &str) -> Result<Scheme, String> {
         let cmd = clap::Command::new("t");
         parser(accepted)
             .parse_ref(&cmd, None, OsStr::new(text))
@@ -196,15 +160,15 @@ mod tests {
 
     #[test]
     fn names_and_parameters_parse_to_the_library_scheme() {
-        assert_eq!(parse(all, "sqrt3").unwrap(), Scheme::Sqrt3);
+        assert_eq!(parse(Capability::Refine, "sqrt3").unwrap(), Scheme::Sqrt3);
         assert_eq!(
-            parse(all, "butterfly:0.05").unwrap(),
+            parse(Capability::Refine, "butterfly:0.05").unwrap(),
             Scheme::Butterfly { tension: 0.05 }
         );
-        let two_phase = parse(interpolated, "two-phase:0.6").unwrap();
+        let two_phase = parse(Capability::Interpolate, "two-phase:0.6").unwrap();
         assert_eq!(two_phase.two_phase().unwrap().uniform_lambda(), Some(0.6));
         assert!(
-            !parse(interpolated, "two-phase")
+            !parse(Capability::Interpolate, "two-phase")
                 .unwrap()
                 .two_phase()
                 .unwrap()
@@ -214,17 +178,17 @@ mod tests {
 
     #[test]
     fn names_outside_the_command_and_bad_parameters_are_refused() {
-        let e = parse(evaluated, "sqrt3").unwrap_err();
+        let e = parse(Capability::Evaluate, "sqrt3").unwrap_err();
         assert!(
             e.contains("'sqrt3'") && e.contains("catmull-clark, loop"),
             "{e}"
         );
-        let e = parse(all, "butterfly:x").unwrap_err();
+        let e = parse(Capability::Refine, "butterfly:x").unwrap_err();
         assert!(
             e.contains("butterfly:x") && e.contains("not a finite number"),
             "{e}"
         );
-        let e = parse(all, "loop:2").unwrap_err();
+        let e = parse(Capability::Refine, "loop:2").unwrap_err();
         assert!(e.contains("takes no parameter"), "{e}");
         // Each command's list, in the library's order.
         let names = |accepts| {
@@ -234,9 +198,9 @@ mod tests {
                 .map(Scheme::name)
                 .collect::<Vec<_>>()
         };
-        assert_eq!(names(all), Scheme::NAMES);
+        assert_eq!(names(Capability::Refine), Scheme::NAMES);
         assert_eq!(
-            names(with_limit),
+            names(Capability::Limit),
             [
                 "catmull-clark",
                 "loop",
@@ -248,7 +212,7 @@ mod tests {
             ]
         );
         assert_eq!(
-            names(analysed),
+            names(Capability::Analyse),
             [
                 "catmull-clark",
                 "loop",
@@ -258,8 +222,11 @@ mod tests {
                 "modified-butterfly"
             ]
         );
-        assert_eq!(names(evaluated), ["catmull-clark", "loop"]);
-        assert_eq!(names(interpolated), ["catmull-clark", "loop", "two-phase"]);
+        assert_eq!(names(Capability::Evaluate), ["catmull-clark", "loop"]);
+        assert_eq!(
+            names(Capability::Interpolate),
+            ["catmull-clark", "loop", "two-phase"]
+        );
     }
 
     #[test]

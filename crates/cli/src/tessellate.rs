@@ -10,7 +10,7 @@ use serde::Serialize;
 use subd_limit::patches::PatchTable;
 use subd_limit::tessellation::{tessellate_mesh, tessellate_patches};
 
-use subd_schemes::Scheme;
+use subd_schemes::{Capability, Scheme};
 
 use crate::Failure;
 use crate::failure::bad;
@@ -21,7 +21,7 @@ use crate::scheme_arg;
 #[derive(Debug, Args)]
 pub(crate) struct TessellateArgs {
     /// Subdivision scheme (default: the scheme the input names, USD's subdivisionScheme).
-    #[arg(long, value_parser = scheme_arg::parser(scheme_arg::evaluated))]
+    #[arg(long, value_parser = scheme_arg::parser(Capability::Evaluate))]
     scheme: Option<Scheme>,
     /// Segments per base edge (even when a Catmull-Clark face is not a quad: each of its quad
     /// sub-faces takes half).
@@ -77,8 +77,12 @@ pub(crate) fn run(
     let in_file = |e: &dyn std::fmt::Display| bad(format!("{}: {e}", args.input.display()));
     let t1 = Instant::now();
     let options = args.rules.options(&file.mesh.hints);
-    let scheme =
-        scheme_arg::evaluated_or_named(args.scheme.as_ref(), &file.mesh.hints, &args.input)?;
+    let scheme = scheme_arg::given_or_named(
+        args.scheme.as_ref(),
+        &file.mesh.hints,
+        Capability::Evaluate,
+        &args.input,
+    )?;
     let t_setup = t1.elapsed().as_secs_f64();
     let t2 = Instant::now();
     // Refinement and the last level's limit masks at a rate that is a power of two, the

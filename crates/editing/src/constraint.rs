@@ -1,7 +1,7 @@
-//! Constraints on the limit surface and their rows over the control vertices (seed 003 §3).
+//! Constraints on the limit surface and their rows over the control vertices (Li et al. 2008 §3).
 //!
 //! Every constraint becomes one or more linear equations in the *changes* ΔX of the control
-//! vertices (seed 003 §3.4). A point constraint at a limit point with stencil weights `w_v`
+//! vertices (Li et al. 2008 §3.4). A point constraint at a limit point with stencil weights `w_v`
 //! gives three equations `Σ_v w_v ΔX_v[c] = b_c`, one per coordinate. A normal constraint
 //! asks both limit tangents `t = Σ_v w'_v X_v` to be perpendicular to the target normal n:
 //! `Σ_v w'_v (n · ΔX_v) = −n · t(X₀)` couples x, y and z, the Kronecker form `(Bᵀ ⊗ A) vec X`

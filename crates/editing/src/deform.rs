@@ -1,4 +1,4 @@
-//! Simple constrained deformation (Borrel & Moreau 1994, "Scodef"; seed 002 §3 with its
+//! Simple constrained deformation (Borrel & Moreau 1994, "Scodef"; Sun et al. 2012 §3 with its
 //! equation corrected, see SEEDS.md): points Q move by `d(Q) = Σ_i M_i B(‖Q − C_i‖ / R_i)`.
 //!
 //! The blend is Wendland's `B(r) = (1 − r)⁴ (4r + 1)` for r < 1 and 0 beyond: B(0) = 1,

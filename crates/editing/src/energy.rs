@@ -1,5 +1,5 @@
 //! The thin-plate (and membrane) energy of a Catmull-Clark limit surface as a quadratic form
-//! in its control vertices (seed 003 §4).
+//! in its control vertices (Li et al. 2008 §4).
 //!
 //! `E(S) = ∬ S_uu² + 2 S_uv² + S_vv²` (+ `w ∬ S_u² + S_v²`), summed over the faces in each
 //! face's own parameters (sub-faces for non-quads), is `Σ_c X_cᵀ Q X_c` over the three

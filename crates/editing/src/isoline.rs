@@ -1,4 +1,4 @@
-//! Iso-parameter lines across a strip of quads (seed 003 §3.3).
+//! Iso-parameter lines across a strip of quads (Li et al. 2008 §3.3).
 //!
 //! A line starts in a quad at a fixed value of one parameter and runs along the other,
 //! crossing into the quad on the far side of each edge it reaches, for a given number of

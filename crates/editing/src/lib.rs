@@ -1,6 +1,6 @@
-//! Constraint-based editing of subdivision limit surfaces (seed 003: Li, Zhou and Zhang 2008,
+//! Constraint-based editing of subdivision limit surfaces (Li, Zhou and Zhang 2008,
 //! "Interactive shape modification of Catmull-Clark surfaces") and simple constrained
-//! deformation (seed 002 §3).
+//! deformation (Sun et al. 2012 §3).
 //!
 //! Grab the *limit surface*: "this point goes there, the normal here points that way, this
 //! iso-line follows this curve". Each [`Constraint`] becomes sparse linear rows over the

@@ -1,4 +1,4 @@
-//! The two solution methods of seed 003 §3.4 and §4, both as one linear map from the
+//! The two solution methods of Li et al. 2008 §3.4 and §4, both as one linear map from the
 //! constraints' right-hand side to the control-vertex changes, computed once per set of
 //! constraint locations ([`Editor`]).
 //!

@@ -6,6 +6,7 @@ use std::sync::{Arc, Mutex, mpsc};
 use wgpu::util::DeviceExt;
 
 use crate::GpuError;
+use crate::pipeline::Precision;
 
 /// An adapter as `subd info --devices` lists it.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -37,38 +38,6 @@ impl AdapterSummary {
     }
 }
 
-/// The compute pipelines of the WGSL `shader` (named `label`) at `entries`, with its
-/// `Real` type the device's precision (f64 or f32), each with the layout the shader implies.
-pub(crate) fn compute_pipelines(
-    device: &wgpu::Device,
-    precision: Precision,
-    label: &'static str,
-    shader: &str,
-    entries: &[&'static str],
-) -> Vec<wgpu::ComputePipeline> {
-    let real = match precision {
-        Precision::F64 => "f64",
-        Precision::F32 => "f32",
-    };
-    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some(label),
-        source: wgpu::ShaderSource::Wgsl(format!("alias Real = {real};\n{shader}").into()),
-    });
-    entries
-        .iter()
-        .map(|entry| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry),
-                layout: None,
-                module: &module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        })
-        .collect()
-}
-
 /// Routes the device's loss and its uncaught errors to a [`Health`] instead of wgpu's
 /// default panic.
 fn watch(device: &wgpu::Device) -> Arc<Health> {
@@ -94,18 +63,6 @@ pub fn list_adapters() -> Vec<AdapterSummary> {
     let instance = instance();
     let adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all()));
     adapters.iter().map(AdapterSummary::of).collect()
-}
-
-/// The arithmetic of the stencil sums. Values in device buffers are f32 either way.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Precision {
-    /// f64 weights and sums (adapters with `SHADER_F64`): every result within about one
-    /// f32 rounding of the f64 result, however long its stencil.
-    F64,
-    /// f32 weights and sums (every adapter): the error grows with a stencil's length, a
-    /// few f32 roundings per level's row (e.g. 5 units in the last place on a table composed
-    /// over three levels of Catmull-Clark).
-    F32,
 }
 
 /// What the device's callbacks saw: its loss, or an error no error scope caught (wgpu's
@@ -139,9 +96,9 @@ pub struct Gpu {
     adapter: AdapterSummary,
     pub(crate) limits: wgpu::Limits,
     precision: Precision,
-    pub(crate) pipelines: crate::stencils::StencilPipeline,
-    pub(crate) patch_pipelines: crate::patches::PatchPipelines,
-    pub(crate) uniform_pipelines: crate::uniform::UniformPipelines,
+    pub(crate) pipelines: crate::pipeline::StencilPipeline,
+    pub(crate) patch_pipelines: crate::pipeline::PatchPipelines,
+    pub(crate) uniform_pipelines: crate::pipeline::UniformPipelines,
     health: Arc<Health>,
 }
 
@@ -200,9 +157,9 @@ impl Gpu {
                 message: e.to_string(),
             })?;
         let health = watch(&device);
-        let pipelines = crate::stencils::StencilPipeline::new(&device, precision);
-        let patch_pipelines = crate::patches::PatchPipelines::new(&device, precision);
-        let uniform_pipelines = crate::uniform::UniformPipelines::new(&device, precision);
+        let pipelines = crate::pipeline::StencilPipeline::new(&device, precision);
+        let patch_pipelines = crate::pipeline::PatchPipelines::new(&device, precision);
+        let uniform_pipelines = crate::pipeline::UniformPipelines::new(&device, precision);
         health.check()?;
         Ok(Gpu {
             device,

@@ -42,14 +42,16 @@ mod device;
 mod error;
 mod limit;
 mod patches;
+mod pipeline;
 mod refiner;
 mod stencils;
 mod uniform;
 
-pub use device::{AdapterSummary, Gpu, Precision, list_adapters};
+pub use device::{AdapterSummary, Gpu, list_adapters};
 pub use error::GpuError;
 pub use limit::{GpuLimit, GpuLimitStencils};
 pub use patches::{GpuPatchCoords, GpuPatchTable, GpuPatchValues, GpuTessellation, PatchDispatch};
+pub use pipeline::Precision;
 pub use refiner::{GpuFaceVarying, GpuRefiner, LevelTables};
 pub use stencils::{GpuColumns, GpuStencilTable, StencilDispatch};
 pub use uniform::GpuUniformRefinement;

@@ -10,36 +10,12 @@ use subd_limit::patches::{PatchBasisPolynomials, PatchTable, PatchType};
 use subd_mesh::DVec3;
 
 use crate::stencils::f32_rows;
-use crate::{Gpu, GpuColumns, GpuError, GpuStencilTable, Precision, StencilDispatch};
+use crate::{Gpu, GpuColumns, GpuError, GpuStencilTable, StencilDispatch};
 
 /// Threads per workgroup of `patches.wgsl`.
 const WORKGROUP: u32 = 64;
 /// Words per class in `patches.wgsl`'s `words`: points, triangle flag, 20 blend codes.
 const CLASS_WORDS: usize = 22;
-
-/// The compute pipelines of `patches.wgsl`, made once per device.
-#[derive(Debug)]
-pub(crate) struct PatchPipelines {
-    evaluate: wgpu::ComputePipeline,
-    tessellate: wgpu::ComputePipeline,
-    grid_indices: wgpu::ComputePipeline,
-}
-
-impl PatchPipelines {
-    pub(crate) fn new(device: &wgpu::Device, precision: Precision) -> PatchPipelines {
-        let shader = include_str!("shaders/patches.wgsl");
-        let entries = ["evaluate", "tessellate", "grid_indices"];
-        let [evaluate, tessellate, grid_indices]: [wgpu::ComputePipeline; 3] =
-            crate::device::compute_pipelines(device, precision, "patches.wgsl", shader, &entries)
-                .try_into()
-                .expect("one pipeline per entry");
-        PatchPipelines {
-            evaluate,
-            tessellate,
-            grid_indices,
-        }
-    }
-}
 
 /// Positions and first derivatives (with respect to the root face's parameters, as
 /// [`PatchTable::evaluate`] gives them), one row of three f32 each per place.

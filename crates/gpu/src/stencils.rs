@@ -4,32 +4,10 @@
 use subd_mesh::DVec3;
 use subd_schemes::StencilTable;
 
-use crate::{Gpu, GpuError, Precision};
+use crate::{Gpu, GpuError};
 
 /// Threads per workgroup of the stencil shader (`@workgroup_size` in `stencils.wgsl`).
 const WORKGROUP: u32 = 64;
-
-/// The compute pipeline of `stencils.wgsl`, made once per device.
-#[derive(Debug)]
-pub(crate) struct StencilPipeline {
-    pipeline: wgpu::ComputePipeline,
-}
-
-impl StencilPipeline {
-    pub(crate) fn new(device: &wgpu::Device, precision: Precision) -> StencilPipeline {
-        let shader = include_str!("shaders/stencils.wgsl");
-        let mut pipelines = crate::device::compute_pipelines(
-            device,
-            precision,
-            "stencils.wgsl",
-            shader,
-            &["apply"],
-        );
-        StencilPipeline {
-            pipeline: pipelines.remove(0),
-        }
-    }
-}
 
 /// Rows of `width` interleaved f32 columns in a device buffer: row `i`'s column `c` is the
 /// f32 at index `i * width + c` (positions are `width` 3: x, y, z). The buffer is a
@@ -166,7 +144,7 @@ pub(crate) fn f32_rows(points: &[DVec3]) -> Vec<f32> {
         .collect()
 }
 
-/// A [`StencilTable`] on the device, its weights in the device's [`Precision`].
+/// A [`StencilTable`] on the device, its weights in the device's [`Precision`](crate::Precision).
 #[derive(Debug)]
 pub struct GpuStencilTable {
     offsets: wgpu::Buffer,

@@ -11,45 +11,11 @@ use subd_mesh::{BoundaryInterpolation, DVec3, Topology};
 use subd_schemes::rules::Rule;
 use subd_schemes::{Options, Scheme};
 
+use crate::pipeline::STAGES;
 use crate::stencils::f32_rows;
-use crate::{Gpu, GpuColumns, GpuError, GpuStencilTable, Precision, StencilDispatch};
+use crate::{Gpu, GpuColumns, GpuError, GpuStencilTable, StencilDispatch};
 
 const WORKGROUP: u32 = 64;
-
-/// The stages of one level, in the order they run.
-const STAGES: [&str; 9] = [
-    "corners",
-    "twins",
-    "child_faces",
-    "edge_halves",
-    "face_points",
-    "edge_points",
-    "vertex_points",
-    "child_rules",
-    // Not a stage of a level: a level's quads as triangles, on request.
-    "quad_triangles",
-];
-
-/// The compute pipelines of `uniform.wgsl`, one per stage.
-#[derive(Debug)]
-pub(crate) struct UniformPipelines {
-    stages: Vec<wgpu::ComputePipeline>,
-}
-
-impl UniformPipelines {
-    pub(crate) fn new(device: &wgpu::Device, precision: Precision) -> UniformPipelines {
-        let shader = include_str!("shaders/uniform.wgsl");
-        UniformPipelines {
-            stages: crate::device::compute_pipelines(
-                device,
-                precision,
-                "uniform.wgsl",
-                shader,
-                &STAGES,
-            ),
-        }
-    }
-}
 
 /// Element counts of a level.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

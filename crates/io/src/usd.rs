@@ -1,20 +1,20 @@
 //! USD in and out (`.usda`, `.usdc`, `.usdz`) through the `openusd` crate: a `UsdGeomMesh`
 //! prim carries OpenSubdiv's rules as attributes (Pixar designed them together), and they map
-//! one to one onto a [`Mesh`](subd_mesh::Mesh), its tags and its [`SchemeHints`]:
+//! one to one onto a [`Mesh`](subd_mesh::Mesh), its tags and its [`SchemeHints`](subd_mesh::SchemeHints):
 //!
 //! | USD | subd |
 //! |---|---|
 //! | `faceVertexCounts`, `faceVertexIndices`, `points` | topology, positions (`point3f`, read as `f64`) |
-//! | `subdivisionScheme` (`catmullClark`, `loop`, `bilinear`, `none`) | [`SchemeHints::scheme`] |
-//! | `interpolateBoundary` | [`SchemeHints::boundary_interpolation`] (USD's fallback `edgeAndCorner`) |
-//! | `faceVaryingLinearInterpolation` | [`SchemeHints::fvar_interpolation`] (fallback `cornersPlus1`) |
-//! | `triangleSubdivisionRule` | [`SchemeHints::triangle_subdivision`] |
+//! | `subdivisionScheme` (`catmullClark`, `loop`, `bilinear`, `none`) | [`SchemeHints::scheme`](subd_mesh::SchemeHints::scheme) |
+//! | `interpolateBoundary` | [`SchemeHints::boundary_interpolation`](subd_mesh::SchemeHints::boundary_interpolation) (USD's fallback `edgeAndCorner`) |
+//! | `faceVaryingLinearInterpolation` | [`SchemeHints::fvar_interpolation`](subd_mesh::SchemeHints::fvar_interpolation) (fallback `cornersPlus1`) |
+//! | `triangleSubdivisionRule` | [`SchemeHints::triangle_subdivision`](subd_mesh::SchemeHints::triangle_subdivision) |
 //! | `creaseIndices`, `creaseLengths`, `creaseSharpnesses` | edge sharpness (per crease or per edge) |
 //! | `cornerIndices`, `cornerSharpnesses` | vertex sharpness |
 //! | `holeIndices` | holes |
 //! | `orientation = "leftHanded"` | every face's winding reversed on reading |
 //! | `primvars:st` (`faceVarying` with or without indices, `vertex`, `varying`) | the UV channel, seams kept |
-//! | `subd:creaseMethod` (custom) | [`SchemeHints::crease_method`] (USD has no attribute for it) |
+//! | `subd:creaseMethod` (custom) | [`SchemeHints::crease_method`](subd_mesh::SchemeHints::crease_method) (USD has no attribute for it) |
 //!
 //! The mesh prim's composed transform (its own `xformOp`s and its ancestors', `!invert!` and
 //! `!resetXformStack!` included) is applied to the points unless

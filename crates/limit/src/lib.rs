@@ -6,8 +6,8 @@
 //! * [`eigen`]: the local subdivision matrix around a vertex of any valence, read off the
 //!   refinement itself, and its eigen analysis with `faer` (subdominant eigenvalues, limit
 //!   masks as dominant left eigenvectors, tangent masks from the subdominant ones) — checked
-//!   against the closed forms of seed 001 §5, and used where no closed form is exact
-//!   (darts, interior valence 2).
+//!   against the closed forms of the subdivision lecture notes §5, and used where no closed
+//!   form is exact (darts, interior valence 2).
 //! * [`LimitStencilTable`]: limit positions, tangents and normals of every vertex of a
 //!   refinement level as stencil tables. [`limit_stencils`] is the one entry for every
 //!   scheme: [`base_limit`] gives the exact limit of every base vertex of Catmull-Clark and
@@ -527,7 +527,7 @@ fn whole_refinement(
     )))
 }
 
-/// The exact limit of every base vertex under the two-phase scheme of seed 000
+/// The exact limit of every base vertex under the two-phase scheme of Lin et al.
 /// ([`subd_schemes::two_phase`]): phase 1, then ordinary Catmull-Clark to the limit — the
 /// Catmull-Clark limit masks of the phase-1 mesh (after semi-sharp decay), composed back to
 /// the base. On a closed quad mesh this is the paper's formula (2).
@@ -536,7 +536,7 @@ fn whole_refinement(
 /// use subd_mesh::{DVec3, TopologyBuilder};
 /// use subd_schemes::{Options, TwoPhase};
 ///
-/// // A cube (every vertex of valence 3), λ = 1/2: formula (2) of seed 000.
+/// // A cube (every vertex of valence 3), λ = 1/2: formula (2) of Lin et al.
 /// let faces = [0, 1, 3, 2, 2, 3, 5, 4, 4, 5, 7, 6, 6, 7, 1, 0, 1, 7, 5, 3, 6, 0, 2, 4];
 /// let cube = TopologyBuilder::new(8).build(&[4; 6], &faces).unwrap();
 /// let tp = TwoPhase::uniform(0.5).unwrap();

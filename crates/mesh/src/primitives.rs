@@ -93,7 +93,7 @@ pub fn torus_with_hexagons(m: u32, n: u32, every: u32, major: f64, minor: f64) -
 /// A spur gear as a closed triangle mesh of genus 1 — a toothed ring with a round bore, its
 /// rims creased — as a subdivision modeller would build a mechanical part: `teeth` teeth
 /// of `per_tooth` profile points, the flat faces in `annuli` rings between bore and teeth,
-/// `4 · teeth · per_tooth · (annuli + 1)` triangles (seed 002's mechanical part has 2000:
+/// `4 · teeth · per_tooth · (annuli + 1)` triangles (Sun et al.'s mechanical part has 2000:
 /// 20 teeth of 5 points, 4 annuli). The profile rises from the root radius `0.8` to the tip
 /// radius `1.0`; the bore has radius `0.3`; the gear is `0.25` thick. The four rim loops
 /// (top and bottom of the teeth and of the bore) are infinitely sharp creases, so the flat

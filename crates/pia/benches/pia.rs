@@ -9,7 +9,7 @@ use subd_schemes::{Options, Refinement, Scheme};
 
 /// A 160 × 160 torus grid in which every 8th quad pair is merged into a hexagon, refined
 /// once with Catmull-Clark: 101,600 quads, 800 valence-3 and 400 valence-6 vertices (the
-/// construction of `xtask/src/bench.rs`).
+/// construction of `xtask/src/meshes/mod.rs`).
 fn torus() -> (Topology, Vec<DVec3>) {
     let base = subd_mesh::primitives::torus_with_hexagons(160, 160, 8, 3.0, 1.0);
     let r = Refinement::new(&base.topology, Scheme::CatmullClark, &Options::default(), 1)

@@ -2,10 +2,10 @@
 //!
 //! Given a mesh whose vertices are *targets*, PIA finds control positions whose limit surface
 //! passes through them: Chen et al. (2008) for Catmull-Clark, Cheng et al. (2009) for Loop,
-//! and the two-phase modified Catmull-Clark scheme of seed 000 (Lin, Pan et al.), whose
+//! and the two-phase modified Catmull-Clark scheme of Lin et al. (Lin, Pan et al.), whose
 //! per-vertex `λ` shapes the surface between the interpolated points.
 //!
-//! * **Global** PIA moves every vertex; **local** PIA (Zhao & Lin 2012, seed 000 §2) moves
+//! * **Global** PIA moves every vertex; **local** PIA (Zhao & Lin 2012, Lin et al. §2) moves
 //!   only a chosen set `P` and keeps the others (`Q`) where they are, so their limits stay
 //!   approximations ([`Moving`]).
 //! * The limit of every vertex comes from [`subd_limit`]'s exact limit stencils, so
@@ -13,7 +13,7 @@
 //!   scheme's limit is defined. The paper's scheme needs quads; its boundary rule is derived
 //!   in [`subd_schemes::two_phase`].
 //! * Solvers ([`Solver`]): the paper's iteration exactly as published, an optimally weighted
-//!   iteration, conjugate gradients on the symmetrised system (seed 000 eqs. 17–18: the
+//!   iteration, conjugate gradients on the symmetrised system (Lin et al. eqs. 17–18: the
 //!   limit matrix is `C·D` with `C` positive diagonal and `D` symmetric; BiCGSTAB where no
 //!   such split exists, e.g. at boundaries and creases), a Chebyshev iteration on the
 //!   checkerboard-preconditioned system (two-coloured closed quad meshes; see
@@ -54,7 +54,7 @@ use std::sync::Arc;
 use glam::DVec3;
 use subd_limit::LimitError;
 use subd_mesh::Topology;
-use subd_schemes::{Options, Scheme, StencilTable};
+use subd_schemes::{Capability, Options, Scheme, StencilTable};
 use thiserror::Error;
 
 pub use solvers::{Method, Solver};
@@ -91,7 +91,8 @@ pub enum PiaError {
     Tolerance(f64),
     /// A scheme without a limit-position matrix here.
     #[error(
-        "interpolation needs catmull-clark, loop or two-phase (the {scheme} scheme has no limit matrix here)"
+        "interpolation needs {} (the {scheme} scheme has no limit matrix here)",
+        Scheme::list_with(Capability::Interpolate)
     )]
     Scheme {
         /// The scheme given.
@@ -231,7 +232,7 @@ impl Pia {
         // Where every vertex takes its scheme's classical smooth mask, row `i` is `c_i` times
         // one weight for each edge neighbour, another for each face-diagonal vertex and one
         // for the vertex itself: Catmull-Clark 4, 1 and `n²` over `n (n + 5)`; two-phase
-        // `β_n` and `3 β_n / 10` (formula (2); the ratio does not depend on `λ`, seed 000
+        // `β_n` and `3 β_n / 10` (formula (2); the ratio does not depend on `λ`, Lin et al.
         // eqs. 17–18); Loop one weight for the whole ring. Scaled by the edge weight, `D`
         // holds 1 at edge neighbours and `1/4` or `3/10` at diagonal ones on every row
         // alike: `M̄ = C D` with `D` symmetric by construction.
@@ -335,7 +336,7 @@ impl Pia {
     }
 
     /// `M̄ = B[P, P]` as a dense matrix, for analysis of small meshes (spectral radius of
-    /// `I − M̄`, Theorem 1 of seed 000).
+    /// `I − M̄`, Theorem 1 of Lin et al.).
     ///
     /// # Errors
     /// [`PiaError::Vertex`] for a bad index in `moving`.

@@ -121,7 +121,7 @@ impl Matrix {
     }
 
     /// The positive diagonal `C` with `M̄ = C D`, `D` symmetric, when there is one
-    /// (seed 000 eqs. 17–18 for the two-phase scheme; the plain Catmull-Clark and Loop
+    /// (Lin et al. eqs. 17–18 for the two-phase scheme; the plain Catmull-Clark and Loop
     /// limit masks have the same structure on closed meshes). Found by propagating
     /// `c_j = c_i · M̄_ji / M̄_ij` over the coupling graph and checking every pair.
     pub fn symmetrizer(&self) -> Option<Vec<f64>> {

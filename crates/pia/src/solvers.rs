@@ -42,7 +42,7 @@ pub enum Solver {
     /// `x ← x + ω (b − M̄ x)` with `ω = 2 / (λ_min + λ_max)` from estimated extreme
     /// eigenvalues of `M̄`.
     Weighted,
-    /// Conjugate gradients on the symmetric form of `M̄ = C D` (seed 000 eqs. 17–18),
+    /// Conjugate gradients on the symmetric form of `M̄ = C D` (Lin et al. eqs. 17–18),
     /// preconditioned by the checkerboard-conjugated, diagonally scaled matrix `T M̄ T` where
     /// the mesh is two-coloured ([`crate::checkerboard`]); BiCGSTAB when there is no such
     /// `C`.

@@ -6,7 +6,7 @@
 //! a non-finite coordinate, an unknown scheme) are made here, where the library makes them.
 //!
 //! Every function releases the GIL while the library works and runs on the package's own
-//! thread pool ([`pool`]), so Python threads refine in parallel and
+//! thread pool (the `pool` module), so Python threads refine in parallel and
 //! `subd.set_num_threads` takes effect at once.
 
 use pyo3::prelude::*;

@@ -15,7 +15,7 @@ use subd_editing::energy::EnergyOptions;
 use subd_editing::{Deformation, MeshEdit};
 use subd_mesh::{DVec3, Mesh};
 use subd_pia::{Moving, Pia, PiaOptions, Solver};
-use subd_schemes::{Options, Scheme, TwoPhase};
+use subd_schemes::{Capability, Options, Scheme, TwoPhase};
 
 use crate::arrays::contiguous;
 use crate::errors::mesh_error;
@@ -288,11 +288,14 @@ fn edit_method(
 /// The schemes whose limit surface the editor evaluates at any point.
 fn edited_scheme(name: &str) -> PyResult<Scheme> {
     let s = scheme(name)?;
-    match s {
-        Scheme::CatmullClark | Scheme::Loop => Ok(s),
-        _ => Err(PyValueError::new_err(format!(
-            "scheme {name:?}: editing needs catmull-clark or loop"
-        ))),
+    if s.supports(Capability::Edit) {
+        Ok(s)
+    } else {
+        Err(PyValueError::new_err(format!(
+            "scheme {name:?}: {} needs {}",
+            Capability::Edit,
+            Scheme::list_with(Capability::Edit)
+        )))
     }
 }
 

@@ -707,7 +707,8 @@ def test_analyze_equals_the_binarys_report(flags, kwargs):
 def test_curves_reproduce_circles_and_corner_cutting():
     t = 2 * np.pi * np.arange(8) / 8
     octagon = np.stack([np.cos(t), np.sin(t)], axis=1)
-    # The tension scheme with α0 = cos(2π/N) keeps a regular N-gon on a circle (seed 001).
+    # The tension scheme with α0 = cos(2π/N) keeps a regular N-gon on a circle (the subdivision
+    # lecture notes).
     fine = subd.curve(octagon, "tension", 4, closed=True, alpha0=np.cos(2 * np.pi / 8))
     r = np.linalg.norm(fine, axis=1)
     assert fine.shape == (8 * 16, 2) and np.ptp(r) < 1e-14

@@ -1,5 +1,5 @@
 //! Convergence and smoothness of univariate subdivision masks by Laurent polynomials
-//! (seed 001 §7; Dyn 1992).
+//! (the subdivision lecture notes §7; Dyn 1992).
 //!
 //! A stationary scheme of arity `m` refines `p'_i = Σ_k a_{i − m k} p_k`; its symbol is
 //! `a(z) = Σ_j a_j z^j`. With `σ(z) = 1 + z + … + z^{m−1}`:
@@ -15,7 +15,7 @@
 //!    largest `k` for which it succeeds within the level limit is reported).
 //!
 //! [`analyze_bivariate`] does the same for factorable bivariate binary masks on quad and
-//! three-direction grids (seed 001 §7.2), up to C¹.
+//! three-direction grids (the subdivision lecture notes §7.2), up to C¹.
 //!
 //! ```
 //! use subd_schemes::analysis::analyze;
@@ -269,9 +269,9 @@ pub struct BivariateVerdict {
 /// A bivariate polynomial: `c[j][i]` is the coefficient of `z1^i z2^j`.
 type Poly2 = Vec<Vec<f64>>;
 
-/// Convergence and C¹ of a factorable bivariate binary mask (seed 001 §7.2): `coeffs[j][i]`
-/// is `a_{ij}`, the weight of `z1^i z2^j` (rows are powers of `z2`); the four residue classes
-/// mod 2 must each sum to 1.
+/// Convergence and C¹ of a factorable bivariate binary mask (the subdivision lecture notes §7.2):
+/// `coeffs[j][i]` is `a_{ij}`, the weight of `z1^i z2^j` (rows are powers of `z2`); the four
+/// residue classes mod 2 must each sum to 1.
 ///
 /// * **C⁰:** `a` must factor as `(1 + z1)(1 + z2) b` (quad) or `(1 + z1)(1 + z2)(1 + z1 z2) b`
 ///   (three-direction). Differences along direction `k` (`w_k` = `z1`, `z2`, `z1 z2`) obey the

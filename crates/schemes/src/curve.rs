@@ -1,12 +1,13 @@
-//! Subdivision curves: linear schemes on open and closed polylines in 2D or 3D (seed 001 §2–6),
-//! and the nonlinear circle-average schemes on planar point–normal pairs (seed 004).
+//! Subdivision curves: linear schemes on open and closed polylines in 2D or 3D (the subdivision
+//! lecture notes §2–6), and the nonlinear circle-average schemes on planar point–normal pairs (Liu
+//! et al.).
 //!
 //! # Linear schemes
 //!
 //! A stationary scheme of arity `m` (2 binary, 3 ternary) is a mask `a_j`: the new point `i`
 //! is `p'_i = Σ_k a_{i − m k} p_k`. [`CurveScheme`] covers Chaikin, Lane–Riesenfeld B-splines of
-//! any order, the 4-point scheme with tension `ω`, the two-parameter 4-point scheme (seed 004),
-//! the 3-point ternary interpolatory scheme (seed 004), the non-stationary tension scheme that
+//! any order, the 4-point scheme with tension `ω`, the two-parameter 4-point scheme (Liu et al.),
+//! the 3-point ternary interpolatory scheme (Liu et al.), the non-stationary tension scheme that
 //! reproduces circles (a new mask each level), Sabin & Dodgson's circle-preserving 4-point
 //! scheme (nonlinear, planar) and the variational interpolatory scheme (a banded solve each
 //! level).
@@ -27,7 +28,7 @@
 //! point on the circle arc through both points whose normals are the pairs' normals, with the
 //! normal the weighted geodesic average. [`CircleScheme`] rewrites the two-parameter 4-point
 //! and the 3-point ternary schemes as repeated binary averages `A_w(a, b) = (1 − w) a + w b`
-//! and replaces each by the circle average (seed 004):
+//! and replaces each by the circle average (Liu et al.):
 //!
 //! * 4-point, odd: `A_{1/2}(A_{1+2ω}(p_{i−1}, p_i), A_{1+2ω}(p_{i+2}, p_{i+1}))`;
 //!   even: `A_{2μ}(p_i, A_{1/2}(p_{i−1}, p_{i+1}))`.
@@ -79,7 +80,7 @@ pub enum CurveScheme {
     /// Chaikin's corner cutting (the quadratic B-spline, order 3).
     Chaikin,
     /// Uniform B-spline of order `k ≥ 2` (degree `k − 1`) by Lane–Riesenfeld: mask
-    /// `2^{-(k−1)} C(k, j)` (seed 001 §2).
+    /// `2^{-(k−1)} C(k, j)` (the subdivision lecture notes §2).
     BSpline {
         /// Order (2 = linear, 3 = Chaikin, 4 = cubic).
         order: usize,
@@ -90,7 +91,7 @@ pub enum CurveScheme {
         /// Tension.
         omega: f64,
     },
-    /// The two-parameter 4-point binary scheme of seed 004: even rule
+    /// The two-parameter 4-point binary scheme of Liu et al.: even rule
     /// `μ p_{i−1} + (1 − 2μ) p_i + μ p_{i+1}`, odd rule as [`CurveScheme::FourPoint`].
     FourPoint2 {
         /// Tension.
@@ -98,13 +99,13 @@ pub enum CurveScheme {
         /// Displacement of the old points (0: interpolatory).
         mu: f64,
     },
-    /// The 3-point ternary interpolatory scheme of seed 004: `p_{3i} = p_i`,
+    /// The 3-point ternary interpolatory scheme of Liu et al.: `p_{3i} = p_i`,
     /// `p_{3i+1} = (ω − 1/3) p_{i−1} + (4/3 − 2ω) p_i + ω p_{i+1}`, and its mirror image.
     Ternary3 {
         /// The parameter (convergent for 1/6 < ω < 1/3, C¹ for 2/9 < ω < 1/3).
         omega: f64,
     },
-    /// The non-stationary tension scheme (seed 001 §5): at level `k`,
+    /// The non-stationary tension scheme (the subdivision lecture notes §5): at level `k`,
     /// `α_k = sqrt((1 + α_{k−1})/2)`, `p_{2i} = (p_{i−1} + (2 + 4α_k) p_i + p_{i+1})/(4 + 4α_k)`,
     /// `p_{2i+1} = (p_i + p_{i+1})/2`. `α_0 = 1` is the cubic B-spline; on a regular N-gon,
     /// `α_0 = cos(2π/N)` keeps every level on a circle. (The first step uses `α_1`, not `α_0`:
@@ -124,9 +125,9 @@ pub enum CurveScheme {
     /// midpoint). Four points on a circle give a point on it, so circles are reproduced. Open
     /// curves: the end intervals use the one triangle they have and `λ = 0`.
     CirclePreserving,
-    /// Variational interpolatory subdivision (Kobbelt; seed 001 §6(a)): old points stay, new
-    /// points minimise the sum of squared second differences of the refined polygon, i.e.
-    /// solve `u_{i−1} + 6 u_i + u_{i+1} = 4 (p_i + p_{i+1})` (a banded system, faer).
+    /// Variational interpolatory subdivision (Kobbelt; the subdivision lecture notes §6(a)): old
+    /// points stay, new points minimise the sum of squared second differences of the refined
+    /// polygon, i.e. solve `u_{i−1} + 6 u_i + u_{i+1} = 4 (p_i + p_{i+1})` (a banded system, faer).
     Variational,
 }
 
@@ -635,7 +636,7 @@ fn wrap(x: f64) -> f64 {
     if y == -PI { PI } else { y }
 }
 
-/// A circle-average curve scheme (seed 004).
+/// A circle-average curve scheme (Liu et al.).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum CircleScheme {
     /// The two-parameter 4-point binary scheme with circle averages.

@@ -5,7 +5,7 @@
 //! |---|---|---|---|
 //! | `CatmullClark`, `Bilinear` | any polygons | quads, 1 → n | OpenSubdiv's |
 //! | `Loop` | triangles | 1 → 4 | OpenSubdiv's |
-//! | `TwoPhase` (seed 000) | quads | quads | OpenSubdiv's (phase 1, then Catmull-Clark) |
+//! | `TwoPhase` (Lin et al.) | quads | quads | OpenSubdiv's (phase 1, then Catmull-Clark) |
 //! | `DooSabin` | any polygons | dual | split |
 //! | `Sqrt3` | triangles | 1 → 3 with edge flips | split |
 //! | `Butterfly { tension }`, `ModifiedButterfly` | triangles | 1 → 4 | split |
@@ -15,7 +15,7 @@
 //! decaying in `f32`, uniform and Chaikin crease methods, corners, holes, the three boundary
 //! interpolation modes, non-manifold edges and vertices), and positions within 1e-12 of
 //! OpenSubdiv run in double precision. The split family ([`split_schemes`]) holds the
-//! schemes of seed 001 that OpenSubdiv does not have.
+//! schemes of the subdivision lecture notes that OpenSubdiv does not have.
 //!
 //! Refinement is data: [`Refinement::new`] computes the topology of every level and a
 //! [`StencilTable`] per level (child vertices as weighted sums of parent vertices), which
@@ -69,6 +69,7 @@
 pub mod analysis;
 pub mod curve;
 mod face_varying;
+mod facts;
 mod family;
 pub mod named_curve;
 pub mod peak;
@@ -84,13 +85,14 @@ use subd_mesh::{BoundaryInterpolation, CreaseMethod, SchemeHints, TriangleSubdiv
 use thiserror::Error;
 
 pub use face_varying::FaceVarying;
+pub use facts::{Capability, FaceKind, SchemeFacts, Split, TagSupport};
 pub use refine::{
     ChildLayout, ChunkLevel, DepthFirst, FVarLevelState, FVarLevelValues, FVarPatchTag,
     FVarValueKind, FaceStream, FaceVaryingRefinement, LevelCounts, PointStream, refined_counts,
 };
 pub use refinement::Refinement;
 pub use rules::Rule;
-pub use scheme::{FaceKind, ParseSchemeError, Scheme, Split, TagSupport};
+pub use scheme::{ParseSchemeError, Scheme};
 pub use split_schemes::SplitFaceVarying;
 pub use stencil::{RowSink, StencilTable};
 pub use two_phase::TwoPhase;

@@ -1,6 +1,6 @@
 //! Curve schemes by name: [`NamedCurve`] makes one of [`crate::curve`]'s schemes from the
 //! name and parameters `subd curve` and `subd.curve` take (with the same defaults), and
-//! [`subdivide_curve`] runs it on points (with normals for seed 004's circle-average
+//! [`subdivide_curve`] runs it on points (with normals for Liu et al.'s circle-average
 //! schemes, estimated from the polygon when none are given).
 
 use glam::{DVec2, DVec3};
@@ -39,7 +39,7 @@ pub struct CurveParameters {
 pub enum NamedCurve {
     /// A scheme on points alone.
     Linear(CurveScheme),
-    /// Seed 004's circle-average schemes, on planar points with normals.
+    /// Liu et al.'s circle-average schemes, on planar points with normals.
     Circle(CircleScheme),
 }
 

@@ -44,7 +44,7 @@ use crate::{ExplicitTags, FaceStream, Options, PointStream, RefineError, Scheme}
 /// }
 /// ```
 ///
-/// The two-phase scheme of seed 000 refines with Catmull-Clark's topology; its level 1 is
+/// The two-phase scheme of Lin et al. refines with Catmull-Clark's topology; its level 1 is
 /// phase 1:
 ///
 /// ```

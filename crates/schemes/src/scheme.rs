@@ -9,10 +9,11 @@ use thiserror::Error;
 use subd_mesh::Topology;
 
 use crate::TwoPhase;
+use crate::facts::{Capability, FaceKind, SchemeFacts, Split, TagSupport};
 use crate::split_schemes::SplitStep;
 
-/// A surface subdivision scheme: OpenSubdiv's three, seed 000's two-phase scheme, and the
-/// four split schemes of seed 001 §4.
+/// A surface subdivision scheme: OpenSubdiv's three, Lin et al.'s two-phase scheme, and the
+/// four split schemes of the subdivision lecture notes §4.
 ///
 /// Every refinement, limit, evaluation, interpolation and editing entry of subd takes this
 /// type. [`FromStr`] and [`Display`](fmt::Display) use the command line's names; a parameter
@@ -38,7 +39,7 @@ pub enum Scheme {
     Loop,
     /// Bilinear: the quad split with linear interpolation.
     Bilinear,
-    /// Seed 000's two-phase modified Catmull-Clark: level 1 is phase 1 with shape parameter
+    /// Lin et al.'s two-phase modified Catmull-Clark: level 1 is phase 1 with shape parameter
     /// `λ` (one for all vertices or one per vertex), Catmull-Clark after it (see
     /// [`two_phase`](crate::two_phase)).
     TwoPhase(TwoPhase),
@@ -56,59 +57,12 @@ pub enum Scheme {
     ModifiedButterfly,
 }
 
-/// The faces a scheme takes as input.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum FaceKind {
-    /// Any polygons.
-    Any,
-    /// Triangles only.
-    Triangles,
-    /// Quads only.
-    Quads,
-}
-
-/// How one step of a scheme splits the faces of its parent level.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Split {
-    /// An n-gon into n quads around a face point (Catmull-Clark, Bilinear, two-phase).
-    Quad,
-    /// A triangle into four at its edge midpoints (Loop, the butterflies).
-    Triangle,
-    /// A triangle into three around its centroid, then every old edge flipped (√3).
-    Sqrt3,
-    /// The dual split: a face per face, edge and vertex of the parent (Doo-Sabin).
-    Dual,
-}
-
-/// Which tags (and face-varying layouts) a scheme has rules for. A scheme refuses a mesh
-/// that carries a tag it has no rule for, naming the element.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub struct TagSupport {
-    /// Semi-sharp creases (finite sharpness decaying level by level).
-    pub semi_sharp_creases: bool,
-    /// Infinitely sharp creases.
-    pub infinite_creases: bool,
-    /// Corner (vertex sharpness) tags.
-    pub corners: bool,
-    /// Hole faces.
-    pub holes: bool,
-    /// Non-manifold edges and vertices.
-    pub non_manifold: bool,
-    /// OpenSubdiv's six face-varying interpolation modes (the others refine face-varying
-    /// data as a mesh of values: see [`Self::uv_seams`]).
-    pub fvar_modes: bool,
-    /// Face-varying data with seams (texture coordinates that differ across an edge).
-    pub uv_seams: bool,
-}
-
 /// Why a scheme name does not parse.
 #[derive(Debug, Clone, PartialEq, Eq, Error)]
 #[non_exhaustive]
 pub enum ParseSchemeError {
     /// No scheme has this name.
-    #[error(
-        "unknown scheme `{0}` (expected catmull-clark, loop, bilinear, two-phase, doo-sabin, sqrt3, butterfly or modified-butterfly)"
-    )]
+    #[error("unknown scheme `{0}` (expected {names})", names = sentence(&Scheme::NAMES))]
     Unknown(String),
     /// A parameter that is not a number, or that the scheme does not take.
     #[error("scheme `{scheme}`: {why}")]
@@ -120,6 +74,27 @@ pub enum ParseSchemeError {
     },
 }
 
+/// Every scheme's facts, in [`Scheme::NAMES`] order, each from its rule file.
+const ALL_FACTS: [&SchemeFacts; 8] = [
+    &crate::refine::CATMULL_CLARK,
+    &crate::refine::LOOP,
+    &crate::refine::BILINEAR,
+    &crate::two_phase::FACTS,
+    &crate::split_schemes::doo_sabin::FACTS,
+    &crate::split_schemes::sqrt3::FACTS,
+    &crate::split_schemes::butterfly::FACTS,
+    &crate::split_schemes::butterfly::MODIFIED_FACTS,
+];
+
+/// Names as a sentence lists them: `a`, `a or b`, `a, b or c`.
+fn sentence(names: &[&str]) -> String {
+    match names.split_last() {
+        Some((last, [])) => (*last).to_string(),
+        Some((last, rest)) => format!("{} or {last}", rest.join(", ")),
+        None => String::new(),
+    }
+}
+
 impl Scheme {
     /// The classic butterfly, `w = 1/16`.
     pub const BUTTERFLY: Scheme = Scheme::Butterfly {
@@ -128,38 +103,82 @@ impl Scheme {
 
     /// Every scheme name, in the order the documentation lists them.
     pub const NAMES: [&'static str; 8] = [
-        "catmull-clark",
-        "loop",
-        "bilinear",
-        "two-phase",
-        "doo-sabin",
-        "sqrt3",
-        "butterfly",
-        "modified-butterfly",
+        ALL_FACTS[0].name,
+        ALL_FACTS[1].name,
+        ALL_FACTS[2].name,
+        ALL_FACTS[3].name,
+        ALL_FACTS[4].name,
+        ALL_FACTS[5].name,
+        ALL_FACTS[6].name,
+        ALL_FACTS[7].name,
     ];
+
+    /// The scheme's facts, as its rule file declares them.
+    ///
+    /// ```
+    /// use subd_schemes::{Capability, Scheme, Split};
+    ///
+    /// let facts = Scheme::Sqrt3.facts();
+    /// assert_eq!((facts.name, facts.split), ("sqrt3", Split::Sqrt3));
+    /// assert!(facts.capabilities.contains(&Capability::Limit));
+    /// ```
+    pub fn facts(&self) -> &'static SchemeFacts {
+        match self {
+            Scheme::CatmullClark => ALL_FACTS[0],
+            Scheme::Loop => ALL_FACTS[1],
+            Scheme::Bilinear => ALL_FACTS[2],
+            Scheme::TwoPhase(_) => ALL_FACTS[3],
+            Scheme::DooSabin => ALL_FACTS[4],
+            Scheme::Sqrt3 => ALL_FACTS[5],
+            Scheme::Butterfly { .. } => ALL_FACTS[6],
+            Scheme::ModifiedButterfly => ALL_FACTS[7],
+        }
+    }
+
+    /// Whether subd computes `capability` for this scheme.
+    ///
+    /// ```
+    /// use subd_schemes::{Capability, Scheme};
+    ///
+    /// assert!(Scheme::Loop.supports(Capability::Evaluate));
+    /// assert!(!Scheme::Sqrt3.supports(Capability::Evaluate));
+    /// assert!(!Scheme::Bilinear.supports(Capability::Limit));
+    /// ```
+    pub fn supports(&self, capability: Capability) -> bool {
+        self.facts().capabilities.contains(&capability)
+    }
+
+    /// The names of the schemes with `capability`, in [`Self::NAMES`] order.
+    ///
+    /// ```
+    /// use subd_schemes::{Capability, Scheme};
+    ///
+    /// assert_eq!(Scheme::names_with(Capability::Edit), ["catmull-clark", "loop"]);
+    /// ```
+    pub fn names_with(capability: Capability) -> Vec<&'static str> {
+        ALL_FACTS
+            .iter()
+            .filter(|f| f.capabilities.contains(&capability))
+            .map(|f| f.name)
+            .collect()
+    }
+
+    /// [`Self::names_with`] as a sentence lists them, for messages: "catmull-clark or
+    /// loop", "catmull-clark, loop or two-phase".
+    pub fn list_with(capability: Capability) -> String {
+        sentence(&Self::names_with(capability))
+    }
 
     /// The scheme's name as the command line spells it (without parameters).
     pub fn name(&self) -> &'static str {
-        match self {
-            Scheme::CatmullClark => "catmull-clark",
-            Scheme::Loop => "loop",
-            Scheme::Bilinear => "bilinear",
-            Scheme::TwoPhase(_) => "two-phase",
-            Scheme::DooSabin => "doo-sabin",
-            Scheme::Sqrt3 => "sqrt3",
-            Scheme::Butterfly { .. } => "butterfly",
-            Scheme::ModifiedButterfly => "modified-butterfly",
-        }
+        self.facts().name
     }
 
     /// Whether the scheme is one of OpenSubdiv's (or the two-phase scheme, which refines
     /// with Catmull-Clark's topology and rules): the family that reproduces OpenSubdiv's
     /// vertex order, crease semantics and options.
     pub fn is_opensubdiv(&self) -> bool {
-        matches!(
-            self,
-            Scheme::CatmullClark | Scheme::Loop | Scheme::Bilinear | Scheme::TwoPhase(_)
-        )
+        self.facts().opensubdiv_family
     }
 
     /// The scheme a mesh file names (USD's `subdivisionScheme`); `None` for a file that
@@ -195,23 +214,12 @@ impl Scheme {
 
     /// The faces the scheme takes.
     pub fn input_faces(&self) -> FaceKind {
-        match self {
-            Scheme::CatmullClark | Scheme::Bilinear | Scheme::DooSabin => FaceKind::Any,
-            Scheme::TwoPhase(_) => FaceKind::Quads,
-            Scheme::Loop | Scheme::Sqrt3 | Scheme::Butterfly { .. } | Scheme::ModifiedButterfly => {
-                FaceKind::Triangles
-            }
-        }
+        self.facts().input_faces
     }
 
     /// How one step splits the faces.
     pub fn split(&self) -> Split {
-        match self {
-            Scheme::CatmullClark | Scheme::Bilinear | Scheme::TwoPhase(_) => Split::Quad,
-            Scheme::Loop | Scheme::Butterfly { .. } | Scheme::ModifiedButterfly => Split::Triangle,
-            Scheme::Sqrt3 => Split::Sqrt3,
-            Scheme::DooSabin => Split::Dual,
-        }
+        self.facts().split
     }
 
     /// Child faces per parent face of the kind the scheme produces (4 for the quad and
@@ -228,16 +236,13 @@ impl Scheme {
     /// Steps after which the split repeats itself: 2 for √3 (each step turns the mesh, and
     /// the boundary is trisected every second step), 1 for the others.
     pub fn period(&self) -> usize {
-        if *self == Scheme::Sqrt3 { 2 } else { 1 }
+        if self.split() == Split::Sqrt3 { 2 } else { 1 }
     }
 
     /// Whether the vertices of every level stay on the limit surface (Bilinear and the
     /// butterflies).
     pub fn is_interpolating(&self) -> bool {
-        matches!(
-            self,
-            Scheme::Bilinear | Scheme::Butterfly { .. } | Scheme::ModifiedButterfly
-        )
+        self.facts().interpolating
     }
 
     /// Regular interior valence: 6 for the triangle schemes, 4 for the others.
@@ -251,64 +256,12 @@ impl Scheme {
 
     /// The tags the scheme has rules for.
     pub fn tags(&self) -> TagSupport {
-        let opensubdiv = TagSupport {
-            semi_sharp_creases: true,
-            infinite_creases: true,
-            corners: true,
-            holes: true,
-            non_manifold: true,
-            fvar_modes: true,
-            uv_seams: true,
-        };
-        let split = TagSupport {
-            semi_sharp_creases: false,
-            infinite_creases: true,
-            corners: true,
-            holes: false,
-            non_manifold: false,
-            fvar_modes: false,
-            uv_seams: false,
-        };
-        match self {
-            Scheme::CatmullClark | Scheme::Loop | Scheme::TwoPhase(_) => opensubdiv,
-            // Bilinear keeps every vertex and edge: sharpness changes nothing.
-            Scheme::Bilinear => TagSupport {
-                semi_sharp_creases: false,
-                infinite_creases: false,
-                corners: false,
-                ..opensubdiv
-            },
-            Scheme::DooSabin => TagSupport {
-                infinite_creases: false,
-                corners: false,
-                ..split
-            },
-            Scheme::Sqrt3 => split,
-            Scheme::Butterfly { .. } | Scheme::ModifiedButterfly => TagSupport {
-                uv_seams: true,
-                ..split
-            },
-        }
+        self.facts().tags
     }
 
     /// One line on the scheme: who it is by, the faces it takes, and its parameter.
     pub fn summary(&self) -> &'static str {
-        match self {
-            Scheme::CatmullClark => "Catmull-Clark (OpenSubdiv's), any polygons",
-            Scheme::Loop => "Loop (OpenSubdiv's), triangles",
-            Scheme::Bilinear => "Bilinear (OpenSubdiv's), any polygons",
-            Scheme::TwoPhase(_) => {
-                "Seed 000's two-phase modified Catmull-Clark, quads; shape parameter λ (two-phase:λ)"
-            }
-            Scheme::DooSabin => "Doo-Sabin's dual scheme, any polygons",
-            Scheme::Sqrt3 => "Kobbelt's √3 scheme, triangles",
-            Scheme::Butterfly { .. } => {
-                "The interpolating butterfly (Dyn, Levin, Gregory), triangles; tension w (butterfly:w, default 1/16)"
-            }
-            Scheme::ModifiedButterfly => {
-                "Zorin, Schröder and Sweldens' modified butterfly, triangles"
-            }
-        }
+        self.facts().summary
     }
 
     /// Bytes per output vertex at the peak of refining and writing with this scheme, held
@@ -317,14 +270,7 @@ impl Scheme {
     /// up (BENCHMARKS.md, "Memory estimates"; see [`crate::peak::PeakModel`]). The two-phase
     /// scheme is Catmull-Clark's after level 1; the split schemes hold every level.
     pub fn peak_bytes_per_vertex(&self) -> (u64, Option<u64>) {
-        match self {
-            Scheme::CatmullClark | Scheme::TwoPhase(_) => (105, Some(70)),
-            Scheme::Bilinear => (120, Some(70)),
-            Scheme::Loop => (120, Some(90)),
-            Scheme::DooSabin => (145, None),
-            Scheme::Butterfly { .. } | Scheme::ModifiedButterfly => (190, None),
-            Scheme::Sqrt3 => (235, None),
-        }
+        self.facts().peak_bytes_per_vertex
     }
 
     /// The scheme's parameter checked: the butterfly's tension must be finite (the
@@ -561,6 +507,63 @@ mod tests {
             all.iter().filter(|s| s.is_opensubdiv()).count(),
             4,
             "Catmull-Clark, Loop, Bilinear and two-phase"
+        );
+    }
+
+    #[test]
+    fn capabilities_are_the_documented_ones() {
+        use Capability::*;
+        // The README's table of schemes, written out by hand.
+        let expected: [(&str, &[Capability]); 8] = [
+            (
+                "catmull-clark",
+                &[
+                    Refine,
+                    Limit,
+                    Evaluate,
+                    Interpolate,
+                    Edit,
+                    Adaptive,
+                    Analyse,
+                ],
+            ),
+            (
+                "loop",
+                &[
+                    Refine,
+                    Limit,
+                    Evaluate,
+                    Interpolate,
+                    Edit,
+                    Adaptive,
+                    Analyse,
+                ],
+            ),
+            ("bilinear", &[Refine]),
+            ("two-phase", &[Refine, Limit, Interpolate]),
+            ("doo-sabin", &[Refine, Limit, Analyse]),
+            ("sqrt3", &[Refine, Limit, Analyse]),
+            ("butterfly", &[Refine, Limit, Analyse]),
+            ("modified-butterfly", &[Refine, Limit, Analyse]),
+        ];
+        for (name, capabilities) in expected {
+            let scheme: Scheme = name.parse().unwrap();
+            for c in Capability::ALL {
+                assert_eq!(
+                    scheme.supports(c),
+                    capabilities.contains(&c),
+                    "{name} {c:?}"
+                );
+            }
+        }
+        assert_eq!(
+            Scheme::list_with(Interpolate),
+            "catmull-clark, loop or two-phase"
+        );
+        assert_eq!(Scheme::list_with(Evaluate), "catmull-clark or loop");
+        assert_eq!(
+            ParseSchemeError::Unknown("x".into()).to_string(),
+            "unknown scheme `x` (expected catmull-clark, loop, bilinear, two-phase, doo-sabin, sqrt3, butterfly or modified-butterfly)"
         );
     }
 

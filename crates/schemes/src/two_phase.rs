@@ -1,8 +1,8 @@
-//! The two-phase modified Catmull-Clark scheme of seed 000 (Lin, Pan et al., "Local
+//! The two-phase modified Catmull-Clark scheme of Lin et al. (Lin, Pan et al., "Local
 //! progressive interpolation for Catmull-Clark subdivision surfaces with shape control").
 //!
 //! **Phase 1** is one Catmull-Clark step with the same topology, face points and edge points,
-//! and a modified vertex point with a shape parameter `λ` per vertex (seed 000 §1, eq. (1)):
+//! and a modified vertex point with a shape parameter `λ` per vertex (Lin et al. §1, eq. (1)):
 //!
 //! ```text
 //! v' = λ v + (1 − λ) [ α E + (1 − α) F ],   α = 10/13,
@@ -39,8 +39,9 @@
 //! fractional weight, as ordinary Catmull-Clark does. Faces must all be quads.
 
 use crate::RefineError;
+use crate::facts::{Capability, FaceKind, OPENSUBDIV_TAGS, SchemeFacts, Split};
 
-/// `α` of the modified vertex rule (seed 000).
+/// `α` of the modified vertex rule (Lin et al.).
 pub const ALPHA: f64 = 10.0 / 13.0;
 
 /// The exclusive lower end of the `λ` range in which the paper proves convergence.
@@ -177,6 +178,24 @@ impl TwoPhase {
 pub fn crease_vertex_weight(lambda: f64) -> f64 {
     lambda + (1.0 - lambda) * ALPHA * 0.5
 }
+
+/// The two-phase scheme's facts: Catmull-Clark's topology and rules after its first step,
+/// quads only (phase 1 is defined on quads), no exact evaluation of its own.
+pub const FACTS: SchemeFacts = SchemeFacts {
+    name: "two-phase",
+    summary: "Lin et al.'s two-phase modified Catmull-Clark, quads; shape parameter λ (two-phase:λ)",
+    input_faces: FaceKind::Quads,
+    split: Split::Quad,
+    interpolating: false,
+    opensubdiv_family: true,
+    tags: OPENSUBDIV_TAGS,
+    peak_bytes_per_vertex: (105, Some(70)),
+    capabilities: &[
+        Capability::Refine,
+        Capability::Limit,
+        Capability::Interpolate,
+    ],
+};
 
 #[cfg(test)]
 mod tests {

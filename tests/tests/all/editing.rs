@@ -1,4 +1,4 @@
-//! Constraint-based editing (seed 003) and constrained deformation (seed 002 §3): the
+//! Constraint-based editing (Li et al. 2008) and constrained deformation (Sun et al. 2012 §3): the
 //! claims of the seed and the invariants of the methods, checked by evaluating the edited
 //! surface afresh with subd-limit.
 
@@ -655,7 +655,7 @@ fn constraints_at_boundaries_creases_and_extraordinary_vertices_are_met() {
 
 #[test]
 fn mirror_extension_reproduces_the_boundary_rules() {
-    // Seed 003 §2.2: a boundary face of an open grid is the B-spline over its 3 × 4 grid
+    // Li et al. 2008 §2.2: a boundary face of an open grid is the B-spline over its 3 × 4 grid
     // extended by mirrored points v' = 2 v_i − v_j (a corner face by 4v₃ − 2v₂ − 2v₆ + v₉ at
     // its corner), which must be subd-limit's boundary evaluation (edge-only boundaries
     // away from corners, edge-and-corner at corners).

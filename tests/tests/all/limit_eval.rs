@@ -220,7 +220,8 @@ fn prism_level2() -> (Topology, Vec<DVec3>) {
 
 /// Near an extraordinary vertex of valence n the refined control point at parameter
 /// (2^-L, 0) and the exact surface point there differ by a distance that shrinks like λ^L,
-/// λ the subdominant eigenvalue (seed 001 §5): the measured ratio of successive errors is λ.
+/// λ the subdominant eigenvalue (the subdivision lecture notes §5): the measured ratio of
+/// successive errors is λ.
 #[test]
 fn refined_points_approach_the_exact_surface_at_the_subdominant_rate() {
     let (topo, pts) = prism_level2();

@@ -1,4 +1,4 @@
-//! Progressive interpolation: the claims of seed 000 (two-phase scheme, local PIA) and of
+//! Progressive interpolation: the claims of Lin et al. (two-phase scheme, local PIA) and of
 //! the Catmull-Clark and Loop PIA papers, on OpenSubdiv's shapes and synthetic meshes.
 //!
 //! Every check compares with something computed another way: formula (2) in closed form,
@@ -125,7 +125,7 @@ fn spectral_radius_of_iteration(m: &Mat<f64>) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// Seed 000, formula (2), in closed form at a smooth vertex of a closed quad mesh.
+/// Lin et al., formula (2), in closed form at a smooth vertex of a closed quad mesh.
 fn formula_two(t: &Topology, p: &[DVec3], lambda: &[f64], v: usize) -> DVec3 {
     let n = t.valence(v) as f64;
     let l = lambda[v];
@@ -259,7 +259,7 @@ fn two_phase_pia_converges_for_every_lambda_on_closed_quad_meshes() {
                 let (_, m) = pia.moving_matrix(moving).unwrap();
                 let rho = spectral_radius_of_iteration(&m);
                 assert!(rho < 1.0, "{} λ={l}: ρ = {rho}", s.name);
-                // Seed 000 §3: M̄ = C̄ D̄ with D̄ symmetric, so CG applies.
+                // Lin et al. §3: M̄ = C̄ D̄ with D̄ symmetric, so CG applies.
                 assert!(pia.is_symmetrizable(moving).unwrap(), "{} λ={l}", s.name);
                 case.solve_and_check(moving, Solver::Iterate);
             }

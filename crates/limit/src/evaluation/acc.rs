@@ -1,9 +1,9 @@
 //! ACC: the bicubic approximation of Catmull-Clark surfaces by Loop & Schaefer,
 //! "Approximating Catmull-Clark subdivision surfaces with bicubic patches" (ACM TOG 27(1),
-//! 2008; seed 001 §5(c)).
+//! 2008; the subdivision lecture notes §5(c)).
 //!
 //! One bicubic Bézier **geometry patch** per quad, `b[i][j]` (i along u, j along v, corner
-//! (0,0) at the face's vertex 0), from the masks of seed 001 §5(c):
+//! (0,0) at the face's vertex 0), from the masks of the subdivision lecture notes §5(c):
 //! * interior point at corner v (valence n) of the face: `(n v + 2 (e⁺ + e⁻) + f) / (n + 5)`
 //!   (e± the face's two neighbours of v, f its opposite vertex);
 //! * edge point: the average of the two interior points beside it (mask 2n, 4, 2, 2, 1, 1

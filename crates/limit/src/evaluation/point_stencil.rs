@@ -7,7 +7,7 @@
 //! on that support, three vertices at a time (x, y, z), and carry the weights of level-2
 //! vertices back to the base through the refinement's stencils. The result is a
 //! [`PointStencil`]: sparse rows of position and derivatives, exact to rounding, the
-//! building block of constraint rows (seed 003 §3).
+//! building block of constraint rows (Li et al. 2008 §3).
 //!
 //! [`LimitEvaluator::face_patches`](crate::eval::LimitEvaluator::face_patches) exposes the same structure per face: the pieces the
 //! evaluator uses (bicubic B-splines, Stam corner patches), with their control points as

@@ -1,6 +1,6 @@
 //! Exact evaluation of a Catmull-Clark patch with one extraordinary corner: Stam's eigenbasis
 //! method (Stam 1998, "Exact evaluation of Catmull-Clark subdivision surfaces at arbitrary
-//! parameter values"; seed 003 §2.1).
+//! parameter values"; Li et al. 2008 §2.1).
 //!
 //! Around an extraordinary vertex of valence n the patch has 2n + 8 control points
 //! ([`crate::patch`] gives their order). One subdivision step maps them to the 2n + 8 control

@@ -1,4 +1,5 @@
-//! Eigen analysis of the local subdivision matrix around one vertex (seed 001 §5).
+//! Eigen analysis of the local subdivision matrix around one vertex (the subdivision lecture notes
+//! §5).
 //!
 //! The matrix is not written down by hand: it is read off the refinement itself. A small
 //! mesh made of the vertex's 1-ring is refined once with `subd-schemes`, and the stencil rows

@@ -11,7 +11,7 @@
 //!   using Catmull-Clark surfaces" (SIGGRAPH 1993), eq. for the limit point:
 //!   `(n² v + 4 Σ e_i + Σ f_i) / (n (n + 5))`; tangents from the same paper's eigenvectors,
 //!   `Σ 4 cos(2πi/n) e_i + c (cos(2πi/n) + cos(2π(i+1)/n)) f_i` with `c = 1/(4λ − 1)` and λ
-//!   the subdominant eigenvalue (seed 001 §5).
+//!   the subdominant eigenvalue (the subdivision lecture notes §5).
 //! * Crease position `(e_a + 4 v + e_b) / 6` (the cubic B-spline limit of the crease curve);
 //!   cross-crease tangent: Biermann, Levin & Zorin, "Piecewise smooth subdivision surfaces
 //!   with normal control" (SIGGRAPH 2000), with k = faces between the crease edges.
@@ -68,7 +68,7 @@ pub struct LimitMask {
     pub tangent2: RingMask,
 }
 
-/// Catmull-Clark subdominant eigenvalue for valence `n` (seed 001 §5):
+/// Catmull-Clark subdominant eigenvalue for valence `n` (the subdivision lecture notes §5):
 /// `λ = (4 + A_n)/16`, `A_n = 1 + cos(2π/n) + cos(π/n)·sqrt(2(9 + cos(2π/n)))`.
 pub fn catmark_subdominant(n: usize) -> f64 {
     let c = (2.0 * PI / n as f64).cos();
@@ -76,7 +76,8 @@ pub fn catmark_subdominant(n: usize) -> f64 {
     (4.0 + a) / 16.0
 }
 
-/// Loop subdominant eigenvalue for valence `n` (seed 001 §5): `3/8 + cos(2π/n)/4`.
+/// Loop subdominant eigenvalue for valence `n` (the subdivision lecture notes §5): `3/8 +
+/// cos(2π/n)/4`.
 pub fn loop_subdominant(n: usize) -> f64 {
     0.375 + 0.25 * (2.0 * PI / n as f64).cos()
 }

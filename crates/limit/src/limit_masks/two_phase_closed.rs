@@ -1,4 +1,4 @@
-//! The two-phase limit of seed 000 in closed form (its formula (2)), for closed smooth quad
+//! The two-phase limit of Lin et al. in closed form (its formula (2)), for closed smooth quad
 //! meshes: no refinement needed.
 //!
 //! Around a vertex `v` of valence `n` whose faces are all quads, with edge neighbours `e_j`

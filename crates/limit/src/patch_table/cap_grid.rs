@@ -17,7 +17,7 @@ use rayon::prelude::*;
 use subd_schemes::Scheme;
 
 use super::exact_caps::patch_local;
-use super::grid_samples::{MAX_TABLE_POINTS, grid_index, grid_points, grid_step, tabulated_first};
+use super::grid::{MAX_TABLE_POINTS, grid_index, grid_points, grid_step, tabulated_first};
 use super::table::{PatchTable, TablePoints};
 use crate::evaluation::eval::FaceParam;
 use crate::evaluation::patch::Derivatives;

@@ -24,6 +24,7 @@ use rayon::prelude::*;
 
 use super::basis;
 use super::cap_grid::CapGrids;
+use super::grid::{MAX_TABLE_POINTS, grid_index, grid_points, grid_step, tabulated_first};
 use super::table::{PatchTable, TablePoints};
 use super::{PatchParam, PatchType};
 
@@ -33,10 +34,6 @@ use crate::evaluation::eval::FaceParam;
 /// Samples per parallel job: many faces' worth, so that a face's run of samples is rarely
 /// split.
 const SAMPLE_CHUNK: usize = 4096;
-
-/// The largest grid (points of a root face) whose non-product basis is tabulated; beyond
-/// it (rates above 64) those patch types are evaluated sample by sample.
-pub(super) const MAX_TABLE_POINTS: usize = 65 * 65;
 
 /// A cubic B-spline's four values and four derivatives at one grid coordinate.
 type CubicRow = [[f64; 4]; 2];
@@ -107,25 +104,6 @@ fn grid_points_of(kind: PatchType, m: u32) -> usize {
     grid_points(is_triangle(kind), m)
 }
 
-/// Grid points of span `m` on a triangle or a quad.
-pub(super) fn grid_points(triangle: bool, m: u32) -> usize {
-    let m = m as usize;
-    if triangle {
-        (m + 1) * (m + 2) / 2
-    } else {
-        (m + 1) * (m + 1)
-    }
-}
-
-/// The index of grid point `(i, j)` of span `m`, row by row.
-pub(super) fn grid_index(triangle: bool, m: u32, i: u32, j: u32) -> usize {
-    if triangle {
-        (j * (2 * m + 3 - j) / 2 + i) as usize
-    } else {
-        (j * (m + 1) + i) as usize
-    }
-}
-
 /// The position, ∂s and ∂t weights of `kind` at every grid point of span `m`.
 fn tabulate(kind: PatchType, boundary: u8, m: u32) -> Vec<f64> {
     let n = kind
@@ -145,17 +123,6 @@ fn tabulate(kind: PatchType, boundary: u8, m: u32) -> Vec<f64> {
         }
     }
     out
-}
-
-/// The grid step nearest `x · m`, when `x` is a grid coordinate (within rounding).
-pub(super) fn grid_step(x: f64, m: u32) -> Option<u32> {
-    let y = x * f64::from(m);
-    if !(-0.5..=f64::from(m) + 0.5).contains(&y) {
-        return None;
-    }
-    // Rounding by a cast (y + 0.5 ≥ 0 here): `f64::round` is a library call.
-    let k = (y + 0.5) as u32;
-    ((y - f64::from(k)).abs() < 1e-6 && k <= m).then_some(k)
 }
 
 /// One thread's memory of the patch it met last: where it lies, its basis, its points.
@@ -431,18 +398,4 @@ fn cubic_across(rows: &[[DVec3; 4]; 2], s: &CubicRow) -> (DVec3, DVec3, DVec3) {
     let [pos, dt] = rows;
     let sum = |w: &[f64; 4], x: &[DVec3; 4]| w[0] * x[0] + w[1] * x[1] + w[2] * x[2] + w[3] * x[3];
     (sum(&s[0], pos), sum(&s[1], pos), sum(&s[0], dt))
-}
-
-/// Position and first derivatives from tabulated weights (`n` each for the position, ∂s
-/// and ∂t) of the points `cps`.
-pub(super) fn tabulated_first(w: &[f64], cps: &[u32], points: &[DVec3]) -> (DVec3, DVec3, DVec3) {
-    let n = cps.len();
-    let (mut pos, mut du, mut dv) = (DVec3::ZERO, DVec3::ZERO, DVec3::ZERO);
-    for (k, &cp) in cps.iter().enumerate() {
-        let x = points[cp as usize];
-        pos += w[k] * x;
-        du += w[n + k] * x;
-        dv += w[2 * n + k] * x;
-    }
-    (pos, du, dv)
 }

@@ -55,6 +55,7 @@ mod exact_caps;
 mod face_varying;
 mod features;
 mod gather;
+mod grid;
 mod grid_samples;
 mod kind;
 mod levels;

@@ -1,5 +1,6 @@
 //! Eigen analysis of the split schemes (Doo-Sabin, √3, the butterflies) around an
-//! extraordinary vertex or face, read off the schemes' own stencils (seed 001 §5).
+//! extraordinary vertex or face, read off the schemes' own stencils (the subdivision lecture notes
+//! §5).
 //!
 //! The local subdivision matrix is not written down by hand. A disc of `K` rings of regular
 //! faces around a centre of valence `n` is refined once, and both levels are labelled the

@@ -576,7 +576,7 @@ def adaptive(
     ``face_levels`` gives the level of every face.
 
     A face is refined when any criterion asks; with none, every face is refined to
-    ``levels``. ``flatness``: seed 002's test, degrees between the normals at a vertex.
+    ``levels``. ``flatness``: Sun et al.'s test, degrees between the normals at a vertex.
     ``max_distance``: the largest distance to the limit surface, relative to the bounding-box
     diagonal. ``curvature``: Gaussian curvature times the squared diagonal (a sphere: 12).
     ``dihedral``: degrees. ``select_faces``: base faces whose descendants are refined;
@@ -665,7 +665,7 @@ def curve(
     ``mu`` (the two-parameter 4-point schemes), ``order`` (``bspline``, default 4) and
     ``alpha0`` (``tension``, default 1). Returns the points, with the input's columns; for
     the circle-average schemes (``circle-four-point``, ``circle-ternary``: planar points
-    with normals, seed 004) returns ``(points, normals)``, the input's ``normals`` (n, 2)
+    with normals, Liu et al.) returns ``(points, normals)``, the input's ``normals`` (n, 2)
     estimated from the polygon when not given.
     """
     p = _float_array(points, "points")

@@ -23,7 +23,7 @@ pub use fvar::{
 };
 pub(crate) use fvar::{base_corner_kinds, check_channel};
 pub use layout::ChildLayout;
-pub(crate) use osd::OsdRefinement;
+pub(crate) use osd::{BILINEAR, CATMULL_CLARK, LOOP, OsdRefinement};
 pub use stream::{FaceStream, PointStream};
 pub(crate) use tags::{child_explicit_tags, explicit_tags, prepare_base};
 
@@ -539,7 +539,7 @@ impl Step<'_> {
         sink.vertex(v as u32, pw * pm.vertex() + cw * cm.vertex());
     }
 
-    /// Phase 1 of the two-phase scheme at vertex `v` (seed 000 eq. (1); boundary and crease
+    /// Phase 1 of the two-phase scheme at vertex `v` (Lin et al. eq. (1); boundary and crease
     /// rule derived in [`crate::two_phase`]), blended across a rule change as ordinary
     /// Catmull-Clark blends its masks.
     fn phase_one_row<S: MaskSink>(

@@ -7,6 +7,7 @@ use std::sync::OnceLock;
 use subd_mesh::{DVec3, Topology};
 
 use super::Sdc;
+use crate::facts::{Capability, FaceKind, OPENSUBDIV_TAGS, SchemeFacts, Split, TagSupport};
 use crate::rules::Rule;
 use crate::stencil::StencilTable;
 use crate::{ExplicitTags, MAX_LEVELS, Options, RefineError};
@@ -201,7 +202,7 @@ impl OsdRefinement {
         Ok(r)
     }
 
-    /// Refines `base` with the two-phase modified Catmull-Clark scheme of seed 000: level 1
+    /// Refines `base` with the two-phase modified Catmull-Clark scheme of Lin et al.: level 1
     /// is phase 1 (the modified vertex rule with `two_phase`'s `λ`, see
     /// [`two_phase`](crate::two_phase)), levels 2 and on are ordinary Catmull-Clark.
     ///
@@ -449,3 +450,51 @@ impl OsdRefinement {
         }
     }
 }
+
+/// Catmull-Clark's facts (OpenSubdiv's masks, `Sdc::Scheme<CATMARK>`).
+pub(crate) const CATMULL_CLARK: SchemeFacts = SchemeFacts {
+    name: "catmull-clark",
+    summary: "Catmull-Clark (OpenSubdiv's), any polygons",
+    input_faces: FaceKind::Any,
+    split: Split::Quad,
+    interpolating: false,
+    opensubdiv_family: true,
+    tags: OPENSUBDIV_TAGS,
+    peak_bytes_per_vertex: (105, Some(70)),
+    capabilities: &[
+        Capability::Refine,
+        Capability::Limit,
+        Capability::Evaluate,
+        Capability::Interpolate,
+        Capability::Edit,
+        Capability::Adaptive,
+        Capability::Analyse,
+    ],
+};
+
+/// Loop's facts (OpenSubdiv's masks, `Sdc::Scheme<LOOP>`).
+pub(crate) const LOOP: SchemeFacts = SchemeFacts {
+    name: "loop",
+    summary: "Loop (OpenSubdiv's), triangles",
+    input_faces: FaceKind::Triangles,
+    split: Split::Triangle,
+    peak_bytes_per_vertex: (120, Some(90)),
+    ..CATMULL_CLARK
+};
+
+/// Bilinear's facts: it keeps every vertex and edge, so sharpness changes nothing and the
+/// mesh is its own limit.
+pub(crate) const BILINEAR: SchemeFacts = SchemeFacts {
+    name: "bilinear",
+    summary: "Bilinear (OpenSubdiv's), any polygons",
+    interpolating: true,
+    tags: TagSupport {
+        semi_sharp_creases: false,
+        infinite_creases: false,
+        corners: false,
+        ..OPENSUBDIV_TAGS
+    },
+    peak_bytes_per_vertex: (120, Some(70)),
+    capabilities: &[Capability::Refine],
+    ..CATMULL_CLARK
+};

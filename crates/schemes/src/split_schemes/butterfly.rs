@@ -1,5 +1,5 @@
 //! The butterfly schemes on triangles: Dyn, Levin and Gregory's (1990) and Zorin, Schröder
-//! and Sweldens' modified butterfly (1996); seed 001 §4 (d), (e).
+//! and Sweldens' modified butterfly (1996); the subdivision lecture notes §4 (d), (e).
 //!
 //! Both split every triangle into four as Loop does (old vertices first, then one point per
 //! edge in edge order; faces as [`crate::Refinement`] orders Loop's) and keep every old vertex
@@ -22,6 +22,7 @@
 //! across (`x + y − z` for the vertex `z` on this side of edge `xy`). In the modified scheme
 //! the ends of an edge that lie on a boundary or crease count as regular.
 
+use crate::facts::{Capability, FaceKind, SPLIT_TAGS, SchemeFacts, Split, TagSupport};
 use std::f64::consts::TAU;
 
 use rayon::prelude::*;
@@ -232,3 +233,27 @@ impl SplitRule for Step<'_> {
         Some(crate::refine::split::tri_split(self.t))
     }
 }
+
+/// The butterfly's facts: interpolating, texture coordinates with seams carried by the
+/// tension-0 butterfly.
+pub const FACTS: SchemeFacts = SchemeFacts {
+    name: "butterfly",
+    summary: "The interpolating butterfly (Dyn, Levin, Gregory), triangles; tension w (butterfly:w, default 1/16)",
+    input_faces: FaceKind::Triangles,
+    split: Split::Triangle,
+    interpolating: true,
+    opensubdiv_family: false,
+    tags: TagSupport {
+        uv_seams: true,
+        ..SPLIT_TAGS
+    },
+    peak_bytes_per_vertex: (190, None),
+    capabilities: &[Capability::Refine, Capability::Limit, Capability::Analyse],
+};
+
+/// The modified butterfly's facts: the butterfly's, under its own name.
+pub const MODIFIED_FACTS: SchemeFacts = SchemeFacts {
+    name: "modified-butterfly",
+    summary: "Zorin, Schröder and Sweldens' modified butterfly, triangles",
+    ..FACTS
+};

@@ -1,4 +1,4 @@
-//! Doo-Sabin's dual scheme (Doo and Sabin 1978; seed 001 §4 (b)).
+//! Doo-Sabin's dual scheme (Doo and Sabin 1978; the subdivision lecture notes §4 (b)).
 //!
 //! Every corner `k` of an n-sided face gets a child point `Σ_j α_{(j−k) mod n} p_j` with
 //! `α_0 = (n + 5)/(4n)` and `α_d = (3 + 2cos(2πd/n))/(4n)`. The children are joined into an
@@ -27,6 +27,7 @@
 //! next to the edge's first vertex first. Face order: F-faces in face order, E-faces in edge
 //! order, V-faces in vertex order.
 
+use crate::facts::{Capability, FaceKind, SPLIT_TAGS, SchemeFacts, Split, TagSupport};
 use std::f64::consts::TAU;
 
 use subd_mesh::{Topology, TopologyParts};
@@ -260,3 +261,20 @@ impl SplitRule for Step<'_> {
         super::doo_sabin_split::applies(self.p).then(|| super::doo_sabin_split::split(self.p))
     }
 }
+
+/// Doo-Sabin's facts: no crease rules (its dual split moves every vertex off the edges).
+pub const FACTS: SchemeFacts = SchemeFacts {
+    name: "doo-sabin",
+    summary: "Doo-Sabin's dual scheme, any polygons",
+    input_faces: FaceKind::Any,
+    split: Split::Dual,
+    interpolating: false,
+    opensubdiv_family: false,
+    tags: TagSupport {
+        infinite_creases: false,
+        corners: false,
+        ..SPLIT_TAGS
+    },
+    peak_bytes_per_vertex: (145, None),
+    capabilities: &[Capability::Refine, Capability::Limit, Capability::Analyse],
+};

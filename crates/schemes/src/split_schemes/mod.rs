@@ -1,5 +1,5 @@
-//! The schemes of seed 001 §4 that OpenSubdiv does not have: Doo-Sabin, √3 (Kobbelt),
-//! Butterfly (Dyn, Levin, Gregory) and Modified Butterfly (Zorin, Schröder, Sweldens).
+//! The schemes of the subdivision lecture notes §4 that OpenSubdiv does not have: Doo-Sabin, √3
+//! (Kobbelt), Butterfly (Dyn, Levin, Gregory) and Modified Butterfly (Zorin, Schröder, Sweldens).
 //!
 //! Each is a topology split plus masks (one rule file: [`doo_sabin`], [`sqrt3`],
 //! [`butterfly`]), refined one level at a time behind [`crate::Refinement`]: the topology of
@@ -8,7 +8,7 @@
 //!
 //! A rule file gives, for one step over a parent level, the child faces (with the tags the
 //! child keeps) and the mask of every child vertex as weights of parent vertices; a new
-//! scheme is such a file plus its [`Scheme`](crate::Scheme) variant.
+//! scheme is such a file plus its [`Scheme`] variant.
 //!
 //! | scheme | input faces | split | interpolating | boundary | creases |
 //! |---|---|---|---|---|---|
@@ -23,7 +23,7 @@
 //! Every level is a new [`Topology`]; rows of the stencil tables are built in parallel and do
 //! not depend on the number of threads. A level's topology is derived from the level above
 //! in closed form, in parallel, where the rule has a derivation
-//! ([`SplitRule::derived_topology`]: the butterflies always, √3 and Doo-Sabin over closed
+//! (`SplitRule::derived_topology`: the butterflies always, √3 and Doo-Sabin over closed
 //! levels without feature edges) and built from its faces by [`TopologyBuilder`] otherwise;
 //! both give the same topology, relation for relation (the derived one is put in the
 //! builder's order by [`subd_mesh::canonical::builder_order`]).

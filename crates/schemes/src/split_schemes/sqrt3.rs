@@ -1,4 +1,4 @@
-//! Kobbelt's √3 scheme (SIGGRAPH 2000; seed 001 §4): triangles only.
+//! Kobbelt's √3 scheme (SIGGRAPH 2000; the subdivision lecture notes §4): triangles only.
 //!
 //! Every step inserts the centroid of every triangle, moves every old interior vertex of
 //! valence `n` to `(1 − α_n) p + (α_n / n) Σ p_i` with `α_n = (4 − 2cos(2π/n))/9`, and flips
@@ -26,6 +26,7 @@
 //! next to the edge's first vertex first. Faces: per edge in edge order, the triangles it
 //! makes (for a feature edge, those of its first face, then its second).
 
+use crate::facts::{Capability, FaceKind, SPLIT_TAGS, SchemeFacts, Split};
 use std::f64::consts::TAU;
 
 use subd_mesh::{Topology, TopologyParts};
@@ -264,3 +265,16 @@ impl SplitRule for Step<'_> {
             .then(|| super::sqrt3_split::split(self.p))
     }
 }
+
+/// √3's facts.
+pub const FACTS: SchemeFacts = SchemeFacts {
+    name: "sqrt3",
+    summary: "Kobbelt's √3 scheme, triangles",
+    input_faces: FaceKind::Triangles,
+    split: Split::Sqrt3,
+    interpolating: false,
+    opensubdiv_family: false,
+    tags: SPLIT_TAGS,
+    peak_bytes_per_vertex: (235, None),
+    capabilities: &[Capability::Refine, Capability::Limit, Capability::Analyse],
+};

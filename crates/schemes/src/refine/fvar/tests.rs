@@ -55,7 +55,7 @@ fn a_seamless_channel_in_mode_none_is_refined_as_the_positions() {
     let e = tris.find_edge(5, 6).unwrap() as usize;
     tris.set_edge_sharpness(e, 1.5);
     tris.set_vertex_sharpness(10, 2.25);
-    // Seed 000's two-phase scheme too: its phase-1 vertex rule (here with λ varying per
+    // Lin et al.'s two-phase scheme too: its phase-1 vertex rule (here with λ varying per
     // vertex) reaches matching values through the same rows.
     let lambda: Vec<f64> = (0..16).map(|v| 0.4 + 0.03 * v as f64).collect();
     let two_phase = crate::TwoPhase::new(lambda).unwrap();

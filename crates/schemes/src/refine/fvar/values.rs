@@ -5,7 +5,7 @@ use subd_mesh::Topology;
 
 use super::{ChannelLevel, ValueTag};
 
-/// The values of one level of a [`FaceVaryingRefinement`] as limit masks need them: which
+/// The values of one level of a [`FaceVaryingRefinement`](crate::FaceVaryingRefinement) as limit masks need them: which
 /// values each vertex has, whether they follow the geometry (matching) or are seam corners
 /// or seam creases, and a crease value's two end values (`Vtr::FVarLevel`'s state).
 ///

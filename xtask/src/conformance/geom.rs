@@ -14,7 +14,7 @@ use subd_mesh::{DVec3, Topology, TopologyBuilder};
 use subd_schemes::{Options, Refinement, Scheme};
 
 use crate::conformance::Row;
-use crate::geom_ref::{self, Library, RefOutcome};
+use crate::oracles::geom::{self, Library, RefOutcome};
 
 /// Tolerance on the matched distance / bounding-box diagonal.
 const TOLERANCE: f64 = 1e-12;
@@ -214,7 +214,7 @@ fn compare(exe: &Path, name: &str, topo: &Topology, positions: &[DVec3]) -> Vec<
                 ));
             }
             row.vertices = pos.len();
-            match geom_ref::refine(exe, p.library, p.harness_scheme, level, &t, positions) {
+            match geom::refine(exe, p.library, p.harness_scheme, level, &t, positions) {
                 Err(e) => row.problem = Some(e),
                 Ok(RefOutcome::Refused(why)) => {
                     row.problem = Some(format!(
@@ -233,7 +233,7 @@ fn compare(exe: &Path, name: &str, topo: &Topology, positions: &[DVec3]) -> Vec<
                             m.num_faces
                         ));
                     } else {
-                        row.error = geom_ref::matched_error(pos, &m.positions, diag);
+                        row.error = geom::matched_error(pos, &m.positions, diag);
                         if row.error.is_nan() || row.error > TOLERANCE {
                             row.problem = Some(format!("matched |Δ|/diag {:.3e}", row.error));
                         }
@@ -297,7 +297,7 @@ pub fn random(exe: &Path, count: u64) -> Vec<Row> {
         rows.extend(compare(exe, &format!("bipyramid_valence_{n}"), &t, &p));
     }
     rows.par_extend((0..count).into_par_iter().flat_map_iter(|seed| {
-        let c = crate::random_mesh::case(seed);
+        let c = crate::meshes::random::case(seed);
         compare(exe, &c.name, &c.topology, &c.positions)
     }));
     rows

@@ -5,6 +5,17 @@
 //! runs: topology refinement + stencils + positions for subd, topology refinement + primvar
 //! interpolation for OpenSubdiv (double precision, default uniform options).
 
+pub mod adaptive;
+pub mod batch;
+pub mod editing;
+pub mod fvar;
+pub mod patch;
+pub mod pia;
+pub mod scaling;
+pub mod split;
+pub mod tess;
+pub mod usd;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
@@ -12,63 +23,8 @@ use std::time::Instant;
 use subd_mesh::{Mesh, TopologyBuilder};
 use subd_schemes::{Options, Refinement, Scheme};
 
-use crate::osd;
-
-/// A closed quad mesh of about 100k faces with extraordinary vertices: a 160 x 160 torus
-/// grid in which every 8th quad pair is merged into a hexagon (two valence-3 vertices each),
-/// refined once with Catmull-Clark (the hexagon centres become valence-6 vertices).
-pub fn quad_bench_mesh() -> Mesh {
-    let base = subd_mesh::primitives::torus_with_hexagons(160, 160, 8, 3.0, 1.0);
-    let r = Refinement::new(&base.topology, Scheme::CatmullClark, &Options::default(), 1)
-        .expect("refine");
-    let pts = r.refine_points(&base.positions).pop().expect("level 1");
-    Mesh::new(r.into_topology(1), pts).expect("finite")
-}
-
-/// The quad bench mesh with every quad split along its 0-2 diagonal, for Loop.
-pub fn tri_bench_mesh() -> Mesh {
-    split_quads(&quad_bench_mesh())
-}
-
-/// An all-quad mesh with every quad split along its 0-2 diagonal.
-pub fn split_quads(q: &Mesh) -> Mesh {
-    let t = &q.topology;
-    let mut idx = Vec::with_capacity(t.num_faces() * 6);
-    for f in 0..t.num_faces() {
-        let v = t.face_vertices(f);
-        idx.extend_from_slice(&[v[0], v[1], v[2], v[0], v[2], v[3]]);
-    }
-    let topo = TopologyBuilder::new(t.num_vertices())
-        .build(&vec![3; 2 * t.num_faces()], &idx)
-        .expect("valid");
-    Mesh::new(topo, q.positions.clone()).expect("finite")
-}
-
-/// The quad bench mesh with every face whose centre lies in a band around the x axis or
-/// on the negative x side removed (two boundary loops): refinement on it takes the general
-/// path (boundaries), not the closed smooth one.
-pub fn open_quad_bench_mesh() -> Result<Mesh, String> {
-    let quads = quad_bench_mesh();
-    let t = &quads.topology;
-    let mut sizes = Vec::new();
-    let mut corners = Vec::new();
-    for f in 0..t.num_faces() {
-        let fv = t.face_vertices(f);
-        let centre = fv
-            .iter()
-            .map(|&v| quads.positions[v as usize])
-            .sum::<subd_mesh::DVec3>()
-            / fv.len() as f64;
-        if centre.y.abs() > 0.6 || centre.x < 0.0 {
-            sizes.push(fv.len() as u32);
-            corners.extend_from_slice(fv);
-        }
-    }
-    let topo = TopologyBuilder::new(t.num_vertices())
-        .build(&sizes, &corners)
-        .map_err(|e| e.to_string())?;
-    Mesh::new(topo, quads.positions.clone()).map_err(|e| e.to_string())
-}
+use crate::meshes::{open_quad_bench_mesh, quad_bench_mesh, split_quads, tri_bench_mesh};
+use crate::oracles::osd;
 
 pub(crate) fn peak_rss_bytes() -> u64 {
     std::fs::read_to_string("/proc/self/status")
@@ -204,6 +160,72 @@ pub fn run(
     std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
     let me = std::env::current_exe().map_err(|e| e.to_string())?;
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    print_header(rounds, repeats, huge_pages, advice, open, threads);
+    let meshes = if open {
+        let quads = open_quad_bench_mesh()?;
+        let tris = split_quads(&quads);
+        [(Scheme::CatmullClark, quads), (Scheme::Loop, tris)]
+    } else {
+        [
+            (Scheme::CatmullClark, quad_bench_mesh()),
+            (Scheme::Loop, tri_bench_mesh()),
+        ]
+    };
+    let sides = Sides {
+        exe: &exe,
+        me: &me,
+        repeats,
+        huge_pages,
+        advice,
+    };
+    for (scheme, mesh) in meshes {
+        let name = if scheme == Scheme::Loop {
+            "loop"
+        } else {
+            "catmark"
+        };
+        let file = if open {
+            format!("{name}_open")
+        } else {
+            name.to_string()
+        };
+        let path = dir.join(format!("{file}.obj"));
+        subd_io::write_mesh(&path, &mesh, &subd_io::WriteOptions::default())
+            .map_err(|e| e.to_string())?;
+        for level in 1..=levels {
+            let input = osd::encode(
+                &mesh.topology,
+                &mesh.positions,
+                &scheme,
+                &Options::default(),
+                level as u32,
+            );
+            let input_path = dir.join(format!("{file}_{level}.bin"));
+            std::fs::write(&input_path, &input).map_err(|e| e.to_string())?;
+            let mut runs = Vec::with_capacity(rounds);
+            for _ in 0..rounds {
+                runs.push([
+                    sides.osd(&input_path)?,
+                    sides.subd(&path, name, level, 1)?,
+                    sides.subd(&path, name, level, threads)?,
+                ]);
+            }
+            print_row(name, &scheme, &mesh, level, &runs);
+        }
+    }
+    Ok(())
+}
+
+/// The table's opening lines (the setup, the huge-page settings, the meshes) and column
+/// names.
+fn print_header(
+    rounds: usize,
+    repeats: usize,
+    huge_pages: bool,
+    advice: bool,
+    open: bool,
+    threads: usize,
+) {
     println!(
         "subd vs OpenSubdiv 3.5 (Far, double), uniform refinement; {rounds} rounds of (OpenSubdiv, subd 1 thread, subd all threads) back to back, each the median of {repeats} runs; times: median over rounds; ratio = subd time / OpenSubdiv time, median of the rounds' ratios{}",
         if huge_pages {
@@ -235,95 +257,81 @@ pub fn run(
         "osd MB",
         "subd MB"
     );
-    let meshes = if open {
-        let quads = open_quad_bench_mesh()?;
-        let tris = split_quads(&quads);
-        [(Scheme::CatmullClark, quads), (Scheme::Loop, tris)]
-    } else {
-        [
-            (Scheme::CatmullClark, quad_bench_mesh()),
-            (Scheme::Loop, tri_bench_mesh()),
-        ]
-    };
-    for (scheme, mesh) in meshes {
-        let name = if scheme == Scheme::Loop {
-            "loop"
-        } else {
-            "catmark"
-        };
-        let file = if open {
-            format!("{name}_open")
-        } else {
-            name.to_string()
-        };
-        let path = dir.join(format!("{file}.obj"));
-        subd_io::write_mesh(&path, &mesh, &subd_io::WriteOptions::default())
-            .map_err(|e| e.to_string())?;
-        for level in 1..=levels {
-            let input = osd::encode(
-                &mesh.topology,
-                &mesh.positions,
-                &scheme,
-                &Options::default(),
-                level as u32,
-            );
-            let input_path = dir.join(format!("{file}_{level}.bin"));
-            std::fs::write(&input_path, &input).map_err(|e| e.to_string())?;
-            let osd = || {
-                measure(
-                    Command::new(&exe)
-                        .args(["--bench", &repeats.to_string()])
-                        .stdin(std::fs::File::open(&input_path).map_err(|e| e.to_string())?),
-                    huge_pages,
-                )
-            };
-            let subd = |t: usize| {
-                measure(
-                    Command::new(&me)
-                        .args([
-                            "bench-run",
-                            "--mesh",
-                            path.to_str().unwrap(),
-                            "--scheme",
-                            name,
-                            "--levels",
-                            &level.to_string(),
-                            "--threads",
-                            &t.to_string(),
-                            "--repeats",
-                            &repeats.to_string(),
-                        ])
-                        .args((!advice).then_some("--no-huge-page-advice")),
-                    huge_pages,
-                )
-            };
-            let mut runs = Vec::with_capacity(rounds);
-            for _ in 0..rounds {
-                runs.push([osd()?, subd(1)?, subd(threads)?]);
-            }
-            let med = |f: &dyn Fn(&[Measure; 3]) -> f64| median(runs.iter().map(f).collect());
-            let peak = |k: usize| runs.iter().map(|r| r[k].peak).fold(0.0, f64::max);
-            let out_faces = mesh.topology.num_face_vertices()
-                * 4usize.pow(level as u32 - 1)
-                * if scheme == Scheme::Loop { 4 } else { 1 }
-                / if scheme == Scheme::Loop { 3 } else { 1 };
-            println!(
-                "{:<8} {:>8} {:>5} {:>10} {:>10.4} {:>10.4} {:>7.2} {:>10.4} {:>7.2} {:>9.0} {:>9.0}",
-                name,
-                mesh.topology.num_faces(),
-                level,
-                out_faces,
-                med(&|r| r[0].seconds),
-                med(&|r| r[1].seconds),
-                med(&|r| r[1].seconds / r[0].seconds),
-                med(&|r| r[2].seconds),
-                med(&|r| r[2].seconds / r[0].seconds),
-                peak(0),
-                peak(1).max(peak(2))
-            );
-        }
+}
+
+/// The two sides of a refinement measurement, each in its own process: the OpenSubdiv
+/// harness and `xtask bench-run`.
+struct Sides<'a> {
+    exe: &'a Path,
+    me: &'a Path,
+    repeats: usize,
+    huge_pages: bool,
+    advice: bool,
+}
+
+impl Sides<'_> {
+    /// OpenSubdiv on the encoded input at `input_path`.
+    fn osd(&self, input_path: &Path) -> Result<Measure, String> {
+        measure(
+            Command::new(self.exe)
+                .args(["--bench", &self.repeats.to_string()])
+                .stdin(std::fs::File::open(input_path).map_err(|e| e.to_string())?),
+            self.huge_pages,
+        )
     }
-    Ok(())
+
+    /// subd on `threads` threads, the mesh at `path` with the scheme `name` to `level`.
+    fn subd(
+        &self,
+        path: &Path,
+        name: &str,
+        level: usize,
+        threads: usize,
+    ) -> Result<Measure, String> {
+        measure(
+            Command::new(self.me)
+                .args([
+                    "bench-run",
+                    "--mesh",
+                    path.to_str().unwrap(),
+                    "--scheme",
+                    name,
+                    "--levels",
+                    &level.to_string(),
+                    "--threads",
+                    &threads.to_string(),
+                    "--repeats",
+                    &self.repeats.to_string(),
+                ])
+                .args((!self.advice).then_some("--no-huge-page-advice")),
+            self.huge_pages,
+        )
+    }
+}
+
+/// One row: medians over the rounds `runs` (OpenSubdiv, subd on one thread, subd on all),
+/// the ratios the medians of the rounds' ratios, peak memories over the rounds.
+fn print_row(name: &str, scheme: &Scheme, mesh: &Mesh, level: usize, runs: &[[Measure; 3]]) {
+    let med = |f: &dyn Fn(&[Measure; 3]) -> f64| median(runs.iter().map(f).collect());
+    let peak = |k: usize| runs.iter().map(|r| r[k].peak).fold(0.0, f64::max);
+    let out_faces = mesh.topology.num_face_vertices()
+        * 4usize.pow(level as u32 - 1)
+        * if *scheme == Scheme::Loop { 4 } else { 1 }
+        / if *scheme == Scheme::Loop { 3 } else { 1 };
+    println!(
+        "{:<8} {:>8} {:>5} {:>10} {:>10.4} {:>10.4} {:>7.2} {:>10.4} {:>7.2} {:>9.0} {:>9.0}",
+        name,
+        mesh.topology.num_faces(),
+        level,
+        out_faces,
+        med(&|r| r[0].seconds),
+        med(&|r| r[1].seconds),
+        med(&|r| r[1].seconds / r[0].seconds),
+        med(&|r| r[2].seconds),
+        med(&|r| r[2].seconds / r[0].seconds),
+        peak(0),
+        peak(1).max(peak(2))
+    );
 }
 
 /// Points evaluated by the evaluation benchmark.

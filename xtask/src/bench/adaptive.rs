@@ -20,8 +20,9 @@ use subd_adaptive::{
 use subd_mesh::{Mesh, TopologyBuilder};
 use subd_schemes::{Options, Refinement, Scheme};
 
-use crate::bench::{median, quad_bench_mesh, tri_bench_mesh};
-use crate::osd;
+use crate::bench::median;
+use crate::meshes::{quad_bench_mesh, tri_bench_mesh};
+use crate::oracles::osd;
 
 /// Seed 002 gives no flatness threshold; the table shows these.
 const TABLE_FLATNESS_DEGREES: [f64; 3] = [10.0, 20.0, 30.0];
@@ -39,7 +40,7 @@ fn decimated_scan(faces: usize) -> Result<Mesh, String> {
     let dir = bench_dir();
     let out = dir.join(format!("bunny_{faces}.obj"));
     if !out.exists() {
-        let scan = crate::pia_bench::scan_mesh()?;
+        let scan = crate::meshes::scan_mesh()?;
         let full = dir.join("bunny_full.obj");
         subd_io::write_mesh(&full, &scan, &subd_io::WriteOptions::default())
             .map_err(|e| e.to_string())?;
@@ -301,7 +302,7 @@ fn speed(exe: &Path, repeats: usize) -> Result<(), String> {
         "/subd",
         "/osd"
     );
-    let scan = crate::pia_bench::scan_mesh()?;
+    let scan = crate::meshes::scan_mesh()?;
     let cases: Vec<(&str, Scheme, Mesh, f64)> = vec![
         (
             "torus catmark",

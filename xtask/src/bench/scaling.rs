@@ -17,8 +17,9 @@ use subd_mesh::Mesh;
 use subd_mesh::fvar::FVarLinearInterpolation;
 use subd_schemes::{Options, Scheme};
 
-use crate::bench::{json_number, median, open_quad_bench_mesh, quad_bench_mesh, split_quads};
-use crate::osd;
+use crate::bench::{json_number, median};
+use crate::meshes::{open_quad_bench_mesh, quad_bench_mesh, split_quads};
+use crate::oracles::osd;
 
 /// One command line of the table.
 struct Job {
@@ -58,7 +59,7 @@ impl Inputs {
         let triangles = split_quads(&quads);
         let open = split_quads(&open_quad_bench_mesh()?);
         let mut with_uv = quads.clone();
-        with_uv.fvar = vec![crate::fvar_bench::torus_uv(&quads)];
+        with_uv.fvar = vec![crate::bench::fvar::torus_uv(&quads)];
         let path = |name: &str| dir.join(name);
         let write = |m: &Mesh, p: &Path| {
             subd_io::write_mesh(p, m, &subd_io::WriteOptions::default()).map_err(|e| e.to_string())
@@ -104,7 +105,7 @@ fn jobs(inputs: &Inputs, repeats: usize) -> Vec<Job> {
     };
     let (cc, lp) = (Scheme::CatmullClark, Scheme::Loop);
     let uv = &inputs.quads;
-    let channel = crate::fvar_bench::torus_uv(uv);
+    let channel = crate::bench::fvar::torus_uv(uv);
     let fvar = osd::encode_fvar(
         osd::encode(&uv.topology, &uv.positions, &cc, &Options::default(), 2),
         channel.values(),
@@ -273,7 +274,7 @@ fn thread_counts(given: &[usize]) -> Vec<usize> {
 
 /// Runs every job and prints one table per job.
 pub fn run(repeats: usize, threads: &[usize]) -> Result<(), String> {
-    let subd = crate::batch_bench::subd_binary()?;
+    let subd = crate::bench::batch::subd_binary()?;
     let exe = osd::build_harness()?;
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/xtask/bench/scaling");
     std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;

@@ -150,15 +150,43 @@ fn star(rng: &mut Rng, b: &mut Builder, k: u32, closed: bool, triangles_only: bo
     }
 }
 
-/// The random case number `seed`.
+/// The random case number `seed`. Every step draws from the one generator in a fixed
+/// order, so a seed always yields the same mesh.
 pub fn case(seed: u64) -> RandomCase {
     let mut rng = Rng(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1);
-    let scheme = match rng.below(5) {
+    let scheme = random_scheme(&mut rng);
+    let (mut b, kind) = random_shape(&mut rng, scheme == Scheme::Loop);
+    add_fins(&mut rng, &mut b);
+    let sizes: Vec<u32> = b.faces.iter().map(|f| f.len() as u32).collect();
+    let idx: Vec<u32> = b.faces.iter().flatten().copied().collect();
+    let mut topology = TopologyBuilder::new(b.positions.len())
+        .accept_inconsistent_orientation(true)
+        .build(&sizes, &idx)
+        .expect("random mesh is valid");
+    add_tags(&mut rng, &mut topology);
+    let options = random_options(&mut rng);
+    RandomCase {
+        name: case_name(seed, kind, &scheme),
+        topology,
+        positions: b.positions,
+        scheme,
+        options,
+    }
+}
+
+/// The scheme, the first draw: Catmull-Clark and Loop two times in five each, bilinear
+/// once.
+fn random_scheme(rng: &mut Rng) -> Scheme {
+    match rng.below(5) {
         0 | 1 => Scheme::CatmullClark,
         2 | 3 => Scheme::Loop,
         _ => Scheme::Bilinear,
-    };
-    let tri = scheme == Scheme::Loop;
+    }
+}
+
+/// The base shape and its kind (0 grid, 1 torus, 2 star, 3 bipyramid); triangles only
+/// with `tri`. The grid sizes and the star valence are drawn whichever kind is picked.
+fn random_shape(rng: &mut Rng, tri: bool) -> (Builder, u64) {
     let mut b = Builder {
         positions: Vec::new(),
         faces: Vec::new(),
@@ -170,12 +198,17 @@ pub fn case(seed: u64) -> RandomCase {
         3 + rng.below(10) as u32,
     );
     match kind {
-        0 => grid(&mut rng, &mut b, 2 + m, 2 + n, false, tri),
-        1 => grid(&mut rng, &mut b, 3 + m, 3 + n, true, tri),
-        2 => star(&mut rng, &mut b, k, false, tri),
-        _ => star(&mut rng, &mut b, k, true, tri),
+        0 => grid(rng, &mut b, 2 + m, 2 + n, false, tri),
+        1 => grid(rng, &mut b, 3 + m, 3 + n, true, tri),
+        2 => star(rng, &mut b, k, false, tri),
+        _ => star(rng, &mut b, k, true, tri),
     }
-    // Non-manifold fins: a triangle hung on an existing edge (a third face on it).
+    (b, kind)
+}
+
+/// Non-manifold fins, on three meshes in ten: one or two triangles each hung on an
+/// existing edge (a third face on it).
+fn add_fins(rng: &mut Rng, b: &mut Builder) {
     if rng.chance(0.3) {
         for _ in 0..1 + rng.below(2) {
             let f = rng.below(b.faces.len() as u64) as usize;
@@ -188,32 +221,18 @@ pub fn case(seed: u64) -> RandomCase {
             b.faces.push(vec![a, c, v]);
         }
     }
-    let sizes: Vec<u32> = b.faces.iter().map(|f| f.len() as u32).collect();
-    let idx: Vec<u32> = b.faces.iter().flatten().copied().collect();
-    let mut topology = TopologyBuilder::new(b.positions.len())
-        .accept_inconsistent_orientation(true)
-        .build(&sizes, &idx)
-        .expect("random mesh is valid");
-    // Tags, in f32 as a file would give them; non-dyadic values like OpenSubdiv's shapes.
-    const SEMI: [f64; 8] = [0.2, 0.5, 0.9, 1.0, 1.4, 2.5, 2.8, 4.7];
+}
+
+/// Random creases, corners and holes: edges, then vertices, then faces, in index order.
+fn add_tags(rng: &mut Rng, topology: &mut Topology) {
     for e in 0..topology.num_edges() {
         if rng.chance(0.12) {
-            let s = if rng.chance(0.3) {
-                10.0
-            } else {
-                SEMI[rng.below(8) as usize]
-            };
-            topology.set_edge_sharpness(e, s as f32);
+            topology.set_edge_sharpness(e, random_sharpness(rng));
         }
     }
     for v in 0..topology.num_vertices() {
         if rng.chance(0.05) {
-            let s = if rng.chance(0.3) {
-                10.0
-            } else {
-                SEMI[rng.below(8) as usize]
-            };
-            topology.set_vertex_sharpness(v, s as f32);
+            topology.set_vertex_sharpness(v, random_sharpness(rng));
         }
     }
     for f in 0..topology.num_faces() {
@@ -221,7 +240,24 @@ pub fn case(seed: u64) -> RandomCase {
             topology.set_hole(f, true);
         }
     }
-    let options = Options {
+}
+
+/// A tag's sharpness: infinitely sharp three times in ten, else a semi-sharp value.
+fn random_sharpness(rng: &mut Rng) -> f32 {
+    // Tags, in f32 as a file would give them; non-dyadic values like OpenSubdiv's shapes.
+    const SEMI: [f64; 8] = [0.2, 0.5, 0.9, 1.0, 1.4, 2.5, 2.8, 4.7];
+    let s = if rng.chance(0.3) {
+        10.0
+    } else {
+        SEMI[rng.below(8) as usize]
+    };
+    s as f32
+}
+
+/// The scheme options, drawn in field order: boundary interpolation, crease method,
+/// triangle subdivision.
+fn random_options(rng: &mut Rng) -> Options {
+    Options {
         boundary_interpolation: match rng.below(3) {
             0 => BoundaryInterpolation::None,
             1 => BoundaryInterpolation::EdgeOnly,
@@ -237,24 +273,22 @@ pub fn case(seed: u64) -> RandomCase {
         } else {
             TriangleSubdivision::Catmark
         },
-    };
-    let kinds = ["grid", "torus", "star", "bipyramid"];
-    RandomCase {
-        name: format!(
-            "random_{seed:03}_{}_{}",
-            kinds[kind as usize],
-            match scheme {
-                Scheme::CatmullClark => "catmark",
-                Scheme::Loop => "loop",
-                Scheme::Bilinear => "bilinear",
-                other => unreachable!("random cases use OpenSubdiv's schemes, not {other}"),
-            }
-        ),
-        topology,
-        positions: b.positions,
-        scheme,
-        options,
     }
+}
+
+/// `random_<seed>_<kind>_<scheme>`, e.g. `random_073_torus_loop`.
+fn case_name(seed: u64, kind: u64, scheme: &Scheme) -> String {
+    let kinds = ["grid", "torus", "star", "bipyramid"];
+    format!(
+        "random_{seed:03}_{}_{}",
+        kinds[kind as usize],
+        match scheme {
+            Scheme::CatmullClark => "catmark",
+            Scheme::Loop => "loop",
+            Scheme::Bilinear => "bilinear",
+            other => unreachable!("random cases use OpenSubdiv's schemes, not {other}"),
+        }
+    )
 }
 
 #[cfg(test)]

@@ -45,7 +45,7 @@ for _ in range(repeats):
     gc.collect()
 print(statistics.median(times))
 "#;
-    let python = crate::python_tests::env_python(root);
+    let python = crate::system::env_python(root);
     let out = Command::new(&python)
         .args(["-c", script])
         .arg(path)

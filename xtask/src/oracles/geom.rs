@@ -40,7 +40,7 @@ pub enum RefOutcome {
 /// Compiles the harness (when missing or older than its source) and returns its path.
 pub fn build_harness() -> Result<PathBuf, String> {
     // CGAL asks for -frounding-math; its kernel here is plain `double`, header-only.
-    crate::osd::CppHarness {
+    crate::oracles::osd::CppHarness {
         source: "geom_harness.cpp",
         exe: "geom_harness",
         flags: &["-O2", "-std=c++17", "-frounding-math"],

@@ -10,9 +10,10 @@ use subd_limit::patches::{EndCaps, PatchOptions, PatchTable};
 use subd_mesh::Mesh;
 use subd_schemes::{Options, Scheme};
 
-use crate::bench::{json_number, median, quad_bench_mesh, tri_bench_mesh};
-use crate::osd;
-use crate::patch_conformance::harness_args;
+use crate::bench::{json_number, median};
+use crate::conformance::patches::harness_args;
+use crate::meshes::{quad_bench_mesh, tri_bench_mesh};
+use crate::oracles::osd;
 
 /// Random evaluation points, one root face at a time uniformly: (base face, sub-face, u, v)
 /// and the harness's ptex face.

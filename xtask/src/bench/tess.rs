@@ -19,7 +19,7 @@ use subd_mesh::Mesh;
 use subd_schemes::{Options, Scheme};
 
 use crate::bench::{json_number, median};
-use crate::osd;
+use crate::oracles::osd;
 
 /// The rate of the comparison (the issue's).
 const RATE: usize = 8;
@@ -32,7 +32,7 @@ fn meshes() -> Result<Vec<(&'static str, Scheme, Mesh)>, String> {
             Scheme::CatmullClark,
             subd_mesh::primitives::torus(128, 64, 3.0, 1.0),
         ),
-        ("scan (bunny)", Scheme::Loop, crate::pia_bench::scan_mesh()?),
+        ("scan (bunny)", Scheme::Loop, crate::meshes::scan_mesh()?),
         (
             "CAD part (gear)",
             Scheme::Loop,

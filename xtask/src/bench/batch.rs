@@ -8,8 +8,9 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
 
-use crate::bench::{median, quad_bench_mesh};
-use crate::{cargo, run};
+use crate::bench::median;
+use crate::meshes::quad_bench_mesh;
+use crate::system::{cargo, run};
 
 /// Small meshes in the small corpus.
 const SMALL_FILES: usize = 1000;

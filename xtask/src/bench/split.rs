@@ -15,8 +15,9 @@ use subd_mesh::{Mesh, TopologyBuilder};
 
 use subd_schemes::{Options, Refinement, Scheme};
 
-use crate::bench::{json_number, median, peak_rss_bytes, quad_bench_mesh, split_quads};
-use crate::geom_ref::{self, Library};
+use crate::bench::{json_number, median, peak_rss_bytes};
+use crate::meshes::{quad_bench_mesh, split_quads};
+use crate::oracles::geom::{self, Library};
 
 /// The triangle bench mesh: a 112 × 112 torus with hexagons, refined once by Catmull-Clark
 /// (extraordinary vertices of valence 3 and 6) and every quad split along a diagonal: about
@@ -137,38 +138,13 @@ const CASES: &[Case] = &[
 
 /// Runs the comparison and prints the table.
 pub fn run(levels: usize, repeats: usize, rounds: usize) -> Result<(), String> {
-    let harness = geom_ref::build_harness()?;
+    let harness = geom::build_harness()?;
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/xtask/bench");
     std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
     let me = std::env::current_exe().map_err(|e| e.to_string())?;
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let mut files: Vec<(&str, PathBuf, PathBuf, usize)> = Vec::new();
-    for (name, mesh) in [("quad", quad_bench_mesh()), ("tri", tri_100k_mesh())] {
-        let obj = dir.join(format!("split_{name}.obj"));
-        let off = dir.join(format!("split_{name}.off"));
-        subd_io::write_mesh(&obj, &mesh, &subd_io::WriteOptions::default())
-            .map_err(|e| e.to_string())?;
-        geom_ref::write_off(&off, &mesh.topology, &mesh.positions)?;
-        files.push((name, obj, off, mesh.topology.num_faces()));
-    }
-    println!(
-        "subd split schemes vs CGAL 5.5 and OpenMesh 9.0 (double), from face lists to refined positions; {rounds} rounds, each the median of {repeats} runs; ratio = subd 1 thread / the faster reference"
-    );
-    println!(
-        "{:<19} {:>7} {:>5} {:>9} {:>10} {:>10} {:>10} {:>10} {:>7} {:>8} {:>8} {:>8}",
-        "scheme",
-        "faces",
-        "level",
-        "out verts",
-        "cgal s",
-        "openmesh s",
-        "subd 1T s",
-        format!("subd {threads}T s"),
-        "ratio",
-        "cgal MB",
-        "om MB",
-        "subd MB"
-    );
+    let files = write_meshes(&dir)?;
+    print_header(rounds, repeats, threads);
     for case in CASES {
         let (_, obj, off, faces) = files.iter().find(|f| f.0 == case.mesh).expect("bench mesh");
         for level in 1..=levels {
@@ -203,41 +179,82 @@ pub fn run(levels: usize, repeats: usize, rounds: usize) -> Result<(), String> {
                 }
                 runs.push((refs, subd(1)?, subd(threads)?));
             }
-            let med = |f: &dyn Fn(&Round) -> Option<f64>| {
-                let v: Vec<f64> = runs.iter().filter_map(f).collect();
-                (!v.is_empty()).then(|| median(v))
-            };
-            let show = |x: Option<f64>, prec: usize| {
-                x.map_or_else(|| "-".to_string(), |x| format!("{x:.prec$}"))
-            };
-            let cgal = med(&|r| r.0[0].map(|m| m.seconds));
-            let om = med(&|r| r.0[1].map(|m| m.seconds));
-            let ratio = med(&|r| {
-                let faster =
-                    r.0.iter()
-                        .flatten()
-                        .map(|m| m.seconds)
-                        .fold(f64::INFINITY, f64::min);
-                faster.is_finite().then(|| r.1.seconds / faster)
-            });
-            let peak =
-                |f: &dyn Fn(&Round) -> Option<f64>| runs.iter().filter_map(f).reduce(f64::max);
-            println!(
-                "{:<19} {:>7} {:>5} {:>9} {:>10} {:>10} {:>10.4} {:>10.4} {:>7} {:>8} {:>8} {:>8.0}",
-                case.scheme,
-                faces,
-                level,
-                runs[0].1.vertices,
-                show(cgal, 4),
-                show(om, 4),
-                med(&|r| Some(r.1.seconds)).unwrap_or(f64::NAN),
-                med(&|r| Some(r.2.seconds)).unwrap_or(f64::NAN),
-                show(ratio, 3),
-                show(peak(&|r| r.0[0].map(|m| m.peak_mib)), 0),
-                show(peak(&|r| r.0[1].map(|m| m.peak_mib)), 0),
-                peak(&|r| Some(r.1.peak_mib.max(r.2.peak_mib))).unwrap_or(f64::NAN)
-            );
+            print_row(case, *faces, level, &runs);
         }
     }
     Ok(())
+}
+
+/// Writes the quad and triangle bench meshes into `dir`, as OBJ for subd and OFF for the
+/// references; (name, OBJ path, OFF path, faces) of each.
+fn write_meshes(dir: &Path) -> Result<Vec<(&'static str, PathBuf, PathBuf, usize)>, String> {
+    let mut files = Vec::new();
+    for (name, mesh) in [("quad", quad_bench_mesh()), ("tri", tri_100k_mesh())] {
+        let obj = dir.join(format!("split_{name}.obj"));
+        let off = dir.join(format!("split_{name}.off"));
+        subd_io::write_mesh(&obj, &mesh, &subd_io::WriteOptions::default())
+            .map_err(|e| e.to_string())?;
+        geom::write_off(&off, &mesh.topology, &mesh.positions)?;
+        files.push((name, obj, off, mesh.topology.num_faces()));
+    }
+    Ok(files)
+}
+
+/// The table's opening line and column names.
+fn print_header(rounds: usize, repeats: usize, threads: usize) {
+    println!(
+        "subd split schemes vs CGAL 5.5 and OpenMesh 9.0 (double), from face lists to refined positions; {rounds} rounds, each the median of {repeats} runs; ratio = subd 1 thread / the faster reference"
+    );
+    println!(
+        "{:<19} {:>7} {:>5} {:>9} {:>10} {:>10} {:>10} {:>10} {:>7} {:>8} {:>8} {:>8}",
+        "scheme",
+        "faces",
+        "level",
+        "out verts",
+        "cgal s",
+        "openmesh s",
+        "subd 1T s",
+        format!("subd {threads}T s"),
+        "ratio",
+        "cgal MB",
+        "om MB",
+        "subd MB"
+    );
+}
+
+/// One row: medians over the rounds `runs`, "-" where no reference has the scheme; the
+/// ratio against the faster reference of each round; peak memories over the rounds.
+fn print_row(case: &Case, faces: usize, level: usize, runs: &[Round]) {
+    let med = |f: &dyn Fn(&Round) -> Option<f64>| {
+        let v: Vec<f64> = runs.iter().filter_map(f).collect();
+        (!v.is_empty()).then(|| median(v))
+    };
+    let show =
+        |x: Option<f64>, prec: usize| x.map_or_else(|| "-".to_string(), |x| format!("{x:.prec$}"));
+    let cgal = med(&|r| r.0[0].map(|m| m.seconds));
+    let om = med(&|r| r.0[1].map(|m| m.seconds));
+    let ratio = med(&|r| {
+        let faster =
+            r.0.iter()
+                .flatten()
+                .map(|m| m.seconds)
+                .fold(f64::INFINITY, f64::min);
+        faster.is_finite().then(|| r.1.seconds / faster)
+    });
+    let peak = |f: &dyn Fn(&Round) -> Option<f64>| runs.iter().filter_map(f).reduce(f64::max);
+    println!(
+        "{:<19} {:>7} {:>5} {:>9} {:>10} {:>10} {:>10.4} {:>10.4} {:>7} {:>8} {:>8} {:>8.0}",
+        case.scheme,
+        faces,
+        level,
+        runs[0].1.vertices,
+        show(cgal, 4),
+        show(om, 4),
+        med(&|r| Some(r.1.seconds)).unwrap_or(f64::NAN),
+        med(&|r| Some(r.2.seconds)).unwrap_or(f64::NAN),
+        show(ratio, 3),
+        show(peak(&|r| r.0[0].map(|m| m.peak_mib)), 0),
+        show(peak(&|r| r.0[1].map(|m| m.peak_mib)), 0),
+        peak(&|r| Some(r.1.peak_mib.max(r.2.peak_mib))).unwrap_or(f64::NAN)
+    );
 }

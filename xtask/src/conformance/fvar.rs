@@ -13,8 +13,8 @@ use subd_schemes::{FaceVaryingRefinement, Options, Refinement, Scheme};
 use rayon::prelude::*;
 
 use crate::conformance::{Row, levels_for};
-use crate::osd;
-use crate::random_mesh::Rng;
+use crate::meshes::random::Rng;
+use crate::oracles::osd;
 
 /// Tolerance on max |Δ| / diagonal of the UV layout's bounding box.
 const TOLERANCE: f64 = 1e-12;
@@ -354,7 +354,7 @@ pub fn random(exe: &Path, count: u64) -> Vec<Row> {
     (0..count)
         .into_par_iter()
         .flat_map_iter(|seed| {
-            let c = crate::random_mesh::case(seed);
+            let c = crate::meshes::random::case(seed);
             let mut rng = Rng(seed.wrapping_mul(0xD1B5_4A32_D192_ED03) | 1);
             let channel = random_channel(&mut rng, &c.topology);
             let mode = FVarLinearInterpolation::ALL_MODES[rng.below(6) as usize];

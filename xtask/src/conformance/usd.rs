@@ -8,7 +8,7 @@ use std::path::Path;
 use subd_io::ReadOptions;
 use subd_schemes::{Options, Scheme};
 
-use crate::row::Row;
+use crate::conformance::row::Row;
 
 /// Rows for every mesh prim of every stage in `dir`.
 pub fn stages(exe: &Path, dir: &Path) -> Result<Vec<Row>, String> {
@@ -53,7 +53,7 @@ pub fn stages(exe: &Path, dir: &Path) -> Result<Vec<Row>, String> {
                 &options,
             ));
             if let (Some(uv), Some(mode)) = (mesh.uv(), mesh.hints.fvar_interpolation) {
-                rows.extend(crate::fvar_conformance::compare(
+                rows.extend(crate::conformance::fvar::compare(
                     exe,
                     &label,
                     &mesh.topology,

@@ -13,11 +13,11 @@ use subd_mesh::fvar::{FVarChannel, FVarLinearInterpolation};
 use subd_mesh::{DVec3, Topology};
 use subd_schemes::{Options, Scheme};
 
-use crate::fvar_conformance::{random_channel, uv_diagonal};
-use crate::osd;
-use crate::patch_conformance::{decode, eval_points, harness_args, option_label};
-use crate::random_mesh::Rng;
-use crate::row::Row;
+use crate::conformance::fvar::{random_channel, uv_diagonal};
+use crate::conformance::patches::{decode, eval_points, harness_args, option_label};
+use crate::conformance::row::Row;
+use crate::meshes::random::Rng;
+use crate::oracles::osd;
 
 /// The option sets each channel is checked under: a shallow table with Gregory end caps
 /// and OpenSubdiv's default flags, and a deep one with B-spline end caps and every feature
@@ -302,7 +302,7 @@ pub fn random(exe: &Path, count: u64) -> Vec<Row> {
     (0..count)
         .into_par_iter()
         .flat_map_iter(|seed| {
-            let c = crate::random_mesh::case(seed);
+            let c = crate::meshes::random::case(seed);
             if !matches!(c.scheme, Scheme::CatmullClark | Scheme::Loop) {
                 return Vec::new();
             }

@@ -12,8 +12,8 @@ use subd_schemes::{Options, Scheme};
 
 use rayon::prelude::*;
 
-use crate::osd;
-use crate::row::Row;
+use crate::conformance::row::Row;
+use crate::oracles::osd;
 
 /// One patch as the harness writes it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
@@ -596,26 +596,8 @@ fn compare_sets(
                 .map_err(|e| e.to_string())
                 .and_then(|table| {
                     let points = eval_points(&table, topo, scheme, k as u64);
-                    let harness_points: Vec<(u32, f64, f64)> = points
-                        .iter()
-                        .map(|(at, root)| (*root, at.u, at.v))
-                        .collect();
-                    let input = osd::encode(topo, positions, scheme, options, po.isolation.into());
-                    let input = osd::encode_eval_points(input, &harness_points);
-                    let args = harness_args(po);
-                    let args: Vec<&str> = args.iter().map(String::as_str).collect();
-                    let osd = decode(&osd::run(exe, &input, &args)?, points.len())?;
-                    let mine = subd_patches(&table);
-                    if let Some(d) = census_difference(&osd.patches, &mine) {
-                        return Err(d);
-                    }
-                    if osd.local_points != table.census().local_points {
-                        return Err(format!(
-                            "{} local points vs OpenSubdiv's {}",
-                            table.census().local_points,
-                            osd.local_points
-                        ));
-                    }
+                    let osd = osd_table(exe, topo, positions, scheme, options, po, &points)?;
+                    same_census(&table, &osd)?;
                     // subd's uniform refinement to the table's depth, every level.
                     let uniform = || {
                         subd_schemes::Refinement::new(
@@ -631,58 +613,100 @@ fn compare_sets(
                     Ok((osd.patches.len(), points.len(), error))
                 });
             match result {
-                Ok((n, p, errors)) => {
-                    row.vertices = n;
-                    row.error = errors.strict;
-                    let (in_caps, caps_error) = errors.box_caps;
-                    let (at_darts, dart_error) = errors.darts;
-                    let darts = if at_darts > 0 {
-                        format!(
-                            "; {at_darts} of them in patches at valence-2 darts, which \
-                             OpenSubdiv 3.5 builds off the limit (fixed upstream after 3.6.0), \
-                             not compared: there |Δ|/diag ≤ {dart_error:.1e}"
-                        )
-                    } else {
-                        String::new()
-                    };
-                    let (departing, depart_error) = errors.osd_points;
-                    let departs = if departing > 0 {
-                        format!(
-                            "; {departing} of them where OpenSubdiv's adaptive refinement \
-                             leaves its uniform one (its evaluation is subd's basis on its \
-                             control points, which are not uniform refinement's), not \
-                             compared: there |Δ|/diag ≤ {depart_error:.1e}"
-                        )
-                    } else {
-                        String::new()
-                    };
-                    row.note = Some(format!(
-                        "{}; {p} points evaluated{darts}{departs}",
-                        option_label(po)
-                    ));
-                    let apart = in_caps + at_darts + departing;
-                    if apart > 0 {
-                        let worst = caps_error.max(dart_error).max(depart_error);
-                        row.excluded = Some((apart, worst));
-                    }
-                    if errors.strict > 1e-12 {
-                        row.problem = Some(format!(
-                            "{}: evaluation off by {:.3e}",
-                            option_label(po),
-                            errors.strict
-                        ));
-                    } else if caps_error > BOX_SPLINE_CAP_TOLERANCE {
-                        row.problem = Some(format!(
-                            "{}: box-spline end caps off by {caps_error:.3e}",
-                            option_label(po)
-                        ));
-                    }
-                }
+                Ok((n, p, errors)) => record(&mut row, po, n, p, &errors),
                 Err(e) => row.problem = Some(format!("{}: {e}", option_label(po))),
             }
             row
         })
         .collect()
+}
+
+/// OpenSubdiv's patch table for the option set `po`, evaluated at `points`.
+fn osd_table(
+    exe: &Path,
+    topo: &Topology,
+    positions: &[DVec3],
+    scheme: &Scheme,
+    options: &Options,
+    po: &PatchOptions,
+    points: &[(FaceParam, u32)],
+) -> Result<OsdPatchTable, String> {
+    let harness_points: Vec<(u32, f64, f64)> = points
+        .iter()
+        .map(|(at, root)| (*root, at.u, at.v))
+        .collect();
+    let input = osd::encode(topo, positions, scheme, options, po.isolation.into());
+    let input = osd::encode_eval_points(input, &harness_points);
+    let args = harness_args(po);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    decode(&osd::run(exe, &input, &args)?, points.len())
+}
+
+/// The same patches and the same number of local points on both sides, or what differs.
+fn same_census(table: &PatchTable, osd: &OsdPatchTable) -> Result<(), String> {
+    let mine = subd_patches(table);
+    if let Some(d) = census_difference(&osd.patches, &mine) {
+        return Err(d);
+    }
+    if osd.local_points != table.census().local_points {
+        return Err(format!(
+            "{} local points vs OpenSubdiv's {}",
+            table.census().local_points,
+            osd.local_points
+        ));
+    }
+    Ok(())
+}
+
+/// The row of one option set from its `n` patches, `p` evaluated points and their
+/// errors: the points compared apart are counted and noted, and the strict error or the
+/// box-spline caps' error beyond its tolerance is the problem.
+fn record(row: &mut Row, po: &PatchOptions, n: usize, p: usize, errors: &EvalErrors) {
+    row.vertices = n;
+    row.error = errors.strict;
+    let (in_caps, caps_error) = errors.box_caps;
+    let (at_darts, dart_error) = errors.darts;
+    let darts = if at_darts > 0 {
+        format!(
+            "; {at_darts} of them in patches at valence-2 darts, which \
+             OpenSubdiv 3.5 builds off the limit (fixed upstream after 3.6.0), \
+             not compared: there |Δ|/diag ≤ {dart_error:.1e}"
+        )
+    } else {
+        String::new()
+    };
+    let (departing, depart_error) = errors.osd_points;
+    let departs = if departing > 0 {
+        format!(
+            "; {departing} of them where OpenSubdiv's adaptive refinement \
+             leaves its uniform one (its evaluation is subd's basis on its \
+             control points, which are not uniform refinement's), not \
+             compared: there |Δ|/diag ≤ {depart_error:.1e}"
+        )
+    } else {
+        String::new()
+    };
+    row.note = Some(format!(
+        "{}; {p} points evaluated{darts}{departs}",
+        option_label(po)
+    ));
+    let apart = in_caps + at_darts + departing;
+    if apart > 0 {
+        let worst = caps_error.max(dart_error).max(depart_error);
+        row.excluded = Some((apart, worst));
+    }
+    if errors.strict > 1e-12 {
+        row.problem = Some(format!(
+            "{}: evaluation off by {:.3e}",
+            option_label(po),
+            errors.strict
+        ));
+    } else if caps_error > BOX_SPLINE_CAP_TOLERANCE {
+        row.problem = Some(format!(
+            "{}: box-spline end caps off by {caps_error:.3e}",
+            option_label(po)
+        ));
+    }
 }
 
 pub(crate) fn bbox_diagonal(p: &[DVec3]) -> f64 {
@@ -767,7 +791,7 @@ pub fn real_meshes(exe: &Path) -> Result<Vec<Row>, String> {
 /// The faces of the bunny scan within 12 rings of its vertex 0 (a few thousand triangles,
 /// open, with the scan's irregular valences and its own holes where the ring runs out).
 fn scan_piece() -> Result<subd_mesh::Mesh, String> {
-    let scan = crate::pia_bench::scan_mesh()?;
+    let scan = crate::meshes::scan_mesh()?;
     let t = &scan.topology;
     let from = t
         .vertex_ring(0)
@@ -809,7 +833,7 @@ pub fn random(exe: &Path, count: u64) -> Vec<Row> {
     (0..count)
         .into_par_iter()
         .flat_map_iter(|seed| {
-            let c = crate::random_mesh::case(seed);
+            let c = crate::meshes::random::case(seed);
             if !matches!(c.scheme, Scheme::CatmullClark | Scheme::Loop) {
                 return Vec::new();
             }

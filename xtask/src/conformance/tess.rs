@@ -8,12 +8,12 @@ use std::path::Path;
 
 use subd_limit::eval::FaceParam;
 use subd_limit::patches::PatchTable;
-use subd_limit::tessellation::tessellate_mesh;
+use subd_limit::tessellation::{Tessellation, tessellate_mesh};
 use subd_mesh::{DVec3, Topology, TopologyBuilder};
 use subd_schemes::{Options, Scheme};
 
-use crate::osd;
-use crate::row::Row;
+use crate::conformance::row::Row;
+use crate::oracles::osd;
 
 /// The rate compared (even, so Catmull-Clark non-quads are covered too).
 pub const RATE: usize = 4;
@@ -97,12 +97,53 @@ pub fn compare(
     // subd's own tessellation; a mesh with a face the evaluator does not cover has none, and
     // its points are then checked by direct evaluation only.
     let ours = tessellate_mesh(topo, scheme, options, positions, RATE).ok();
+    let mut tally = match_points(&theirs, ours.as_ref(), &table, scheme, diag);
+    if let Err(e) = arbitrate(exe, topo, positions, scheme, options, diag, &mut tally) {
+        row.problem = Some(format!("Far patch table: {e}"));
+        return row;
+    }
+    fill_row(&mut row, topo, &theirs, ours.as_ref(), &tally);
+    row
+}
+
+/// Where Bfr's points stand against subd's.
+#[derive(Default)]
+struct Tally {
+    /// The largest difference over the compared points, / diag.
+    error: f64,
+    /// The compared point with the largest difference, once arbitration found one over
+    /// the tolerance.
+    worst: Option<FaceParam>,
+    /// Points compared and found equal (or, after arbitration, charged to subd).
+    compared: usize,
+    /// Points at a patch corner off by more than the tolerance (reported, not checked),
+    /// and their largest difference.
+    corners: usize,
+    corner_error: f64,
+    /// Points neither subd's grid nor its evaluation covers.
+    uncovered: usize,
+    /// Points that are not samples of subd's grid.
+    unmatched: usize,
+    /// Points off by more than the tolerance, to be arbitrated by Far's patch table.
+    disputed: Vec<(FaceParam, DVec3, f64)>,
+    /// Disputed points where Bfr is the one off, and their largest difference.
+    bfr_off: (usize, f64),
+}
+
+/// Looks each Bfr point up in subd's tessellation `ours` (or, without one, evaluates
+/// `table` there) and sorts it: equal, at a corner, disputed, uncovered or unmatched.
+fn match_points(
+    theirs: &[BfrPoint],
+    ours: Option<&Tessellation>,
+    table: &PatchTable,
+    scheme: &Scheme,
+    diag: f64,
+) -> Tally {
     let grids: HashMap<(usize, usize), subd_limit::tessellation::SampleGrid> = ours
-        .as_ref()
         .map(|t| t.grids.iter().map(|g| ((g.face, g.sub), *g)).collect())
         .unwrap_or_default();
     // The sample of subd's grid at a Bfr point's parameter.
-    let lookup = |t: &subd_limit::tessellation::Tessellation, at: &FaceParam| {
+    let lookup = |t: &Tessellation, at: &FaceParam| {
         let g = grids.get(&(at.face, at.sub))?;
         let m = f64::from(g.segments);
         let (i, j) = ((at.u * m).round(), (at.v * m).round());
@@ -111,26 +152,21 @@ pub fn compare(
         (on_grid && i + if triangle { j } else { 0.0 } <= m && j <= m)
             .then(|| t.positions[t.grid_vertex(g, triangle, i as u32, j as u32) as usize])
     };
-    let (mut error, mut corner_error) = (0.0f64, 0.0f64);
-    let mut worst: Option<FaceParam> = None;
-    // Points off by more than the tolerance, to be arbitrated by Far's patch table.
-    let mut disputed: Vec<(FaceParam, DVec3, f64)> = Vec::new();
-    let (mut corners, mut uncovered, mut unmatched, mut compared) =
-        (0usize, 0usize, 0usize, 0usize);
-    for p in &theirs {
+    let mut tally = Tally::default();
+    for p in theirs {
         let at = p.at;
-        let sample = match &ours {
+        let sample = match ours {
             Some(t) => match lookup(t, &at) {
                 Some(q) => Some(q),
                 None => {
-                    unmatched += 1;
+                    tally.unmatched += 1;
                     continue;
                 }
             },
             None => table.evaluate(at).ok().map(|s| s.position),
         };
         let Some(ours_p) = sample else {
-            uncovered += 1;
+            tally.uncovered += 1;
             continue;
         };
         let d = (ours_p - p.position).length() / diag;
@@ -139,25 +175,38 @@ pub fn compare(
             // Bfr's irregular patches end in Gregory caps whose corner is the limit mask at
             // the approximation level: exact at smooth and crease vertices, not always at
             // darts, corners or semi-sharp ones. Reported, not checked.
-            corners += 1;
-            corner_error = corner_error.max(d);
+            tally.corners += 1;
+            tally.corner_error = tally.corner_error.max(d);
         } else if d > 1e-12 {
-            disputed.push((at, ours_p, d));
+            tally.disputed.push((at, ours_p, d));
         } else {
-            compared += 1;
-            error = error.max(d);
+            tally.compared += 1;
+            tally.error = tally.error.max(d);
         }
     }
-    // Where Bfr and subd disagree, Far's patch table at isolation 10 (exact outside its
-    // end-cap squares) decides: a point where subd agrees with it is Bfr's inexactness
-    // (its irregular-patch approximation), reported, not a failure.
-    // Where Far is off too (it is at some semi-sharp and dart configurations, see the eval
-    // check), a dyadic point is decided by the exact limit of uniform refinement's vertex
-    // there.
-    let mut bfr_off = (0usize, 0.0f64);
-    let refined = (!disputed.is_empty())
-        .then(|| crate::refined_limits::RefinedLimits::new(topo, positions, scheme, options))
-        .flatten();
+    tally
+}
+
+/// Where Bfr and subd disagree, Far's patch table at isolation 10 (exact outside its
+/// end-cap squares) decides: a point where subd agrees with it is Bfr's inexactness (its
+/// irregular-patch approximation), reported, not a failure. Where Far is off too (it is at
+/// some semi-sharp and dart configurations, see the eval check), a dyadic point is decided
+/// by the exact limit of uniform refinement's vertex there. An error when Far's table
+/// cannot be had.
+fn arbitrate(
+    exe: &Path,
+    topo: &Topology,
+    positions: &[DVec3],
+    scheme: &Scheme,
+    options: &Options,
+    diag: f64,
+    tally: &mut Tally,
+) -> Result<(), String> {
+    if tally.disputed.is_empty() {
+        return Ok(());
+    }
+    let refined =
+        crate::oracles::refined_limits::RefinedLimits::new(topo, positions, scheme, options);
     let refinement_agrees = |at: &FaceParam, p: DVec3| {
         let quad_or_tri = at.sub == 0 && (*scheme == Scheme::Loop || topo.face_size(at.face) == 4);
         quad_or_tri
@@ -166,40 +215,44 @@ pub fn compare(
                 .and_then(|r| r.at(at.face, at.u, at.v))
                 .is_some_and(|q| (q - p).length() / diag <= 1e-12)
     };
-    if !disputed.is_empty() {
-        match far_positions(exe, topo, positions, scheme, options, &disputed) {
-            Ok(far) => {
-                for ((at, ours_p, d), f) in disputed.iter().zip(far) {
-                    if (*ours_p - f).length() / diag <= 1e-12 || refinement_agrees(at, *ours_p) {
-                        bfr_off.0 += 1;
-                        bfr_off.1 = bfr_off.1.max(*d);
-                    } else {
-                        compared += 1;
-                        if *d > error {
-                            error = *d;
-                            worst = Some(*at);
-                        }
-                    }
-                }
-            }
-            Err(e) => {
-                row.problem = Some(format!("Far patch table: {e}"));
-                return row;
+    let far = far_positions(exe, topo, positions, scheme, options, &tally.disputed)?;
+    for ((at, ours_p, d), f) in tally.disputed.iter().zip(far) {
+        if (*ours_p - f).length() / diag <= 1e-12 || refinement_agrees(at, *ours_p) {
+            tally.bfr_off.0 += 1;
+            tally.bfr_off.1 = tally.bfr_off.1.max(*d);
+        } else {
+            tally.compared += 1;
+            if *d > tally.error {
+                tally.error = *d;
+                tally.worst = Some(*at);
             }
         }
     }
-    row.vertices = compared;
+    Ok(())
+}
+
+/// The row's counts, notes and problem from the tally: a closed input must also give a
+/// closed, manifold tessellation.
+fn fill_row(
+    row: &mut Row,
+    topo: &Topology,
+    theirs: &[BfrPoint],
+    ours: Option<&Tessellation>,
+    tally: &Tally,
+) {
+    let error = tally.error;
+    row.vertices = tally.compared;
     row.error = error;
-    row.excluded = Some((corners + uncovered, corner_error));
+    row.excluded = Some((tally.corners + tally.uncovered, tally.corner_error));
     let closed_input = closed_manifold(topo) && (0..topo.num_faces()).all(|f| !topo.is_hole(f));
     let mut notes = vec![format!("{} Bfr points", theirs.len())];
-    if bfr_off.0 > 0 {
+    if tally.bfr_off.0 > 0 {
         notes.push(format!(
             "{} where Bfr is off by up to {:.1e} × diag while subd agrees with Far's patches or, at dyadic points, with uniform refinement's limit",
-            bfr_off.0, bfr_off.1
+            tally.bfr_off.0, tally.bfr_off.1
         ));
     }
-    match &ours {
+    match ours {
         Some(t) => {
             let sizes: Vec<u32> = t.face_offsets.windows(2).map(|w| w[1] - w[0]).collect();
             let built = TopologyBuilder::new(t.positions.len()).build(&sizes, &t.face_vertices);
@@ -217,24 +270,24 @@ pub fn compare(
             .push("subd tessellate does not cover this mesh; points evaluated one by one".into()),
     }
     row.note = Some(notes.join(", "));
-    if unmatched > 0 && row.problem.is_none() {
+    if tally.unmatched > 0 && row.problem.is_none() {
         row.problem = Some(format!(
-            "{unmatched} Bfr points are not samples of subd's grid"
+            "{} Bfr points are not samples of subd's grid",
+            tally.unmatched
         ));
     }
     if row.problem.is_none() && error > 1e-12 {
-        let at = worst.expect("a compared point");
+        let at = tally.worst.expect("a compared point");
         row.problem = Some(format!(
             "positions differ by {error:.2e} × diag (worst at face {} sub {} ({}, {}))",
             at.face, at.sub, at.u, at.v
         ));
     }
-    if theirs.is_empty() && ours.as_ref().is_none_or(|t| t.grids.is_empty()) {
+    if theirs.is_empty() && ours.is_none_or(|t| t.grids.is_empty()) {
         row.error = 0.0;
         notes.push("no face has a limit surface (holes, or boundary interpolation none)".into());
         row.note = Some(notes.join(", "));
     }
-    row
 }
 
 /// Far's patch-table positions (isolation 10) at `points`.
