@@ -126,6 +126,10 @@ struct ConformanceArgs {
     /// compared apart and counted.
     #[arg(long, default_value_t = 360)]
     random_fvar_patches: u64,
+    /// Print the table of checks run on every mesh (what each samples, what subd computes,
+    /// what it is compared with) and exit.
+    #[arg(long)]
+    list: bool,
 }
 
 /// The flags of `cargo xtask bench`.
@@ -226,6 +230,10 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Task::Test { extra } => test_task(&extra),
+        Task::Conformance(args) if args.list => {
+            print!("{}", conformance::describe());
+            Ok(())
+        }
         Task::Conformance(args) => {
             ensure_system_packages(REFERENCE_PACKAGES).and_then(|_| conformance_task(&args))
         }

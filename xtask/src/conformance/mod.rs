@@ -180,7 +180,6 @@ pub const MESH_CHECKS: &[Check] = &[
 
 /// [`MESH_CHECKS`] as aligned text, one line per check (name | samples | computes |
 /// compares), for `cargo xtask conformance --list`.
-#[allow(dead_code)] // printed by `cargo xtask conformance --list`, not wired yet
 pub fn describe() -> String {
     let header = ["check", "samples", "subd computes", "compared with"];
     let lines: Vec<[&str; 4]> = std::iter::once(header)
