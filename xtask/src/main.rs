@@ -173,11 +173,11 @@ struct BenchArgs {
     /// Only the PIA benchmark (solvers on the quad bench mesh, Loop on a scan).
     #[arg(long)]
     pia_only: bool,
-    /// Only the adaptive benchmark (seed 002's Table 1, faces for a given accuracy,
+    /// Only the adaptive benchmark (Sun et al.'s Table 1, faces for a given accuracy,
     /// speed against uniform refinement).
     #[arg(long)]
     adaptive_only: bool,
-    /// Only the editing benchmark (least squares, energy, re-solve; seed 003's
+    /// Only the editing benchmark (least squares, energy, re-solve; Li et al.'s
     /// examples).
     #[arg(long)]
     editing_only: bool,

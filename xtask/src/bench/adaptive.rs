@@ -1,6 +1,6 @@
 //! The adaptive lines of `cargo xtask bench`:
 //!
-//! * seed 002's Table 1 side by side — faces after 1 and 2 Loop levels, uniform and adaptive
+//! * Sun et al.'s Table 1 side by side — faces after 1 and 2 Loop levels, uniform and adaptive
 //!   (flatness), with each result's largest sampled distance to the limit surface — on a
 //!   ~5k-face organic scan (the Stanford bunny of `pymeshfix`, decimated to the paper's
 //!   4801 faces with the `fast-simplification` package from PyPI) and a 2000-face
@@ -24,7 +24,7 @@ use crate::bench::median;
 use crate::meshes::{quad_bench_mesh, tri_bench_mesh};
 use crate::oracles::osd;
 
-/// Seed 002 gives no flatness threshold; the table shows these.
+/// Sun et al. 2012 gives no flatness threshold; the table shows these.
 const TABLE_FLATNESS_DEGREES: [f64; 3] = [10.0, 20.0, 30.0];
 
 fn bench_dir() -> PathBuf {
@@ -130,7 +130,7 @@ fn adaptive(
     })
 }
 
-/// Seed 002's Table 1 and the fair comparison on the scan and the gear.
+/// Sun et al.'s Table 1 and the fair comparison on the scan and the gear.
 fn table_one() -> Result<(), String> {
     let meshes: Vec<(&str, usize, Mesh)> = vec![
         ("scan (bunny)", 4801, decimated_scan(4801)?),
@@ -138,7 +138,7 @@ fn table_one() -> Result<(), String> {
     ];
     println!();
     println!(
-        "Seed 002 Table 1 side by side (Loop): faces after 1 and 2 levels, uniform and adaptive (flatness, the seed's rule; the seed gives no ε_T), with each result's largest sampled distance to the limit surface / diagonal (vertices at their refined positions); paper: head 4801 → 19204 / 76816 uniform, 13442 / 30151 adaptive; gear 2000 → 8000 / 32000, 5963 / 11357"
+        "Sun et al. 2012 Table 1 side by side (Loop): faces after 1 and 2 levels, uniform and adaptive (flatness, the paper's rule; the paper gives no ε_T), with each result's largest sampled distance to the limit surface / diagonal (vertices at their refined positions); paper: head 4801 → 19204 / 76816 uniform, 13442 / 30151 adaptive; gear 2000 → 8000 / 32000, 5963 / 11357"
     );
     println!(
         "{:<14} {:>6} {:>5} {:>10} {:>11} {:>5} {:>10} {:>11} {:>7} {:>12}",

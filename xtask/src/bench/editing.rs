@@ -1,6 +1,6 @@
 //! The editing lines of `cargo xtask bench` (issue 20): least squares, the energy method and
 //! the editor's re-solve on closed meshes of 10k and 100k control vertices with 20
-//! constraints (points, normals, two iso-lines), and seed 003's two examples next to the
+//! constraints (points, normals, two iso-lines), and Li et al.'s two examples next to the
 //! paper's timings (2.9 GHz Pentium 4).
 
 use std::sync::Arc;
@@ -167,7 +167,7 @@ fn edit_time(m: &Mesh, cs: &[Constraint], method: Method, repeats: usize) -> (f6
 }
 
 /// Runs the editing benchmark and prints its two tables: the 10k and 100k closed meshes,
-/// then seed 003's examples.
+/// then Li et al.'s examples.
 pub fn run(repeats: usize) -> Result<(), String> {
     let repeats = repeats.max(3);
     closed_meshes(repeats);
@@ -195,7 +195,7 @@ fn methods(label: &str) -> Vec<(Method, &'static str)> {
 /// The first table: the 20 constraints on the closed 10k and 100k meshes, each method's
 /// evaluator, edit and re-solve times.
 fn closed_meshes(repeats: usize) {
-    println!("\n## Constraint-based editing (seed 003)\n");
+    println!("\n## Constraint-based editing (Li et al. 2008)\n");
     println!(
         "20 constraints (7 vertex points, 7 face points, 4 normals, 2 iso-lines over 4 regular faces) on closed Catmull-Clark meshes with valence-6 vertices; medians of {repeats} runs. `edit` is the constraint rows, the energy assembly, the factorisation and one solve, with the mesh's limit evaluator built beforehand (once per mesh, as a modeller keeps it; its time is the `evaluator` column).\n"
     );
@@ -242,11 +242,11 @@ fn closed_meshes(repeats: usize) {
     }
 }
 
-/// The second table: seed 003's two examples on stand-in meshes, least squares and the
+/// The second table: Li et al.'s two examples on stand-in meshes, least squares and the
 /// energy method beside the paper's timings.
 fn seed_examples(repeats: usize) {
     println!(
-        "\nSeed 003's two examples (its meshes are not published: an open 20 × 20 grid on a bump and the closed 10k mesh above stand in), edits as above, against the paper's Pentium 4 timings:\n"
+        "\nLi et al.'s two examples (its meshes are not published: an open 20 × 20 grid on a bump and the closed 10k mesh above stand in), edits as above, against the paper's Pentium 4 timings:\n"
     );
     println!("| example | constraints | least squares | paper | energy (exact, 3 rings) | paper |");
     println!("|---|---|---:|---:|---:|---:|");
