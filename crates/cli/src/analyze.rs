@@ -3,7 +3,7 @@
 
 use std::io::Write;
 
-use clap::{Args, ValueEnum};
+use clap::Args;
 use subd_limit::spectrum::{
     RingSpectrum, SplitSpectrumReport, SurfaceSpectrum, VALENCES, surface_spectrum,
 };
@@ -11,14 +11,9 @@ use subd_schemes::analysis::{Lattice, analyze, analyze_bivariate, check_total};
 use subd_schemes::{Capability, Scheme};
 
 use crate::Failure;
+use crate::choice_arg;
 use crate::failure::bad;
 use crate::scheme_arg;
-
-#[derive(Debug, Clone, Copy, ValueEnum)]
-pub(crate) enum LatticeArg {
-    Quad,
-    ThreeDirection,
-}
 
 #[derive(Debug, Args)]
 pub(crate) struct AnalyzeArgs {
@@ -36,8 +31,8 @@ pub(crate) struct AnalyzeArgs {
     #[arg(long, allow_hyphen_values = true, conflicts_with = "surface")]
     mask2: Option<String>,
     /// Lattice of --mask2.
-    #[arg(long, value_enum, default_value = "quad")]
-    lattice: LatticeArg,
+    #[arg(long, default_value = "quad", value_parser = choice_arg::parser::<Lattice>())]
+    lattice: Lattice,
     /// Arity of the mask: 2 (binary) or 3 (ternary).
     #[arg(long, default_value_t = 2)]
     arity: usize,
@@ -158,11 +153,7 @@ fn run_bivariate(text: &str, args: &AnalyzeArgs, out: &mut dyn Write) -> Result<
         .collect::<Result<_, _>>()?;
     let all: Vec<f64> = rows.iter().flatten().copied().collect();
     check_total(&all, 4.0, "a bivariate binary mask").map_err(|e| bad(format!("--mask2: {e}")))?;
-    let lattice = match args.lattice {
-        LatticeArg::Quad => Lattice::Quad,
-        LatticeArg::ThreeDirection => Lattice::ThreeDirection,
-    };
-    let v = analyze_bivariate(&rows, lattice, args.max_levels)
+    let v = analyze_bivariate(&rows, args.lattice, args.max_levels)
         .map_err(|e| bad(format!("--mask2: {e}")))?;
     if args.json {
         crate::print_json(out, &v);

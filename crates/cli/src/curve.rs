@@ -5,63 +5,23 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use clap::{Args, ValueEnum};
+use clap::Args;
 use glam::{DVec2, DVec3};
 use serde::Serialize;
-use subd_schemes::named_curve::{CurveParameters, NamedCurve, SubdividedCurve, subdivide_curve};
+use subd_mesh::choice::Choice;
+use subd_schemes::named_curve::{
+    CurveName, CurveParameters, NamedCurve, SubdividedCurve, subdivide_curve,
+};
 
 use crate::Failure;
+use crate::choice_arg;
 use crate::failure::{bad, refuse_overwrite};
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub(crate) enum CurveSchemeArg {
-    /// Chaikin corner cutting (quadratic B-spline).
-    Chaikin,
-    /// Uniform B-spline of order --order (default 4, cubic).
-    Bspline,
-    /// Interpolatory 4-point scheme, tension --omega (default 1/16).
-    FourPoint,
-    /// Two-parameter 4-point scheme, --omega (default 1/16) and --mu (default 0).
-    // Spelt as the report and the library name it; the old spelling still works.
-    #[value(name = "four-point-2p", alias = "four-point2p")]
-    FourPoint2p,
-    /// 3-point ternary interpolatory scheme, --omega (default 1/4).
-    #[value(name = "ternary-3pt", alias = "ternary3pt")]
-    Ternary3pt,
-    /// Non-stationary tension scheme, --alpha0 (default 1: cubic B-spline).
-    Tension,
-    /// Sabin–Dodgson circle-preserving 4-point scheme (planar points).
-    CirclePreserving,
-    /// Variational interpolatory scheme (Kobbelt).
-    Variational,
-    /// Circle-average two-parameter 4-point scheme on point–normal pairs, --omega, --mu.
-    CircleFourPoint,
-    /// Circle-average 3-point ternary scheme on point–normal pairs, --omega.
-    CircleTernary,
-}
-
-impl CurveSchemeArg {
-    fn name(self) -> &'static str {
-        match self {
-            CurveSchemeArg::Chaikin => "chaikin",
-            CurveSchemeArg::Bspline => "bspline",
-            CurveSchemeArg::FourPoint => "four-point",
-            CurveSchemeArg::FourPoint2p => "four-point-2p",
-            CurveSchemeArg::Ternary3pt => "ternary-3pt",
-            CurveSchemeArg::Tension => "tension",
-            CurveSchemeArg::CirclePreserving => "circle-preserving",
-            CurveSchemeArg::Variational => "variational",
-            CurveSchemeArg::CircleFourPoint => "circle-four-point",
-            CurveSchemeArg::CircleTernary => "circle-ternary",
-        }
-    }
-}
 
 #[derive(Debug, Args)]
 pub(crate) struct CurveArgs {
     /// Curve scheme.
-    #[arg(long, value_enum)]
-    scheme: CurveSchemeArg,
+    #[arg(long, value_parser = choice_arg::parser::<CurveName>())]
+    scheme: CurveName,
     /// Number of subdivision levels.
     #[arg(long)]
     levels: usize,
@@ -177,7 +137,7 @@ pub(crate) fn run(
     let ext = check_arguments(args)?;
     let name = args.scheme.name();
     let file = read_points(&args.input)?;
-    let scheme = NamedCurve::new(name, &parameters(args))
+    let scheme = NamedCurve::of(args.scheme, &parameters(args))
         .map_err(|e| bad(format!("--scheme {name}: {e}")))?;
     let circle = matches!(scheme, NamedCurve::Circle(_));
     if circle && file.columns == 3 {
@@ -255,7 +215,7 @@ fn check_arguments(args: &CurveArgs) -> Result<String, Failure> {
         )));
     }
     let scheme = args.scheme;
-    let takes = |flag: &str| NamedCurve::takes(scheme.name(), flag);
+    let takes = |flag: &str| scheme.takes(flag);
     for (flag, given) in [
         ("omega", args.omega.is_some()),
         ("mu", args.mu.is_some()),

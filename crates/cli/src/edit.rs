@@ -5,26 +5,18 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use clap::{Args, ValueEnum};
+use clap::Args;
 use serde::Serialize;
-use subd_editing::energy::EnergyOptions;
-use subd_editing::{Constraint, Deformation, DependentGroup, Method};
+use subd_editing::{Constraint, Deformation, EditReport, Method, MethodKind, MethodRequest};
 use subd_mesh::{DVec3, Mesh};
 use subd_schemes::{Capability, Scheme};
 
 use crate::batch::{self, Files, Job};
+use crate::choice_arg;
 use crate::failure::bad;
 use crate::rule_args::RuleArgs;
 use crate::scheme_arg;
 use crate::{Failure, print_warnings};
-
-#[derive(Debug, Clone, Copy, ValueEnum)]
-pub(crate) enum EditMethodArg {
-    /// The smallest change of the control vertices the constraints involve (A⁺ r).
-    LeastSquares,
-    /// The smallest thin-plate (+ membrane) energy of the change over a region.
-    Energy,
-}
 
 #[derive(Debug, Args)]
 pub(crate) struct EditArgs {
@@ -32,14 +24,14 @@ pub(crate) struct EditArgs {
     #[arg(long, value_name = "FILE")]
     constraints: PathBuf,
     /// How the control vertices change.
-    #[arg(long, value_enum, default_value = "least-squares")]
-    method: EditMethodArg,
+    #[arg(long, default_value = "least-squares", value_parser = choice_arg::parser::<MethodKind>())]
+    method: MethodKind,
     /// Scheme of the limit surface (the energy method needs catmull-clark; default: the
     /// scheme the input names, USD's subdivisionScheme, if catmull-clark or loop, else
     /// catmull-clark).
     #[arg(long, value_parser = scheme_arg::parser(Capability::Edit))]
     scheme: Option<Scheme>,
-    /// Energy method: the seed's penalty form with this weight (relative to
+    /// Energy method: Li et al.'s penalty form with this weight (relative to
     /// mean diag Q / mean diag AᵀA) instead of the exact solve.
     #[arg(long, conflicts_with = "exact")]
     penalty: Option<f64>,
@@ -63,16 +55,7 @@ pub(crate) struct EditArgs {
 }
 
 #[derive(Serialize)]
-struct ConstraintReport {
-    constraint: usize,
-    kind: &'static str,
-    /// Measured on OUT with a fresh limit evaluator: distance (points, iso-lines, model
-    /// units) or the sine of the angle to the target normal.
-    residual: f64,
-}
-
-#[derive(Serialize)]
-struct EditSeconds {
+struct Seconds {
     read: f64,
     constraints: f64,
     assemble: f64,
@@ -83,45 +66,15 @@ struct EditSeconds {
     total: f64,
 }
 
+/// `subd edit --json`: the files, the library's report of the edit, and the time of every
+/// step.
 #[derive(Serialize)]
-struct EditReport {
+struct CliEditReport<'a> {
     input: String,
     output: String,
-    scheme: Scheme,
-    method: &'static str,
-    vertices: usize,
-    constraints: usize,
-    rows: usize,
-    rank: usize,
-    /// Whether the constraints were dependent or conflicting (least-squares solution).
-    rank_deficient: bool,
-    /// The groups of dependent constraints: which, how many dependent rows, whether they
-    /// agree (`consistent`) and what no change can meet (`residual`).
-    dependencies: Vec<DependentGroup>,
-    /// Vertices allowed to move (the constraints' support, or the energy's region).
-    free_vertices: usize,
-    moved_vertices: Vec<u32>,
-    residuals: Vec<ConstraintReport>,
-    /// The largest point residual over the bounding-box diagonal.
-    max_residual_relative: f64,
-    /// Thin-plate energy `∬ S_uu² + 2 S_uv² + S_vv²` of the whole limit surface (every face
-    /// but holes, in each face's parameters; `subd_editing::energy::surface_energy`), before
-    /// and after (Catmull-Clark): the same definition for every method, with no membrane
-    /// term whatever `--membrane` says.
-    energy_before: Option<f64>,
-    energy_after: Option<f64>,
-    /// The energy of the displacement over the faces the free vertices touch, with the
-    /// energy method's membrane term (what that method minimises).
-    displacement_energy: Option<f64>,
-    seconds: EditSeconds,
-}
-
-fn kind(c: &Constraint) -> &'static str {
-    match c {
-        Constraint::Point { .. } => "point",
-        Constraint::Normal { .. } => "normal",
-        Constraint::Isoline { .. } => "isoline",
-    }
+    #[serde(flatten)]
+    edit: &'a EditReport,
+    seconds: Seconds,
 }
 
 fn read_text(path: &Path) -> Result<String, Failure> {
@@ -141,38 +94,15 @@ fn region_rings(text: &str) -> Result<Option<usize>, Failure> {
 
 /// The method the arguments ask for.
 fn method(args: &EditArgs) -> Result<Method, Failure> {
-    let energy_only = args.penalty.is_some() || args.exact || args.membrane != 0.0;
-    match args.method {
-        EditMethodArg::LeastSquares => {
-            if energy_only {
-                return Err(bad(
-                    "--penalty, --exact and --membrane apply to --method energy only".into(),
-                ));
-            }
-            Ok(Method::LeastSquares)
-        }
-        EditMethodArg::Energy => {
-            if let Some(p) = args.penalty
-                && (p.is_nan() || p <= 0.0)
-            {
-                return Err(bad(format!("--penalty {p}: must be a positive number")));
-            }
-            if !(args.membrane >= 0.0 && args.membrane.is_finite()) {
-                return Err(bad(format!(
-                    "--membrane {}: must be a non-negative number",
-                    args.membrane
-                )));
-            }
-            Ok(Method::Energy {
-                penalty: args.penalty,
-                region_rings: region_rings(&args.region_rings)?,
-                energy: EnergyOptions {
-                    membrane: args.membrane,
-                    ..EnergyOptions::default()
-                },
-            })
-        }
+    MethodRequest {
+        kind: args.method,
+        penalty: args.penalty,
+        exact: args.exact,
+        membrane: args.membrane,
+        region_rings: region_rings(&args.region_rings)?,
     }
+    .method()
+    .map_err(bad)
 }
 
 pub(crate) fn run(
@@ -205,19 +135,6 @@ fn read_constraints(path: &Path) -> Result<Vec<Constraint>, Failure> {
         return Err(bad(format!("{}: no constraints", path.display())));
     }
     Ok(constraints)
-}
-
-fn residual_reports(constraints: &[Constraint], res: &[f64]) -> Vec<ConstraintReport> {
-    constraints
-        .iter()
-        .zip(res)
-        .enumerate()
-        .map(|(i, (c, &r))| ConstraintReport {
-            constraint: i,
-            kind: kind(c),
-            residual: r,
-        })
-        .collect()
 }
 
 /// Writes IN's topology, tags and texture coordinates with the edited control vertices: a
@@ -270,48 +187,23 @@ fn run_one(
     let edited = subd_editing::edit_mesh(&file.mesh, &scheme, &options, &constraints, method, true)
         .map_err(named)?;
     print_warnings(err, &args.constraints, &edited.warnings);
-    let measured = edited
-        .measured
-        .as_ref()
-        .expect("edit_mesh measures when asked to");
-    let edit = &edited.edit;
-
     let t_write = Instant::now();
-    write_edited(job, file, &scheme, &edit.positions, err)?;
+    write_edited(job, file, &scheme, &edited.edit.positions, err)?;
     let t_write = t_write.elapsed().as_secs_f64();
 
     if args.json {
-        let t = edited.timings;
-        let energies = measured.energies.as_ref();
-        let report = EditReport {
+        let t = edited.seconds();
+        let report = CliEditReport {
             input: job.input.display().to_string(),
             output: job.output.display().to_string(),
-            scheme,
-            method: match args.method {
-                EditMethodArg::LeastSquares => "least-squares",
-                EditMethodArg::Energy if args.penalty.is_some() => "energy-penalty",
-                EditMethodArg::Energy => "energy-exact",
-            },
-            vertices: topo.num_vertices(),
-            constraints: constraints.len(),
-            rows: edited.rows,
-            rank: edited.rank,
-            rank_deficient: edited.rank_deficient,
-            dependencies: edit.dependencies.clone(),
-            free_vertices: edited.free_vertices,
-            moved_vertices: edit.moved.clone(),
-            residuals: residual_reports(&constraints, &measured.residuals),
-            max_residual_relative: measured.max_residual_relative,
-            energy_before: energies.map(|e| e.before),
-            energy_after: energies.map(|e| e.after),
-            displacement_energy: energies.map(|e| e.displacement),
-            seconds: EditSeconds {
+            edit: &edited.report(&scheme, &method, topo.num_vertices(), &constraints),
+            seconds: Seconds {
                 read: t_read,
                 constraints: t.constraints,
                 assemble: t.assemble,
                 factor: t.factor,
                 solve: t.solve,
-                check: measured.seconds,
+                check: t.check,
                 write: t_write,
                 total: opened.elapsed(),
             },

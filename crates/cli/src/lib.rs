@@ -18,6 +18,7 @@ mod analyze;
 mod batch;
 mod budget;
 mod cage;
+mod choice_arg;
 mod curve;
 mod depth_first;
 mod edit;

@@ -4,38 +4,15 @@
 use std::io::Write;
 use std::path::PathBuf;
 
-use clap::{Args, ValueEnum};
+use clap::Args;
 use subd_limit::patches::{EndCaps, MAX_ISOLATION, PatchOptions, PatchTable};
 use subd_schemes::{Capability, Scheme};
 
+use crate::choice_arg;
 use crate::failure::{bad, refuse_overwrite};
 use crate::rule_args::RuleArgs;
 use crate::scheme_arg;
 use crate::{Failure, print_warnings};
-
-/// `--end-caps`.
-#[derive(Debug, Clone, Copy, ValueEnum)]
-pub(crate) enum EndCapsArg {
-    /// Gregory patches (20 points; Gregory triangles of 18 for Loop), OpenSubdiv's default.
-    Gregory,
-    /// Regular B-spline (box-spline) patches fitted to the irregular ones.
-    Bspline,
-    /// Bilinear quads (linear triangles) through the corners' limit points.
-    Bilinear,
-    /// The irregular patches evaluated exactly (subd's own).
-    Exact,
-}
-
-impl From<EndCapsArg> for EndCaps {
-    fn from(a: EndCapsArg) -> EndCaps {
-        match a {
-            EndCapsArg::Gregory => EndCaps::GregoryBasis,
-            EndCapsArg::Bspline => EndCaps::BSpline,
-            EndCapsArg::Bilinear => EndCaps::Bilinear,
-            EndCapsArg::Exact => EndCaps::Exact,
-        }
-    }
-}
 
 #[derive(Debug, Args)]
 pub(crate) struct PatchesArgs {
@@ -49,8 +26,8 @@ pub(crate) struct PatchesArgs {
           value_parser = clap::value_parser!(u8).range(1..=i64::from(MAX_ISOLATION)))]
     isolation: u8,
     /// How the irregular patches left at the isolation level are represented.
-    #[arg(long, value_enum, default_value = "gregory")]
-    end_caps: EndCapsArg,
+    #[arg(long, default_value = "gregory", value_parser = choice_arg::parser::<EndCaps>())]
+    end_caps: EndCaps,
     /// Regular patches along one semi-sharp crease keep it instead of isolating it.
     #[arg(long)]
     single_crease: bool,
@@ -77,7 +54,7 @@ impl PatchesArgs {
     fn options(&self) -> PatchOptions {
         PatchOptions {
             isolation: self.isolation,
-            end_caps: self.end_caps.into(),
+            end_caps: self.end_caps,
             single_crease: self.single_crease,
             inf_sharp: self.inf_sharp,
             legacy_sharp_corners: !self.no_legacy_sharp_corners,
@@ -149,8 +126,8 @@ pub(crate) struct OnPatchesArgs {
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..=i64::from(MAX_ISOLATION)))]
     isolation: Option<u8>,
     /// Evaluate on a patch table with these end caps (default: the exact limit).
-    #[arg(long, value_enum)]
-    end_caps: Option<EndCapsArg>,
+    #[arg(long, value_parser = choice_arg::parser::<EndCaps>())]
+    end_caps: Option<EndCaps>,
 }
 
 impl OnPatchesArgs {
@@ -161,7 +138,7 @@ impl OnPatchesArgs {
         }
         Some(PatchOptions {
             isolation: self.isolation.unwrap_or(MAX_ISOLATION),
-            end_caps: self.end_caps.map_or(EndCaps::Exact, EndCaps::from),
+            end_caps: self.end_caps.unwrap_or(EndCaps::Exact),
             ..Default::default()
         })
     }

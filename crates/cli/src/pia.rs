@@ -5,38 +5,22 @@ use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;
 
-use clap::{Args, ValueEnum};
+use clap::Args;
 use serde::Serialize;
 use subd_mesh::Mesh;
-use subd_pia::{Method, Moving, Pia, PiaOptions, Solver};
+use subd_pia::{
+    InterpolationReport, InterpolationRequest, Moving, PiaOptions, Solver, interpolate,
+};
 use subd_schemes::{Capability, Scheme};
 
 use crate::batch::{self, Files, Job};
+use crate::choice_arg;
 use crate::failure::bad;
 use crate::progress::Spinner;
 use crate::rule_args::RuleArgs;
 use crate::scheme_arg;
 use crate::vertex_data::{LambdaArgs, read_indices};
 use crate::{EXIT_FAILURE, Failure, print_warnings};
-
-#[derive(Debug, Clone, Copy, ValueEnum)]
-pub(crate) enum SolverArg {
-    /// The fastest valid solver (Chebyshev on the checkerboard-preconditioned system for
-    /// closed two-coloured quad meshes with every vertex moving; otherwise conjugate
-    /// gradients, BiCGSTAB where the system has no symmetric form).
-    Auto,
-    /// The paper's iteration: every moving vertex moves by its interpolation error.
-    Iterate,
-    /// The iteration with the optimal weight 2 / (λ_min + λ_max).
-    Weighted,
-    /// Conjugate gradients on the symmetrised system (BiCGSTAB where there is none).
-    Cg,
-    /// Chebyshev iteration on the checkerboard-preconditioned system (Catmull-Clark and
-    /// two-phase on two-coloured closed quad meshes; CG elsewhere).
-    Chebyshev,
-    /// Sparse Cholesky / LU.
-    Direct,
-}
 
 #[derive(Debug, Args)]
 pub(crate) struct PiaArgs {
@@ -54,8 +38,8 @@ pub(crate) struct PiaArgs {
     #[arg(long, value_name = "FILE")]
     fixed: Option<PathBuf>,
     /// Solver.
-    #[arg(long, value_enum, default_value = "auto")]
-    solver: SolverArg,
+    #[arg(long, default_value = "auto", value_parser = choice_arg::parser::<Solver>())]
+    solver: Solver,
     /// Stop when every moving vertex's limit is within tol × the bounding-box diagonal of
     /// its target.
     #[arg(long, default_value_t = 1e-10)]
@@ -82,27 +66,16 @@ struct Seconds {
     total: f64,
 }
 
+/// `subd pia --json`: the files, the library's report of the interpolation, and the time
+/// of every step.
 #[derive(Serialize)]
-struct PiaReport {
+struct PiaReport<'a> {
     input: String,
     output: String,
-    scheme: &'static str,
-    solver: Solver,
-    method: Method,
-    vertices: usize,
-    moving: usize,
-    iterations: usize,
-    converged: bool,
-    /// Max |limit − target| over the moving vertices, from a limit table built afresh for
-    /// the output mesh (model units).
-    max_error: f64,
-    /// `max_error` over the targets' bounding-box diagonal.
-    max_error_relative: f64,
-    tol: f64,
-    /// The solver's max interpolation error before the first iteration and after each.
-    history: Vec<f64>,
+    #[serde(flatten)]
+    interpolation: &'a InterpolationReport,
     seconds: Seconds,
-    warnings: Vec<String>,
+    warnings: &'a [String],
 }
 
 /// `subd pia` writes meshes.
@@ -142,75 +115,49 @@ fn run_one(
         &job.input,
     )?;
     let scheme = scheme_arg::with_lambda(&named, &args.lambda, &job.input, nv)?;
-    let name = scheme.name();
     let moving = moving_vertices(args, nv)?;
-    let solver = args.solver.solver();
-    let at_input = |e: subd_pia::PiaError| bad(format!("{}: {e}", job.input.display()));
-    let spinner = Spinner::new(args.json || job.quiet, "limit stencils");
-    let t0 = Instant::now();
-    let pia = Pia::new(topo, &scheme, &options).map_err(at_input)?;
-    let t_setup = t0.elapsed().as_secs_f64();
-    spinner.message("solving");
-    let t1 = Instant::now();
-    let opts = PiaOptions {
-        solver,
-        tol: args.tol,
-        max_iter: args.max_iter,
+    let request = InterpolationRequest {
+        scheme: &scheme,
+        options: &options,
+        moving: &moving,
+        solve: PiaOptions {
+            solver: args.solver,
+            tol: args.tol,
+            max_iter: args.max_iter,
+        },
     };
-    let result = pia
-        .solve(&file.mesh.positions, &moving, &opts)
-        .map_err(at_input)?;
-    let t_solve = t1.elapsed().as_secs_f64();
-
-    // The error of the output, measured with a limit table built afresh and applied to the
-    // written positions, not the solver's own residual.
-    spinner.message("checking");
-    let t2 = Instant::now();
-    let positions = &file.mesh.positions;
-    let deviation =
-        subd_pia::deviation(topo, &scheme, &options, &result.points, positions, &moving)
-            .map_err(at_input)?;
-    let (max_error, relative) = (deviation.max_error, deviation.relative);
-    let t_check = t2.elapsed().as_secs_f64();
+    let spinner = Spinner::new(args.json || job.quiet, "interpolating");
+    let fitted = interpolate(topo, &file.mesh.positions, &request)
+        .map_err(|e| bad(format!("{}: {e}", job.input.display())))?;
     spinner.finish();
-    if !result.converged || !deviation.within(args.tol) {
-        return Err(not_converged(args, job, name, &result, relative));
+    if !fitted.report.converged {
+        return Err(not_converged(args, job, &fitted.report));
     }
-    let fitted = Fitted {
+    let t_write = Instant::now();
+    let cage = Fitted {
         mesh: &file.mesh,
-        points: &result.points,
+        points: &fitted.points,
         scheme: &scheme,
         options: file.output_options(),
     };
-
-    let t3 = Instant::now();
-    fitted.write(job, err)?;
-    let t_write = t3.elapsed().as_secs_f64();
+    cage.write(job, err)?;
+    let t_write = t_write.elapsed().as_secs_f64();
 
     if args.json {
+        let s = fitted.seconds;
         let report = PiaReport {
             input: job.input.display().to_string(),
             output: job.output.display().to_string(),
-            scheme: name,
-            solver,
-            method: result.method,
-            vertices: nv,
-            moving: result.moving,
-            iterations: result.iterations,
-            converged: result.converged,
-            max_error,
-            max_error_relative: relative,
-            tol: args.tol,
-            history: result.history,
+            interpolation: &fitted.report,
             seconds: Seconds {
                 read: t_read,
-                setup: t_setup,
-                solve: t_solve,
-                check: t_check,
+                setup: s.setup,
+                solve: s.solve,
+                check: s.check,
                 write: t_write,
                 total: opened.elapsed(),
             },
-            warnings: file.warnings.clone(),
+            warnings: &file.warnings,
         };
         crate::print_json(out, &report);
     }
@@ -227,37 +174,18 @@ fn moving_vertices(args: &PiaArgs, nv: usize) -> Result<Moving, Failure> {
 }
 
 /// The failure of an interpolation that did not reach `--tol`: nothing is written.
-fn not_converged(
-    args: &PiaArgs,
-    job: &Job,
-    name: &str,
-    result: &subd_pia::PiaResult,
-    relative: f64,
-) -> Failure {
+fn not_converged(args: &PiaArgs, job: &Job, report: &InterpolationReport) -> Failure {
     Failure {
         code: EXIT_FAILURE,
         message: format!(
-            "{}: {name} interpolation did not reach --tol {} in {} iterations ({:?}): max error {:e} of the diagonal; no output written (raise --max-iter or try another --solver)",
+            "{}: {} interpolation did not reach --tol {} in {} iterations ({:?}): max error {:e} of the diagonal; no output written (raise --max-iter or try another --solver)",
             job.input.display(),
+            report.scheme,
             args.tol,
-            result.iterations,
-            result.method,
-            relative
+            report.iterations,
+            report.method,
+            report.max_error_relative
         ),
-    }
-}
-
-impl SolverArg {
-    /// The library's solver.
-    fn solver(self) -> Solver {
-        match self {
-            SolverArg::Auto => Solver::Auto,
-            SolverArg::Iterate => Solver::Iterate,
-            SolverArg::Weighted => Solver::Weighted,
-            SolverArg::Cg => Solver::Cg,
-            SolverArg::Chebyshev => Solver::Chebyshev,
-            SolverArg::Direct => Solver::Direct,
-        }
     }
 }
 

@@ -3,69 +3,33 @@
 //! `--weld-tolerance`): defaults from the file's tags,
 //! overridden on the command line.
 
-use clap::{Args, ValueEnum};
+use clap::Args;
 use subd_mesh::fvar::FVarLinearInterpolation;
 use subd_mesh::{BoundaryInterpolation, CreaseMethod, SchemeHints, TriangleSubdivision};
 use subd_schemes::Options;
 
-#[derive(Debug, Clone, Copy, ValueEnum)]
-pub(crate) enum BoundaryArg {
-    None,
-    EdgeOnly,
-    EdgeAndCorner,
-}
-
-#[derive(Debug, Clone, Copy, ValueEnum)]
-pub(crate) enum CreaseArg {
-    Uniform,
-    Chaikin,
-}
-
-/// OpenSubdiv's face-varying interpolation modes, by their command-line names.
-#[derive(Debug, Clone, Copy, ValueEnum)]
-pub(crate) enum FVarArg {
-    /// Smooth everywhere; only what the geometry makes sharp is pinned.
-    None,
-    /// Smooth, with UV corners (a value used by one face at its vertex) pinned.
-    CornersOnly,
-    /// As corners-only, plus junctions of three or more UV regions (USD's, Blender's default).
-    #[value(name = "corners-plus1")]
-    CornersPlus1,
-    /// As corners-plus1, plus concave corners and seam ends inside the mesh.
-    #[value(name = "corners-plus2")]
-    CornersPlus2,
-    /// Seams and the mesh boundary kept piecewise linear, interiors smooth.
-    Boundaries,
-    /// Linear everywhere (bilinear UVs).
-    All,
-}
-
-#[derive(Debug, Clone, Copy, ValueEnum)]
-pub(crate) enum TriangleArg {
-    Catmark,
-    Smooth,
-}
+use crate::choice_arg;
 
 /// The rule options a command shares: defaults from the file's tags, overridden here.
 #[derive(Debug, Clone, Args)]
 pub(crate) struct RuleArgs {
     /// Boundary interpolation (default: the file's `t interpolateboundary` tag, else
     /// edge-only).
-    #[arg(long, value_enum)]
-    boundary: Option<BoundaryArg>,
+    #[arg(long, value_parser = choice_arg::parser::<BoundaryInterpolation>())]
+    boundary: Option<BoundaryInterpolation>,
     /// Crease method for semi-sharp creases (default: the file's `t creasemethod` tag, else
     /// uniform).
-    #[arg(long, value_enum)]
-    crease_method: Option<CreaseArg>,
+    #[arg(long, value_parser = choice_arg::parser::<CreaseMethod>())]
+    crease_method: Option<CreaseMethod>,
     /// Catmull-Clark triangle rule (default: the file's `t smoothtriangles` tag, else
     /// catmark).
-    #[arg(long, value_enum)]
-    pub(crate) triangles: Option<TriangleArg>,
+    #[arg(long, value_parser = choice_arg::parser::<TriangleSubdivision>())]
+    pub(crate) triangles: Option<TriangleSubdivision>,
     /// How texture coordinates are interpolated along seams and the boundary (default: the
     /// file's `t facevaryinginterpolateboundary` tag, else corners-plus1, as USD and
     /// Blender).
-    #[arg(long, value_enum, value_name = "MODE")]
-    fvar_interpolation: Option<FVarArg>,
+    #[arg(long, value_name = "MODE", value_parser = choice_arg::parser::<FVarLinearInterpolation>())]
+    fvar_interpolation: Option<FVarLinearInterpolation>,
     /// Accept faces whose windings disagree across a shared edge (treated as non-manifold).
     #[arg(long)]
     pub(crate) accept_inconsistent_orientation: bool,
@@ -103,23 +67,13 @@ impl RuleArgs {
     pub(crate) fn options(&self, hints: &SchemeHints) -> Options {
         let mut options = Options::from_hints(hints);
         if let Some(b) = self.boundary {
-            options.boundary_interpolation = match b {
-                BoundaryArg::None => BoundaryInterpolation::None,
-                BoundaryArg::EdgeOnly => BoundaryInterpolation::EdgeOnly,
-                BoundaryArg::EdgeAndCorner => BoundaryInterpolation::EdgeAndCorner,
-            };
+            options.boundary_interpolation = b;
         }
         if let Some(c) = self.crease_method {
-            options.crease_method = match c {
-                CreaseArg::Uniform => CreaseMethod::Uniform,
-                CreaseArg::Chaikin => CreaseMethod::Chaikin,
-            };
+            options.crease_method = c;
         }
         if let Some(t) = self.triangles {
-            options.triangle_subdivision = match t {
-                TriangleArg::Catmark => TriangleSubdivision::Catmark,
-                TriangleArg::Smooth => TriangleSubdivision::Smooth,
-            };
+            options.triangle_subdivision = t;
         }
         options
     }
@@ -127,16 +81,9 @@ impl RuleArgs {
     /// The face-varying interpolation: this command line's, else the file's tag, else
     /// corners-plus1.
     pub(crate) fn fvar_mode(&self, hints: &SchemeHints) -> FVarLinearInterpolation {
-        use FVarLinearInterpolation as M;
-        match self.fvar_interpolation {
-            Some(FVarArg::None) => M::None,
-            Some(FVarArg::CornersOnly) => M::CornersOnly,
-            Some(FVarArg::CornersPlus1) => M::CornersPlus1,
-            Some(FVarArg::CornersPlus2) => M::CornersPlus2,
-            Some(FVarArg::Boundaries) => M::Boundaries,
-            Some(FVarArg::All) => M::All,
-            None => hints.fvar_interpolation.unwrap_or(M::CornersPlus1),
-        }
+        self.fvar_interpolation
+            .or(hints.fvar_interpolation)
+            .unwrap_or(FVarLinearInterpolation::CornersPlus1)
     }
 
     /// Reader options.

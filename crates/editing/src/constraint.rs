@@ -5,7 +5,7 @@
 //! gives three equations `Σ_v w_v ΔX_v[c] = b_c`, one per coordinate. A normal constraint
 //! asks both limit tangents `t = Σ_v w'_v X_v` to be perpendicular to the target normal n:
 //! `Σ_v w'_v (n · ΔX_v) = −n · t(X₀)` couples x, y and z, the Kronecker form `(Bᵀ ⊗ A) vec X`
-//! of the seed written row by row. So one row here is a list of (vertex, weight) with a
+//! of Li et al. written row by row. So one row here is a list of (vertex, weight) with a
 //! [`Coupling`]: one coordinate, or a direction dotted with the vertex's change.
 
 use glam::DVec3;

@@ -12,7 +12,7 @@
 //!   steps its quarters k = 1, 2, 3 are B-splines with control points `Ā_k A^(m−1) C` on
 //!   squares of side `2^−m`. Second derivatives scale by `4^m` there and the area by `4^−m`,
 //!   so `Q = Σ_{m≥1} 4^m (A^(m−1))ᵀ M A^(m−1)` with `M = Σ_k Ā_kᵀ Q₀ Ā_k`. In A's eigenbasis
-//!   the pair (λᵢ, λⱼ) contributes `Gᵢⱼ · 4/(1 − 4λᵢλⱼ)`: the denominator the seed prints
+//!   the pair (λᵢ, λⱼ) contributes `Gᵢⱼ · 4/(1 − 4λᵢλⱼ)`: the denominator Li et al. print
 //!   as `4 − λᵢλⱼ` is `¼ − λᵢλⱼ` (with the 4 pulled out), a geometric series in `4λᵢλⱼ`.
 //!   The series is summed here with the matrices themselves (robust to A's defective
 //!   eigenvalues), with the eigenvalue 1 taken out first: `M` annihilates constants, so

@@ -3,13 +3,13 @@
 //! A line starts in a quad at a fixed value of one parameter and runs along the other,
 //! crossing into the quad on the far side of each edge it reaches, for a given number of
 //! faces. Over a strip of regular faces the limit curve along it is a uniform cubic
-//! B-spline, and its `faces + 3` control points are linear in the control vertices (the
-//! seed's `N₀(t)..N₃(t)` combinations of the strip's rows; `(1/6, 2/3, 1/6)` at t = 0). Here
+//! B-spline, and its `faces + 3` control points are linear in the control vertices (Li et al.'s
+//! `N₀(t)..N₃(t)` combinations of the strip's rows; `(1/6, 2/3, 1/6)` at t = 0). Here
 //! they are read off position and first and second derivatives along the line at the start
 //! of each face, which for a cubic B-spline give its control points exactly:
 //! `c₁ = P − P''/6`, `c₀ = c₁ − P' + P''/2`, `c₂ = c₁ + P' + P''/2`. Constraining them makes
 //! the line *equal* the target curve. Where a face of the strip is not a B-spline patch
-//! (an extraordinary vertex or a feature nearby; the seed leaves this open) the line is
+//! (an extraordinary vertex or a feature nearby; Li et al. leave this open) the line is
 //! sampled instead: points at four parameters per face, each constrained to the target
 //! curve's point there.
 

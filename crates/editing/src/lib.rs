@@ -12,7 +12,7 @@
 //! * **least squares**: the smallest change (`ΔX = A⁺ r`), touching only the vertices that
 //!   influence the constraints;
 //! * **energy**: the fairest change, minimising the thin-plate (+ membrane) energy of the
-//!   displacement ([`energy`]) over a region of influence, exactly (KKT) or with the seed's
+//!   displacement ([`energy`]) over a region of influence, exactly (KKT) or with Li et al.'s
 //!   penalty.
 //!
 //! An [`Editor`] factors once per set of constraint locations; [`Editor::solve`] with new
@@ -55,6 +55,7 @@ pub mod dependency;
 pub mod energy;
 pub mod isoline;
 pub mod mesh_edit;
+pub mod report;
 pub mod solve;
 pub mod spec;
 
@@ -64,7 +65,8 @@ pub use dependency::DependentGroup;
 pub use energy::{EnergyMatrix, EnergyOptions};
 pub use isoline::{Axis, Isoline};
 pub use mesh_edit::{Energies, Measured, MeshEdit, edit_mesh};
-pub use solve::{Edit, Editor, Method, Timings};
+pub use report::{ConstraintResidual, EditReport, EditSeconds};
+pub use solve::{Edit, Editor, Method, MethodKind, MethodRequest, Timings};
 
 #[cfg(doctest)]
 #[doc = include_str!("../README.md")]

@@ -12,7 +12,7 @@
 //!   (the rest fixed), subject to the rows. Exactly (the KKT system `[Q Aᵀ; A 0]` by faer's
 //!   sparse LU; when it is singular — dependent or conflicting rows — by its Schur
 //!   complement `ΔX = Q⁻¹Aᵀ (A Q⁻¹ Aᵀ)⁺ r`, Q by faer's sparse Cholesky, the c × c Schur
-//!   matrix's pseudo-inverse giving the least-squares solution), or by the seed's penalty
+//!   matrix's pseudo-inverse giving the least-squares solution), or by Li et al.'s penalty
 //!   `(Q + λ AᵀA) ΔX = λ Aᵀ r`. `Q` gets `1e-12` of its largest diagonal added: that keeps it
 //!   definite when no vertex of a component is fixed (a translation costs no energy; with
 //!   the term the smallest such move is taken) and changes nothing else measurably.
@@ -30,6 +30,7 @@ use faer::{Mat, Side};
 use glam::DVec3;
 use subd_limit::eval::LimitEvaluator;
 use subd_mesh::Topology;
+use subd_mesh::choice::Choice;
 use subd_mesh::neighbourhood;
 use subd_schemes::{Options, Scheme};
 
@@ -56,6 +57,105 @@ pub enum Method {
         /// The energy.
         energy: EnergyOptions,
     },
+}
+
+/// The methods by name, as `subd edit --method` and `subd.edit(method=…)` take them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum MethodKind {
+    /// [`Method::LeastSquares`].
+    #[default]
+    LeastSquares,
+    /// [`Method::Energy`].
+    Energy,
+}
+
+impl Choice for MethodKind {
+    const OPTION: &'static str = "editing method";
+    const VALUES: &'static [(Self, &'static str, &'static str)] = &[
+        (
+            MethodKind::LeastSquares,
+            "least-squares",
+            "The smallest change of the control vertices the constraints involve (A⁺ r)",
+        ),
+        (
+            MethodKind::Energy,
+            "energy",
+            "The smallest thin-plate (+ membrane) energy of the change over a region",
+        ),
+    ];
+}
+
+subd_mesh::choice_by_name!(MethodKind);
+
+/// A method as a request names it: the kind and the energy method's options, checked by
+/// [`MethodRequest::method`] the same way for every front.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct MethodRequest {
+    /// Which method.
+    pub kind: MethodKind,
+    /// Energy method: the penalty form with this weight instead of the exact solve.
+    pub penalty: Option<f64>,
+    /// Energy method: the exact equality-constrained solve (the default; refused with a
+    /// penalty).
+    pub exact: bool,
+    /// Energy method: weight of the membrane term (≥ 0).
+    pub membrane: f64,
+    /// Energy method: rings around the constraints' vertices that may move (`None`: all).
+    pub region_rings: Option<usize>,
+}
+
+impl MethodRequest {
+    /// The method, or why the options do not fit it (energy options given to least
+    /// squares, a penalty that is not positive, a membrane weight that is negative or not
+    /// finite, both a penalty and `exact`).
+    pub fn method(&self) -> Result<Method, String> {
+        let energy_only = self.penalty.is_some() || self.exact || self.membrane != 0.0;
+        match self.kind {
+            MethodKind::LeastSquares if energy_only => {
+                Err("penalty, exact and membrane apply to the energy method only".into())
+            }
+            MethodKind::LeastSquares => Ok(Method::LeastSquares),
+            MethodKind::Energy => self.energy(),
+        }
+    }
+
+    /// The energy method's options, checked.
+    fn energy(&self) -> Result<Method, String> {
+        if self.penalty.is_some() && self.exact {
+            return Err("penalty and exact: give one of them".into());
+        }
+        if let Some(p) = self.penalty
+            && (p.is_nan() || p <= 0.0)
+        {
+            return Err(format!("penalty {p}: must be a positive number"));
+        }
+        let m = self.membrane;
+        if !(m >= 0.0 && m.is_finite()) {
+            return Err(format!("membrane {m}: must be a non-negative number"));
+        }
+        Ok(Method::Energy {
+            penalty: self.penalty,
+            region_rings: self.region_rings,
+            energy: EnergyOptions {
+                membrane: m,
+                ..EnergyOptions::default()
+            },
+        })
+    }
+}
+
+impl Method {
+    /// The name reports give the method: `least-squares`, `energy-exact` or
+    /// `energy-penalty`.
+    pub fn report_name(&self) -> &'static str {
+        match self {
+            Method::LeastSquares => "least-squares",
+            Method::Energy { penalty: None, .. } => "energy-exact",
+            Method::Energy {
+                penalty: Some(_), ..
+            } => "energy-penalty",
+        }
+    }
 }
 
 /// Seconds spent in each phase.

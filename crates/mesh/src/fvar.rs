@@ -11,6 +11,7 @@
 use thiserror::Error;
 
 use crate::Topology;
+use crate::choice::Choice;
 
 /// How face-varying values are interpolated along their seams and boundaries: OpenSubdiv's
 /// `Sdc::Options::FVarLinearInterpolation`, in its order (which is also the value of the
@@ -70,16 +71,47 @@ impl FVarLinearInterpolation {
 
     /// The name the command line uses (`corners-plus1`, ...).
     pub fn name(self) -> &'static str {
-        match self {
-            FVarLinearInterpolation::None => "none",
-            FVarLinearInterpolation::CornersOnly => "corners-only",
-            FVarLinearInterpolation::CornersPlus1 => "corners-plus1",
-            FVarLinearInterpolation::CornersPlus2 => "corners-plus2",
-            FVarLinearInterpolation::Boundaries => "boundaries",
-            FVarLinearInterpolation::All => "all",
-        }
+        <Self as Choice>::name(self)
     }
 }
+
+impl Choice for FVarLinearInterpolation {
+    const OPTION: &'static str = "face-varying interpolation";
+    const VALUES: &'static [(Self, &'static str, &'static str)] = &[
+        (
+            FVarLinearInterpolation::None,
+            "none",
+            "Smooth everywhere; only what the geometry makes sharp is pinned",
+        ),
+        (
+            FVarLinearInterpolation::CornersOnly,
+            "corners-only",
+            "Smooth, with UV corners (a value used by one face at its vertex) pinned",
+        ),
+        (
+            FVarLinearInterpolation::CornersPlus1,
+            "corners-plus1",
+            "As corners-only, plus junctions of three or more UV regions (USD's, Blender's default)",
+        ),
+        (
+            FVarLinearInterpolation::CornersPlus2,
+            "corners-plus2",
+            "As corners-plus1, plus concave corners and seam ends inside the mesh",
+        ),
+        (
+            FVarLinearInterpolation::Boundaries,
+            "boundaries",
+            "Seams and the mesh boundary kept piecewise linear, interiors smooth",
+        ),
+        (
+            FVarLinearInterpolation::All,
+            "all",
+            "Linear everywhere (bilinear UVs)",
+        ),
+    ];
+}
+
+crate::choice_by_name!(FVarLinearInterpolation);
 
 /// Why a face-varying channel was rejected; each variant names the element.
 #[derive(Debug, Clone, PartialEq, Error)]

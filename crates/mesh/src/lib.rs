@@ -29,6 +29,7 @@
 pub mod analysis;
 mod build;
 pub mod canonical;
+pub mod choice;
 pub mod csr;
 pub mod cut;
 pub mod error;

@@ -8,6 +8,8 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use crate::choice::Choice;
+
 /// Sharpness at or above which an edge or vertex is infinitely sharp (OpenSubdiv's
 /// `Sdc::Crease::SHARPNESS_INFINITE`).
 pub const SHARPNESS_INFINITE: f32 = 10.0;
@@ -196,6 +198,63 @@ pub enum TriangleSubdivision {
     /// The "smooth triangle" edge weights (`TRI_SUB_SMOOTH`).
     Smooth,
 }
+
+impl Choice for BoundaryInterpolation {
+    const OPTION: &'static str = "boundary interpolation";
+    const VALUES: &'static [(Self, &'static str, &'static str)] = &[
+        (
+            BoundaryInterpolation::None,
+            "none",
+            "Faces on the boundary are left out of the limit surface",
+        ),
+        (
+            BoundaryInterpolation::EdgeOnly,
+            "edge-only",
+            "Boundary edges are infinitely sharp (OpenSubdiv's default)",
+        ),
+        (
+            BoundaryInterpolation::EdgeAndCorner,
+            "edge-and-corner",
+            "Boundary edges and corner vertices (one face) are infinitely sharp",
+        ),
+    ];
+}
+
+impl Choice for CreaseMethod {
+    const OPTION: &'static str = "crease method";
+    const VALUES: &'static [(Self, &'static str, &'static str)] = &[
+        (
+            CreaseMethod::Uniform,
+            "uniform",
+            "Semi-sharp creases lose one unit of sharpness per level (OpenSubdiv's default)",
+        ),
+        (
+            CreaseMethod::Chaikin,
+            "chaikin",
+            "Chaikin's averaging of the sharpness along a crease",
+        ),
+    ];
+}
+
+impl Choice for TriangleSubdivision {
+    const OPTION: &'static str = "triangle rule";
+    const VALUES: &'static [(Self, &'static str, &'static str)] = &[
+        (
+            TriangleSubdivision::Catmark,
+            "catmark",
+            "Catmull-Clark's own masks on triangles (OpenSubdiv's default)",
+        ),
+        (
+            TriangleSubdivision::Smooth,
+            "smooth",
+            "OpenSubdiv's smooth-triangle edge weights",
+        ),
+    ];
+}
+
+crate::choice_by_name!(BoundaryInterpolation);
+crate::choice_by_name!(CreaseMethod);
+crate::choice_by_name!(TriangleSubdivision);
 
 /// The subdivision scheme a mesh file names for its surface: USD's `subdivisionScheme`
 /// (the schemes USD shares with OpenSubdiv), kept as the file says it. The crates that know

@@ -44,6 +44,7 @@
 //! ```
 
 pub mod checkerboard;
+pub mod interpolation;
 mod matrix;
 mod ritz;
 mod solvers;
@@ -57,6 +58,7 @@ use subd_mesh::Topology;
 use subd_schemes::{Capability, Options, Scheme, StencilTable};
 use thiserror::Error;
 
+pub use interpolation::{Interpolation, InterpolationReport, InterpolationRequest, interpolate};
 pub use solvers::{Method, Solver};
 use system::{FullSystem, ReducedSystem};
 

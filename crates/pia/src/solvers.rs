@@ -14,6 +14,7 @@ use faer::{Mat, Side};
 use glam::DVec3;
 use rayon::prelude::*;
 use serde::Serialize;
+use subd_mesh::choice::Choice;
 use subd_mesh::memory;
 
 use crate::PiaError;
@@ -56,6 +57,40 @@ pub enum Solver {
     /// Sparse Cholesky of `D` (LU of `M̄` when not symmetrisable), faer.
     Direct,
 }
+
+impl Choice for Solver {
+    const OPTION: &'static str = "solver";
+    const VALUES: &'static [(Self, &'static str, &'static str)] = &[
+        (
+            Solver::Auto,
+            "auto",
+            "The fastest valid solver (Chebyshev on the checkerboard-preconditioned system for closed two-coloured quad meshes with every vertex moving; otherwise conjugate gradients, BiCGSTAB where the system has no symmetric form)",
+        ),
+        (
+            Solver::Iterate,
+            "iterate",
+            "The paper's iteration: every moving vertex moves by its interpolation error",
+        ),
+        (
+            Solver::Weighted,
+            "weighted",
+            "The iteration with the optimal weight 2 / (λ_min + λ_max)",
+        ),
+        (
+            Solver::Cg,
+            "cg",
+            "Conjugate gradients on the symmetrised system (BiCGSTAB where there is none)",
+        ),
+        (
+            Solver::Chebyshev,
+            "chebyshev",
+            "Chebyshev iteration on the checkerboard-preconditioned system (Catmull-Clark and two-phase on two-coloured closed quad meshes; CG elsewhere)",
+        ),
+        (Solver::Direct, "direct", "Sparse Cholesky / LU"),
+    ];
+}
+
+subd_mesh::choice_by_name!(Solver);
 
 /// The method that actually ran.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]

@@ -8,7 +8,7 @@ use serde::Serialize;
 use subd_schemes::analysis::{Lattice, analyze, analyze_bivariate, check_total};
 
 use crate::errors::mesh_error;
-use crate::ops::scheme;
+use crate::ops::{named, scheme};
 use crate::pool;
 
 /// The levels of the difference scheme a verdict may try.
@@ -40,15 +40,7 @@ pub(crate) fn analyze_mask2(
     max_levels: usize,
 ) -> PyResult<String> {
     check_levels(max_levels)?;
-    let lattice = match lattice {
-        "quad" => Lattice::Quad,
-        "three-direction" => Lattice::ThreeDirection,
-        _ => {
-            return Err(PyValueError::new_err(format!(
-                "lattice: unknown value {lattice:?} (one of quad, three-direction)"
-            )));
-        }
-    };
+    let lattice: Lattice = named("lattice", lattice)?;
     let all: Vec<f64> = rows.iter().flatten().copied().collect();
     check_total(&all, 4.0, "a bivariate binary mask")
         .map_err(|e| mesh_error(format!("mask2: {e}")))?;

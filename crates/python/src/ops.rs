@@ -8,6 +8,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use subd_limit::refined_mesh::{MeshRefinement, RefinedMesh, refine_mesh};
 use subd_mesh::Mesh;
+use subd_mesh::choice::Choice;
 use subd_mesh::fvar::FVarLinearInterpolation;
 use subd_mesh::report::MeshReport;
 use subd_schemes::{Options, Scheme};
@@ -39,32 +40,15 @@ pub(crate) struct RuleNames<'a> {
 impl RuleNames<'_> {
     /// The options for a mesh with `hints`, or a `ValueError` listing the names.
     pub(crate) fn options(&self, hints: &subd_mesh::SchemeHints) -> PyResult<Options> {
-        use subd_mesh::{BoundaryInterpolation as B, CreaseMethod as C, TriangleSubdivision as T};
         let mut o = Options::from_hints(hints);
-        let bad = |what: &str, got: &str, names: &str| {
-            PyValueError::new_err(format!("{what}: unknown value {got:?} (one of {names})"))
-        };
         if let Some(b) = self.boundary {
-            o.boundary_interpolation = match b {
-                "none" => B::None,
-                "edge-only" => B::EdgeOnly,
-                "edge-and-corner" => B::EdgeAndCorner,
-                _ => return Err(bad("boundary", b, "none, edge-only, edge-and-corner")),
-            };
+            o.boundary_interpolation = named("boundary", b)?;
         }
         if let Some(c) = self.crease_method {
-            o.crease_method = match c {
-                "uniform" => C::Uniform,
-                "chaikin" => C::Chaikin,
-                _ => return Err(bad("crease_method", c, "uniform, chaikin")),
-            };
+            o.crease_method = named("crease_method", c)?;
         }
         if let Some(t) = self.triangles {
-            o.triangle_subdivision = match t {
-                "catmark" => T::Catmark,
-                "smooth" => T::Smooth,
-                _ => return Err(bad("triangles", t, "catmark, smooth")),
-            };
+            o.triangle_subdivision = named("triangles", t)?;
         }
         Ok(o)
     }
@@ -75,25 +59,22 @@ impl RuleNames<'_> {
         &self,
         hints: &subd_mesh::SchemeHints,
     ) -> PyResult<FVarLinearInterpolation> {
-        let Some(name) = self.fvar_interpolation else {
-            return Ok(hints
-                .fvar_interpolation
-                .unwrap_or(FVarLinearInterpolation::CornersPlus1));
-        };
-        FVarLinearInterpolation::ALL_MODES
-            .into_iter()
-            .find(|m| m.name() == name)
-            .ok_or_else(|| {
-                let names: Vec<&str> = FVarLinearInterpolation::ALL_MODES
-                    .iter()
-                    .map(|m| m.name())
-                    .collect();
-                PyValueError::new_err(format!(
-                    "fvar_interpolation: unknown value {name:?} (one of {})",
-                    names.join(", ")
-                ))
-            })
+        let given = self.fvar_interpolation;
+        Ok(
+            match given.map(|n| named("fvar_interpolation", n)).transpose()? {
+                Some(mode) => mode,
+                None => hints
+                    .fvar_interpolation
+                    .unwrap_or(FVarLinearInterpolation::CornersPlus1),
+            },
+        )
     }
+}
+
+/// `value` as one of the option `T`'s names, or a `ValueError` naming the argument `arg` and
+/// listing the names.
+pub(crate) fn named<T: Choice>(arg: &str, value: &str) -> PyResult<T> {
+    T::from_name(value).map_err(|e| PyValueError::new_err(format!("{arg}: {e}")))
 }
 
 /// Reads a mesh file (OBJ with OpenSubdiv's tags, PLY, glTF, USD): the mesh and the

@@ -18,7 +18,7 @@ use crate::arrays::{contiguous, copied1, filled1, points, view2};
 use crate::device::{choose, device_error, fallback_warning};
 use crate::errors::{mesh_error, warn};
 use crate::mesh::CoreMesh;
-use crate::ops::{RuleNames, scheme};
+use crate::ops::{RuleNames, named, scheme};
 use crate::pool;
 
 /// A patch table of one mesh, with the points of its current positions.
@@ -68,7 +68,7 @@ impl CorePatchTable {
     ) -> PyResult<CorePatchTable> {
         let (gpu, mut device_warning) = choose(device)?;
         let scheme = scheme(scheme_name)?;
-        let end_caps: EndCaps = end_caps.parse().map_err(PyValueError::new_err)?;
+        let end_caps: EndCaps = named("end_caps", end_caps)?;
         let base = mesh.mesh(py)?;
         let names = RuleNames {
             boundary,

@@ -5,22 +5,19 @@
 //! dict (as `info` does). Constraints come as the JSON text the CLI reads from its files,
 //! parsed by the same parser, so both accept the same lists and name the same problems.
 
-use std::time::Instant;
-
 use numpy::PyReadonlyArray1;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use serde_json::json;
-use subd_editing::energy::EnergyOptions;
-use subd_editing::{Deformation, MeshEdit};
+use subd_editing::{Deformation, MeshEdit, MethodRequest};
 use subd_mesh::{DVec3, Mesh};
-use subd_pia::{Moving, Pia, PiaOptions, Solver};
+use subd_pia::{InterpolationRequest, Moving, PiaOptions};
 use subd_schemes::{Capability, Options, Scheme, TwoPhase};
 
 use crate::arrays::contiguous;
 use crate::errors::mesh_error;
 use crate::mesh::CoreMesh;
-use crate::ops::{RuleNames, scheme};
+use crate::ops::{RuleNames, named, scheme};
 use crate::pool;
 
 /// `base`'s topology, tags and texture coordinates with `positions` (checked finite).
@@ -65,23 +62,6 @@ fn moving_vertices(moving: Option<&[i64]>, fixed: Option<&[i64]>, nv: usize) -> 
         (None, Some(f)) => Ok(Moving::AllBut(vertex_list(f, nv, "fixed")?)),
         (None, None) => Ok(Moving::All),
     }
-}
-
-/// The solver named as the CLI's `--solver`.
-fn solver_by_name(name: &str) -> PyResult<Solver> {
-    Ok(match name {
-        "auto" => Solver::Auto,
-        "iterate" => Solver::Iterate,
-        "weighted" => Solver::Weighted,
-        "cg" => Solver::Cg,
-        "chebyshev" => Solver::Chebyshev,
-        "direct" => Solver::Direct,
-        _ => {
-            return Err(PyValueError::new_err(format!(
-                "solver: unknown value {name:?} (one of auto, iterate, weighted, cg, chebyshev, direct)"
-            )));
-        }
-    })
 }
 
 /// `scheme` with the two-phase scheme's `λ` from `lam` (one value for every vertex, or one
@@ -183,7 +163,7 @@ pub(crate) fn pia(
         options: rules.options(&base.hints)?,
         moving: moving_vertices(moving, fixed, nv)?,
         solve: PiaOptions {
-            solver: solver_by_name(solver)?,
+            solver: named("solver", solver)?,
             tol,
             max_iter,
         },
@@ -193,49 +173,24 @@ pub(crate) fn pia(
     Ok((solved.map(cage_of), report))
 }
 
-/// Sets up and solves the interpolation, then measures the result with a limit table built
-/// afresh (as `subd pia` does): the fitted mesh where that meets the tolerance.
+/// The library's interpolation workflow (as `subd pia` runs it): the fitted mesh where the
+/// fresh measurement meets the tolerance, and the report as JSON.
 fn interpolate(base: &Mesh, r: &PiaRequest) -> Result<(Option<Mesh>, String), String> {
-    let fail = |e: subd_pia::PiaError| e.to_string();
-    let t0 = Instant::now();
-    let pia = Pia::new(&base.topology, &r.scheme, &r.options).map_err(fail)?;
-    let t1 = Instant::now();
-    let result = pia
-        .solve(&base.positions, &r.moving, &r.solve)
-        .map_err(fail)?;
-    let t2 = Instant::now();
-    let (topo, targets) = (&base.topology, &base.positions);
-    let deviation = subd_pia::deviation(
-        topo,
-        &r.scheme,
-        &r.options,
-        &result.points,
-        targets,
-        &r.moving,
-    )
-    .map_err(fail)?;
-    let converged = result.converged && deviation.within(r.solve.tol);
-    let report = json!({
-        "scheme": r.scheme.name(),
-        "solver": r.solve.solver,
-        "method": result.method,
-        "vertices": topo.num_vertices(),
-        "moving": result.moving,
-        "iterations": result.iterations,
-        "converged": converged,
-        "max_error": deviation.max_error,
-        "max_error_relative": deviation.relative,
-        "tol": r.solve.tol,
-        "history": result.history,
-        "seconds": {
-            "setup": (t1 - t0).as_secs_f64(),
-            "solve": (t2 - t1).as_secs_f64(),
-            "check": t2.elapsed().as_secs_f64(),
-        },
-    });
+    let request = InterpolationRequest {
+        scheme: &r.scheme,
+        options: &r.options,
+        moving: &r.moving,
+        solve: r.solve,
+    };
+    let fitted = subd_pia::interpolate(&base.topology, &base.positions, &request)
+        .map_err(|e| e.to_string())?;
+    let mut report = serde_json::to_value(&fitted.report).map_err(|e| e.to_string())?;
+    report["seconds"] = json!(fitted.seconds);
     // A solve that did not converge may hold points that are not finite: no mesh of them.
-    let mesh = converged
-        .then(|| cage(base, result.points, &r.scheme))
+    let mesh = fitted
+        .report
+        .converged
+        .then(|| cage(base, fitted.points, &r.scheme))
         .transpose()?;
     Ok((mesh, report.to_string()))
 }
@@ -248,41 +203,15 @@ fn edit_method(
     membrane: f64,
     region_rings: Option<usize>,
 ) -> PyResult<subd_editing::Method> {
-    let energy_only = penalty.is_some() || exact || membrane != 0.0;
-    match method {
-        "least-squares" if energy_only => Err(mesh_error(
-            "penalty, exact and membrane apply to method=\"energy\" only",
-        )),
-        "least-squares" => Ok(subd_editing::Method::LeastSquares),
-        "energy" => {
-            if penalty.is_some() && exact {
-                return Err(mesh_error("penalty and exact: give one of them"));
-            }
-            if let Some(p) = penalty
-                && (p.is_nan() || p <= 0.0)
-            {
-                return Err(mesh_error(format!(
-                    "penalty {p}: must be a positive number"
-                )));
-            }
-            if !(membrane >= 0.0 && membrane.is_finite()) {
-                return Err(mesh_error(format!(
-                    "membrane {membrane}: must be a non-negative number"
-                )));
-            }
-            Ok(subd_editing::Method::Energy {
-                penalty,
-                region_rings,
-                energy: EnergyOptions {
-                    membrane,
-                    ..EnergyOptions::default()
-                },
-            })
-        }
-        _ => Err(PyValueError::new_err(format!(
-            "method: unknown value {method:?} (one of least-squares, energy)"
-        ))),
+    MethodRequest {
+        kind: named("method", method)?,
+        penalty,
+        exact,
+        membrane,
+        region_rings,
     }
+    .method()
+    .map_err(mesh_error)
 }
 
 /// The schemes whose limit surface the editor evaluates at any point.
@@ -345,49 +274,19 @@ pub(crate) fn edit(
         Ok((e, moved))
     })?
     .map_err(mesh_error)?;
-    let report = edit_report(&edited, &scheme, base.topology.num_vertices(), &constraints);
+    let mut report = serde_json::to_value(edited.report(
+        &scheme,
+        &method,
+        base.topology.num_vertices(),
+        &constraints,
+    ))
+    .map_err(|e| mesh_error(e.to_string()))?;
+    report["seconds"] = json!(edited.seconds());
     Ok((
         CoreMesh::plain(moved).made_from(mesh).cage_of(&scheme),
         edited.warnings,
-        report,
+        report.to_string(),
     ))
-}
-
-/// What `subd edit --json` reports of an edit, less the files and the reading and writing.
-fn edit_report(
-    e: &MeshEdit,
-    scheme: &Scheme,
-    vertices: usize,
-    constraints: &[subd_editing::Constraint],
-) -> String {
-    let measured = e.measured.as_ref();
-    let energies = measured.and_then(|m| m.energies);
-    let t = e.timings;
-    json!({
-        "scheme": scheme.name(),
-        "vertices": vertices,
-        "constraints": constraints.len(),
-        "rows": e.rows,
-        "rank": e.rank,
-        "rank_deficient": e.rank_deficient,
-        "dependencies": e.edit.dependencies,
-        "free_vertices": e.free_vertices,
-        "moved_vertices": e.edit.moved,
-        "residuals": measured.map(|m| &m.residuals),
-        "max_residual_relative": measured.map(|m| m.max_residual_relative),
-        "energy_before": energies.map(|x| x.before),
-        "energy_after": energies.map(|x| x.after),
-        "displacement_energy": energies.map(|x| x.displacement),
-        "seconds": {
-            "evaluator": t.evaluator,
-            "constraints": t.constraints,
-            "assemble": t.assemble,
-            "factor": t.factor,
-            "solve": t.solve,
-            "check": measured.map_or(0.0, |m| m.seconds),
-        },
-    })
-    .to_string()
 }
 
 /// The mesh with its vertices moved by the deformation of `constraints_json` (the CLI's

@@ -205,3 +205,15 @@ def test_update_uv_moves_the_refined_values_in_place():
     assert plain.face_varying is None
     with pytest.raises(ValueError):
         plain.evaluate_uv([0], [0.5], [0.5])
+
+
+@pytest.mark.parametrize("kwargs,match", [
+    ({"end_caps": "round"},
+     'end_caps: unknown end caps "round" \\(one of gregory, bspline, bilinear, exact\\)'),
+    ({"boundary": "sharp"}, 'boundary: unknown boundary interpolation "sharp"'),
+    ({"fvar_interpolation": "corners"}, "fvar_interpolation: unknown face-varying interpolation"),
+])
+def test_unknown_option_names_are_listed(kwargs, match):
+    # The names come from the library's tables, the same the CLI offers.
+    with pytest.raises(ValueError, match=match):
+        subd.PatchTable(subd.Mesh(CUBE_V, CUBE_F), "catmull-clark", **kwargs)

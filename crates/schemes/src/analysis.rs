@@ -27,6 +27,7 @@
 //! assert_eq!(v.smoothness, Some(1));
 //! ```
 
+use subd_mesh::choice::Choice;
 use thiserror::Error;
 
 /// Why a mask cannot be analysed.
@@ -249,6 +250,24 @@ pub enum Lattice {
     /// Three-direction (triangle) grids: directions `z1`, `z2`, `z1 z2`.
     ThreeDirection,
 }
+
+impl Choice for Lattice {
+    const OPTION: &'static str = "lattice";
+    const VALUES: &'static [(Self, &'static str, &'static str)] = &[
+        (
+            Lattice::Quad,
+            "quad",
+            "Quad (tensor) grids: directions z1, z2",
+        ),
+        (
+            Lattice::ThreeDirection,
+            "three-direction",
+            "Three-direction (triangle) grids: directions z1, z2, z1 z2",
+        ),
+    ];
+}
+
+subd_mesh::choice_by_name!(Lattice);
 
 /// The outcome of [`analyze_bivariate`].
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]

@@ -5,21 +5,131 @@
 
 use glam::{DVec2, DVec3};
 
+use subd_mesh::choice::Choice;
+
 use crate::curve::{CircleScheme, CurveError, CurveScheme, PointNormal};
 
-/// The curve schemes' names, as the CLI and the Python package spell them.
-pub const CURVE_SCHEMES: [&str; 10] = [
-    "chaikin",
-    "bspline",
-    "four-point",
-    "four-point-2p",
-    "ternary-3pt",
-    "tension",
-    "circle-preserving",
-    "variational",
-    "circle-four-point",
-    "circle-ternary",
-];
+/// The curve schemes by name, as the CLI and the Python package spell them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum CurveName {
+    /// `chaikin`.
+    Chaikin,
+    /// `bspline`.
+    BSpline,
+    /// `four-point`.
+    FourPoint,
+    /// `four-point-2p`.
+    FourPoint2p,
+    /// `ternary-3pt`.
+    Ternary3pt,
+    /// `tension`.
+    Tension,
+    /// `circle-preserving`.
+    CirclePreserving,
+    /// `variational`.
+    Variational,
+    /// `circle-four-point`.
+    CircleFourPoint,
+    /// `circle-ternary`.
+    CircleTernary,
+}
+
+impl Choice for CurveName {
+    const OPTION: &'static str = "curve scheme";
+    const VALUES: &'static [(Self, &'static str, &'static str)] = &[
+        (
+            CurveName::Chaikin,
+            "chaikin",
+            "Chaikin corner cutting (quadratic B-spline)",
+        ),
+        (
+            CurveName::BSpline,
+            "bspline",
+            "Uniform B-spline of order --order (default 4, cubic)",
+        ),
+        (
+            CurveName::FourPoint,
+            "four-point",
+            "Interpolatory 4-point scheme, tension --omega (default 1/16)",
+        ),
+        (
+            CurveName::FourPoint2p,
+            "four-point-2p",
+            "Two-parameter 4-point scheme, --omega (default 1/16) and --mu (default 0)",
+        ),
+        (
+            CurveName::Ternary3pt,
+            "ternary-3pt",
+            "3-point ternary interpolatory scheme, --omega (default 1/4)",
+        ),
+        (
+            CurveName::Tension,
+            "tension",
+            "Non-stationary tension scheme, --alpha0 (default 1: cubic B-spline)",
+        ),
+        (
+            CurveName::CirclePreserving,
+            "circle-preserving",
+            "Sabin–Dodgson circle-preserving 4-point scheme (planar points)",
+        ),
+        (
+            CurveName::Variational,
+            "variational",
+            "Variational interpolatory scheme (Kobbelt)",
+        ),
+        (
+            CurveName::CircleFourPoint,
+            "circle-four-point",
+            "Circle-average two-parameter 4-point scheme on point–normal pairs, --omega, --mu",
+        ),
+        (
+            CurveName::CircleTernary,
+            "circle-ternary",
+            "Circle-average 3-point ternary scheme on point–normal pairs, --omega",
+        ),
+    ];
+    // Earlier spellings of the command line's.
+    const ALIASES: &'static [(&'static str, Self)] = &[
+        ("four-point2p", CurveName::FourPoint2p),
+        ("ternary3pt", CurveName::Ternary3pt),
+    ];
+}
+
+subd_mesh::choice_by_name!(CurveName);
+
+impl CurveName {
+    /// Whether the scheme takes `parameter` (`omega`, `mu`, `order`, `alpha0`).
+    pub fn takes(self, parameter: &str) -> bool {
+        use CurveName as C;
+        match parameter {
+            "omega" => matches!(
+                self,
+                C::FourPoint
+                    | C::FourPoint2p
+                    | C::Ternary3pt
+                    | C::CircleFourPoint
+                    | C::CircleTernary
+            ),
+            "mu" => matches!(self, C::FourPoint2p | C::CircleFourPoint),
+            "order" => self == C::BSpline,
+            "alpha0" => self == C::Tension,
+            _ => false,
+        }
+    }
+}
+
+/// The curve schemes' names, in [`CurveName`]'s order.
+pub const CURVE_SCHEMES: [&str; 10] = {
+    let values = <CurveName as Choice>::VALUES;
+    assert!(values.len() == 10);
+    let mut names = [""; 10];
+    let mut i = 0;
+    while i < names.len() {
+        names[i] = values[i].1;
+        i += 1;
+    }
+    names
+};
 
 /// The parameters a curve scheme may take (`None`: the scheme's default).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -58,12 +168,15 @@ impl NamedCurve {
     /// [`CurveError::Parameter`] for an unknown name, or a parameter the scheme does not
     /// take (refused rather than ignored).
     pub fn new(name: &str, parameters: &CurveParameters) -> Result<NamedCurve, CurveError> {
-        if !CURVE_SCHEMES.contains(&name) {
-            return Err(CurveError::Parameter(format!(
-                "unknown curve scheme {name:?} (one of {})",
-                CURVE_SCHEMES.join(", ")
-            )));
-        }
+        let name = CurveName::from_name(name).map_err(|e| CurveError::Parameter(e.to_string()))?;
+        Self::of(name, parameters)
+    }
+
+    /// The scheme `name` with `parameters` ([`NamedCurve::new`] by value).
+    ///
+    /// # Errors
+    /// [`CurveError::Parameter`] for a parameter the scheme does not take.
+    pub fn of(name: CurveName, parameters: &CurveParameters) -> Result<NamedCurve, CurveError> {
         let p = parameters;
         for (parameter, given) in [
             ("omega", p.omega.is_some()),
@@ -71,51 +184,40 @@ impl NamedCurve {
             ("order", p.order.is_some()),
             ("alpha0", p.alpha0.is_some()),
         ] {
-            if given && !Self::takes(name, parameter) {
+            if given && !name.takes(parameter) {
                 return Err(CurveError::Parameter(format!(
                     "{parameter} does not apply to the {name} scheme"
                 )));
             }
         }
-        let ternary = matches!(name, "ternary-3pt" | "circle-ternary");
+        let ternary = matches!(name, CurveName::Ternary3pt | CurveName::CircleTernary);
         let omega = p.omega.unwrap_or(if ternary { 0.25 } else { 1.0 / 16.0 });
         let mu = p.mu.unwrap_or(0.0);
-        Ok(match name {
-            "circle-four-point" => NamedCurve::Circle(CircleScheme::FourPoint { omega, mu }),
-            "circle-ternary" => NamedCurve::Circle(CircleScheme::Ternary { omega }),
-            _ => NamedCurve::Linear(match name {
-                "chaikin" => CurveScheme::Chaikin,
-                "bspline" => CurveScheme::BSpline {
-                    order: p.order.unwrap_or(4),
-                },
-                "four-point" => CurveScheme::FourPoint { omega },
-                "four-point-2p" => CurveScheme::FourPoint2 { omega, mu },
-                "ternary-3pt" => CurveScheme::Ternary3 { omega },
-                "tension" => CurveScheme::Tension {
-                    alpha0: p.alpha0.unwrap_or(1.0),
-                },
-                "circle-preserving" => CurveScheme::CirclePreserving,
-                _ => CurveScheme::Variational,
+        let linear = |scheme| Ok(NamedCurve::Linear(scheme));
+        match name {
+            CurveName::CircleFourPoint => {
+                Ok(NamedCurve::Circle(CircleScheme::FourPoint { omega, mu }))
+            }
+            CurveName::CircleTernary => Ok(NamedCurve::Circle(CircleScheme::Ternary { omega })),
+            CurveName::Chaikin => linear(CurveScheme::Chaikin),
+            CurveName::BSpline => linear(CurveScheme::BSpline {
+                order: p.order.unwrap_or(4),
             }),
-        })
+            CurveName::FourPoint => linear(CurveScheme::FourPoint { omega }),
+            CurveName::FourPoint2p => linear(CurveScheme::FourPoint2 { omega, mu }),
+            CurveName::Ternary3pt => linear(CurveScheme::Ternary3 { omega }),
+            CurveName::Tension => linear(CurveScheme::Tension {
+                alpha0: p.alpha0.unwrap_or(1.0),
+            }),
+            CurveName::CirclePreserving => linear(CurveScheme::CirclePreserving),
+            CurveName::Variational => linear(CurveScheme::Variational),
+        }
     }
 
-    /// Whether the scheme `name` takes `parameter` (`omega`, `mu`, `order`, `alpha0`).
+    /// Whether the scheme `name` takes `parameter` (`omega`, `mu`, `order`, `alpha0`);
+    /// `false` for a name that is no curve scheme.
     pub fn takes(name: &str, parameter: &str) -> bool {
-        match parameter {
-            "omega" => matches!(
-                name,
-                "four-point"
-                    | "four-point-2p"
-                    | "ternary-3pt"
-                    | "circle-four-point"
-                    | "circle-ternary"
-            ),
-            "mu" => matches!(name, "four-point-2p" | "circle-four-point"),
-            "order" => name == "bspline",
-            "alpha0" => name == "tension",
-            _ => false,
-        }
+        CurveName::from_name(name).is_ok_and(|n| n.takes(parameter))
     }
 }
 
@@ -225,4 +327,50 @@ pub fn estimate_normals(p: &[DVec3], closed: bool) -> Vec<DVec2> {
             flip * DVec2::new(t.y, -t.x).normalize_or_zero()
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_name_makes_its_scheme_and_the_old_spellings_still_work() {
+        assert_eq!(CURVE_SCHEMES.len(), CurveName::VALUES.len());
+        for (name, &(value, listed, _)) in CURVE_SCHEMES.iter().zip(CurveName::VALUES) {
+            assert_eq!(*name, listed);
+            let by_name = NamedCurve::new(name, &CurveParameters::default()).unwrap();
+            assert_eq!(
+                by_name,
+                NamedCurve::of(value, &CurveParameters::default()).unwrap()
+            );
+        }
+        assert_eq!("four-point2p".parse(), Ok(CurveName::FourPoint2p));
+        assert_eq!("ternary3pt".parse(), Ok(CurveName::Ternary3pt));
+        // The closed forms of the defaults: the classic 4-point tension, the ternary ¼.
+        let four = NamedCurve::new("four-point", &CurveParameters::default()).unwrap();
+        assert_eq!(
+            four,
+            NamedCurve::Linear(CurveScheme::FourPoint { omega: 1.0 / 16.0 })
+        );
+        let ternary = NamedCurve::new("ternary-3pt", &CurveParameters::default()).unwrap();
+        assert_eq!(
+            ternary,
+            NamedCurve::Linear(CurveScheme::Ternary3 { omega: 0.25 })
+        );
+    }
+
+    #[test]
+    fn a_parameter_the_scheme_does_not_take_is_refused() {
+        let p = CurveParameters {
+            mu: Some(0.1),
+            ..Default::default()
+        };
+        let e = NamedCurve::new("chaikin", &p).unwrap_err().to_string();
+        assert!(e.contains("mu does not apply to the chaikin scheme"), "{e}");
+        let e = NamedCurve::new("cubic", &p).unwrap_err().to_string();
+        assert!(
+            e.contains("unknown curve scheme \"cubic\" (one of chaikin, bspline"),
+            "{e}"
+        );
+    }
 }

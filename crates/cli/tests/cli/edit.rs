@@ -128,7 +128,7 @@ fn edit_and_deform_bad_input_exit_2_without_output() {
         out.to_str().unwrap(),
     ]);
     assert_eq!(code, 2, "{err}");
-    assert!(err.contains("--method energy only"), "{err}");
+    assert!(err.contains("apply to the energy method only"), "{err}");
     let (code, _, err) = subd(&[
         "edit",
         "--constraints",

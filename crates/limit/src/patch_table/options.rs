@@ -1,8 +1,7 @@
 //! What a patch table is built with: OpenSubdiv 3.5's `PatchTableFactory::Options`, and the
 //! exact end caps no other library has.
 
-use std::fmt;
-use std::str::FromStr;
+use subd_mesh::choice::Choice;
 
 /// How the patches around an irregular feature that isolation leaves behind (an
 /// extraordinary vertex, an irregular sharp feature) are represented.
@@ -36,30 +35,37 @@ impl EndCaps {
 
     /// The command-line name (`gregory`, `bspline`, `bilinear`, `exact`).
     pub fn name(self) -> &'static str {
-        match self {
-            EndCaps::Bilinear => "bilinear",
-            EndCaps::BSpline => "bspline",
-            EndCaps::GregoryBasis => "gregory",
-            EndCaps::Exact => "exact",
-        }
+        <Self as Choice>::name(self)
     }
 }
 
-impl fmt::Display for EndCaps {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
+impl Choice for EndCaps {
+    const OPTION: &'static str = "end caps";
+    const VALUES: &'static [(Self, &'static str, &'static str)] = &[
+        (
+            EndCaps::GregoryBasis,
+            "gregory",
+            "Gregory patches (20 points; Gregory triangles of 18 for Loop), OpenSubdiv's default",
+        ),
+        (
+            EndCaps::BSpline,
+            "bspline",
+            "Regular B-spline (box-spline) patches fitted to the irregular ones",
+        ),
+        (
+            EndCaps::Bilinear,
+            "bilinear",
+            "Bilinear quads (linear triangles) through the corners' limit points",
+        ),
+        (
+            EndCaps::Exact,
+            "exact",
+            "The irregular patches evaluated exactly (subd's own)",
+        ),
+    ];
 }
 
-impl FromStr for EndCaps {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        EndCaps::ALL
-            .into_iter()
-            .find(|e| e.name() == s)
-            .ok_or_else(|| format!("unknown end caps '{s}' (gregory, bspline, bilinear, exact)"))
-    }
-}
+subd_mesh::choice_by_name!(EndCaps);
 
 /// The deepest isolation level (OpenSubdiv's patch parameters hold 4 bits of depth and 10 of
 /// u and v).

@@ -858,9 +858,6 @@ class PatchTable:
         isolation = _count(isolation, "isolation")
         if not 1 <= isolation <= 10:
             raise ValueError(f"isolation: {isolation} is outside 1..10")
-        if end_caps not in ("gregory", "bspline", "bilinear", "exact"):
-            raise ValueError(f"end_caps: unknown value {end_caps!r} "
-                             "(one of gregory, bspline, bilinear, exact)")
         rules = _rule_names(boundary, crease_method, triangles, fvar_interpolation)
         self._scheme, self._end_caps, self._isolation = (
             _scheme_name(scheme, None, None, mesh), end_caps, isolation)

@@ -226,7 +226,8 @@ def edit(
 
     With ``return_report=True`` the result is ``(mesh, report)``, the report measured with
     a limit evaluator built afresh: ``residuals`` (one per constraint: a distance, or the
-    sine of the angle to a target normal), ``max_residual_relative``, ``rows``, ``rank``,
+    sine of the angle to a target normal), ``max_residual_relative``, ``method``
+    (``"least-squares"``, ``"energy-exact"`` or ``"energy-penalty"``), ``rows``, ``rank``,
     ``rank_deficient``, ``dependencies``, ``free_vertices``, ``moved_vertices`` (an array),
     ``energy_before``, ``energy_after`` and ``displacement_energy`` (Catmull-Clark) and
     ``seconds``.
@@ -250,7 +251,10 @@ def edit(
     report = json.loads(report_text)
     report["moved_vertices"] = np.asarray(report["moved_vertices"], dtype=np.int64)
     if report["residuals"] is not None:
-        report["residuals"] = np.asarray(report["residuals"], dtype=np.float64)
+        # The library reports each constraint's kind beside its residual; here the
+        # residuals are an array in the constraints' order.
+        report["residuals"] = np.asarray(
+            [r["residual"] for r in report["residuals"]], dtype=np.float64)
     return _with_report(Mesh._wrap(core), report, return_report)
 
 
