@@ -7,7 +7,7 @@ use clap::Args;
 use subd_limit::spectrum::{
     RingSpectrum, SplitSpectrumReport, SurfaceSpectrum, VALENCES, surface_spectrum,
 };
-use subd_schemes::analysis::{Lattice, analyze, analyze_bivariate, check_total};
+use subd_schemes::analysis::{AnalysisError, LEVEL_RANGE, Lattice, analyze_mask, analyze_mask2};
 use subd_schemes::{Capability, Scheme};
 
 use crate::Failure;
@@ -78,26 +78,7 @@ pub(crate) fn run(args: &AnalyzeArgs, out: &mut dyn Write) -> Result<(), Failure
             })
         })
         .collect::<Result<_, _>>()?;
-    if coeffs.is_empty() {
-        return Err(bad("--mask: no coefficients".into()));
-    }
-    if !(2..=3).contains(&args.arity) {
-        return Err(bad(format!("--arity {}: must be 2 or 3", args.arity)));
-    }
-    check_total(
-        &coeffs,
-        args.arity as f64,
-        &format!("a mask of arity {}", args.arity),
-    )
-    .map_err(|e| bad(format!("--mask: {e}")))?;
-    if args.max_levels == 0 || args.max_levels > 20 {
-        return Err(bad(format!(
-            "--max-levels {}: must be 1 to 20",
-            args.max_levels
-        )));
-    }
-    let v =
-        analyze(&coeffs, args.arity, args.max_levels).map_err(|e| bad(format!("--mask: {e}")))?;
+    let v = analyze_mask(&coeffs, args.arity, args.max_levels).map_err(|e| refusal("--mask", e))?;
     if args.json {
         crate::print_json(out, &v);
         return Ok(());
@@ -151,10 +132,8 @@ fn run_bivariate(text: &str, args: &AnalyzeArgs, out: &mut dyn Write) -> Result<
                 .collect::<Result<Vec<f64>, _>>()
         })
         .collect::<Result<_, _>>()?;
-    let all: Vec<f64> = rows.iter().flatten().copied().collect();
-    check_total(&all, 4.0, "a bivariate binary mask").map_err(|e| bad(format!("--mask2: {e}")))?;
-    let v = analyze_bivariate(&rows, args.lattice, args.max_levels)
-        .map_err(|e| bad(format!("--mask2: {e}")))?;
+    let v =
+        analyze_mask2(&rows, args.lattice, args.max_levels).map_err(|e| refusal("--mask2", e))?;
     if args.json {
         crate::print_json(out, &v);
         return Ok(());
@@ -256,4 +235,17 @@ fn split_line(s: &SplitSpectrumReport) -> String {
             Some(r) => format!("no: {r}"),
         }
     )
+}
+
+/// The library's refusal, named by the flag at fault.
+fn refusal(mask: &str, e: AnalysisError) -> Failure {
+    bad(match e {
+        AnalysisError::Levels(n) => format!(
+            "--max-levels {n}: must be {} to {}",
+            LEVEL_RANGE.start(),
+            LEVEL_RANGE.end()
+        ),
+        AnalysisError::Arity(n) => format!("--arity {n}: must be 2 or 3"),
+        e => format!("{mask}: {e}"),
+    })
 }

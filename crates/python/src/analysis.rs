@@ -5,14 +5,11 @@
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use serde::Serialize;
-use subd_schemes::analysis::{Lattice, analyze, analyze_bivariate, check_total};
+use subd_schemes::analysis::{self, AnalysisError, Lattice};
 
 use crate::errors::mesh_error;
 use crate::ops::{named, scheme};
 use crate::pool;
-
-/// The levels of the difference scheme a verdict may try.
-const MAX_LEVELS: std::ops::RangeInclusive<usize> = 1..=20;
 
 /// A univariate mask (`a_j` by increasing power of `z`, summing to the arity).
 #[pyfunction]
@@ -22,11 +19,8 @@ pub(crate) fn analyze_mask(
     arity: usize,
     max_levels: usize,
 ) -> PyResult<String> {
-    check_levels(max_levels)?;
-    check_total(&mask, arity as f64, &format!("a mask of arity {arity}"))
-        .map_err(|e| mesh_error(format!("mask: {e}")))?;
-    let verdict = pool::run(py, || analyze(&mask, arity, max_levels))?
-        .map_err(|e| mesh_error(format!("mask: {e}")))?;
+    let verdict = pool::run(py, || analysis::analyze_mask(&mask, arity, max_levels))?
+        .map_err(|e| analysis_error("mask", e))?;
     json(&verdict)
 }
 
@@ -39,14 +33,23 @@ pub(crate) fn analyze_mask2(
     lattice: &str,
     max_levels: usize,
 ) -> PyResult<String> {
-    check_levels(max_levels)?;
     let lattice: Lattice = named("lattice", lattice)?;
-    let all: Vec<f64> = rows.iter().flatten().copied().collect();
-    check_total(&all, 4.0, "a bivariate binary mask")
-        .map_err(|e| mesh_error(format!("mask2: {e}")))?;
-    let verdict = pool::run(py, || analyze_bivariate(&rows, lattice, max_levels))?
-        .map_err(|e| mesh_error(format!("mask2: {e}")))?;
+    let verdict = pool::run(py, || analysis::analyze_mask2(&rows, lattice, max_levels))?
+        .map_err(|e| analysis_error("mask2", e))?;
     json(&verdict)
+}
+
+/// The library's refusal, named by the argument at fault: a `ValueError` for the level
+/// limit, a `MeshError` for the mask.
+fn analysis_error(mask: &str, e: AnalysisError) -> PyErr {
+    match e {
+        AnalysisError::Levels(n) => PyValueError::new_err(format!(
+            "max_levels {n}: must be {} to {}",
+            analysis::LEVEL_RANGE.start(),
+            analysis::LEVEL_RANGE.end()
+        )),
+        e => mesh_error(format!("{mask}: {e}")),
+    }
 }
 
 /// The eigenvalue test of a surface scheme at an interior vertex of valence `valence`.
@@ -62,17 +65,6 @@ pub(crate) fn analyze_surface(
     })?
     .map_err(|e| mesh_error(format!("{}: {e}", scheme.name())))?;
     json(&spectrum)
-}
-
-fn check_levels(max_levels: usize) -> PyResult<()> {
-    if MAX_LEVELS.contains(&max_levels) {
-        return Ok(());
-    }
-    Err(PyValueError::new_err(format!(
-        "max_levels {max_levels}: must be {} to {}",
-        MAX_LEVELS.start(),
-        MAX_LEVELS.end()
-    )))
 }
 
 fn json(value: &impl Serialize) -> PyResult<String> {

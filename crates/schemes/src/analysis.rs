@@ -37,9 +37,60 @@ pub enum AnalysisError {
     /// Arity other than 2 or 3.
     #[error("arity {0}: only binary (2) and ternary (3) masks are analysed")]
     Arity(usize),
-    /// No coefficients, or one that is not finite.
+    /// No coefficients, one that is not finite, or sums other than the arity's.
     #[error("{0}")]
     Mask(String),
+    /// A level limit outside [`LEVEL_RANGE`].
+    #[error("{0} levels: the analysis tries 1 to 20")]
+    Levels(usize),
+}
+
+/// The levels `L` of the difference schemes a checked analysis may try
+/// ([`analyze_mask`], [`analyze_mask2`]).
+pub const LEVEL_RANGE: std::ops::RangeInclusive<usize> = 1..=20;
+
+/// The analysis `subd analyze --mask` and `subd.analyze(mask=…)` run: the level limit and
+/// the mask's total checked ([`check_total`]), then [`analyze`].
+///
+/// # Errors
+/// [`AnalysisError::Levels`], [`AnalysisError::Arity`], or [`AnalysisError::Mask`] for an
+/// empty mask, a coefficient that is not finite or coefficients that do not sum to the
+/// arity.
+pub fn analyze_mask(
+    coeffs: &[f64],
+    arity: usize,
+    max_levels: usize,
+) -> Result<Verdict, AnalysisError> {
+    if !LEVEL_RANGE.contains(&max_levels) {
+        return Err(AnalysisError::Levels(max_levels));
+    }
+    if !(2..=3).contains(&arity) {
+        return Err(AnalysisError::Arity(arity));
+    }
+    if coeffs.is_empty() {
+        return Err(AnalysisError::Mask("the mask has no coefficients".into()));
+    }
+    check_total(coeffs, arity as f64, &format!("a mask of arity {arity}"))?;
+    analyze(coeffs, arity, max_levels)
+}
+
+/// The analysis `subd analyze --mask2` and `subd.analyze(mask2=…)` run: the level limit
+/// and the mask's total (4) checked, then [`analyze_bivariate`].
+///
+/// # Errors
+/// [`AnalysisError::Levels`], or [`AnalysisError::Mask`] for a mask that is empty, ragged,
+/// not finite or does not sum to 4.
+pub fn analyze_mask2(
+    rows: &[Vec<f64>],
+    lattice: Lattice,
+    max_levels: usize,
+) -> Result<BivariateVerdict, AnalysisError> {
+    if !LEVEL_RANGE.contains(&max_levels) {
+        return Err(AnalysisError::Levels(max_levels));
+    }
+    let all: Vec<f64> = rows.iter().flatten().copied().collect();
+    check_total(&all, 4.0, "a bivariate binary mask")?;
+    analyze_bivariate(rows, lattice, max_levels)
 }
 
 /// The outcome of [`analyze`].
@@ -697,5 +748,27 @@ mod tests {
         assert!(!v.converges && v.note.contains("sum rule"));
         assert!(analyze(&[], 2, 4).is_err());
         assert!(analyze(&[1.0, 1.0], 4, 4).is_err());
+    }
+
+    #[test]
+    fn the_checked_analyses_refuse_what_the_fronts_refused() {
+        // The cubic B-spline (1, 4, 6, 4, 1) / 8: C² by the closed form of its difference
+        // masks, the same verdict checked or not.
+        let cubic = [0.125, 0.5, 0.75, 0.5, 0.125];
+        assert_eq!(analyze_mask(&cubic, 2, 10), analyze(&cubic, 2, 10));
+        assert_eq!(analyze_mask(&cubic, 2, 10).unwrap().smoothness, Some(2));
+        assert_eq!(analyze_mask(&cubic, 2, 0), Err(AnalysisError::Levels(0)));
+        assert_eq!(analyze_mask(&cubic, 2, 21), Err(AnalysisError::Levels(21)));
+        assert_eq!(analyze_mask(&cubic, 4, 10), Err(AnalysisError::Arity(4)));
+        let e = analyze_mask(&[0.5, 1.0], 2, 10).unwrap_err().to_string();
+        assert!(
+            e.contains("sum to 1.5; a mask of arity 2 must sum to 2"),
+            "{e}"
+        );
+        let half = vec![vec![0.5, 0.5], vec![0.5, 0.5]];
+        let e = analyze_mask2(&half, Lattice::Quad, 5)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("a bivariate binary mask must sum to 4"), "{e}");
     }
 }

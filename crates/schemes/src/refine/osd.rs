@@ -461,15 +461,8 @@ pub(crate) const CATMULL_CLARK: SchemeFacts = SchemeFacts {
     opensubdiv_family: true,
     tags: OPENSUBDIV_TAGS,
     peak_bytes_per_vertex: (105, Some(70)),
-    capabilities: &[
-        Capability::Refine,
-        Capability::Limit,
-        Capability::Evaluate,
-        Capability::Interpolate,
-        Capability::Edit,
-        Capability::Adaptive,
-        Capability::Analyse,
-    ],
+    // Everything subd computes, it computes for Catmull-Clark.
+    capabilities: &Capability::ALL,
 };
 
 /// Loop's facts (OpenSubdiv's masks, `Sdc::Scheme<LOOP>`).
