@@ -1,456 +1,478 @@
-//! The serial build, kept as the reference the parallel build is tested against: it numbers
-//! edges by walking the half-edges one after another, exactly as the rules read.
+//! An independent oracle for the topology build.
+//!
+//! [`build_serial`] computes what [`super::TopologyBuilder::build_with_warnings`] must
+//! return, written the plainest way from the documented rules: the docs of `build.rs`,
+//! `topology.rs` and `error.rs`, and the two OpenSubdiv routines they follow,
+//! `Vtr::Level::completeTopologyFromFaceVertices` (edge numbering, non-manifold edges) and
+//! `Vtr::Level::orderVertexFacesAndEdges` (the counter-clockwise fans). The parallel build is
+//! therefore tested against a second reading of the rules, not against a copy of itself.
+//!
+//! It shares no code with `build.rs`, `build/face_loops.rs` or `csr.rs`: not the index and
+//! face-size checks, not the half-edge pairing by smaller vertex, not the counting sorts or
+//! any CSR helper, not the edge flagging, not the fan walk. Instead it keeps a `HashMap` from
+//! each unordered vertex pair to the first edge made for it, gathers every relation as one
+//! `Vec` per face, edge or vertex while walking the faces once, in order, and flattens the
+//! rows into offset arrays only at the end. Nothing runs in parallel.
+//!
+//! From the crate it takes only what it has to produce: the [`Topology`] struct (its
+//! `pub(crate)` fields are filled directly, so every array and flag is this module's own),
+//! `Tags::new` for the default tags (all smooth, no holes), the flag constants and
+//! [`MAX_FACE_SIZE`], and the error and warning types.
 
-use super::{check_index_range, checked_face_offsets};
-use crate::csr::{RowSlots, group_by_key, offsets_of_keys};
+use std::collections::HashMap;
+
 use crate::error::{BuildWarning, TopologyError};
 use crate::tags::Tags;
-use crate::topology::*;
+use crate::topology::{
+    EDGE_BOUNDARY, EDGE_DEGENERATE, EDGE_NON_MANIFOLD, MAX_FACE_SIZE, Topology, VERTEX_BOUNDARY,
+    VERTEX_ISOLATED, VERTEX_NON_MANIFOLD,
+};
 
-const NONE: u32 = u32::MAX;
+/// A face or vertex with the position of an edge or vertex in that face.
+type FaceCorner = (u32, u16);
 
-/// [`super::TopologyBuilder::build_with_warnings`], serially.
+/// [`super::TopologyBuilder::build_with_warnings`], computed independently. Errors come in
+/// the order the rules check them (sizes, then vertex indices, then orientation), each the
+/// first in face order; warnings list every repeated vertex, then every accepted
+/// orientation conflict, each in face order.
 pub(super) fn build_serial(
     nv: usize,
     accept_inconsistent_orientation: bool,
     face_sizes: &[u32],
     face_vertices: &[u32],
 ) -> Result<(Topology, Vec<BuildWarning>), TopologyError> {
-    check_index_range(nv, face_sizes, face_vertices)?;
-    let face_offsets = checked_face_offsets(face_sizes, face_vertices.len())?;
-    let faces = FaceLoops {
-        offsets: &face_offsets,
-        vertices: face_vertices,
-    };
-    let mut warnings = Vec::new();
-    let mut stamp = vec![NONE; nv];
-    faces.check_vertices(nv, &mut stamp, &mut warnings)?;
-    let half_face = faces.half_faces();
-    let first_half = faces.first_halves(nv, &half_face, &mut stamp);
-    let numbering = EdgeNumbering::number(
-        &faces,
-        &half_face,
-        &first_half,
-        accept_inconsistent_orientation,
-        &mut warnings,
-    )?;
-    let topo = assemble(
-        nv,
-        face_offsets.clone(),
-        face_vertices.to_vec(),
-        numbering.face_edges,
-        numbering.edge_vertices,
-        numbering.edge_flags,
-    );
-    Ok((topo, warnings))
+    check_counts(nv, face_sizes, face_vertices)?;
+    let faces = split_into_faces(face_sizes, face_vertices)?;
+    check_vertex_indices(nv, &faces)?;
+    let mut warnings = repeated_vertex_warnings(&faces);
+    let edges = find_edges(&faces, accept_inconsistent_orientation, &mut warnings)?;
+    Ok((assemble(nv, &faces, edges), warnings))
 }
 
-/// The faces as closed loops of face-vertices ("half-edges": face-vertex `h` starts the
-/// half-edge to the next vertex of its face).
-struct FaceLoops<'a> {
-    offsets: &'a [u32],
-    vertices: &'a [u32],
-}
-
-impl FaceLoops<'_> {
-    fn num_faces(&self) -> usize {
-        self.offsets.len() - 1
-    }
-
-    fn range(&self, f: usize) -> std::ops::Range<usize> {
-        self.offsets[f] as usize..self.offsets[f + 1] as usize
-    }
-
-    /// The vertices at the two ends of half-edge `h` of face `f`.
-    #[inline]
-    fn ends(&self, f: usize, h: usize) -> (u32, u32) {
-        let end = self.offsets[f + 1] as usize;
-        let next = if h + 1 == end {
-            self.offsets[f] as usize
-        } else {
-            h + 1
-        };
-        (self.vertices[h], self.vertices[next])
-    }
-
-    /// Refuses vertex indices out of range; warns about faces that repeat a vertex.
-    fn check_vertices(
-        &self,
-        nv: usize,
-        stamp: &mut [u32],
-        warnings: &mut Vec<BuildWarning>,
-    ) -> Result<(), TopologyError> {
-        for f in 0..self.num_faces() {
-            for (corner, &v) in self.vertices[self.range(f)].iter().enumerate() {
-                if v as usize >= nv {
-                    return Err(TopologyError::VertexIndexOutOfRange {
-                        face: f,
-                        corner,
-                        index: v as u64,
-                        num_vertices: nv,
-                    });
-                }
-                if stamp[v as usize] == f as u32 {
-                    warnings.push(BuildWarning::RepeatedVertex { face: f, vertex: v });
-                }
-                stamp[v as usize] = f as u32;
-            }
-        }
-        Ok(())
-    }
-
-    /// The face of every half-edge.
-    fn half_faces(&self) -> Vec<u32> {
-        let mut half_face = vec![0u32; self.vertices.len()];
-        for f in 0..self.num_faces() {
-            half_face[self.range(f)].fill(f as u32);
-        }
-        half_face
-    }
-
-    /// Pass 1 of the build: for every non-degenerate half-edge, the first half-edge (in face
-    /// order) joining the same unordered vertex pair. Half-edges are bucketed by their
-    /// smaller vertex with a stable counting sort, then matched on the larger vertex
-    /// (`stamp` is scratch space of one entry per vertex).
-    fn first_halves(&self, nv: usize, half_face: &[u32], stamp: &mut [u32]) -> Vec<u32> {
-        let non_degenerate_by_smaller_end = (0..self.vertices.len()).filter_map(|h| {
-            let (a, b) = self.ends(half_face[h] as usize, h);
-            (a != b).then_some((a.min(b), h as u32))
+/// Every count must fit a `u32` index with `u32::MAX` left over (the build's "no index").
+fn check_counts(nv: usize, face_sizes: &[u32], face_vertices: &[u32]) -> Result<(), TopologyError> {
+    let limit = u32::MAX as usize;
+    if nv >= limit {
+        return Err(TopologyError::TooLarge {
+            what: "vertex",
+            count: nv,
         });
-        let buckets = group_by_key(nv, non_degenerate_by_smaller_end);
-        let mut first_half = vec![NONE; self.vertices.len()];
-        stamp.fill(NONE);
-        let mut first_of = vec![0u32; nv];
-        for a in 0..nv {
-            for &h in buckets.row(a) {
-                let h = h as usize;
-                let (x, y) = self.ends(half_face[h] as usize, h);
-                let b = x.max(y) as usize;
-                if stamp[b] != a as u32 {
-                    stamp[b] = a as u32;
-                    first_of[b] = h as u32;
-                }
-                first_half[h] = first_of[b];
-            }
-        }
-        first_half
     }
+    if face_vertices.len() >= limit || face_sizes.len() >= limit {
+        return Err(TopologyError::TooLarge {
+            what: "face-vertex",
+            count: face_vertices.len(),
+        });
+    }
+    Ok(())
 }
 
-/// Pass 2 of the build: the edges numbered by first appearance, following OpenSubdiv's rules
-/// for non-manifold cases (Vtr::Level::completeTopologyFromFaceVertices).
-struct EdgeNumbering {
-    face_edges: Vec<u32>,
-    edge_vertices: Vec<[u32; 2]>,
-    edge_flags: Vec<u8>,
-    edge_face_count: Vec<u32>,
-    edge_last_face: Vec<u32>,
-}
-
-impl EdgeNumbering {
-    fn number(
-        faces: &FaceLoops<'_>,
-        half_face: &[u32],
-        first_half: &[u32],
-        accept_inconsistent_orientation: bool,
-        warnings: &mut Vec<BuildWarning>,
-    ) -> Result<EdgeNumbering, TopologyError> {
-        let nh = faces.vertices.len();
-        let mut n = EdgeNumbering {
-            face_edges: vec![0u32; nh],
-            edge_vertices: Vec::with_capacity(nh / 2 + 16),
-            edge_flags: Vec::with_capacity(nh / 2 + 16),
-            edge_face_count: Vec::with_capacity(nh / 2 + 16),
-            edge_last_face: Vec::with_capacity(nh / 2 + 16),
+/// The face-vertex list cut into faces. Faces are checked in order: the first one with
+/// fewer than 3 or more than `MAX_FACE_SIZE` vertices is refused, and so is the list when a
+/// face runs past its end or the faces leave some of it over (reporting the sum of all the
+/// sizes, as `FaceVertexCountMismatch` documents).
+fn split_into_faces<'a>(
+    face_sizes: &[u32],
+    face_vertices: &'a [u32],
+) -> Result<Vec<&'a [u32]>, TopologyError> {
+    let sum_of_sizes: usize = face_sizes.iter().map(|&n| n as usize).sum();
+    let mismatch = TopologyError::FaceVertexCountMismatch {
+        expected: sum_of_sizes,
+        actual: face_vertices.len(),
+    };
+    let mut faces = Vec::with_capacity(face_sizes.len());
+    let mut start = 0;
+    for (face, &n) in face_sizes.iter().enumerate() {
+        let size = n as usize;
+        if size < 3 {
+            return Err(TopologyError::FaceTooSmall { face, size });
+        }
+        if size > MAX_FACE_SIZE {
+            return Err(TopologyError::FaceTooLarge {
+                face,
+                size,
+                max: MAX_FACE_SIZE,
+            });
+        }
+        let Some(face_vertices) = face_vertices.get(start..start + size) else {
+            return Err(mismatch);
         };
-        for h in 0..nh {
-            let f = half_face[h];
-            let (v0, v1) = faces.ends(f as usize, h);
-            let mut edge = NONE;
-            let mut new_flags = 0u8;
-            if v0 == v1 {
-                new_flags = EDGE_NON_MANIFOLD | EDGE_DEGENERATE;
-            } else if first_half[h] != h as u32 {
-                let e = n.face_edges[first_half[h] as usize] as usize;
-                if n.edge_last_face[e] == f {
-                    // The pair occurs twice in this face: a new, non-manifold instance.
-                    n.edge_flags[e] |= EDGE_NON_MANIFOLD;
-                    new_flags = EDGE_NON_MANIFOLD;
-                } else {
-                    n.add_face(e, f, v0, v1, accept_inconsistent_orientation, warnings)?;
-                    edge = e as u32;
-                }
+        faces.push(face_vertices);
+        start += size;
+    }
+    if start != face_vertices.len() {
+        return Err(mismatch);
+    }
+    Ok(faces)
+}
+
+/// Refuses the first vertex index, in face order, that names no vertex.
+fn check_vertex_indices(nv: usize, faces: &[&[u32]]) -> Result<(), TopologyError> {
+    for (face, vertices) in faces.iter().enumerate() {
+        for (corner, &v) in vertices.iter().enumerate() {
+            if v as usize >= nv {
+                return Err(TopologyError::VertexIndexOutOfRange {
+                    face,
+                    corner,
+                    index: v as u64,
+                    num_vertices: nv,
+                });
             }
-            if edge == NONE {
-                edge = n.edge_vertices.len() as u32;
-                n.edge_vertices.push([v0, v1]);
-                n.edge_face_count.push(1);
-                n.edge_last_face.push(f);
-                n.edge_flags.push(new_flags);
-            }
-            n.face_edges[h] = edge;
         }
-        Ok(n)
+    }
+    Ok(())
+}
+
+/// One warning for every corner whose vertex already occurs at an earlier corner of the same
+/// face (a vertex listed three times warns twice), in face order.
+fn repeated_vertex_warnings(faces: &[&[u32]]) -> Vec<BuildWarning> {
+    let mut warnings = Vec::new();
+    for (face, vertices) in faces.iter().enumerate() {
+        for (corner, &vertex) in vertices.iter().enumerate() {
+            if vertices[..corner].contains(&vertex) {
+                warnings.push(BuildWarning::RepeatedVertex { face, vertex });
+            }
+        }
+    }
+    warnings
+}
+
+/// The edges, as the faces make them.
+#[derive(Default)]
+struct Edges {
+    /// Per edge: its two vertices, in the direction of the first face that used it.
+    vertices: Vec<[u32; 2]>,
+    /// Per edge: its faces in face order, with the edge's position in each.
+    faces: Vec<Vec<FaceCorner>>,
+    /// Per edge: made non-manifold by a rule of the numbering (repeated in a face, a third
+    /// face, a same-direction second face). Degenerate edges and face counts are flagged
+    /// later, from `vertices` and `faces`.
+    non_manifold: Vec<bool>,
+    /// Per face: the edge at each corner (from that corner's vertex to the next one's).
+    of_face: Vec<Vec<u32>>,
+}
+
+impl Edges {
+    /// Makes a new edge from `v0` to `v1` whose first face is `face`, at `corner`.
+    fn make(&mut self, v0: u32, v1: u32, face: usize, corner: usize, non_manifold: bool) -> usize {
+        self.vertices.push([v0, v1]);
+        self.faces.push(vec![(face as u32, corner as u16)]);
+        self.non_manifold.push(non_manifold);
+        self.vertices.len() - 1
     }
 
-    /// Adds face `f`, traversing `v0 -> v1`, to edge `e` that an earlier face already has:
-    /// a third face makes it non-manifold, and so does a second face in the same direction
-    /// (an orientation conflict, refused unless accepted).
-    fn add_face(
+    /// Adds `face`, which runs `v0 -> v1` at `corner`, to edge `e` that earlier faces made
+    /// or joined. A third face makes the edge non-manifold. A second face running the same
+    /// way as the first means the two faces disagree on orientation: refused, or (accepted)
+    /// a warning and a non-manifold edge.
+    fn join(
         &mut self,
         e: usize,
-        f: u32,
-        v0: u32,
-        v1: u32,
+        (face, corner): (usize, usize),
+        (v0, v1): (u32, u32),
         accept_inconsistent_orientation: bool,
         warnings: &mut Vec<BuildWarning>,
     ) -> Result<(), TopologyError> {
-        if self.edge_face_count[e] > 1 {
-            self.edge_flags[e] |= EDGE_NON_MANIFOLD;
-        } else if v0 == self.edge_vertices[e][0] {
-            let first_face = self.edge_last_face[e] as usize;
+        if self.faces[e].len() >= 2 {
+            self.non_manifold[e] = true;
+        } else if self.vertices[e][0] == v0 {
+            let first_face = self.faces[e][0].0 as usize;
             if !accept_inconsistent_orientation {
                 return Err(TopologyError::InconsistentOrientation {
                     first_face,
-                    second_face: f as usize,
+                    second_face: face,
                     v0,
                     v1,
                 });
             }
             warnings.push(BuildWarning::InconsistentOrientation {
                 first_face,
-                second_face: f as usize,
+                second_face: face,
                 v0,
                 v1,
             });
-            self.edge_flags[e] |= EDGE_NON_MANIFOLD;
+            self.non_manifold[e] = true;
         }
-        self.edge_face_count[e] += 1;
-        self.edge_last_face[e] = f;
+        self.faces[e].push((face as u32, corner as u16));
         Ok(())
     }
 }
 
-/// Completes a topology from face-vertices, face-edges and numbered edges: edge-faces,
-/// vertex-faces, vertex-edges (ordered), boundary/non-manifold/isolated flags. `edge_flags`
-/// carries non-manifold and degenerate flags already known; boundary flags and edges with
-/// more than two faces are added here.
-pub(super) fn assemble(
+/// Numbers the edges by first appearance, walking the faces in order and each face's
+/// corners `(v_i, v_{i+1})`, as OpenSubdiv does: a pair of distinct vertices seen before
+/// joins the first edge made for that pair, unless that edge's last face is this face (the
+/// face repeats the pair), which makes a new non-manifold instance and flags the first one
+/// too. Every degenerate corner (`v_i == v_{i+1}`) makes an edge of its own.
+fn find_edges(
+    faces: &[&[u32]],
+    accept_inconsistent_orientation: bool,
+    warnings: &mut Vec<BuildWarning>,
+) -> Result<Edges, TopologyError> {
+    let mut edges = Edges::default();
+    // Keyed by (smaller, larger) vertex: both directions find the same edge.
+    let mut first_edge_of_pair: HashMap<(u32, u32), usize> = HashMap::new();
+    for (face, vertices) in faces.iter().enumerate() {
+        let n = vertices.len();
+        let mut face_edges = Vec::with_capacity(n);
+        for corner in 0..n {
+            let (v0, v1) = (vertices[corner], vertices[(corner + 1) % n]);
+            let pair = (v0.min(v1), v0.max(v1));
+            let earlier = (v0 != v1)
+                .then(|| first_edge_of_pair.get(&pair).copied())
+                .flatten();
+            let e = match earlier {
+                Some(e) if edges.faces[e].last().map(|fc| fc.0) == Some(face as u32) => {
+                    edges.non_manifold[e] = true;
+                    edges.make(v0, v1, face, corner, true)
+                }
+                Some(e) => {
+                    let at = (face, corner);
+                    edges.join(e, at, (v0, v1), accept_inconsistent_orientation, warnings)?;
+                    e
+                }
+                None => {
+                    let e = edges.make(v0, v1, face, corner, false);
+                    if v0 != v1 {
+                        first_edge_of_pair.insert(pair, e);
+                    }
+                    e
+                }
+            };
+            face_edges.push(e as u32);
+        }
+        edges.of_face.push(face_edges);
+    }
+    Ok(edges)
+}
+
+/// The edge flags: degenerate edges (both ends the same vertex) are degenerate and
+/// non-manifold; edges with one face are boundary; edges with more than two faces, or that
+/// a numbering rule flagged, are non-manifold.
+fn edge_flags(edges: &Edges) -> Vec<u8> {
+    let mut flags = Vec::with_capacity(edges.vertices.len());
+    for (e, &[a, b]) in edges.vertices.iter().enumerate() {
+        let mut fl = 0;
+        if a == b {
+            fl |= EDGE_DEGENERATE | EDGE_NON_MANIFOLD;
+        }
+        if edges.non_manifold[e] || edges.faces[e].len() > 2 {
+            fl |= EDGE_NON_MANIFOLD;
+        }
+        if edges.faces[e].len() == 1 {
+            fl |= EDGE_BOUNDARY;
+        }
+        flags.push(fl);
+    }
+    flags
+}
+
+/// The vertex relations before any fan is ordered: each vertex's faces with its corner in
+/// each, in face order (a face that repeats the vertex is listed once per corner), and its
+/// edges in edge order (a degenerate edge is listed twice, once per end).
+fn vertex_relations(
     nv: usize,
-    face_offsets: Vec<u32>,
-    face_vertices: Vec<u32>,
-    face_edges: Vec<u32>,
-    edge_vertices: Vec<[u32; 2]>,
-    mut edge_flags: Vec<u8>,
-) -> Topology {
-    let nf = face_offsets.len() - 1;
-    let ne = edge_vertices.len();
-    let faces = FaceLoops {
-        offsets: &face_offsets,
-        vertices: &face_vertices,
+    faces: &[&[u32]],
+    edge_vertices: &[[u32; 2]],
+) -> (Vec<Vec<FaceCorner>>, Vec<Vec<u32>>) {
+    let mut vertex_faces = vec![Vec::new(); nv];
+    for (face, vertices) in faces.iter().enumerate() {
+        for (corner, &v) in vertices.iter().enumerate() {
+            vertex_faces[v as usize].push((face as u32, corner as u16));
+        }
+    }
+    let mut vertex_edges = vec![Vec::new(); nv];
+    for (e, &[a, b]) in edge_vertices.iter().enumerate() {
+        vertex_edges[a as usize].push(e as u32);
+        vertex_edges[b as usize].push(e as u32);
+    }
+    (vertex_faces, vertex_edges)
+}
+
+/// Vertex flags before the fans are walked: boundary on a boundary edge, non-manifold on a
+/// non-manifold edge, isolated when no face uses the vertex.
+fn vertex_flags(
+    vertex_faces: &[Vec<FaceCorner>],
+    edge_vertices: &[[u32; 2]],
+    edge_flags: &[u8],
+) -> Vec<u8> {
+    let mut flags: Vec<u8> = vertex_faces
+        .iter()
+        .map(|faces| if faces.is_empty() { VERTEX_ISOLATED } else { 0 })
+        .collect();
+    for (&[a, b], &fl) in edge_vertices.iter().zip(edge_flags) {
+        for v in [a, b] {
+            if fl & EDGE_BOUNDARY != 0 {
+                flags[v as usize] |= VERTEX_BOUNDARY;
+            }
+            if fl & EDGE_NON_MANIFOLD != 0 {
+                flags[v as usize] |= VERTEX_NON_MANIFOLD;
+            }
+        }
+    }
+    flags
+}
+
+/// What a fan walk reads: the faces' vertices and edges, and the edges' faces.
+struct Mesh<'a> {
+    faces: &'a [&'a [u32]],
+    face_edges: &'a [Vec<u32>],
+    edge_faces: &'a [Vec<FaceCorner>],
+}
+
+impl Mesh<'_> {
+    /// The first corner of `face` at vertex `v` (OpenSubdiv's `findInArray`).
+    fn corner_of(&self, face: usize, v: u32) -> usize {
+        self.faces[face].iter().position(|&x| x == v).unwrap_or(0)
+    }
+
+    /// Where the walk around `v` starts: face, corner of `v` in it, and first edge. With as
+    /// many edges as faces (interior) it is the first face and the edge leaving `v` there;
+    /// otherwise the first one-face edge (in edge order) that leaves `v` in its face, or
+    /// failing that the last one-face edge; `None` when `v` has no one-face edge.
+    fn fan_start(&self, v: u32, vf: &[FaceCorner], ve: &[u32]) -> Option<(usize, usize, u32)> {
+        if vf.len() == ve.len() {
+            let face = vf[0].0 as usize;
+            let corner = self.corner_of(face, v);
+            return Some((face, corner, self.face_edges[face][corner]));
+        }
+        let mut start = None;
+        for &e in ve {
+            if let [(face, _)] = self.edge_faces[e as usize][..] {
+                let face = face as usize;
+                let corner = self.corner_of(face, v);
+                start = Some((face, corner, e));
+                if self.face_edges[face][corner] == e {
+                    break;
+                }
+            }
+        }
+        start
+    }
+
+    /// OpenSubdiv's `orderVertexFacesAndEdges` for vertex `v`, whose faces `vf` and edges
+    /// `ve` come in face and edge order: from the start, step to the edge entering `v` in the
+    /// current face (the next edge counter-clockwise), then across it to its other face.
+    /// `None` (`v` is non-manifold) when the counts cannot make one fan, when the walk meets
+    /// the same edge twice running or its first edge again, when an edge has no other face
+    /// to cross to, or when it ends without having visited every face.
+    fn walk_fan(
+        &self,
+        v: u32,
+        vf: &[FaceCorner],
+        ve: &[u32],
+    ) -> Option<(Vec<FaceCorner>, Vec<u32>)> {
+        let (nf, ne) = (vf.len(), ve.len());
+        if nf == 0 || ne < 2 || ne > nf + 1 {
+            return None;
+        }
+        let (mut face, mut corner, mut edge) = self.fan_start(v, vf, ve)?;
+        let first_edge = edge;
+        let mut faces = vec![(face as u32, corner as u16)];
+        let mut edges = vec![edge];
+        while edges.len() < ne {
+            let n = self.faces[face].len();
+            let next = self.face_edges[face][(corner + n - 1) % n];
+            if next == edge || next == first_edge {
+                return None;
+            }
+            edges.push(next);
+            if faces.len() < nf {
+                // Across `next` to its other face, where `next` leaves `v`.
+                let (g, at) = match self.edge_faces[next as usize][..] {
+                    [] => return None,
+                    [(g, _)] if g as usize == face => return None,
+                    [(g, _), (h, at), ..] if g as usize == face => (h, at),
+                    [(g, at), ..] => (g, at),
+                };
+                (face, corner) = (g as usize, at as usize);
+                faces.push((g, at));
+            }
+            edge = next;
+        }
+        (faces.len() == nf).then_some((faces, edges))
+    }
+}
+
+/// Orders the faces and edges around every vertex that is neither isolated nor already
+/// non-manifold counter-clockwise; a vertex whose walk fails becomes non-manifold and keeps
+/// its faces and edges in face and edge order.
+fn order_fans(
+    mesh: &Mesh<'_>,
+    vertex_faces: &mut [Vec<FaceCorner>],
+    vertex_edges: &mut [Vec<u32>],
+    vertex_flags: &mut [u8],
+) {
+    for v in 0..vertex_flags.len() {
+        if vertex_flags[v] & (VERTEX_ISOLATED | VERTEX_NON_MANIFOLD) != 0 {
+            continue;
+        }
+        match mesh.walk_fan(v as u32, &vertex_faces[v], &vertex_edges[v]) {
+            Some((faces, edges)) => {
+                vertex_faces[v] = faces;
+                vertex_edges[v] = edges;
+            }
+            None => vertex_flags[v] |= VERTEX_NON_MANIFOLD,
+        }
+    }
+}
+
+/// Rows laid end to end: `(offsets, values)` with row `i` at `offsets[i]..offsets[i + 1]`.
+fn flatten<T: Copy>(rows: &[impl AsRef<[T]>]) -> (Vec<u32>, Vec<T>) {
+    let mut offsets = vec![0u32];
+    let mut values = Vec::new();
+    for row in rows {
+        values.extend_from_slice(row.as_ref());
+        offsets.push(values.len() as u32);
+    }
+    (offsets, values)
+}
+
+/// [`flatten`] for rows of (face, position) pairs, split into two arrays.
+fn flatten_face_corners(rows: &[Vec<FaceCorner>]) -> (Vec<u32>, Vec<u32>, Vec<u16>) {
+    let (offsets, pairs) = flatten(rows);
+    let (faces, positions) = pairs.into_iter().unzip();
+    (offsets, faces, positions)
+}
+
+/// Completes the relations and lays them out as a [`Topology`].
+fn assemble(nv: usize, faces: &[&[u32]], edges: Edges) -> Topology {
+    let edge_flags = edge_flags(&edges);
+    let (mut vertex_faces, mut vertex_edges) = vertex_relations(nv, faces, &edges.vertices);
+    let mut vertex_flags = vertex_flags(&vertex_faces, &edges.vertices, &edge_flags);
+    let mesh = Mesh {
+        faces,
+        face_edges: &edges.of_face,
+        edge_faces: &edges.faces,
     };
-    let half_face = faces.half_faces();
-    // Edge -> faces and vertex -> faces, in face order (vertex fans are ordered below), with
-    // the edge's or vertex's position in each face.
-    let (edge_face_offsets, edge_faces, edge_face_local) =
-        faces_by_key(ne, &face_edges, &half_face, &face_offsets);
-    flag_edges_by_face_count(&edge_face_offsets, &mut edge_flags);
-    let (vertex_face_offsets, vertex_faces, vertex_face_local) =
-        faces_by_key(nv, &face_vertices, &half_face, &face_offsets);
-    drop(half_face);
-    // Vertex -> edges in creation order (a degenerate edge appears twice at its vertex).
-    let vertex_edges = group_by_key(
-        nv,
-        (0..ne as u32).flat_map(|e| {
-            let [a, b] = edge_vertices[e as usize];
-            [(a, e), (b, e)]
-        }),
+    order_fans(
+        &mesh,
+        &mut vertex_faces,
+        &mut vertex_edges,
+        &mut vertex_flags,
     );
-    let vertex_flags = vertex_flags(nv, &edge_vertices, &edge_flags, &vertex_face_offsets);
-    let mut topo = Topology {
+    let (face_offsets, face_vertices) = flatten(faces);
+    let (_, face_edges) = flatten(&edges.of_face);
+    let (edge_face_offsets, edge_faces, edge_face_local) = flatten_face_corners(&edges.faces);
+    let (vertex_face_offsets, vertex_faces, vertex_face_local) =
+        flatten_face_corners(&vertex_faces);
+    let (vertex_edge_offsets, vertex_edges) = flatten(&vertex_edges);
+    let (ne, nf) = (edges.vertices.len(), faces.len());
+    Topology {
         num_vertices: nv as u32,
         face_offsets,
         face_vertices,
         face_edges,
-        edge_vertices,
+        edge_vertices: edges.vertices,
         edge_face_offsets,
         edge_faces,
         edge_face_local,
         vertex_face_offsets,
         vertex_faces,
         vertex_face_local,
-        vertex_edge_offsets: vertex_edges.offsets,
-        vertex_edges: vertex_edges.values,
+        vertex_edge_offsets,
+        vertex_edges,
         edge_flags,
         vertex_flags,
         tags: Tags::new(nv, ne, nf),
-    };
-    topo.order_vertex_fans_serial();
-    topo
-}
-
-/// The faces of each of `num_rows` keys, where face-vertex `h` belongs to row `keys[h]`
-/// (its edge or its vertex), in face order: offsets, faces, and the face-vertex's position
-/// in its face.
-fn faces_by_key(
-    num_rows: usize,
-    keys: &[u32],
-    half_face: &[u32],
-    face_offsets: &[u32],
-) -> (Vec<u32>, Vec<u32>, Vec<u16>) {
-    let offsets = offsets_of_keys(num_rows, keys.iter().copied());
-    let mut faces = vec![0u32; keys.len()];
-    let mut local = vec![0u16; keys.len()];
-    let mut slots = RowSlots::new(&offsets);
-    for (h, &key) in keys.iter().enumerate() {
-        let f = half_face[h];
-        let slot = slots.take(key as usize);
-        faces[slot] = f;
-        local[slot] = (h - face_offsets[f as usize] as usize) as u16;
-    }
-    (offsets, faces, local)
-}
-
-/// Flags edges with one face as boundary and edges with more than two as non-manifold.
-fn flag_edges_by_face_count(edge_face_offsets: &[u32], edge_flags: &mut [u8]) {
-    for (e, fl) in edge_flags.iter_mut().enumerate() {
-        let count = edge_face_offsets[e + 1] - edge_face_offsets[e];
-        if count > 2 {
-            *fl |= EDGE_NON_MANIFOLD;
-        }
-        if count == 1 {
-            *fl |= EDGE_BOUNDARY;
-        }
-    }
-}
-
-/// Vertex flags: boundary and non-manifold from the vertex's edges, isolated when no face
-/// uses it.
-fn vertex_flags(
-    nv: usize,
-    edge_vertices: &[[u32; 2]],
-    edge_flags: &[u8],
-    vertex_face_offsets: &[u32],
-) -> Vec<u8> {
-    let mut vertex_flags = vec![0u8; nv];
-    for (e, &[a, b]) in edge_vertices.iter().enumerate() {
-        let fl = edge_flags[e];
-        let mut vf = 0;
-        if fl & EDGE_BOUNDARY != 0 {
-            vf |= VERTEX_BOUNDARY;
-        }
-        if fl & EDGE_NON_MANIFOLD != 0 {
-            vf |= VERTEX_NON_MANIFOLD;
-        }
-        vertex_flags[a as usize] |= vf;
-        vertex_flags[b as usize] |= vf;
-    }
-    for v in 0..nv {
-        if vertex_face_offsets[v] == vertex_face_offsets[v + 1] {
-            vertex_flags[v] |= VERTEX_ISOLATED;
-        }
-    }
-    vertex_flags
-}
-
-impl Topology {
-    /// Orders the faces and edges around every vertex counter-clockwise; a vertex whose
-    /// neighbourhood is not a single fan is flagged non-manifold and keeps face order.
-    fn order_vertex_fans_serial(&mut self) {
-        let mut faces: Vec<(u32, u16)> = Vec::new();
-        let mut edges: Vec<u32> = Vec::new();
-        for v in 0..self.num_vertices() {
-            if self.vertex_flags[v] & (VERTEX_NON_MANIFOLD | VERTEX_ISOLATED) != 0 {
-                continue;
-            }
-            if self.walk_fan_serial(v, &mut faces, &mut edges) {
-                let fr =
-                    self.vertex_face_offsets[v] as usize..self.vertex_face_offsets[v + 1] as usize;
-                for (slot, &(f, c)) in fr.zip(faces.iter()) {
-                    self.vertex_faces[slot] = f;
-                    self.vertex_face_local[slot] = c;
-                }
-                let er =
-                    self.vertex_edge_offsets[v] as usize..self.vertex_edge_offsets[v + 1] as usize;
-                self.vertex_edges[er].copy_from_slice(&edges);
-            } else {
-                self.vertex_flags[v] |= VERTEX_NON_MANIFOLD;
-            }
-        }
-    }
-
-    /// Walks the fan of faces around `v` counter-clockwise, starting (on a boundary) at the
-    /// boundary edge that leaves `v` in its face. Returns `false` when the faces and edges
-    /// around `v` do not form a single fan. Mirrors the conditions of OpenSubdiv's
-    /// `Vtr::Level::orderVertexFacesAndEdges` so the same vertices come out non-manifold.
-    fn walk_fan_serial(&self, v: usize, faces: &mut Vec<(u32, u16)>, edges: &mut Vec<u32>) -> bool {
-        faces.clear();
-        edges.clear();
-        let vf = self.vertex_faces(v);
-        let ve = self.vertex_edges(v);
-        let (nf, ne) = (vf.len(), ve.len());
-        if nf == 0 || ne < 2 || ne > nf + 1 {
-            return false;
-        }
-        let corner_of = |f: usize| -> u16 {
-            self.face_vertices(f)
-                .iter()
-                .position(|&x| x as usize == v)
-                .unwrap_or(0) as u16
-        };
-        let (mut f, mut c, mut e_cur);
-        if ne == nf {
-            f = vf[0] as usize;
-            c = corner_of(f);
-            e_cur = self.face_edges(f)[c as usize];
-        } else {
-            let mut start = None;
-            for &e in ve {
-                let ef = self.edge_faces(e as usize);
-                if ef.len() == 1 {
-                    let f0 = ef[0] as usize;
-                    let c0 = corner_of(f0);
-                    start = Some((f0, c0, e));
-                    if self.face_edges(f0)[c0 as usize] == e {
-                        break;
-                    }
-                }
-            }
-            let Some((f0, c0, e0)) = start else {
-                return false;
-            };
-            (f, c, e_cur) = (f0, c0, e0);
-        }
-        let e_first = e_cur;
-        faces.push((f as u32, c));
-        edges.push(e_cur);
-        while edges.len() < ne {
-            let fe = self.face_edges(f);
-            let prev = if c == 0 { fe.len() - 1 } else { c as usize - 1 };
-            let e_next = fe[prev];
-            if e_next == e_cur || e_next == e_first {
-                return false;
-            }
-            edges.push(e_next);
-            if faces.len() < nf {
-                let ef = self.edge_faces(e_next as usize);
-                if ef.is_empty() || (ef.len() == 1 && ef[0] as usize == f) {
-                    return false;
-                }
-                let g = if ef[0] as usize == f && ef.len() > 1 {
-                    ef[1]
-                } else {
-                    ef[0]
-                } as usize;
-                let Some(pos) = self.face_edges(g).iter().position(|&x| x == e_next) else {
-                    return false;
-                };
-                f = g;
-                c = pos as u16;
-                faces.push((f as u32, c));
-            }
-            e_cur = e_next;
-        }
-        faces.len() == nf
     }
 }

@@ -316,3 +316,31 @@ fn repeated_corners_small_and_large_faces() {
     large[39] = 38;
     assert_eq!(repeated_corners(&large), [20, 35, 39]);
 }
+
+#[test]
+fn malformed_face_lists_are_refused_alike() {
+    let quad = |sizes: Vec<u32>, vertices: Vec<u32>| Input {
+        nv: 4,
+        sizes,
+        vertices,
+    };
+    let cases = [
+        (
+            "a face of two vertices",
+            quad(vec![4, 2], vec![0, 1, 2, 3, 0, 1]),
+        ),
+        ("a face of none", quad(vec![0, 4], vec![0, 1, 2, 3])),
+        (
+            "sizes past the list",
+            quad(vec![4, 4], vec![0, 1, 2, 3, 0, 1]),
+        ),
+        ("indices left over", quad(vec![4], vec![0, 1, 2, 3, 0])),
+        (
+            "a face over the size limit",
+            quad(vec![MAX_FACE_SIZE as u32 + 1], vec![0; MAX_FACE_SIZE + 1]),
+        ),
+    ];
+    for (what, input) in cases {
+        assert!(check_same(&input, false, what).is_err(), "{what}");
+    }
+}
