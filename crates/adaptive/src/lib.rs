@@ -51,6 +51,7 @@ mod fvar;
 mod hierarchy;
 mod level;
 mod limit;
+pub mod report;
 pub mod request;
 
 use glam::DVec3;

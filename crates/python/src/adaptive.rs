@@ -94,6 +94,7 @@ fn assembled(
         mesh: a,
         uv,
         warnings,
+        ..
     } = adapted;
     let AdaptiveMesh {
         positions,
