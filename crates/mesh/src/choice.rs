@@ -129,6 +129,22 @@ mod tests {
     }
 
     #[test]
+    fn the_fvar_modes_keep_opensubdivs_order() {
+        // `Sdc::Options::FVarLinearInterpolation`: the shape tag's value is the position.
+        use FVarLinearInterpolation as M;
+        let osd = [
+            M::None,
+            M::CornersOnly,
+            M::CornersPlus1,
+            M::CornersPlus2,
+            M::Boundaries,
+            M::All,
+        ];
+        assert_eq!(M::ALL_MODES, osd);
+        assert_eq!(M::from_shape_tag(2), Some(M::CornersPlus1));
+    }
+
+    #[test]
     fn an_unknown_name_lists_the_names() {
         let e = "cubic".parse::<CreaseMethod>().unwrap_err();
         assert_eq!(e.option, "crease method");

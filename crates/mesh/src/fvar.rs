@@ -44,14 +44,19 @@ pub enum FVarLinearInterpolation {
 
 impl FVarLinearInterpolation {
     /// Every mode, in OpenSubdiv's order.
-    pub const ALL_MODES: [FVarLinearInterpolation; 6] = [
-        FVarLinearInterpolation::None,
-        FVarLinearInterpolation::CornersOnly,
-        FVarLinearInterpolation::CornersPlus1,
-        FVarLinearInterpolation::CornersPlus2,
-        FVarLinearInterpolation::Boundaries,
-        FVarLinearInterpolation::All,
-    ];
+    pub const ALL_MODES: [FVarLinearInterpolation; 6] = {
+        // Read off the one table of names (kept in OpenSubdiv's order, which the shape tag's
+        // value is the position in).
+        let values = <FVarLinearInterpolation as Choice>::VALUES;
+        assert!(values.len() == 6);
+        let mut all = [FVarLinearInterpolation::All; 6];
+        let mut i = 0;
+        while i < all.len() {
+            all[i] = values[i].0;
+            i += 1;
+        }
+        all
+    };
 
     /// The mode of OpenSubdiv's shape tag value (`t facevaryinginterpolateboundary 1/0/0 N`),
     /// which is its position in `Sdc::Options::FVarLinearInterpolation`.
@@ -75,6 +80,7 @@ impl FVarLinearInterpolation {
     }
 }
 
+// In OpenSubdiv's order: `ALL_MODES` and the shape tag's value follow it.
 impl Choice for FVarLinearInterpolation {
     const OPTION: &'static str = "face-varying interpolation";
     const VALUES: &'static [(Self, &'static str, &'static str)] = &[

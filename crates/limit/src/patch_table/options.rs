@@ -26,12 +26,18 @@ pub enum EndCaps {
 
 impl EndCaps {
     /// Every kind, in the order the command line lists them.
-    pub const ALL: [EndCaps; 4] = [
-        EndCaps::GregoryBasis,
-        EndCaps::BSpline,
-        EndCaps::Bilinear,
-        EndCaps::Exact,
-    ];
+    pub const ALL: [EndCaps; 4] = {
+        // Read off the one table of names, so the two lists cannot drift apart.
+        let values = <EndCaps as Choice>::VALUES;
+        assert!(values.len() == 4);
+        let mut all = [EndCaps::GregoryBasis; 4];
+        let mut i = 0;
+        while i < all.len() {
+            all[i] = values[i].0;
+            i += 1;
+        }
+        all
+    };
 
     /// The command-line name (`gregory`, `bspline`, `bilinear`, `exact`).
     pub fn name(self) -> &'static str {
